@@ -1,0 +1,7 @@
+#include "commands.hpp"
+
+namespace codyna::cli {
+
+void add_linearize(CLI::App& app) { (void)app; }
+
+}  // namespace codyna::cli

@@ -1,0 +1,14 @@
+// The codyna subcommands. Each add_* registers a subcommand whose callback
+// runs it and records the exit code (0 = success, 1 = bad input, 2 = failure).
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace codyna::cli {
+
+void add_info(CLI::App& app);
+void add_linearize(CLI::App& app);
+int exit_code();
+void set_exit_code(int code);
+
+}  // namespace codyna::cli

@@ -1,0 +1,34 @@
+// LinearSystem: a plant linearized about an operating point, with everything
+// that must travel with the matrices (names, units, offsets, provenance).
+//   dx = A x + B u,  y = C x + D u   (deviations: x = x0 + dx, u = u0 + du, y = y0 + dy)
+// Ts = 0 means continuous time; Ts > 0 means the discrete map x[k+1] = A x[k] + B u[k]
+// obtained by an exact zero-order hold with sample time Ts.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+namespace codyna {
+
+struct LinearSystem {
+  Eigen::MatrixXd A, B, C, D;
+  Eigen::VectorXd x0, u0, y0, xdot0;
+  double Ts = 0.0;
+  std::vector<std::string> state_names, input_names, output_names;
+  std::vector<std::string> state_units, input_units, output_units;
+
+  // provenance
+  std::string model_name;        // as in the model file
+  std::string model_file;        // path it was loaded from, if any
+  std::string operating_point;   // e.g. "initial", "equilibrium", "trim", "time=1.5"
+  std::string method;            // "exact", "fd-forward", "fd-central"
+  double time = 0.0;             // time of the operating point
+  std::string codyna_version;
+
+  int nx() const { return static_cast<int>(A.rows()); }
+  int nu() const { return static_cast<int>(B.cols()); }
+  int ny() const { return static_cast<int>(C.rows()); }
+};
+
+}  // namespace codyna

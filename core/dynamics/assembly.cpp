@@ -1,0 +1,68 @@
+#include "dynamics/assembly.hpp"
+
+#include <Eigen/QR>
+#include <algorithm>
+
+#include "dynamics/constraints.hpp"
+#include "dynamics/joint.hpp"
+
+namespace codyna {
+
+AssemblyResult assemble(const Model& model, const Eigen::VectorXd& q_guess, const Eigen::VectorXd& v_guess,
+                        const AssemblyOptions& opt) {
+  AssemblyResult r;
+  r.q = q_guess;
+  r.v = v_guess;
+  normalize(model, r.q);
+  if (model.nc == 0) {
+    r.converged = true;
+    return r;
+  }
+  Data d(model);
+  const Eigen::VectorXd zero_v = Eigen::VectorXd::Zero(model.nv);
+  auto residual = [&](const Eigen::VectorXd& q) { return Eigen::VectorXd(constraint_residual<double>(model, d, q)); };
+  Eigen::VectorXd phi = residual(r.q);
+  for (r.iterations = 0; r.iterations < opt.max_iterations; ++r.iterations) {
+    if (phi.lpNorm<Eigen::Infinity>() <= opt.tolerance) break;
+    constraint_terms<double>(model, d, r.q, zero_v);
+    const Eigen::VectorXd step = -Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(d.Jc).solve(phi);
+    double t = 1.0;
+    bool improved = false;
+    for (int k = 0; k < 30; ++k, t *= 0.5) {
+      Eigen::VectorXd qn = integrate<double>(model, r.q, Eigen::VectorXd(t * step));
+      normalize(model, qn);
+      const Eigen::VectorXd pn = residual(qn);
+      if (pn.norm() < phi.norm()) {
+        r.q = qn;
+        phi = pn;
+        improved = true;
+        break;
+      }
+    }
+    if (!improved) break;
+  }
+  phi = residual(r.q);
+  r.position_residual = phi.size() ? phi.lpNorm<Eigen::Infinity>() : 0.0;
+  if (phi.size()) phi.cwiseAbs().maxCoeff(&r.worst_row);
+  constraint_terms<double>(model, d, r.q, zero_v);
+  const Eigen::MatrixXd J = d.Jc;
+  r.v = r.v - Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(J).solve(J * r.v);
+  r.velocity_residual = (J * r.v).lpNorm<Eigen::Infinity>();
+  r.converged = r.position_residual <= std::max(opt.tolerance, 1e-10) && r.velocity_residual <= 1e-8 * (1.0 + r.v.norm());
+  return r;
+}
+
+RowPartition partition_rows(const Eigen::MatrixXd& Jc, double relative_tolerance) {
+  RowPartition p;
+  if (Jc.rows() == 0) return p;
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Jc.transpose());
+  qr.setThreshold(relative_tolerance);
+  const Eigen::Index rank = qr.rank();
+  const auto& perm = qr.colsPermutation().indices();
+  for (Eigen::Index k = 0; k < perm.size(); ++k) (k < rank ? p.independent : p.redundant).push_back(perm[k]);
+  std::sort(p.independent.begin(), p.independent.end());
+  std::sort(p.redundant.begin(), p.redundant.end());
+  return p;
+}
+
+}  // namespace codyna

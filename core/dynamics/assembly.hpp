@@ -1,0 +1,38 @@
+// Assembly: from a user's approximate initial state, find q on the
+// constraint manifold phi(q) = 0 closest (least change, in the tangent
+// space) to it by damped Gauss-Newton with minimum-norm steps, then project v
+// onto the velocity constraint Jc v = 0 (least change). Redundant rows are
+// tolerated (minimum-norm steps through a complete orthogonal decomposition).
+#pragma once
+
+#include <vector>
+
+#include "model/data.hpp"
+
+namespace codyna {
+
+struct AssemblyOptions {
+  double tolerance = 1e-12;    // on max |phi| (and max |Jc v|)
+  int max_iterations = 100;
+};
+
+struct AssemblyResult {
+  Eigen::VectorXd q, v;
+  double position_residual = 0.0;  // max |phi(q)|
+  double velocity_residual = 0.0;  // max |Jc(q) v|
+  int worst_row = -1;              // row with the largest position residual
+  int iterations = 0;
+  bool converged = false;
+};
+
+AssemblyResult assemble(const Model& model, const Eigen::VectorXd& q_guess, const Eigen::VectorXd& v_guess,
+                        const AssemblyOptions& options = {});
+
+// Rows of Jc (nc x nv) that are linearly independent (kept) and those that
+// depend on them (redundant), by QR with column pivoting of Jc^T.
+struct RowPartition {
+  std::vector<int> independent, redundant;
+};
+RowPartition partition_rows(const Eigen::MatrixXd& Jc, double relative_tolerance = 1e-9);
+
+}  // namespace codyna

@@ -1,0 +1,22 @@
+// Loop-closure constraints phi(q) = 0 (see ConstraintModel), stacked in
+// model order:
+//   ball             phi = p_a - p_b                          (world, 3 rows)
+//   revolute         ball rows, then a . b1, a . b2            (a = axis_a on body_a,
+//                                                               b1, b2 perpendicular to axis_b on body_b)
+//   planar_revolute  e1 . (p_a - p_b), e2 . (p_a - p_b)         (e1, e2 perpendicular to axis_a, on body_a)
+// constraint_residual(q):   writes liMi, oMi, Sb, phi.
+// constraint_terms(q, v):   + v, cJ, a (at qdd = 0), Jc = d phi/dq (tangent), gamma = dJc/dt v,
+//                           so that d2/dt2 phi = Jc qdd + gamma.
+#pragma once
+
+#include "model/data.hpp"
+
+namespace codyna {
+
+template <class S>
+const VecXT<S>& constraint_residual(const Model& model, DataT<S>& data, const VecXT<S>& q);
+
+template <class S>
+void constraint_terms(const Model& model, DataT<S>& data, const VecXT<S>& q, const VecXT<S>& v);
+
+}  // namespace codyna

@@ -1,0 +1,13 @@
+// Composite-rigid-body algorithm: the joint-space mass matrix M(q)
+// (= B^T M B of the velocity transformation method), symmetric, full.
+// Writes liMi, oMi, Sb, Ic, M; returns data.M. O(n d) for tree depth d.
+#pragma once
+
+#include "model/data.hpp"
+
+namespace codyna {
+
+template <class S>
+const MatXT<S>& crba(const Model& model, DataT<S>& data, const VecXT<S>& q);
+
+}  // namespace codyna

@@ -1,0 +1,90 @@
+#include "dynamics/effects.hpp"
+
+#include <cmath>
+
+#include "dynamics/kinematics.hpp"
+#include "dynamics/rnea.hpp"
+#include "spatial/autodiff.hpp"
+
+namespace codyna {
+
+EffectCounters& effect_counters() {
+  static thread_local EffectCounters counters;
+  return counters;
+}
+
+namespace {
+// adds a world force F at point p (body coordinates) and a world torque T to body's fext
+template <class S>
+void add_world_force(DataT<S>& d, int body, const Eigen::Vector3d& p, const Vec3T<S>& F, const Vec3T<S>& T) {
+  if (body == 0) return;  // ground reacts; it does not move
+  const Mat3T<S> Rt = d.oMi[body].R.transpose();
+  const Vec3T<S> f = Rt * F;
+  d.fext[body].template tail<3>() += f;
+  d.fext[body].template head<3>() += p.cast<S>().cross(f) + Rt * T;
+}
+}  // namespace
+
+template <class S>
+const VecXT<S>& applied_forces(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>& v,
+                               const VecXT<S>& u) {
+  using std::sqrt;
+  EffectCounters& count = effect_counters();
+  d.Q.setZero(model.nv);
+  bool any_body_force = false;
+  for (auto& f : d.fext) f.setZero();
+  const Vec3T<S> zero3 = Vec3T<S>::Zero();
+
+  for (const SpringDamperModel& s : model.springs) {
+    ++count.springs;
+    const Vec3T<S> dp = point_position<S>(d, s.body_b, s.point_b) - point_position<S>(d, s.body_a, s.point_a);
+    const S L = sqrt(dp.squaredNorm());
+    if (!(ad_value(L) > 1e-12)) continue;  // coincident points: direction undefined, no force
+    const Vec3T<S> n = dp / L;
+    const S Ld = n.dot(point_velocity<S>(d, s.body_b, s.point_b) - point_velocity<S>(d, s.body_a, s.point_a));
+    const S tension = S(s.stiffness) * (L - S(s.rest_length)) + S(s.damping) * Ld;
+    add_world_force<S>(d, s.body_a, s.point_a, Vec3T<S>(tension * n), zero3);
+    add_world_force<S>(d, s.body_b, s.point_b, Vec3T<S>(-tension * n), zero3);
+    any_body_force = true;
+  }
+  for (const JointSpringModel& s : model.joint_springs) {
+    ++count.joint_springs;
+    d.Q[s.iv] -= S(s.stiffness) * (q[s.iq] - S(s.rest_position)) + S(s.damping) * v[s.iv];
+  }
+  for (const JointSpringModel& s : model.joint_frictions) {
+    ++count.joint_frictions;
+    d.Q[s.iv] -= S(s.damping) * v[s.iv];
+  }
+  for (const BodyForceModel& b : model.body_forces) {
+    ++count.body_forces;
+    Vec3T<S> F = b.force.cast<S>(), T = b.torque.cast<S>();
+    if (!b.in_world) {
+      F = d.oMi[b.body].R * F;
+      T = d.oMi[b.body].R * T;
+    }
+    add_world_force<S>(d, b.body, b.point, F, T);
+    any_body_force = true;
+  }
+  for (int k = 0; k < model.nu(); ++k) {
+    ++count.actuators;
+    const ActuatorModel& a = model.actuators[k];
+    const S value = S(a.gain) * u[k];
+    if (a.type == ActuatorType::JointForce) {
+      d.Q[a.iv] += value;
+    } else {
+      Vec3T<S> F = a.direction.cast<S>() * value;
+      if (!a.in_world) F = d.oMi[a.body].R * F;
+      add_world_force<S>(d, a.body, a.point, F, zero3);
+      any_body_force = true;
+    }
+  }
+  if (any_body_force) d.Q += body_forces_to_generalized<S>(model, d);
+  return d.Q;
+}
+
+template const VecXT<double>& applied_forces<double>(const Model&, DataT<double>&, const VecXT<double>&,
+                                                     const VecXT<double>&, const VecXT<double>&);
+template const VecXT<ADScalar>& applied_forces<ADScalar>(const Model&, DataT<ADScalar>&, const VecXT<ADScalar>&,
+                                                         const VecXT<ADScalar>&, const VecXT<ADScalar>&);
+
+}  // namespace codyna

@@ -1,0 +1,15 @@
+// Mechanical energy. kinetic = 1/2 sum v_i^T I_i v_i; potential = gravity
+// (-m g . c) + point-to-point springs 1/2 k (L - L0)^2 + joint springs
+// 1/2 k (q - q_rest)^2. Each runs forward_kinematics itself.
+#pragma once
+
+#include "model/data.hpp"
+
+namespace codyna {
+
+template <class S>
+S kinetic_energy(const Model& model, DataT<S>& data, const VecXT<S>& q, const VecXT<S>& v);
+template <class S>
+S potential_energy(const Model& model, DataT<S>& data, const VecXT<S>& q);
+
+}  // namespace codyna

@@ -1,0 +1,58 @@
+#include "dynamics/forward_dynamics.hpp"
+
+#include "dynamics/aba.hpp"
+#include "dynamics/constraints.hpp"
+#include "dynamics/crba.hpp"
+#include "dynamics/effects.hpp"
+#include "dynamics/kinematics.hpp"
+#include "dynamics/rnea.hpp"
+#include "spatial/autodiff.hpp"
+#include "spatial/linalg.hpp"
+
+namespace codyna {
+
+template <class S>
+const VecXT<S>& forward_dynamics(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>& v,
+                                 const VecXT<S>& u, const Baumgarte& stab) {
+  forward_kinematics<S>(model, d, q, v);
+  const VecXT<S> Q = applied_forces<S>(model, d, q, v, u);
+  if (model.active_rows.empty()) {
+    d.lambda.setZero(model.nc);
+    return aba<S>(model, d, q, v, Q);
+  }
+  crba<S>(model, d, q);
+  nonlinear_effects<S>(model, d, q, v);
+  constraint_terms<S>(model, d, q, v);
+  const int na = static_cast<int>(model.active_rows.size());
+  MatXT<S> J(na, model.nv);
+  VecXT<S> rhs(na);
+  for (int k = 0; k < na; ++k) {
+    const int r = model.active_rows[k];
+    J.row(k) = d.Jc.row(r);
+    rhs[k] = d.gamma[r];
+  }
+  if (stab.alpha != 0.0 || stab.beta != 0.0) {
+    const VecXT<S> Jv = J * v;
+    for (int k = 0; k < na; ++k)
+      rhs[k] += S(2.0 * stab.alpha) * Jv[k] + S(stab.beta * stab.beta) * d.phi[model.active_rows[k]];
+  }
+  // [qdd_free, M^-1 J^T] in one factorization
+  MatXT<S> B(model.nv, 1 + na);
+  B.col(0) = Q - d.nle;
+  B.rightCols(na) = J.transpose();
+  const MatXT<S> X = cholesky_solve<S>(d.M, B);
+  const MatXT<S> A = J * X.rightCols(na);
+  const VecXT<S> lam = cholesky_solve<S>(A, MatXT<S>(J * X.col(0) + rhs)).col(0);
+  d.qdd = X.col(0) - X.rightCols(na) * lam;
+  d.lambda.setZero(model.nc);
+  for (int k = 0; k < na; ++k) d.lambda[model.active_rows[k]] = lam[k];
+  return d.qdd;
+}
+
+template const VecXT<double>& forward_dynamics<double>(const Model&, DataT<double>&, const VecXT<double>&,
+                                                       const VecXT<double>&, const VecXT<double>&, const Baumgarte&);
+template const VecXT<ADScalar>& forward_dynamics<ADScalar>(const Model&, DataT<ADScalar>&, const VecXT<ADScalar>&,
+                                                           const VecXT<ADScalar>&, const VecXT<ADScalar>&,
+                                                           const Baumgarte&);
+
+}  // namespace codyna

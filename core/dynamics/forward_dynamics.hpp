@@ -1,0 +1,22 @@
+// Forward dynamics of the whole model: accelerations qdd and loop-closure
+// multipliers lambda for state (q, v) and actuator values u (one per actuator):
+//   M qdd + nle(q, v) = Q(q, v, u) - Jc^T lambda,   Jc qdd + gamma = -stab
+// Trees use ABA (O(n)); closed loops use CRBA + the constraint terms and the
+// Schur complement on the independent (non-redundant) rows. Redundant rows get
+// lambda = 0. `stab` is an optional Baumgarte term 2 alpha Jc v + beta^2 phi.
+// Writes everything the algorithms it calls write; returns data.qdd.
+#pragma once
+
+#include "model/data.hpp"
+
+namespace codyna {
+
+struct Baumgarte {
+  double alpha = 0.0, beta = 0.0;
+};
+
+template <class S>
+const VecXT<S>& forward_dynamics(const Model& model, DataT<S>& data, const VecXT<S>& q, const VecXT<S>& v,
+                                 const VecXT<S>& u, const Baumgarte& stab = {});
+
+}  // namespace codyna

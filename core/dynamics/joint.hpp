@@ -1,0 +1,44 @@
+// Joint kinematics and configuration-space operations.
+//
+// joint_transform: X_FM(q) (pose of the child joint frame M in the parent
+//   joint frame F) and the motion subspace S_M (6 x nv, M coordinates), so the
+//   joint velocity is v_J = S_M qd. Reads q[idx_q .. idx_q+nq).
+// joint_bias: c_J = (d/dt S_M) qd in M coordinates (non-zero for universal
+//   and planar joints).
+// integrate / difference / qdot / normalize: q lives on a manifold (quaternions
+//   for spherical and free joints), v in its tangent space; integrate(q, dv) is
+//   the retraction q (+) dv used by Newton solves, linearization and integrators,
+//   difference its inverse.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "model/model.hpp"
+#include "spatial/spatial.hpp"
+
+namespace codyna {
+
+template <class S>
+void joint_transform(const JointModel& j, const VecXT<S>& q, SE3T<S>& X_FM, Mat6xT<S>& S_M);
+
+template <class S>
+Vec6T<S> joint_bias(const JointModel& j, const VecXT<S>& q, const VecXT<S>& v);
+
+// q (+) dv, size nq
+template <class S>
+VecXT<S> integrate(const Model& model, const VecXT<S>& q, const VecXT<S>& dv);
+
+// dv such that integrate(q0, dv) == q1 (double only)
+Eigen::VectorXd difference(const Model& model, const Eigen::VectorXd& q0, const Eigen::VectorXd& q1);
+
+// time derivative of q for velocity v, size nq
+template <class S>
+VecXT<S> qdot(const Model& model, const VecXT<S>& q, const VecXT<S>& v);
+
+// unit quaternions, in place
+void normalize(const Model& model, Eigen::VectorXd& q);
+
+// the zero configuration (identity quaternions)
+Eigen::VectorXd neutral(const Model& model);
+
+}  // namespace codyna

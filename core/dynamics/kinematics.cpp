@@ -1,0 +1,112 @@
+#include "dynamics/kinematics.hpp"
+
+#include "dynamics/joint.hpp"
+#include "spatial/autodiff.hpp"
+
+namespace codyna {
+
+namespace {
+template <class S>
+void fk(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>* v, const VecXT<S>* qdd) {
+  SE3T<S> X_FM;
+  Mat6xT<S> S_M;
+  for (int i = 1; i < model.nbodies; ++i) {
+    const JointModel& j = model.joints[i];
+    const int p = j.parent;
+    joint_transform<S>(j, q, X_FM, S_M);
+    const SE3T<S> X_CM = j.X_CM.cast<S>();
+    d.liMi[i] = j.X_PF.cast<S>() * X_FM * X_CM.inverse();
+    d.oMi[i] = d.oMi[p] * d.liMi[i];
+    d.Sb[i] = X_CM.motion_matrix() * S_M;
+    if (!v) continue;
+    const auto qd = v->segment(j.idx_v, j.nv);
+    const Vec6T<S> vJ = d.Sb[i] * qd;
+    d.cJ[i] = X_CM.act_motion(joint_bias<S>(j, q, *v));
+    d.v[i] = d.liMi[i].inv_act_motion(d.v[p]) + vJ;
+    if (!qdd) continue;
+    d.a[i] = d.liMi[i].inv_act_motion(d.a[p]) + d.Sb[i] * qdd->segment(j.idx_v, j.nv) + d.cJ[i] +
+             cross_motion<S>(d.v[i], vJ);
+  }
+}
+}  // namespace
+
+template <class S>
+void forward_kinematics(const Model& model, DataT<S>& data, const VecXT<S>& q) {
+  fk<S>(model, data, q, nullptr, nullptr);
+}
+template <class S>
+void forward_kinematics(const Model& model, DataT<S>& data, const VecXT<S>& q, const VecXT<S>& v) {
+  fk<S>(model, data, q, &v, nullptr);
+}
+template <class S>
+void forward_kinematics(const Model& model, DataT<S>& data, const VecXT<S>& q, const VecXT<S>& v, const VecXT<S>& qdd) {
+  fk<S>(model, data, q, &v, &qdd);
+}
+
+template <class S>
+Vec3T<S> point_position(const DataT<S>& data, int body, const Eigen::Vector3d& p) {
+  return data.oMi[body].act_point(p.cast<S>());
+}
+
+template <class S>
+Vec3T<S> point_velocity(const DataT<S>& data, int body, const Eigen::Vector3d& p) {
+  const Vec6T<S>& v = data.v[body];
+  const Vec3T<S> w = v.template head<3>();
+  return data.oMi[body].R * (Vec3T<S>(v.template tail<3>()) + w.cross(p.cast<S>()));
+}
+
+template <class S>
+Vec3T<S> point_acceleration(const DataT<S>& data, int body, const Eigen::Vector3d& p) {
+  const Vec6T<S>& v = data.v[body];
+  const Vec6T<S>& a = data.a[body];
+  const Vec3T<S> w = v.template head<3>(), al = a.template head<3>();
+  const Vec3T<S> r = p.cast<S>();
+  const Vec3T<S> vp = Vec3T<S>(v.template tail<3>()) + w.cross(r);
+  return data.oMi[body].R * (Vec3T<S>(a.template tail<3>()) + al.cross(r) + w.cross(vp));
+}
+
+template <class S>
+Vec3T<S> angular_velocity(const DataT<S>& data, int body) {
+  return data.oMi[body].R * Vec3T<S>(data.v[body].template head<3>());
+}
+
+template <class S>
+Vec3T<S> angular_acceleration(const DataT<S>& data, int body) {
+  return data.oMi[body].R * Vec3T<S>(data.a[body].template head<3>());
+}
+
+template <class S>
+MatXT<S> body_jacobian_world(const Model& model, const DataT<S>& data, int body) {
+  MatXT<S> J = MatXT<S>::Zero(6, model.nv);
+  for (int i = body; i > 0; i = model.parent[i]) {
+    const JointModel& j = model.joints[i];
+    if (j.nv == 0) continue;
+    J.block(0, j.idx_v, 6, j.nv) = data.oMi[i].motion_matrix() * data.Sb[i];
+  }
+  return J;
+}
+
+template <class S>
+MatXT<S> point_jacobian(const Model& model, const DataT<S>& data, int body, const Eigen::Vector3d& p) {
+  const MatXT<S> J6 = body_jacobian_world<S>(model, data, body);
+  const Vec3T<S> pw = point_position<S>(data, body, p);
+  return J6.bottomRows(3) - skew<S>(pw) * J6.topRows(3);
+}
+
+#define CODYNA_INSTANTIATE(S)                                                                              \
+  template void forward_kinematics<S>(const Model&, DataT<S>&, const VecXT<S>&);                          \
+  template void forward_kinematics<S>(const Model&, DataT<S>&, const VecXT<S>&, const VecXT<S>&);         \
+  template void forward_kinematics<S>(const Model&, DataT<S>&, const VecXT<S>&, const VecXT<S>&,          \
+                                      const VecXT<S>&);                                                   \
+  template Vec3T<S> point_position<S>(const DataT<S>&, int, const Eigen::Vector3d&);                      \
+  template Vec3T<S> point_velocity<S>(const DataT<S>&, int, const Eigen::Vector3d&);                      \
+  template Vec3T<S> point_acceleration<S>(const DataT<S>&, int, const Eigen::Vector3d&);                  \
+  template Vec3T<S> angular_velocity<S>(const DataT<S>&, int);                                            \
+  template Vec3T<S> angular_acceleration<S>(const DataT<S>&, int);                                        \
+  template MatXT<S> body_jacobian_world<S>(const Model&, const DataT<S>&, int);                           \
+  template MatXT<S> point_jacobian<S>(const Model&, const DataT<S>&, int, const Eigen::Vector3d&);
+CODYNA_INSTANTIATE(double)
+CODYNA_INSTANTIATE(ADScalar)
+#undef CODYNA_INSTANTIATE
+
+}  // namespace codyna

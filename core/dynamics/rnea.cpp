@@ -1,0 +1,54 @@
+#include "dynamics/rnea.hpp"
+
+#include "dynamics/kinematics.hpp"
+#include "spatial/autodiff.hpp"
+
+namespace codyna {
+
+template <class S>
+const VecXT<S>& rnea(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>& v, const VecXT<S>& a) {
+  forward_kinematics<S>(model, d, q, v, a);
+  const Vec3T<S> g = model.gravity.cast<S>();
+  for (int i = 1; i < model.nbodies; ++i) {
+    Vec6T<S> ag = d.a[i];
+    if (model.has_gravity) ag.template tail<3>() -= d.oMi[i].R.transpose() * g;
+    const Mat6T<S> I = model.inertia[i].cast<S>();
+    d.f[i] = I * ag + cross_force<S>(d.v[i], Vec6T<S>(I * d.v[i]));
+  }
+  for (int i = model.nbodies - 1; i > 0; --i) {
+    const JointModel& j = model.joints[i];
+    if (j.nv > 0) d.tau.segment(j.idx_v, j.nv) = d.Sb[i].transpose() * d.f[i];
+    if (j.parent > 0) d.f[j.parent] += d.liMi[i].act_force(d.f[i]);
+  }
+  return d.tau;
+}
+
+template <class S>
+const VecXT<S>& nonlinear_effects(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>& v) {
+  const VecXT<S> zero = VecXT<S>::Zero(model.nv);
+  d.nle = rnea<S>(model, d, q, v, zero);
+  return d.nle;
+}
+
+template <class S>
+VecXT<S> body_forces_to_generalized(const Model& model, DataT<S>& d) {
+  VecXT<S> Q = VecXT<S>::Zero(model.nv);
+  std::vector<Vec6T<S>> f = d.fext;
+  for (int i = model.nbodies - 1; i > 0; --i) {
+    const JointModel& j = model.joints[i];
+    if (j.nv > 0) Q.segment(j.idx_v, j.nv) = d.Sb[i].transpose() * f[i];
+    if (j.parent > 0) f[j.parent] += d.liMi[i].act_force(f[i]);
+  }
+  return Q;
+}
+
+#define CODYNA_INSTANTIATE(S)                                                                           \
+  template const VecXT<S>& rnea<S>(const Model&, DataT<S>&, const VecXT<S>&, const VecXT<S>&,          \
+                                   const VecXT<S>&);                                                   \
+  template const VecXT<S>& nonlinear_effects<S>(const Model&, DataT<S>&, const VecXT<S>&, const VecXT<S>&); \
+  template VecXT<S> body_forces_to_generalized<S>(const Model&, DataT<S>&);
+CODYNA_INSTANTIATE(double)
+CODYNA_INSTANTIATE(ADScalar)
+#undef CODYNA_INSTANTIATE
+
+}  // namespace codyna

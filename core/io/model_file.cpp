@@ -1,0 +1,895 @@
+#include "io/model_file.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <optional>
+#include <random>
+#include <stdexcept>
+#include <string_view>
+#include <system_error>
+#include <vector>
+
+#ifdef _WIN32
+#include <io.h>
+#else
+#include <unistd.h>
+#endif
+
+#include "model/errors.hpp"
+
+namespace codyna {
+namespace {
+
+using json = nlohmann::json;
+using ojson = nlohmann::ordered_json;  // written files keep the fields in schema order
+
+constexpr int kFormatVersion = 1;
+constexpr double kUnitTolerance = 1e-14;      // a vector this close to unit length is kept bit-exact
+constexpr double kRotationTolerance = 1e-9;   // largest entry of |R^T R - I|
+constexpr double kSymmetryTolerance = 1e-12;  // of an inertia matrix, relative to its largest entry
+
+std::string quote(std::string_view s) { return "\"" + std::string(s) + "\""; }
+
+std::string dump(const json& j) { return j.dump(-1, ' ', false, json::error_handler_t::replace); }
+
+std::string join(const std::vector<std::string_view>& names) {
+  std::string s;
+  for (std::string_view n : names) s += (s.empty() ? "" : ", ") + std::string(n);
+  return s;
+}
+
+// "got ..." part of an error message.
+std::string describe(const json& j) {
+  switch (j.type()) {
+    case json::value_t::null: return "null";
+    case json::value_t::boolean: return "boolean " + dump(j);
+    case json::value_t::string: return "string " + dump(j);
+    case json::value_t::number_integer:
+    case json::value_t::number_unsigned:
+    case json::value_t::number_float: return "number " + dump(j);
+    case json::value_t::array:
+      return "an array of " + std::to_string(j.size()) + (j.size() == 1 ? " element" : " elements");
+    case json::value_t::object: return "an object";
+    default: return j.type_name();
+  }
+}
+
+// A key as a JSON-pointer token.
+std::string pointer_token(std::string_view key) {
+  std::string t;
+  for (char c : key) t += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
+  return t;
+}
+
+// ---------------------------------------------------------------------------
+// Reading: a value together with where it is, so every error can name both.
+
+class Node {
+ public:
+  Node(const json& j, std::string path, const std::string& file) : j_(&j), path_(std::move(path)), file_(&file) {}
+
+  const json& value() const { return *j_; }
+  Node element(std::size_t i) const { return Node((*j_)[i], path_ + "/" + std::to_string(i), *file_); }
+  Node member(const std::string& key) const { return Node(j_->at(key), path_ + "/" + pointer_token(key), *file_); }
+
+  [[noreturn]] void fail(const std::string& detail) const { throw ModelError(*file_, path_, detail); }
+  [[noreturn]] void expected(const std::string& what) const { fail("expected " + what + ", got " + describe(*j_)); }
+
+ private:
+  const json* j_;
+  std::string path_;
+  const std::string* file_;
+};
+
+// A JSON object whose fields are looked up by name.
+class Object {
+ public:
+  explicit Object(const Node& n) : n_(n) {
+    if (!n.value().is_object()) n.expected("an object");
+  }
+  const Node& node() const { return n_; }
+
+  // Every field must be one of `allowed`; `owner` ("a gravity effect") qualifies the message.
+  void allow(const std::vector<std::string_view>& allowed, const std::string& owner = {}) const {
+    for (const auto& item : n_.value().items()) {
+      if (std::find(allowed.begin(), allowed.end(), item.key()) != allowed.end()) continue;
+      n_.member(item.key()).fail("unknown field " + quote(item.key()) + " (allowed" +
+                                 (owner.empty() ? "" : " for " + owner) + ": " + join(allowed) + ")");
+    }
+  }
+  std::optional<Node> get(const std::string& key) const {
+    if (!n_.value().contains(key)) return std::nullopt;
+    return n_.member(key);
+  }
+  Node need(const std::string& key) const {
+    if (auto f = get(key)) return *f;
+    n_.fail("missing required field " + quote(key));
+  }
+
+ private:
+  Node n_;
+};
+
+double read_number(const Node& n) {
+  if (!n.value().is_number() || !std::isfinite(n.value().get<double>())) n.expected("a number");
+  return n.value().get<double>();
+}
+
+// Integral values written as 2.0 are accepted too.
+int read_integer(const Node& n) {
+  if (n.value().is_number()) {
+    const double x = n.value().get<double>();
+    if (x == std::floor(x) && x >= std::numeric_limits<int>::min() && x <= std::numeric_limits<int>::max())
+      return static_cast<int>(x);
+  }
+  n.expected("an integer");
+}
+
+std::string read_string(const Node& n) {
+  if (!n.value().is_string()) n.expected("a string");
+  return n.value().get<std::string>();
+}
+
+std::vector<Node> read_elements(const Node& n) {
+  if (!n.value().is_array()) n.expected("an array");
+  std::vector<Node> out;
+  for (std::size_t i = 0; i < n.value().size(); ++i) out.push_back(n.element(i));
+  return out;
+}
+
+std::vector<std::string> read_names(const Node& n) {
+  std::vector<std::string> out;
+  for (const Node& e : read_elements(n)) out.push_back(read_string(e));
+  return out;
+}
+
+Eigen::VectorXd read_numbers(const Node& n, std::size_t size) {
+  if (!n.value().is_array() || n.value().size() != size) n.expected("an array of " + std::to_string(size) + " numbers");
+  Eigen::VectorXd v(size);
+  for (std::size_t i = 0; i < size; ++i) v[i] = read_number(n.element(i));
+  return v;
+}
+
+Eigen::Vector3d read_vec3(const Node& n) { return read_numbers(n, 3); }
+
+Eigen::Matrix3d read_matrix3(const Node& n) {
+  if (!n.value().is_array() || n.value().size() != 3) n.expected("a 3x3 array (3 rows of 3 numbers)");
+  Eigen::Matrix3d m;
+  for (int r = 0; r < 3; ++r) m.row(r) = read_numbers(n.element(r), 3).transpose();
+  return m;
+}
+
+// Scales v to unit length; false if v is zero. A vector already of unit length
+// (within kUnitTolerance) is left alone, so a saved file reads back bit-exactly.
+bool normalize(Eigen::Ref<Eigen::VectorXd> v) {
+  const double norm = v.norm();
+  if (norm == 0.0) return false;
+  if (std::abs(norm - 1.0) > kUnitTolerance) v /= norm;
+  return true;
+}
+
+// An axis or direction: a non-zero vec3, normalized.
+Eigen::Vector3d read_direction(const Node& n) {
+  Eigen::Vector3d v = read_vec3(n);
+  if (!normalize(v)) n.fail("expected a non-zero vector, got " + dump(n.value()));
+  return v;
+}
+
+Eigen::Vector4d read_quaternion(const Node& n) {
+  Eigen::Vector4d wxyz = read_numbers(n, 4);
+  if (!normalize(wxyz)) n.fail("expected a non-zero quaternion [w, x, y, z], got " + dump(n.value()));
+  return wxyz;
+}
+
+Eigen::Matrix3d read_rotation_matrix(const Node& n) {
+  const Eigen::Matrix3d R = read_matrix3(n);
+  const double error = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  if (!(error <= kRotationTolerance))
+    n.fail("rotation matrix is not orthonormal (largest entry of |R^T R - I| is " + dump(error) +
+           ", tolerance " + dump(kRotationTolerance) + ")");
+  if (R.determinant() < 0) n.fail("rotation matrix has determinant -1 (a reflection); expected +1");
+  return R;
+}
+
+// {"axis", "angle"} | {"axis", "angle_deg"} | {"quaternion"} | {"matrix"} | {"rpy"}
+Eigen::Matrix3d read_rotation(const Node& n) {
+  using Eigen::AngleAxisd;
+  using Eigen::Vector3d;
+  const Object o(n);
+  o.allow({"axis", "angle", "angle_deg", "quaternion", "matrix", "rpy"}, "a rotation");
+  std::vector<std::string> forms;
+  for (const char* key : {"axis", "quaternion", "matrix", "rpy"})
+    if (o.get(key)) forms.push_back(key);
+  if (forms.empty())
+    n.fail("expected a rotation: {\"axis\", \"angle\"}, {\"axis\", \"angle_deg\"}, {\"quaternion\"}, "
+           "{\"matrix\"} or {\"rpy\"}");
+  if (forms.size() > 1) n.fail("expected one rotation form, got both " + quote(forms[0]) + " and " + quote(forms[1]));
+  const std::optional<Node> angle = o.get("angle"), angle_deg = o.get("angle_deg");
+  if (forms[0] != "axis") {
+    if (angle || angle_deg)
+      (angle ? *angle : *angle_deg).fail("an angle goes with \"axis\", not with " + quote(forms[0]));
+    if (forms[0] == "quaternion") {
+      const Eigen::Vector4d q = read_quaternion(o.need("quaternion"));
+      return Eigen::Quaterniond(q[0], q[1], q[2], q[3]).toRotationMatrix();
+    }
+    if (forms[0] == "matrix") return read_rotation_matrix(o.need("matrix"));
+    const Vector3d rpy = read_vec3(o.need("rpy"));
+    return (AngleAxisd(rpy.z(), Vector3d::UnitZ()) * AngleAxisd(rpy.y(), Vector3d::UnitY()) *
+            AngleAxisd(rpy.x(), Vector3d::UnitX())).toRotationMatrix();
+  }
+  if (angle && angle_deg) angle_deg->fail("give \"angle\" or \"angle_deg\", not both");
+  if (!angle && !angle_deg) n.fail("missing required field \"angle\" (or \"angle_deg\")");
+  const double a = angle ? read_number(*angle) : read_number(*angle_deg) * std::numbers::pi / 180.0;
+  return AngleAxisd(a, read_direction(o.need("axis"))).toRotationMatrix();
+}
+
+// [Ixx, Iyy, Izz] | [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] | 3x3 (symmetric)
+Eigen::Matrix3d read_inertia(const Node& n) {
+  const json& j = n.value();
+  if (!j.is_array() || (j.size() != 3 && j.size() != 6))
+    n.expected("[Ixx, Iyy, Izz], [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] or a 3x3 array");
+  if (j.size() == 3 && j[0].is_array()) {
+    const Eigen::Matrix3d I = read_matrix3(n);
+    const double asymmetry = (I - I.transpose()).cwiseAbs().maxCoeff();
+    if (asymmetry > kSymmetryTolerance * I.cwiseAbs().maxCoeff())
+      n.fail("inertia matrix is not symmetric (largest entry of |I - I^T| is " + dump(asymmetry) + ")");
+    return I;  // as written, so that encode_inertia's 3x3 form reads back exactly
+  }
+  const Eigen::VectorXd d = read_numbers(n, j.size());
+  Eigen::Matrix3d I = d.head<3>().asDiagonal();
+  if (d.size() == 6) {
+    I(0, 1) = I(1, 0) = d[3];
+    I(0, 2) = I(2, 0) = d[4];
+    I(1, 2) = I(2, 1) = d[5];
+  }
+  return I;
+}
+
+Eigen::Vector4d read_color(const Node& n) {
+  const json& j = n.value();
+  if (!j.is_array() || (j.size() != 3 && j.size() != 4)) n.expected("[r, g, b] or [r, g, b, a]");
+  Eigen::Vector4d c(0.0, 0.0, 0.0, 1.0);
+  for (std::size_t i = 0; i < j.size(); ++i) {
+    const Node e = n.element(i);
+    c[i] = read_number(e);
+    if (c[i] < 0.0 || c[i] > 1.0) e.expected("a number in [0, 1]");
+  }
+  return c;
+}
+
+// "world" | "body" (axes of a force)
+bool read_in_world(const Node& n) {
+  const std::string s = read_string(n);
+  if (s != "world" && s != "body") n.fail("unknown frame " + quote(s) + " (expected one of: world, body)");
+  return s == "world";
+}
+
+// "x" | "y" | "z" | 0 | 1 | 2
+int read_component(const Node& n) {
+  if (n.value().is_string()) {
+    const std::string s = read_string(n);
+    if (s == "x" || s == "y" || s == "z") return s[0] - 'x';
+  } else if (n.value().is_number()) {
+    const int c = read_integer(n);
+    if (c >= 0 && c < 3) return c;
+  }
+  n.expected("\"x\", \"y\", \"z\", 0, 1 or 2");
+}
+
+// The enumerators of E are 0, 1, ...; to_string gives "?" past the last one.
+template <class E>
+std::vector<std::string_view> enum_names() {
+  std::vector<std::string_view> names;
+  for (int i = 0; std::string_view(to_string(static_cast<E>(i))) != "?"; ++i)
+    names.push_back(to_string(static_cast<E>(i)));
+  return names;
+}
+
+template <class E>
+E read_enum(const Node& n, const char* what, std::optional<E> (*from_string)(const std::string&)) {
+  const std::string s = read_string(n);
+  if (auto e = from_string(s)) return *e;
+  n.fail("unknown " + std::string(what) + " " + quote(s) + " (expected one of: " + join(enum_names<E>()) + ")");
+}
+
+// q0 or v0 of a joint: a number (one value) or an array of exactly `size` numbers.
+Eigen::VectorXd read_coordinates(const Node& n, int size, const std::string& what) {
+  const json& j = n.value();
+  if (!j.is_number() && !j.is_array()) n.expected("a number or an array of numbers");
+  const std::size_t count = j.is_number() ? 1 : j.size();
+  if (count != static_cast<std::size_t>(size))
+    n.fail("expected " + std::to_string(size) + (size == 1 ? " value" : " values") + " (" + what + "), got " +
+           std::to_string(count));
+  return j.is_number() ? Eigen::VectorXd::Constant(1, read_number(n)) : read_numbers(n, count);
+}
+
+int quaternion_index(JointType t) { return t == JointType::Spherical ? 0 : t == JointType::Free ? 3 : -1; }
+
+FrameSpec read_frame(const Node& n);
+
+// Arrays as in the table of model_spec.hpp; spherical joints also take
+// {"rotation"} and free joints {"position", "rotation"}.
+Eigen::VectorXd read_q0(const Node& n, JointType type) {
+  const std::string joint = "a " + std::string(to_string(type)) + " joint";
+  const int iq = quaternion_index(type);
+  if (iq < 0 || !n.value().is_object()) {
+    Eigen::VectorXd q = read_coordinates(n, joint_nq(type), "nq of " + joint);
+    if (iq >= 0 && !normalize(q.segment<4>(iq)))
+      n.fail("expected a non-zero quaternion (w, x, y, z) in q0, got " + dump(n.value()));
+    return q;
+  }
+  if (type == JointType::Spherical) Object(n).allow({"rotation"}, "the q0 of " + joint);
+  const FrameSpec f = read_frame(n);
+  const Eigen::Quaterniond r(f.rotation);
+  Eigen::VectorXd q(joint_nq(type));
+  if (type == JointType::Free) q.head<3>() = f.position;
+  q.segment<4>(iq) << r.w(), r.x(), r.y(), r.z();
+  return q;
+}
+
+// ---------------------------------------------------------------------------
+// Writing
+
+ojson encode(double x) { return x; }
+ojson encode(int x) { return x; }
+ojson encode(const std::string& s) { return s; }
+ojson encode(const std::optional<double>& x) { return x ? ojson(*x) : ojson(); }
+ojson encode(const std::vector<std::string>& names) { return names; }
+
+ojson encode(const Eigen::Ref<const Eigen::VectorXd>& v) {
+  ojson a = ojson::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(v[i]);
+  return a;
+}
+
+ojson encode_rotation(const Eigen::Matrix3d& R) {
+  ojson rows = ojson::array();
+  for (int r = 0; r < 3; ++r) rows.push_back(encode(R.row(r).transpose()));
+  ojson o = ojson::object();
+  o["matrix"] = rows;
+  return o;
+}
+
+// Six numbers, unless rounding has left I slightly asymmetric: then all nine.
+ojson encode_inertia(const Eigen::Matrix3d& I) {
+  if (I != I.transpose())
+    return {encode(I.row(0).transpose()), encode(I.row(1).transpose()), encode(I.row(2).transpose())};
+  return {I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2)};
+}
+
+ojson encode_in_world(bool in_world) { return in_world ? "world" : "body"; }
+
+ojson encode_component(int c) { return c >= 0 && c < 3 ? ojson(std::string(1, char('x' + c))) : ojson(c); }
+
+// An empty description or unit is left out of the file.
+ojson encode_optional_text(const std::string& s) { return s.empty() ? ojson() : ojson(s); }
+
+template <class E>
+ojson encode_enum(E e) { return to_string(e); }
+
+// ---------------------------------------------------------------------------
+// Schemas: each spec struct is described once, as the fields of its JSON
+// object; reading and writing both follow that description.
+
+enum class Need { Optional, Required };
+
+template <class S>
+struct Field {
+  std::string_view key;
+  Need need;
+  std::function<void(const Node&, S&)> read;
+  std::function<void(ojson&, const S&)> write;  // sets j[key], or leaves an optional field out
+};
+
+template <class S>
+struct Schema {
+  std::vector<Field<S>> fields;
+  const char* kind = nullptr;  // of a typed element ("effect"); names it in messages
+  // Keys that apply to s, whose type has been read; all fields when null.
+  std::vector<std::string_view> (*keys)(const S&) = nullptr;
+
+  const Field<S>& field(std::string_view key) const {
+    const auto f = std::find_if(fields.begin(), fields.end(), [&](const Field<S>& f) { return f.key == key; });
+    assert(f != fields.end() && "a key without a field");
+    return *f;
+  }
+  std::vector<std::string_view> keys_of(const S& s) const {
+    if (keys) return keys(s);
+    std::vector<std::string_view> all;
+    for (const Field<S>& f : fields) all.push_back(f.key);
+    return all;
+  }
+};
+
+template <class S>
+concept Typed = requires(S s) { s.type; };
+
+template <class S>
+const Schema<S>& schema();  // one specialization per spec struct, below
+
+template <class S>
+S read_struct(const Node& n) {
+  const Schema<S>& sch = schema<S>();
+  const Object o(n);
+  S s;
+  std::string owner;
+  if constexpr (Typed<S>) {
+    sch.field("type").read(o.need("type"), s);  // the type decides which other fields apply
+    owner = "a " + std::string(to_string(s.type)) + " " + sch.kind;
+  }
+  const std::vector<std::string_view> keys = sch.keys_of(s);
+  o.allow(keys, owner);
+  for (std::string_view key : keys) {
+    if (key == "type") continue;
+    const Field<S>& f = sch.field(key);
+    if (auto v = o.get(std::string(key)))
+      f.read(*v, s);
+    else if (f.need == Need::Required)
+      n.fail("missing required field " + quote(key));
+  }
+  return s;
+}
+
+template <class S>
+ojson write_struct(const S& s) {
+  const Schema<S>& sch = schema<S>();
+  ojson j = ojson::object();
+  for (std::string_view key : sch.keys_of(s)) sch.field(key).write(j, s);
+  return j;
+}
+
+template <class T>
+std::vector<T> read_list(const Node& n) {
+  std::vector<T> out;
+  for (const Node& e : read_elements(n)) out.push_back(read_struct<T>(e));
+  return out;
+}
+
+template <class T>
+ojson write_list(const std::vector<T>& v) {
+  ojson a = ojson::array();
+  for (const T& e : v) a.push_back(write_struct(e));
+  return a;
+}
+
+// A field stored in member m, read by `read` and written by `write`. Optional
+// fields that write as null or as an empty array or object are left out.
+template <class S, class T, class Read, class Write>
+Field<S> field(std::string_view key, T S::*m, Read read, Write write, Need need = Need::Optional) {
+  return {key, need, [m, read](const Node& n, S& s) { s.*m = read(n); },
+          [key, m, write, need](ojson& j, const S& s) {
+            ojson v = write(s.*m);
+            const bool empty = v.is_null() || ((v.is_array() || v.is_object()) && v.empty());
+            if (need == Need::Required || !empty) j[std::string(key)] = std::move(v);
+          }};
+}
+
+template <class S, class T, class Read>
+Field<S> field(std::string_view key, T S::*m, Read read, Need need = Need::Optional) {
+  return field(key, m, read, [](const T& v) { return encode(v); }, need);
+}
+
+template <class S, class T>
+Field<S> struct_field(std::string_view key, T S::*m) {
+  return field(key, m, read_struct<T>, write_struct<T>);
+}
+
+template <class S, class T>
+Field<S> list_field(std::string_view key, std::vector<T> S::*m, Need need = Need::Optional) {
+  return field(key, m, read_list<T>, write_list<T>, need);
+}
+
+template <class S, class E>
+Field<S> type_field(const char* what, std::optional<E> (*from_string)(const std::string&)) {
+  return field("type", &S::type, [what, from_string](const Node& n) { return read_enum(n, what, from_string); },
+               encode_enum<E>, Need::Required);
+}
+
+template <class S>
+Field<S> name_field() {
+  return field("name", &S::name, read_string, Need::Required);
+}
+
+// Keys of a typed element: "name", "type", the type's own, then `tail`.
+std::vector<std::string_view> element_keys(const std::vector<std::string_view>& own,
+                                           const std::vector<std::string_view>& tail = {}) {
+  std::vector<std::string_view> k{"name", "type"};
+  k.insert(k.end(), own.begin(), own.end());
+  k.insert(k.end(), tail.begin(), tail.end());
+  return k;
+}
+
+template <>
+const Schema<FrameSpec>& schema<FrameSpec>() {
+  static const Schema<FrameSpec> s{{
+      field("position", &FrameSpec::position, read_vec3),
+      field("rotation", &FrameSpec::rotation, read_rotation, encode_rotation),
+  }};
+  return s;
+}
+
+FrameSpec read_frame(const Node& n) { return read_struct<FrameSpec>(n); }
+
+template <>
+const Schema<ShapeSpec>& schema<ShapeSpec>() {
+  static const Schema<ShapeSpec> s{
+      {
+          type_field<ShapeSpec>("shape type", shape_type_from_string),
+          field("size", &ShapeSpec::size, read_vec3),
+          field("radius", &ShapeSpec::radius, read_number),
+          field("length", &ShapeSpec::length, read_number),
+          struct_field("frame", &ShapeSpec::frame),
+          field("color", &ShapeSpec::color, read_color),
+      },
+      "shape",
+      [](const ShapeSpec& s) -> std::vector<std::string_view> {
+        switch (s.type) {
+          case ShapeType::Box: return {"type", "size", "frame", "color"};
+          case ShapeType::Cylinder: return {"type", "radius", "length", "frame", "color"};
+          case ShapeType::Sphere: return {"type", "radius", "frame", "color"};
+        }
+        return {"type", "frame", "color"};
+      }};
+  return s;
+}
+
+template <>
+const Schema<BodySpec>& schema<BodySpec>() {
+  static const Schema<BodySpec> s{{
+      name_field<BodySpec>(),
+      field("mass", &BodySpec::mass, read_number, Need::Required),
+      field("com", &BodySpec::com, read_vec3),
+      field("inertia", &BodySpec::inertia, read_inertia, encode_inertia, Need::Required),
+      list_field("shapes", &BodySpec::shapes),
+  }};
+  return s;
+}
+
+bool joint_has_axis(JointType t) {
+  return t == JointType::Revolute || t == JointType::Prismatic || t == JointType::Universal ||
+         t == JointType::Cylindrical;
+}
+
+template <>
+const Schema<JointSpec>& schema<JointSpec>() {
+  static const Schema<JointSpec> s{
+      {
+          name_field<JointSpec>(),
+          type_field<JointSpec>("joint type", joint_type_from_string),
+          field("parent", &JointSpec::parent, read_string, Need::Required),
+          field("child", &JointSpec::child, read_string, Need::Required),
+          struct_field("parent_frame", &JointSpec::parent_frame),
+          struct_field("child_frame", &JointSpec::child_frame),
+          field("axis", &JointSpec::axis, read_direction),
+          field("axis2", &JointSpec::axis2, read_direction),
+          {"q0", Need::Optional, [](const Node& n, JointSpec& j) { j.q0 = read_q0(n, j.type); },
+           [](ojson& o, const JointSpec& j) { if (j.q0.size() > 0) o["q0"] = encode(j.q0); }},
+          {"v0", Need::Optional,
+           [](const Node& n, JointSpec& j) {
+             j.v0 = read_coordinates(n, joint_nv(j.type), "nv of a " + std::string(to_string(j.type)) + " joint");
+           },
+           [](ojson& o, const JointSpec& j) { if (j.v0.size() > 0) o["v0"] = encode(j.v0); }},
+      },
+      "joint",
+      [](const JointSpec& j) {
+        std::vector<std::string_view> own{"parent", "child", "parent_frame", "child_frame"};
+        if (joint_has_axis(j.type)) own.push_back("axis");
+        if (j.type == JointType::Universal) own.push_back("axis2");
+        return element_keys(own, {"q0", "v0"});
+      }};
+  return s;
+}
+
+template <class S>
+std::vector<Field<S>> point_pair_fields() {
+  return {field("body_a", &S::body_a, read_string, Need::Required), field("point_a", &S::point_a, read_vec3),
+          field("body_b", &S::body_b, read_string, Need::Required), field("point_b", &S::point_b, read_vec3)};
+}
+
+template <class S>
+std::vector<Field<S>> joint_dof_fields() {
+  return {field("joint", &S::joint, read_string, Need::Required), field("dof", &S::dof, read_integer)};
+}
+
+// Concatenation of field lists.
+template <class S>
+std::vector<Field<S>> fields(std::initializer_list<std::vector<Field<S>>> parts) {
+  std::vector<Field<S>> all;
+  for (const auto& p : parts) all.insert(all.end(), p.begin(), p.end());
+  return all;
+}
+
+constexpr std::string_view kPointPair[] = {"body_a", "point_a", "body_b", "point_b"};
+
+std::vector<std::string_view> point_pair_and(std::vector<std::string_view> more) {
+  more.insert(more.begin(), std::begin(kPointPair), std::end(kPointPair));
+  return more;
+}
+
+template <>
+const Schema<ConstraintSpec>& schema<ConstraintSpec>() {
+  static const Schema<ConstraintSpec> s{
+      fields<ConstraintSpec>({
+          {name_field<ConstraintSpec>(), type_field<ConstraintSpec>("constraint type", constraint_type_from_string)},
+          point_pair_fields<ConstraintSpec>(),
+          {field("axis_a", &ConstraintSpec::axis_a, read_direction),
+           field("axis_b", &ConstraintSpec::axis_b, read_direction)},
+      }),
+      "constraint",
+      [](const ConstraintSpec& c) {
+        switch (c.type) {
+          case ConstraintType::Ball: return element_keys(point_pair_and({}));
+          case ConstraintType::Revolute: return element_keys(point_pair_and({"axis_a", "axis_b"}));
+          case ConstraintType::PlanarRevolute: return element_keys(point_pair_and({"axis_a"}));
+        }
+        return element_keys({});
+      }};
+  return s;
+}
+
+template <>
+const Schema<EffectSpec>& schema<EffectSpec>() {
+  static const Schema<EffectSpec> s{
+      fields<EffectSpec>({
+          {name_field<EffectSpec>(), type_field<EffectSpec>("effect type", effect_type_from_string),
+           field("g", &EffectSpec::g, read_vec3)},
+          point_pair_fields<EffectSpec>(),
+          joint_dof_fields<EffectSpec>(),
+          {field("stiffness", &EffectSpec::stiffness, read_number),
+           field("damping", &EffectSpec::damping, read_number),
+           field("rest_length", &EffectSpec::rest_length, read_number),
+           field("rest_position", &EffectSpec::rest_position, read_number),
+           field("body", &EffectSpec::body_a, read_string, Need::Required),
+           field("point", &EffectSpec::point_a, read_vec3),
+           field("force", &EffectSpec::force, read_vec3),
+           field("torque", &EffectSpec::torque, read_vec3),
+           field("frame", &EffectSpec::in_world, read_in_world, encode_in_world)},
+      }),
+      "effect",
+      [](const EffectSpec& e) {
+        switch (e.type) {
+          case EffectType::Gravity: return element_keys({"g"});
+          case EffectType::SpringDamper: return element_keys(point_pair_and({"stiffness", "damping", "rest_length"}));
+          case EffectType::JointSpringDamper:
+            return element_keys({"joint", "dof", "stiffness", "damping", "rest_position"});
+          case EffectType::JointFriction: return element_keys({"joint", "dof", "damping"});
+          case EffectType::BodyForce: return element_keys({"body", "point", "force", "torque", "frame"});
+        }
+        return element_keys({});
+      }};
+  return s;
+}
+
+template <>
+const Schema<ActuatorSpec>& schema<ActuatorSpec>() {
+  static const Schema<ActuatorSpec> s{
+      fields<ActuatorSpec>({
+          {name_field<ActuatorSpec>(), type_field<ActuatorSpec>("actuator type", actuator_type_from_string)},
+          joint_dof_fields<ActuatorSpec>(),
+          {field("body", &ActuatorSpec::body, read_string, Need::Required),
+           field("point", &ActuatorSpec::point, read_vec3),
+           field("direction", &ActuatorSpec::direction, read_direction),
+           field("frame", &ActuatorSpec::in_world, read_in_world, encode_in_world),
+           field("gain", &ActuatorSpec::gain, read_number), field("u0", &ActuatorSpec::u0, read_number),
+           field("min", &ActuatorSpec::min, read_number), field("max", &ActuatorSpec::max, read_number),
+           field("unit", &ActuatorSpec::unit, read_string, encode_optional_text)},
+      }),
+      "actuator",
+      [](const ActuatorSpec& a) {
+        const std::vector<std::string_view> tail{"gain", "u0", "min", "max", "unit"};
+        switch (a.type) {
+          case ActuatorType::JointForce: return element_keys({"joint", "dof"}, tail);
+          case ActuatorType::BodyForce: return element_keys({"body", "point", "direction", "frame"}, tail);
+        }
+        return element_keys({}, tail);
+      }};
+  return s;
+}
+
+template <>
+const Schema<SensorSpec>& schema<SensorSpec>() {
+  static const Schema<SensorSpec> s{
+      fields<SensorSpec>({
+          {name_field<SensorSpec>(), type_field<SensorSpec>("sensor type", sensor_type_from_string)},
+          joint_dof_fields<SensorSpec>(),
+          point_pair_fields<SensorSpec>(),
+          {field("body", &SensorSpec::body, read_string, Need::Required),
+           field("point", &SensorSpec::point, read_vec3),
+           field("component", &SensorSpec::component, read_component, encode_component),
+           field("frame", &SensorSpec::frame, read_string), field("axis", &SensorSpec::axis, read_direction),
+           field("unit", &SensorSpec::unit, read_string, encode_optional_text)},
+      }),
+      "sensor",
+      [](const SensorSpec& s) {
+        switch (s.type) {
+          case SensorType::JointPosition:
+          case SensorType::JointVelocity: return element_keys({"joint", "dof"}, {"unit"});
+          case SensorType::PointPosition:
+          case SensorType::PointVelocity: return element_keys({"body", "point", "component", "frame"}, {"unit"});
+          case SensorType::BodyAngle: return element_keys({"body", "axis"}, {"unit"});
+          case SensorType::Distance: return element_keys(point_pair_and({}), {"unit"});
+        }
+        return element_keys({}, {"unit"});
+      }};
+  return s;
+}
+
+template <>
+const Schema<PlantSpec>& schema<PlantSpec>() {
+  static const Schema<PlantSpec> s{{
+      field("inputs", &PlantSpec::inputs, read_names),
+      field("outputs", &PlantSpec::outputs, read_names),
+  }};
+  return s;
+}
+
+template <>
+const Schema<SolverSpec>& schema<SolverSpec>() {
+  static const Schema<SolverSpec> s{{
+      field("integrator", &SolverSpec::integrator, read_string),
+      field("rtol", &SolverSpec::rtol, read_number),
+      field("atol", &SolverSpec::atol, read_number),
+      field("t_end", &SolverSpec::t_end, read_number),
+      field("output_step", &SolverSpec::output_step, read_number),
+      field("max_step", &SolverSpec::max_step, read_number),
+  }};
+  return s;
+}
+
+template <>
+const Schema<ModelSpec>& schema<ModelSpec>() {
+  static const Schema<ModelSpec> s{{
+      {"codyna_model", Need::Optional,
+       [](const Node& n, ModelSpec&) {
+         if (read_integer(n) != kFormatVersion)
+           n.fail("unsupported format version " + dump(n.value()) + " (this codyna reads version " +
+                  std::to_string(kFormatVersion) + ")");
+       },
+       [](ojson& j, const ModelSpec&) { j["codyna_model"] = kFormatVersion; }},
+      name_field<ModelSpec>(),
+      field("description", &ModelSpec::description, read_string, encode_optional_text),
+      list_field("bodies", &ModelSpec::bodies, Need::Required),
+      list_field("joints", &ModelSpec::joints, Need::Required),
+      list_field("constraints", &ModelSpec::constraints),
+      list_field("effects", &ModelSpec::effects),
+      list_field("actuators", &ModelSpec::actuators),
+      list_field("sensors", &ModelSpec::sensors),
+      struct_field("plant", &ModelSpec::plant),
+      struct_field("solver", &ModelSpec::solver),
+  }};
+  return s;
+}
+
+// "line L, column C" of the byte at 1-based offset `byte` (as nlohmann counts).
+std::string location(const std::string& text, std::size_t byte) {
+  const std::size_t pos = std::min(byte > 0 ? byte - 1 : 0, text.size());
+  const std::size_t line = 1 + std::count(text.begin(), text.begin() + pos, '\n');
+  const std::size_t line_start = pos == 0 ? 0 : text.rfind('\n', pos - 1) + 1;  // npos + 1 == 0
+  return "line " + std::to_string(line) + ", column " + std::to_string(pos - line_start + 1);
+}
+
+// nlohmann's message without its "[json.exception...] parse error at ...: " prefix.
+std::string reason(const json::exception& e) {
+  std::string s = e.what();
+  if (auto p = s.find("] "); p != std::string::npos) s.erase(0, p + 2);
+  if (s.rfind("parse error", 0) == 0)
+    if (auto p = s.find(": "); p != std::string::npos) s.erase(0, p + 2);
+  return s;
+}
+
+// A value that goes on one line: a scalar, an empty container or an array of scalars.
+bool is_flat(const ojson& j) {
+  return j.empty() || j.is_primitive() ||
+         (j.is_array() && std::all_of(j.begin(), j.end(), [](const ojson& e) { return e.is_primitive(); }));
+}
+
+// Like dump(2), but a vector, or a row of a matrix, stays on one line: "position": [0.0, 0.5, 0.0].
+void print(const ojson& j, std::string& out, int depth = 0) {
+  const bool object = j.is_object();
+  if (is_flat(j)) {
+    if (!j.is_array()) return void(out += j.dump());
+    out += "[";
+    for (std::size_t i = 0; i < j.size(); ++i) out += (i ? ", " : "") + j[i].dump();
+    return void(out += "]");
+  }
+  const std::string indent(2 * depth + 2, ' ');
+  out += object ? "{\n" : "[\n";
+  std::size_t i = 0;
+  for (const auto& item : j.items()) {
+    out += (i++ ? ",\n" : "") + indent;
+    if (object) out += ojson(item.key()).dump() + ": ";
+    print(item.value(), out, depth + 1);
+  }
+  out += "\n" + std::string(2 * depth, ' ') + (object ? "}" : "]");
+}
+
+struct Closer {
+  void operator()(std::FILE* f) const { std::fclose(f); }
+};
+using File = std::unique_ptr<std::FILE, Closer>;
+
+std::string error_text(int err) { return std::generic_category().message(err); }
+
+// Flushes f's data to the storage device.
+bool sync(std::FILE* f) {
+  if (std::fflush(f) != 0) return false;
+#ifdef _WIN32
+  return _commit(_fileno(f)) == 0;
+#else
+  return fsync(fileno(f)) == 0;
+#endif
+}
+
+}  // namespace
+
+ModelSpec parse_model_spec(const nlohmann::json& j, const std::string& file_label) {
+  return read_struct<ModelSpec>(Node(j, "", file_label));
+}
+
+ModelSpec parse_model_spec_text(const std::string& text, const std::string& file_label) {
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const json::parse_error& e) {
+    throw ModelError(file_label, "", "invalid JSON at " + location(text, e.byte) + ": " + reason(e));
+  } catch (const json::exception& e) {
+    throw ModelError(file_label, "", "invalid JSON: " + reason(e));
+  }
+  return parse_model_spec(j, file_label);
+}
+
+ModelSpec load_model_spec(const std::string& path) {
+  File f(std::fopen(path.c_str(), "rb"));
+  if (!f) throw ModelError(path, "", "cannot open file: " + error_text(errno));
+  std::string text;
+  char buffer[1 << 16];
+  while (const std::size_t n = std::fread(buffer, 1, sizeof buffer, f.get())) text.append(buffer, n);
+  if (std::ferror(f.get())) throw ModelError(path, "", "cannot read file: " + error_text(errno));
+  return parse_model_spec_text(text, path);
+}
+
+nlohmann::json to_json(const ModelSpec& spec) { return nlohmann::json(write_struct(spec)); }
+
+void save_model_spec(const ModelSpec& spec, const std::string& path) {
+  const auto fail = [&](const std::string& why) {
+    throw std::runtime_error("cannot save model file \"" + path + "\": " + why);
+  };
+  std::string text;
+  try {
+    print(write_struct(spec), text);
+    text += "\n";
+  } catch (const ojson::exception& e) {  // e.g. a name that is not valid UTF-8
+    fail(e.what());
+  }
+
+  // "x": fail rather than reuse an existing file; retry on the unlikely name clash.
+  std::string tmp;
+  File f;
+  std::mt19937_64 random(std::random_device{}());
+  for (int attempt = 0; !f && attempt < 20; ++attempt) {
+    tmp = path + ".tmp-" + std::to_string(random() % 1000000);
+    f.reset(std::fopen(tmp.c_str(), "wbx"));
+    if (!f && errno != EEXIST) fail(error_text(errno));
+  }
+  if (!f) fail("cannot create a temporary file next to it");
+
+  bool ok = std::fwrite(text.data(), 1, text.size(), f.get()) == text.size() && sync(f.get());
+  int err = errno;
+  if (std::fclose(f.release()) != 0 && ok) ok = false, err = errno;
+  std::error_code ec;
+  if (ok) std::filesystem::rename(tmp, path, ec);
+  if (!ok || ec) {
+    std::remove(tmp.c_str());
+    fail(ok ? ec.message() : error_text(err));
+  }
+}
+
+}  // namespace codyna

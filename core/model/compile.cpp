@@ -1,0 +1,582 @@
+#include "model/compile.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "dynamics/assembly.hpp"
+#include "dynamics/crba.hpp"
+#include "dynamics/constraints.hpp"
+#include "dynamics/joint.hpp"
+#include "dynamics/kinematics.hpp"
+#include "model/data.hpp"
+
+namespace codyna {
+
+namespace {
+
+std::string quoted(const std::string& s) { return "\"" + s + "\""; }
+
+std::string fmt(double x) {
+  std::ostringstream os;
+  os.precision(6);
+  os << x;
+  return os.str();
+}
+
+std::string join_names(const std::vector<std::string>& names) {
+  std::string s;
+  for (std::size_t i = 0; i < names.size() && i < 12; ++i) s += (i ? ", " : "") + names[i];
+  if (names.size() > 12) s += ", ...";
+  return s.empty() ? "(none)" : s;
+}
+
+Eigen::Vector3d perpendicular(const Eigen::Vector3d& a) {
+  const Eigen::Vector3d t = std::abs(a.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  return a.cross(t).normalized();
+}
+
+bool is_angular(JointType t, int dof) {
+  switch (t) {
+    case JointType::Revolute: case JointType::Spherical: case JointType::Universal: return true;
+    case JointType::Cylindrical: return dof == 0;
+    case JointType::Planar: return dof == 2;
+    case JointType::Free: return dof < 3;
+    default: return false;
+  }
+}
+
+bool has_scalar_positions(JointType t) { return t != JointType::Spherical && t != JointType::Free; }
+
+class Compiler {
+ public:
+  Compiler(const ModelSpec& spec, std::string file) : spec_(spec), file_(std::move(file)) {}
+
+  Model run() {
+    m_.name = spec_.name;
+    m_.spec = spec_;
+    m_.source_file = file_;
+    if (spec_.name.empty()) fail("/name", "expected a non-empty model name");
+    check_names();
+    check_bodies();
+    build_tree();
+    build_constraints();
+    build_effects();
+    build_actuators();
+    build_sensors();
+    build_plant();
+    check_solver();
+    initial_state();
+    check_mass_matrix();
+    return std::move(m_);
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& path, const std::string& what) const { throw ModelError(file_, path, what); }
+
+  static std::string at(const char* list, std::size_t i) { return "/" + std::string(list) + "/" + std::to_string(i); }
+
+  template <class T>
+  void unique_names(const std::vector<T>& items, const char* list, const char* what) {
+    std::map<std::string, std::size_t> seen;
+    for (std::size_t i = 0; i < items.size(); ++i) {
+      const std::string& n = items[i].name;
+      if (n.empty()) fail(at(list, i) + "/name", std::string("expected a non-empty ") + what + " name");
+      auto [it, fresh] = seen.emplace(n, i);
+      if (!fresh) fail(at(list, i) + "/name", std::string("duplicate ") + what + " name " + quoted(n) + " (also " + at(list, it->second) + ")");
+    }
+  }
+
+  void check_names() {
+    unique_names(spec_.bodies, "bodies", "body");
+    unique_names(spec_.joints, "joints", "joint");
+    unique_names(spec_.constraints, "constraints", "constraint");
+    unique_names(spec_.effects, "effects", "effect");
+    unique_names(spec_.actuators, "actuators", "actuator");
+    unique_names(spec_.sensors, "sensors", "sensor");
+    for (std::size_t i = 0; i < spec_.bodies.size(); ++i)
+      if (spec_.bodies[i].name == kGroundName) fail(at("bodies", i) + "/name", "\"ground\" is reserved for the fixed world body");
+  }
+
+  void check_bodies() {
+    for (std::size_t i = 0; i < spec_.bodies.size(); ++i) {
+      const BodySpec& b = spec_.bodies[i];
+      const std::string p = at("bodies", i);
+      if (!std::isfinite(b.mass) || b.mass < 0) fail(p + "/mass", "expected a non-negative mass in kg, got " + fmt(b.mass));
+      if (!b.com.allFinite()) fail(p + "/com", "expected finite coordinates");
+      const Eigen::Matrix3d& I = b.inertia;
+      if (!I.allFinite()) fail(p + "/inertia", "expected finite entries");
+      if ((I - I.transpose()).norm() > 1e-9 * std::max(1.0, I.norm())) fail(p + "/inertia", "expected a symmetric inertia matrix");
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(I);
+      const Eigen::Vector3d ev = es.eigenvalues();  // ascending
+      const double scale = std::max(ev.cwiseAbs().maxCoeff(), 1e-300);
+      if (b.mass > 0 && !(ev[0] > 1e-12 * scale))
+        fail(p + "/inertia", "expected a positive definite inertia matrix for a body with mass, got principal moments " +
+                                 fmt(ev[0]) + ", " + fmt(ev[1]) + ", " + fmt(ev[2]));
+      if (b.mass == 0 && ev[0] < -1e-12 * scale) fail(p + "/inertia", "expected a positive semi-definite inertia matrix");
+      if (ev[0] + ev[1] < ev[2] * (1 - 1e-9))
+        fail(p + "/inertia", "principal moments " + fmt(ev[0]) + ", " + fmt(ev[1]) + ", " + fmt(ev[2]) +
+                                 " violate the triangle inequality (I1 + I2 >= I3): no rigid body has them");
+      body_index_spec_[b.name] = static_cast<int>(i);
+    }
+  }
+
+  // body name -> compiled index (after build_tree); ground -> 0
+  int body(const std::string& name, const std::string& path, bool allow_ground = true) const {
+    if (name == kGroundName) {
+      if (!allow_ground) fail(path, "expected a moving body, got \"ground\"");
+      return 0;
+    }
+    auto it = compiled_.find(name);
+    if (it == compiled_.end()) {
+      std::vector<std::string> names{kGroundName};
+      for (const auto& b : spec_.bodies) names.push_back(b.name);
+      fail(path, "unknown body " + quoted(name) + " (bodies: " + join_names(names) + ")");
+    }
+    return it->second;
+  }
+
+  // joint name -> compiled body index of the joint
+  int joint(const std::string& name, const std::string& path) const {
+    const int j = m_.find_joint(name);
+    if (j < 0) {
+      std::vector<std::string> names;
+      for (const auto& s : spec_.joints) names.push_back(s.name);
+      fail(path, "unknown joint " + quoted(name) + " (joints: " + join_names(names) + ")");
+    }
+    return j;
+  }
+
+  void check_dof(int jb, int dof, const std::string& path) const {
+    const JointModel& j = m_.joints[jb];
+    if (dof < 0 || dof >= j.nv)
+      fail(path, "expected a coordinate index from 0 to " + std::to_string(j.nv - 1) + " of " + to_string(j.type) +
+                     " joint " + quoted(j.name) + ", got " + std::to_string(dof));
+  }
+
+  static Eigen::Vector3d unit(const Eigen::Vector3d& a, const std::string& path, const Compiler& c) {
+    if (!a.allFinite() || a.norm() < 1e-12) c.fail(path, "expected a non-zero direction");
+    return a.normalized();
+  }
+
+  void build_tree() {
+    const auto& joints = spec_.joints;
+    std::map<std::string, std::size_t> child_of;  // body -> joint spec index
+    for (std::size_t k = 0; k < joints.size(); ++k) {
+      const JointSpec& j = joints[k];
+      const std::string p = at("joints", k);
+      if (j.parent != kGroundName && !body_index_spec_.count(j.parent)) {
+        std::vector<std::string> names{kGroundName};
+        for (const auto& b : spec_.bodies) names.push_back(b.name);
+        fail(p + "/parent", "unknown body " + quoted(j.parent) + " (bodies: " + join_names(names) + ")");
+      }
+      if (j.child == kGroundName) fail(p + "/child", "the ground cannot be a joint's child");
+      if (!body_index_spec_.count(j.child)) fail(p + "/child", "unknown body " + quoted(j.child));
+      if (j.child == j.parent) fail(p + "/child", "a joint cannot connect body " + quoted(j.child) + " to itself");
+      auto [it, fresh] = child_of.emplace(j.child, k);
+      if (!fresh)
+        fail(p + "/child", "body " + quoted(j.child) + " is already moved by joint " + quoted(joints[it->second].name) +
+                               "; close kinematic loops with a constraint");
+      if (j.q0.size() != 0 && j.q0.size() != joint_nq(j.type))
+        fail(p + "/q0", "expected " + std::to_string(joint_nq(j.type)) + " values for a " + to_string(j.type) + " joint, got " + std::to_string(j.q0.size()));
+      if (j.v0.size() != 0 && j.v0.size() != joint_nv(j.type))
+        fail(p + "/v0", "expected " + std::to_string(joint_nv(j.type)) + " values for a " + to_string(j.type) + " joint, got " + std::to_string(j.v0.size()));
+      if ((j.q0.size() && !j.q0.allFinite()) || (j.v0.size() && !j.v0.allFinite())) fail(p, "expected finite q0 and v0");
+    }
+    for (std::size_t i = 0; i < spec_.bodies.size(); ++i)
+      if (!child_of.count(spec_.bodies[i].name))
+        fail(at("bodies", i), "body " + quoted(spec_.bodies[i].name) + " is not the child of any joint (attach it, e.g. with a \"fixed\" joint)");
+
+    // stable topological order: a joint is placed once its parent is placed
+    std::vector<std::size_t> order;
+    std::set<std::string> placed{kGroundName};
+    std::vector<bool> done(joints.size(), false);
+    for (bool progress = true; progress;) {
+      progress = false;
+      for (std::size_t k = 0; k < joints.size(); ++k)
+        if (!done[k] && placed.count(joints[k].parent)) {
+          done[k] = progress = true;
+          placed.insert(joints[k].child);
+          order.push_back(k);
+        }
+    }
+    for (std::size_t k = 0; k < joints.size(); ++k)
+      if (!done[k]) {
+        // every body has one parent joint, so an unplaced joint lies on (or hangs from) a cycle
+        std::string chain = joints[k].child;
+        std::string b = joints[k].parent;
+        std::set<std::string> seen{joints[k].child};
+        while (!seen.count(b)) {
+          chain = b + " -> " + chain;
+          seen.insert(b);
+          b = joints[child_of.at(b)].parent;
+        }
+        chain = b + " -> " + chain;
+        fail(at("joints", k), "the joints form a cycle (" + chain + "); a tree must hang from \"ground\": cut one joint of the loop and close it with a constraint");
+      }
+
+    m_.nbodies = static_cast<int>(order.size()) + 1;
+    m_.body_names = {kGroundName};
+    m_.parent = {-1};
+    m_.joints.assign(1, JointModel{});
+    m_.mass = {0.0};
+    m_.com = {Eigen::Vector3d::Zero()};
+    m_.inertia = {Mat6T<double>::Zero()};
+    m_.body_spec_index = {-1};
+    compiled_[kGroundName] = 0;
+    int iq = 0, iv = 0;
+    for (std::size_t k : order) {
+      const JointSpec& js = joints[k];
+      const std::string p = at("joints", k);
+      const int bs = body_index_spec_.at(js.child);
+      const BodySpec& b = spec_.bodies[bs];
+      const int index = static_cast<int>(m_.body_names.size());
+      compiled_[b.name] = index;
+      JointModel j;
+      j.name = js.name;
+      j.type = js.type;
+      j.parent = compiled_.at(js.parent);
+      j.nq = joint_nq(js.type);
+      j.nv = joint_nv(js.type);
+      j.idx_q = iq;
+      j.idx_v = iv;
+      j.X_PF = SE3(js.parent_frame.rotation, js.parent_frame.position);
+      j.X_CM = SE3(js.child_frame.rotation, js.child_frame.position);
+      j.axis = unit(js.axis, p + "/axis", *this);
+      j.axis2 = unit(js.axis2, p + "/axis2", *this);
+      if (js.type == JointType::Universal && j.axis.cross(j.axis2).norm() < 1e-6)
+        fail(p + "/axis2", "expected a second axis not parallel to the first");
+      j.spec_index = static_cast<int>(k);
+      for (const FrameSpec* f : {&js.parent_frame, &js.child_frame}) {
+        const Eigen::Matrix3d& R = f->rotation;
+        if (!R.allFinite() || !f->position.allFinite() || (R.transpose() * R - Eigen::Matrix3d::Identity()).norm() > 1e-9 || R.determinant() < 0)
+          fail(p + (f == &js.parent_frame ? "/parent_frame" : "/child_frame"), "expected a finite position and a proper rotation");
+      }
+      add_coordinate_names(j);
+      iq += j.nq;
+      iv += j.nv;
+      m_.body_names.push_back(b.name);
+      m_.parent.push_back(j.parent);
+      m_.joints.push_back(j);
+      m_.mass.push_back(b.mass);
+      m_.com.push_back(b.com);
+      m_.inertia.push_back(spatial_inertia(b.mass, b.com, b.inertia));
+      m_.body_spec_index.push_back(bs);
+    }
+    m_.nq = iq;
+    m_.nv = iv;
+  }
+
+  void add_coordinate_names(const JointModel& j) {
+    std::vector<std::string> qs, vs;
+    switch (j.type) {
+      case JointType::Revolute: case JointType::Prismatic: qs = vs = {""}; break;
+      case JointType::Fixed: break;
+      case JointType::Spherical: qs = {"qw", "qx", "qy", "qz"}; vs = {"wx", "wy", "wz"}; break;
+      case JointType::Universal: qs = vs = {"1", "2"}; break;
+      case JointType::Cylindrical: qs = vs = {"angle", "slide"}; break;
+      case JointType::Planar: qs = vs = {"x", "y", "angle"}; break;
+      case JointType::Free: qs = {"x", "y", "z", "qw", "qx", "qy", "qz"}; vs = {"wx", "wy", "wz", "vx", "vy", "vz"}; break;
+    }
+    for (const auto& s : qs) m_.q_names.push_back(s.empty() ? j.name : j.name + "." + s);
+    for (std::size_t k = 0; k < vs.size(); ++k) {
+      m_.v_names.push_back(vs[k].empty() ? j.name : j.name + "." + vs[k]);
+      m_.v_units.push_back(is_angular(j.type, static_cast<int>(k)) ? "rad" : "m");
+    }
+  }
+
+  void build_constraints() {
+    int row = 0;
+    for (std::size_t k = 0; k < spec_.constraints.size(); ++k) {
+      const ConstraintSpec& cs = spec_.constraints[k];
+      const std::string p = at("constraints", k);
+      ConstraintModel c;
+      c.name = cs.name;
+      c.type = cs.type;
+      c.body_a = body(cs.body_a, p + "/body_a");
+      c.body_b = body(cs.body_b, p + "/body_b");
+      if (c.body_a == c.body_b) fail(p + "/body_b", "expected two different bodies");
+      if (!cs.point_a.allFinite()) fail(p + "/point_a", "expected finite coordinates");
+      if (!cs.point_b.allFinite()) fail(p + "/point_b", "expected finite coordinates");
+      c.point_a = cs.point_a;
+      c.point_b = cs.point_b;
+      c.axis_a = unit(cs.axis_a, p + "/axis_a", *this);
+      const Eigen::Vector3d axis_b = unit(cs.axis_b, p + "/axis_b", *this);
+      c.perp_a1 = perpendicular(c.axis_a);
+      c.perp_a2 = c.axis_a.cross(c.perp_a1);
+      c.perp_b1 = perpendicular(axis_b);
+      c.perp_b2 = axis_b.cross(c.perp_b1);
+      c.row = row;
+      std::vector<std::string> rows;
+      if (c.type == ConstraintType::PlanarRevolute) rows = {"u", "v"};
+      else rows = {"x", "y", "z"};
+      if (c.type == ConstraintType::Revolute) rows.insert(rows.end(), {"axis1", "axis2"});
+      c.nrows = static_cast<int>(rows.size());
+      for (const auto& r : rows) m_.row_names.push_back(c.name + "." + r);
+      row += c.nrows;
+      m_.constraints.push_back(c);
+    }
+    m_.nc = row;
+  }
+
+  void non_negative(double x, const std::string& path, const char* what) const {
+    if (!std::isfinite(x) || x < 0) fail(path, std::string("expected a non-negative ") + what + ", got " + fmt(x));
+  }
+
+  void build_effects() {
+    bool gravity_seen = false;
+    for (std::size_t k = 0; k < spec_.effects.size(); ++k) {
+      const EffectSpec& e = spec_.effects[k];
+      const std::string p = at("effects", k);
+      switch (e.type) {
+        case EffectType::Gravity:
+          if (gravity_seen) fail(p, "gravity is declared twice");
+          if (!e.g.allFinite()) fail(p + "/g", "expected finite components");
+          gravity_seen = true;
+          m_.has_gravity = true;
+          m_.gravity = e.g;
+          break;
+        case EffectType::SpringDamper: {
+          SpringDamperModel s;
+          s.name = e.name;
+          s.body_a = body(e.body_a, p + "/body_a");
+          s.body_b = body(e.body_b, p + "/body_b");
+          if (s.body_a == s.body_b) fail(p + "/body_b", "expected two different bodies");
+          s.point_a = e.point_a;
+          s.point_b = e.point_b;
+          non_negative(e.stiffness, p + "/stiffness", "stiffness");
+          non_negative(e.damping, p + "/damping", "damping");
+          non_negative(e.rest_length, p + "/rest_length", "rest length");
+          s.stiffness = e.stiffness;
+          s.damping = e.damping;
+          s.rest_length = e.rest_length;
+          m_.springs.push_back(s);
+          break;
+        }
+        case EffectType::JointSpringDamper:
+        case EffectType::JointFriction: {
+          const int jb = joint(e.joint, p + "/joint");
+          check_dof(jb, e.dof, p + "/dof");
+          const JointModel& j = m_.joints[jb];
+          JointSpringModel s;
+          s.name = e.name;
+          s.iv = j.idx_v + e.dof;
+          s.iq = j.idx_q + e.dof;
+          non_negative(e.damping, p + "/damping", "damping");
+          s.damping = e.damping;
+          if (e.type == EffectType::JointFriction) {
+            m_.joint_frictions.push_back(s);
+            break;
+          }
+          if (!has_scalar_positions(j.type))
+            fail(p + "/joint", "a joint_spring_damper needs a joint with scalar coordinates; " + quoted(j.name) + " is " + to_string(j.type));
+          non_negative(e.stiffness, p + "/stiffness", "stiffness");
+          if (!std::isfinite(e.rest_position)) fail(p + "/rest_position", "expected a finite number");
+          s.stiffness = e.stiffness;
+          s.rest_position = e.rest_position;
+          m_.joint_springs.push_back(s);
+          break;
+        }
+        case EffectType::BodyForce: {
+          BodyForceModel b;
+          b.name = e.name;
+          b.body = body(e.body_a, p + "/body", false);
+          if (!e.force.allFinite()) fail(p + "/force", "expected finite components");
+          if (!e.torque.allFinite()) fail(p + "/torque", "expected finite components");
+          b.point = e.point_a;
+          b.force = e.force;
+          b.torque = e.torque;
+          b.in_world = e.in_world;
+          m_.body_forces.push_back(b);
+          break;
+        }
+      }
+    }
+  }
+
+  void build_actuators() {
+    for (std::size_t k = 0; k < spec_.actuators.size(); ++k) {
+      const ActuatorSpec& s = spec_.actuators[k];
+      const std::string p = at("actuators", k);
+      ActuatorModel a;
+      a.name = s.name;
+      a.type = s.type;
+      if (s.type == ActuatorType::JointForce) {
+        const int jb = joint(s.joint, p + "/joint");
+        check_dof(jb, s.dof, p + "/dof");
+        a.iv = m_.joints[jb].idx_v + s.dof;
+        a.unit = is_angular(m_.joints[jb].type, s.dof) ? "N m" : "N";
+      } else {
+        a.body = body(s.body, p + "/body", false);
+        a.point = s.point;
+        a.direction = unit(s.direction, p + "/direction", *this);
+        a.in_world = s.in_world;
+        a.unit = "N";
+      }
+      if (!std::isfinite(s.gain)) fail(p + "/gain", "expected a finite number");
+      if (!std::isfinite(s.u0)) fail(p + "/u0", "expected a finite number");
+      a.gain = s.gain;
+      a.u0 = s.u0;
+      if (s.min) a.min = *s.min;
+      if (s.max) a.max = *s.max;
+      if (a.min > a.max) fail(p + "/min", "expected min <= max");
+      if (!s.unit.empty()) a.unit = s.unit;
+      m_.actuators.push_back(a);
+    }
+  }
+
+  void build_sensors() {
+    for (std::size_t k = 0; k < spec_.sensors.size(); ++k) {
+      const SensorSpec& s = spec_.sensors[k];
+      const std::string p = at("sensors", k);
+      SensorModel o;
+      o.name = s.name;
+      o.type = s.type;
+      switch (s.type) {
+        case SensorType::JointPosition:
+        case SensorType::JointVelocity: {
+          const int jb = joint(s.joint, p + "/joint");
+          check_dof(jb, s.dof, p + "/dof");
+          const JointModel& j = m_.joints[jb];
+          if (s.type == SensorType::JointPosition && !has_scalar_positions(j.type))
+            fail(p + "/joint", "joint_position needs a joint with scalar coordinates; " + quoted(j.name) + " is " + to_string(j.type) + " (use body_angle)");
+          o.iq = j.idx_q + s.dof;
+          o.iv = j.idx_v + s.dof;
+          const bool ang = is_angular(j.type, s.dof);
+          o.unit = s.type == SensorType::JointPosition ? (ang ? "rad" : "m") : (ang ? "rad/s" : "m/s");
+          break;
+        }
+        case SensorType::PointPosition:
+        case SensorType::PointVelocity:
+          o.body = body(s.body, p + "/body");
+          o.frame = body(s.frame, p + "/frame");
+          if (s.component < 0 || s.component > 2) fail(p + "/component", "expected x, y or z (0, 1 or 2)");
+          o.point = s.point;
+          o.component = s.component;
+          o.unit = s.type == SensorType::PointPosition ? "m" : "m/s";
+          break;
+        case SensorType::BodyAngle:
+          o.body = body(s.body, p + "/body", false);
+          o.axis = unit(s.axis, p + "/axis", *this);
+          o.perp1 = perpendicular(o.axis);
+          o.perp2 = o.axis.cross(o.perp1);
+          o.unit = "rad";
+          break;
+        case SensorType::Distance:
+          o.body_a = body(s.body_a, p + "/body_a");
+          o.body_b = body(s.body_b, p + "/body_b");
+          o.point_a = s.point_a;
+          o.point_b = s.point_b;
+          o.unit = "m";
+          break;
+      }
+      if (!s.unit.empty()) o.unit = s.unit;
+      m_.sensors.push_back(o);
+    }
+    // body_angle measures from the orientation at the zero configuration
+    Data d(m_);
+    forward_kinematics<double>(m_, d, neutral(m_));
+    for (SensorModel& o : m_.sensors)
+      if (o.type == SensorType::BodyAngle) o.R0 = d.oMi[o.body].R;
+  }
+
+  void build_plant() {
+    auto resolve = [&](const std::vector<std::string>& names, const char* list, bool inputs) {
+      std::vector<int> idx;
+      std::set<std::string> seen;
+      for (std::size_t k = 0; k < names.size(); ++k) {
+        const std::string p = "/plant/" + std::string(list) + "/" + std::to_string(k);
+        const int i = inputs ? m_.find_actuator(names[k]) : m_.find_sensor(names[k]);
+        if (i < 0) {
+          std::vector<std::string> all;
+          if (inputs) for (const auto& a : m_.actuators) all.push_back(a.name);
+          else for (const auto& s : m_.sensors) all.push_back(s.name);
+          fail(p, std::string("unknown ") + (inputs ? "actuator " : "sensor ") + quoted(names[k]) + " (" +
+                      (inputs ? "actuators: " : "sensors: ") + join_names(all) + ")");
+        }
+        if (!seen.insert(names[k]).second) fail(p, quoted(names[k]) + " is listed twice");
+        idx.push_back(i);
+      }
+      return idx;
+    };
+    m_.plant_inputs = resolve(spec_.plant.inputs, "inputs", true);
+    m_.plant_outputs = resolve(spec_.plant.outputs, "outputs", false);
+  }
+
+  void check_solver() {
+    const SolverSpec& s = spec_.solver;
+    static const std::set<std::string> integrators{"ida", "cvode-bdf", "cvode-adams", "arkode", "rk4"};
+    if (!integrators.count(s.integrator)) fail("/solver/integrator", "unknown integrator " + quoted(s.integrator) + " (expected one of: ida, cvode-bdf, cvode-adams, arkode, rk4)");
+    auto positive = [&](double x, const char* f) {
+      if (!std::isfinite(x) || x <= 0) fail(std::string("/solver/") + f, "expected a positive number, got " + fmt(x));
+    };
+    positive(s.rtol, "rtol");
+    positive(s.atol, "atol");
+    positive(s.t_end, "t_end");
+    positive(s.output_step, "output_step");
+    if (!std::isfinite(s.max_step) || s.max_step < 0) fail("/solver/max_step", "expected a non-negative number (0 = no limit)");
+  }
+
+  void initial_state() {
+    Eigen::VectorXd q = neutral(m_), v = Eigen::VectorXd::Zero(m_.nv);
+    for (int i = 1; i < m_.nbodies; ++i) {
+      const JointModel& j = m_.joints[i];
+      const JointSpec& js = spec_.joints[j.spec_index];
+      if (js.q0.size()) q.segment(j.idx_q, j.nq) = js.q0;
+      if (js.v0.size()) v.segment(j.idx_v, j.nv) = js.v0;
+    }
+    for (int i = 1; i < m_.nbodies; ++i) {
+      const JointModel& j = m_.joints[i];
+      const int qi = j.type == JointType::Spherical ? j.idx_q : j.type == JointType::Free ? j.idx_q + 3 : -1;
+      if (qi >= 0 && q.segment<4>(qi).norm() < 1e-12) fail(at("joints", j.spec_index) + "/q0", "expected a non-zero quaternion");
+    }
+    m_.q0 = q;
+    m_.v0 = v;
+    if (m_.nc == 0) return;
+    const AssemblyResult r = assemble(m_, q, v);
+    if (r.position_residual > 1e-9) {
+      int k = 0;
+      while (k + 1 < static_cast<int>(m_.constraints.size()) && m_.constraints[k + 1].row <= r.worst_row) ++k;
+      fail(at("constraints", k), "the loop cannot be assembled from the joints' q0: residual " + fmt(r.position_residual) +
+                                     " on " + m_.row_names[r.worst_row] + " after " + std::to_string(r.iterations) +
+                                     " iterations (check the constraint points and the joints' q0)");
+    }
+    m_.q0 = r.q;
+    m_.v0 = r.v;
+    m_.assembly_residual = std::max(r.position_residual, r.velocity_residual);
+    Data d(m_);
+    constraint_terms<double>(m_, d, m_.q0, m_.v0);
+    const RowPartition rows = partition_rows(d.Jc);
+    m_.active_rows = rows.independent;
+    m_.redundant_rows = rows.redundant;
+  }
+
+  void check_mass_matrix() {
+    if (m_.nv == 0) return;
+    Data d(m_);
+    const Eigen::MatrixXd M = crba<double>(m_, d, m_.q0);
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(M);
+    const double top = std::max(es.eigenvalues().maxCoeff(), 1e-300);
+    if (es.eigenvalues()[0] > 1e-12 * top) return;
+    Eigen::Index k;
+    es.eigenvectors().col(0).cwiseAbs().maxCoeff(&k);
+    fail("/bodies", "the mass matrix is singular at the initial state: coordinate " + quoted(m_.v_names[k]) +
+                        " moves no mass or inertia (give the bodies it moves mass and inertia)");
+  }
+
+  const ModelSpec& spec_;
+  std::string file_;
+  Model m_;
+  std::map<std::string, int> body_index_spec_;
+  std::map<std::string, int> compiled_;
+};
+
+}  // namespace
+
+Model compile(const ModelSpec& spec, const std::string& file) { return Compiler(spec, file).run(); }
+
+}  // namespace codyna

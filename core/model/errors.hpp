@@ -1,0 +1,34 @@
+// ModelError: what a bad model (file or spec) reports. It names the file (when
+// there is one), the path of the offending field in JSON-pointer-like form
+// ("/joints/2/parent"), and what was expected.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+namespace codyna {
+
+class ModelError : public std::runtime_error {
+ public:
+  ModelError(std::string file, std::string path, std::string what_expected)
+      : std::runtime_error(compose(file, path, what_expected)),
+        file_(std::move(file)), path_(std::move(path)), detail_(std::move(what_expected)) {}
+
+  const std::string& file() const { return file_; }
+  const std::string& path() const { return path_; }
+  const std::string& detail() const { return detail_; }
+
+  // The same error, attributed to a file (used when a spec error surfaces while loading a file).
+  ModelError in_file(const std::string& f) const { return ModelError(f, path_, detail_); }
+
+ private:
+  static std::string compose(const std::string& file, const std::string& path, const std::string& d) {
+    std::string s;
+    if (!file.empty()) s += file + ": ";
+    if (!path.empty()) s += path + ": ";
+    return s + d;
+  }
+  std::string file_, path_, detail_;
+};
+
+}  // namespace codyna

@@ -1,0 +1,33 @@
+#include "model/model.hpp"
+
+namespace codyna {
+
+namespace {
+template <class T>
+int find_named(const std::vector<T>& items, const std::string& name) {
+  for (std::size_t i = 0; i < items.size(); ++i)
+    if (items[i].name == name) return static_cast<int>(i);
+  return -1;
+}
+}  // namespace
+
+Eigen::VectorXd Model::u_nominal() const {
+  Eigen::VectorXd u(nu());
+  for (int k = 0; k < nu(); ++k) u[k] = actuators[k].u0;
+  return u;
+}
+
+int Model::find_body(const std::string& n) const {
+  for (int i = 0; i < nbodies; ++i)
+    if (body_names[i] == n) return i;
+  return -1;
+}
+int Model::find_actuator(const std::string& n) const { return find_named(actuators, n); }
+int Model::find_sensor(const std::string& n) const { return find_named(sensors, n); }
+int Model::find_joint(const std::string& n) const {
+  for (int i = 1; i < nbodies; ++i)
+    if (joints[i].name == n) return i;
+  return -1;
+}
+
+}  // namespace codyna

@@ -1,0 +1,142 @@
+// Model: the immutable, index-based form of a ModelSpec, made by compile().
+// Body 0 is the ground; body i >= 1 is moved by joint i relative to its
+// parent body parent[i] < i (topological order). Algorithms read a Model
+// and write into a Data (model/data.hpp); they never change a Model.
+#pragma once
+
+#include <Eigen/Core>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "model/model_spec.hpp"
+#include "spatial/spatial.hpp"
+
+namespace codyna {
+
+struct JointModel {
+  std::string name;
+  JointType type = JointType::Fixed;
+  int parent = -1;                 // parent body
+  int idx_q = 0, idx_v = 0;        // first coordinate in q and in v
+  int nq = 0, nv = 0;
+  SE3 X_PF;                        // joint frame F in parent body coordinates
+  SE3 X_CM;                        // joint frame M in child body coordinates
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();   // unit, joint frame
+  Eigen::Vector3d axis2 = Eigen::Vector3d::UnitY();  // unit, joint frame (universal)
+  int spec_index = -1;             // position in ModelSpec::joints (for messages)
+};
+
+struct ConstraintModel {
+  std::string name;
+  ConstraintType type = ConstraintType::Ball;
+  int body_a = 0, body_b = 0;
+  Eigen::Vector3d point_a = Eigen::Vector3d::Zero(), point_b = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis_a = Eigen::Vector3d::UnitZ();           // unit, body_a
+  Eigen::Vector3d perp_a1 = Eigen::Vector3d::UnitX(), perp_a2 = Eigen::Vector3d::UnitY();  // unit, body_a, perpendicular to axis_a
+  Eigen::Vector3d perp_b1 = Eigen::Vector3d::UnitX(), perp_b2 = Eigen::Vector3d::UnitY();  // unit, body_b, perpendicular to axis_b
+  int row = 0, nrows = 0;          // rows in the stacked constraint vector
+};
+
+struct SpringDamperModel {
+  std::string name;
+  int body_a = 0, body_b = 0;
+  Eigen::Vector3d point_a = Eigen::Vector3d::Zero(), point_b = Eigen::Vector3d::Zero();
+  double stiffness = 0, damping = 0, rest_length = 0;
+};
+
+struct JointSpringModel {
+  std::string name;
+  int iq = 0, iv = 0;             // the coordinate it acts on
+  double stiffness = 0, damping = 0, rest_position = 0;
+};
+
+struct BodyForceModel {
+  std::string name;
+  int body = 0;
+  Eigen::Vector3d point = Eigen::Vector3d::Zero(), force = Eigen::Vector3d::Zero(), torque = Eigen::Vector3d::Zero();
+  bool in_world = true;
+};
+
+struct ActuatorModel {
+  std::string name;
+  ActuatorType type = ActuatorType::JointForce;
+  int iv = 0;                      // joint_force: velocity index it drives
+  int body = 0;                    // body_force
+  Eigen::Vector3d point = Eigen::Vector3d::Zero(), direction = Eigen::Vector3d::UnitX();  // direction unit
+  bool in_world = true;
+  double gain = 1.0, u0 = 0.0;
+  double min = -std::numeric_limits<double>::infinity(), max = std::numeric_limits<double>::infinity();
+  std::string unit;
+};
+
+struct SensorModel {
+  std::string name;
+  SensorType type = SensorType::JointPosition;
+  int iq = 0, iv = 0;              // joint sensors
+  int body = 0;                    // point sensors, body_angle
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  int component = 0;
+  int frame = 0;                   // body whose axes express point sensors (0 = ground)
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ(), perp1 = Eigen::Vector3d::UnitX(), perp2 = Eigen::Vector3d::UnitY();
+  Eigen::Matrix3d R0 = Eigen::Matrix3d::Identity();  // body_angle: body orientation at zero configuration
+  int body_a = 0, body_b = 0;
+  Eigen::Vector3d point_a = Eigen::Vector3d::Zero(), point_b = Eigen::Vector3d::Zero();
+  std::string unit;
+};
+
+struct Model {
+  std::string name;
+  int nq = 0;                      // configuration size
+  int nv = 0;                      // velocity (tangent) size = degrees of freedom of the tree
+  int nbodies = 1;                 // including ground
+
+  std::vector<std::string> body_names;   // [nbodies]
+  std::vector<int> parent;               // [nbodies], parent[0] = -1
+  std::vector<JointModel> joints;        // [nbodies], joints[0] unused (ground)
+  std::vector<double> mass;              // [nbodies]
+  std::vector<Eigen::Vector3d> com;      // [nbodies], body coordinates
+  std::vector<Mat6T<double>> inertia;    // [nbodies], spatial inertia in body coordinates
+  std::vector<int> body_spec_index;      // [nbodies], position in ModelSpec::bodies (-1 for ground)
+
+  std::vector<std::string> q_names;      // [nq]
+  std::vector<std::string> v_names;      // [nv]
+  std::vector<std::string> v_units;      // [nv] "rad" or "m"
+
+  // loop closures
+  std::vector<ConstraintModel> constraints;
+  int nc = 0;                            // stacked constraint rows
+  std::vector<std::string> row_names;    // [nc]
+  std::vector<int> active_rows;          // independent rows, used in dynamics
+  std::vector<int> redundant_rows;       // rows dependent on the others (named in row_names)
+
+  // effects: only these are evaluated
+  bool has_gravity = false;
+  Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
+  std::vector<SpringDamperModel> springs;
+  std::vector<JointSpringModel> joint_springs;
+  std::vector<JointSpringModel> joint_frictions;  // damping only
+  std::vector<BodyForceModel> body_forces;
+
+  std::vector<ActuatorModel> actuators;  // [nu_all]
+  std::vector<SensorModel> sensors;      // [ny_all]
+  std::vector<int> plant_inputs;         // indices into actuators
+  std::vector<int> plant_outputs;        // indices into sensors
+
+  Eigen::VectorXd q0, v0;                // assembled initial state
+  double assembly_residual = 0.0;        // max |phi(q0)|, |J v0| after assembly
+
+  ModelSpec spec;                        // the spec it was compiled from
+  std::string source_file;               // where the spec was read, if from a file
+
+  int nu() const { return static_cast<int>(actuators.size()); }
+  int ny() const { return static_cast<int>(sensors.size()); }
+  int dof() const { return nv - static_cast<int>(active_rows.size()); }
+  Eigen::VectorXd u_nominal() const;     // u0 of every actuator
+  int find_body(const std::string& name) const;  // -1 if absent
+  int find_actuator(const std::string& name) const;
+  int find_sensor(const std::string& name) const;
+  int find_joint(const std::string& name) const;  // body index of the joint, -1 if absent
+};
+
+}  // namespace codyna

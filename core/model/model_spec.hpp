@@ -1,0 +1,210 @@
+// ModelSpec: the editable, named description of a mechanism. This is what a
+// model file holds (io/model_file.hpp reads and writes it as JSON) and what
+// the GUI edits. Nothing here is indexed or validated: compile() (model/compile.hpp)
+// checks a spec and turns it into an immutable Model.
+//
+// Conventions: SI units; vectors in the frame named beside them; rotations
+// as 3x3 matrices (the file format also accepts axis-angle and quaternions);
+// the ground body is named "ground" and is implicit.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace codyna {
+
+inline constexpr const char* kGroundName = "ground";
+
+// A frame given relative to a body frame: x_body = rotation * x_frame + position.
+struct FrameSpec {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+};
+
+enum class ShapeType { Box, Cylinder, Sphere };
+
+struct ShapeSpec {
+  ShapeType type = ShapeType::Box;
+  Eigen::Vector3d size = Eigen::Vector3d::Ones();  // box: full edge lengths x, y, z
+  double radius = 0.05;                            // cylinder, sphere
+  double length = 1.0;                             // cylinder, along the shape frame's z
+  FrameSpec frame;                                 // shape frame in the body frame
+  Eigen::Vector4d color{0.7, 0.7, 0.75, 1.0};      // rgba in [0, 1]
+};
+
+struct BodySpec {
+  std::string name;
+  double mass = 0.0;                                   // kg
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();       // m, body frame
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();   // kg m^2, about the com, body axes
+  std::vector<ShapeSpec> shapes;
+};
+
+enum class JointType { Revolute, Prismatic, Fixed, Spherical, Universal, Cylindrical, Planar, Free };
+
+// A joint moves `child` relative to `parent`. The joint frame F is fixed on the
+// parent (parent_frame, in parent body coordinates), M on the child
+// (child_frame, in child body coordinates); at zero joint position F and M
+// coincide. Generalized coordinates by type (q | v):
+//   revolute     angle about axis (rad)           | rate
+//   prismatic    slide along axis (m)             | rate
+//   fixed        -                                | -
+//   spherical    quaternion (w, x, y, z) of M in F | angular velocity of M in M axes (3)
+//   universal    angle about axis, then about axis2 (2) | rates (2)
+//   cylindrical  angle about axis, slide along axis      | rates (2)
+//   planar       x, y in F, angle about F's z            | rates (3)
+//   free         position of M in F (3), quaternion (4)  | angular velocity, linear velocity of M's origin, both in M axes (6)
+struct JointSpec {
+  std::string name;
+  JointType type = JointType::Revolute;
+  std::string parent;   // body name or "ground"
+  std::string child;    // body name
+  FrameSpec parent_frame;
+  FrameSpec child_frame;
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();   // joint frame; revolute, prismatic, universal (first), cylindrical
+  Eigen::Vector3d axis2 = Eigen::Vector3d::UnitY();  // universal (second), in the joint frame at zero angle
+  Eigen::VectorXd q0;   // initial position (size nq of the type); empty = zero position
+  Eigen::VectorXd v0;   // initial velocity (size nv of the type); empty = zero
+};
+
+// Loop-closure constraints close kinematic loops that the joint tree leaves open.
+//   ball             point_a on body_a coincides with point_b on body_b (3 equations)
+//   revolute         ball + axis_a (on body_a) stays parallel to axis_b (on body_b) (5)
+//   planar_revolute  the two points coincide in the plane normal to axis_a (2);
+//                    for planar mechanisms, whose loops would be redundant in 3-D
+enum class ConstraintType { Ball, Revolute, PlanarRevolute };
+
+struct ConstraintSpec {
+  std::string name;
+  ConstraintType type = ConstraintType::Ball;
+  std::string body_a, body_b;  // body names or "ground"
+  Eigen::Vector3d point_a = Eigen::Vector3d::Zero();  // body_a frame
+  Eigen::Vector3d point_b = Eigen::Vector3d::Zero();  // body_b frame
+  Eigen::Vector3d axis_a = Eigen::Vector3d::UnitZ();  // body_a frame (revolute, planar_revolute)
+  Eigen::Vector3d axis_b = Eigen::Vector3d::UnitZ();  // body_b frame (revolute)
+};
+
+// Force elements. Only those listed in a model are ever evaluated.
+enum class EffectType {
+  Gravity,           // g (world)
+  SpringDamper,      // point-to-point: body_a/point_a to body_b/point_b; stiffness, damping, rest_length
+  JointSpringDamper, // on one joint coordinate: stiffness, damping, rest_position
+  JointFriction,     // viscous, on one joint coordinate: damping
+  BodyForce,         // constant force at a body point and constant torque; in world or body axes
+};
+
+struct EffectSpec {
+  std::string name;
+  EffectType type = EffectType::Gravity;
+  Eigen::Vector3d g{0.0, -9.81, 0.0};
+  std::string body_a, body_b;                         // spring_damper; body_a is the body of body_force
+  Eigen::Vector3d point_a = Eigen::Vector3d::Zero();
+  Eigen::Vector3d point_b = Eigen::Vector3d::Zero();
+  double stiffness = 0.0;                             // N/m or N m/rad
+  double damping = 0.0;                               // N s/m or N m s/rad
+  double rest_length = 0.0;                           // m (spring_damper)
+  std::string joint;                                  // joint effects
+  int dof = 0;                                        // which coordinate of that joint (velocity index)
+  double rest_position = 0.0;                         // joint_spring_damper
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();    // body_force, N
+  Eigen::Vector3d torque = Eigen::Vector3d::Zero();   // body_force, N m
+  bool in_world = true;                               // body_force: axes of force/torque ("world" or "body")
+};
+
+// Actuators are the candidate plant inputs: each takes one scalar u.
+enum class ActuatorType {
+  JointForce,  // generalized force/torque on one coordinate of a joint: tau = gain * u
+  BodyForce,   // force gain * u * direction at point of body; direction in world or body axes
+};
+
+struct ActuatorSpec {
+  std::string name;
+  ActuatorType type = ActuatorType::JointForce;
+  std::string joint;
+  int dof = 0;
+  std::string body;
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
+  bool in_world = true;
+  double gain = 1.0;
+  double u0 = 0.0;  // nominal value (used when the actuator is not driven)
+  std::optional<double> min, max;
+  std::string unit;  // shown with the input; default from the type
+};
+
+// Sensors are the candidate plant outputs: each gives one scalar y.
+enum class SensorType {
+  JointPosition,   // joint, dof (for ball/free joints: the tangent coordinate relative to q0 is not offered; use body_angle)
+  JointVelocity,   // joint, dof
+  PointPosition,   // body, point; component (0, 1, 2) in the axes of `frame` (a body name or "ground")
+  PointVelocity,   // same, velocity relative to ground, in the axes of `frame`
+  BodyAngle,       // rotation of body about `axis` (world axes), measured from its zero-configuration orientation
+  Distance,        // |p_b - p_a| between body_a/point_a and body_b/point_b
+};
+
+struct SensorSpec {
+  std::string name;
+  SensorType type = SensorType::JointPosition;
+  std::string joint;
+  int dof = 0;
+  std::string body;      // point sensors, body_angle
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  int component = 0;
+  std::string frame = kGroundName;
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+  std::string body_a, body_b;  // distance
+  Eigen::Vector3d point_a = Eigen::Vector3d::Zero();
+  Eigen::Vector3d point_b = Eigen::Vector3d::Zero();
+  std::string unit;
+};
+
+// The Plant/In and Plant/Out panels: names of actuators and sensors, in order.
+struct PlantSpec {
+  std::vector<std::string> inputs;
+  std::vector<std::string> outputs;
+};
+
+struct SolverSpec {
+  std::string integrator = "ida";
+  double rtol = 1e-8;
+  double atol = 1e-10;
+  double t_end = 5.0;
+  double output_step = 0.01;
+  double max_step = 0.0;  // 0 = no limit
+};
+
+struct ModelSpec {
+  std::string name = "model";
+  std::string description;
+  std::vector<BodySpec> bodies;
+  std::vector<JointSpec> joints;
+  std::vector<ConstraintSpec> constraints;
+  std::vector<EffectSpec> effects;
+  std::vector<ActuatorSpec> actuators;
+  std::vector<SensorSpec> sensors;
+  PlantSpec plant;
+  SolverSpec solver;
+};
+
+// Sizes of a joint type: configuration (nq) and velocity (nv).
+int joint_nq(JointType t);
+int joint_nv(JointType t);
+
+// Names as used in model files ("revolute", "ball", "spring_damper", ...), and back.
+const char* to_string(JointType t);
+const char* to_string(ConstraintType t);
+const char* to_string(EffectType t);
+const char* to_string(ActuatorType t);
+const char* to_string(SensorType t);
+const char* to_string(ShapeType t);
+std::optional<JointType> joint_type_from_string(const std::string& s);
+std::optional<ConstraintType> constraint_type_from_string(const std::string& s);
+std::optional<EffectType> effect_type_from_string(const std::string& s);
+std::optional<ActuatorType> actuator_type_from_string(const std::string& s);
+std::optional<SensorType> sensor_type_from_string(const std::string& s);
+std::optional<ShapeType> shape_type_from_string(const std::string& s);
+
+}  // namespace codyna

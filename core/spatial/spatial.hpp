@@ -1,0 +1,140 @@
+// Spatial algebra after Featherstone, in Pinocchio's body-frame flavour.
+// A spatial motion m = [w; v] (angular; linear velocity of the point at the
+// frame origin), a spatial force f = [n; f] (moment about the frame origin;
+// force). SE3 X_AB is the pose of frame B in frame A: p_A = R p_B + p.
+// Everything is templated on the scalar so that automatic differentiation
+// runs through the same code.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace codyna {
+
+template <class S> using Vec3T = Eigen::Matrix<S, 3, 1>;
+template <class S> using Mat3T = Eigen::Matrix<S, 3, 3>;
+template <class S> using Vec6T = Eigen::Matrix<S, 6, 1>;
+template <class S> using Mat6T = Eigen::Matrix<S, 6, 6>;
+template <class S> using Mat6xT = Eigen::Matrix<S, 6, Eigen::Dynamic, 0, 6, 6>;  // at most 6 columns, no heap
+template <class S> using VecXT = Eigen::Matrix<S, Eigen::Dynamic, 1>;
+template <class S> using MatXT = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>;
+
+template <class S>
+Mat3T<S> skew(const Vec3T<S>& w) {
+  Mat3T<S> m;
+  m << S(0), -w.z(), w.y(), w.z(), S(0), -w.x(), -w.y(), w.x(), S(0);
+  return m;
+}
+
+template <class S>
+struct SE3T {
+  Mat3T<S> R = Mat3T<S>::Identity();
+  Vec3T<S> p = Vec3T<S>::Zero();
+
+  SE3T() = default;
+  SE3T(const Mat3T<S>& R_, const Vec3T<S>& p_) : R(R_), p(p_) {}
+
+  SE3T operator*(const SE3T& o) const { return SE3T(R * o.R, R * o.p + p); }
+  SE3T inverse() const { return SE3T(R.transpose(), -(R.transpose() * p)); }
+  Vec3T<S> act_point(const Vec3T<S>& x) const { return R * x + p; }
+
+  // motion given in B coordinates -> A coordinates
+  Vec6T<S> act_motion(const Vec6T<S>& m) const {
+    Vec6T<S> r;
+    r.template head<3>() = R * m.template head<3>();
+    r.template tail<3>() = R * m.template tail<3>() + p.cross(Vec3T<S>(r.template head<3>()));
+    return r;
+  }
+  // motion given in A coordinates -> B coordinates
+  Vec6T<S> inv_act_motion(const Vec6T<S>& m) const {
+    Vec6T<S> r;
+    r.template head<3>() = R.transpose() * m.template head<3>();
+    r.template tail<3>() = R.transpose() * (m.template tail<3>() - p.cross(Vec3T<S>(m.template head<3>())));
+    return r;
+  }
+  // force given in B coordinates -> A coordinates
+  Vec6T<S> act_force(const Vec6T<S>& f) const {
+    Vec6T<S> r;
+    r.template tail<3>() = R * f.template tail<3>();
+    r.template head<3>() = R * f.template head<3>() + p.cross(Vec3T<S>(r.template tail<3>()));
+    return r;
+  }
+  // force given in A coordinates -> B coordinates
+  Vec6T<S> inv_act_force(const Vec6T<S>& f) const {
+    Vec6T<S> r;
+    r.template tail<3>() = R.transpose() * f.template tail<3>();
+    r.template head<3>() = R.transpose() * (f.template head<3>() - p.cross(Vec3T<S>(f.template tail<3>())));
+    return r;
+  }
+  // 6x6 motion transform (B coordinates -> A coordinates), for Jacobian columns and inertias
+  Mat6T<S> motion_matrix() const {
+    Mat6T<S> X = Mat6T<S>::Zero();
+    X.template topLeftCorner<3, 3>() = R;
+    X.template bottomRightCorner<3, 3>() = R;
+    X.template bottomLeftCorner<3, 3>() = skew<S>(p) * R;
+    return X;
+  }
+
+  template <class T>
+  SE3T<T> cast() const { return SE3T<T>(R.template cast<T>(), p.template cast<T>()); }
+};
+
+using SE3 = SE3T<double>;
+
+// m1 x m2 (motion cross motion)
+template <class S>
+Vec6T<S> cross_motion(const Vec6T<S>& m1, const Vec6T<S>& m2) {
+  const Vec3T<S> w = m1.template head<3>(), v = m1.template tail<3>();
+  const Vec3T<S> w2 = m2.template head<3>(), v2 = m2.template tail<3>();
+  Vec6T<S> r;
+  r.template head<3>() = w.cross(w2);
+  r.template tail<3>() = w.cross(v2) + v.cross(w2);
+  return r;
+}
+
+// m x* f (motion cross force)
+template <class S>
+Vec6T<S> cross_force(const Vec6T<S>& m, const Vec6T<S>& f) {
+  const Vec3T<S> w = m.template head<3>(), v = m.template tail<3>();
+  const Vec3T<S> n = f.template head<3>(), fl = f.template tail<3>();
+  Vec6T<S> r;
+  r.template head<3>() = w.cross(n) + v.cross(fl);
+  r.template tail<3>() = w.cross(fl);
+  return r;
+}
+
+// 6x6 spatial inertia (body frame) of mass m, com c, rotational inertia Ic about the com.
+inline Mat6T<double> spatial_inertia(double m, const Eigen::Vector3d& c, const Eigen::Matrix3d& Ic) {
+  Mat6T<double> I;
+  const Eigen::Matrix3d cx = skew<double>(c);
+  I.topLeftCorner<3, 3>() = Ic + m * cx * cx.transpose();
+  I.topRightCorner<3, 3>() = m * cx;
+  I.bottomLeftCorner<3, 3>() = m * cx.transpose();
+  I.bottomRightCorner<3, 3>() = m * Eigen::Matrix3d::Identity();
+  return I;
+}
+
+// Rotation by angle about a unit axis, for any scalar.
+template <class S>
+Mat3T<S> axis_angle(const Eigen::Vector3d& axis, const S& angle) {
+  using std::cos;
+  using std::sin;
+  const S c = cos(angle), s = sin(angle);
+  const Mat3T<S> K = skew<S>(axis.template cast<S>());
+  return Mat3T<S>::Identity() + s * K + (S(1) - c) * (K * K);
+}
+
+// Rotation matrix of a quaternion stored (w, x, y, z); normalized inside.
+template <class S>
+Mat3T<S> quat_to_matrix(const S& w0, const S& x0, const S& y0, const S& z0) {
+  using std::sqrt;
+  const S n = sqrt(w0 * w0 + x0 * x0 + y0 * y0 + z0 * z0);
+  const S w = w0 / n, x = x0 / n, y = y0 / n, z = z0 / n;
+  Mat3T<S> R;
+  R << S(1) - S(2) * (y * y + z * z), S(2) * (x * y - z * w), S(2) * (x * z + y * w),
+       S(2) * (x * y + z * w), S(1) - S(2) * (x * x + z * z), S(2) * (y * z - x * w),
+       S(2) * (x * z - y * w), S(2) * (y * z + x * w), S(1) - S(2) * (x * x + y * y);
+  return R;
+}
+
+}  // namespace codyna

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Installs, from Debian packages, whatever codyna needs and the machine lacks.
+# Runs as root (or through sudo when not root). Safe to run again: it only
+# calls apt-get when a package is missing.
+set -euo pipefail
+
+PKGS=(
+  build-essential cmake pkg-config
+  libeigen3-dev libsundials-dev libhdf5-dev libmatio-dev
+  nlohmann-json3-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
+  octave octave-control python3 python3-scipy python3-h5py python3-numpy
+)
+
+missing=()
+for p in "${PKGS[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed'; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "deps: all ${#PKGS[@]} packages present"
+  exit 0
+fi
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+echo "deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"

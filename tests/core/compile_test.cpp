@@ -1,0 +1,157 @@
+// compile(): indices, ordering, and one test per kind of bad model, each
+// checking that the error names the file, the field path and what was expected.
+#include "model/compile.hpp"
+
+#include "io/model_file.hpp"
+#include "test_util.hpp"
+
+namespace codyna {
+namespace {
+
+ModelSpec two_links() {
+  return parse_model_spec_text(R"({
+    "name": "two_links",
+    "bodies": [
+      {"name": "a", "mass": 1, "com": [0.5, 0, 0], "inertia": [0.01, 0.1, 0.1]},
+      {"name": "b", "mass": 2, "com": [0.5, 0, 0], "inertia": [0.01, 0.2, 0.2]}
+    ],
+    "joints": [
+      {"name": "jb", "type": "revolute", "parent": "a", "child": "b", "parent_frame": {"position": [1, 0, 0]}},
+      {"name": "ja", "type": "revolute", "parent": "ground", "child": "a"}
+    ],
+    "effects": [{"name": "g", "type": "gravity", "g": [0, -9.81, 0]}],
+    "actuators": [{"name": "tau", "type": "joint_force", "joint": "ja"}],
+    "sensors": [{"name": "angle", "type": "joint_position", "joint": "jb"}],
+    "plant": {"inputs": ["tau"], "outputs": ["angle"]}
+  })", "two_links.json");
+}
+
+// compile must throw a ModelError whose message holds the file, the path and the phrase
+void expect_error(const ModelSpec& s, const std::string& path, const std::string& phrase) {
+  try {
+    compile(s, "model.json");
+    ADD_FAILURE() << "no error for " << path;
+  } catch (const ModelError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(e.path(), path) << what;
+    EXPECT_NE(what.find("model.json: " + path + ": "), std::string::npos) << what;
+    EXPECT_NE(what.find(phrase), std::string::npos) << what;
+  }
+}
+
+TEST(Compile, OrdersTheTreeAndAssignsIndices) {
+  const Model m = compile(two_links());
+  EXPECT_EQ(m.nbodies, 3);
+  EXPECT_EQ(m.body_names[1], "a");  // placed before its child although listed second
+  EXPECT_EQ(m.body_names[2], "b");
+  EXPECT_EQ(m.parent[2], 1);
+  EXPECT_EQ(m.joints[1].name, "ja");
+  EXPECT_EQ(m.joints[1].idx_v, 0);
+  EXPECT_EQ(m.joints[2].idx_v, 1);
+  EXPECT_EQ(m.v_names, (std::vector<std::string>{"ja", "jb"}));
+  EXPECT_EQ(m.plant_inputs, std::vector<int>{0});
+  EXPECT_EQ(m.sensors[0].iq, 1);
+  EXPECT_EQ(m.actuators[0].unit, "N m");
+  EXPECT_TRUE(m.has_gravity);
+}
+
+TEST(Compile, AllExamplesCompile) {
+  for (const char* name : {"pendulum.json", "cart_pendulum.json", "double_pendulum.json", "four_bar.json",
+                           "andrews_squeezer.json", "bricard.json", "heavy_top.json"}) {
+    EXPECT_NO_THROW(test::load_example(name)) << name;
+  }
+}
+
+TEST(CompileErrors, NegativeMass) {
+  ModelSpec s = two_links();
+  s.bodies[1].mass = -2;
+  expect_error(s, "/bodies/1/mass", "non-negative mass");
+}
+
+TEST(CompileErrors, InertiaNotPositiveDefinite) {
+  ModelSpec s = two_links();
+  s.bodies[0].inertia = Eigen::Vector3d(0.1, -0.1, 0.1).asDiagonal();
+  expect_error(s, "/bodies/0/inertia", "positive definite");
+}
+
+TEST(CompileErrors, InertiaViolatesTriangleInequality) {
+  ModelSpec s = two_links();
+  s.bodies[0].inertia = Eigen::Vector3d(0.01, 0.01, 0.5).asDiagonal();
+  expect_error(s, "/bodies/0/inertia", "triangle inequality");
+}
+
+TEST(CompileErrors, JointNamesMissingBody) {
+  ModelSpec s = two_links();
+  s.joints[0].parent = "nobody";
+  expect_error(s, "/joints/0/parent", "unknown body \"nobody\"");
+}
+
+TEST(CompileErrors, CycleInTheTree) {
+  ModelSpec s = two_links();
+  s.joints[1].parent = "b";  // a is moved by b and b by a
+  expect_error(s, "/joints/0", "cycle");
+}
+
+TEST(CompileErrors, BodyWithoutJoint) {
+  ModelSpec s = two_links();
+  s.joints.erase(s.joints.begin());
+  s.sensors.clear();
+  s.plant.outputs.clear();
+  expect_error(s, "/bodies/1", "not the child of any joint");
+}
+
+TEST(CompileErrors, BodyMovedTwice) {
+  ModelSpec s = two_links();
+  JointSpec j = s.joints[0];
+  j.name = "again";
+  j.parent = kGroundName;
+  s.joints.push_back(j);
+  expect_error(s, "/joints/2/child", "already moved by joint");
+}
+
+TEST(CompileErrors, DuplicateNames) {
+  ModelSpec s = two_links();
+  s.bodies[1].name = "a";
+  expect_error(s, "/bodies/1/name", "duplicate body name");
+}
+
+TEST(CompileErrors, UnknownPlantInput) {
+  ModelSpec s = two_links();
+  s.plant.inputs = {"force"};
+  expect_error(s, "/plant/inputs/0", "unknown actuator \"force\"");
+}
+
+TEST(CompileErrors, DofOutOfRange) {
+  ModelSpec s = two_links();
+  s.actuators[0].dof = 1;
+  expect_error(s, "/actuators/0/dof", "coordinate index from 0 to 0");
+}
+
+TEST(CompileErrors, LoopThatCannotBeAssembled) {
+  ModelSpec s = two_links();
+  ConstraintSpec c;
+  c.name = "too_far";
+  c.type = ConstraintType::Ball;
+  c.body_a = "b";
+  c.point_a = Eigen::Vector3d(1, 0, 0);  // reaches at most 2 m from the origin
+  c.body_b = kGroundName;
+  c.point_b = Eigen::Vector3d(5, 0, 0);
+  s.constraints.push_back(c);
+  expect_error(s, "/constraints/0", "cannot be assembled");
+}
+
+TEST(CompileErrors, MasslessCoordinate) {
+  ModelSpec s = two_links();
+  s.bodies[1].mass = 0;
+  s.bodies[1].inertia.setZero();
+  expect_error(s, "/bodies", "mass matrix is singular");
+}
+
+TEST(CompileErrors, UnknownIntegrator) {
+  ModelSpec s = two_links();
+  s.solver.integrator = "euler";
+  expect_error(s, "/solver/integrator", "unknown integrator");
+}
+
+}  // namespace
+}  // namespace codyna

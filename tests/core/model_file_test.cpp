@@ -1,0 +1,736 @@
+#include "io/model_file.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <random>
+#include <string>
+
+#include "model/errors.hpp"
+
+namespace codyna {
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+constexpr double kPi = std::numbers::pi;
+
+// A pendulum with a few of everything; the bad-input tests each break one thing in it.
+constexpr const char* kPendulum = R"({
+  "codyna_model": 1,
+  "name": "pendulum",
+  "description": "a rod on a pin",
+  "bodies": [
+    {"name": "link", "mass": 2.0, "com": [0, -0.5, 0], "inertia": [0.1, 0.001, 0.1],
+     "shapes": [{"type": "cylinder", "radius": 0.02, "length": 1.0,
+                 "frame": {"position": [0, -0.5, 0], "rotation": {"axis": [1, 0, 0], "angle_deg": 90}},
+                 "color": [0.2, 0.4, 0.6]}]}
+  ],
+  "joints": [
+    {"name": "pivot", "type": "revolute", "parent": "ground", "child": "link",
+     "parent_frame": {"position": [0, 1.5, 0]}, "axis": [0, 0, 2], "q0": 0.5, "v0": [-1.25]}
+  ],
+  "effects": [{"name": "gravity", "type": "gravity"}],
+  "actuators": [{"name": "motor", "type": "joint_force", "joint": "pivot", "min": -2, "max": 2, "unit": "N m"}],
+  "sensors": [{"name": "tip_x", "type": "point_position", "body": "link", "point": [0, -1, 0], "component": "x"}],
+  "plant": {"inputs": ["motor"], "outputs": ["tip_x"]},
+  "solver": {"integrator": "rk4", "t_end": 2.5}
+})";
+
+// One element of every type, every field given a value other than its default.
+constexpr const char* kEverything = R"({
+  "codyna_model": 1,
+  "name": "everything",
+  "description": "one of each element",
+  "bodies": [
+    {"name": "b1", "mass": 1.5, "com": [0.1, 0.2, 0.3], "inertia": [0.01, 0.02, 0.03, 0.001, -0.002, 0.003],
+     "shapes": [
+       {"type": "box", "size": [0.1, 0.2, 0.3], "color": [0.1, 0.2, 0.3, 0.4],
+        "frame": {"position": [0, 0.5, 0], "rotation": {"rpy": [0.1, 0.2, 0.3]}}},
+       {"type": "cylinder", "radius": 0.02, "length": 0.7, "color": [1, 0, 0]},
+       {"type": "sphere", "radius": 0.04, "frame": {"rotation": {"quaternion": [1, 2, 3, 4]}}}]},
+    {"name": "b2", "mass": 2, "inertia": [[0.1, 0, 0], [0, 0.2, 0], [0, 0, 0.3]]},
+    {"name": "b3", "mass": 3, "inertia": [1, 1, 1]},
+    {"name": "b4", "mass": 4, "inertia": [1, 1, 1]},
+    {"name": "b5", "mass": 5, "inertia": [1, 1, 1]},
+    {"name": "b6", "mass": 6, "inertia": [1, 1, 1]},
+    {"name": "b7", "mass": 7, "inertia": [1, 1, 1]},
+    {"name": "b8", "mass": 8, "inertia": [1, 1, 1]}
+  ],
+  "joints": [
+    {"name": "j1", "type": "revolute", "parent": "ground", "child": "b1",
+     "parent_frame": {"position": [0.1, 0.2, 0.3], "rotation": {"axis": [1, 1, 1], "angle": 0.7}},
+     "child_frame": {"position": [-0.1, 0, 0], "rotation": {"rpy": [0.3, -0.2, 0.1]}},
+     "axis": [1, 1, 0], "q0": 0.3, "v0": -0.1},
+    {"name": "j2", "type": "prismatic", "parent": "b1", "child": "b2", "axis": [1, 0, 0], "q0": [0.2], "v0": [0.5]},
+    {"name": "j3", "type": "fixed", "parent": "b2", "child": "b3",
+     "parent_frame": {"rotation": {"matrix": [[0, -1, 0], [1, 0, 0], [0, 0, 1]]}}},
+    {"name": "j4", "type": "spherical", "parent": "b3", "child": "b4",
+     "q0": {"rotation": {"axis": [1, 2, 3], "angle": 0.4}}, "v0": [0.1, 0.2, 0.3]},
+    {"name": "j5", "type": "universal", "parent": "b4", "child": "b5", "axis": [0, 0, 3], "axis2": [1, 0, 1],
+     "q0": [0.1, 0.2], "v0": [0.3, 0.4]},
+    {"name": "j6", "type": "cylindrical", "parent": "b5", "child": "b6", "axis": [0, 1, 0],
+     "q0": [0.1, 0.2], "v0": [1, 2]},
+    {"name": "j7", "type": "planar", "parent": "b6", "child": "b7", "q0": [1, 2, 0.3], "v0": [0.1, 0.2, 0.3]},
+    {"name": "j8", "type": "free", "parent": "ground", "child": "b8",
+     "q0": [1, 2, 3, 1, 1, 0, 0], "v0": [1, 2, 3, 4, 5, 6]}
+  ],
+  "constraints": [
+    {"name": "c1", "type": "ball", "body_a": "b1", "point_a": [1, 0, 0], "body_b": "b2", "point_b": [0, 1, 0]},
+    {"name": "c2", "type": "revolute", "body_a": "b3", "point_a": [0, 0, 1], "body_b": "ground",
+     "point_b": [1, 1, 1], "axis_a": [1, 0, 0], "axis_b": [0, 3, 4]},
+    {"name": "c3", "type": "planar_revolute", "body_a": "b5", "body_b": "b6", "axis_a": [0, 1, 0]}
+  ],
+  "effects": [
+    {"name": "e1", "type": "gravity", "g": [0, 0, -9.81]},
+    {"name": "e2", "type": "spring_damper", "body_a": "b1", "point_a": [0.1, 0, 0], "body_b": "ground",
+     "point_b": [0, 0.2, 0], "stiffness": 100, "damping": 2.5, "rest_length": 0.3},
+    {"name": "e3", "type": "joint_spring_damper", "joint": "j7", "dof": 2, "stiffness": 10, "damping": 0.1,
+     "rest_position": 0.2},
+    {"name": "e4", "type": "joint_friction", "joint": "j5", "dof": 1, "damping": 0.05},
+    {"name": "e5", "type": "body_force", "body": "b8", "point": [0, 0, 1], "force": [1, 2, 3],
+     "torque": [0.1, 0.2, 0.3], "frame": "body"}
+  ],
+  "actuators": [
+    {"name": "a1", "type": "joint_force", "joint": "j6", "dof": 1, "gain": 2, "u0": 0.5, "min": -1, "max": 3,
+     "unit": "N"},
+    {"name": "a2", "type": "body_force", "body": "b8", "point": [1, 0, 0], "direction": [0, 3, 4], "frame": "body",
+     "gain": 10, "u0": -0.5, "max": 1}
+  ],
+  "sensors": [
+    {"name": "s1", "type": "joint_position", "joint": "j1", "unit": "deg"},
+    {"name": "s2", "type": "joint_velocity", "joint": "j7", "dof": 2},
+    {"name": "s3", "type": "point_position", "body": "b2", "point": [1, 2, 3], "component": "y", "frame": "b1"},
+    {"name": "s4", "type": "point_velocity", "body": "b2", "point": [0, 0, 1], "component": 2},
+    {"name": "s5", "type": "body_angle", "body": "b4", "axis": [1, 0, 0]},
+    {"name": "s6", "type": "distance", "body_a": "b1", "point_a": [1, 0, 0], "body_b": "b8", "point_b": [0, 0, 1]}
+  ],
+  "plant": {"inputs": ["a1", "a2"], "outputs": ["s1", "s3", "s6"]},
+  "solver": {"integrator": "cvode", "rtol": 1e-6, "atol": 1e-9, "t_end": 10, "output_step": 0.05, "max_step": 0.1}
+})";
+
+// ---------------------------------------------------------------- helpers
+
+void expect_near(const Eigen::MatrixXd& actual, const Eigen::MatrixXd& expected, double tol) {
+  ASSERT_EQ(actual.rows(), expected.rows());
+  ASSERT_EQ(actual.cols(), expected.cols());
+  EXPECT_LE((actual - expected).cwiseAbs().maxCoeff(), tol) << "actual:\n" << actual << "\nexpected:\n" << expected;
+}
+
+// Bit-exact equality of doubles, vectors and matrices; plain == for the rest.
+template <class T>
+bool same(const T& a, const T& b) {
+  if constexpr (std::is_base_of_v<Eigen::DenseBase<T>, T>)
+    return a.rows() == b.rows() && a.cols() == b.cols() &&
+           std::memcmp(a.data(), b.data(), sizeof(double) * a.size()) == 0;
+  else if constexpr (std::is_same_v<T, double>)
+    return std::memcmp(&a, &b, sizeof a) == 0;
+  else
+    return a == b;
+}
+
+#define EXPECT_SAME(field) EXPECT_TRUE(same(a.field, b.field)) << "field " #field
+
+void expect_same(const FrameSpec& a, const FrameSpec& b) {
+  EXPECT_SAME(position);
+  EXPECT_SAME(rotation);
+}
+
+void expect_same(const ShapeSpec& a, const ShapeSpec& b) {
+  EXPECT_SAME(type);
+  EXPECT_SAME(size);
+  EXPECT_SAME(radius);
+  EXPECT_SAME(length);
+  EXPECT_SAME(color);
+  expect_same(a.frame, b.frame);
+}
+
+void expect_same(const BodySpec& a, const BodySpec& b);
+void expect_same(const JointSpec& a, const JointSpec& b);
+void expect_same(const ConstraintSpec& a, const ConstraintSpec& b);
+void expect_same(const EffectSpec& a, const EffectSpec& b);
+void expect_same(const ActuatorSpec& a, const ActuatorSpec& b);
+void expect_same(const SensorSpec& a, const SensorSpec& b);
+
+template <class T>
+void expect_same(const std::vector<T>& a, const std::vector<T>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    SCOPED_TRACE("element " + std::to_string(i));
+    expect_same(a[i], b[i]);
+  }
+}
+
+void expect_same(const BodySpec& a, const BodySpec& b) {
+  EXPECT_SAME(name);
+  EXPECT_SAME(mass);
+  EXPECT_SAME(com);
+  EXPECT_SAME(inertia);
+  expect_same(a.shapes, b.shapes);
+}
+
+void expect_same(const JointSpec& a, const JointSpec& b) {
+  EXPECT_SAME(name);
+  EXPECT_SAME(type);
+  EXPECT_SAME(parent);
+  EXPECT_SAME(child);
+  EXPECT_SAME(axis);
+  EXPECT_SAME(axis2);
+  EXPECT_SAME(q0);
+  EXPECT_SAME(v0);
+  expect_same(a.parent_frame, b.parent_frame);
+  expect_same(a.child_frame, b.child_frame);
+}
+
+void expect_same(const ConstraintSpec& a, const ConstraintSpec& b) {
+  EXPECT_SAME(name);
+  EXPECT_SAME(type);
+  EXPECT_SAME(body_a);
+  EXPECT_SAME(body_b);
+  EXPECT_SAME(point_a);
+  EXPECT_SAME(point_b);
+  EXPECT_SAME(axis_a);
+  EXPECT_SAME(axis_b);
+}
+
+void expect_same(const EffectSpec& a, const EffectSpec& b) {
+  EXPECT_SAME(name);
+  EXPECT_SAME(type);
+  EXPECT_SAME(g);
+  EXPECT_SAME(body_a);
+  EXPECT_SAME(body_b);
+  EXPECT_SAME(point_a);
+  EXPECT_SAME(point_b);
+  EXPECT_SAME(stiffness);
+  EXPECT_SAME(damping);
+  EXPECT_SAME(rest_length);
+  EXPECT_SAME(joint);
+  EXPECT_SAME(dof);
+  EXPECT_SAME(rest_position);
+  EXPECT_SAME(force);
+  EXPECT_SAME(torque);
+  EXPECT_SAME(in_world);
+}
+
+void expect_same(const ActuatorSpec& a, const ActuatorSpec& b) {
+  EXPECT_SAME(name);
+  EXPECT_SAME(type);
+  EXPECT_SAME(joint);
+  EXPECT_SAME(dof);
+  EXPECT_SAME(body);
+  EXPECT_SAME(point);
+  EXPECT_SAME(direction);
+  EXPECT_SAME(in_world);
+  EXPECT_SAME(gain);
+  EXPECT_SAME(u0);
+  EXPECT_SAME(min);
+  EXPECT_SAME(max);
+  EXPECT_SAME(unit);
+}
+
+void expect_same(const SensorSpec& a, const SensorSpec& b) {
+  EXPECT_SAME(name);
+  EXPECT_SAME(type);
+  EXPECT_SAME(joint);
+  EXPECT_SAME(dof);
+  EXPECT_SAME(body);
+  EXPECT_SAME(point);
+  EXPECT_SAME(component);
+  EXPECT_SAME(frame);
+  EXPECT_SAME(axis);
+  EXPECT_SAME(body_a);
+  EXPECT_SAME(body_b);
+  EXPECT_SAME(point_a);
+  EXPECT_SAME(point_b);
+  EXPECT_SAME(unit);
+}
+
+void expect_same(const ModelSpec& a, const ModelSpec& b) {
+  EXPECT_SAME(name);
+  EXPECT_SAME(description);
+  expect_same(a.bodies, b.bodies);
+  expect_same(a.joints, b.joints);
+  expect_same(a.constraints, b.constraints);
+  expect_same(a.effects, b.effects);
+  expect_same(a.actuators, b.actuators);
+  expect_same(a.sensors, b.sensors);
+  EXPECT_SAME(plant.inputs);
+  EXPECT_SAME(plant.outputs);
+  EXPECT_SAME(solver.integrator);
+  EXPECT_SAME(solver.rtol);
+  EXPECT_SAME(solver.atol);
+  EXPECT_SAME(solver.t_end);
+  EXPECT_SAME(solver.output_step);
+  EXPECT_SAME(solver.max_step);
+}
+
+#undef EXPECT_SAME
+
+ModelSpec parse(const std::string& text) { return parse_model_spec_text(text, "test.json"); }
+
+// f() must throw a ModelError for `file` at exactly `path` whose message contains `phrase`.
+template <class F>
+void expect_model_error(F f, const std::string& file, const std::string& path, const std::string& phrase) {
+  try {
+    f();
+    ADD_FAILURE() << "expected a ModelError at " << path;
+  } catch (const ModelError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(e.path(), path) << what;
+    EXPECT_EQ(what.rfind(file + ": " + (path.empty() ? "" : path + ": "), 0), 0u) << what;
+    EXPECT_NE(what.find(phrase), std::string::npos) << what << "\n  lacks: " << phrase;
+  }
+}
+
+void expect_model_error(const json& j, const std::string& path, const std::string& phrase) {
+  expect_model_error([&] { parse_model_spec(j, "bad.json"); }, "bad.json", path, phrase);
+}
+
+json pendulum() { return json::parse(kPendulum); }
+
+// The rotation matrix that `rotation` (the JSON of a ROT) reads as.
+Eigen::Matrix3d read_rotation(const json& rotation) {
+  json j = pendulum();
+  j["joints"][0]["parent_frame"]["rotation"] = rotation;
+  return parse_model_spec(j, "rotation.json").joints[0].parent_frame.rotation;
+}
+
+Eigen::Matrix3d read_inertia(const json& inertia) {
+  json j = pendulum();
+  j["bodies"][0]["inertia"] = inertia;
+  return parse_model_spec(j, "inertia.json").bodies[0].inertia;
+}
+
+Eigen::Matrix3d rot_x(double a) {
+  Eigen::Matrix3d R;
+  R << 1, 0, 0, 0, std::cos(a), -std::sin(a), 0, std::sin(a), std::cos(a);
+  return R;
+}
+Eigen::Matrix3d rot_y(double a) {
+  Eigen::Matrix3d R;
+  R << std::cos(a), 0, std::sin(a), 0, 1, 0, -std::sin(a), 0, std::cos(a);
+  return R;
+}
+Eigen::Matrix3d rot_z(double a) {
+  Eigen::Matrix3d R;
+  R << std::cos(a), -std::sin(a), 0, std::sin(a), std::cos(a), 0, 0, 0, 1;
+  return R;
+}
+
+// A fresh, empty directory, removed at the end of the test.
+class TempDir {
+ public:
+  TempDir() {
+    const auto* info = testing::UnitTest::GetInstance()->current_test_info();
+    path_ = fs::temp_directory_path() / ("codyna_model_file_" + std::string(info->name()) + "_" +
+                                         std::to_string(std::random_device{}()));
+    fs::remove_all(path_);
+    fs::create_directories(path_);
+  }
+  ~TempDir() { fs::remove_all(path_); }
+  const fs::path& path() const { return path_; }
+  std::size_t count() const { return std::distance(fs::directory_iterator(path_), fs::directory_iterator()); }
+
+ private:
+  fs::path path_;
+};
+
+// ---------------------------------------------------------------- reading
+
+TEST(ModelFile, ParsesSmallModel) {
+  const ModelSpec m = parse(kPendulum);
+  EXPECT_EQ(m.name, "pendulum");
+  EXPECT_EQ(m.description, "a rod on a pin");
+
+  ASSERT_EQ(m.bodies.size(), 1u);
+  const BodySpec& link = m.bodies[0];
+  EXPECT_EQ(link.name, "link");
+  EXPECT_EQ(link.mass, 2.0);
+  EXPECT_EQ(link.com, Eigen::Vector3d(0, -0.5, 0));
+  EXPECT_EQ(link.inertia, Eigen::Vector3d(0.1, 0.001, 0.1).asDiagonal().toDenseMatrix());
+  ASSERT_EQ(link.shapes.size(), 1u);
+  const ShapeSpec& rod = link.shapes[0];
+  EXPECT_EQ(rod.type, ShapeType::Cylinder);
+  EXPECT_EQ(rod.radius, 0.02);
+  EXPECT_EQ(rod.length, 1.0);
+  EXPECT_EQ(rod.frame.position, Eigen::Vector3d(0, -0.5, 0));
+  expect_near(rod.frame.rotation, rot_x(kPi / 2), 1e-15);
+  EXPECT_EQ(rod.color, Eigen::Vector4d(0.2, 0.4, 0.6, 1.0));
+
+  ASSERT_EQ(m.joints.size(), 1u);
+  const JointSpec& pivot = m.joints[0];
+  EXPECT_EQ(pivot.name, "pivot");
+  EXPECT_EQ(pivot.type, JointType::Revolute);
+  EXPECT_EQ(pivot.parent, "ground");
+  EXPECT_EQ(pivot.child, "link");
+  EXPECT_EQ(pivot.parent_frame.position, Eigen::Vector3d(0, 1.5, 0));
+  EXPECT_EQ(pivot.parent_frame.rotation, Eigen::Matrix3d::Identity());
+  EXPECT_EQ(pivot.child_frame.position, Eigen::Vector3d::Zero());
+  EXPECT_EQ(pivot.axis, Eigen::Vector3d(0, 0, 1));  // normalized
+  EXPECT_EQ(pivot.axis2, Eigen::Vector3d(0, 1, 0));
+  EXPECT_EQ(pivot.q0, Eigen::VectorXd::Constant(1, 0.5));
+  EXPECT_EQ(pivot.v0, Eigen::VectorXd::Constant(1, -1.25));
+
+  ASSERT_EQ(m.effects.size(), 1u);
+  EXPECT_EQ(m.effects[0].type, EffectType::Gravity);
+  EXPECT_EQ(m.effects[0].g, Eigen::Vector3d(0, -9.81, 0));
+
+  ASSERT_EQ(m.actuators.size(), 1u);
+  const ActuatorSpec& motor = m.actuators[0];
+  EXPECT_EQ(motor.type, ActuatorType::JointForce);
+  EXPECT_EQ(motor.joint, "pivot");
+  EXPECT_EQ(motor.dof, 0);
+  EXPECT_EQ(motor.gain, 1.0);
+  EXPECT_EQ(motor.min, -2.0);
+  EXPECT_EQ(motor.max, 2.0);
+  EXPECT_EQ(motor.unit, "N m");
+
+  ASSERT_EQ(m.sensors.size(), 1u);
+  const SensorSpec& tip = m.sensors[0];
+  EXPECT_EQ(tip.type, SensorType::PointPosition);
+  EXPECT_EQ(tip.body, "link");
+  EXPECT_EQ(tip.point, Eigen::Vector3d(0, -1, 0));
+  EXPECT_EQ(tip.component, 0);
+  EXPECT_EQ(tip.frame, "ground");
+
+  EXPECT_EQ(m.plant.inputs, std::vector<std::string>{"motor"});
+  EXPECT_EQ(m.plant.outputs, std::vector<std::string>{"tip_x"});
+  EXPECT_EQ(m.solver.integrator, "rk4");
+  EXPECT_EQ(m.solver.t_end, 2.5);
+  EXPECT_EQ(m.solver.rtol, SolverSpec{}.rtol);
+  EXPECT_TRUE(m.constraints.empty());
+}
+
+TEST(ModelFile, ParsesEveryElementType) {
+  const ModelSpec m = parse(kEverything);
+  ASSERT_EQ(m.joints.size(), 8u);
+  EXPECT_EQ(m.joints[0].axis, Eigen::Vector3d(1, 1, 0) / std::sqrt(2.0));
+  EXPECT_EQ(m.joints[4].axis2, Eigen::Vector3d(1, 0, 1) / std::sqrt(2.0));
+  EXPECT_EQ(m.constraints[1].axis_b, Eigen::Vector3d(0, 0.6, 0.8));
+  EXPECT_EQ(m.effects[2].dof, 2);
+  EXPECT_EQ(m.effects[4].body_a, "b8");
+  EXPECT_EQ(m.effects[4].point_a, Eigen::Vector3d(0, 0, 1));
+  EXPECT_FALSE(m.effects[4].in_world);
+  EXPECT_EQ(m.actuators[1].direction, Eigen::Vector3d(0, 0.6, 0.8));
+  EXPECT_FALSE(m.actuators[1].in_world);
+  EXPECT_FALSE(m.actuators[1].min.has_value());
+  EXPECT_EQ(m.actuators[1].max, 1.0);
+  EXPECT_EQ(m.sensors[2].component, 1);
+  EXPECT_EQ(m.sensors[2].frame, "b1");
+  EXPECT_EQ(m.sensors[3].component, 2);
+  EXPECT_EQ(m.sensors[5].body_b, "b8");
+  EXPECT_EQ(m.solver.max_step, 0.1);
+}
+
+TEST(ModelFile, RotationForms) {
+  const double a = 0.7;
+  const Eigen::Vector3d u = Eigen::Vector3d(1, 2, 2) / 3.0;
+  const Eigen::Matrix3d K = (Eigen::Matrix3d() << 0, -u.z(), u.y(), u.z(), 0, -u.x(), -u.y(), u.x(), 0).finished();
+  const Eigen::Matrix3d rodrigues = Eigen::Matrix3d::Identity() + std::sin(a) * K + (1 - std::cos(a)) * K * K;
+
+  expect_near(read_rotation({{"axis", {1, 2, 2}}, {"angle", a}}), rodrigues, 1e-15);
+  expect_near(read_rotation({{"axis", {0, 0, 5}}, {"angle_deg", 90}}), rot_z(kPi / 2), 1e-15);
+  // (w, x, y, z) = (1, 1, 0, 0) / sqrt(2): 90 degrees about x; normalized on read
+  expect_near(read_rotation({{"quaternion", {3, 3, 0, 0}}}), rot_x(kPi / 2), 1e-15);
+  expect_near(read_rotation({{"quaternion", {std::cos(a / 2), u.x() * std::sin(a / 2), u.y() * std::sin(a / 2),
+                                             u.z() * std::sin(a / 2)}}}),
+              rodrigues, 1e-15);
+  const json rows = {{0, 0, 1}, {1, 0, 0}, {0, 1, 0}};
+  Eigen::Matrix3d cyclic;
+  cyclic << 0, 0, 1, 1, 0, 0, 0, 1, 0;
+  EXPECT_EQ(read_rotation({{"matrix", rows}}), cyclic);  // taken as is
+  expect_near(read_rotation({{"rpy", {0.1, -0.2, 0.3}}}), rot_z(0.3) * rot_y(-0.2) * rot_x(0.1), 1e-15);
+  EXPECT_EQ(read_rotation({{"rpy", {0.0, 0.0, 0.0}}}), Eigen::Matrix3d::Identity());
+}
+
+TEST(ModelFile, InertiaForms) {
+  EXPECT_EQ(read_inertia({1, 2, 3}), Eigen::Vector3d(1, 2, 3).asDiagonal().toDenseMatrix());
+
+  Eigen::Matrix3d full;
+  full << 1, 0.1, 0.2,  //
+      0.1, 2, 0.3,      //
+      0.2, 0.3, 3;
+  EXPECT_EQ(read_inertia({1, 2, 3, 0.1, 0.2, 0.3}), full);
+  EXPECT_EQ(read_inertia({{1, 0.1, 0.2}, {0.1, 2, 0.3}, {0.2, 0.3, 3}}), full);
+
+  // asymmetry below 1e-12 (relative) is accepted, and kept so that the spec round-trips exactly
+  const Eigen::Matrix3d I = read_inertia({{1, 0.1, 0.2}, {0.1 + 1e-13, 2, 0.3}, {0.2, 0.3, 3}});
+  EXPECT_EQ(I(1, 0), 0.1 + 1e-13);
+  expect_near(I, full, 2e-13);
+}
+
+TEST(ModelFile, JointInitialValueForms) {
+  json j = json::parse(kEverything);
+  const ModelSpec m = parse_model_spec(j, "q0.json");
+
+  const Eigen::Quaterniond r(Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 3).normalized()));
+  const JointSpec& spherical = m.joints[3];
+  ASSERT_EQ(spherical.q0.size(), 4);
+  expect_near(spherical.q0, Eigen::Vector4d(r.w(), r.x(), r.y(), r.z()), 1e-15);
+
+  const JointSpec& free = m.joints[7];
+  ASSERT_EQ(free.q0.size(), 7);
+  const double h = 1 / std::sqrt(2.0);
+  expect_near(free.q0, (Eigen::VectorXd(7) << 1, 2, 3, h, h, 0, 0).finished(), 1e-16);
+  EXPECT_EQ(free.v0, (Eigen::VectorXd(6) << 1, 2, 3, 4, 5, 6).finished());
+  EXPECT_EQ(m.joints[2].q0.size(), 0);  // fixed joint: nothing
+
+  // a free joint's q0 as a pose
+  j["joints"][7]["q0"] = {{"position", {4, 5, 6}}, {"rotation", {{"axis", {0, 0, 1}}, {"angle_deg", 90}}}};
+  const Eigen::VectorXd q = parse_model_spec(j, "q0.json").joints[7].q0;
+  expect_near(q, (Eigen::VectorXd(7) << 4, 5, 6, h, 0, 0, h).finished(), 1e-15);
+}
+
+TEST(ModelFile, DefaultsOfOptionalFields) {
+  const ModelSpec m = parse(R"({
+    "name": "bare",
+    "bodies": [{"name": "b", "mass": 1, "inertia": [1, 1, 1], "shapes": [{"type": "box"}]}],
+    "joints": [{"name": "j", "type": "universal", "parent": "ground", "child": "b"}],
+    "sensors": [{"name": "s", "type": "point_velocity", "body": "b"}]
+  })");
+  const ShapeSpec shape_default;
+  EXPECT_EQ(m.bodies[0].com, Eigen::Vector3d::Zero());
+  EXPECT_EQ(m.bodies[0].shapes[0].size, shape_default.size);
+  EXPECT_EQ(m.bodies[0].shapes[0].color, shape_default.color);
+  EXPECT_EQ(m.joints[0].axis, Eigen::Vector3d::UnitZ());
+  EXPECT_EQ(m.joints[0].axis2, Eigen::Vector3d::UnitY());
+  EXPECT_EQ(m.joints[0].q0.size(), 0);
+  EXPECT_EQ(m.sensors[0].frame, "ground");
+  EXPECT_EQ(m.sensors[0].component, 0);
+  EXPECT_EQ(m.solver.integrator, SolverSpec{}.integrator);
+  EXPECT_TRUE(m.plant.inputs.empty());
+}
+
+// ---------------------------------------------------------------- writing
+
+TEST(ModelFile, RoundTripIsExact) {
+  for (const char* text : {kPendulum, kEverything}) {
+    const ModelSpec m = parse(text);
+    const json j = to_json(m);
+    expect_same(parse_model_spec(j, "written.json"), m);
+    expect_same(parse(j.dump()), m);
+    EXPECT_EQ(to_json(parse_model_spec(j, "written.json")), j);
+    EXPECT_EQ(j["bodies"][0]["inertia"].size(), 6u);
+    EXPECT_TRUE(j["joints"][0]["parent_frame"]["rotation"].contains("matrix"));
+  }
+}
+
+TEST(ModelFile, RoundTripOfBuiltSpecIsBitExact) {
+  ModelSpec m;
+  m.name = "built";
+  for (int i = 0; i < 20; ++i) {
+    const Eigen::Vector3d w = Eigen::Vector3d::Random();
+    const Eigen::Quaterniond q(Eigen::AngleAxisd(w.norm() * 3, w.normalized()));
+    BodySpec b;
+    b.name = "b" + std::to_string(i);
+    b.mass = 1.0 / (i + 3);
+    b.com = Eigen::Vector3d::Random() / 3;
+    const Eigen::Matrix3d A = Eigen::Matrix3d::Random();
+    b.inertia = A * A.transpose();  // symmetric up to rounding; sometimes exactly
+    m.bodies.push_back(b);
+    JointSpec j;
+    j.name = "j" + std::to_string(i);
+    j.type = JointType::Free;
+    j.parent = kGroundName;
+    j.child = b.name;
+    j.parent_frame.rotation = q.toRotationMatrix();
+    j.parent_frame.position = w * 1e-7;
+    j.q0.resize(7);
+    j.q0 << w, q.w(), q.x(), q.y(), q.z();
+    j.v0 = Eigen::VectorXd::Random(6) * 1e300;
+    m.joints.push_back(j);
+  }
+  expect_same(parse(to_json(m).dump()), m);
+}
+
+TEST(ModelFile, SaveThenLoad) {
+  const TempDir dir;
+  const std::string path = (dir.path() / "everything.json").string();
+  const ModelSpec m = parse(kEverything);
+  save_model_spec(parse(kPendulum), path);
+  save_model_spec(m, path);  // replaces the file
+  expect_same(load_model_spec(path), m);
+  EXPECT_EQ(json::parse(std::ifstream(path)), to_json(m));
+  EXPECT_EQ(dir.count(), 1u);  // no temporary left over
+
+  // readable by people: format version and name first
+  std::ifstream in(path);
+  std::string line1, line2, line3;
+  std::getline(in, line1), std::getline(in, line2), std::getline(in, line3);
+  EXPECT_EQ(line2, "  \"codyna_model\": 1,");
+  EXPECT_EQ(line3, "  \"name\": \"everything\",");
+}
+
+TEST(ModelFile, SaveIntoMissingDirectoryThrowsAndWritesNothing) {
+  const TempDir dir;
+  const fs::path missing = dir.path() / "missing";
+  const std::string path = (missing / "m.json").string();
+  try {
+    save_model_spec(parse(kPendulum), path);
+    ADD_FAILURE() << "save into a missing directory did not throw";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(missing));
+  EXPECT_EQ(dir.count(), 0u);
+}
+
+TEST(ModelFile, FailedRenameLeavesNoTemporaryFile) {
+  const TempDir dir;
+  const fs::path target = dir.path() / "taken";
+  fs::create_directory(target);  // a file cannot replace a non-empty directory
+  std::ofstream(target / "keep") << "x";
+  EXPECT_THROW(save_model_spec(parse(kPendulum), target.string()), std::runtime_error);
+  EXPECT_EQ(dir.count(), 1u);
+  EXPECT_TRUE(fs::is_directory(target));
+}
+
+// ---------------------------------------------------------------- bad input
+
+TEST(ModelFileErrors, MalformedJsonReportsLineAndColumn) {
+  const std::string text = "{\n  \"name\": \"m\",\n  \"bodies\": [\n    {\"name\": \"a\", \"mass\": 1,}\n  ]\n}\n";
+  expect_model_error([&] { parse_model_spec_text(text, "inline.json"); }, "inline.json", "",
+                     "invalid JSON at line 4, column 29");
+  expect_model_error([&] { parse_model_spec_text("", "empty.json"); }, "empty.json", "", "line 1, column 1");
+}
+
+TEST(ModelFileErrors, MalformedJsonFile) {
+  const std::string path = CODYNA_TEST_DATA_DIR "/bad_malformed.json";
+  expect_model_error([&] { load_model_spec(path); }, path, "", "invalid JSON at line 6, column 5");
+}
+
+TEST(ModelFileErrors, UnknownJointTypeInFile) {
+  const std::string path = CODYNA_TEST_DATA_DIR "/bad_joint_type.json";
+  expect_model_error([&] { load_model_spec(path); }, path, "/joints/0/type",
+                     "unknown joint type \"hinge\" (expected one of: revolute, prismatic, fixed, spherical, "
+                     "universal, cylindrical, planar, free)");
+}
+
+TEST(ModelFileErrors, UnknownTypeInEveryList) {
+  json j = pendulum();
+  j["constraints"] = {{{"name", "c"}, {"type", "ball"}, {"body_a", "link"}, {"body_b", "ground"}}};
+  const struct {
+    json::json_pointer type;
+    const char* phrase;
+  } cases[] = {
+      {"/bodies/0/shapes/0/type"_json_pointer, "unknown shape type \"bogus\" (expected one of: box, cylinder, sphere)"},
+      {"/joints/0/type"_json_pointer, "unknown joint type \"bogus\""},
+      {"/constraints/0/type"_json_pointer,
+       "unknown constraint type \"bogus\" (expected one of: ball, revolute, planar_revolute)"},
+      {"/effects/0/type"_json_pointer, "unknown effect type \"bogus\" (expected one of: gravity, spring_damper,"},
+      {"/actuators/0/type"_json_pointer, "unknown actuator type \"bogus\" (expected one of: joint_force, body_force)"},
+      {"/sensors/0/type"_json_pointer, "unknown sensor type \"bogus\" (expected one of: joint_position,"},
+  };
+  for (const auto& c : cases) {
+    json bad = j;
+    bad[c.type] = "bogus";
+    expect_model_error(bad, c.type.to_string(), c.phrase);
+  }
+}
+
+TEST(ModelFileErrors, MissingRequiredField) {
+  json j = pendulum();
+  j["joints"][0].erase("child");
+  expect_model_error(j, "/joints/0", "missing required field \"child\"");
+
+  j = pendulum();
+  j.erase("name");
+  expect_model_error(j, "", "missing required field \"name\"");
+
+  j = pendulum();
+  j["effects"] = {{{"name", "spring"}, {"type", "spring_damper"}, {"body_a", "link"}}};
+  expect_model_error(j, "/effects/0", "missing required field \"body_b\"");
+}
+
+TEST(ModelFileErrors, WrongType) {
+  json j = pendulum();
+  j["bodies"][0]["mass"] = "ten";
+  expect_model_error(j, "/bodies/0/mass", "expected a number, got string \"ten\"");
+
+  j = pendulum();
+  j["bodies"][0]["com"] = {0, 1};
+  expect_model_error(j, "/bodies/0/com", "expected an array of 3 numbers, got an array of 2 elements");
+
+  j = pendulum();
+  j["actuators"][0]["dof"] = 0.5;
+  expect_model_error(j, "/actuators/0/dof", "expected an integer, got number 0.5");
+
+  j = pendulum();
+  j["bodies"] = {{"name", "link"}};
+  expect_model_error(j, "/bodies", "expected an array, got an object");
+}
+
+TEST(ModelFileErrors, UnknownField) {
+  json j = pendulum();
+  j["bodies"][0]["mas"] = 2.0;
+  expect_model_error(j, "/bodies/0/mas", "unknown field \"mas\" (allowed: name, mass, com, inertia, shapes)");
+
+  // a field of another type is unknown too
+  j = pendulum();
+  j["effects"][0]["stiffness"] = 10;
+  expect_model_error(j, "/effects/0/stiffness",
+                     "unknown field \"stiffness\" (allowed for a gravity effect: name, type, g)");
+}
+
+TEST(ModelFileErrors, InitialValueOfWrongLength) {
+  json j = pendulum();
+  j["joints"][0]["q0"] = {0.1, 0.2};
+  expect_model_error(j, "/joints/0/q0", "expected 1 value (nq of a revolute joint), got 2");
+
+  j = json::parse(kEverything);
+  j["joints"][3]["v0"] = {1, 2, 3, 4};
+  expect_model_error(j, "/joints/3/v0", "expected 3 values (nv of a spherical joint), got 4");
+}
+
+TEST(ModelFileErrors, NonOrthonormalRotationMatrix) {
+  json j = pendulum();
+  j["joints"][0]["parent_frame"]["rotation"] = {{"matrix", {{1, 0, 0}, {0, 1, 1e-6}, {0, 0, 1}}}};
+  expect_model_error(j, "/joints/0/parent_frame/rotation/matrix", "rotation matrix is not orthonormal");
+
+  j["joints"][0]["parent_frame"]["rotation"] = {{"matrix", {{1, 0, 0}, {0, 1, 0}, {0, 0, -1}}}};
+  expect_model_error(j, "/joints/0/parent_frame/rotation/matrix", "determinant -1");
+}
+
+TEST(ModelFileErrors, ZeroAxis) {
+  json j = pendulum();
+  j["joints"][0]["axis"] = {0, 0, 0};
+  expect_model_error(j, "/joints/0/axis", "expected a non-zero vector");
+
+  j = pendulum();
+  j["bodies"][0]["shapes"][0]["frame"]["rotation"] = {{"quaternion", {0, 0, 0, 0}}};
+  expect_model_error(j, "/bodies/0/shapes/0/frame/rotation/quaternion", "expected a non-zero quaternion");
+}
+
+TEST(ModelFileErrors, NonSymmetricInertia) {
+  json j = pendulum();
+  j["bodies"][0]["inertia"] = {{1, 0.1, 0}, {0, 1, 0}, {0, 0, 1}};
+  expect_model_error(j, "/bodies/0/inertia", "inertia matrix is not symmetric");
+}
+
+TEST(ModelFileErrors, BadRotationObject) {
+  json j = pendulum();
+  auto& rotation = j["joints"][0]["parent_frame"]["rotation"];
+  rotation = {{"rpy", {0, 0, 1}}, {"matrix", {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}}};
+  expect_model_error(j, "/joints/0/parent_frame/rotation", "expected one rotation form");
+  rotation = {{"axis", {0, 0, 1}}};
+  expect_model_error(j, "/joints/0/parent_frame/rotation", "missing required field \"angle\"");
+}
+
+TEST(ModelFileErrors, UnsupportedFormatVersion) {
+  json j = pendulum();
+  j["codyna_model"] = 2;
+  expect_model_error(j, "/codyna_model", "unsupported format version 2");
+}
+
+TEST(ModelFileErrors, FileNotFound) {
+  const std::string path = CODYNA_TEST_DATA_DIR "/no_such_model.json";
+  expect_model_error([&] { load_model_spec(path); }, path, "", "cannot open file");
+}
+
+}  // namespace
+}  // namespace codyna
