@@ -21,7 +21,7 @@ LinearSystem discretize_zoh(const LinearSystem& c, double Ts) {
   Eigen::MatrixXd M = Eigen::MatrixXd::Zero(nx + nu, nx + nu);
   M.topLeftCorner(nx, nx) = c.A * Ts;
   M.topRightCorner(nx, nu) = c.B * Ts;
-  const Eigen::MatrixXd E = M.exp();
+  const Eigen::MatrixXd E = M.size() == 0 ? M : Eigen::MatrixXd(M.exp());  // Eigen's exp asserts on 0x0
 
   LinearSystem d = c;
   d.A = E.topLeftCorner(nx, nx);

@@ -45,7 +45,9 @@ std::string format_complex(std::complex<double> c) {
 }
 
 std::string state_name(const ModalAnalysis& m, Eigen::Index i) {
-  return i < static_cast<Eigen::Index>(m.state_names.size()) ? m.state_names[i] : "x" + std::to_string(i + 1);
+  if (i < static_cast<Eigen::Index>(m.state_names.size())) return m.state_names[i];
+  std::string name = "x";  // (not "x" + to_string(): GCC 12 warns falsely on that, -Wrestrict)
+  return name += std::to_string(i + 1);
 }
 
 // "theta (1.00), theta_dot (0.44)": states with |entry| >= 0.5, largest first

@@ -210,6 +210,60 @@ VecXT<S> qdot(const Model& model, const VecXT<S>& q, const VecXT<S>& v) {
   return r;
 }
 
+namespace {
+// rotation matrix Exp(t) and inverse right Jacobian Jr^-1(t) of a rotation
+// vector; series near zero keep values and derivatives exact there
+template <class S>
+Mat3T<S> so3_exp(const Vec3T<S>& t) {
+  using std::cos;
+  using std::sin;
+  using std::sqrt;
+  const S t2 = t.squaredNorm();
+  const Mat3T<S> K = skew<S>(t);
+  S a, b;  // sin(x)/x, (1 - cos x)/x^2
+  if (ad_value(t2) < 1e-12) {
+    a = S(1) - t2 / S(6);
+    b = S(0.5) - t2 / S(24);
+  } else {
+    const S x = sqrt(t2);
+    a = sin(x) / x;
+    b = (S(1) - cos(x)) / t2;
+  }
+  return Mat3T<S>::Identity() + a * K + b * (K * K);
+}
+
+template <class S>
+Mat3T<S> so3_jr_inv(const Vec3T<S>& t) {
+  using std::cos;
+  using std::sin;
+  using std::sqrt;
+  const S t2 = t.squaredNorm();
+  const Mat3T<S> K = skew<S>(t);
+  S c;  // 1/x^2 - (1 + cos x)/(2 x sin x)
+  if (ad_value(t2) < 1e-8) {
+    c = S(1.0 / 12.0) + t2 / S(720);
+  } else {
+    const S x = sqrt(t2);
+    c = S(1) / t2 - (S(1) + cos(x)) / (S(2) * x * sin(x));
+  }
+  return Mat3T<S>::Identity() + S(0.5) * K + c * (K * K);
+}
+}  // namespace
+
+template <class S>
+VecXT<S> tangent_rate(const Model& model, const VecXT<S>& dq, const VecXT<S>& v) {
+  VecXT<S> r = v;
+  for (int b = 1; b < model.nbodies; ++b) {
+    const JointModel& j = model.joints[b];
+    const int iv = j.idx_v;
+    if (j.type != JointType::Spherical && j.type != JointType::Free) continue;
+    const Vec3T<S> t = dq.template segment<3>(iv);
+    r.template segment<3>(iv) = so3_jr_inv<S>(t) * Vec3T<S>(v.template segment<3>(iv));
+    if (j.type == JointType::Free) r.template segment<3>(iv + 3) = so3_exp<S>(t) * Vec3T<S>(v.template segment<3>(iv + 3));
+  }
+  return r;
+}
+
 void normalize(const Model& model, Eigen::VectorXd& q) {
   for (int b = 1; b < model.nbodies; ++b) {
     const JointModel& j = model.joints[b];
@@ -234,7 +288,8 @@ Eigen::VectorXd neutral(const Model& model) {
   template void joint_transform<S>(const JointModel&, const VecXT<S>&, SE3T<S>&, Mat6xT<S>&); \
   template Vec6T<S> joint_bias<S>(const JointModel&, const VecXT<S>&, const VecXT<S>&);       \
   template VecXT<S> integrate<S>(const Model&, const VecXT<S>&, const VecXT<S>&);             \
-  template VecXT<S> qdot<S>(const Model&, const VecXT<S>&, const VecXT<S>&);
+  template VecXT<S> qdot<S>(const Model&, const VecXT<S>&, const VecXT<S>&);                  \
+  template VecXT<S> tangent_rate<S>(const Model&, const VecXT<S>&, const VecXT<S>&);
 CODYNA_INSTANTIATE(double)
 CODYNA_INSTANTIATE(ADScalar)
 #undef CODYNA_INSTANTIATE

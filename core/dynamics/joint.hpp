@@ -35,6 +35,12 @@ Eigen::VectorXd difference(const Model& model, const Eigen::VectorXd& q0, const 
 template <class S>
 VecXT<S> qdot(const Model& model, const VecXT<S>& q, const VecXT<S>& v);
 
+// d/dt of a tangent deviation dq (q = integrate(q_ref, dq), q_ref fixed) for
+// velocity v: v itself for additive coordinates; Jr^-1(dq) w for rotations,
+// Exp(dq_w) v_lin for the translation of a free joint. Size nv.
+template <class S>
+VecXT<S> tangent_rate(const Model& model, const VecXT<S>& dq, const VecXT<S>& v);
+
 // unit quaternions, in place
 void normalize(const Model& model, Eigen::VectorXd& q);
 

@@ -41,6 +41,13 @@ std::array<NameList, 6> name_lists(const LinearSystem& s) {
            {"output_units", &s.output_units}}};
 }
 
+// The numeric variables of NAME.mat in the order they are written.
+std::vector<std::pair<const char*, Eigen::MatrixXd>> plant_matrices(const LinearSystem& s) {
+  return {{"A", s.A},   {"B", s.B},   {"C", s.C},         {"D", s.D},
+          {"x0", s.x0}, {"u0", s.u0}, {"y0", s.y0},       {"xdot0", s.xdot0},
+          {"Ts", Eigen::MatrixXd::Constant(1, 1, s.Ts)}};
+}
+
 class PlantChecker {
  public:
   explicit PlantChecker(std::string file) : file_(std::move(file)) {}
@@ -209,7 +216,8 @@ VarPtr char_var(const char* name, const std::string& s) {
 VarPtr cellstr_var(const char* name, const std::vector<std::string>& list) {
   size_t dims[2] = {list.size(), 1};
   VarPtr cell = checked(Mat_VarCreate(name, MAT_C_CELL, MAT_T_CELL, 2, dims, nullptr, 0), name);
-  for (std::size_t i = 0; i < list.size(); ++i) Mat_VarSetCell(cell.get(), static_cast<int>(i), char_var(nullptr, list[i]).release());
+  for (std::size_t i = 0; i < list.size(); ++i)
+    Mat_VarSetCell(cell.get(), static_cast<int>(i), char_var(nullptr, list[i]).release());
   return cell;
 }
 
@@ -284,15 +292,7 @@ VarPtr info_var(const LinearSystem& s, const std::string& name) {
 void write_plant_mat(const LinearSystem& s, const std::string& name, const std::string& path, MatVersion v,
                      const std::string& target) {
   MatWriter w(path, v, target);
-  w.write(double_var("A", s.A));
-  w.write(double_var("B", s.B));
-  w.write(double_var("C", s.C));
-  w.write(double_var("D", s.D));
-  w.write(double_var("x0", s.x0));
-  w.write(double_var("u0", s.u0));
-  w.write(double_var("y0", s.y0));
-  w.write(double_var("xdot0", s.xdot0));
-  w.write(double_var("Ts", Eigen::MatrixXd::Constant(1, 1, s.Ts)));
+  for (const auto& [var, m] : plant_matrices(s)) w.write(double_var(var, m));
   for (const auto& l : name_lists(s)) {
     w.write(cellstr_var(l.var, *l.list));
     if (v == MatVersion::V73) w.write(char_matrix_var((std::string(l.var) + "_char").c_str(), *l.list));
@@ -331,8 +331,8 @@ std::string header_comment(const LinearSystem& s, const std::string& name, MatVe
   std::ostringstream h;
   h << "% " << name << ".m - plant exported by codyna " << one_line(s.codyna_version) << "\n"
     << "%\n"
-    << "% Model:            " << one_line(s.model_name) << (s.model_file.empty() ? "" : "  (" + one_line(s.model_file) + ")")
-    << "\n"
+    << "% Model:            " << one_line(s.model_name)
+    << (s.model_file.empty() ? "" : "  (" + one_line(s.model_file) + ")") << "\n"
     << "% Operating point:  " << one_line(s.operating_point) << ", t = " << number(s.time) << " s\n"
     << "% Linearization:    " << one_line(s.method) << "\n"
     << "% Time:             "
@@ -343,7 +343,8 @@ std::string header_comment(const LinearSystem& s, const std::string& name, MatVe
     << "%   x = x0 + dx,  u = u0 + du,  y = y0 + dy\n"
     << (s.Ts > 0 ? "%   dx[k+1] = A dx[k] + B du[k]\n" : "%   d(dx)/dt = A dx + B du\n")
     << "%   dy = C dx + D du\n"
-    << "% Away from an equilibrium xdot0 is not zero: d(x)/dt = xdot0 + A dx + B du.\n"
+    << (s.Ts > 0 ? "% xdot0 is the continuous-time derivative at the operating point (0 at an equilibrium).\n"
+                 : "% Away from an equilibrium xdot0 is not zero: d(dx)/dt = xdot0 + A dx + B du.\n")
     << "%\n"
     << "% Inputs (plant_inputs):\n"
     << signal_table(s.input_names, s.input_units) << "% Outputs (plant_outputs):\n"
@@ -381,14 +382,8 @@ std::string load_block(const std::string& name, MatVersion v) {
 std::string v73_fixups(const LinearSystem& s) {
   std::ostringstream out;
   out << "% Octave reads the empty matrices of a v7.3 file as their sizes and skips its cell arrays:\n";
-  const std::pair<const char*, const Eigen::MatrixXd*> matrices[] = {
-      {"A", &s.A}, {"B", &s.B}, {"C", &s.C}, {"D", &s.D}};
-  const std::pair<const char*, const Eigen::VectorXd*> vectors[] = {
-      {"x0", &s.x0}, {"u0", &s.u0}, {"y0", &s.y0}, {"xdot0", &s.xdot0}};
-  for (const auto& [var, m] : matrices)
-    if (m->size() == 0) out << var << " = zeros(" << m->rows() << ", " << m->cols() << ");\n";
-  for (const auto& [var, m] : vectors)
-    if (m->size() == 0) out << var << " = zeros(0, 1);\n";
+  for (const auto& [var, m] : plant_matrices(s))
+    if (m.size() == 0) out << var << " = zeros(" << m.rows() << ", " << m.cols() << ");\n";
   for (const auto& l : name_lists(s)) {
     const std::string var = l.var;
     if (l.list->empty())
@@ -418,7 +413,11 @@ const char* model_block =
 std::string or_unset(const std::string& s) { return s.empty() ? "(unset)" : s; }
 
 std::string summary_block(const LinearSystem& s, const std::string& name) {
-  return "if Ts > 0, codyna_kind = sprintf('discrete-time (Ts = %g s)', Ts); else codyna_kind = 'continuous-time'; end\n"
+  return "if Ts > 0\n"
+         "  codyna_kind = sprintf('discrete-time (Ts = %g s)', Ts);\n"
+         "else\n"
+         "  codyna_kind = 'continuous-time';\n"
+         "end\n"
          "fprintf(['%s: %s plant of model %s at operating point %s (%s linearization),\\n' ...\n"
          "         '  %d states (%s),\\n  %d inputs (%s),\\n  %d outputs (%s).\\n'], ...\n"
          "        '" + name + "', codyna_kind, " + quoted(or_unset(s.model_name)) + ", " +
@@ -475,8 +474,8 @@ ExportPaths export_plant(const LinearSystem& sys, const std::string& dir, const 
   const std::string base = (std::filesystem::path(dir) / name).string();
   const ExportPaths paths{base + ".mat", base + ".m"};
   if (matlab_identifier(name) != name)
-    throw std::runtime_error(paths.mat_file + ": '" + name + "' is not a valid MATLAB identifier or is reserved (use '" +
-                             matlab_identifier(name) + "')");
+    throw std::runtime_error(paths.mat_file + ": '" + name + "' is not a valid MATLAB identifier or is reserved" +
+                             " (use '" + matlab_identifier(name) + "')");
   const LinearSystem s = completed_plant(sys, paths.mat_file);
   const std::string script = plant_script(s, name, v);
 
@@ -543,7 +542,8 @@ bool numeric_matrix(const matvar_t* v, Eigen::MatrixXd& out, std::string& why) {
   if (v->isComplex) return why = "complex", false;
   if (v->rank != 2) return why = std::to_string(v->rank) + "-D array", false;
   switch (v->class_type) {
-    case MAT_C_EMPTY: out = Eigen::MatrixXd(static_cast<Eigen::Index>(v->dims[0]), static_cast<Eigen::Index>(v->dims[1])); return true;
+    case MAT_C_EMPTY: out.resize(static_cast<Eigen::Index>(v->dims[0]), static_cast<Eigen::Index>(v->dims[1]));
+      return true;
     case MAT_C_DOUBLE: out = as_double<double>(v); return true;
     case MAT_C_SINGLE: out = as_double<float>(v); return true;
     case MAT_C_INT8: out = as_double<mat_int8_t>(v); return true;

@@ -12,7 +12,9 @@
 //                                method, time (double), codyna_version, name
 // and, in v7.3 files only, the six lists again as blank-padded char matrices
 // (state_names_char, ...), because Octave cannot read the cell arrays of a v7.3
-// file; NAME.m falls back to cellstr() of those. Text is stored as UTF-16 (what
+// file; NAME.m falls back to cellstr() of those (Octave also reads the empty
+// matrices of a v7.3 file as their size vectors; a v7.3 NAME.m resets those from
+// the sizes it was written with). Text is stored as UTF-16 (what
 // MATLAB writes; Octave converts it); scipy.io.loadmat needs uint16_codec='utf-16'
 // for non-ASCII text.
 //
@@ -43,7 +45,9 @@ struct ExportPaths {
 // as x1.., u1.., y1.., empty unit lists as ''. Throws std::runtime_error naming
 // the file and the reason (bad NAME, sizes that do not fit, NaN/Inf entries, a
 // directory that is missing or not writable, a failed write); nothing is then
-// left behind, and existing files of that name are untouched.
+// left behind, and existing files of that name are untouched. (Both files are
+// complete before the two renames; only a failure of the second rename, after
+// the first succeeded, would leave a new NAME.mat beside an old NAME.m.)
 ExportPaths export_plant(const LinearSystem& sys, const std::string& dir, const std::string& name,
                          MatVersion v = MatVersion::V5);
 
@@ -59,7 +63,7 @@ std::string plant_script(const LinearSystem& sys, const std::string& name, MatVe
 
 struct SkippedVariable {
   std::string name;
-  std::string reason;  // "complex", "cell", "char", "struct", "sparse", "3-D array", ...
+  std::string reason;  // "complex", "struct", "cell" (not all char rows), "sparse (store full())", "3-D array", ...
 };
 
 struct MatVariables {

@@ -5,24 +5,18 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <optional>
-#include <random>
 #include <stdexcept>
 #include <string_view>
 #include <system_error>
 #include <vector>
 
-#ifdef _WIN32
-#include <io.h>
-#else
-#include <unistd.h>
-#endif
-
+#include "io/atomic_file.hpp"
 #include "model/errors.hpp"
 
 namespace codyna {
@@ -95,8 +89,6 @@ class Object {
   explicit Object(const Node& n) : n_(n) {
     if (!n.value().is_object()) n.expected("an object");
   }
-  const Node& node() const { return n_; }
-
   // Every field must be one of `allowed`; `owner` ("a gravity effect") qualifies the message.
   void allow(const std::vector<std::string_view>& allowed, const std::string& owner = {}) const {
     for (const auto& item : n_.value().items()) {
@@ -818,16 +810,6 @@ using File = std::unique_ptr<std::FILE, Closer>;
 
 std::string error_text(int err) { return std::generic_category().message(err); }
 
-// Flushes f's data to the storage device.
-bool sync(std::FILE* f) {
-  if (std::fflush(f) != 0) return false;
-#ifdef _WIN32
-  return _commit(_fileno(f)) == 0;
-#else
-  return fsync(fileno(f)) == 0;
-#endif
-}
-
 }  // namespace
 
 ModelSpec parse_model_spec(const nlohmann::json& j, const std::string& file_label) {
@@ -859,37 +841,13 @@ ModelSpec load_model_spec(const std::string& path) {
 nlohmann::json to_json(const ModelSpec& spec) { return nlohmann::json(write_struct(spec)); }
 
 void save_model_spec(const ModelSpec& spec, const std::string& path) {
-  const auto fail = [&](const std::string& why) {
-    throw std::runtime_error("cannot save model file \"" + path + "\": " + why);
-  };
   std::string text;
   try {
     print(write_struct(spec), text);
-    text += "\n";
   } catch (const ojson::exception& e) {  // e.g. a name that is not valid UTF-8
-    fail(e.what());
+    throw std::runtime_error(path + ": cannot save the model: " + e.what());
   }
-
-  // "x": fail rather than reuse an existing file; retry on the unlikely name clash.
-  std::string tmp;
-  File f;
-  std::mt19937_64 random(std::random_device{}());
-  for (int attempt = 0; !f && attempt < 20; ++attempt) {
-    tmp = path + ".tmp-" + std::to_string(random() % 1000000);
-    f.reset(std::fopen(tmp.c_str(), "wbx"));
-    if (!f && errno != EEXIST) fail(error_text(errno));
-  }
-  if (!f) fail("cannot create a temporary file next to it");
-
-  bool ok = std::fwrite(text.data(), 1, text.size(), f.get()) == text.size() && sync(f.get());
-  int err = errno;
-  if (std::fclose(f.release()) != 0 && ok) ok = false, err = errno;
-  std::error_code ec;
-  if (ok) std::filesystem::rename(tmp, path, ec);
-  if (!ok || ec) {
-    std::remove(tmp.c_str());
-    fail(ok ? ec.message() : error_text(err));
-  }
+  write_file_atomically(path, text + "\n");
 }
 
 }  // namespace codyna

@@ -29,10 +29,10 @@ ModelSpec parse_model_spec_text(const std::string& text, const std::string& file
 // The JSON document for `spec` (rotations as matrices, inertia as 6 numbers).
 nlohmann::json to_json(const ModelSpec& spec);
 
-// Writes `spec` to `path` atomically: a temporary file in the same directory
-// is written, flushed and renamed over `path`, so `path` holds either the old
-// or the new content. Throws std::runtime_error naming `path` on failure and
-// leaves no temporary file behind.
+// Writes `spec` to `path` atomically (io/atomic_file.hpp): a temporary file in
+// the same directory is written, flushed and renamed over `path`, so `path`
+// holds either the old or the new content. Throws std::runtime_error naming
+// `path` on failure and leaves no temporary file behind.
 void save_model_spec(const ModelSpec& spec, const std::string& path);
 
 }  // namespace codyna

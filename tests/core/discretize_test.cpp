@@ -69,6 +69,19 @@ TEST(DiscretizeZoh, WorksWithoutInputs) {
   EXPECT_EQ(d.B.cols(), 0);
 }
 
+TEST(DiscretizeZoh, StaticGainHasNoStates) {
+  LinearSystem s;
+  s.A.resize(0, 0);
+  s.B.resize(0, 2);
+  s.C.resize(1, 0);
+  s.D = Eigen::RowVector2d(3, 4);
+  const LinearSystem d = discretize_zoh(s, 0.1);
+  EXPECT_EQ(d.A.size(), 0);
+  EXPECT_EQ(d.B.cols(), 2);
+  EXPECT_TRUE(MatrixNear(d.D, s.D, 0.0));
+  EXPECT_EQ(d.Ts, 0.1);
+}
+
 TEST(DiscretizeZoh, RejectsBadSampleTimeAndDiscreteInput) {
   const LinearSystem c = double_integrator();
   for (double T : {0.0, -0.1, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()})

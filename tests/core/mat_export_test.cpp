@@ -127,7 +127,7 @@ void write_text(const std::string& path, const std::string& text) { std::ofstrea
       statement;                                                                          \
       ADD_FAILURE() << "no exception from " #statement;                                   \
     } catch (const std::runtime_error& e) {                                               \
-      for (const std::string part : {__VA_ARGS__})                                        \
+      for (const std::string& part : Strings{__VA_ARGS__})                               \
         EXPECT_NE(std::string(e.what()).find(part), std::string::npos)                    \
             << "message \"" << e.what() << "\" lacks \"" << part << "\"";                 \
     }                                                                                     \
@@ -146,7 +146,8 @@ TEST(MatlabIdentifier, MakesValidNamesAndKeepsValidOnes) {
   EXPECT_EQ(matlab_identifier("A"), "A_plant");  // NAME.m defines A: typing A would show the matrix
   EXPECT_EQ(matlab_identifier("ss"), "ss_plant");  // NAME.m calls ss()
   EXPECT_EQ(matlab_identifier(std::string(100, 'x')), std::string(63, 'x'));
-  for (const std::string& s : Strings{"cart-pendulum 2", "2dof", "end", "A", "\xce\xb8 pendulum", std::string(80, '9')}) {
+  const Strings raw = {"cart-pendulum 2", "2dof", "end", "A", "\xce\xb8 pendulum", std::string(80, '9')};
+  for (const std::string& s : raw) {
     const std::string id = matlab_identifier(s);
     EXPECT_EQ(matlab_identifier(id), id) << s;
     EXPECT_LE(id.size(), 63u);
@@ -343,8 +344,8 @@ using VarPtr = std::unique_ptr<matvar_t, void (*)(matvar_t*)>;
 
 VarPtr make_var(const char* name, matio_classes cls, matio_types type, std::vector<size_t> dims, const void* data,
                 int flags = 0) {
-  return VarPtr(Mat_VarCreate(name, cls, type, static_cast<int>(dims.size()), dims.data(), const_cast<void*>(data), flags),
-                Mat_VarFree);
+  const int rank = static_cast<int>(dims.size());
+  return VarPtr(Mat_VarCreate(name, cls, type, rank, dims.data(), const_cast<void*>(data), flags), Mat_VarFree);
 }
 
 void write_mat(const std::string& path, const std::vector<VarPtr>& vars) {
@@ -438,8 +439,15 @@ std::string peer_script(const std::string& file) { return std::string(CODYNA_SOU
 
 bool on_path(const std::string& program) { return run_command("command -v " + program).exit_code == 0; }
 
+// `command` stopped after 60 s where coreutils' timeout exists (a hung peer must not hang CTest)
+std::string bounded(const std::string& command) {
+  static const bool have_timeout = on_path("timeout");
+  return (have_timeout ? "timeout 60 " : "") + command;
+}
+
 std::vector<std::complex<double>> sorted(std::vector<std::complex<double>> v) {
-  std::sort(v.begin(), v.end(), [](auto a, auto b) { return a.real() != b.real() ? a.real() < b.real() : a.imag() < b.imag(); });
+  std::sort(v.begin(), v.end(),
+            [](auto a, auto b) { return a.real() != b.real() ? a.real() < b.real() : a.imag() < b.imag(); });
   return v;
 }
 
@@ -464,8 +472,8 @@ const OctaveRun& octave_run() {
     };
     const std::string eval = "addpath('" + peer_script("") + "'); " + call("cart_pendulum", "peer5.mat", "K.mat") +
                              call("cart_pendulum73", "peer73.mat", "K73.mat");
-    r->result = run_command("cd " + shell_quoted(r->dir / "work") + " && timeout 60 octave-cli --no-gui --quiet --eval " +
-                            shell_quoted(eval));
+    r->result = run_command("cd " + shell_quoted(r->dir / "work") + " && " +
+                            bounded("octave-cli --no-gui --quiet --eval " + shell_quoted(eval)));
     if (r->result.exit_code == 0) {
       r->v5 = read_mat_file(r->dir / "peer5.mat");
       r->v73 = read_mat_file(r->dir / "peer73.mat");
@@ -514,7 +522,8 @@ TEST_F(OctavePeer, EigenvaluesMatchModalAnalysis) {
   ASSERT_EQ(codyna.size(), 4u);
   octave = sorted(octave);
   codyna = sorted(codyna);
-  for (std::size_t i = 0; i < 4; ++i) EXPECT_LE(std::abs(octave[i] - codyna[i]), 1e-10) << octave[i] << " vs " << codyna[i];
+  for (std::size_t i = 0; i < 4; ++i)
+    EXPECT_LE(std::abs(octave[i] - codyna[i]), 1e-10) << octave[i] << " vs " << codyna[i];
   EXPECT_NEAR(codyna[3].real(), std::sqrt(6 * 30 * 9.81 / (90 * 2)), 1e-12);  // sqrt(6 (m2+m3) g / ((4 m2+m3) l3))
 }
 
@@ -559,9 +568,8 @@ void expect_python_reads_plant(const std::string& reader, MatVersion v) {
   TempDir dir;
   const LinearSystem s = cart_pendulum();
   const ExportPaths paths = export_plant(s, dir.path(), "cart_pendulum", v);
-  const CommandResult r = run_command("timeout 60 " + shell_quoted(*python) + " " +
-                                      shell_quoted(peer_script("read_plant.py")) + " " + reader + " " +
-                                      shell_quoted(paths.mat_file));
+  const CommandResult r = run_command(bounded(shell_quoted(*python) + " " + shell_quoted(peer_script("read_plant.py")) +
+                                              " " + reader + " " + shell_quoted(paths.mat_file)));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto seen = nlohmann::json::parse(r.output);
   const auto matrix = [&](const char* name) {

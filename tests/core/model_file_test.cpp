@@ -127,7 +127,7 @@ template <class T>
 bool same(const T& a, const T& b) {
   if constexpr (std::is_base_of_v<Eigen::DenseBase<T>, T>)
     return a.rows() == b.rows() && a.cols() == b.cols() &&
-           std::memcmp(a.data(), b.data(), sizeof(double) * a.size()) == 0;
+           (a.size() == 0 || std::memcmp(a.data(), b.data(), sizeof(double) * a.size()) == 0);
   else if constexpr (std::is_same_v<T, double>)
     return std::memcmp(&a, &b, sizeof a) == 0;
   else
@@ -580,14 +580,24 @@ TEST(ModelFile, SaveIntoMissingDirectoryThrowsAndWritesNothing) {
   EXPECT_EQ(dir.count(), 0u);
 }
 
-TEST(ModelFile, FailedRenameLeavesNoTemporaryFile) {
+TEST(ModelFile, FailedSaveLeavesNoTemporaryFile) {
   const TempDir dir;
   const fs::path target = dir.path() / "taken";
-  fs::create_directory(target);  // a file cannot replace a non-empty directory
-  std::ofstream(target / "keep") << "x";
+  fs::create_directory(target);  // a file cannot replace a directory
   EXPECT_THROW(save_model_spec(parse(kPendulum), target.string()), std::runtime_error);
   EXPECT_EQ(dir.count(), 1u);
   EXPECT_TRUE(fs::is_directory(target));
+
+  ModelSpec m = parse(kPendulum);
+  m.name = "\xff";  // not UTF-8: cannot be written as JSON
+  const std::string path = (dir.path() / "m.json").string();
+  try {
+    save_model_spec(m, path);
+    ADD_FAILURE() << "save of a name that is not UTF-8 did not throw";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(dir.count(), 1u);
 }
 
 // ---------------------------------------------------------------- bad input

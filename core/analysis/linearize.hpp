@@ -1,0 +1,42 @@
+// Linearization of the plant (Plant/In -> Plant/Out) at an operating point,
+// in minimal coordinates (see plant_function.hpp for the state):
+//   dx = A x + B u,  y = C x + D u   about (x0, u0, y0), with xdot0 = f(x0, u0).
+// Jacobians two ways behind one interface:
+//   Exact            forward-mode automatic differentiation of the same
+//                    Scalar-templated dynamics (default)
+//   ForwardDifference (f(x + h e) - f(x)) / h,      h = sqrt(eps) max(1, |x_i|)
+//   CentralDifference (f(x + h e) - f(x - h e)) / 2h, h = cbrt(eps) max(1, |x_i|)
+// The finite-difference results carry an accuracy estimate: their largest
+// difference from the exact Jacobian, relative to its largest entry.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "analysis/linear_system.hpp"
+#include "analysis/operating_point.hpp"
+#include "analysis/plant_function.hpp"
+
+namespace codyna {
+
+enum class JacobianMethod { Exact, ForwardDifference, CentralDifference };
+const char* to_string(JacobianMethod m);  // "exact", "fd-forward", "fd-central"
+
+struct LinearizeOptions {
+  JacobianMethod method = JacobianMethod::Exact;
+  std::vector<std::string> independent;  // closed loops: coordinate names to keep (empty = automatic)
+};
+
+struct Linearization {
+  LinearSystem system;
+  CoordinatePartition partition;
+  double fd_error = 0.0;  // finite differences: max |J_fd - J_exact| / max |J_exact|; 0 for exact
+};
+
+Linearization linearize(const Model& model, const OperatingPoint& op, const LinearizeOptions& options = {});
+
+// The full Jacobian [A B; C D] of the plant function at x, u (for checks and trim).
+Eigen::MatrixXd plant_jacobian(const PlantFunction& f, const Eigen::VectorXd& x, const Eigen::VectorXd& u,
+                               JacobianMethod method);
+
+}  // namespace codyna

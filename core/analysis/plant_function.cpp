@@ -1,0 +1,256 @@
+#include "analysis/plant_function.hpp"
+
+#include <Eigen/LU>
+#include <Eigen/QR>
+#include <algorithm>
+#include <set>
+#include <stdexcept>
+
+#include "dynamics/constraints.hpp"
+#include "dynamics/forward_dynamics.hpp"
+#include "dynamics/joint.hpp"
+#include "dynamics/kinematics.hpp"
+#include "dynamics/sensors.hpp"
+#include "spatial/autodiff.hpp"
+#include "spatial/linalg.hpp"
+
+namespace codyna {
+
+namespace {
+
+Eigen::MatrixXd active_jacobian(const Model& m, const Eigen::VectorXd& q) {
+  Data d(m);
+  constraint_terms<double>(m, d, q, Eigen::VectorXd::Zero(m.nv));
+  Eigen::MatrixXd J(m.active_rows.size(), m.nv);
+  for (std::size_t k = 0; k < m.active_rows.size(); ++k) J.row(k) = d.Jc.row(m.active_rows[k]);
+  return J;
+}
+
+Eigen::MatrixXd columns(const Eigen::MatrixXd& J, const std::vector<int>& cols) {
+  Eigen::MatrixXd r(J.rows(), cols.size());
+  for (std::size_t k = 0; k < cols.size(); ++k) r.col(k) = J.col(cols[k]);
+  return r;
+}
+
+template <class S>
+MatXT<S> columns_t(const MatXT<S>& J, const std::vector<int>& cols) {
+  MatXT<S> r(J.rows(), static_cast<Eigen::Index>(cols.size()));
+  for (std::size_t k = 0; k < cols.size(); ++k) r.col(k) = J.col(cols[k]);
+  return r;
+}
+
+}  // namespace
+
+CoordinatePartition partition_coordinates(const Model& m, const Eigen::VectorXd& q,
+                                          const std::vector<std::string>& preferred) {
+  CoordinatePartition p;
+  if (m.active_rows.empty()) {
+    for (int i = 0; i < m.nv; ++i) p.independent.push_back(i);
+    if (!preferred.empty() && static_cast<int>(preferred.size()) != m.nv)
+      throw std::invalid_argument("independent coordinates: a tree model has all " + std::to_string(m.nv) +
+                                  " coordinates independent");
+    return p;
+  }
+  const Eigen::MatrixXd J = active_jacobian(m, q);
+  if (preferred.empty()) {
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(J);
+    const auto& perm = qr.colsPermutation().indices();
+    std::set<int> dep;
+    for (Eigen::Index k = 0; k < J.rows(); ++k) dep.insert(perm[k]);
+    for (int i = 0; i < m.nv; ++i) (dep.count(i) ? p.dependent : p.independent).push_back(i);
+  } else {
+    std::set<int> ind;
+    for (const std::string& name : preferred) {
+      auto it = std::find(m.v_names.begin(), m.v_names.end(), name);
+      if (it == m.v_names.end())
+        throw std::invalid_argument("independent coordinates: unknown coordinate \"" + name + "\"");
+      ind.insert(static_cast<int>(it - m.v_names.begin()));
+    }
+    if (static_cast<int>(ind.size()) != m.dof())
+      throw std::invalid_argument("independent coordinates: the model has " + std::to_string(m.dof()) +
+                                  " degrees of freedom, " + std::to_string(ind.size()) + " distinct coordinates given");
+    for (int i = 0; i < m.nv; ++i) (ind.count(i) ? p.independent : p.dependent).push_back(i);
+  }
+  const Eigen::MatrixXd Jd = columns(J, p.dependent);
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(Jd);
+  const Eigen::VectorXd s = svd.singularValues();
+  if (s.size() && s[s.size() - 1] < 1e-8 * std::max(1.0, s[0]))
+    throw std::invalid_argument("independent coordinates: the dependent coordinates cannot be solved from the "
+                                "constraints at this configuration (their Jacobian is singular); choose others");
+  return p;
+}
+
+PlantFunction::PlantFunction(const Model& model, const Eigen::VectorXd& q_ref, const Eigen::VectorXd& u_all,
+                             CoordinatePartition partition)
+    : model_(model), q_ref_(q_ref), u_all_(u_all), part_(std::move(partition)) {}
+
+Eigen::VectorXd PlantFunction::solve_dependent(const Eigen::VectorXd& z) const {
+  const int nd = static_cast<int>(part_.dependent.size());
+  Eigen::VectorXd dq = Eigen::VectorXd::Zero(model_.nv);
+  for (int k = 0; k < nz(); ++k) dq[part_.independent[k]] = z[k];
+  Data d(model_);
+  for (int it = 0; it < 50; ++it) {
+    const Eigen::VectorXd q = integrate<double>(model_, q_ref_, dq);
+    constraint_terms<double>(model_, d, q, Eigen::VectorXd::Zero(model_.nv));
+    Eigen::VectorXd phi(nd);
+    Eigen::MatrixXd J(nd, model_.nv);
+    for (int k = 0; k < nd; ++k) {
+      phi[k] = d.phi[model_.active_rows[k]];
+      J.row(k) = d.Jc.row(model_.active_rows[k]);
+    }
+    if (phi.lpNorm<Eigen::Infinity>() < 1e-14) break;
+    const Eigen::VectorXd step = columns(J, part_.dependent).partialPivLu().solve(phi);
+    for (int k = 0; k < nd; ++k) dq[part_.dependent[k]] -= step[k];
+  }
+  Eigen::VectorXd r(nd);
+  for (int k = 0; k < nd; ++k) r[k] = dq[part_.dependent[k]];
+  return r;
+}
+
+template <class S>
+void PlantFunction::eval(const VecXT<S>& x, const VecXT<S>& u, VecXT<S>& xdot, VecXT<S>& y) const {
+  const Model& m = model_;
+  const int n = nz(), nd = static_cast<int>(part_.dependent.size());
+  const auto& ind = part_.independent;
+  const auto& dep = part_.dependent;
+  VecXT<S> dq = VecXT<S>::Zero(m.nv), v = VecXT<S>::Zero(m.nv);
+  for (int k = 0; k < n; ++k) {
+    dq[ind[k]] = x[k];
+    v[ind[k]] = x[n + k];
+  }
+  DataT<S> d(m);
+  const VecXT<S> zero_v = VecXT<S>::Zero(m.nv);
+  if (nd > 0) {
+    // dependent positions: converged Newton in double, then one Newton step in S,
+    // which carries the exact derivative (implicit function theorem) since phi ~ 0
+    Eigen::VectorXd zv(n);
+    for (int k = 0; k < n; ++k) zv[k] = ad_value(x[k]);
+    const Eigen::VectorXd dd = solve_dependent(zv);
+    for (int k = 0; k < nd; ++k) dq[dep[k]] = S(dd[k]);
+    constraint_terms<S>(m, d, integrate<S>(m, q_ref_.cast<S>(), dq), zero_v);
+    MatXT<S> Ja(nd, m.nv);
+    VecXT<S> phi(nd);
+    for (int k = 0; k < nd; ++k) {
+      Ja.row(k) = d.Jc.row(m.active_rows[k]);
+      phi[k] = d.phi[m.active_rows[k]];
+    }
+    MatXT<double> Jd_value(nd, nd);
+    for (int r = 0; r < nd; ++r)
+      for (int c = 0; c < nd; ++c) Jd_value(r, c) = ad_value(Ja(r, dep[c]));
+    const VecXT<S> step = lu_solve<S>(Jd_value.cast<S>(), MatXT<S>(phi)).col(0);
+    for (int k = 0; k < nd; ++k) dq[dep[k]] -= step[k];
+    // dependent velocities from Jc v = 0
+    constraint_terms<S>(m, d, integrate<S>(m, q_ref_.cast<S>(), dq), zero_v);
+    for (int k = 0; k < nd; ++k) Ja.row(k) = d.Jc.row(m.active_rows[k]);
+    const MatXT<S> Jd = columns_t<S>(Ja, dep), Jz = columns_t<S>(Ja, ind);
+    VecXT<S> w(n);
+    for (int k = 0; k < n; ++k) w[k] = x[n + k];
+    const VecXT<S> vd = -lu_solve<S>(Jd, MatXT<S>(Jz * w)).col(0);
+    for (int k = 0; k < nd; ++k) v[dep[k]] = vd[k];
+  }
+  const VecXT<S> q = integrate<S>(m, q_ref_.cast<S>(), dq);
+  VecXT<S> u_all = u_all_.cast<S>();
+  for (int k = 0; k < nu(); ++k) u_all[m.plant_inputs[k]] = u[k];
+  const VecXT<S> qdd = forward_dynamics<S>(m, d, q, v, u_all);
+  const VecXT<S> rate = tangent_rate<S>(m, dq, v);
+  xdot.resize(2 * n);
+  for (int k = 0; k < n; ++k) {
+    xdot[k] = rate[ind[k]];
+    xdot[n + k] = qdd[ind[k]];
+  }
+  forward_kinematics<S>(m, d, q, v);
+  y = sensor_outputs<S>(m, d, m.plant_outputs, q, v);
+}
+
+void PlantFunction::state_to_qv(const Eigen::VectorXd& x, Eigen::VectorXd& q, Eigen::VectorXd& v) const {
+  Eigen::VectorXd xd, y;
+  const int n = nz();
+  Eigen::VectorXd dq = Eigen::VectorXd::Zero(model_.nv);
+  for (int k = 0; k < n; ++k) dq[part_.independent[k]] = x[k];
+  if (!part_.dependent.empty()) {
+    const Eigen::VectorXd dd = solve_dependent(x.head(n));
+    for (std::size_t k = 0; k < part_.dependent.size(); ++k) dq[part_.dependent[k]] = dd[k];
+  }
+  q = integrate<double>(model_, q_ref_, dq);
+  v = Eigen::VectorXd::Zero(model_.nv);
+  for (int k = 0; k < n; ++k) v[part_.independent[k]] = x[n + k];
+  if (!part_.dependent.empty()) {
+    const Eigen::MatrixXd J = active_jacobian(model_, q);
+    const Eigen::VectorXd vd = -columns(J, part_.dependent).partialPivLu().solve(columns(J, part_.independent) * x.tail(n));
+    for (std::size_t k = 0; k < part_.dependent.size(); ++k) v[part_.dependent[k]] = vd[k];
+  }
+}
+
+Eigen::VectorXd PlantFunction::qv_to_state(const Eigen::VectorXd& q, const Eigen::VectorXd& v) const {
+  const Eigen::VectorXd dq = difference(model_, q_ref_, q);
+  const int n = nz();
+  Eigen::VectorXd x(2 * n);
+  for (int k = 0; k < n; ++k) {
+    x[k] = dq[part_.independent[k]];
+    x[n + k] = v[part_.independent[k]];
+  }
+  return x;
+}
+
+namespace {
+// joint of velocity index i, and the coordinate's place in it
+const JointModel& joint_of(const Model& m, int i, int& k) {
+  for (int b = 1; b < m.nbodies; ++b) {
+    const JointModel& j = m.joints[b];
+    if (i >= j.idx_v && i < j.idx_v + j.nv) {
+      k = i - j.idx_v;
+      return j;
+    }
+  }
+  throw std::logic_error("velocity index out of range");
+}
+}  // namespace
+
+std::vector<std::string> PlantFunction::state_names() const {
+  std::vector<std::string> pos, vel;
+  static const char* rot[] = {"rx", "ry", "rz"};
+  static const char* lin[] = {"dx", "dy", "dz"};
+  for (int i : part_.independent) {
+    int k = 0;
+    const JointModel& j = joint_of(model_, i, k);
+    if (j.type == JointType::Spherical) pos.push_back(j.name + "." + rot[k]);
+    else if (j.type == JointType::Free) pos.push_back(j.name + "." + (k < 3 ? rot[k] : lin[k - 3]));
+    else pos.push_back(model_.v_names[i]);
+    vel.push_back(j.type == JointType::Spherical || j.type == JointType::Free ? model_.v_names[i]
+                                                                              : model_.v_names[i] + "_dot");
+  }
+  pos.insert(pos.end(), vel.begin(), vel.end());
+  return pos;
+}
+
+std::vector<std::string> PlantFunction::state_units() const {
+  std::vector<std::string> pos, vel;
+  for (int i : part_.independent) {
+    pos.push_back(model_.v_units[i]);
+    vel.push_back(model_.v_units[i] + "/s");
+  }
+  pos.insert(pos.end(), vel.begin(), vel.end());
+  return pos;
+}
+
+Eigen::VectorXd PlantFunction::state_offset(const Eigen::VectorXd& v_ref) const {
+  const int n = nz();
+  Eigen::VectorXd x0 = Eigen::VectorXd::Zero(2 * n);
+  for (int k = 0; k < n; ++k) {
+    const int i = part_.independent[k];
+    int c = 0;
+    const JointModel& j = joint_of(model_, i, c);
+    // additive coordinates carry their absolute value; rotation/translation tangents of
+    // spherical and free joints are deviations from the reference pose (offset 0)
+    if (j.type != JointType::Spherical && j.type != JointType::Free) x0[k] = q_ref_[j.idx_q + c];
+    x0[n + k] = v_ref[i];
+  }
+  return x0;
+}
+
+template void PlantFunction::eval<double>(const VecXT<double>&, const VecXT<double>&, VecXT<double>&,
+                                          VecXT<double>&) const;
+template void PlantFunction::eval<ADScalar>(const VecXT<ADScalar>&, const VecXT<ADScalar>&, VecXT<ADScalar>&,
+                                            VecXT<ADScalar>&) const;
+
+}  // namespace codyna

@@ -1,0 +1,70 @@
+// The plant as a first-order system in minimal coordinates about a base
+// configuration q_ref:
+//   x = [z; w]   z: tangent deviation of the independent coordinates from q_ref
+//                w: the independent velocities
+//   xdot = f(x, u),  y = h(x, u)       u: values of the Plant/In actuators
+// For a tree every coordinate is independent. For closed loops the
+// independent coordinates come from coordinate partitioning of the constraint
+// Jacobian (or the user's choice); the dependent ones follow from phi(q) = 0
+// (Newton) and Jc v = 0. Rotations of spherical/free joints are tangent
+// vectors (right-trivialized: R = R_ref Exp(z)), never quaternion components.
+// eval is templated so that exact Jacobians come from automatic differentiation
+// through the same code; double and ADScalar are instantiated.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "model/data.hpp"
+
+namespace codyna {
+
+struct CoordinatePartition {
+  std::vector<int> independent;  // v indices, size DOF
+  std::vector<int> dependent;    // v indices, size = independent constraint rows
+};
+
+// Chooses independent coordinates at q: the dependent ones are the pivot
+// columns of a column-pivoted QR of the active constraint rows (the best
+// conditioned choice). `preferred` (coordinate names, Model::v_names) overrides
+// it; throws std::invalid_argument if a name is unknown, the count is not the
+// DOF, or the remaining coordinates cannot be solved from the constraints.
+CoordinatePartition partition_coordinates(const Model& model, const Eigen::VectorXd& q,
+                                          const std::vector<std::string>& preferred = {});
+
+class PlantFunction {
+ public:
+  // u_all: every actuator's value at the reference (plant inputs are replaced by eval's u)
+  PlantFunction(const Model& model, const Eigen::VectorXd& q_ref, const Eigen::VectorXd& u_all,
+                CoordinatePartition partition);
+
+  int nz() const { return static_cast<int>(part_.independent.size()); }
+  int nx() const { return 2 * nz(); }
+  int nu() const { return static_cast<int>(model_.plant_inputs.size()); }
+  int ny() const { return static_cast<int>(model_.plant_outputs.size()); }
+
+  template <class S>
+  void eval(const VecXT<S>& x, const VecXT<S>& u, VecXT<S>& xdot, VecXT<S>& y) const;
+
+  // the full configuration and velocity of state x (double)
+  void state_to_qv(const Eigen::VectorXd& x, Eigen::VectorXd& q, Eigen::VectorXd& v) const;
+  // x of a full (q, v) near q_ref: z = difference(q_ref, q)[independent], w = v[independent]
+  Eigen::VectorXd qv_to_state(const Eigen::VectorXd& q, const Eigen::VectorXd& v) const;
+
+  // names and units, in state order; absolute values of the additive coordinates at x = 0
+  std::vector<std::string> state_names() const;
+  std::vector<std::string> state_units() const;
+  Eigen::VectorXd state_offset(const Eigen::VectorXd& v_ref) const;
+
+  const CoordinatePartition& partition() const { return part_; }
+  const Eigen::VectorXd& u_all() const { return u_all_; }
+
+ private:
+  Eigen::VectorXd solve_dependent(const Eigen::VectorXd& z) const;  // tangent deviation of dependent coords
+
+  const Model& model_;
+  Eigen::VectorXd q_ref_, u_all_;
+  CoordinatePartition part_;
+};
+
+}  // namespace codyna

@@ -1,0 +1,262 @@
+// Linearization against the paper's closed forms (docs MISSION.md), exact
+// against finite differences, and a closed loop against an energy method.
+#include "analysis/linearize.hpp"
+
+#include <cmath>
+
+#include "analysis/operating_point.hpp"
+#include "dynamics/constraints.hpp"
+#include "dynamics/energy.hpp"
+#include "test_util.hpp"
+
+namespace codyna {
+namespace {
+
+using test::MatrixNear;
+constexpr double g = 9.81;
+
+TEST(Linearize, PaperPendulumUpright) {
+  const Model m = test::load_example("pendulum.json");
+  const OperatingPoint op = static_equilibrium(m, initial_point(m));  // starts 10 deg off upright
+  ASSERT_NEAR(op.q[0], M_PI / 2, 1e-12);
+  const double mass = 10, l = 2;
+  Eigen::MatrixXd A(2, 2), B(2, 1), C(1, 2), D = Eigen::MatrixXd::Zero(1, 1);
+  A << 0, 1, 3 * g / (2 * l), 0;
+  B << 0, 3 / (mass * l * l);
+  C << 1, 0;
+  const LinearSystem s = linearize(m, op).system;
+  EXPECT_TRUE(MatrixNear(s.A, A, 1e-10));
+  EXPECT_TRUE(MatrixNear(s.B, B, 1e-10));
+  EXPECT_TRUE(MatrixNear(s.C, C, 1e-10));
+  EXPECT_TRUE(MatrixNear(s.D, D, 1e-10));
+  EXPECT_NEAR(s.A(1, 0), 3 * g / 4, 1e-10 * 3 * g / 4);
+  EXPECT_NEAR(s.B(1, 0), 0.075, 1e-12);
+  EXPECT_NEAR(s.x0[0], M_PI / 2, 1e-12);
+  EXPECT_NEAR(s.y0[0], M_PI / 2, 1e-12);
+  EXPECT_EQ(s.state_names, (std::vector<std::string>{"pivot", "pivot_dot"}));
+  EXPECT_EQ(s.input_names, std::vector<std::string>{"torque"});
+  EXPECT_EQ(s.output_names, std::vector<std::string>{"theta"});
+}
+
+TEST(Linearize, PaperPendulumAwayFromEquilibrium) {
+  const Model m = test::load_example("pendulum.json");
+  const OperatingPoint op = initial_point(m);
+  const double th = op.q[0], l = 2;
+  const LinearSystem s = linearize(m, op).system;
+  EXPECT_NEAR(s.A(1, 0), 3 * g / (2 * l) * std::sin(th), 1e-10);
+  EXPECT_NEAR(s.xdot0[1], -3 * g / (2 * l) * std::cos(th), 1e-10);  // not at rest: xdot0 != 0
+  EXPECT_NEAR(s.xdot0[0], 0.0, 1e-15);
+}
+
+TEST(Linearize, PaperCartPendulumUpright) {
+  const Model m = test::load_example("cart_pendulum.json");
+  const OperatingPoint op = static_equilibrium(m, initial_point(m));
+  ASSERT_NEAR(op.q[1], 0.0, 1e-12);
+  const double m2 = 20, m3 = 10, l3 = 2, den = 4 * m2 + m3;
+  // states [h, theta, h_dot, theta_dot] (positions first); the paper orders them
+  // [h, h', theta, theta']: compare through the permutation
+  Eigen::MatrixXd Ap(4, 4), Bp(4, 1), Cp(2, 4);
+  Ap << 0, 1, 0, 0, 0, 0, -3 * m3 * g / den, 0, 0, 0, 0, 1, 0, 0, 6 * (m2 + m3) * g / (den * l3), 0;
+  Bp << 0, 4 / den, 0, -6 / (l3 * den);
+  Cp << 1, 0, 0, 0, 0, 0, 1, 0;
+  Eigen::PermutationMatrix<4> P;  // ours = P * paper
+  P.indices() << 0, 2, 1, 3;      // paper index -> our index
+  const LinearSystem s = linearize(m, op).system;
+  EXPECT_TRUE(MatrixNear(s.A, P * Ap * P.transpose(), 1e-10));
+  EXPECT_TRUE(MatrixNear(s.B, P * Bp, 1e-10));
+  EXPECT_TRUE(MatrixNear(s.C, Cp * P.transpose(), 1e-10));
+  EXPECT_TRUE(MatrixNear(s.D, Eigen::MatrixXd::Zero(2, 1), 1e-10));
+  EXPECT_EQ(s.state_names, (std::vector<std::string>{"cart_slider", "rod_pivot", "cart_slider_dot", "rod_pivot_dot"}));
+  EXPECT_EQ(s.output_names, (std::vector<std::string>{"h", "theta"}));
+}
+
+TEST(Linearize, FiniteDifferencesAgreeWithinTheirReportedAccuracy) {
+  const Model m = test::load_example("cart_pendulum.json");
+  const OperatingPoint op = static_equilibrium(m, initial_point(m));
+  const LinearSystem exact = linearize(m, op).system;
+  for (JacobianMethod method : {JacobianMethod::ForwardDifference, JacobianMethod::CentralDifference}) {
+    LinearizeOptions o;
+    o.method = method;
+    const Linearization fd = linearize(m, op, o);
+    EXPECT_GT(fd.fd_error, 0.0);
+    EXPECT_LT(fd.fd_error, method == JacobianMethod::CentralDifference ? 1e-8 : 1e-5);
+    const double tol = 1.01 * fd.fd_error;
+    EXPECT_TRUE(MatrixNear(fd.system.A, exact.A, tol * std::max(1.0, exact.A.cwiseAbs().maxCoeff())));
+    EXPECT_TRUE(MatrixNear(fd.system.B, exact.B, tol * std::max(1.0, exact.A.cwiseAbs().maxCoeff())));
+  }
+}
+
+// a random 3-D tree with ball and free joints, inputs and outputs of every kind
+ModelSpec random_plant(unsigned seed) {
+  ModelSpec s = test::random_tree_spec(seed, 10);
+  ActuatorSpec a;
+  a.name = "tau1";
+  a.type = ActuatorType::JointForce;
+  a.joint = "j1";
+  s.actuators.push_back(a);
+  a.name = "push";
+  a.type = ActuatorType::BodyForce;
+  a.body = "b4";
+  a.point = Eigen::Vector3d(0.1, 0.2, 0.3);
+  a.direction = Eigen::Vector3d(1, 2, 3);
+  a.in_world = false;
+  s.actuators.push_back(a);
+  SensorSpec y;
+  y.name = "p5";
+  y.type = SensorType::PointPosition;
+  y.body = "b5";
+  y.point = Eigen::Vector3d(0.3, 0, 0);
+  y.component = 2;
+  y.frame = "b1";
+  s.sensors.push_back(y);
+  y.name = "v6";
+  y.type = SensorType::PointVelocity;
+  y.body = "b6";
+  y.component = 0;
+  y.frame = kGroundName;
+  s.sensors.push_back(y);
+  y.name = "ang2";
+  y.type = SensorType::BodyAngle;
+  y.body = "b2";
+  y.axis = Eigen::Vector3d(0, 0, 1);
+  s.sensors.push_back(y);
+  y.name = "dist";
+  y.type = SensorType::Distance;
+  y.body_a = "b3";
+  y.body_b = "b8";
+  y.point_b = Eigen::Vector3d(0.1, 0.1, 0.1);
+  s.sensors.push_back(y);
+  y.name = "w1";
+  y.type = SensorType::JointVelocity;
+  y.joint = "j1";
+  s.sensors.push_back(y);
+  s.plant.inputs = {"tau1", "push"};
+  s.plant.outputs = {"p5", "v6", "ang2", "dist", "w1"};
+  EffectSpec e;
+  e.name = "spring";
+  e.type = EffectType::SpringDamper;
+  e.body_a = "b3";
+  e.body_b = "b7";
+  e.stiffness = 50;
+  e.damping = 2;
+  e.rest_length = 0.1;
+  s.effects.push_back(e);
+  e.name = "fric";
+  e.type = EffectType::JointFriction;
+  e.joint = "j4";  // universal: two coordinates
+  e.dof = 1;
+  e.damping = 0.3;
+  s.effects.push_back(e);
+  return s;
+}
+
+TEST(Linearize, ExactMatchesCentralDifferencesOnRandom3DTree) {
+  for (unsigned seed : {91u, 92u}) {
+    const Model m = compile(random_plant(seed));
+    std::mt19937 rng(seed);
+    OperatingPoint op = initial_point(m);
+    op.q = test::random_q(m, rng);
+    op.v = test::random_v(m, rng, 1.0);
+    op.u << 0.7, -1.3;
+    const PlantFunction f(m, op.q, op.u, partition_coordinates(m, op.q));
+    // at a point with non-zero tangent deviation too, where the rotation maps are not identity
+    Eigen::VectorXd x(f.nx());
+    for (int k = 0; k < f.nz(); ++k) x[f.nz() + k] = op.v[k];
+    x.head(f.nz()) = test::random_v(m, rng, 0.3);
+    const Eigen::VectorXd u = Eigen::Vector2d(0.7, -1.3);
+    const Eigen::MatrixXd Je = plant_jacobian(f, x, u, JacobianMethod::Exact);
+    const Eigen::MatrixXd Jc = plant_jacobian(f, x, u, JacobianMethod::CentralDifference);
+    EXPECT_TRUE(MatrixNear(Jc, Je, 1e-7)) << "seed " << seed;
+  }
+}
+
+TEST(Linearize, ExactMatchesCentralDifferencesOnFourBar) {
+  const Model m = test::load_example("four_bar.json");
+  const PlantFunction f(m, m.q0, m.u_nominal(), partition_coordinates(m, m.q0));
+  ASSERT_EQ(f.nz(), 1);
+  for (double z : {0.0, 0.2}) {
+    const Eigen::VectorXd x = Eigen::Vector2d(z, 1.3), u = Eigen::VectorXd::Constant(f.nu(), 0.4);
+    EXPECT_TRUE(MatrixNear(plant_jacobian(f, x, u, JacobianMethod::CentralDifference),
+                           plant_jacobian(f, x, u, JacobianMethod::Exact), 1e-7));
+  }
+}
+
+TEST(Linearize, ChoosableIndependentCoordinates) {
+  const Model m = test::load_example("four_bar.json");
+  LinearizeOptions o;
+  o.independent = {m.v_names[2]};
+  const Linearization a = linearize(m, initial_point(m), o);
+  EXPECT_EQ(a.system.state_names[0], m.v_names[2]);
+  o.independent = {"nonexistent"};
+  EXPECT_THROW(linearize(m, initial_point(m), o), std::invalid_argument);
+}
+
+// Four-bar with a crank spring about its static equilibrium: the frequency
+// from A equals sqrt(V''/m) computed from the potential and kinetic energy
+// along the one-parameter family of assembled configurations.
+TEST(Linearize, FourBarFrequencyMatchesEnergyMethod) {
+  const Model m = test::load_example("four_bar.json");
+  const OperatingPoint op = static_equilibrium(m, initial_point(m));
+  ASSERT_LT(op.residual, 1e-10);
+  const LinearSystem s = linearize(m, op).system;
+  ASSERT_EQ(s.nx(), 2);
+  const double w2_lin = -s.A(1, 0);
+  ASSERT_GT(w2_lin, 0.0);
+
+  // energy method, independent of the dynamics: solve the loop for a crank angle
+  // (Newton with a finite-difference Jacobian on the two other joints)
+  const int crank = m.joints[m.find_joint(s.state_names[0])].idx_q;
+  auto configuration = [&](double th) {
+    Eigen::VectorXd q = op.q;
+    q[crank] = th;
+    Data d(m);
+    std::vector<int> other;
+    for (int i = 0; i < m.nq; ++i)
+      if (i != crank) other.push_back(i);
+    for (int it = 0; it < 30; ++it) {
+      const Eigen::VectorXd phi = constraint_residual<double>(m, d, q);
+      Eigen::MatrixXd J(phi.size(), 2);
+      for (int k = 0; k < 2; ++k) {
+        Eigen::VectorXd qp = q;
+        qp[other[k]] += 1e-7;
+        J.col(k) = (constraint_residual<double>(m, d, qp) - phi) / 1e-7;
+      }
+      const Eigen::VectorXd dx = J.colPivHouseholderQr().solve(phi);
+      q[other[0]] -= dx[0];
+      q[other[1]] -= dx[1];
+    }
+    return q;
+  };
+  auto V = [&](double th) {
+    Data d(m);
+    return potential_energy<double>(m, d, configuration(th));
+  };
+  const double th0 = op.q[crank], h = 1e-4;
+  EXPECT_NEAR((V(th0 + h) - V(th0 - h)) / (2 * h), 0.0, 1e-6);  // it is an equilibrium
+  const double Vpp = (V(th0 + h) - 2 * V(th0) + V(th0 - h)) / (h * h);
+  const Eigen::VectorXd v = (configuration(th0 + 1e-6) - configuration(th0 - 1e-6)) / 2e-6;  // unit crank rate
+  Data d(m);
+  const double mass = 2 * kinetic_energy<double>(m, d, op.q, v);
+  EXPECT_NEAR(w2_lin, Vpp / mass, 1e-5 * w2_lin);
+}
+
+TEST(OperatingPoint, TrimHoldsThePendulumAtEightyDegrees) {
+  const Model m = test::load_example("pendulum.json");
+  const OperatingPoint op = trim(m, initial_point(m));
+  const double mass = 10, l = 2;
+  EXPECT_NEAR(op.u[0], mass * g * l / 2 * std::cos(op.q[0]), 1e-10);
+  EXPECT_LT(op.residual, 1e-12);
+  EXPECT_NEAR(op.q[0], m.q0[0], 0.0);
+}
+
+TEST(OperatingPoint, EquilibriumKeepsNeutralCoordinates) {
+  const Model m = test::load_example("cart_pendulum.json");
+  OperatingPoint start = initial_point(m);
+  start.q[0] = 0.75;  // cart position is neutral: any h is an equilibrium
+  const OperatingPoint op = static_equilibrium(m, start);
+  EXPECT_NEAR(op.q[0], 0.75, 1e-12);
+  EXPECT_NEAR(op.q[1], 0.0, 1e-12);
+}
+
+}  // namespace
+}  // namespace codyna
