@@ -1,7 +1,165 @@
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include "analysis/discretize.hpp"
+#include "analysis/linearize.hpp"
+#include "analysis/modal.hpp"
+#include "analysis/operating_point.hpp"
 #include "commands.hpp"
+#include "common.hpp"
+#include "dynamics/assembly.hpp"
+#include "io/mat_export.hpp"
+#include "simulation/reference_integrator.hpp"
 
 namespace codyna::cli {
 
-void add_linearize(CLI::App& app) { (void)app; }
+namespace {
+
+struct LinearizeArgs {
+  std::string model, out, op = "initial", method = "exact", mat_version = "5", name;
+  double discrete = 0.0;
+  std::vector<std::string> independent, set;
+};
+
+void print_matrix(const char* label, const Eigen::MatrixXd& M, const std::vector<std::string>& rows,
+                  const std::vector<std::string>& cols) {
+  std::cout << label << " (" << M.rows() << " x " << M.cols() << ")\n";
+  if (M.size() == 0) return;
+  std::size_t w = 8;
+  for (const auto& r : rows) w = std::max(w, r.size() + 1);
+  std::cout << std::setw(static_cast<int>(w)) << "";
+  for (const auto& c : cols) std::cout << std::setw(14) << c.substr(0, 13);
+  std::cout << "\n";
+  for (Eigen::Index i = 0; i < M.rows(); ++i) {
+    std::cout << std::left << std::setw(static_cast<int>(w)) << rows[i] << std::right;
+    for (Eigen::Index j = 0; j < M.cols(); ++j) std::cout << std::setw(14) << std::setprecision(6) << M(i, j);
+    std::cout << "\n";
+  }
+}
+
+// applies --set NAME=VALUE to joint coordinates, then re-assembles loops
+Model with_settings(Model m, const std::vector<std::string>& set) {
+  if (set.empty()) return m;
+  for (const std::string& s : set) {
+    const auto eq = s.find('=');
+    if (eq == std::string::npos) throw std::invalid_argument("--set " + s + ": expected NAME=VALUE");
+    const std::string name = s.substr(0, eq);
+    double value;
+    try {
+      value = std::stod(s.substr(eq + 1));
+    } catch (const std::exception&) {
+      throw std::invalid_argument("--set " + s + ": expected a number after '='");
+    }
+    const auto it = std::find(m.q_names.begin(), m.q_names.end(), name);
+    if (it == m.q_names.end()) {
+      std::string all;
+      for (const auto& n : m.q_names) all += (all.empty() ? "" : ", ") + n;
+      throw std::invalid_argument("--set " + s + ": unknown coordinate \"" + name + "\" (coordinates: " + all + ")");
+    }
+    m.q0[it - m.q_names.begin()] = value;
+  }
+  const AssemblyResult r = assemble(m, m.q0, m.v0);
+  if (!r.converged) throw std::invalid_argument("--set: the loops cannot be assembled at the given coordinates");
+  m.q0 = r.q;
+  m.v0 = r.v;
+  return m;
+}
+
+OperatingPoint operating_point(const Model& m, const LinearizeArgs& a) {
+  const OperatingPoint start = initial_point(m);
+  if (a.op == "initial") return start;
+  if (a.op == "equilibrium") return static_equilibrium(m, start, a.independent);
+  if (a.op == "trim") return trim(m, start, a.independent);
+  if (a.op.rfind("time=", 0) == 0) {
+    double t;
+    try {
+      t = std::stod(a.op.substr(5));
+    } catch (const std::exception&) {
+      throw std::invalid_argument("--operating-point " + a.op + ": expected time=T with T a number of seconds");
+    }
+    if (!(t >= 0)) throw std::invalid_argument("--operating-point: the time must be >= 0");
+    // the state reached at t with the actuators at their nominal values (reference RK4, 1 ms steps or finer)
+    const int n = static_cast<int>(std::ceil(t / std::min(1e-3, m.spec.solver.output_step)));
+    State x{m.q0, m.v0};
+    if (n > 0) x = rk4_integrate(m, x, start.u, t / n, n);
+    return snapshot_point(m, t, x.q, x.v, start.u);
+  }
+  throw std::invalid_argument("--operating-point " + a.op + ": expected initial, equilibrium, trim or time=T");
+}
+
+JacobianMethod method_of(const std::string& s) {
+  if (s == "exact") return JacobianMethod::Exact;
+  if (s == "fd-forward") return JacobianMethod::ForwardDifference;
+  if (s == "fd-central") return JacobianMethod::CentralDifference;
+  throw std::invalid_argument("--method " + s + ": expected exact, fd-forward or fd-central");
+}
+
+void run(const LinearizeArgs& a) {
+  const Model m = with_settings(load_model(a.model), a.set);
+  if (m.plant_inputs.empty() && m.plant_outputs.empty())
+    std::cerr << "codyna: warning: the model selects no Plant/In or Plant/Out; exporting the state equations only\n";
+  const OperatingPoint op = operating_point(m, a);
+  LinearizeOptions opt;
+  opt.method = method_of(a.method);
+  opt.independent = a.independent;
+  const Linearization lin = linearize(m, op, opt);
+  LinearSystem sys = lin.system;
+  if (a.discrete > 0) sys = discretize_zoh(sys, a.discrete);
+  else if (a.discrete < 0) throw std::invalid_argument("--discrete: the sample time must be positive");
+  const MatVersion version = a.mat_version == "7.3" ? MatVersion::V73 : MatVersion::V5;
+  if (a.mat_version != "5" && a.mat_version != "7.3") throw std::invalid_argument("--mat-version: expected 5 or 7.3");
+
+  std::cout << "model            " << m.name << " (" << m.dof() << " DOF)\n"
+            << "operating point  " << op.kind;
+  if (op.kind != "initial") std::cout << " (residual " << op.residual << ", " << op.iterations << " iterations)";
+  std::cout << "\nmethod           " << to_string(opt.method);
+  if (opt.method != JacobianMethod::Exact) std::cout << " (max relative difference from exact: " << lin.fd_error << ")";
+  std::cout << "\ntime             " << (sys.Ts > 0 ? "discrete, Ts = " + std::to_string(sys.Ts) : std::string("continuous")) << "\n";
+  if (!lin.partition.dependent.empty()) {
+    std::cout << "independent      ";
+    for (std::size_t k = 0; k < lin.partition.independent.size(); ++k)
+      std::cout << (k ? ", " : "") << m.v_names[lin.partition.independent[k]];
+    std::cout << "\n";
+  }
+  std::cout << "\n";
+  auto labelled = [](const std::vector<std::string>& names, const Eigen::VectorXd& v) {
+    std::ostringstream os;
+    for (std::size_t k = 0; k < names.size(); ++k) os << "  " << names[k] << " = " << v[k] << "\n";
+    return os.str();
+  };
+  std::cout << "x0\n" << labelled(sys.state_names, sys.x0) << "u0\n" << labelled(sys.input_names, sys.u0)
+            << "y0\n" << labelled(sys.output_names, sys.y0) << "xdot0\n" << labelled(sys.state_names, sys.xdot0) << "\n";
+  print_matrix("A", sys.A, sys.state_names, sys.state_names);
+  print_matrix("B", sys.B, sys.state_names, sys.input_names);
+  print_matrix("C", sys.C, sys.output_names, sys.state_names);
+  print_matrix("D", sys.D, sys.output_names, sys.input_names);
+  std::cout << "\n" << format_modes(modal_analysis(sys)) << "\n";
+
+  std::filesystem::create_directories(a.out);
+  const std::string name = a.name.empty() ? matlab_identifier(m.name) : a.name;
+  if (name != matlab_identifier(name))
+    throw std::invalid_argument("--name " + name + ": not a valid MATLAB identifier (try " + matlab_identifier(name) + ")");
+  const ExportPaths p = export_plant(sys, a.out, name, version);
+  std::cout << "wrote " << p.mat_file << "\nwrote " << p.m_file << "\n";
+}
+
+}  // namespace
+
+void add_linearize(CLI::App& app) {
+  auto a = std::make_shared<LinearizeArgs>();
+  auto* cmd = app.add_subcommand("linearize", "Linearize the plant (Plant/In -> Plant/Out) and export NAME.mat + NAME.m");
+  cmd->add_option("model", a->model, "model file (JSON)")->required();
+  cmd->add_option("--out", a->out, "output directory (created if missing)")->required();
+  cmd->add_option("--operating-point", a->op, "initial | equilibrium | trim | time=T")->capture_default_str();
+  cmd->add_option("--method", a->method, "exact | fd-forward | fd-central")->capture_default_str();
+  cmd->add_option("--discrete", a->discrete, "sample time Ts > 0: exact zero-order-hold discrete model");
+  cmd->add_option("--mat-version", a->mat_version, "5 | 7.3")->capture_default_str();
+  cmd->add_option("--independent", a->independent, "closed loops: independent coordinate names")->delimiter(',');
+  cmd->add_option("--set", a->set, "NAME=VALUE: set a joint coordinate of the initial state (repeatable)");
+  cmd->add_option("--name", a->name, "plant name (default: the model name as a MATLAB identifier)");
+  cmd->callback([a] { set_exit_code(run_guarded([&] { run(*a); })); });
+}
 
 }  // namespace codyna::cli
