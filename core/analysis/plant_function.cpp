@@ -6,6 +6,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "dynamics/assembly.hpp"
 #include "dynamics/constraints.hpp"
 #include "dynamics/forward_dynamics.hpp"
 #include "dynamics/joint.hpp"
@@ -18,11 +19,19 @@ namespace codyna {
 
 namespace {
 
-Eigen::MatrixXd active_jacobian(const Model& m, const Eigen::VectorXd& q) {
+// the constraint rows that are independent at q (redundancy can move between rows)
+std::vector<int> independent_rows(const Model& m, const Eigen::VectorXd& q) {
+  if (m.nc == 0) return {};
   Data d(m);
   constraint_terms<double>(m, d, q, Eigen::VectorXd::Zero(m.nv));
-  Eigen::MatrixXd J(m.active_rows.size(), m.nv);
-  for (std::size_t k = 0; k < m.active_rows.size(); ++k) J.row(k) = d.Jc.row(m.active_rows[k]);
+  return partition_rows(d.Jc, 1e-9, static_cast<int>(m.active_rows.size())).independent;
+}
+
+Eigen::MatrixXd active_jacobian(const Model& m, const Eigen::VectorXd& q, const std::vector<int>& rows) {
+  Data d(m);
+  constraint_terms<double>(m, d, q, Eigen::VectorXd::Zero(m.nv));
+  Eigen::MatrixXd J(rows.size(), m.nv);
+  for (std::size_t k = 0; k < rows.size(); ++k) J.row(k) = d.Jc.row(rows[k]);
   return J;
 }
 
@@ -44,14 +53,15 @@ MatXT<S> columns_t(const MatXT<S>& J, const std::vector<int>& cols) {
 CoordinatePartition partition_coordinates(const Model& m, const Eigen::VectorXd& q,
                                           const std::vector<std::string>& preferred) {
   CoordinatePartition p;
-  if (m.active_rows.empty()) {
+  const std::vector<int> rows = independent_rows(m, q);
+  if (rows.empty()) {
     for (int i = 0; i < m.nv; ++i) p.independent.push_back(i);
     if (!preferred.empty() && static_cast<int>(preferred.size()) != m.nv)
       throw std::invalid_argument("independent coordinates: a tree model has all " + std::to_string(m.nv) +
                                   " coordinates independent");
     return p;
   }
-  const Eigen::MatrixXd J = active_jacobian(m, q);
+  const Eigen::MatrixXd J = active_jacobian(m, q, rows);
   if (preferred.empty()) {
     Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(J);
     const auto& perm = qr.colsPermutation().indices();
@@ -82,7 +92,10 @@ CoordinatePartition partition_coordinates(const Model& m, const Eigen::VectorXd&
 
 PlantFunction::PlantFunction(const Model& model, const Eigen::VectorXd& q_ref, const Eigen::VectorXd& u_all,
                              CoordinatePartition partition)
-    : model_(model), q_ref_(q_ref), u_all_(u_all), part_(std::move(partition)) {}
+    : model_(model), q_ref_(q_ref), u_all_(u_all), part_(std::move(partition)), rows_(independent_rows(model, q_ref)) {
+  if (rows_.size() != part_.dependent.size())
+    throw std::invalid_argument("coordinate partition does not match the constraints at the reference configuration");
+}
 
 Eigen::VectorXd PlantFunction::solve_dependent(const Eigen::VectorXd& z) const {
   const int nd = static_cast<int>(part_.dependent.size());
@@ -95,8 +108,8 @@ Eigen::VectorXd PlantFunction::solve_dependent(const Eigen::VectorXd& z) const {
     Eigen::VectorXd phi(nd);
     Eigen::MatrixXd J(nd, model_.nv);
     for (int k = 0; k < nd; ++k) {
-      phi[k] = d.phi[model_.active_rows[k]];
-      J.row(k) = d.Jc.row(model_.active_rows[k]);
+      phi[k] = d.phi[rows_[k]];
+      J.row(k) = d.Jc.row(rows_[k]);
     }
     if (phi.lpNorm<Eigen::Infinity>() < 1e-14) break;
     const Eigen::VectorXd step = columns(J, part_.dependent).partialPivLu().solve(phi);
@@ -131,8 +144,8 @@ void PlantFunction::eval(const VecXT<S>& x, const VecXT<S>& u, VecXT<S>& xdot, V
     MatXT<S> Ja(nd, m.nv);
     VecXT<S> phi(nd);
     for (int k = 0; k < nd; ++k) {
-      Ja.row(k) = d.Jc.row(m.active_rows[k]);
-      phi[k] = d.phi[m.active_rows[k]];
+      Ja.row(k) = d.Jc.row(rows_[k]);
+      phi[k] = d.phi[rows_[k]];
     }
     MatXT<double> Jd_value(nd, nd);
     for (int r = 0; r < nd; ++r)
@@ -141,7 +154,7 @@ void PlantFunction::eval(const VecXT<S>& x, const VecXT<S>& u, VecXT<S>& xdot, V
     for (int k = 0; k < nd; ++k) dq[dep[k]] -= step[k];
     // dependent velocities from Jc v = 0
     constraint_terms<S>(m, d, integrate<S>(m, q_ref_.cast<S>(), dq), zero_v);
-    for (int k = 0; k < nd; ++k) Ja.row(k) = d.Jc.row(m.active_rows[k]);
+    for (int k = 0; k < nd; ++k) Ja.row(k) = d.Jc.row(rows_[k]);
     const MatXT<S> Jd = columns_t<S>(Ja, dep), Jz = columns_t<S>(Ja, ind);
     VecXT<S> w(n);
     for (int k = 0; k < n; ++k) w[k] = x[n + k];
@@ -175,7 +188,7 @@ void PlantFunction::state_to_qv(const Eigen::VectorXd& x, Eigen::VectorXd& q, Ei
   v = Eigen::VectorXd::Zero(model_.nv);
   for (int k = 0; k < n; ++k) v[part_.independent[k]] = x[n + k];
   if (!part_.dependent.empty()) {
-    const Eigen::MatrixXd J = active_jacobian(model_, q);
+    const Eigen::MatrixXd J = active_jacobian(model_, q, rows_);
     const Eigen::VectorXd vd = -columns(J, part_.dependent).partialPivLu().solve(columns(J, part_.independent) * x.tail(n));
     for (std::size_t k = 0; k < part_.dependent.size(); ++k) v[part_.dependent[k]] = vd[k];
   }

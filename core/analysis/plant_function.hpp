@@ -65,6 +65,7 @@ class PlantFunction {
   const Model& model_;
   Eigen::VectorXd q_ref_, u_all_;
   CoordinatePartition part_;
+  std::vector<int> rows_;  // constraint rows independent at q_ref
 };
 
 }  // namespace codyna

@@ -8,6 +8,18 @@
 
 namespace codyna {
 
+namespace {
+// minimum-norm least-squares solve that treats nearly dependent rows as dependent:
+// off the manifold a redundant constraint row is only almost dependent, and a
+// plain solve would divide by its tiny singular value
+Eigen::VectorXd min_norm_solve(const Eigen::MatrixXd& J, const Eigen::VectorXd& b) {
+  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod;
+  cod.setThreshold(1e-9);
+  cod.compute(J);
+  return cod.solve(b);
+}
+}  // namespace
+
 AssemblyResult assemble(const Model& model, const Eigen::VectorXd& q_guess, const Eigen::VectorXd& v_guess,
                         const AssemblyOptions& opt) {
   AssemblyResult r;
@@ -25,7 +37,7 @@ AssemblyResult assemble(const Model& model, const Eigen::VectorXd& q_guess, cons
   for (r.iterations = 0; r.iterations < opt.max_iterations; ++r.iterations) {
     if (phi.lpNorm<Eigen::Infinity>() <= opt.tolerance) break;
     constraint_terms<double>(model, d, r.q, zero_v);
-    const Eigen::VectorXd step = -Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(d.Jc).solve(phi);
+    const Eigen::VectorXd step = -min_norm_solve(d.Jc, phi);
     double t = 1.0;
     bool improved = false;
     for (int k = 0; k < 30; ++k, t *= 0.5) {
@@ -46,18 +58,18 @@ AssemblyResult assemble(const Model& model, const Eigen::VectorXd& q_guess, cons
   if (phi.size()) phi.cwiseAbs().maxCoeff(&r.worst_row);
   constraint_terms<double>(model, d, r.q, zero_v);
   const Eigen::MatrixXd J = d.Jc;
-  r.v = r.v - Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(J).solve(J * r.v);
+  r.v = r.v - min_norm_solve(J, J * r.v);
   r.velocity_residual = (J * r.v).lpNorm<Eigen::Infinity>();
   r.converged = r.position_residual <= std::max(opt.tolerance, 1e-10) && r.velocity_residual <= 1e-8 * (1.0 + r.v.norm());
   return r;
 }
 
-RowPartition partition_rows(const Eigen::MatrixXd& Jc, double relative_tolerance) {
+RowPartition partition_rows(const Eigen::MatrixXd& Jc, double relative_tolerance, int fixed_rank) {
   RowPartition p;
   if (Jc.rows() == 0) return p;
   Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Jc.transpose());
   qr.setThreshold(relative_tolerance);
-  const Eigen::Index rank = qr.rank();
+  const Eigen::Index rank = fixed_rank >= 0 ? fixed_rank : qr.rank();
   const auto& perm = qr.colsPermutation().indices();
   for (Eigen::Index k = 0; k < perm.size(); ++k) (k < rank ? p.independent : p.redundant).push_back(perm[k]);
   std::sort(p.independent.begin(), p.independent.end());

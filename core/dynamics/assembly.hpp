@@ -29,10 +29,13 @@ AssemblyResult assemble(const Model& model, const Eigen::VectorXd& q_guess, cons
                         const AssemblyOptions& options = {});
 
 // Rows of Jc (nc x nv) that are linearly independent (kept) and those that
-// depend on them (redundant), by QR with column pivoting of Jc^T.
+// depend on them (redundant), by QR with column pivoting of Jc^T. With rank >= 0
+// the best `rank` rows are kept whatever the numerical rank: off the constraint
+// manifold a redundant row is only nearly dependent, and taking it would make
+// the dynamics ill-conditioned, so the dynamics keep the rank found at assembly.
 struct RowPartition {
   std::vector<int> independent, redundant;
 };
-RowPartition partition_rows(const Eigen::MatrixXd& Jc, double relative_tolerance = 1e-9);
+RowPartition partition_rows(const Eigen::MatrixXd& Jc, double relative_tolerance = 1e-9, int rank = -1);
 
 }  // namespace codyna

@@ -2,7 +2,8 @@
 // multipliers lambda for state (q, v) and actuator values u (one per actuator):
 //   M qdd + nle(q, v) = Q(q, v, u) - Jc^T lambda,   Jc qdd + gamma = -stab
 // Trees use ABA (O(n)); closed loops use CRBA + the constraint terms and the
-// Schur complement on the independent (non-redundant) rows. Redundant rows get
+// Schur complement on the rows that are independent at (q) (chosen anew at each
+// call: redundancy can move between rows along a motion). Redundant rows get
 // lambda = 0. `stab` is an optional Baumgarte term 2 alpha Jc v + beta^2 phi.
 // Writes everything the algorithms it calls write; returns data.qdd.
 #pragma once

@@ -27,6 +27,10 @@
 #include "test_util.hpp"
 
 namespace codyna {
+
+// readable parameter values in test names (found by ADL, so outside the unnamed namespace)
+static void PrintTo(MatVersion v, std::ostream* os) { *os << (v == MatVersion::V5 ? "v5" : "v7.3"); }
+
 namespace {
 
 namespace fs = std::filesystem;

@@ -1,0 +1,158 @@
+#include "simulation/closed_loop.hpp"
+
+#include <Eigen/SVD>
+#include <algorithm>
+
+#include "dynamics/assembly.hpp"
+#include "dynamics/constraints.hpp"
+#include "dynamics/crba.hpp"
+#include "dynamics/effects.hpp"
+#include "dynamics/joint.hpp"
+#include "dynamics/kinematics.hpp"
+#include "dynamics/rnea.hpp"
+#include "dynamics/sensors.hpp"
+#include "spatial/autodiff.hpp"
+
+namespace codyna {
+
+ClosedLoopSystem::ClosedLoopSystem(const Model& model, const Controller* controller, const PlantFunction* plant,
+                                   const Eigen::VectorXd& x_ref, const Eigen::VectorXd& u_nominal, Baumgarte stab)
+    : model_(model), controller_(controller), plant_(plant), x_ref_(x_ref), u_nominal_(u_nominal), stab_(stab),
+      data_(model) {
+  if (controller_ && controller_->sample_time() == 0) continuous_states_ = controller_->nxc();
+  if (controller_ && controller_->needs_state() && !plant_)
+    throw std::invalid_argument("state feedback needs the plant's linearization (its state order)");
+}
+
+ControllerInput ClosedLoopSystem::measure(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v) const {
+  ControllerInput in;
+  in.t = t;
+  const auto& out = model_.plant_outputs;
+  if (controller_ && controller_->needs_rates()) {
+    // outputs and their rates in one pass: q(s) = q (+) s v, derivative at s = 0
+    ADVec dq(model_.nv), va(model_.nv);
+    for (int i = 0; i < model_.nv; ++i) {
+      dq[i] = ADScalar(0.0, Eigen::VectorXd::Constant(1, v[i]));
+      va[i] = ADScalar(v[i], Eigen::VectorXd::Zero(1));
+    }
+    DataT<ADScalar> d(model_);
+    const ADVec qa = integrate<ADScalar>(model_, q.cast<ADScalar>(), dq);
+    forward_kinematics<ADScalar>(model_, d, qa, va);
+    const ADVec y = sensor_outputs<ADScalar>(model_, d, out, qa, va);
+    in.y.resize(y.size());
+    in.ydot.resize(y.size());
+    for (Eigen::Index k = 0; k < y.size(); ++k) {
+      in.y[k] = y[k].value();
+      in.ydot[k] = y[k].derivatives().size() ? y[k].derivatives()[0] : 0.0;
+    }
+  } else {
+    forward_kinematics<double>(model_, data_, q, v);
+    in.y = sensor_outputs<double>(model_, data_, out, q, v);
+  }
+  if (controller_ && controller_->needs_state()) in.x = plant_->qv_to_state(q, v) - x_ref_;
+  return in;
+}
+
+Eigen::VectorXd ClosedLoopSystem::saturate(Eigen::VectorXd u) const {
+  for (int k = 0; k < model_.nu(); ++k) u[k] = std::clamp(u[k], model_.actuators[k].min, model_.actuators[k].max);
+  return u;
+}
+
+Eigen::VectorXd ClosedLoopSystem::inputs(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+                                         const Eigen::VectorXd& xc) const {
+  Eigen::VectorXd u = u_nominal_;
+  if (!controller_) return saturate(u);
+  Eigen::VectorXd up;
+  if (controller_->sample_time() > 0) {
+    if (!held_) return saturate(u);
+    up = *held_;
+  } else {
+    up = controller_->output(measure(t, q, v), xc);
+  }
+  for (std::size_t k = 0; k < model_.plant_inputs.size(); ++k) u[model_.plant_inputs[k]] = up[k];
+  return saturate(u);
+}
+
+void ClosedLoopSystem::rhs(double t, const Eigen::VectorXd& y, Eigen::VectorXd& ydot) {
+  ++evaluations_;
+  const int nq = model_.nq, nv = model_.nv, nx = nxc();
+  const Eigen::VectorXd q = y.head(nq), v = y.segment(nq, nv), xc = y.tail(nx);
+  const Eigen::VectorXd u = inputs(t, q, v, xc);
+  ydot.resize(ode_size());
+  ydot.head(nq) = qdot<double>(model_, q, v);
+  ydot.segment(nq, nv) = forward_dynamics<double>(model_, data_, q, v, u, stab_);
+  if (nx) ydot.tail(nx) = controller_->update(measure(t, q, v), xc);
+}
+
+void ClosedLoopSystem::residual(double t, const Eigen::VectorXd& Y, const Eigen::VectorXd& Yp, Eigen::VectorXd& F) {
+  ++evaluations_;
+  const int nq = model_.nq, nv = model_.nv, nx = nxc(), n = na();
+  const Eigen::VectorXd q = Y.head(nq), v = Y.segment(nq, nv), xc = Y.segment(nq + nv, nx);
+  const Eigen::VectorXd vp = Yp.segment(nq, nv);
+  const Eigen::VectorXd u = inputs(t, q, v, xc);
+  F.resize(dae_size());
+  F.head(nq) = Yp.head(nq) - qdot<double>(model_, q, v);
+  forward_kinematics<double>(model_, data_, q, v);
+  const Eigen::VectorXd Q = applied_forces<double>(model_, data_, q, v, u);
+  const Eigen::MatrixXd M = crba<double>(model_, data_, q);
+  const Eigen::VectorXd h = nonlinear_effects<double>(model_, data_, q, v);
+  Eigen::VectorXd dyn = M * vp + h - Q;
+  if (n) {
+    constraint_terms<double>(model_, data_, q, v);
+    const Eigen::VectorXd lambda = Y.tail(n);
+    for (int k = 0; k < n; ++k) {
+      const int r = rows_[k];
+      dyn += data_.Jc.row(r).transpose() * lambda[k];
+      F[ode_size() + k] = data_.Jc.row(r).dot(vp) + data_.gamma[r] + 2.0 * stab_.alpha * data_.Jc.row(r).dot(v) +
+                          stab_.beta * stab_.beta * data_.phi[r];
+    }
+  }
+  F.segment(nq, nv) = dyn;
+  if (nx) F.segment(nq + nv, nx) = Yp.segment(nq + nv, nx) - controller_->update(measure(t, q, v), xc);
+}
+
+void ClosedLoopSystem::consistent(double t, const Eigen::VectorXd& y, Eigen::VectorXd& Y, Eigen::VectorXd& Yp) {
+  Eigen::VectorXd yd;
+  rhs(t, y, yd);
+  Y.resize(dae_size());
+  Yp = Eigen::VectorXd::Zero(dae_size());
+  Y.head(ode_size()) = y;
+  Yp.head(ode_size()) = yd;
+  if (na()) {
+    constraint_terms<double>(model_, data_, y.head(model_.nq), y.segment(model_.nq, model_.nv));
+    rows_ = partition_rows(data_.Jc, 1e-9, na()).independent;
+    rhs(t, y, yd);  // multipliers for these rows
+  }
+  for (int k = 0; k < na(); ++k) Y[ode_size() + k] = data_.lambda[rows_[k]];
+}
+
+bool ClosedLoopSystem::rows_degraded(const Eigen::VectorXd& q) {
+  if (rows_.empty()) return false;
+  constraint_terms<double>(model_, data_, q, Eigen::VectorXd::Zero(model_.nv));
+  Eigen::MatrixXd Ja(rows_.size(), model_.nv);
+  for (std::size_t k = 0; k < rows_.size(); ++k) Ja.row(k) = data_.Jc.row(rows_[k]);
+  const Eigen::VectorXd s_all = Eigen::JacobiSVD<Eigen::MatrixXd>(data_.Jc).singularValues();
+  const Eigen::VectorXd s_rows = Eigen::JacobiSVD<Eigen::MatrixXd>(Ja).singularValues();
+  return s_rows[s_rows.size() - 1] < 0.3 * s_all[rows_.size() - 1];
+}
+
+std::pair<double, double> ClosedLoopSystem::violation(const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
+  if (model_.nc == 0) return {0.0, 0.0};
+  constraint_terms<double>(model_, data_, q, v);
+  return {data_.phi.cwiseAbs().maxCoeff(), (data_.Jc * v).cwiseAbs().maxCoeff()};
+}
+
+bool ClosedLoopSystem::project(Eigen::VectorXd& y, double tol) {
+  if (model_.nc == 0) return false;
+  const Eigen::VectorXd q = y.head(model_.nq), v = y.segment(model_.nq, model_.nv);
+  const auto [p, w] = violation(q, v);
+  if (p <= tol && w <= tol * std::max(1.0, v.norm())) return false;
+  AssemblyOptions opt;
+  opt.tolerance = std::min(1e-12, tol * 1e-3);
+  const AssemblyResult r = assemble(model_, q, v, opt);
+  y.head(model_.nq) = r.q;
+  y.segment(model_.nq, model_.nv) = r.v;
+  return true;
+}
+
+}  // namespace codyna

@@ -1,0 +1,74 @@
+// The closed loop as equations an integrator can step:
+//   ODE form  y = [q; v; xc]            y' = [qdot(q, v); qdd(q, v, u); dxc/dt]
+//   DAE form  Y = [q; v; xc; lambda]    F(t, Y, Y') = [q' - qdot(q, v);
+//                                                      M v' + nle - Q(u) + Ja^T lambda;
+//                                                      dxc/dt residual;
+//                                                      Ja v' + gamma + stab]      (index 1)
+// (the residual system (3) of the paper, with the output equation evaluated
+// separately). u = saturate(controller(y, ...)) on Plant/In, nominal u0 on the
+// other actuators. xc holds only continuous controller states; a discrete
+// controller's state and held output live in the simulator.
+// Not thread-safe: one ClosedLoopSystem per simulation (it owns a Data).
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+
+#include "analysis/plant_function.hpp"
+#include "dynamics/forward_dynamics.hpp"
+#include "model/data.hpp"
+#include "simulation/controller.hpp"
+
+namespace codyna {
+
+class ClosedLoopSystem {
+ public:
+  // plant: the linearization's plant function (needed by state feedback); w_ref: its reference velocities
+  ClosedLoopSystem(const Model& model, const Controller* controller, const PlantFunction* plant,
+                   const Eigen::VectorXd& x_ref, const Eigen::VectorXd& u_nominal, Baumgarte stab = {});
+
+  int nq() const { return model_.nq; }
+  int nv() const { return model_.nv; }
+  int nxc() const { return continuous_states_; }
+  int na() const { return static_cast<int>(model_.active_rows.size()); }
+  int ode_size() const { return nq() + nv() + nxc(); }
+  int dae_size() const { return ode_size() + na(); }
+  const Model& model() const { return model_; }
+
+  // discrete controllers: the plant inputs held until the next sample
+  void set_held(const Eigen::VectorXd& u_plant) { held_ = u_plant; }
+
+  ControllerInput measure(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v) const;
+  // every actuator's value at a state (controller output on Plant/In, saturated)
+  Eigen::VectorXd inputs(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& xc) const;
+
+  void rhs(double t, const Eigen::VectorXd& y, Eigen::VectorXd& ydot);
+  void residual(double t, const Eigen::VectorXd& Y, const Eigen::VectorXd& Yp, Eigen::VectorXd& F);
+  // from an ODE-layout y: the DAE's consistent Y (with lambda) and Y'
+  void consistent(double t, const Eigen::VectorXd& y, Eigen::VectorXd& Y, Eigen::VectorXd& Yp);
+  // the DAE form's constraint rows (chosen in consistent()) have become ill-conditioned
+  // at q compared with the best choice: the integrator should be reset
+  bool rows_degraded(const Eigen::VectorXd& q);
+  // back onto phi = 0, Jc v = 0 if the violation exceeds tol; returns whether it moved
+  bool project(Eigen::VectorXd& y, double tol);
+  // max |phi|, max |Jc v|
+  std::pair<double, double> violation(const Eigen::VectorXd& q, const Eigen::VectorXd& v);
+
+  long evaluations() const { return evaluations_; }
+
+ private:
+  Eigen::VectorXd saturate(Eigen::VectorXd u_all) const;
+
+  const Model& model_;
+  const Controller* controller_;
+  const PlantFunction* plant_;
+  Eigen::VectorXd x_ref_, u_nominal_;
+  std::optional<Eigen::VectorXd> held_;
+  Baumgarte stab_;
+  int continuous_states_ = 0;
+  std::vector<int> rows_;  // DAE form: constraint rows carrying multipliers
+  mutable Data data_;
+  long evaluations_ = 0;
+};
+
+}  // namespace codyna

@@ -1,0 +1,158 @@
+#include "simulation/controller.hpp"
+
+#include <sstream>
+#include <stdexcept>
+
+#include "io/mat_export.hpp"
+
+namespace codyna {
+
+std::vector<std::string> Controller::state_names() const {
+  std::vector<std::string> n;
+  for (int k = 0; k < nxc(); ++k) n.push_back("xc" + std::to_string(k + 1));
+  return n;
+}
+
+namespace {
+
+class Pid final : public Controller {
+ public:
+  Pid(Eigen::MatrixXd Kp, Eigen::MatrixXd Ki, Eigen::MatrixXd Kd, Eigen::VectorXd r, Eigen::VectorXd u0)
+      : Kp_(std::move(Kp)), Ki_(std::move(Ki)), Kd_(std::move(Kd)), r_(std::move(r)), u0_(std::move(u0)) {}
+  int nxc() const override { return Ki_.size() ? static_cast<int>(r_.size()) : 0; }
+  bool needs_rates() const override { return Kd_.size() > 0; }
+  Eigen::VectorXd output(const ControllerInput& in, const Eigen::VectorXd& xc) const override {
+    Eigen::VectorXd u = u0_ + Kp_ * (r_ - in.y);
+    if (Ki_.size()) u += Ki_ * xc;
+    if (Kd_.size()) u -= Kd_ * in.ydot;
+    return u;
+  }
+  Eigen::VectorXd update(const ControllerInput& in, const Eigen::VectorXd&) const override {
+    return Ki_.size() ? Eigen::VectorXd(r_ - in.y) : Eigen::VectorXd();
+  }
+  std::vector<std::string> state_names() const override {
+    std::vector<std::string> n;
+    for (int k = 0; k < nxc(); ++k) n.push_back("integral_error" + std::to_string(k + 1));
+    return n;
+  }
+  std::string describe() const override {
+    return std::string(Ki_.size() ? "PID" : "PD") + (Kd_.size() ? "" : " (no derivative action)") + " on the plant outputs";
+  }
+
+ private:
+  Eigen::MatrixXd Kp_, Ki_, Kd_;
+  Eigen::VectorXd r_, u0_;
+};
+
+class StateFeedback final : public Controller {
+ public:
+  StateFeedback(Eigen::MatrixXd K, Eigen::VectorXd u0) : K_(std::move(K)), u0_(std::move(u0)) {}
+  bool needs_state() const override { return true; }
+  Eigen::VectorXd output(const ControllerInput& in, const Eigen::VectorXd&) const override { return u0_ - K_ * in.x; }
+  std::string describe() const override { return "state feedback u = u0 - K (x - x0)"; }
+
+ private:
+  Eigen::MatrixXd K_;
+  Eigen::VectorXd u0_;
+};
+
+class Lti final : public Controller {
+ public:
+  Lti(Eigen::MatrixXd Ac, Eigen::MatrixXd Bc, Eigen::MatrixXd Cc, Eigen::MatrixXd Dc, double Ts, Eigen::VectorXd y0,
+      Eigen::VectorXd u0)
+      : Ac_(std::move(Ac)), Bc_(std::move(Bc)), Cc_(std::move(Cc)), Dc_(std::move(Dc)), Ts_(Ts), y0_(std::move(y0)),
+        u0_(std::move(u0)) {}
+  int nxc() const override { return static_cast<int>(Ac_.rows()); }
+  double sample_time() const override { return Ts_; }
+  Eigen::VectorXd output(const ControllerInput& in, const Eigen::VectorXd& xc) const override {
+    return u0_ + Cc_ * xc + Dc_ * (in.y - y0_);
+  }
+  Eigen::VectorXd update(const ControllerInput& in, const Eigen::VectorXd& xc) const override {
+    return Ac_ * xc + Bc_ * (in.y - y0_);
+  }
+  std::string describe() const override {
+    std::ostringstream os;
+    os << "LTI controller, " << nxc() << " states, " << (Ts_ > 0 ? "discrete Ts = " + std::to_string(Ts_) + " s (ZOH)" : "continuous");
+    return os.str();
+  }
+
+ private:
+  Eigen::MatrixXd Ac_, Bc_, Cc_, Dc_;
+  double Ts_;
+  Eigen::VectorXd y0_, u0_;
+};
+
+void check_size(const std::string& file, const char* name, const Eigen::MatrixXd& M, Eigen::Index rows, Eigen::Index cols) {
+  if (M.rows() != rows || M.cols() != cols) {
+    std::ostringstream os;
+    os << file << ": variable " << name << " is " << M.rows() << " x " << M.cols() << ", expected " << rows << " x "
+       << cols;
+    throw std::invalid_argument(os.str());
+  }
+}
+
+}  // namespace
+
+std::unique_ptr<Controller> make_pid(const Eigen::MatrixXd& Kp, const Eigen::MatrixXd& Ki, const Eigen::MatrixXd& Kd,
+                                     const Eigen::VectorXd& r, const Eigen::VectorXd& u0) {
+  const Eigen::Index nu = u0.size(), ny = r.size();
+  check_size("PID", "Kp", Kp, nu, ny);
+  if (Ki.size()) check_size("PID", "Ki", Ki, nu, ny);
+  if (Kd.size()) check_size("PID", "Kd", Kd, nu, ny);
+  return std::make_unique<Pid>(Kp, Ki, Kd, r, u0);
+}
+
+std::unique_ptr<Controller> make_state_feedback(const Eigen::MatrixXd& K, const Eigen::VectorXd& u0) {
+  if (K.rows() != u0.size()) throw std::invalid_argument("state feedback: K has " + std::to_string(K.rows()) + " rows, the plant " + std::to_string(u0.size()) + " inputs");
+  return std::make_unique<StateFeedback>(K, u0);
+}
+
+std::unique_ptr<Controller> make_lti(const Eigen::MatrixXd& Ac, const Eigen::MatrixXd& Bc, const Eigen::MatrixXd& Cc,
+                                     const Eigen::MatrixXd& Dc, double Ts, const Eigen::VectorXd& y0,
+                                     const Eigen::VectorXd& u0) {
+  const Eigen::Index n = Ac.rows();
+  check_size("LTI", "Ac", Ac, n, n);
+  check_size("LTI", "Bc", Bc, n, y0.size());
+  check_size("LTI", "Cc", Cc, u0.size(), n);
+  check_size("LTI", "Dc", Dc, u0.size(), y0.size());
+  if (!(Ts >= 0)) throw std::invalid_argument("LTI: Ts must be >= 0");
+  return std::make_unique<Lti>(Ac, Bc, Cc, Dc, Ts, y0, u0);
+}
+
+std::unique_ptr<Controller> load_controller(const std::string& path, int nx, int nu, int ny, const Eigen::VectorXd& y0,
+                                            const Eigen::VectorXd& u0) {
+  MatVariables vars;
+  try {
+    vars = read_mat_file(path);
+  } catch (const std::runtime_error& e) {
+    throw std::invalid_argument(e.what());
+  }
+  const auto& m = vars.matrices;
+  auto has = [&](const char* n) { return m.count(n) > 0; };
+  auto get = [&](const char* n, Eigen::Index rows, Eigen::Index cols) {
+    const Eigen::MatrixXd& M = m.at(n);
+    check_size(path, n, M, rows, cols);
+    return M;
+  };
+  if (has("Ac") || has("Bc") || has("Cc") || has("Dc")) {
+    for (const char* n : {"Ac", "Bc", "Cc", "Dc"})
+      if (!has(n)) throw std::invalid_argument(path + ": an LTI controller needs Ac, Bc, Cc and Dc; " + n + " is missing");
+    const Eigen::Index n = m.at("Ac").rows();
+    double Ts = 0;
+    if (has("Ts")) Ts = get("Ts", 1, 1)(0, 0);
+    if (Ts < 0) throw std::invalid_argument(path + ": Ts must be >= 0 (0 = continuous)");
+    return make_lti(get("Ac", n, n), get("Bc", n, ny), get("Cc", nu, n), get("Dc", nu, ny), Ts, y0, u0);
+  }
+  if (has("K")) return make_state_feedback(get("K", nu, nx), u0);
+  if (has("Kp")) {
+    const Eigen::VectorXd r = has("r") ? Eigen::VectorXd(get("r", ny, 1)) : y0;
+    return make_pid(get("Kp", nu, ny), has("Ki") ? get("Ki", nu, ny) : Eigen::MatrixXd(),
+                    has("Kd") ? get("Kd", nu, ny) : Eigen::MatrixXd(), r, u0);
+  }
+  std::string found;
+  for (const auto& [k, v] : m) found += (found.empty() ? "" : ", ") + k;
+  throw std::invalid_argument(path + ": no controller found: expected K (state feedback), Kp [Ki Kd] (PID) or Ac Bc Cc Dc "
+                              "(LTI); the file holds " + (found.empty() ? std::string("no numeric variables") : found));
+}
+
+}  // namespace codyna

@@ -1,0 +1,70 @@
+// Controllers in the loop. A controller maps the plant's measured outputs
+// (Plant/Out, and for state feedback the plant state in the export's order)
+// to the Plant/In actuator values:
+//   PID           u = u0 + Kp (r - y) + Ki xi - Kd dy/dt,   dxi/dt = r - y
+//                 (the paper's u = k (y0 - y) with derivative action on the measurement)
+//   state feedback u = u0 - K (x - x0)    x in the state order of the linearization/export
+//   LTI           dxc/dt = Ac xc + Bc (y - y0),  u = u0 + Cc xc + Dc (y - y0)
+//                 or, with Ts > 0, sampled with zero-order hold:
+//                 xc[k+1] = Ac xc[k] + Bc (y[k] - y0),  u[k] = u0 + Cc xc[k] + Dc (y[k] - y0)
+// Inputs are then clamped to the actuators' [min, max] (saturation).
+// Sizes are checked against the plant when the controller is made.
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "analysis/plant_function.hpp"
+#include "model/model.hpp"
+
+namespace codyna {
+
+// what a controller sees at time t
+struct ControllerInput {
+  double t = 0;
+  Eigen::VectorXd y;     // plant outputs [ny]
+  Eigen::VectorXd ydot;  // their rates at constant velocity [ny] (exact for position outputs)
+  Eigen::VectorXd x;     // plant state deviation x - x0 in minimal coordinates [nx] (state feedback only)
+};
+
+class Controller {
+ public:
+  virtual ~Controller() = default;
+  virtual int nxc() const { return 0; }             // controller states
+  virtual double sample_time() const { return 0; }  // > 0: discrete (zero-order hold)
+  virtual bool needs_state() const { return false; }
+  virtual bool needs_rates() const { return false; }
+  // plant input values (before saturation) for controller state xc
+  virtual Eigen::VectorXd output(const ControllerInput& in, const Eigen::VectorXd& xc) const = 0;
+  // continuous: d xc/dt; discrete: xc at the next sample
+  virtual Eigen::VectorXd update(const ControllerInput& in, const Eigen::VectorXd& xc) const {
+    return Eigen::VectorXd::Zero(nxc());
+  }
+  virtual std::vector<std::string> state_names() const;
+  virtual std::string describe() const = 0;
+};
+
+// gains are (nu x ny); empty Ki / Kd mean no integral / derivative action; r defaults to y0
+std::unique_ptr<Controller> make_pid(const Eigen::MatrixXd& Kp, const Eigen::MatrixXd& Ki, const Eigen::MatrixXd& Kd,
+                                     const Eigen::VectorXd& r, const Eigen::VectorXd& u0);
+
+// K is (nu x nx), same state order as the export; x0/u0 are the operating point's
+std::unique_ptr<Controller> make_state_feedback(const Eigen::MatrixXd& K, const Eigen::VectorXd& u0);
+
+std::unique_ptr<Controller> make_lti(const Eigen::MatrixXd& Ac, const Eigen::MatrixXd& Bc, const Eigen::MatrixXd& Cc,
+                                     const Eigen::MatrixXd& Dc, double Ts, const Eigen::VectorXd& y0,
+                                     const Eigen::VectorXd& u0);
+
+// Reads a controller from a .mat file of plain matrices (Octave save -v7, MATLAB save):
+//   K                        -> state feedback
+//   Kp [, Ki] [, Kd] [, r]   -> PID on the outputs
+//   Ac, Bc, Cc, Dc [, Ts]    -> LTI (discrete when Ts > 0)
+// u0, y0 come from the operating point; nx, nu, ny are the plant's sizes.
+// Wrong sizes, missing variables, NaN, or an unreadable file give std::invalid_argument
+// naming the file, the variable and the expected size.
+std::unique_ptr<Controller> load_controller(const std::string& path, int nx, int nu, int ny, const Eigen::VectorXd& y0,
+                                            const Eigen::VectorXd& u0);
+
+}  // namespace codyna

@@ -1,0 +1,49 @@
+// Integrators behind one interface, so that benchmarks swap them freely:
+//   ida          SUNDIALS IDA (variable-order BDF) on the index-1 DAE form with
+//                multipliers as algebraic variables (the paper's residual form)
+//   cvode-bdf    SUNDIALS CVODE, BDF with Newton iterations (stiff problems)
+//   cvode-adams  SUNDIALS CVODE, Adams-Moulton with fixed-point iterations (non-stiff)
+//   arkode       SUNDIALS ARKODE ERKStep, adaptive explicit Runge-Kutta (order 4 default)
+//   rk4          fixed-step classical Runge-Kutta (step = max_step, or 1 ms), the reference
+// All advance to an exact output/event time (stop time set, no overshoot) and
+// can be reset after a discontinuity (controller sample, projection).
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "simulation/closed_loop.hpp"
+#include "simulation/result.hpp"
+
+namespace codyna {
+
+struct IntegratorSettings {
+  std::string method = "ida";
+  double rtol = 1e-8, atol = 1e-10;
+  double max_step = 0;  // 0 = no limit (rk4: its fixed step, default 1e-3)
+};
+
+class IntegratorFailure : public std::runtime_error {
+ public:
+  IntegratorFailure(double t, const std::string& reason) : std::runtime_error(reason), t_(t) {}
+  double time() const { return t_; }
+
+ private:
+  double t_;
+};
+
+class Integrator {
+ public:
+  virtual ~Integrator() = default;
+  virtual void reset(double t, const Eigen::VectorXd& y) = 0;  // y in ODE layout [q; v; xc]
+  virtual void advance(double t_out) = 0;                       // throws IntegratorFailure
+  virtual Eigen::VectorXd state() const = 0;                    // ODE layout
+  virtual void add_stats(SolverStats& s) const = 0;
+};
+
+// throws std::invalid_argument for an unknown method or bad tolerances
+std::unique_ptr<Integrator> make_integrator(ClosedLoopSystem& system, const IntegratorSettings& settings);
+
+}  // namespace codyna

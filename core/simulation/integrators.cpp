@@ -1,0 +1,333 @@
+// SUNDIALS adapters (CVODE, ARKODE ERKStep, IDA) and the fixed-step RK4.
+#include <arkode/arkode_erkstep.h>
+#include <cvode/cvode.h>
+#include <ida/ida.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_context.h>
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunmatrix/sunmatrix_dense.h>
+#include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
+
+#include <cmath>
+#include <sstream>
+
+#include "dynamics/joint.hpp"
+#include "simulation/integrator.hpp"
+#include "simulation/reference_integrator.hpp"
+
+namespace codyna {
+
+namespace {
+
+Eigen::Map<Eigen::VectorXd> view(N_Vector v) { return {N_VGetArrayPointer(v), N_VGetLength(v)}; }
+
+// owns a SUNContext, the state vector(s) and the solver memory
+class SundialsBase : public Integrator {
+ protected:
+  SundialsBase(ClosedLoopSystem& sys, const IntegratorSettings& s) : sys_(sys), set_(s) {
+    if (SUNContext_Create(nullptr, &ctx_) != 0) throw std::runtime_error("SUNDIALS: cannot create a context");
+  }
+  ~SundialsBase() override {
+    if (LS_) SUNLinSolFree(LS_);
+    if (A_) SUNMatDestroy(A_);
+    if (NLS_) SUNNonlinSolFree(NLS_);
+    if (y_) N_VDestroy(y_);
+    if (yp_) N_VDestroy(yp_);
+    if (id_) N_VDestroy(id_);
+    SUNContext_Free(&ctx_);
+  }
+  // right-hand side / residual callbacks report exceptions here and return -1 (unrecoverable)
+  template <class F>
+  int guarded(F&& f) {
+    try {
+      f();
+      return 0;
+    } catch (const std::exception& e) {
+      error_ = e.what();
+      return -1;
+    }
+  }
+  [[noreturn]] void fail(const char* solver, int flag, double t) {
+    std::ostringstream os;
+    os << solver << " failed (flag " << flag << ")";
+    if (!error_.empty()) os << ": " << error_;
+    if (!last_message_.empty()) os << ": " << last_message_;
+    throw IntegratorFailure(t, os.str());
+  }
+  static void on_error(int, const char*, const char* function, char* msg, void* self) {
+    auto* me = static_cast<SundialsBase*>(self);
+    me->last_message_ = std::string(function) + ": " + msg;
+  }
+
+  // counters of the solver runs before the last re-initialization
+  void add_done(SolverStats& s) const {
+    s.steps += done_.steps;
+    s.rhs_evals += done_.rhs_evals;
+    s.jac_evals += done_.jac_evals;
+    s.error_test_failures += done_.error_test_failures;
+    s.nonlinear_iterations += done_.nonlinear_iterations;
+    s.nonlinear_failures += done_.nonlinear_failures;
+  }
+
+  ClosedLoopSystem& sys_;
+  IntegratorSettings set_;
+  SolverStats done_;
+  SUNContext ctx_ = nullptr;
+  N_Vector y_ = nullptr, yp_ = nullptr, id_ = nullptr;
+  SUNMatrix A_ = nullptr;
+  SUNLinearSolver LS_ = nullptr;
+  SUNNonlinearSolver NLS_ = nullptr;
+  void* mem_ = nullptr;
+  double t_ = 0;
+  std::string error_, last_message_;
+};
+
+class Cvode final : public SundialsBase {
+ public:
+  Cvode(ClosedLoopSystem& sys, const IntegratorSettings& s, bool bdf) : SundialsBase(sys, s), bdf_(bdf) {}
+  ~Cvode() override {
+    if (mem_) CVodeFree(&mem_);
+  }
+  void reset(double t, const Eigen::VectorXd& y) override {
+    t_ = t;
+    if (!y_) {
+      y_ = N_VNew_Serial(sys_.ode_size(), ctx_);
+      view(y_) = y;
+      mem_ = CVodeCreate(bdf_ ? CV_BDF : CV_ADAMS, ctx_);
+      check(CVodeInit(mem_, &Cvode::f, t, y_), "CVodeInit");
+      check(CVodeSetUserData(mem_, this), "CVodeSetUserData");
+      check(CVodeSStolerances(mem_, set_.rtol, set_.atol), "CVodeSStolerances");
+      check(CVodeSetErrHandlerFn(mem_, &SundialsBase::on_error, this), "CVodeSetErrHandlerFn");
+      check(CVodeSetMaxNumSteps(mem_, 1000000), "CVodeSetMaxNumSteps");
+      if (set_.max_step > 0) check(CVodeSetMaxStep(mem_, set_.max_step), "CVodeSetMaxStep");
+      if (bdf_) {
+        A_ = SUNDenseMatrix(sys_.ode_size(), sys_.ode_size(), ctx_);
+        LS_ = SUNLinSol_Dense(y_, A_, ctx_);
+        check(CVodeSetLinearSolver(mem_, LS_, A_), "CVodeSetLinearSolver");
+      } else {
+        NLS_ = SUNNonlinSol_FixedPoint(y_, 0, ctx_);
+        check(CVodeSetNonlinearSolver(mem_, NLS_), "CVodeSetNonlinearSolver");
+      }
+    } else {
+      view(y_) = y;
+      counters(done_);
+      check(CVodeReInit(mem_, t, y_), "CVodeReInit");
+    }
+  }
+  void advance(double t_out) override {
+    CVodeSetStopTime(mem_, t_out);
+    const int flag = CVode(mem_, t_out, y_, &t_, CV_NORMAL);
+    if (flag < 0) fail("CVODE", flag, t_);
+  }
+  Eigen::VectorXd state() const override { return view(y_); }
+  void add_stats(SolverStats& s) const override {
+    add_done(s);
+    counters(s);
+  }
+  void counters(SolverStats& s) const {
+    long v = 0;
+    CVodeGetNumSteps(mem_, &v), s.steps += v;
+    CVodeGetNumRhsEvals(mem_, &v), s.rhs_evals += v;
+    CVodeGetNumErrTestFails(mem_, &v), s.error_test_failures += v;
+    CVodeGetNumNonlinSolvIters(mem_, &v), s.nonlinear_iterations += v;
+    CVodeGetNumNonlinSolvConvFails(mem_, &v), s.nonlinear_failures += v;
+    if (bdf_) CVodeGetNumJacEvals(mem_, &v), s.jac_evals += v;
+  }
+
+ private:
+  static int f(double t, N_Vector y, N_Vector yd, void* self) {
+    auto* me = static_cast<Cvode*>(self);
+    return me->guarded([&] {
+      Eigen::VectorXd out;
+      me->sys_.rhs(t, view(y), out);
+      view(yd) = out;
+    });
+  }
+  void check(int flag, const char* what) {
+    if (flag < 0) throw std::runtime_error(std::string("CVODE setup: ") + what + " failed");
+  }
+  bool bdf_;
+};
+
+class Erk final : public SundialsBase {
+ public:
+  Erk(ClosedLoopSystem& sys, const IntegratorSettings& s) : SundialsBase(sys, s) {}
+  ~Erk() override {
+    if (mem_) ERKStepFree(&mem_);
+  }
+  void reset(double t, const Eigen::VectorXd& y) override {
+    t_ = t;
+    if (!y_) {
+      y_ = N_VNew_Serial(sys_.ode_size(), ctx_);
+      view(y_) = y;
+      mem_ = ERKStepCreate(&Erk::f, t, y_, ctx_);
+      if (!mem_) throw std::runtime_error("ARKODE setup: ERKStepCreate failed");
+      ERKStepSetUserData(mem_, this);
+      ERKStepSStolerances(mem_, set_.rtol, set_.atol);
+      ERKStepSetErrHandlerFn(mem_, &SundialsBase::on_error, this);
+      ERKStepSetMaxNumSteps(mem_, 10000000);
+      if (set_.max_step > 0) ERKStepSetMaxStep(mem_, set_.max_step);
+    } else {
+      view(y_) = y;
+      counters(done_);
+      ERKStepReInit(mem_, &Erk::f, t, y_);
+    }
+  }
+  void advance(double t_out) override {
+    ERKStepSetStopTime(mem_, t_out);
+    const int flag = ERKStepEvolve(mem_, t_out, y_, &t_, ARK_NORMAL);
+    if (flag < 0) fail("ARKODE", flag, t_);
+  }
+  Eigen::VectorXd state() const override { return view(y_); }
+  void add_stats(SolverStats& s) const override {
+    add_done(s);
+    counters(s);
+  }
+  void counters(SolverStats& s) const {
+    long v = 0;
+    ERKStepGetNumSteps(mem_, &v), s.steps += v;
+    ERKStepGetNumRhsEvals(mem_, &v), s.rhs_evals += v;
+    ERKStepGetNumErrTestFails(mem_, &v), s.error_test_failures += v;
+  }
+
+ private:
+  static int f(double t, N_Vector y, N_Vector yd, void* self) {
+    auto* me = static_cast<Erk*>(self);
+    return me->guarded([&] {
+      Eigen::VectorXd out;
+      me->sys_.rhs(t, view(y), out);
+      view(yd) = out;
+    });
+  }
+};
+
+class Ida final : public SundialsBase {
+ public:
+  Ida(ClosedLoopSystem& sys, const IntegratorSettings& s) : SundialsBase(sys, s) {}
+  ~Ida() override {
+    if (mem_) IDAFree(&mem_);
+  }
+  void reset(double t, const Eigen::VectorXd& y) override {
+    t_ = t;
+    Eigen::VectorXd Y, Yp;
+    sys_.consistent(t, y, Y, Yp);
+    const int n = sys_.dae_size();
+    if (!y_) {
+      y_ = N_VNew_Serial(n, ctx_);
+      yp_ = N_VNew_Serial(n, ctx_);
+      id_ = N_VNew_Serial(n, ctx_);
+      view(y_) = Y;
+      view(yp_) = Yp;
+      Eigen::VectorXd id = Eigen::VectorXd::Ones(n);
+      id.tail(sys_.na()).setZero();  // multipliers are algebraic
+      view(id_) = id;
+      mem_ = IDACreate(ctx_);
+      check(IDAInit(mem_, &Ida::res, t, y_, yp_), "IDAInit");
+      check(IDASetUserData(mem_, this), "IDASetUserData");
+      check(IDASStolerances(mem_, set_.rtol, set_.atol), "IDASStolerances");
+      check(IDASetErrHandlerFn(mem_, &SundialsBase::on_error, this), "IDASetErrHandlerFn");
+      check(IDASetId(mem_, id_), "IDASetId");
+      check(IDASetSuppressAlg(mem_, SUNTRUE), "IDASetSuppressAlg");  // index-1 multipliers: no error test
+      check(IDASetMaxNumSteps(mem_, 1000000), "IDASetMaxNumSteps");
+      if (set_.max_step > 0) check(IDASetMaxStep(mem_, set_.max_step), "IDASetMaxStep");
+      A_ = SUNDenseMatrix(n, n, ctx_);
+      LS_ = SUNLinSol_Dense(y_, A_, ctx_);
+      check(IDASetLinearSolver(mem_, LS_, A_), "IDASetLinearSolver");
+    } else {
+      view(y_) = Y;
+      view(yp_) = Yp;
+      counters(done_);
+      check(IDAReInit(mem_, t, y_, yp_), "IDAReInit");
+    }
+  }
+  void advance(double t_out) override {
+    IDASetStopTime(mem_, t_out);
+    const int flag = IDASolve(mem_, t_out, &t_, y_, yp_, IDA_NORMAL);
+    if (flag < 0) fail("IDA", flag, t_);
+  }
+  Eigen::VectorXd state() const override { return view(y_).head(sys_.ode_size()); }
+  void add_stats(SolverStats& s) const override {
+    add_done(s);
+    counters(s);
+  }
+  void counters(SolverStats& s) const {
+    long v = 0;
+    IDAGetNumSteps(mem_, &v), s.steps += v;
+    IDAGetNumResEvals(mem_, &v), s.rhs_evals += v;
+    IDAGetNumErrTestFails(mem_, &v), s.error_test_failures += v;
+    IDAGetNumNonlinSolvIters(mem_, &v), s.nonlinear_iterations += v;
+    IDAGetNumNonlinSolvConvFails(mem_, &v), s.nonlinear_failures += v;
+    IDAGetNumJacEvals(mem_, &v), s.jac_evals += v;
+  }
+
+ private:
+  static int res(double t, N_Vector Y, N_Vector Yp, N_Vector F, void* self) {
+    auto* me = static_cast<Ida*>(self);
+    return me->guarded([&] {
+      Eigen::VectorXd out;
+      me->sys_.residual(t, view(Y), view(Yp), out);
+      view(F) = out;
+    });
+  }
+  void check(int flag, const char* what) {
+    if (flag < 0) throw std::runtime_error(std::string("IDA setup: ") + what + " failed");
+  }
+};
+
+class Rk4 final : public Integrator {
+ public:
+  Rk4(ClosedLoopSystem& sys, const IntegratorSettings& s) : sys_(sys), h_(s.max_step > 0 ? s.max_step : 1e-3) {}
+  void reset(double t, const Eigen::VectorXd& y) override {
+    t_ = t;
+    y_ = y;
+  }
+  void advance(double t_out) override {
+    const int n = std::max(1, static_cast<int>(std::ceil((t_out - t_) / h_ - 1e-9)));
+    const double h = (t_out - t_) / n;
+    Eigen::VectorXd k1, k2, k3, k4;
+    for (int i = 0; i < n; ++i) {
+      try {
+        sys_.rhs(t_, y_, k1);
+        sys_.rhs(t_ + h / 2, y_ + h / 2 * k1, k2);
+        sys_.rhs(t_ + h / 2, y_ + h / 2 * k2, k3);
+        sys_.rhs(t_ + h, y_ + h * k3, k4);
+      } catch (const std::exception& e) {
+        throw IntegratorFailure(t_, std::string("rk4: ") + e.what());
+      }
+      y_ += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+      if (!y_.allFinite()) throw IntegratorFailure(t_, "rk4: the state is no longer finite (step too large?)");
+      Eigen::VectorXd q = y_.head(sys_.nq());
+      normalize(sys_.model(), q);
+      y_.head(sys_.nq()) = q;
+      t_ += h;
+      ++steps_;
+    }
+    t_ = t_out;
+  }
+  Eigen::VectorXd state() const override { return y_; }
+  void add_stats(SolverStats& s) const override {
+    s.steps += steps_;
+    s.rhs_evals += 4 * steps_;
+  }
+
+ private:
+  ClosedLoopSystem& sys_;
+  double h_, t_ = 0;
+  Eigen::VectorXd y_;
+  long steps_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<Integrator> make_integrator(ClosedLoopSystem& system, const IntegratorSettings& s) {
+  if (!(s.rtol > 0) || !(s.atol > 0)) throw std::invalid_argument("integrator: rtol and atol must be positive");
+  if (!(s.max_step >= 0)) throw std::invalid_argument("integrator: max_step must be >= 0");
+  if (s.method == "ida") return std::make_unique<Ida>(system, s);
+  if (s.method == "cvode-bdf") return std::make_unique<Cvode>(system, s, true);
+  if (s.method == "cvode-adams") return std::make_unique<Cvode>(system, s, false);
+  if (s.method == "arkode") return std::make_unique<Erk>(system, s);
+  if (s.method == "rk4") return std::make_unique<Rk4>(system, s);
+  throw std::invalid_argument("unknown integrator \"" + s.method + "\" (expected ida, cvode-bdf, cvode-adams, arkode or rk4)");
+}
+
+}  // namespace codyna

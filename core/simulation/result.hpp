@@ -1,0 +1,51 @@
+// SimulationResult: what a simulation produces, sample by sample (one row per
+// output time), with names, units, solver statistics and provenance, so that a
+// results file (io/results_file.hpp) is self-describing.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+namespace codyna {
+
+struct SolverStats {
+  std::string integrator;          // "ida", "cvode-bdf", "cvode-adams", "arkode", "rk4"
+  double rtol = 0, atol = 0, max_step = 0;
+  long steps = 0;                  // internal steps
+  long rhs_evals = 0;              // right-hand side / residual evaluations
+  long jac_evals = 0;              // Jacobian evaluations (0 for explicit methods)
+  long error_test_failures = 0;
+  long nonlinear_iterations = 0;
+  long nonlinear_failures = 0;
+  long projections = 0;            // constraint projections (closed loops)
+  long restarts = 0;               // re-initializations at controller samples / projections
+  double wall_time = 0;            // seconds
+};
+
+struct SimulationResult {
+  std::vector<double> t;                       // [N] output times
+  Eigen::MatrixXd q, v;                        // [N x nq], [N x nv]
+  Eigen::MatrixXd u;                           // [N x nu] every actuator's value (after saturation)
+  Eigen::MatrixXd y;                           // [N x ny] plant outputs (Plant/Out)
+  Eigen::MatrixXd xc;                          // [N x nxc] controller states (may have 0 columns)
+  std::vector<double> kinetic_energy, potential_energy;  // [N]
+  std::vector<double> constraint_violation;    // [N] max |phi(q)| (0 for trees)
+  std::vector<double> velocity_violation;      // [N] max |Jc v|
+  Eigen::MatrixXd y_linear;                    // [N x ny] linear closed loop from the same start (empty if not run)
+
+  std::vector<std::string> q_names, v_names, input_names, output_names, controller_state_names;
+  std::vector<std::string> input_units, output_units;
+
+  SolverStats stats;
+  bool completed = false;                      // reached t_end
+  bool cancelled = false;                      // stopped by the caller (partial result kept)
+  std::string failure;                         // solver failure: time and reason (partial result kept)
+
+  std::string model_name, model_file, controller, codyna_version;
+  std::string settings_json;                   // the settings of the run, as JSON text
+
+  int samples() const { return static_cast<int>(t.size()); }
+};
+
+}  // namespace codyna

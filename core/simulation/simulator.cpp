@@ -1,0 +1,253 @@
+#include "simulation/simulator.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "dynamics/assembly.hpp"
+#include "dynamics/energy.hpp"
+#include "dynamics/kinematics.hpp"
+#include "dynamics/sensors.hpp"
+
+namespace codyna {
+
+namespace {
+
+// the samples recorded so far, grown row by row
+struct Recorder {
+  std::vector<double> t;
+  std::vector<Eigen::VectorXd> q, v, u, y, xc;
+  std::vector<double> T, V, pv, vv;
+  std::vector<Eigen::VectorXd> y_linear;
+
+  static Eigen::MatrixXd stack(const std::vector<Eigen::VectorXd>& rows, Eigen::Index cols) {
+    Eigen::MatrixXd M(static_cast<Eigen::Index>(rows.size()), cols);
+    for (std::size_t i = 0; i < rows.size(); ++i) M.row(i) = rows[i].transpose();
+    return M;
+  }
+};
+
+// the linear closed loop: dx' = xdot0 + A dx + B du, y = y0 + C dx + D du, same controller,
+// integrated by RK4 with 20 substeps per output step (events at controller samples)
+std::vector<Eigen::VectorXd> linear_run(const Model& model, const Controller* ctrl, const LinearPlant& plant,
+                                        const std::vector<double>& times, const Eigen::VectorXd& dx0) {
+  const LinearSystem& s = plant.lin.system;
+  const int nx = s.nx(), nz = nx / 2;
+  const bool discrete = ctrl && ctrl->sample_time() > 0;
+  const int nxc = ctrl ? ctrl->nxc() : 0;
+  Eigen::VectorXd held = s.u0, xcd = Eigen::VectorXd::Zero(discrete ? nxc : 0);
+  auto measure = [&](const Eigen::VectorXd& dx, const Eigen::VectorXd& du) {
+    ControllerInput in;
+    in.y = s.y0 + s.C * dx + s.D * du;
+    Eigen::VectorXd rate = Eigen::VectorXd::Zero(nx);  // constant-velocity rate, as for the nonlinear plant
+    rate.head(nz) = dx.tail(nz) + s.xdot0.head(nz);
+    in.ydot = s.C * rate;
+    in.x = dx;
+    return in;
+  };
+  auto input = [&](const Eigen::VectorXd& dx, const Eigen::VectorXd& xc) -> Eigen::VectorXd {
+    if (!ctrl) return s.u0;
+    Eigen::VectorXd u = discrete ? held : ctrl->output(measure(dx, Eigen::VectorXd::Zero(s.nu())), xc);
+    for (int k = 0; k < s.nu(); ++k) {
+      const ActuatorModel& a = model.actuators[model.plant_inputs[k]];
+      u[k] = std::clamp(u[k], a.min, a.max);
+    }
+    return u;
+  };
+  const int nc = discrete ? 0 : nxc;
+  auto f = [&](const Eigen::VectorXd& z) {
+    const Eigen::VectorXd dx = z.head(nx), xc = z.tail(nc);
+    const Eigen::VectorXd du = input(dx, xc) - s.u0;
+    Eigen::VectorXd r(nx + nc);
+    r.head(nx) = s.xdot0 + s.A * dx + s.B * du;
+    if (nc) r.tail(nc) = ctrl->update(measure(dx, du), xc);
+    return r;
+  };
+  Eigen::VectorXd z = Eigen::VectorXd::Zero(nx + nc);
+  z.head(nx) = dx0;
+  std::vector<Eigen::VectorXd> out;
+  double t = times.front(), next_sample = t;
+  const double Ts = discrete ? ctrl->sample_time() : 0;
+  auto sample = [&]() {
+    const ControllerInput in = measure(z.head(nx), held - s.u0);
+    held = ctrl->output(in, xcd);
+    xcd = ctrl->update(in, xcd);
+    next_sample += Ts;
+  };
+  if (discrete) sample();
+  auto record = [&]() { out.push_back(s.y0 + s.C * z.head(nx) + s.D * (input(z.head(nx), z.tail(nc)) - s.u0)); };
+  record();
+  for (std::size_t i = 1; i < times.size(); ++i) {
+    while (t < times[i] - 1e-12) {
+      const double target = discrete ? std::min(times[i], next_sample) : times[i];
+      const int n = 20;
+      const double h = (target - t) / n;
+      for (int k = 0; k < n; ++k) {
+        const Eigen::VectorXd k1 = f(z), k2 = f(z + h / 2 * k1), k3 = f(z + h / 2 * k2), k4 = f(z + h * k3);
+        z += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+      }
+      t = target;
+      if (discrete && t >= next_sample - 1e-12) sample();
+    }
+    record();
+  }
+  return out;
+}
+
+}  // namespace
+
+SimulationResult simulate(const Model& model, const Controller* controller, const LinearPlant* plant,
+                          const SimulationOptions& o, const SimulationCallbacks& cb) {
+  if (!(o.t_end > o.t0)) throw std::invalid_argument("simulate: t_end must be after t0");
+  if (!(o.output_step > 0)) throw std::invalid_argument("simulate: output_step must be positive");
+  if (controller && controller->needs_state() && !plant)
+    throw std::invalid_argument("simulate: state feedback needs the linearized plant it was designed on");
+  const auto wall0 = std::chrono::steady_clock::now();
+
+  std::optional<PlantFunction> pf;
+  Eigen::VectorXd x_ref;
+  if (plant) {
+    pf.emplace(model, plant->op.q, plant->op.u, plant->lin.partition);
+    x_ref = Eigen::VectorXd::Zero(pf->nx());
+    for (int k = 0; k < pf->nz(); ++k) x_ref[pf->nz() + k] = plant->op.v[plant->lin.partition.independent[k]];
+  }
+  const Eigen::VectorXd u_nominal = plant ? plant->op.u : model.u_nominal();
+  ClosedLoopSystem sys(model, controller, pf ? &*pf : nullptr, x_ref, u_nominal, o.stabilization);
+
+  // initial state, on the constraint manifold
+  Eigen::VectorXd q0 = o.q0.size() ? o.q0 : model.q0, v0 = o.v0.size() ? o.v0 : model.v0;
+  if (q0.size() != model.nq || v0.size() != model.nv) throw std::invalid_argument("simulate: initial state has the wrong size");
+  if (model.nc) {
+    const AssemblyResult a = assemble(model, q0, v0);
+    if (!a.converged) throw std::invalid_argument("simulate: the initial state cannot be assembled onto the loop closures");
+    q0 = a.q;
+    v0 = a.v;
+  }
+  Eigen::VectorXd y(sys.ode_size());
+  y << q0, v0, Eigen::VectorXd::Zero(sys.nxc());
+
+  const bool discrete = controller && controller->sample_time() > 0;
+  const double Ts = discrete ? controller->sample_time() : 0;
+  Eigen::VectorXd xcd = Eigen::VectorXd::Zero(discrete ? controller->nxc() : 0);
+  long sample_index = 0;
+  auto controller_sample = [&](double t) {
+    const ControllerInput in = sys.measure(t, y.head(model.nq), y.segment(model.nq, model.nv));
+    sys.set_held(controller->output(in, xcd));
+    xcd = controller->update(in, xcd);
+    ++sample_index;
+  };
+  if (discrete) controller_sample(o.t0);
+
+  SimulationResult r;
+  r.stats.integrator = o.integrator.method;
+  r.stats.rtol = o.integrator.rtol;
+  r.stats.atol = o.integrator.atol;
+  r.stats.max_step = o.integrator.max_step;
+  auto integrator = make_integrator(sys, o.integrator);
+  integrator->reset(o.t0, y);
+
+  Recorder rec;
+  Data d(model);
+  auto record = [&](double t) {
+    const Eigen::VectorXd q = y.head(model.nq), v = y.segment(model.nq, model.nv);
+    const Eigen::VectorXd xc = discrete ? xcd : Eigen::VectorXd(y.tail(sys.nxc()));
+    const Eigen::VectorXd u = sys.inputs(t, q, v, y.tail(sys.nxc()));
+    forward_kinematics<double>(model, d, q, v);
+    const Eigen::VectorXd out = sensor_outputs<double>(model, d, model.plant_outputs, q, v);
+    const auto [pv, vv] = sys.violation(q, v);
+    rec.t.push_back(t);
+    rec.q.push_back(q);
+    rec.v.push_back(v);
+    rec.u.push_back(u);
+    rec.y.push_back(out);
+    rec.xc.push_back(xc);
+    rec.T.push_back(kinetic_energy<double>(model, d, q, v));
+    rec.V.push_back(potential_energy<double>(model, d, q));
+    rec.pv.push_back(pv);
+    rec.vv.push_back(vv);
+    if (cb.on_sample) cb.on_sample(Snapshot{t, q, v, u, out});
+    if (cb.progress) cb.progress(t, o.t_end);
+  };
+  record(o.t0);
+
+  const double eps = 1e-12 * std::max(1.0, std::abs(o.t_end));
+  long out_index = 1;
+  double t = o.t0;
+  while (t < o.t_end - eps) {
+    if (cb.cancel && cb.cancel->load()) {
+      r.cancelled = true;
+      break;
+    }
+    const double next_out = std::min(o.t0 + out_index * o.output_step, o.t_end);
+    const double next_sample = discrete ? o.t0 + sample_index * Ts : o.t_end;
+    const double target = std::min({next_out, next_sample, o.t_end});
+    try {
+      integrator->advance(target);
+    } catch (const IntegratorFailure& f) {
+      std::ostringstream os;
+      os << "t = " << f.time() << " s: " << f.what();
+      r.failure = os.str();
+      break;
+    }
+    t = target;
+    y = integrator->state();
+    bool restart = false;
+    if (model.nc && sys.project(y, o.projection_tolerance)) {
+      ++r.stats.projections;
+      restart = true;
+    }
+    if (model.nc && sys.rows_degraded(y.head(model.nq))) restart = true;  // re-choose the multiplier rows
+    if (discrete && t >= next_sample - eps) {
+      controller_sample(t);
+      restart = true;
+    }
+    if (restart) {
+      integrator->reset(t, y);
+      ++r.stats.restarts;
+    }
+    if (t >= next_out - eps) {
+      record(t);
+      ++out_index;
+    }
+  }
+  r.completed = !r.cancelled && r.failure.empty();
+  integrator->add_stats(r.stats);
+
+  const int N = static_cast<int>(rec.t.size());
+  r.t = rec.t;
+  r.q = Recorder::stack(rec.q, model.nq);
+  r.v = Recorder::stack(rec.v, model.nv);
+  r.u = Recorder::stack(rec.u, model.nu());
+  r.y = Recorder::stack(rec.y, static_cast<Eigen::Index>(model.plant_outputs.size()));
+  r.xc = Recorder::stack(rec.xc, discrete ? controller->nxc() : sys.nxc());
+  r.kinetic_energy = rec.T;
+  r.potential_energy = rec.V;
+  r.constraint_violation = rec.pv;
+  r.velocity_violation = rec.vv;
+  r.q_names = model.q_names;
+  r.v_names = model.v_names;
+  for (const auto& a : model.actuators) {
+    r.input_names.push_back(a.name);
+    r.input_units.push_back(a.unit);
+  }
+  for (int k : model.plant_outputs) {
+    r.output_names.push_back(model.sensors[k].name);
+    r.output_units.push_back(model.sensors[k].unit);
+  }
+  if (controller) r.controller_state_names = controller->state_names();
+  r.controller = controller ? controller->describe() : "none (actuators at their nominal values)";
+  r.model_name = model.name;
+  r.model_file = model.source_file;
+  r.codyna_version = CODYNA_VERSION;
+
+  if (o.compare_linear && plant && N > 0) {
+    const Eigen::VectorXd dx0 = pf->qv_to_state(q0, v0) - x_ref;
+    const auto lin = linear_run(model, controller, *plant, rec.t, dx0);
+    r.y_linear = Recorder::stack(lin, r.y.cols());
+  }
+  r.stats.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  (void)N;
+  return r;
+}
+
+}  // namespace codyna

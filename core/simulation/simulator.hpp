@@ -1,0 +1,53 @@
+// simulate(): the closed-loop nonlinear simulation of a model, with the
+// controller in the loop, recorded at output times; optionally the linear
+// closed loop (A, B, C, D with the same controller) from the same initial
+// offset beside it.
+//
+// Ready for a GUI worker thread: progress and sample callbacks receive copies
+// (never the integrator's data), cancellation is cooperative through an
+// atomic flag, and a cancelled or failed run returns its partial result with
+// the reason (SimulationResult::cancelled / failure).
+#pragma once
+
+#include <atomic>
+#include <functional>
+#include <optional>
+
+#include "analysis/linearize.hpp"
+#include "simulation/controller.hpp"
+#include "simulation/integrator.hpp"
+#include "simulation/result.hpp"
+
+namespace codyna {
+
+struct SimulationOptions {
+  IntegratorSettings integrator;
+  double t0 = 0.0, t_end = 5.0, output_step = 0.01;
+  Eigen::VectorXd q0, v0;              // initial state; empty = the model's (assembled) initial state
+  double projection_tolerance = 1e-9;  // closed loops: project when max |phi| exceeds it
+  Baumgarte stabilization{};           // optional, on the acceleration-level constraints
+  bool compare_linear = false;         // also run the linear closed loop (needs a plant)
+};
+
+// What a sample callback gets: copies, safe to hand to another thread.
+struct Snapshot {
+  double t = 0;
+  Eigen::VectorXd q, v, u, y;
+};
+
+struct SimulationCallbacks {
+  std::function<void(double t, double t_end)> progress;
+  std::function<void(const Snapshot&)> on_sample;
+  const std::atomic<bool>* cancel = nullptr;
+};
+
+// The linearized plant a controller was designed on (state order, offsets).
+struct LinearPlant {
+  OperatingPoint op;
+  Linearization lin;
+};
+
+SimulationResult simulate(const Model& model, const Controller* controller, const LinearPlant* plant,
+                          const SimulationOptions& options, const SimulationCallbacks& callbacks = {});
+
+}  // namespace codyna

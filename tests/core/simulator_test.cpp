@@ -1,0 +1,228 @@
+// Closed-loop nonlinear simulation: the paper's examples held upright, the
+// integrators against each other and against closed forms, constraint drift,
+// energy, linear vs nonlinear, cancellation and failures.
+#include "simulation/simulator.hpp"
+
+#include <cmath>
+#include <iostream>
+
+#include "analysis/operating_point.hpp"
+#include "test_util.hpp"
+
+namespace codyna {
+namespace {
+
+constexpr double g = 9.81;
+constexpr double deg = M_PI / 180;
+
+SimulationOptions options(const std::string& method, double t_end, double rtol = 1e-8, double atol = 1e-10) {
+  SimulationOptions o;
+  o.integrator.method = method;
+  o.integrator.rtol = rtol;
+  o.integrator.atol = atol;
+  o.t_end = t_end;
+  o.output_step = 0.01;
+  return o;
+}
+
+LinearPlant plant_at_equilibrium(const Model& m) {
+  LinearPlant p;
+  p.op = static_equilibrium(m, initial_point(m));
+  p.lin = linearize(m, p.op);
+  return p;
+}
+
+// Paper 4.1: a PD law on the joint torque holds the rod upright from 10 degrees off
+TEST(Simulate, PaperPendulumHeldUprightByPd) {
+  const Model m = test::load_example("pendulum.json");
+  ASSERT_NEAR(m.q0[0], 80 * deg, 1e-12);
+  const LinearPlant p = plant_at_equilibrium(m);
+  // closed loop s^2 + 0.075 Kd s + 0.075 Kp - 3g/4: wn = 3 rad/s, zeta = 0.8
+  const double Kp = (9 + 3 * g / 4) / 0.075, Kd = 4.8 / 0.075;
+  const auto pd = make_pid(Eigen::MatrixXd::Constant(1, 1, Kp), Eigen::MatrixXd(), Eigen::MatrixXd::Constant(1, 1, Kd),
+                           Eigen::VectorXd::Constant(1, M_PI / 2), Eigen::VectorXd::Zero(1));
+  for (const char* method : {"ida", "cvode-bdf"}) {
+    const SimulationResult r = simulate(m, pd.get(), &p, options(method, 5.0));
+    ASSERT_TRUE(r.completed) << r.failure;
+    EXPECT_NEAR(r.y(r.samples() - 1, 0), M_PI / 2, 0.5 * deg) << method;
+    // settled: after 3 s (five time constants of 1/(zeta wn)) it stays within 0.5 degree
+    for (int i = 0; i < r.samples(); ++i)
+      if (r.t[i] >= 3.0) EXPECT_NEAR(r.y(i, 0), M_PI / 2, 0.5 * deg) << "t = " << r.t[i];
+    EXPECT_LT(r.u.cwiseAbs().maxCoeff(), Kp * 10 * deg + 1.0);  // bounded: at most the initial P action
+    EXPECT_NEAR(r.u(0, 0), Kp * 10 * deg, 1e-9);
+  }
+}
+
+// The same loop with a sampled (ZOH) LTI controller: backward-difference PD, Ts = 5 ms
+TEST(Simulate, PaperPendulumHeldUprightByDiscreteController) {
+  const Model m = test::load_example("pendulum.json");
+  const LinearPlant p = plant_at_equilibrium(m);
+  const double Kp = (9 + 3 * g / 4) / 0.075, Kd = 4.8 / 0.075, Ts = 0.005;
+  // xc[k+1] = e[k]; u = -Kp e - Kd (e - xc) / Ts, e = y - y0
+  const auto c = make_lti(Eigen::MatrixXd::Zero(1, 1), Eigen::MatrixXd::Ones(1, 1), Eigen::MatrixXd::Constant(1, 1, Kd / Ts),
+                          Eigen::MatrixXd::Constant(1, 1, -(Kp + Kd / Ts)), Ts, p.lin.system.y0, p.lin.system.u0);
+  SimulationOptions o = options("ida", 4.0);
+  const SimulationResult r = simulate(m, c.get(), &p, o);
+  ASSERT_TRUE(r.completed) << r.failure;
+  EXPECT_NEAR(r.y(r.samples() - 1, 0), M_PI / 2, 0.5 * deg);
+  EXPECT_GE(r.stats.restarts, 799);  // one restart per sample
+  // zero-order hold: the input is piecewise constant between samples
+  EXPECT_EQ(r.xc.cols(), 1);
+}
+
+// every integrator against the fixed-step reference on a passive double pendulum
+TEST(Simulate, IntegratorsAgreeWithTheReference) {
+  const Model m = test::load_example("double_pendulum.json");
+  SimulationOptions ref = options("rk4", 2.0);
+  ref.integrator.max_step = 1e-4;
+  const SimulationResult r0 = simulate(m, nullptr, nullptr, ref);
+  ASSERT_TRUE(r0.completed);
+  for (const char* method : {"ida", "cvode-bdf", "cvode-adams", "arkode"}) {
+    const SimulationResult r = simulate(m, nullptr, nullptr, options(method, 2.0, 1e-10, 1e-12));
+    ASSERT_TRUE(r.completed) << method << ": " << r.failure;
+    ASSERT_EQ(r.samples(), r0.samples());
+    EXPECT_LT((r.q - r0.q).cwiseAbs().maxCoeff(), 1e-7) << method;
+    EXPECT_GT(r.stats.steps, 0) << method;
+    EXPECT_GT(r.stats.rhs_evals, 0) << method;
+  }
+}
+
+// IFToMM A01-like check: small-amplitude pendulum period against 2 pi sqrt(2 l / 3 g) with the
+// finite-amplitude correction; here the exact period from the complete elliptic integral
+TEST(Simulate, PendulumPeriodMatchesEllipticIntegral) {
+  ModelSpec s = load_model_spec(test::example_path("pendulum.json"));
+  s.joints[0].q0 = Eigen::VectorXd::Constant(1, -M_PI / 2 + 0.5);  // 0.5 rad from hanging straight down
+  s.plant = {};
+  const Model m = compile(s);
+  // period of a compound pendulum (rod about its end): T = 4 sqrt(2 l / (3 g)) K(sin(a/2))
+  const double a = 0.5, k = std::sin(a / 2), l = 2;
+  double K = 0;  // complete elliptic integral of the first kind by the arithmetic-geometric mean
+  {
+    double x = 1, y = std::sqrt(1 - k * k);
+    for (int i = 0; i < 30; ++i) {
+      const double xn = (x + y) / 2;
+      y = std::sqrt(x * y);
+      x = xn;
+    }
+    K = M_PI / (2 * x);
+  }
+  const double T = 4 * std::sqrt(2 * l / (3 * g)) * K;
+  SimulationOptions o = options("ida", 1.5 * T, 1e-10, 1e-12);
+  o.output_step = 1e-3;
+  const SimulationResult r = simulate(m, nullptr, nullptr, o);
+  ASSERT_TRUE(r.completed);
+  // the angle returns to its starting maximum after one period: the sample maximum near T
+  int best = -1;
+  for (int i = 1; i + 1 < r.samples(); ++i)
+    if (std::abs(r.t[i] - T) < 0.05 && (best < 0 || r.q(i, 0) > r.q(best, 0))) best = i;
+  ASSERT_GT(best, 0);
+  // refine by a parabola through the three samples around the maximum
+  const double y0 = r.q(best - 1, 0), y1 = r.q(best, 0), y2 = r.q(best + 1, 0);
+  const double t_peak = r.t[best] + o.output_step * (y0 - y2) / (2 * (y0 - 2 * y1 + y2));
+  EXPECT_NEAR(t_peak, T, 1e-5);
+}
+
+TEST(Simulate, ConstraintDriftStaysBelowToleranceOnLoops) {
+  for (const char* name : {"four_bar.json", "bricard.json"}) {
+    const Model m = test::load_example(name);
+    for (const char* method : {"ida", "cvode-bdf"}) {
+      const SimulationResult r = simulate(m, nullptr, nullptr, options(method, 3.0));
+      ASSERT_TRUE(r.completed) << name << " " << method << ": " << r.failure;
+      const double drift = *std::max_element(r.constraint_violation.begin(), r.constraint_violation.end());
+      EXPECT_LT(drift, 1e-8) << name << " " << method;
+      // passive: energy conserved to the integration tolerance
+      const double E0 = r.kinetic_energy[0] + r.potential_energy[0];
+      for (int i = 0; i < r.samples(); ++i)
+        EXPECT_NEAR(r.kinetic_energy[i] + r.potential_energy[i], E0, 1e-5 * std::max(1.0, std::abs(E0))) << name;
+    }
+  }
+}
+
+TEST(Simulate, AndrewsSqueezerMatchesTheTestSetReference) {
+  const Model m = test::load_example("andrews_squeezer.json");
+  SimulationOptions o = options("ida", 0.03, 1e-10, 1e-10);
+  o.output_step = 1e-3;
+  const SimulationResult r = simulate(m, nullptr, nullptr, o);
+  ASSERT_TRUE(r.completed) << r.failure;
+  const std::pair<const char*, double> ref[] = {
+      {"beta", 15.81077119629904}, {"Theta", -15.75637105984298}, {"gamma", 0.04082224013073101},
+      {"Phi", -0.5347301163226948}, {"delta", 0.5244099658805304}, {"Omega", 0.5347301163226948},
+      {"epsilon", 1.048080741042263}};
+  double scd_err = 0;
+  for (const auto& [name, value] : ref) {
+    const double y = r.q(r.samples() - 1, m.joints[m.find_joint(name)].idx_q);
+    scd_err = std::max(scd_err, std::abs(y - value) / std::abs(value));
+  }
+  EXPECT_GT(-std::log10(scd_err), 5.0) << "significant correct digits " << -std::log10(scd_err);
+  std::cout << "Andrews at t = 0.03 (ida, rtol = atol = 1e-10): SCD " << -std::log10(scd_err) << ", "
+            << r.stats.steps << " steps\n";
+  const double drift = *std::max_element(r.constraint_violation.begin(), r.constraint_violation.end());
+  EXPECT_LT(drift, 1e-8);
+}
+
+TEST(Simulate, LinearAndNonlinearAgreeForSmallOffsets) {
+  const Model m = test::load_example("pendulum.json");
+  const LinearPlant p = plant_at_equilibrium(m);
+  const double Kp = (9 + 3 * g / 4) / 0.075, Kd = 4.8 / 0.075;
+  const auto pd = make_pid(Eigen::MatrixXd::Constant(1, 1, Kp), Eigen::MatrixXd(), Eigen::MatrixXd::Constant(1, 1, Kd),
+                           Eigen::VectorXd::Constant(1, M_PI / 2), Eigen::VectorXd::Zero(1));
+  auto divergence = [&](double offset) {
+    SimulationOptions o = options("ida", 3.0);
+    o.compare_linear = true;
+    o.q0 = Eigen::VectorXd::Constant(1, M_PI / 2 - offset);
+    o.v0 = Eigen::VectorXd::Zero(1);
+    const SimulationResult r = simulate(m, pd.get(), &p, o);
+    EXPECT_EQ(r.y_linear.rows(), r.samples());
+    return (r.y - r.y_linear).cwiseAbs().maxCoeff() / offset;  // relative to the initial offset
+  };
+  const double small = divergence(1 * deg), large = divergence(60 * deg);
+  EXPECT_LT(small, 0.01);        // within 1% of the offset
+  EXPECT_GT(large, 0.02);        // a large offset leaves the linear range
+  EXPECT_GT(large, 10 * small);  // and the gap grows faster than the offset
+  std::cout << "linear vs nonlinear, max |y - y_lin| / offset: 1 deg " << small << ", 60 deg " << large << "\n";
+}
+
+TEST(Simulate, CancelKeepsThePartialResult) {
+  const Model m = test::load_example("double_pendulum.json");
+  std::atomic<bool> cancel{false};
+  SimulationCallbacks cb;
+  int seen = 0;
+  cb.on_sample = [&](const Snapshot& s) {
+    if (++seen == 50) cancel = true;
+    EXPECT_EQ(s.q.size(), m.nq);
+  };
+  cb.cancel = &cancel;
+  const SimulationResult r = simulate(m, nullptr, nullptr, options("ida", 5.0), cb);
+  EXPECT_TRUE(r.cancelled);
+  EXPECT_FALSE(r.completed);
+  EXPECT_EQ(r.samples(), 50);
+  EXPECT_NEAR(r.t.back(), 0.49, 1e-12);
+}
+
+TEST(Simulate, SolverFailureIsReportedWithTimeAndReason) {
+  const Model m = test::load_example("pendulum.json");
+  const LinearPlant p = plant_at_equilibrium(m);
+  // positive feedback with an absurd gain: the fixed-step reference blows up
+  const auto bad = make_pid(Eigen::MatrixXd::Constant(1, 1, -1e9), Eigen::MatrixXd(), Eigen::MatrixXd(),
+                            Eigen::VectorXd::Constant(1, M_PI / 2), Eigen::VectorXd::Zero(1));
+  SimulationOptions o = options("rk4", 5.0);
+  o.integrator.max_step = 0.01;
+  const SimulationResult r = simulate(m, bad.get(), &p, o);
+  EXPECT_FALSE(r.completed);
+  EXPECT_NE(r.failure.find("t = "), std::string::npos) << r.failure;
+  EXPECT_NE(r.failure.find("finite"), std::string::npos) << r.failure;
+  EXPECT_GT(r.samples(), 0);
+}
+
+TEST(Simulate, UnknownIntegratorIsAClearError) {
+  const Model m = test::load_example("pendulum.json");
+  try {
+    simulate(m, nullptr, nullptr, options("euler", 1.0));
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown integrator \"euler\""), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace codyna
