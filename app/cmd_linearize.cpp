@@ -9,9 +9,7 @@
 #include "analysis/operating_point.hpp"
 #include "commands.hpp"
 #include "common.hpp"
-#include "dynamics/assembly.hpp"
 #include "io/mat_export.hpp"
-#include "simulation/reference_integrator.hpp"
 
 namespace codyna::cli {
 
@@ -39,56 +37,6 @@ void print_matrix(const char* label, const Eigen::MatrixXd& M, const std::vector
   }
 }
 
-// applies --set NAME=VALUE to joint coordinates, then re-assembles loops
-Model with_settings(Model m, const std::vector<std::string>& set) {
-  if (set.empty()) return m;
-  for (const std::string& s : set) {
-    const auto eq = s.find('=');
-    if (eq == std::string::npos) throw std::invalid_argument("--set " + s + ": expected NAME=VALUE");
-    const std::string name = s.substr(0, eq);
-    double value;
-    try {
-      value = std::stod(s.substr(eq + 1));
-    } catch (const std::exception&) {
-      throw std::invalid_argument("--set " + s + ": expected a number after '='");
-    }
-    const auto it = std::find(m.q_names.begin(), m.q_names.end(), name);
-    if (it == m.q_names.end()) {
-      std::string all;
-      for (const auto& n : m.q_names) all += (all.empty() ? "" : ", ") + n;
-      throw std::invalid_argument("--set " + s + ": unknown coordinate \"" + name + "\" (coordinates: " + all + ")");
-    }
-    m.q0[it - m.q_names.begin()] = value;
-  }
-  const AssemblyResult r = assemble(m, m.q0, m.v0);
-  if (!r.converged) throw std::invalid_argument("--set: the loops cannot be assembled at the given coordinates");
-  m.q0 = r.q;
-  m.v0 = r.v;
-  return m;
-}
-
-OperatingPoint operating_point(const Model& m, const LinearizeArgs& a) {
-  const OperatingPoint start = initial_point(m);
-  if (a.op == "initial") return start;
-  if (a.op == "equilibrium") return static_equilibrium(m, start, a.independent);
-  if (a.op == "trim") return trim(m, start, a.independent);
-  if (a.op.rfind("time=", 0) == 0) {
-    double t;
-    try {
-      t = std::stod(a.op.substr(5));
-    } catch (const std::exception&) {
-      throw std::invalid_argument("--operating-point " + a.op + ": expected time=T with T a number of seconds");
-    }
-    if (!(t >= 0)) throw std::invalid_argument("--operating-point: the time must be >= 0");
-    // the state reached at t with the actuators at their nominal values (reference RK4, 1 ms steps or finer)
-    const int n = static_cast<int>(std::ceil(t / std::min(1e-3, m.spec.solver.output_step)));
-    State x{m.q0, m.v0};
-    if (n > 0) x = rk4_integrate(m, x, start.u, t / n, n);
-    return snapshot_point(m, t, x.q, x.v, start.u);
-  }
-  throw std::invalid_argument("--operating-point " + a.op + ": expected initial, equilibrium, trim or time=T");
-}
-
 JacobianMethod method_of(const std::string& s) {
   if (s == "exact") return JacobianMethod::Exact;
   if (s == "fd-forward") return JacobianMethod::ForwardDifference;
@@ -100,7 +48,7 @@ void run(const LinearizeArgs& a) {
   const Model m = with_settings(load_model(a.model), a.set);
   if (m.plant_inputs.empty() && m.plant_outputs.empty())
     std::cerr << "codyna: warning: the model selects no Plant/In or Plant/Out; exporting the state equations only\n";
-  const OperatingPoint op = operating_point(m, a);
+  const OperatingPoint op = operating_point(m, a.op, a.independent);
   LinearizeOptions opt;
   opt.method = method_of(a.method);
   opt.independent = a.independent;

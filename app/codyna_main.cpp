@@ -11,6 +11,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("codyna ") + CODYNA_VERSION);
   codyna::cli::add_info(app);
   codyna::cli::add_linearize(app);
+  codyna::cli::add_simulate(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -327,6 +327,69 @@ Eigen::VectorXd read_q0(const Node& n, JointType type) {
   return q;
 }
 
+// "1 row", "2 rows"
+std::string counted(Eigen::Index n, const std::string& noun) {
+  return std::to_string(n) + " " + noun + (n == 1 ? "" : "s");
+}
+
+std::string size_of(const Eigen::MatrixXd& m) { return std::to_string(m.rows()) + " x " + std::to_string(m.cols()); }
+
+// A matrix: an array of rows, each a non-empty array of numbers, all of the
+// same length; a number is a 1 x 1 matrix.
+Eigen::MatrixXd read_matrix(const Node& n) {
+  const json& j = n.value();
+  if (j.is_number()) return Eigen::MatrixXd::Constant(1, 1, read_number(n));
+  if (!j.is_array() || j.empty())
+    n.expected("a matrix (an array of rows, each an array of numbers; a 1 x 1 matrix may be a number)");
+  if (j[0].is_number()) n.expected("an array of rows (a row vector is written [[a, b, ...]])");
+  const Node first = n.element(0);
+  if (!first.value().is_array() || first.value().empty()) first.expected("a row (a non-empty array of numbers)");
+  const auto rows = static_cast<Eigen::Index>(j.size());
+  const auto cols = static_cast<Eigen::Index>(first.value().size());
+  Eigen::MatrixXd m(rows, cols);
+  for (Eigen::Index r = 0; r < rows; ++r) {
+    const Node row = n.element(r);
+    if (!row.value().is_array()) row.expected("an array of " + counted(cols, "number") + " like the first row");
+    if (row.value().size() != first.value().size())
+      row.fail("expected " + counted(cols, "number") + " like the first row, got " + std::to_string(row.value().size()));
+    for (Eigen::Index c = 0; c < cols; ++c) m(r, c) = read_number(row.element(c));
+  }
+  return m;
+}
+
+// An array of numbers of any length.
+Eigen::VectorXd read_vector(const Node& n) {
+  if (!n.value().is_array()) n.expected("an array of numbers");
+  return read_numbers(n, n.value().size());
+}
+
+// The diagonal of an LQR weight: numbers >= 0, or > 0 if `positive`.
+std::vector<double> read_weights(const Node& n, bool positive) {
+  std::vector<double> w;
+  for (const Node& e : read_elements(n)) {
+    const double x = read_number(e);
+    if (positive && !(x > 0)) e.expected("a number > 0 (R = diag(r_weights) must be positive definite)");
+    if (!positive && x < 0) e.expected("a number >= 0");
+    w.push_back(x);
+  }
+  return w;
+}
+
+double read_sample_time(const Node& n) {
+  const double Ts = read_number(n);
+  if (Ts < 0) n.expected("a number >= 0 (0 = continuous)");
+  return Ts;
+}
+
+// Where the plant is linearized for a controller.
+std::string read_operating_point(const Node& n) {
+  static const std::vector<std::string_view> names{"initial", "equilibrium", "trim"};
+  const std::string s = read_string(n);
+  if (std::find(names.begin(), names.end(), s) == names.end())
+    n.fail("unknown operating point " + quote(s) + " (expected one of: " + join(names) + ")");
+  return s;
+}
+
 // ---------------------------------------------------------------------------
 // Writing
 
@@ -335,6 +398,7 @@ ojson encode(int x) { return x; }
 ojson encode(const std::string& s) { return s; }
 ojson encode(const std::optional<double>& x) { return x ? ojson(*x) : ojson(); }
 ojson encode(const std::vector<std::string>& names) { return names; }
+ojson encode(const std::vector<double>& v) { return v; }
 
 ojson encode(const Eigen::Ref<const Eigen::VectorXd>& v) {
   ojson a = ojson::array();
@@ -348,6 +412,13 @@ ojson encode_rotation(const Eigen::Matrix3d& R) {
   ojson o = ojson::object();
   o["matrix"] = rows;
   return o;
+}
+
+// A matrix as an array of rows (always, also when 1 x 1).
+ojson encode_matrix(const Eigen::MatrixXd& m) {
+  ojson rows = ojson::array();
+  for (Eigen::Index r = 0; r < m.rows(); ++r) rows.push_back(encode(m.row(r).transpose()));
+  return rows;
 }
 
 // Six numbers, unless rounding has left I slightly asymmetric: then all nine.
@@ -723,6 +794,92 @@ const Schema<PlantSpec>& schema<PlantSpec>() {
   return s;
 }
 
+// A matrix of a controller; `check` tests it against the fields read before it
+// (sizes against the plant are checked when a simulation uses the controller).
+Field<ControllerSpec> matrix_field(std::string_view key, Eigen::MatrixXd ControllerSpec::*m, Need need,
+                                   void (*check)(const Node&, const ControllerSpec&) = nullptr) {
+  Field<ControllerSpec> f = field(key, m, read_matrix, encode_matrix, need);
+  if (check)
+    f.read = [m, check](const Node& n, ControllerSpec& c) {
+      c.*m = read_matrix(n);
+      check(n, c);
+    };
+  return f;
+}
+
+void expect_size(const Node& n, const Eigen::MatrixXd& m, Eigen::Index rows, Eigen::Index cols,
+                 const std::string& why) {
+  if (m.rows() != rows || m.cols() != cols)
+    n.fail("expected a " + std::to_string(rows) + " x " + std::to_string(cols) + " matrix (" + why + "), got " +
+           size_of(m));
+}
+
+void expect_size_of_kp(const Node& n, const Eigen::MatrixXd& m, const ControllerSpec& c) {
+  expect_size(n, m, c.kp.rows(), c.kp.cols(), "the size of kp");
+}
+
+template <>
+const Schema<ControllerSpec>& schema<ControllerSpec>() {
+  using C = ControllerSpec;
+  static const Schema<C> s{
+      {
+          type_field<C>("controller type", controller_type_from_string),
+          matrix_field("kp", &C::kp, Need::Required),
+          matrix_field("ki", &C::ki, Need::Optional, [](const Node& n, const C& c) { expect_size_of_kp(n, c.ki, c); }),
+          matrix_field("kd", &C::kd, Need::Optional, [](const Node& n, const C& c) { expect_size_of_kp(n, c.kd, c); }),
+          {"setpoint", Need::Optional,
+           [](const Node& n, C& c) {
+             c.setpoint = read_vector(n);
+             if (c.setpoint.size() != c.kp.cols())
+               n.fail("expected " + counted(c.kp.cols(), "value") + " (one per column of kp), got " +
+                      std::to_string(c.setpoint.size()));
+           },
+           [](ojson& j, const C& c) { if (c.setpoint.size() > 0) j["setpoint"] = encode(c.setpoint); }},
+          matrix_field("K", &C::K, Need::Required),
+          matrix_field("Ac", &C::Ac, Need::Required,
+                       [](const Node& n, const C& c) {
+                         if (c.Ac.rows() != c.Ac.cols()) n.fail("expected a square matrix, got " + size_of(c.Ac));
+                       }),
+          matrix_field("Bc", &C::Bc, Need::Required,
+                       [](const Node& n, const C& c) {
+                         if (c.Bc.rows() != c.Ac.rows())
+                           n.fail("expected " + counted(c.Ac.rows(), "row") + " (as many as Ac), got " +
+                                  std::to_string(c.Bc.rows()));
+                       }),
+          matrix_field("Cc", &C::Cc, Need::Required,
+                       [](const Node& n, const C& c) {
+                         if (c.Cc.cols() != c.Ac.cols())
+                           n.fail("expected " + counted(c.Ac.cols(), "column") + " (as many as Ac), got " +
+                                  std::to_string(c.Cc.cols()));
+                       }),
+          matrix_field("Dc", &C::Dc, Need::Required,
+                       [](const Node& n, const C& c) {
+                         expect_size(n, c.Dc, c.Cc.rows(), c.Bc.cols(), "rows of Cc by columns of Bc");
+                       }),
+          field("Ts", &C::Ts, read_sample_time),
+          field("q_weights", &C::q_weights, [](const Node& n) { return read_weights(n, false); }),
+          field("r_weights", &C::r_weights, [](const Node& n) { return read_weights(n, true); }),
+          field("operating_point", &C::operating_point, read_operating_point),
+      },
+      "controller",
+      [](const C& c) -> std::vector<std::string_view> {
+        switch (c.type) {
+          case ControllerType::None: return {"type"};
+          case ControllerType::Pid: return {"type", "kp", "ki", "kd", "setpoint", "operating_point"};
+          case ControllerType::StateFeedback: return {"type", "K", "operating_point"};
+          case ControllerType::Lti: return {"type", "Ac", "Bc", "Cc", "Dc", "Ts", "operating_point"};
+          case ControllerType::Lqr: return {"type", "q_weights", "r_weights", "operating_point"};
+        }
+        return {"type"};
+      }};
+  return s;
+}
+
+// No controller (type none) is left out of the file.
+ojson write_controller(const ControllerSpec& c) {
+  return c.type == ControllerType::None ? ojson() : write_struct(c);
+}
+
 template <>
 const Schema<SolverSpec>& schema<SolverSpec>() {
   static const Schema<SolverSpec> s{{
@@ -755,6 +912,7 @@ const Schema<ModelSpec>& schema<ModelSpec>() {
       list_field("actuators", &ModelSpec::actuators),
       list_field("sensors", &ModelSpec::sensors),
       struct_field("plant", &ModelSpec::plant),
+      field("controller", &ModelSpec::controller, read_struct<ControllerSpec>, write_controller),
       struct_field("solver", &ModelSpec::solver),
   }};
   return s;

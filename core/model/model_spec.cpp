@@ -58,6 +58,13 @@ constexpr std::array<std::pair<ShapeType, const char*>, 3> kShapes{{
     {ShapeType::Cylinder, "cylinder"},
     {ShapeType::Sphere, "sphere"},
 }};
+constexpr std::array<std::pair<ControllerType, const char*>, 5> kControllers{{
+    {ControllerType::None, "none"},
+    {ControllerType::Pid, "pid"},
+    {ControllerType::StateFeedback, "state_feedback"},
+    {ControllerType::Lti, "lti"},
+    {ControllerType::Lqr, "lqr"},
+}};
 }  // namespace
 
 int joint_nq(JointType t) {
@@ -90,11 +97,15 @@ const char* to_string(EffectType t) { return name_of(kEffects, t); }
 const char* to_string(ActuatorType t) { return name_of(kActuators, t); }
 const char* to_string(SensorType t) { return name_of(kSensors, t); }
 const char* to_string(ShapeType t) { return name_of(kShapes, t); }
+const char* to_string(ControllerType t) { return name_of(kControllers, t); }
 std::optional<JointType> joint_type_from_string(const std::string& s) { return value_of(kJoints, s); }
 std::optional<ConstraintType> constraint_type_from_string(const std::string& s) { return value_of(kConstraints, s); }
 std::optional<EffectType> effect_type_from_string(const std::string& s) { return value_of(kEffects, s); }
 std::optional<ActuatorType> actuator_type_from_string(const std::string& s) { return value_of(kActuators, s); }
 std::optional<SensorType> sensor_type_from_string(const std::string& s) { return value_of(kSensors, s); }
 std::optional<ShapeType> shape_type_from_string(const std::string& s) { return value_of(kShapes, s); }
+std::optional<ControllerType> controller_type_from_string(const std::string& s) {
+  return value_of(kControllers, s);
+}
 
 }  // namespace codyna

@@ -167,6 +167,38 @@ struct PlantSpec {
   std::vector<std::string> outputs;
 };
 
+// A controller designed for the plant and stored with the model, so that it
+// travels with it. Its signals are deviations from an operating point
+// (x0, u0, y0) at which codyna linearizes the plant; u is in Plant/In order,
+// y in Plant/Out order, x in the state order of codyna's linearization.
+//   pid             u = u0 + kp (r - y) + ki xi - kd dy/dt,   dxi/dt = r - y
+//                   (derivative action on the measurement)
+//   state_feedback  u = u0 - K (x - x0)
+//   lti             dxc/dt = Ac xc + Bc (y - y0),   u = u0 + Cc xc + Dc (y - y0);
+//                   with Ts > 0 sampled, zero-order hold:
+//                   xc[k+1] = Ac xc[k] + Bc (y[k] - y0),   u[k] = u0 + Cc xc[k] + Dc (y[k] - y0)
+//   lqr             K = lqr(A, B, Q, R) of the linearized plant, then as state_feedback
+// Reading a model file checks only that the matrices fit each other; their
+// sizes against the plant (nu, ny, nx) are checked when a simulation uses them.
+enum class ControllerType { None, Pid, StateFeedback, Lti, Lqr };
+
+struct ControllerSpec {
+  ControllerType type = ControllerType::None;
+  // pid: gains (nu x ny, rows = Plant/In order, columns = Plant/Out order); empty ki/kd = none
+  Eigen::MatrixXd kp, ki, kd;
+  Eigen::VectorXd setpoint;  // pid: r (ny); empty = the operating point's y0
+  // state_feedback: u = u0 - K (x - x0), K is nu x nx in the state order of codyna's linearization
+  Eigen::MatrixXd K;
+  // lti: dxc/dt = Ac xc + Bc (y - y0), u = u0 + Cc xc + Dc (y - y0); Ts > 0: sampled, zero-order hold
+  Eigen::MatrixXd Ac, Bc, Cc, Dc;
+  double Ts = 0.0;
+  // lqr: designed by codyna on the linearized plant: Q = diag(q_weights) (nx), R = diag(r_weights) (nu);
+  // empty = identity
+  std::vector<double> q_weights, r_weights;
+  // where the plant is linearized for the controller's offsets/state order: "initial", "equilibrium", "trim"
+  std::string operating_point = "equilibrium";
+};
+
 struct SolverSpec {
   std::string integrator = "ida";
   double rtol = 1e-8;
@@ -186,6 +218,7 @@ struct ModelSpec {
   std::vector<ActuatorSpec> actuators;
   std::vector<SensorSpec> sensors;
   PlantSpec plant;
+  ControllerSpec controller;  // type None: no controller
   SolverSpec solver;
 };
 
@@ -200,11 +233,13 @@ const char* to_string(EffectType t);
 const char* to_string(ActuatorType t);
 const char* to_string(SensorType t);
 const char* to_string(ShapeType t);
+const char* to_string(ControllerType t);  // None is "none"; a model file leaves such a controller out
 std::optional<JointType> joint_type_from_string(const std::string& s);
 std::optional<ConstraintType> constraint_type_from_string(const std::string& s);
 std::optional<EffectType> effect_type_from_string(const std::string& s);
 std::optional<ActuatorType> actuator_type_from_string(const std::string& s);
 std::optional<SensorType> sensor_type_from_string(const std::string& s);
 std::optional<ShapeType> shape_type_from_string(const std::string& s);
+std::optional<ControllerType> controller_type_from_string(const std::string& s);
 
 }  // namespace codyna

@@ -111,8 +111,18 @@ constexpr const char* kEverything = R"({
     {"name": "s6", "type": "distance", "body_a": "b1", "point_a": [1, 0, 0], "body_b": "b8", "point_b": [0, 0, 1]}
   ],
   "plant": {"inputs": ["a1", "a2"], "outputs": ["s1", "s3", "s6"]},
+  "controller": {"type": "pid", "kp": [[1, 2, 3], [4, 5, 6]], "ki": [[0.1, 0, 0], [0, 0.2, -0.3]],
+                 "kd": [[0.5, 0, 0], [0, 0, 0.25]], "setpoint": [0.1, -0.2, 0.3], "operating_point": "trim"},
   "solver": {"integrator": "cvode", "rtol": 1e-6, "atol": 1e-9, "t_end": 10, "output_step": 0.05, "max_step": 0.1}
 })";
+
+// The controller forms of docs/model-format.md, one of each type.
+constexpr const char* kPidController =
+    R"({"type": "pid", "kp": [[218.1]], "kd": [[64]], "setpoint": [1.5708], "operating_point": "equilibrium"})";
+constexpr const char* kStateFeedbackController = R"({"type": "state_feedback", "K": [[-31.6, -959.4, -66.2, -323.5]]})";
+constexpr const char* kLtiController =
+    R"({"type": "lti", "Ac": [[0]], "Bc": [[1]], "Cc": [[12800]], "Dc": [[-13018]], "Ts": 0.005})";
+constexpr const char* kLqrController = R"({"type": "lqr", "q_weights": [10, 100, 1, 1], "r_weights": [0.01]})";
 
 // ---------------------------------------------------------------- helpers
 
@@ -250,6 +260,25 @@ void expect_same(const SensorSpec& a, const SensorSpec& b) {
   EXPECT_SAME(unit);
 }
 
+void expect_same(const ControllerSpec& a, const ControllerSpec& b) {
+  EXPECT_SAME(type);
+  EXPECT_SAME(kp);
+  EXPECT_SAME(ki);
+  EXPECT_SAME(kd);
+  EXPECT_SAME(setpoint);
+  EXPECT_SAME(K);
+  EXPECT_SAME(Ac);
+  EXPECT_SAME(Bc);
+  EXPECT_SAME(Cc);
+  EXPECT_SAME(Dc);
+  EXPECT_SAME(Ts);
+  ASSERT_EQ(a.q_weights.size(), b.q_weights.size());
+  for (std::size_t i = 0; i < a.q_weights.size(); ++i) EXPECT_TRUE(same(a.q_weights[i], b.q_weights[i])) << i;
+  ASSERT_EQ(a.r_weights.size(), b.r_weights.size());
+  for (std::size_t i = 0; i < a.r_weights.size(); ++i) EXPECT_TRUE(same(a.r_weights[i], b.r_weights[i])) << i;
+  EXPECT_SAME(operating_point);
+}
+
 void expect_same(const ModelSpec& a, const ModelSpec& b) {
   EXPECT_SAME(name);
   EXPECT_SAME(description);
@@ -261,6 +290,7 @@ void expect_same(const ModelSpec& a, const ModelSpec& b) {
   expect_same(a.sensors, b.sensors);
   EXPECT_SAME(plant.inputs);
   EXPECT_SAME(plant.outputs);
+  expect_same(a.controller, b.controller);
   EXPECT_SAME(solver.integrator);
   EXPECT_SAME(solver.rtol);
   EXPECT_SAME(solver.atol);
@@ -292,6 +322,24 @@ void expect_model_error(const json& j, const std::string& path, const std::strin
 }
 
 json pendulum() { return json::parse(kPendulum); }
+
+// The pendulum with `controller` (JSON text) as its controller.
+json with_controller(const std::string& controller) {
+  json j = pendulum();
+  j["controller"] = json::parse(controller);
+  return j;
+}
+
+ControllerSpec read_controller(const std::string& controller) {
+  return parse_model_spec(with_controller(controller), "controller.json").controller;
+}
+
+// `actual` has exactly the size and (bit for bit) the entries of `expected`.
+void expect_exact(const Eigen::MatrixXd& actual, const Eigen::MatrixXd& expected) {
+  EXPECT_TRUE(same(actual, expected)) << "actual (" << actual.rows() << " x " << actual.cols() << "):\n"
+                                      << actual << "\nexpected (" << expected.rows() << " x " << expected.cols()
+                                      << "):\n" << expected;
+}
 
 // The rotation matrix that `rotation` (the JSON of a ROT) reads as.
 Eigen::Matrix3d read_rotation(const json& rotation) {
@@ -504,6 +552,93 @@ TEST(ModelFile, DefaultsOfOptionalFields) {
   EXPECT_EQ(m.sensors[0].component, 0);
   EXPECT_EQ(m.solver.integrator, SolverSpec{}.integrator);
   EXPECT_TRUE(m.plant.inputs.empty());
+  EXPECT_EQ(m.controller.type, ControllerType::None);
+}
+
+TEST(ModelFile, ControllerNames) {
+  for (ControllerType t : {ControllerType::None, ControllerType::Pid, ControllerType::StateFeedback,
+                           ControllerType::Lti, ControllerType::Lqr})
+    EXPECT_EQ(controller_type_from_string(to_string(t)), t);
+  EXPECT_STREQ(to_string(ControllerType::StateFeedback), "state_feedback");
+  EXPECT_FALSE(controller_type_from_string("PID").has_value());
+}
+
+TEST(ModelFile, ParsesPidController) {
+  const ControllerSpec c = read_controller(kPidController);
+  EXPECT_EQ(c.type, ControllerType::Pid);
+  expect_exact(c.kp, Eigen::MatrixXd{{218.1}});
+  EXPECT_EQ(c.ki.size(), 0);  // no integral action
+  expect_exact(c.kd, Eigen::MatrixXd{{64.0}});
+  expect_exact(c.setpoint, Eigen::VectorXd::Constant(1, 1.5708));
+  EXPECT_EQ(c.operating_point, "equilibrium");
+
+  // a 1 x 1 matrix may be a plain number; without a setpoint r is the operating point's y0 (empty)
+  const ControllerSpec p = read_controller(R"({"type": "pid", "kp": 218.1, "ki": 2})");
+  expect_exact(p.kp, Eigen::MatrixXd{{218.1}});
+  expect_exact(p.ki, Eigen::MatrixXd{{2.0}});
+  EXPECT_EQ(p.kd.size(), 0);
+  EXPECT_EQ(p.setpoint.size(), 0);
+
+  // multivariable: nu x ny, rows in Plant/In order
+  const ModelSpec m = parse(kEverything);
+  expect_exact(m.controller.kp, Eigen::MatrixXd{{1, 2, 3}, {4, 5, 6}});
+  expect_exact(m.controller.ki, Eigen::MatrixXd{{0.1, 0, 0}, {0, 0.2, -0.3}});
+  expect_exact(m.controller.kd, Eigen::MatrixXd{{0.5, 0, 0}, {0, 0, 0.25}});
+  expect_exact(m.controller.setpoint, Eigen::Vector3d(0.1, -0.2, 0.3));
+  EXPECT_EQ(m.controller.operating_point, "trim");
+}
+
+TEST(ModelFile, ParsesStateFeedbackController) {
+  const ControllerSpec c = read_controller(kStateFeedbackController);
+  EXPECT_EQ(c.type, ControllerType::StateFeedback);
+  expect_exact(c.K, Eigen::MatrixXd{{-31.6, -959.4, -66.2, -323.5}});
+  EXPECT_EQ(c.operating_point, "equilibrium");  // the default
+  EXPECT_EQ(c.kp.size(), 0);
+
+  const ControllerSpec two = read_controller(R"({"type": "state_feedback", "K": [[1, 2], [3, 4], [5, 6]],
+                                                 "operating_point": "initial"})");
+  expect_exact(two.K, Eigen::MatrixXd{{1, 2}, {3, 4}, {5, 6}});
+  EXPECT_EQ(two.operating_point, "initial");
+}
+
+TEST(ModelFile, ParsesLtiController) {
+  const ControllerSpec c = read_controller(kLtiController);
+  EXPECT_EQ(c.type, ControllerType::Lti);
+  expect_exact(c.Ac, Eigen::MatrixXd{{0.0}});
+  expect_exact(c.Bc, Eigen::MatrixXd{{1.0}});
+  expect_exact(c.Cc, Eigen::MatrixXd{{12800.0}});
+  expect_exact(c.Dc, Eigen::MatrixXd{{-13018.0}});
+  EXPECT_EQ(c.Ts, 0.005);
+
+  // continuous (Ts left out), 2 states, 1 output, 2 inputs
+  const ControllerSpec d = read_controller(R"({"type": "lti", "Ac": [[0, 1], [-2, -3]], "Bc": [[0], [1]],
+                                               "Cc": [[1, 0], [0, 1]], "Dc": [[0.5], [-0.5]]})");
+  expect_exact(d.Ac, Eigen::MatrixXd{{0, 1}, {-2, -3}});
+  expect_exact(d.Bc, Eigen::MatrixXd{{0}, {1}});
+  expect_exact(d.Cc, Eigen::MatrixXd{{1, 0}, {0, 1}});
+  expect_exact(d.Dc, Eigen::MatrixXd{{0.5}, {-0.5}});
+  EXPECT_EQ(d.Ts, 0.0);
+}
+
+TEST(ModelFile, ParsesLqrController) {
+  const ControllerSpec c = read_controller(kLqrController);
+  EXPECT_EQ(c.type, ControllerType::Lqr);
+  EXPECT_EQ(c.q_weights, (std::vector<double>{10, 100, 1, 1}));
+  EXPECT_EQ(c.r_weights, std::vector<double>{0.01});
+  EXPECT_EQ(c.operating_point, "equilibrium");
+
+  // weights left out: identity; a zero state weight is allowed
+  const ControllerSpec d = read_controller(R"({"type": "lqr", "q_weights": [0, 1]})");
+  EXPECT_EQ(d.q_weights, (std::vector<double>{0, 1}));
+  EXPECT_TRUE(d.r_weights.empty());
+}
+
+TEST(ModelFile, NoController) {
+  // "none" reads as no controller, which is not written
+  const ModelSpec m = parse_model_spec(with_controller(R"({"type": "none"})"), "none.json");
+  EXPECT_EQ(m.controller.type, ControllerType::None);
+  EXPECT_FALSE(to_json(m).contains("controller"));
+  EXPECT_FALSE(to_json(parse(kPendulum)).contains("controller"));
 }
 
 // ---------------------------------------------------------------- writing
@@ -518,6 +653,24 @@ TEST(ModelFile, RoundTripIsExact) {
     EXPECT_EQ(j["bodies"][0]["inertia"].size(), 6u);
     EXPECT_TRUE(j["joints"][0]["parent_frame"]["rotation"].contains("matrix"));
   }
+}
+
+TEST(ModelFile, RoundTripOfEveryControllerIsExact) {
+  for (const char* controller : {kPidController, kStateFeedbackController, kLtiController, kLqrController}) {
+    SCOPED_TRACE(controller);
+    const ModelSpec m = parse_model_spec(with_controller(controller), "controller.json");
+    const json j = to_json(m);
+    expect_same(parse_model_spec(j, "written.json"), m);
+    expect_same(parse(j.dump()), m);
+    EXPECT_EQ(to_json(parse_model_spec(j, "written.json")), j);
+    // written as given, with operating_point made explicit, matrices always as arrays of rows
+    json expected = json::parse(controller);
+    expected["operating_point"] = "equilibrium";
+    EXPECT_EQ(j["controller"], expected);
+  }
+  // a 1 x 1 matrix given as a number is written as [[x]]
+  const json j = to_json(parse_model_spec(with_controller(R"({"type": "pid", "kp": 2.5})"), "number.json"));
+  EXPECT_EQ(j["controller"]["kp"], json::parse("[[2.5]]"));
 }
 
 TEST(ModelFile, RoundTripOfBuiltSpecIsBitExact) {
@@ -545,7 +698,34 @@ TEST(ModelFile, RoundTripOfBuiltSpecIsBitExact) {
     j.v0 = Eigen::VectorXd::Random(6) * 1e300;
     m.joints.push_back(j);
   }
+  // a sampled lti controller with awkward numbers
+  ControllerSpec& c = m.controller;
+  c.type = ControllerType::Lti;
+  c.Ac = Eigen::MatrixXd::Random(3, 3) / 3;
+  c.Bc = Eigen::MatrixXd::Random(3, 2) * 1e-300;
+  c.Cc = Eigen::MatrixXd::Random(4, 3) * 1e300;
+  c.Dc = Eigen::MatrixXd::Random(4, 2) / 7;
+  c.Ts = 1.0 / 3;
+  c.operating_point = "initial";
   expect_same(parse(to_json(m).dump()), m);
+
+  // and each of the other types, with the fields of the others left at their defaults
+  ModelSpec pid = m;
+  pid.controller = {};
+  pid.controller.type = ControllerType::Pid;
+  pid.controller.kp = Eigen::MatrixXd::Random(2, 3) / 3;
+  pid.controller.ki = Eigen::MatrixXd::Random(2, 3) * 1e-10;
+  pid.controller.kd = Eigen::MatrixXd::Random(2, 3) / 11;
+  pid.controller.setpoint = Eigen::VectorXd::Random(3) * std::numbers::pi;
+  expect_same(parse(to_json(pid).dump()), pid);
+
+  ModelSpec lqr = m;
+  lqr.controller = {};
+  lqr.controller.type = ControllerType::Lqr;
+  lqr.controller.q_weights = {1.0 / 3, 0.0, 1e-300, 1e300};
+  lqr.controller.r_weights = {2.0 / 3};
+  lqr.controller.operating_point = "trim";
+  expect_same(parse(to_json(lqr).dump()), lqr);
 }
 
 TEST(ModelFile, SaveThenLoad) {
@@ -735,6 +915,108 @@ TEST(ModelFileErrors, UnsupportedFormatVersion) {
   json j = pendulum();
   j["codyna_model"] = 2;
   expect_model_error(j, "/codyna_model", "unsupported format version 2");
+}
+
+// `controller` (JSON text) as the pendulum's controller must fail at `path` with `phrase`.
+void expect_controller_error(const std::string& controller, const std::string& path, const std::string& phrase) {
+  SCOPED_TRACE(controller);
+  expect_model_error(with_controller(controller), path, phrase);
+}
+
+TEST(ModelFileErrors, UnknownControllerType) {
+  expect_controller_error(R"({"type": "mpc"})", "/controller/type",
+                          "unknown controller type \"mpc\" (expected one of: none, pid, state_feedback, lti, lqr)");
+  expect_controller_error(R"({"kp": 1})", "/controller", "missing required field \"type\"");
+  expect_model_error(with_controller("[1]"), "/controller", "expected an object, got an array of 1 element");
+}
+
+TEST(ModelFileErrors, UnknownControllerField) {
+  expect_controller_error(R"({"type": "pid", "kp": 1, "kq": 2})", "/controller/kq",
+                          "unknown field \"kq\" (allowed for a pid controller: type, kp, ki, kd, setpoint, "
+                          "operating_point)");
+  // a field of another controller type is unknown too
+  expect_controller_error(R"({"type": "state_feedback", "K": [[1, 2]], "Ts": 0.01})", "/controller/Ts",
+                          "unknown field \"Ts\" (allowed for a state_feedback controller: type, K, operating_point)");
+  expect_controller_error(R"({"type": "none", "kp": 1})", "/controller/kp",
+                          "unknown field \"kp\" (allowed for a none controller: type)");
+}
+
+TEST(ModelFileErrors, MissingControllerMatrix) {
+  expect_controller_error(R"({"type": "pid", "kd": 1})", "/controller", "missing required field \"kp\"");
+  expect_controller_error(R"({"type": "state_feedback"})", "/controller", "missing required field \"K\"");
+  expect_controller_error(R"({"type": "lti", "Ac": 0, "Bc": 1, "Cc": 1})", "/controller",
+                          "missing required field \"Dc\"");
+}
+
+TEST(ModelFileErrors, RaggedControllerMatrix) {
+  expect_controller_error(R"({"type": "state_feedback", "K": [[1, 2, 3, 4], [5, 6, 7]]})", "/controller/K/1",
+                          "expected 4 numbers like the first row, got 3");
+  expect_controller_error(R"({"type": "state_feedback", "K": [[1], [2, 3]]})", "/controller/K/1",
+                          "expected 1 number like the first row, got 2");
+  expect_controller_error(R"({"type": "state_feedback", "K": [[1, 2], 3]})", "/controller/K/1",
+                          "expected an array of 2 numbers like the first row, got number 3");
+}
+
+TEST(ModelFileErrors, MalformedControllerMatrix) {
+  expect_controller_error(R"({"type": "pid", "kp": [[1, "2"]]})", "/controller/kp/0/1",
+                          "expected a number, got string \"2\"");
+  expect_controller_error(R"({"type": "pid", "kp": [[1, null]]})", "/controller/kp/0/1",
+                          "expected a number, got null");
+  // a row vector is an array of one row
+  expect_controller_error(R"({"type": "state_feedback", "K": [1, 2]})", "/controller/K",
+                          "expected an array of rows (a row vector is written [[a, b, ...]]), got an array of 2");
+  expect_controller_error(R"({"type": "state_feedback", "K": []})", "/controller/K",
+                          "expected a matrix (an array of rows, each an array of numbers; a 1 x 1 matrix may be a "
+                          "number), got an array of 0 elements");
+  expect_controller_error(R"({"type": "state_feedback", "K": [[]]})", "/controller/K/0",
+                          "expected a row (a non-empty array of numbers), got an array of 0 elements");
+  expect_controller_error(R"({"type": "state_feedback", "K": "1"})", "/controller/K",
+                          "expected a matrix");
+}
+
+TEST(ModelFileErrors, InconsistentPidGains) {
+  expect_controller_error(R"({"type": "pid", "kp": [[1, 2]], "ki": [[1], [2]]})", "/controller/ki",
+                          "expected a 1 x 2 matrix (the size of kp), got 2 x 1");
+  expect_controller_error(R"({"type": "pid", "kp": [[1, 2]], "kd": 3})", "/controller/kd",
+                          "expected a 1 x 2 matrix (the size of kp), got 1 x 1");
+  expect_controller_error(R"({"type": "pid", "kp": [[1, 2]], "setpoint": [0.5]})", "/controller/setpoint",
+                          "expected 2 values (one per column of kp), got 1");
+  expect_controller_error(R"({"type": "pid", "kp": 1, "setpoint": 0.5})", "/controller/setpoint",
+                          "expected an array of numbers, got number 0.5");
+}
+
+TEST(ModelFileErrors, InconsistentLtiMatrices) {
+  expect_controller_error(R"({"type": "lti", "Ac": [[1, 2]], "Bc": [[1]], "Cc": [[1, 2]], "Dc": [[0]]})",
+                          "/controller/Ac", "expected a square matrix, got 1 x 2");
+  expect_controller_error(R"({"type": "lti", "Ac": [[1, 0], [0, 1]], "Bc": [[1]], "Cc": [[1, 2]], "Dc": [[0]]})",
+                          "/controller/Bc", "expected 2 rows (as many as Ac), got 1");
+  expect_controller_error(R"({"type": "lti", "Ac": [[1, 0], [0, 1]], "Bc": [[1], [2]], "Cc": 1, "Dc": [[0]]})",
+                          "/controller/Cc", "expected 2 columns (as many as Ac), got 1");
+  expect_controller_error(R"({"type": "lti", "Ac": 1, "Bc": [[1, 2]], "Cc": [[1], [2]], "Dc": [[0, 0]]})",
+                          "/controller/Dc", "expected a 2 x 2 matrix (rows of Cc by columns of Bc), got 1 x 2");
+}
+
+TEST(ModelFileErrors, NegativeSampleTime) {
+  expect_controller_error(R"({"type": "lti", "Ac": 0, "Bc": 1, "Cc": 1, "Dc": 0, "Ts": -0.005})", "/controller/Ts",
+                          "expected a number >= 0 (0 = continuous), got number -0.005");
+}
+
+TEST(ModelFileErrors, BadLqrWeight) {
+  expect_controller_error(R"({"type": "lqr", "q_weights": [10, -1, 1, 1]})", "/controller/q_weights/1",
+                          "expected a number >= 0, got number -1");
+  expect_controller_error(R"({"type": "lqr", "r_weights": [-0.01]})", "/controller/r_weights/0",
+                          "expected a number > 0 (R = diag(r_weights) must be positive definite), got number -0.01");
+  expect_controller_error(R"({"type": "lqr", "r_weights": [1, 0]})", "/controller/r_weights/1",
+                          "expected a number > 0");
+  expect_controller_error(R"({"type": "lqr", "q_weights": 10})", "/controller/q_weights",
+                          "expected an array, got number 10");
+}
+
+TEST(ModelFileErrors, BadOperatingPoint) {
+  expect_controller_error(R"({"type": "lqr", "operating_point": "upright"})", "/controller/operating_point",
+                          "unknown operating point \"upright\" (expected one of: initial, equilibrium, trim)");
+  expect_controller_error(R"({"type": "lqr", "operating_point": 0})", "/controller/operating_point",
+                          "expected a string, got number 0");
 }
 
 TEST(ModelFileErrors, FileNotFound) {

@@ -226,3 +226,56 @@ TEST(Simulate, UnknownIntegratorIsAClearError) {
 
 }  // namespace
 }  // namespace codyna
+
+#include "control/lqr.hpp"
+#include "dynamics/effects.hpp"
+
+namespace codyna {
+namespace {
+
+// Paper 4.2: an LQR law on the cart force holds the rod upright while the cart settles
+TEST(Simulate, PaperCartPendulumHeldUprightByLqr) {
+  const Model m = test::load_example("cart_pendulum.json");
+  ASSERT_NEAR(m.q0[1], 0.1, 1e-12);
+  const LinearPlant p = plant_at_equilibrium(m);
+  const LinearSystem& s = p.lin.system;
+  Eigen::VectorXd qw(4);
+  qw << 10, 100, 1, 1;
+  const LqrResult d = lqr(s.A, s.B, qw.asDiagonal(), Eigen::MatrixXd::Constant(1, 1, 0.01));
+  const auto c = make_state_feedback(d.K, s.u0);
+  for (const char* method : {"ida", "cvode-bdf", "arkode"}) {
+    const SimulationResult r = simulate(m, c.get(), &p, options(method, 8.0));
+    ASSERT_TRUE(r.completed) << method << ": " << r.failure;
+    for (int i = 0; i < r.samples(); ++i)
+      if (r.t[i] >= 5.0) {
+        EXPECT_NEAR(r.y(i, 1), 0.0, 0.5 * deg) << method << " t = " << r.t[i];  // theta
+        EXPECT_NEAR(r.y(i, 0), 0.0, 0.05) << method << " t = " << r.t[i];       // cart settles back
+      }
+    // bounded input: no more than the initial state-feedback kick
+    EXPECT_LE(r.u.cwiseAbs().maxCoeff(), std::abs(d.K(0, 1)) * 0.1 + 1e-6) << method;
+  }
+}
+
+// Only declared effects are evaluated: the pendulum has no springs or friction
+TEST(Simulate, AbsentEffectsAreNeverEvaluated) {
+  const Model m = test::load_example("pendulum.json");
+  ASSERT_TRUE(m.springs.empty() && m.joint_springs.empty() && m.joint_frictions.empty() && m.body_forces.empty());
+  effect_counters() = {};
+  const SimulationResult r = simulate(m, nullptr, nullptr, options("cvode-bdf", 0.5));
+  ASSERT_TRUE(r.completed);
+  EXPECT_EQ(effect_counters().springs, 0);
+  EXPECT_EQ(effect_counters().joint_springs, 0);
+  EXPECT_EQ(effect_counters().joint_frictions, 0);
+  EXPECT_EQ(effect_counters().body_forces, 0);
+  EXPECT_GT(effect_counters().actuators, 0);  // the torque actuator is declared
+  // and a declared spring is: the four-bar's crank spring, once per evaluation
+  const Model fb = test::load_example("four_bar.json");
+  effect_counters() = {};
+  const SimulationResult r2 = simulate(fb, nullptr, nullptr, options("cvode-bdf", 0.2));
+  ASSERT_TRUE(r2.completed);
+  EXPECT_GT(effect_counters().joint_springs, r2.stats.rhs_evals / 2);
+  EXPECT_EQ(effect_counters().springs, 0);
+}
+
+}  // namespace
+}  // namespace codyna

@@ -1,0 +1,190 @@
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+
+#include "analysis/linearize.hpp"
+#include "commands.hpp"
+#include "common.hpp"
+#include "control/lqr.hpp"
+#include "io/results_file.hpp"
+#include "simulation/simulator.hpp"
+
+namespace codyna::cli {
+
+namespace {
+
+struct SimulateArgs {
+  std::string model, out, csv, controller, op = "equilibrium", integrator;
+  bool lqr = false, compare_linear = false, quiet = false;
+  std::vector<double> q_weights, r_weights;
+  double t_end = 0, rtol = 0, atol = 0, max_step = -1, output_step = 0;
+  std::vector<std::string> independent, set;
+};
+
+Eigen::MatrixXd diagonal(const std::vector<double>& w, int n, const char* what) {
+  if (w.empty()) return Eigen::MatrixXd::Identity(n, n);
+  if (static_cast<int>(w.size()) != n)
+    throw std::invalid_argument(std::string(what) + ": expected " + std::to_string(n) + " weights, got " + std::to_string(w.size()));
+  for (double x : w)
+    if (!(x >= 0)) throw std::invalid_argument(std::string(what) + ": weights must be >= 0");
+  return Eigen::Map<const Eigen::VectorXd>(w.data(), n).asDiagonal();
+}
+
+std::string row(const Eigen::MatrixXd& M, int r) {
+  std::ostringstream os;
+  os.precision(17);
+  for (Eigen::Index c = 0; c < M.cols(); ++c) os << (c ? " " : "") << M(r, c);
+  return os.str();
+}
+
+void summary(const SimulationResult& r, const Model& m, const LinearPlant* plant) {
+  const int N = r.samples();
+  std::cout << "\nsimulation       " << (r.completed ? "completed" : r.cancelled ? "cancelled" : "FAILED") << ", t = "
+            << r.t.front() << " .. " << r.t.back() << " s, " << N << " samples\n";
+  if (!r.failure.empty()) std::cout << "failure          " << r.failure << "\n";
+  std::cout << "controller       " << r.controller << "\n"
+            << "integrator       " << r.stats.integrator << " (rtol " << r.stats.rtol << ", atol " << r.stats.atol
+            << "): " << r.stats.steps << " steps, " << r.stats.rhs_evals << " evaluations, " << r.stats.jac_evals
+            << " Jacobians, " << r.stats.projections << " projections, " << std::setprecision(3) << r.stats.wall_time
+            << " s\n" << std::setprecision(6);
+  if (N == 0) return;
+  for (int k = 0; k < r.y.cols(); ++k) {
+    const double y0 = plant ? plant->lin.system.y0[k] : r.y(0, k);
+    std::cout << "output " << std::left << std::setw(10) << r.output_names[k] << std::right << " start "
+              << std::setw(11) << r.y(0, k) << "  end " << std::setw(11) << r.y(N - 1, k) << "  (operating point "
+              << y0 << ") [" << r.output_units[k] << "]\n";
+  }
+  for (int k : m.plant_inputs)
+    std::cout << "input  " << std::left << std::setw(10) << m.actuators[k].name << std::right << " max |u| "
+              << r.u.col(k).cwiseAbs().maxCoeff() << " [" << m.actuators[k].unit << "]\n";
+  const double E0 = r.kinetic_energy[0] + r.potential_energy[0], E1 = r.kinetic_energy[N - 1] + r.potential_energy[N - 1];
+  std::cout << "energy           " << E0 << " -> " << E1 << " J\n";
+  if (m.nc) {
+    std::cout << "constraint drift max |phi| " << *std::max_element(r.constraint_violation.begin(), r.constraint_violation.end())
+              << ", max |Jc v| " << *std::max_element(r.velocity_violation.begin(), r.velocity_violation.end()) << "\n";
+  }
+  if (r.y_linear.rows() == N && N > 0) {
+    std::cout << "linear vs nonlinear (same controller, same start):\n";
+    for (int k = 0; k < r.y.cols(); ++k) {
+      const Eigen::VectorXd d = (r.y.col(k) - r.y_linear.col(k)).cwiseAbs();
+      const double range = std::max((r.y.col(k).array() - r.y(N - 1, k)).abs().maxCoeff(), 1e-12);
+      int first = -1;
+      for (int i = 0; i < N; ++i)
+        if (d[i] > 0.01 * range) {
+          first = i;
+          break;
+        }
+      std::cout << "  " << std::left << std::setw(10) << r.output_names[k] << std::right << " max |y - y_lin| "
+                << d.maxCoeff() << " (" << 100 * d.maxCoeff() / range << " % of its excursion); "
+                << (first < 0 ? std::string("within 1 % throughout")
+                              : "parts beyond 1 % at t = " + std::to_string(r.t[first]) + " s")
+                << "\n";
+    }
+  }
+}
+
+void run(const SimulateArgs& a) {
+  const Model m = with_settings(load_model(a.model), a.set);
+  if (!a.controller.empty() && a.lqr) throw std::invalid_argument("--controller and --lqr: choose one");
+  const bool need_plant = a.lqr || !a.controller.empty() || a.compare_linear;
+  std::unique_ptr<LinearPlant> plant;
+  if (need_plant) {
+    if (m.plant_inputs.empty()) throw std::invalid_argument(a.model + ": a controller needs Plant/In actuators (plant.inputs)");
+    plant = std::make_unique<LinearPlant>();
+    plant->op = operating_point(m, a.op, a.independent);
+    LinearizeOptions lo;
+    lo.independent = a.independent;
+    plant->lin = linearize(m, plant->op, lo);
+  }
+  std::unique_ptr<Controller> controller;
+  if (a.lqr) {
+    const LinearSystem& s = plant->lin.system;
+    const LqrResult d = lqr(s.A, s.B, diagonal(a.q_weights, s.nx(), "--q-weights"), diagonal(a.r_weights, s.nu(), "--r-weights"));
+    std::cout << "LQR about the " << plant->op.kind << " point, states (" ;
+    for (std::size_t k = 0; k < s.state_names.size(); ++k) std::cout << (k ? ", " : "") << s.state_names[k];
+    std::cout << "):\n";
+    for (int r = 0; r < d.K.rows(); ++r) std::cout << "K(" << s.input_names[r] << ") = [" << row(d.K, r) << "]\n";
+    controller = make_state_feedback(d.K, s.u0);
+  } else if (!a.controller.empty()) {
+    const LinearSystem& s = plant->lin.system;
+    controller = load_controller(a.controller, s.nx(), s.nu(), s.ny(), s.y0, s.u0);
+    std::cout << "controller from " << a.controller << ": " << controller->describe() << "\n";
+  }
+
+  SimulationOptions o;
+  const SolverSpec& sp = m.spec.solver;
+  o.integrator.method = a.integrator.empty() ? sp.integrator : a.integrator;
+  o.integrator.rtol = a.rtol > 0 ? a.rtol : sp.rtol;
+  o.integrator.atol = a.atol > 0 ? a.atol : sp.atol;
+  o.integrator.max_step = a.max_step >= 0 ? a.max_step : sp.max_step;
+  o.t_end = a.t_end > 0 ? a.t_end : sp.t_end;
+  o.output_step = a.output_step > 0 ? a.output_step : sp.output_step;
+  o.compare_linear = a.compare_linear && plant;
+
+  // check the output paths before spending time on the run
+  for (const std::string& p : {a.out, a.csv}) {
+    if (p.empty()) continue;
+    const auto dir = std::filesystem::path(p).parent_path();
+    if (!dir.empty() && !std::filesystem::is_directory(dir))
+      throw std::invalid_argument(p + ": the directory " + dir.string() + " does not exist");
+  }
+  SimulationCallbacks cb;
+  const bool bar = !a.quiet && isatty(STDERR_FILENO);
+  int last = -1;
+  if (bar)
+    cb.progress = [&](double t, double t_end) {
+      const int pct = static_cast<int>(100 * (t - o.t0) / (t_end - o.t0));
+      if (pct == last) return;
+      last = pct;
+      const int w = 40, filled = pct * w / 100;
+      std::fprintf(stderr, "\r[%s%s] %3d%%  t = %.3f s", std::string(filled, '#').c_str(), std::string(w - filled, '.').c_str(), pct, t);
+      std::fflush(stderr);
+    };
+  const SimulationResult r = simulate(m, controller.get(), plant.get(), o, cb);
+  if (bar) std::fprintf(stderr, "\n");
+  SimulationResult out = r;
+  out.model_file = a.model;
+  std::ostringstream settings;
+  settings << "{\"integrator\": \"" << o.integrator.method << "\", \"rtol\": " << o.integrator.rtol << ", \"atol\": "
+           << o.integrator.atol << ", \"max_step\": " << o.integrator.max_step << ", \"t_end\": " << o.t_end
+           << ", \"output_step\": " << o.output_step << ", \"operating_point\": \"" << (plant ? plant->op.kind : "") << "\"}";
+  out.settings_json = settings.str();
+  write_results_hdf5(out, a.out);
+  if (!a.csv.empty()) write_results_csv(out, a.csv);
+  summary(r, m, plant.get());
+  std::cout << "wrote " << a.out << (a.csv.empty() ? "" : "\nwrote " + a.csv) << "\n";
+  if (!r.completed && !r.cancelled) throw std::runtime_error("the solver failed; the partial result is in " + a.out);
+}
+
+}  // namespace
+
+void add_simulate(CLI::App& app) {
+  auto a = std::make_shared<SimulateArgs>();
+  auto* cmd = app.add_subcommand("simulate", "Simulate the nonlinear model, with a controller in the loop");
+  cmd->add_option("model", a->model, "model file (JSON)")->required();
+  cmd->add_option("--out", a->out, "results file (HDF5)")->required();
+  cmd->add_option("--csv", a->csv, "also write the results as CSV");
+  cmd->add_option("--controller", a->controller, "controller .mat: K (state feedback), Kp/Ki/Kd (PID) or Ac,Bc,Cc,Dc[,Ts] (LTI)");
+  cmd->add_flag("--lqr", a->lqr, "design an LQR state feedback on the linearized plant and use it");
+  cmd->add_option("--q-weights", a->q_weights, "LQR state weights (diagonal of Q), in state order")->delimiter(',');
+  cmd->add_option("--r-weights", a->r_weights, "LQR input weights (diagonal of R)")->delimiter(',');
+  cmd->add_option("--operating-point", a->op, "where the controller's plant is linearized: initial | equilibrium | trim | time=T")->capture_default_str();
+  cmd->add_flag("--compare-linear", a->compare_linear, "also simulate the linear closed loop and report where it parts from the nonlinear one");
+  cmd->add_option("--t-end", a->t_end, "end time [s] (default: the model's solver settings)");
+  cmd->add_option("--integrator", a->integrator, "ida | cvode-bdf | cvode-adams | arkode | rk4");
+  cmd->add_option("--rtol", a->rtol, "relative tolerance");
+  cmd->add_option("--atol", a->atol, "absolute tolerance");
+  cmd->add_option("--max-step", a->max_step, "largest step [s] (rk4: its fixed step)");
+  cmd->add_option("--output-step", a->output_step, "output interval [s]");
+  cmd->add_option("--independent", a->independent, "closed loops: independent coordinate names")->delimiter(',');
+  cmd->add_option("--set", a->set, "NAME=VALUE: set a joint coordinate of the initial state (repeatable)");
+  cmd->add_flag("--quiet", a->quiet, "no progress bar");
+  cmd->callback([a] { set_exit_code(run_guarded([&] { run(*a); })); });
+}
+
+}  // namespace codyna::cli
