@@ -12,6 +12,7 @@
 #include "common.hpp"
 #include "control/lqr.hpp"
 #include "io/results_file.hpp"
+#include "simulation/model_controller.hpp"
 #include "simulation/simulator.hpp"
 
 namespace codyna::cli {
@@ -20,7 +21,7 @@ namespace {
 
 struct SimulateArgs {
   std::string model, out, csv, controller, op = "equilibrium", integrator;
-  bool lqr = false, compare_linear = false, quiet = false;
+  bool lqr = false, compare_linear = false, quiet = false, open_loop = false;
   std::vector<double> q_weights, r_weights;
   double t_end = 0, rtol = 0, atol = 0, max_step = -1, output_step = 0;
   std::vector<std::string> independent, set;
@@ -90,10 +91,15 @@ void summary(const SimulationResult& r, const Model& m, const LinearPlant* plant
 
 void run(const SimulateArgs& a) {
   const Model m = with_settings(load_model(a.model), a.set);
-  if (!a.controller.empty() && a.lqr) throw std::invalid_argument("--controller and --lqr: choose one");
-  const bool need_plant = a.lqr || !a.controller.empty() || a.compare_linear;
+  if (!a.controller.empty() + a.lqr + a.open_loop > 1)
+    throw std::invalid_argument("--controller, --lqr and --open-loop: choose one");
+  // the model's own controller, unless the command line names another (or none)
+  const bool from_model = a.controller.empty() && !a.lqr && !a.open_loop && has_model_controller(m);
+  const bool need_plant = a.lqr || !a.controller.empty() || a.compare_linear || from_model;
   std::unique_ptr<LinearPlant> plant;
-  if (need_plant) {
+  if (from_model) {
+    plant = std::make_unique<LinearPlant>(controller_plant(m));
+  } else if (need_plant) {
     if (m.plant_inputs.empty()) throw std::invalid_argument(a.model + ": a controller needs Plant/In actuators (plant.inputs)");
     plant = std::make_unique<LinearPlant>();
     plant->op = operating_point(m, a.op, a.independent);
@@ -102,7 +108,11 @@ void run(const SimulateArgs& a) {
     plant->lin = linearize(m, plant->op, lo);
   }
   std::unique_ptr<Controller> controller;
-  if (a.lqr) {
+  if (from_model) {
+    controller = make_model_controller(m, *plant);
+    std::cout << "controller from the model file: " << controller->describe() << " (about the " << plant->op.kind
+              << " point)\n";
+  } else if (a.lqr) {
     const LinearSystem& s = plant->lin.system;
     const LqrResult d = lqr(s.A, s.B, diagonal(a.q_weights, s.nx(), "--q-weights"), diagonal(a.r_weights, s.nu(), "--r-weights"));
     std::cout << "LQR about the " << plant->op.kind << " point, states (" ;
@@ -169,7 +179,8 @@ void add_simulate(CLI::App& app) {
   cmd->add_option("model", a->model, "model file (JSON)")->required();
   cmd->add_option("--out", a->out, "results file (HDF5)")->required();
   cmd->add_option("--csv", a->csv, "also write the results as CSV");
-  cmd->add_option("--controller", a->controller, "controller .mat: K (state feedback), Kp/Ki/Kd (PID) or Ac,Bc,Cc,Dc[,Ts] (LTI)");
+  cmd->add_option("--controller", a->controller, "controller .mat: K (state feedback), Kp/Ki/Kd (PID) or Ac,Bc,Cc,Dc[,Ts] (LTI); default: the model file's controller, if any");
+  cmd->add_flag("--open-loop", a->open_loop, "ignore the model's controller: actuators at their nominal values");
   cmd->add_flag("--lqr", a->lqr, "design an LQR state feedback on the linearized plant and use it");
   cmd->add_option("--q-weights", a->q_weights, "LQR state weights (diagonal of Q), in state order")->delimiter(',');
   cmd->add_option("--r-weights", a->r_weights, "LQR input weights (diagonal of R)")->delimiter(',');

@@ -350,8 +350,8 @@ Eigen::MatrixXd read_matrix(const Node& n) {
   for (Eigen::Index r = 0; r < rows; ++r) {
     const Node row = n.element(r);
     if (!row.value().is_array()) row.expected("an array of " + counted(cols, "number") + " like the first row");
-    if (row.value().size() != first.value().size())
-      row.fail("expected " + counted(cols, "number") + " like the first row, got " + std::to_string(row.value().size()));
+    if (const std::size_t size = row.value().size(); size != first.value().size())
+      row.fail("expected " + counted(cols, "number") + " like the first row, got " + std::to_string(size));
     for (Eigen::Index c = 0; c < cols; ++c) m(r, c) = read_number(row.element(c));
   }
   return m;

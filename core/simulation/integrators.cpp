@@ -54,6 +54,18 @@ class SundialsBase : public Integrator {
     if (!last_message_.empty()) os << ": " << last_message_;
     throw IntegratorFailure(t, os.str());
   }
+  // the ODE right-hand side, shared by CVODE and ARKODE
+  static int ode_rhs(double t, N_Vector y, N_Vector yd, void* self) {
+    auto* me = static_cast<SundialsBase*>(self);
+    return me->guarded([&] {
+      Eigen::VectorXd out;
+      me->sys_.rhs(t, view(y), out);
+      view(yd) = out;
+    });
+  }
+  static void check(int flag, const char* solver, const char* what) {
+    if (flag < 0) throw std::runtime_error(std::string(solver) + " setup: " + what + " failed");
+  }
   static void on_error(int, const char*, const char* function, char* msg, void* self) {
     auto* me = static_cast<SundialsBase*>(self);
     me->last_message_ = std::string(function) + ": " + msg;
@@ -94,10 +106,10 @@ class Cvode final : public SundialsBase {
       y_ = N_VNew_Serial(sys_.ode_size(), ctx_);
       view(y_) = y;
       mem_ = CVodeCreate(bdf_ ? CV_BDF : CV_ADAMS, ctx_);
-      check(CVodeInit(mem_, &Cvode::f, t, y_), "CVodeInit");
-      check(CVodeSetUserData(mem_, this), "CVodeSetUserData");
+      check(CVodeInit(mem_, &SundialsBase::ode_rhs, t, y_), "CVodeInit");
+      check(CVodeSetUserData(mem_, static_cast<SundialsBase*>(this)), "CVodeSetUserData");
       check(CVodeSStolerances(mem_, set_.rtol, set_.atol), "CVodeSStolerances");
-      check(CVodeSetErrHandlerFn(mem_, &SundialsBase::on_error, this), "CVodeSetErrHandlerFn");
+      check(CVodeSetErrHandlerFn(mem_, &SundialsBase::on_error, static_cast<SundialsBase*>(this)), "CVodeSetErrHandlerFn");
       check(CVodeSetMaxNumSteps(mem_, 1000000), "CVodeSetMaxNumSteps");
       if (set_.max_step > 0) check(CVodeSetMaxStep(mem_, set_.max_step), "CVodeSetMaxStep");
       if (bdf_) {
@@ -135,17 +147,7 @@ class Cvode final : public SundialsBase {
   }
 
  private:
-  static int f(double t, N_Vector y, N_Vector yd, void* self) {
-    auto* me = static_cast<Cvode*>(self);
-    return me->guarded([&] {
-      Eigen::VectorXd out;
-      me->sys_.rhs(t, view(y), out);
-      view(yd) = out;
-    });
-  }
-  void check(int flag, const char* what) {
-    if (flag < 0) throw std::runtime_error(std::string("CVODE setup: ") + what + " failed");
-  }
+  static void check(int flag, const char* what) { SundialsBase::check(flag, "CVODE", what); }
   bool bdf_;
 };
 
@@ -160,17 +162,17 @@ class Erk final : public SundialsBase {
     if (!y_) {
       y_ = N_VNew_Serial(sys_.ode_size(), ctx_);
       view(y_) = y;
-      mem_ = ERKStepCreate(&Erk::f, t, y_, ctx_);
+      mem_ = ERKStepCreate(&SundialsBase::ode_rhs, t, y_, ctx_);
       if (!mem_) throw std::runtime_error("ARKODE setup: ERKStepCreate failed");
-      ERKStepSetUserData(mem_, this);
-      ERKStepSStolerances(mem_, set_.rtol, set_.atol);
-      ERKStepSetErrHandlerFn(mem_, &SundialsBase::on_error, this);
-      ERKStepSetMaxNumSteps(mem_, 10000000);
-      if (set_.max_step > 0) ERKStepSetMaxStep(mem_, set_.max_step);
+      check(ERKStepSetUserData(mem_, static_cast<SundialsBase*>(this)), "ARKODE", "ERKStepSetUserData");
+      check(ERKStepSStolerances(mem_, set_.rtol, set_.atol), "ARKODE", "ERKStepSStolerances");
+      check(ERKStepSetErrHandlerFn(mem_, &SundialsBase::on_error, static_cast<SundialsBase*>(this)), "ARKODE", "ERKStepSetErrHandlerFn");
+      check(ERKStepSetMaxNumSteps(mem_, 10000000), "ARKODE", "ERKStepSetMaxNumSteps");
+      if (set_.max_step > 0) check(ERKStepSetMaxStep(mem_, set_.max_step), "ARKODE", "ERKStepSetMaxStep");
     } else {
       view(y_) = y;
       counters(done_);
-      ERKStepReInit(mem_, &Erk::f, t, y_);
+      ERKStepReInit(mem_, &SundialsBase::ode_rhs, t, y_);
     }
   }
   void advance(double t_out) override {
@@ -191,14 +193,6 @@ class Erk final : public SundialsBase {
   }
 
  private:
-  static int f(double t, N_Vector y, N_Vector yd, void* self) {
-    auto* me = static_cast<Erk*>(self);
-    return me->guarded([&] {
-      Eigen::VectorXd out;
-      me->sys_.rhs(t, view(y), out);
-      view(yd) = out;
-    });
-  }
 };
 
 class Ida final : public SundialsBase {
@@ -225,7 +219,7 @@ class Ida final : public SundialsBase {
       check(IDAInit(mem_, &Ida::res, t, y_, yp_), "IDAInit");
       check(IDASetUserData(mem_, this), "IDASetUserData");
       check(IDASStolerances(mem_, set_.rtol, set_.atol), "IDASStolerances");
-      check(IDASetErrHandlerFn(mem_, &SundialsBase::on_error, this), "IDASetErrHandlerFn");
+      check(IDASetErrHandlerFn(mem_, &SundialsBase::on_error, static_cast<SundialsBase*>(this)), "IDASetErrHandlerFn");
       check(IDASetId(mem_, id_), "IDASetId");
       check(IDASetSuppressAlg(mem_, SUNTRUE), "IDASetSuppressAlg");  // index-1 multipliers: no error test
       check(IDASetMaxNumSteps(mem_, 1000000), "IDASetMaxNumSteps");
@@ -269,9 +263,7 @@ class Ida final : public SundialsBase {
       view(F) = out;
     });
   }
-  void check(int flag, const char* what) {
-    if (flag < 0) throw std::runtime_error(std::string("IDA setup: ") + what + " failed");
-  }
+  static void check(int flag, const char* what) { SundialsBase::check(flag, "IDA", what); }
 };
 
 class Rk4 final : public Integrator {
