@@ -16,7 +16,7 @@ namespace codyna::cli {
 namespace {
 
 struct LinearizeArgs {
-  std::string model, out, op = "initial", method = "exact", mat_version = "5", name;
+  std::string model, out, op = "equilibrium", method = "exact", mat_version = "5", name;
   double discrete = 0.0;
   std::vector<std::string> independent, set;
 };
@@ -46,6 +46,9 @@ JacobianMethod method_of(const std::string& s) {
 
 void run(const LinearizeArgs& a) {
   const Model m = with_settings(load_model(a.model), a.set);
+  const std::string name = a.name.empty() ? matlab_identifier(m.name) : a.name;
+  if (name != matlab_identifier(name))
+    throw std::invalid_argument("--name " + name + ": not a valid MATLAB identifier (try " + matlab_identifier(name) + ")");
   if (m.plant_inputs.empty() && m.plant_outputs.empty())
     std::cerr << "codyna: warning: the model selects no Plant/In or Plant/Out; exporting the state equations only\n";
   const OperatingPoint op = operating_point(m, a.op, a.independent);
@@ -61,7 +64,8 @@ void run(const LinearizeArgs& a) {
 
   std::cout << "model            " << m.name << " (" << m.dof() << " DOF)\n"
             << "operating point  " << op.kind;
-  if (op.kind != "initial") std::cout << " (residual " << op.residual << ", " << op.iterations << " iterations)";
+  if (op.kind == "equilibrium" || op.kind == "trim")
+    std::cout << " (residual " << op.residual << ", " << op.iterations << " iterations)";
   std::cout << "\nmethod           " << to_string(opt.method);
   if (opt.method != JacobianMethod::Exact) std::cout << " (max relative difference from exact: " << lin.fd_error << ")";
   std::cout << "\ntime             " << (sys.Ts > 0 ? "discrete, Ts = " + std::to_string(sys.Ts) : std::string("continuous")) << "\n";
@@ -86,9 +90,6 @@ void run(const LinearizeArgs& a) {
   std::cout << "\n" << format_modes(modal_analysis(sys)) << "\n";
 
   std::filesystem::create_directories(a.out);
-  const std::string name = a.name.empty() ? matlab_identifier(m.name) : a.name;
-  if (name != matlab_identifier(name))
-    throw std::invalid_argument("--name " + name + ": not a valid MATLAB identifier (try " + matlab_identifier(name) + ")");
   const ExportPaths p = export_plant(sys, a.out, name, version);
   std::cout << "wrote " << p.mat_file << "\nwrote " << p.m_file << "\n";
 }

@@ -22,6 +22,7 @@ namespace {
 struct SimulateArgs {
   std::string model, out, csv, controller, op = "equilibrium", integrator;
   bool lqr = false, compare_linear = false, quiet = false, open_loop = false;
+  bool op_given = false;  // --operating-point on the command line overrides the model controller's
   std::vector<double> q_weights, r_weights;
   double t_end = 0, rtol = 0, atol = 0, max_step = -1, output_step = 0;
   std::vector<std::string> independent, set;
@@ -97,7 +98,7 @@ void run(const SimulateArgs& a) {
   const bool from_model = a.controller.empty() && !a.lqr && !a.open_loop && has_model_controller(m);
   const bool need_plant = a.lqr || !a.controller.empty() || a.compare_linear || from_model;
   std::unique_ptr<LinearPlant> plant;
-  if (from_model) {
+  if (from_model && !a.op_given && a.independent.empty()) {
     plant = std::make_unique<LinearPlant>(controller_plant(m));
   } else if (need_plant) {
     if (m.plant_inputs.empty()) throw std::invalid_argument(a.model + ": a controller needs Plant/In actuators (plant.inputs)");
@@ -195,7 +196,10 @@ void add_simulate(CLI::App& app) {
   cmd->add_option("--independent", a->independent, "closed loops: independent coordinate names")->delimiter(',');
   cmd->add_option("--set", a->set, "NAME=VALUE: set a joint coordinate of the initial state (repeatable)");
   cmd->add_flag("--quiet", a->quiet, "no progress bar");
-  cmd->callback([a] { set_exit_code(run_guarded([&] { run(*a); })); });
+  cmd->callback([a, cmd] {
+    a->op_given = cmd->count("--operating-point") > 0;
+    set_exit_code(run_guarded([&] { run(*a); }));
+  });
 }
 
 }  // namespace codyna::cli

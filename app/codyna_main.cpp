@@ -1,5 +1,5 @@
 // codyna: the headless command line. main() and argument parsing only; all
-// work is done by codyna_core (the commands live in app/commands/*.cpp).
+// work is done by codyna_core (the commands live in app/cmd_*.cpp).
 #include <CLI/CLI.hpp>
 #include <iostream>
 

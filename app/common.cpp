@@ -49,7 +49,14 @@ Model with_settings(Model m, const std::vector<std::string>& set) {
 OperatingPoint operating_point(const Model& m, const std::string& which, const std::vector<std::string>& independent) {
   const OperatingPoint start = initial_point(m);
   if (which == "initial") return start;
-  if (which == "equilibrium") return static_equilibrium(m, start, independent);
+  if (which == "equilibrium") {
+    const OperatingPoint op = static_equilibrium(m, start, independent);
+    if (!(op.residual < 1e-8))
+      throw std::invalid_argument("--operating-point equilibrium: no static equilibrium found near the initial state "
+                                  "(accelerations " + std::to_string(op.residual) + " left after " +
+                                  std::to_string(op.iterations) + " iterations); use --operating-point initial, trim or time=T");
+    return op;
+  }
   if (which == "trim") return trim(m, start, independent);
   if (which.rfind("time=", 0) == 0) {
     double t;

@@ -18,8 +18,9 @@ Model load_model(const std::string& path);
 // applies --set NAME=VALUE (joint coordinates of the initial state), then re-assembles loops
 Model with_settings(Model m, const std::vector<std::string>& set);
 
-// --operating-point: initial | equilibrium | trim | time=T (state reached by the reference
-// integrator with the actuators at their nominal values)
+// --operating-point: initial | equilibrium | trim | time=T (the state the simulation reaches
+// at T with the actuators at their nominal values and the model's solver settings).
+// An equilibrium that cannot be found is an error, not a silent best effort.
 OperatingPoint operating_point(const Model& m, const std::string& which, const std::vector<std::string>& independent);
 
 // runs f; prints "codyna: error: ..." for exceptions and returns the exit code

@@ -1,6 +1,7 @@
 #include "analysis/operating_point.hpp"
 
 #include <Eigen/QR>
+#include <sstream>
 #include <stdexcept>
 
 #include "analysis/linearize.hpp"
@@ -22,7 +23,9 @@ OperatingPoint snapshot_point(const Model& model, double t, const Eigen::VectorX
   if (q.size() != model.nq || v.size() != model.nv || u.size() != model.nu())
     throw std::invalid_argument("snapshot: state sizes do not match the model");
   OperatingPoint op;
-  op.kind = "time=" + std::to_string(t);
+  std::ostringstream label;
+  label << "time=" << t;
+  op.kind = label.str();
   op.t = t;
   op.q = q;
   op.v = v;

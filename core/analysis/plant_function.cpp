@@ -56,6 +56,9 @@ CoordinatePartition partition_coordinates(const Model& m, const Eigen::VectorXd&
   const std::vector<int> rows = independent_rows(m, q);
   if (rows.empty()) {
     for (int i = 0; i < m.nv; ++i) p.independent.push_back(i);
+    for (const std::string& name : preferred)
+      if (std::find(m.v_names.begin(), m.v_names.end(), name) == m.v_names.end())
+        throw std::invalid_argument("independent coordinates: unknown coordinate \"" + name + "\"");
     if (!preferred.empty() && static_cast<int>(preferred.size()) != m.nv)
       throw std::invalid_argument("independent coordinates: a tree model has all " + std::to_string(m.nv) +
                                   " coordinates independent");

@@ -6,10 +6,30 @@
 
 namespace codyna {
 
+namespace {
+// inverse of a small joint-space matrix; the common one-coordinate case without a factorization
+template <class S>
+void small_inverse(const Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>& D,
+                   Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>& Dinv) {
+  const Eigen::Index n = D.rows();
+  Dinv.resize(n, n);
+  if (n == 1) {
+    Dinv(0, 0) = S(1) / D(0, 0);
+  } else if (n > 1) {
+    Dinv = lu_solve<S>(MatXT<S>(D), MatXT<S>::Identity(n, n));
+  }
+}
+}  // namespace
+
 template <class S>
 const VecXT<S>& aba(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>& v, const VecXT<S>& tau) {
   forward_kinematics<S>(model, d, q, v);
-  std::vector<Vec6T<S>> c(model.nbodies, Vec6T<S>::Zero());
+  return aba_after_kinematics<S>(model, d, v, tau);
+}
+
+template <class S>
+const VecXT<S>& aba_after_kinematics(const Model& model, DataT<S>& d, const VecXT<S>& v, const VecXT<S>& tau) {
+  std::vector<Vec6T<S>>& c = d.c;
   for (int i = 1; i < model.nbodies; ++i) {
     const JointModel& j = model.joints[i];
     const Mat6T<S> I = model.inertia[i].cast<S>();
@@ -20,8 +40,8 @@ const VecXT<S>& aba(const Model& model, DataT<S>& d, const VecXT<S>& q, const Ve
   for (int i = model.nbodies - 1; i > 0; --i) {
     const JointModel& j = model.joints[i];
     d.U[i] = d.IA[i] * d.Sb[i];
-    const MatXT<S> D = d.Sb[i].transpose() * d.U[i];
-    d.Dinv[i] = lu_solve<S>(D, MatXT<S>::Identity(j.nv, j.nv));
+    const Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6> D = d.Sb[i].transpose() * d.U[i];
+    small_inverse<S>(D, d.Dinv[i]);
     d.u[i] = tau.segment(j.idx_v, j.nv) - d.Sb[i].transpose() * d.pA[i];
     const int p = j.parent;
     if (p == 0) continue;
@@ -36,7 +56,7 @@ const VecXT<S>& aba(const Model& model, DataT<S>& d, const VecXT<S>& q, const Ve
   for (int i = 1; i < model.nbodies; ++i) {
     const JointModel& j = model.joints[i];
     const Vec6T<S> ap = d.liMi[i].inv_act_motion(d.a[j.parent]) + c[i];
-    const VecXT<S> qdd_i = d.Dinv[i] * (d.u[i] - d.U[i].transpose() * ap);
+    const Eigen::Matrix<S, Eigen::Dynamic, 1, 0, 6, 1> qdd_i = d.Dinv[i] * (d.u[i] - d.U[i].transpose() * ap);
     if (j.nv > 0) d.qdd.segment(j.idx_v, j.nv) = qdd_i;
     d.a[i] = ap + d.Sb[i] * qdd_i;
   }
@@ -50,6 +70,10 @@ const VecXT<S>& aba(const Model& model, DataT<S>& d, const VecXT<S>& q, const Ve
   return d.qdd;
 }
 
+template const VecXT<double>& aba_after_kinematics<double>(const Model&, DataT<double>&, const VecXT<double>&,
+                                                          const VecXT<double>&);
+template const VecXT<ADScalar>& aba_after_kinematics<ADScalar>(const Model&, DataT<ADScalar>&, const VecXT<ADScalar>&,
+                                                              const VecXT<ADScalar>&);
 template const VecXT<double>& aba<double>(const Model&, DataT<double>&, const VecXT<double>&, const VecXT<double>&,
                                           const VecXT<double>&);
 template const VecXT<ADScalar>& aba<ADScalar>(const Model&, DataT<ADScalar>&, const VecXT<ADScalar>&,

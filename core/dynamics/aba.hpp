@@ -11,4 +11,9 @@ namespace codyna {
 template <class S>
 const VecXT<S>& aba(const Model& model, DataT<S>& data, const VecXT<S>& q, const VecXT<S>& v, const VecXT<S>& tau);
 
+// the same, reusing the kinematics (liMi, oMi, Sb, v, cJ) that
+// forward_kinematics(q, v) already wrote into data
+template <class S>
+const VecXT<S>& aba_after_kinematics(const Model& model, DataT<S>& data, const VecXT<S>& v, const VecXT<S>& tau);
+
 }  // namespace codyna

@@ -19,7 +19,7 @@ const VecXT<S>& forward_dynamics(const Model& model, DataT<S>& d, const VecXT<S>
   const VecXT<S> Q = applied_forces<S>(model, d, q, v, u);
   if (model.nc == 0) {
     d.lambda.setZero(model.nc);
-    return aba<S>(model, d, q, v, Q);
+    return aba_after_kinematics<S>(model, d, v, Q);
   }
   crba<S>(model, d, q);
   nonlinear_effects<S>(model, d, q, v);

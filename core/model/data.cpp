@@ -20,6 +20,7 @@ DataT<S>::DataT(const Model& model) {
   U.assign(nb, Mat6xT<S>(6, 0));
   Dinv.resize(nb);
   u.resize(nb);
+  c.assign(nb, Vec6T<S>::Zero());
   Ic.assign(nb, Mat6T<S>::Zero());
   tau = VecXT<S>::Zero(model.nv);
   M = MatXT<S>::Zero(model.nv, model.nv);

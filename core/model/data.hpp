@@ -42,6 +42,7 @@ struct DataT {
   std::vector<Mat6xT<S>> U;
   std::vector<Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>> Dinv;
   std::vector<Eigen::Matrix<S, Eigen::Dynamic, 1, 0, 6, 1>> u;
+  std::vector<Vec6T<S>> c;       // velocity-product accelerations
 
   // crba workspace
   std::vector<Mat6T<S>> Ic;      // composite inertia

@@ -23,7 +23,8 @@ namespace codyna {
 
 class ClosedLoopSystem {
  public:
-  // plant: the linearization's plant function (needed by state feedback); w_ref: its reference velocities
+  // plant: the linearization's plant function (needed by state feedback); x_ref: its state at the
+  // operating point ([0; w_ref]), so that state feedback sees x - x0
   ClosedLoopSystem(const Model& model, const Controller* controller, const PlantFunction* plant,
                    const Eigen::VectorXd& x_ref, const Eigen::VectorXd& u_nominal, Baumgarte stab = {});
 

@@ -36,7 +36,7 @@ class Pid final : public Controller {
     return n;
   }
   std::string describe() const override {
-    return std::string(Ki_.size() ? "PID" : "PD") + (Kd_.size() ? "" : " (no derivative action)") + " on the plant outputs";
+    return std::string("P") + (Ki_.size() ? "I" : "") + (Kd_.size() ? "D" : "") + " on the plant outputs";
   }
 
  private:

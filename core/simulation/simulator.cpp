@@ -1,5 +1,6 @@
 #include "simulation/simulator.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -225,7 +226,9 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
   r.constraint_violation = rec.pv;
   r.velocity_violation = rec.vv;
   r.q_names = model.q_names;
-  r.v_names = model.v_names;
+  // a scalar joint's position and rate share the joint's name in the model: keep results columns distinct
+  for (const std::string& n : model.v_names)
+    r.v_names.push_back(std::find(model.q_names.begin(), model.q_names.end(), n) != model.q_names.end() ? n + "_dot" : n);
   for (const auto& a : model.actuators) {
     r.input_names.push_back(a.name);
     r.input_units.push_back(a.unit);

@@ -24,7 +24,8 @@ struct SimulationOptions {
   IntegratorSettings integrator;
   double t0 = 0.0, t_end = 5.0, output_step = 0.01;
   Eigen::VectorXd q0, v0;              // initial state; empty = the model's (assembled) initial state
-  double projection_tolerance = 1e-9;  // closed loops: project when max |phi| exceeds it
+  double projection_tolerance = 1e-9;  // closed loops: at every stop (output time, controller sample)
+                                       // project when max |phi| (or max |Jc v| / max(1, |v|)) exceeds it
   Baumgarte stabilization{};           // optional, on the acceleration-level constraints
   bool compare_linear = false;         // also run the linear closed loop (needs a plant)
 };

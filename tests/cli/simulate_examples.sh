@@ -15,7 +15,7 @@ grep -q "controller from the model file: PD" "$work/p.txt" || { cat "$work/p.txt
 "$codyna" simulate "$src/examples/cart_pendulum.json" --quiet --t-end 8 --compare-linear --out "$work/cart.h5" > "$work/c.txt"
 grep -q "within 1 % throughout" "$work/c.txt" || { cat "$work/c.txt"; fail "linear comparison missing"; }
 "$codyna" simulate "$src/examples/pendulum.json" --open-loop --quiet --t-end 2 --out "$work/open.h5" > /dev/null
-head -1 "$work/pendulum.csv" | grep -q '^t,pivot,pivot,torque,theta' || fail "CSV header: $(head -1 "$work/pendulum.csv")"
+head -1 "$work/pendulum.csv" | grep -q '^t,pivot,pivot_dot,torque,theta' || fail "CSV header: $(head -1 "$work/pendulum.csv")"
 
 "$PY" - "$work" <<'PY'
 import sys, math

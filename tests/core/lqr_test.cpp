@@ -4,35 +4,32 @@
 #include "control/lqr.hpp"
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <Eigen/Dense>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <iostream>
-#include <limits>
 #include <random>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <unsupported/Eigen/MatrixFunctions>
 #include <vector>
 
+#include "peer_util.hpp"
+
 namespace codyna {
 namespace {
 
 using Eigen::MatrixXd;
+using test::CommandResult;
+using test::octave_literal;
+using test::octave_print;
+using test::on_path;
+using test::parse_matrix;
+using test::relative_difference;
+using test::run_octave;
 
 // ------------------------------------------------------------------ helpers
-
-// max |a - b| over max |b| (0 when both are zero); infinite on a size mismatch
-double relative_difference(const MatrixXd& a, const MatrixXd& b) {
-  if (a.rows() != b.rows() || a.cols() != b.cols()) return std::numeric_limits<double>::infinity();
-  const double scale = b.cwiseAbs().maxCoeff();
-  const double err = (a - b).cwiseAbs().maxCoeff();
-  return err == 0 ? 0 : err / scale;
-}
 
 #define EXPECT_INVALID_ARGUMENT_WITH(statement, ...)                                    \
   do {                                                                                  \
@@ -280,67 +277,6 @@ TEST(LinearMatrixEquations, SolveTheirEquations) {
 }
 
 // ------------------------------------------------------------------ peer: GNU Octave
-
-struct CommandResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr
-};
-
-CommandResult run_command(const std::string& command) {
-  CommandResult r;
-  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buf;
-  while (std::size_t n = std::fread(buf.data(), 1, buf.size(), pipe)) r.output.append(buf.data(), n);
-  const int status = ::pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
-
-bool on_path(const std::string& program) { return run_command("command -v " + program).exit_code == 0; }
-
-// an Octave matrix literal that reproduces every double exactly
-std::string octave_literal(const MatrixXd& M) {
-  std::string s = "[";
-  char buf[32];
-  for (Eigen::Index i = 0; i < M.rows(); ++i) {
-    for (Eigen::Index j = 0; j < M.cols(); ++j) {
-      std::snprintf(buf, sizeof buf, "%.17g", M(i, j));
-      s += (j ? " " : "") + std::string(buf);
-    }
-    s += i + 1 < M.rows() ? "; " : "";
-  }
-  return s + "]";
-}
-
-// Octave code that prints "CODYNA <name> <rows> <cols> <column-major values>"
-std::string octave_print(const std::string& name) {
-  return "printf('CODYNA " + name + " %d %d', rows(" + name + "), columns(" + name + ")); printf(' %.17g', " + name +
-         "); printf('\\n'); ";
-}
-
-MatrixXd parse_matrix(const std::string& output, const std::string& name) {
-  const std::string key = "CODYNA " + name + " ";
-  const auto at = output.find(key);
-  if (at == std::string::npos) throw std::runtime_error("no " + name + " in Octave's output:\n" + output);
-  std::istringstream in(output.substr(at + key.size()));
-  int rows = 0, cols = 0;
-  in >> rows >> cols;
-  MatrixXd M(rows, cols);
-  for (Eigen::Index k = 0; k < M.size(); ++k) in >> M.data()[k];  // both column-major
-  if (!in) throw std::runtime_error("cannot read " + name + " from Octave's output:\n" + output);
-  return M;
-}
-
-// runs `body` in octave-cli with the control package; the marker proves it got to the end
-CommandResult run_octave(const std::string& body) {
-  const std::string script = "pkg load control; " + body + " disp('CODYNA_PEER_DONE');";
-  std::string quoted = "'";
-  for (char c : script) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  quoted += "'";
-  const std::string timeout = on_path("timeout") ? "timeout 60 " : "";
-  return run_command(timeout + "octave-cli --no-gui --quiet --norc --eval " + quoted);
-}
 
 class OctaveLqrPeer : public ::testing::Test {
  protected:

@@ -4,14 +4,12 @@
 #include <gtest/gtest.h>
 #include <matio.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <complex>
-#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -24,6 +22,7 @@
 #include "analysis/discretize.hpp"
 #include "analysis/modal.hpp"
 #include "io/mat_export.hpp"
+#include "peer_util.hpp"
 #include "test_util.hpp"
 
 namespace codyna {
@@ -34,7 +33,14 @@ static void PrintTo(MatVersion v, std::ostream* os) { *os << (v == MatVersion::V
 namespace {
 
 namespace fs = std::filesystem;
+using test::bounded;
+using test::CommandResult;
 using test::MatrixNear;
+using test::on_path;
+using test::peer_script;
+using test::python_with;
+using test::run_command;
+using test::shell_quoted;
 using Strings = std::vector<std::string>;
 
 // ------------------------------------------------------------------ fixtures
@@ -417,38 +423,6 @@ TEST(ReadMatFile, ExplainsFilesItCannotRead) {
 
 // ------------------------------------------------------------------ peers
 
-struct CommandResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr
-};
-
-CommandResult run_command(const std::string& command) {
-  CommandResult r;
-  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buf;
-  while (std::size_t n = std::fread(buf.data(), 1, buf.size(), pipe)) r.output.append(buf.data(), n);
-  const int status = ::pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
-
-std::string shell_quoted(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
-std::string peer_script(const std::string& file) { return std::string(CODYNA_SOURCE_DIR) + "/tests/peers/" + file; }
-
-bool on_path(const std::string& program) { return run_command("command -v " + program).exit_code == 0; }
-
-// `command` stopped after 60 s where coreutils' timeout exists (a hung peer must not hang CTest)
-std::string bounded(const std::string& command) {
-  static const bool have_timeout = on_path("timeout");
-  return (have_timeout ? "timeout 60 " : "") + command;
-}
-
 std::vector<std::complex<double>> sorted(std::vector<std::complex<double>> v) {
   std::sort(v.begin(), v.end(),
             [](auto a, auto b) { return a.real() != b.real() ? a.real() < b.real() : a.imag() < b.imag(); });
@@ -556,18 +530,8 @@ TEST_F(OctavePeer, C2dMatchesDiscretizeZoh) {
   EXPECT_DOUBLE_EQ(d.Ts, 0.01);
 }
 
-// A python3 that has scipy and h5py: $CODYNA_PYTHON, python3 on PATH, or the system one.
-std::optional<std::string> python_with_scipy_and_h5py() {
-  std::vector<std::string> candidates;
-  if (const char* env = std::getenv("CODYNA_PYTHON")) candidates.push_back(env);
-  candidates.insert(candidates.end(), {"python3", "/usr/bin/python3"});
-  for (const auto& py : candidates)
-    if (run_command(shell_quoted(py) + " -c 'import scipy.io, h5py'").exit_code == 0) return py;
-  return std::nullopt;
-}
-
 void expect_python_reads_plant(const std::string& reader, MatVersion v) {
-  static const std::optional<std::string> python = python_with_scipy_and_h5py();
+  static const std::optional<std::string> python = python_with("scipy.io, h5py");
   if (!python) GTEST_SKIP() << "no python3 with scipy and h5py (set CODYNA_PYTHON; CI installs them)";
   TempDir dir;
   const LinearSystem s = cart_pendulum();

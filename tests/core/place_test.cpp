@@ -4,20 +4,19 @@
 #include "control/place.hpp"
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <Eigen/Dense>
-#include <array>
 #include <cmath>
 #include <complex>
 #include <cstdio>
 #include <iostream>
 #include <limits>
 #include <random>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "peer_util.hpp"
 
 namespace codyna {
 namespace {
@@ -25,6 +24,13 @@ namespace {
 using Eigen::MatrixXd;
 using Eigen::VectorXcd;
 using Complex = std::complex<double>;
+using test::CommandResult;
+using test::octave_literal;
+using test::octave_print;
+using test::on_path;
+using test::parse_matrix;
+using test::relative_difference;
+using test::run_octave;
 
 // ------------------------------------------------------------------ helpers
 
@@ -39,12 +45,6 @@ using Complex = std::complex<double>;
             << "message \"" << e.what() << "\" lacks \"" << part << "\"";               \
     }                                                                                   \
   } while (0)
-
-double relative_difference(const MatrixXd& a, const MatrixXd& b) {
-  if (a.rows() != b.rows() || a.cols() != b.cols()) return std::numeric_limits<double>::infinity();
-  const double err = (a - b).cwiseAbs().maxCoeff();
-  return err == 0 ? 0 : err / b.cwiseAbs().maxCoeff();
-}
 
 // the largest |placed - wanted| over max(1, |wanted|), each wanted pole matched
 // to its nearest unmatched eigenvalue of A - B K
@@ -188,37 +188,7 @@ TEST(Place, RejectsMismatchedSizes) {
 
 // ------------------------------------------------------------------ peer: GNU Octave
 
-struct CommandResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr
-};
-
-CommandResult run_command(const std::string& command) {
-  CommandResult r;
-  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buf;
-  while (std::size_t n = std::fread(buf.data(), 1, buf.size(), pipe)) r.output.append(buf.data(), n);
-  const int status = ::pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
-
-bool on_path(const std::string& program) { return run_command("command -v " + program).exit_code == 0; }
-
-std::string octave_literal(const MatrixXd& M) {
-  std::string s = "[";
-  char buf[32];
-  for (Eigen::Index i = 0; i < M.rows(); ++i) {
-    for (Eigen::Index j = 0; j < M.cols(); ++j) {
-      std::snprintf(buf, sizeof buf, "%.17g", M(i, j));
-      s += (j ? " " : "") + std::string(buf);
-    }
-    s += i + 1 < M.rows() ? "; " : "";
-  }
-  return s + "]";
-}
-
+// an Octave row of complex poles, each part exact (the complex sibling of test::octave_literal)
 std::string octave_literal(const VectorXcd& v) {
   std::string s = "[";
   char buf[80];
@@ -227,33 +197,6 @@ std::string octave_literal(const VectorXcd& v) {
     s += buf;
   }
   return s + "]";
-}
-
-std::string octave_print(const std::string& name) {
-  return "printf('CODYNA " + name + " %d %d', rows(" + name + "), columns(" + name + ")); printf(' %.17g', " + name +
-         "); printf('\\n'); ";
-}
-
-MatrixXd parse_matrix(const std::string& output, const std::string& name) {
-  const std::string key = "CODYNA " + name + " ";
-  const auto at = output.find(key);
-  if (at == std::string::npos) throw std::runtime_error("no " + name + " in Octave's output:\n" + output);
-  std::istringstream in(output.substr(at + key.size()));
-  int rows = 0, cols = 0;
-  in >> rows >> cols;
-  MatrixXd M(rows, cols);
-  for (Eigen::Index k = 0; k < M.size(); ++k) in >> M.data()[k];
-  if (!in) throw std::runtime_error("cannot read " + name + " from Octave's output:\n" + output);
-  return M;
-}
-
-CommandResult run_octave(const std::string& body) {
-  const std::string script = "pkg load control; " + body + " disp('CODYNA_PEER_DONE');";
-  std::string quoted = "'";
-  for (char c : script) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  quoted += "'";
-  const std::string timeout = on_path("timeout") ? "timeout 60 " : "";
-  return run_command(timeout + "octave-cli --no-gui --quiet --norc --eval " + quoted);
 }
 
 // Single input: K is unique, so it must equal Octave's. Multi-input: Octave

@@ -6,7 +6,6 @@
 
 #include <gtest/gtest.h>
 #include <stdlib.h>
-#include <sys/wait.h>
 
 #include <algorithm>
 #include <array>
@@ -21,12 +20,22 @@
 #include <optional>
 #include <sstream>
 
+#include "peer_util.hpp"
+
 namespace codyna {
 namespace {
 
 namespace fs = std::filesystem;
 using Strings = std::vector<std::string>;
 using nlohmann::json;
+using test::bounded;
+using test::CommandResult;
+using test::on_path;
+using test::peer_script;
+using test::peers_dir;
+using test::python_with;
+using test::run_command;
+using test::shell_quoted;
 
 // ------------------------------------------------------------------ fixtures
 
@@ -269,44 +278,12 @@ TEST(ResultsHdf5, ReadFailuresNameThePathAndTheReason) {
 
 // ------------------------------------------------------------------ peers
 
-struct CommandResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr
-};
-
-CommandResult run_command(const std::string& command) {
-  CommandResult r;
-  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buf;
-  while (std::size_t n = std::fread(buf.data(), 1, buf.size(), pipe)) r.output.append(buf.data(), n);
-  const int status = ::pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
-
-std::string shell_quoted(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
 // `s` as an Octave string literal
 std::string octave_string(const std::string& s) {
   std::string out = "'";
   for (char c : s) out += c == '\'' ? std::string("''") : std::string(1, c);
   return out + "'";
 }
-
-bool on_path(const std::string& program) { return run_command("command -v " + program).exit_code == 0; }
-
-// `command` stopped after 60 s where coreutils' timeout exists (a hung peer must not hang CTest)
-std::string bounded(const std::string& command) {
-  static const bool have_timeout = on_path("timeout");
-  return (have_timeout ? "timeout 60 " : "") + command;
-}
-
-std::string peers_dir() { return std::string(CODYNA_SOURCE_DIR) + "/tests/peers"; }
 
 // What a reader of the file written from `r` must find (the format of
 // tests/peers/read_results.py): the layout of io/results_file.hpp, stated again here.
@@ -394,23 +371,13 @@ std::vector<PeerCase> write_peer_cases(const TempDir& dir) {
   return cases;
 }
 
-// A python3 with numpy and h5py: $CODYNA_PYTHON, python3 on PATH, or the system one.
-std::optional<std::string> python_with_h5py() {
-  Strings candidates;
-  if (const char* env = std::getenv("CODYNA_PYTHON")) candidates.push_back(env);
-  candidates.insert(candidates.end(), {"python3", "/usr/bin/python3"});
-  for (const std::string& py : candidates)
-    if (run_command(shell_quoted(py) + " -c 'import numpy, h5py'").exit_code == 0) return py;
-  return std::nullopt;
-}
-
 TEST(ResultsFilePeer, H5pyReadsTheDocumentedLayout) {
-  static const std::optional<std::string> python = python_with_h5py();
+  static const std::optional<std::string> python = python_with("numpy, h5py");
   if (!python) GTEST_SKIP() << "no python3 with numpy and h5py (set CODYNA_PYTHON; CI installs them)";
   TempDir dir;
   for (const PeerCase& c : write_peer_cases(dir)) {
     const CommandResult r =
-        run_command(bounded(shell_quoted(*python) + " " + shell_quoted(peers_dir() + "/read_results.py") + " " +
+        run_command(bounded(shell_quoted(*python) + " " + shell_quoted(peer_script("read_results.py")) + " " +
                             shell_quoted(c.h5) + " " + shell_quoted(c.expected)));
     EXPECT_EQ(r.exit_code, 0) << c.name << ":\n" << r.output;
     // the script counts the numeric datasets and string lists it found
