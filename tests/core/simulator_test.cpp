@@ -279,3 +279,27 @@ TEST(Simulate, AbsentEffectsAreNeverEvaluated) {
 
 }  // namespace
 }  // namespace codyna
+
+namespace codyna {
+namespace {
+
+// Actuator limits saturate the controller's command: the pendulum's PD asks for
+// 38 N m at the start, the motor gives at most 20 and still lifts the rod
+TEST(Simulate, ActuatorLimitsSaturateTheCommand) {
+  ModelSpec s = load_model_spec(test::example_path("pendulum.json"));
+  s.actuators[0].min = -20.0;
+  s.actuators[0].max = 20.0;
+  const Model m = compile(s);
+  const LinearPlant p = plant_at_equilibrium(m);
+  const double Kp = (9 + 3 * g / 4) / 0.075, Kd = 4.8 / 0.075;
+  const auto pd = make_pid(Eigen::MatrixXd::Constant(1, 1, Kp), Eigen::MatrixXd(), Eigen::MatrixXd::Constant(1, 1, Kd),
+                           Eigen::VectorXd::Constant(1, M_PI / 2), Eigen::VectorXd::Zero(1));
+  const SimulationResult r = simulate(m, pd.get(), &p, options("ida", 6.0));
+  ASSERT_TRUE(r.completed) << r.failure;
+  EXPECT_DOUBLE_EQ(r.u(0, 0), 20.0);                 // clamped at the start (unclamped: 38.07)
+  EXPECT_LE(r.u.cwiseAbs().maxCoeff(), 20.0 + 1e-12);
+  EXPECT_NEAR(r.y(r.samples() - 1, 0), M_PI / 2, 0.5 * deg);
+}
+
+}  // namespace
+}  // namespace codyna
