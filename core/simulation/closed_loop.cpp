@@ -148,7 +148,7 @@ bool ClosedLoopSystem::project(Eigen::VectorXd& y, double tol) {
   const auto [p, w] = violation(q, v);
   if (p <= tol && w <= tol * std::max(1.0, v.norm())) return false;
   AssemblyOptions opt;
-  opt.tolerance = std::min(1e-12, tol * 1e-3);
+  opt.tolerance = tol > 0 ? std::min(1e-12, tol * 1e-3) : 1e-12;
   const AssemblyResult r = assemble(model_, q, v, opt);
   y.head(model_.nq) = r.q;
   y.segment(model_.nq, model_.nv) = r.v;

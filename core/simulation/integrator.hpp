@@ -1,7 +1,8 @@
 // Integrators behind one interface, so that benchmarks swap them freely:
 //   ida          SUNDIALS IDA (variable-order BDF) on the index-1 DAE form with
 //                multipliers as algebraic variables (the paper's residual form)
-//   cvode-bdf    SUNDIALS CVODE, BDF with Newton iterations (stiff problems)
+//   cvode-bdf    SUNDIALS CVODE, BDF with Newton iterations (stiff problems); for closed
+//                loops it projects onto the constraints after every step (CVodeSetProjFn)
 //   cvode-adams  SUNDIALS CVODE, Adams-Moulton with fixed-point iterations (non-stiff)
 //   arkode       SUNDIALS ARKODE ERKStep, adaptive explicit Runge-Kutta (order 4 default)
 //   rk4          fixed-step classical Runge-Kutta (step = max_step, or 1 ms), the reference
@@ -40,6 +41,7 @@ class Integrator {
   virtual void reset(double t, const Eigen::VectorXd& y) = 0;  // y in ODE layout [q; v; xc]
   virtual void advance(double t_out) = 0;                       // throws IntegratorFailure
   virtual Eigen::VectorXd state() const = 0;                    // ODE layout
+  virtual bool projects() const { return false; }               // keeps loops on the manifold itself
   virtual void add_stats(SolverStats& s) const = 0;
 };
 

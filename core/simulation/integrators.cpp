@@ -1,6 +1,7 @@
 // SUNDIALS adapters (CVODE, ARKODE ERKStep, IDA) and the fixed-step RK4.
 #include <arkode/arkode_erkstep.h>
 #include <cvode/cvode.h>
+#include <cvode/cvode_proj.h>
 #include <ida/ida.h>
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>
@@ -116,6 +117,8 @@ class Cvode final : public SundialsBase {
         A_ = SUNDenseMatrix(sys_.ode_size(), sys_.ode_size(), ctx_);
         LS_ = SUNLinSol_Dense(y_, A_, ctx_);
         check(CVodeSetLinearSolver(mem_, LS_, A_), "CVodeSetLinearSolver");
+        // loops: CVODE projects after every step itself, so the simulator need not restart it
+        if (sys_.model().nc > 0) check(CVodeSetProjFn(mem_, &Cvode::project), "CVodeSetProjFn");
       } else {
         NLS_ = SUNNonlinSol_FixedPoint(y_, 0, ctx_);
         check(CVodeSetNonlinearSolver(mem_, NLS_), "CVodeSetNonlinearSolver");
@@ -132,9 +135,11 @@ class Cvode final : public SundialsBase {
     if (flag < 0) fail("CVODE", flag, t_);
   }
   Eigen::VectorXd state() const override { return view(y_); }
+  bool projects() const override { return bdf_ && sys_.model().nc > 0; }
   void add_stats(SolverStats& s) const override {
     add_done(s);
     counters(s);
+    s.projections += projections_;
   }
   void counters(SolverStats& s) const {
     long v = 0;
@@ -148,7 +153,18 @@ class Cvode final : public SundialsBase {
 
  private:
   static void check(int flag, const char* what) { SundialsBase::check(flag, "CVODE", what); }
+  // CVProjFn: the correction that brings ycur back onto phi = 0, Jc v = 0 (the error estimate is left as it is)
+  static int project(double, N_Vector ycur, N_Vector corr, double, N_Vector, void* self) {
+    auto* me = static_cast<Cvode*>(static_cast<SundialsBase*>(self));
+    return me->guarded([&] {
+      Eigen::VectorXd y = view(ycur);
+      const Eigen::VectorXd y0 = y;
+      if (me->sys_.project(y, 0.0)) ++me->projections_;
+      view(corr) = y - y0;
+    });
+  }
   bool bdf_;
+  long projections_ = 0;
 };
 
 class Erk final : public SundialsBase {

@@ -193,7 +193,7 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
     t = target;
     y = integrator->state();
     bool restart = false;
-    if (model.nc && sys.project(y, o.projection_tolerance)) {
+    if (model.nc && !integrator->projects() && sys.project(y, o.projection_tolerance)) {
       ++r.stats.projections;
       restart = true;
     }
