@@ -1,5 +1,6 @@
 #include "simulation/closed_loop.hpp"
 
+#include <Eigen/QR>
 #include <Eigen/SVD>
 #include <algorithm>
 
@@ -140,6 +141,17 @@ std::pair<double, double> ClosedLoopSystem::violation(const Eigen::VectorXd& q, 
   if (model_.nc == 0) return {0.0, 0.0};
   constraint_terms<double>(model_, data_, q, v);
   return {data_.phi.cwiseAbs().maxCoeff(), (data_.Jc * v).cwiseAbs().maxCoeff()};
+}
+
+void ClosedLoopSystem::project_tangent(const Eigen::VectorXd& y, Eigen::VectorXd& e) {
+  if (model_.nc == 0) return;
+  constraint_terms<double>(model_, data_, y.head(model_.nq), Eigen::VectorXd::Zero(model_.nv));
+  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod;
+  cod.setThreshold(1e-9);
+  cod.compute(data_.Jc);
+  auto remove_normal = [&](auto&& block) { block -= cod.solve(data_.Jc * Eigen::VectorXd(block)); };
+  remove_normal(e.segment(model_.nq, model_.nv));
+  if (model_.nq == model_.nv) remove_normal(e.head(model_.nq));
 }
 
 bool ClosedLoopSystem::project(Eigen::VectorXd& y, double tol) {

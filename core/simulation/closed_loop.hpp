@@ -52,6 +52,9 @@ class ClosedLoopSystem {
   bool rows_degraded(const Eigen::VectorXd& q);
   // back onto phi = 0, Jc v = 0 if the violation exceeds tol; returns whether it moved
   bool project(Eigen::VectorXd& y, double tol);
+  // removes from a state-space vector e (ODE layout, e.g. an error estimate) its components
+  // normal to the constraint manifold at y: Jc e_v = 0 and, where q is additive, Jc e_q = 0
+  void project_tangent(const Eigen::VectorXd& y, Eigen::VectorXd& e);
   // max |phi|, max |Jc v|
   std::pair<double, double> violation(const Eigen::VectorXd& q, const Eigen::VectorXd& v);
 

@@ -153,14 +153,20 @@ class Cvode final : public SundialsBase {
 
  private:
   static void check(int flag, const char* what) { SundialsBase::check(flag, "CVODE", what); }
-  // CVProjFn: the correction that brings ycur back onto phi = 0, Jc v = 0 (the error estimate is left as it is)
-  static int project(double, N_Vector ycur, N_Vector corr, double, N_Vector, void* self) {
+  // CVProjFn: the correction that brings ycur back onto phi = 0, Jc v = 0, and the error
+  // estimate projected onto the constraints' tangent space (CVODE's default expects both)
+  static int project(double, N_Vector ycur, N_Vector corr, double, N_Vector err, void* self) {
     auto* me = static_cast<Cvode*>(static_cast<SundialsBase*>(self));
     return me->guarded([&] {
       Eigen::VectorXd y = view(ycur);
       const Eigen::VectorXd y0 = y;
       if (me->sys_.project(y, 0.0)) ++me->projections_;
       view(corr) = y - y0;
+      if (err) {
+        Eigen::VectorXd e = view(err);
+        me->sys_.project_tangent(y, e);
+        view(err) = e;
+      }
     });
   }
   bool bdf_;
