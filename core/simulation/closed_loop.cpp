@@ -62,9 +62,9 @@ Eigen::VectorXd ClosedLoopSystem::saturate(Eigen::VectorXd u) const {
 Eigen::VectorXd ClosedLoopSystem::inputs(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
                                          const Eigen::VectorXd& xc) const {
   Eigen::VectorXd u = u_nominal_;
-  if (!controller_) return saturate(u);
   Eigen::VectorXd up;
-  if (controller_->sample_time() > 0) {
+  if (!controller_ || controller_->sample_time() > 0) {
+    // held values: a discrete controller's last output, or inputs set from outside (co-simulation)
     if (!held_) return saturate(u);
     up = *held_;
   } else {

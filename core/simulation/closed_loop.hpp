@@ -36,7 +36,8 @@ class ClosedLoopSystem {
   int dae_size() const { return ode_size() + na(); }
   const Model& model() const { return model_; }
 
-  // discrete controllers: the plant inputs held until the next sample
+  // the Plant/In values held until changed: by a discrete controller at its samples,
+  // or from outside when there is no controller (co-simulation, Stepper)
   void set_held(const Eigen::VectorXd& u_plant) { held_ = u_plant; }
 
   ControllerInput measure(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v) const;

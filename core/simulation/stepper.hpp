@@ -1,0 +1,46 @@
+// Stepper: the nonlinear plant stepped from outside, for co-simulation (a MEX
+// gateway stepping it from Octave/MATLAB as the paper's S-function did, a GUI's
+// interactive mode). The caller holds the Plant/In values constant over each
+// step (zero-order hold) and reads the Plant/Out values at its end; the other
+// actuators stay at their nominal u0. Loops are kept on the constraint manifold
+// as in simulate(). One Stepper per thread.
+#pragma once
+
+#include <memory>
+
+#include "simulation/closed_loop.hpp"
+#include "simulation/integrator.hpp"
+
+namespace codyna {
+
+class Stepper {
+ public:
+  Stepper(const Model& model, const IntegratorSettings& settings, double projection_tolerance = 1e-9);
+
+  // back to a state (assembled onto the loops); empty q/v = the model's initial state
+  void reset(double t0 = 0.0, const Eigen::VectorXd& q = {}, const Eigen::VectorXd& v = {});
+  // advances by dt > 0 with Plant/In values u held; returns the Plant/Out values at the end
+  // throws IntegratorFailure (the state stays at the last successful step) or std::invalid_argument
+  const Eigen::VectorXd& step(const Eigen::VectorXd& u, double dt);
+
+  double time() const { return t_; }
+  Eigen::VectorXd q() const { return y_.head(model_.nq); }
+  Eigen::VectorXd v() const { return y_.segment(model_.nq, model_.nv); }
+  const Eigen::VectorXd& outputs() const { return out_; }
+  int nu() const { return static_cast<int>(model_.plant_inputs.size()); }
+  int ny() const { return static_cast<int>(model_.plant_outputs.size()); }
+  SolverStats stats() const;
+
+ private:
+  void measure();
+
+  const Model& model_;
+  double projection_tolerance_;
+  ClosedLoopSystem sys_;
+  std::unique_ptr<Integrator> integrator_;
+  Eigen::VectorXd y_, out_;
+  double t_ = 0;
+  SolverStats extra_;
+};
+
+}  // namespace codyna
