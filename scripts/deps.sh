@@ -9,7 +9,7 @@ PKGS=(
   libeigen3-dev libsundials-dev libhdf5-dev libmatio-dev
   nlohmann-json3-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
   libmujoco-dev  # the MuJoCo peer test (tests/peers_mujoco); the build skips it without
-  octave octave-control python3 python3-scipy python3-h5py python3-numpy
+  octave octave-control liboctave-dev python3 python3-scipy python3-h5py python3-numpy
 )
 
 missing=()
