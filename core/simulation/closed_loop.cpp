@@ -36,7 +36,8 @@ ControllerInput ClosedLoopSystem::measure(double t, const Eigen::VectorXd& q, co
       dq[i] = ADScalar(0.0, Eigen::VectorXd::Constant(1, v[i]));
       va[i] = ADScalar(v[i], Eigen::VectorXd::Zero(1));
     }
-    DataT<ADScalar> d(model_);
+    if (!ad_data_) ad_data_ = std::make_unique<DataT<ADScalar>>(model_);
+    DataT<ADScalar>& d = *ad_data_;
     const ADVec qa = integrate<ADScalar>(model_, q.cast<ADScalar>(), dq);
     forward_kinematics<ADScalar>(model_, d, qa, va);
     const ADVec y = sensor_outputs<ADScalar>(model_, d, out, qa, va);

@@ -12,11 +12,13 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <memory>
 #include <optional>
 
 #include "analysis/plant_function.hpp"
 #include "dynamics/forward_dynamics.hpp"
 #include "model/data.hpp"
+#include "spatial/autodiff.hpp"
 #include "simulation/controller.hpp"
 
 namespace codyna {
@@ -73,6 +75,7 @@ class ClosedLoopSystem {
   int continuous_states_ = 0;
   std::vector<int> rows_;  // DAE form: constraint rows carrying multipliers
   mutable Data data_;
+  mutable std::unique_ptr<DataT<ADScalar>> ad_data_;  // output rates (PD), made on first use
   long evaluations_ = 0;
 };
 

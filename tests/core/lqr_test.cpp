@@ -15,6 +15,7 @@
 #include <unsupported/Eigen/MatrixFunctions>
 #include <vector>
 
+#include "test_util.hpp"
 #include "peer_util.hpp"
 
 namespace codyna {
@@ -31,17 +32,6 @@ using test::run_octave;
 
 // ------------------------------------------------------------------ helpers
 
-#define EXPECT_INVALID_ARGUMENT_WITH(statement, ...)                                    \
-  do {                                                                                  \
-    try {                                                                               \
-      statement;                                                                        \
-      ADD_FAILURE() << "no exception from " #statement;                                 \
-    } catch (const std::invalid_argument& e) {                                          \
-      for (const std::string& part : std::vector<std::string>{__VA_ARGS__})             \
-        EXPECT_NE(std::string(e.what()).find(part), std::string::npos)                  \
-            << "message \"" << e.what() << "\" lacks \"" << part << "\"";               \
-    }                                                                                   \
-  } while (0)
 
 MatrixXd scalar(double v) { return MatrixXd::Constant(1, 1, v); }
 

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "test_util.hpp"
 #include "peer_util.hpp"
 
 namespace codyna {
@@ -34,17 +35,6 @@ using test::run_octave;
 
 // ------------------------------------------------------------------ helpers
 
-#define EXPECT_INVALID_ARGUMENT_WITH(statement, ...)                                    \
-  do {                                                                                  \
-    try {                                                                               \
-      statement;                                                                        \
-      ADD_FAILURE() << "no exception from " #statement;                                 \
-    } catch (const std::invalid_argument& e) {                                          \
-      for (const std::string& part : std::vector<std::string>{__VA_ARGS__})             \
-        EXPECT_NE(std::string(e.what()).find(part), std::string::npos)                  \
-            << "message \"" << e.what() << "\" lacks \"" << part << "\"";               \
-    }                                                                                   \
-  } while (0)
 
 // the largest |placed - wanted| over max(1, |wanted|), each wanted pole matched
 // to its nearest unmatched eigenvalue of A - B K

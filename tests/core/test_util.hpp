@@ -11,6 +11,20 @@
 #include "io/model_file.hpp"
 #include "model/compile.hpp"
 
+// EXPECT_INVALID_ARGUMENT_WITH(statement, "part", ...): the statement throws
+// std::invalid_argument and its message contains every part
+#define EXPECT_INVALID_ARGUMENT_WITH(statement, ...)                                    \
+  do {                                                                                  \
+    try {                                                                               \
+      statement;                                                                        \
+      ADD_FAILURE() << "no exception from " #statement;                                 \
+    } catch (const std::invalid_argument& e) {                                          \
+      for (const std::string& part : std::vector<std::string>{__VA_ARGS__})             \
+        EXPECT_NE(std::string(e.what()).find(part), std::string::npos)                  \
+            << "message \"" << e.what() << "\" lacks \"" << part << "\"";               \
+    }                                                                                   \
+  } while (0)
+
 namespace codyna::test {
 
 // |a - b| <= tol * max(1, |b|) entrywise-norm, with a readable failure message
