@@ -1,3 +1,4 @@
+#include <Eigen/Eigenvalues>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -10,6 +11,9 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "io/mat_export.hpp"
+#include "simulation/model_controller.hpp"
+#include "simulation/simulator.hpp"
+#include "simulation/trajectory_linearization.hpp"
 
 namespace codyna::cli {
 
@@ -17,7 +21,7 @@ namespace {
 
 struct LinearizeArgs {
   std::string model, out, op = "equilibrium", method = "exact", mat_version = "5", name;
-  double discrete = 0.0;
+  double discrete = 0.0, trajectory = 0.0, trajectory_step = 0.0;
   std::vector<std::string> independent, set;
 };
 
@@ -44,6 +48,49 @@ JacobianMethod method_of(const std::string& s) {
   throw std::invalid_argument("--method " + s + ": expected exact, fd-forward or fd-central");
 }
 
+// --trajectory: simulate (with the model's controller, if it declares one) and linearize
+// the plant about every output sample
+void run_trajectory(const Model& m, const LinearizeArgs& a, const std::string& name) {
+  if (a.discrete != 0) throw std::invalid_argument("--trajectory: export is continuous-time only (drop --discrete)");
+  if (a.mat_version != "5") throw std::invalid_argument("--trajectory: export is MAT v5 only");
+  SimulationOptions o;
+  o.integrator.method = m.spec.solver.integrator;
+  o.integrator.rtol = m.spec.solver.rtol;
+  o.integrator.atol = m.spec.solver.atol;
+  o.integrator.max_step = m.spec.solver.max_step;
+  o.t_end = a.trajectory;
+  o.output_step = a.trajectory_step > 0 ? a.trajectory_step : m.spec.solver.output_step;
+  std::unique_ptr<LinearPlant> plant;
+  std::unique_ptr<Controller> controller;
+  if (has_model_controller(m)) {
+    plant = std::make_unique<LinearPlant>(controller_plant(m));
+    controller = make_model_controller(m, *plant);
+  }
+  const SimulationResult r = simulate(m, controller.get(), plant.get(), o);
+  if (!r.completed) throw std::runtime_error("--trajectory: the simulation failed: " + r.failure);
+  LinearizeOptions lo;
+  lo.method = method_of(a.method);
+  lo.independent = a.independent;
+  const std::vector<Linearization> lin = linearize_along(m, r, lo);
+  std::vector<LinearSystem> systems;
+  for (const Linearization& l : lin) systems.push_back(l.system);
+  std::cout << "model            " << m.name << " (" << m.dof() << " DOF)\n"
+            << "trajectory       " << lin.size() << " points, t = 0 .. " << r.t.back() << " s, "
+            << (controller ? controller->describe() : std::string("open loop")) << "\n"
+            << "method           " << to_string(lo.method) << "\n"
+            << "states           ";
+  for (std::size_t k = 0; k < systems[0].state_names.size(); ++k) std::cout << (k ? ", " : "") << systems[0].state_names[k];
+  std::cout << "\n\n     t [s]   max Re(eig A)   min Re(eig A)\n";
+  const std::size_t every = std::max<std::size_t>(1, lin.size() / 10);
+  for (std::size_t k = 0; k < lin.size(); k += every) {
+    const Eigen::VectorXcd ev = systems[k].A.eigenvalues();
+    std::cout << std::setw(10) << r.t[k] << std::setw(16) << ev.real().maxCoeff() << std::setw(16) << ev.real().minCoeff() << "\n";
+  }
+  std::filesystem::create_directories(a.out);
+  const ExportPaths p = export_trajectory(systems, std::vector<double>(r.t.begin(), r.t.end()), a.out, name);
+  std::cout << "\nwrote " << p.mat_file << "\nwrote " << p.m_file << "\n";
+}
+
 void run(const LinearizeArgs& a) {
   const Model m = with_settings(load_model(a.model), a.set);
   const std::string name = a.name.empty() ? matlab_identifier(m.name) : a.name;
@@ -51,6 +98,8 @@ void run(const LinearizeArgs& a) {
     throw std::invalid_argument("--name " + name + ": not a valid MATLAB identifier (try " + matlab_identifier(name) + ")");
   if (m.plant_inputs.empty() && m.plant_outputs.empty())
     std::cerr << "codyna: warning: the model selects no Plant/In or Plant/Out; exporting the state equations only\n";
+  if (a.trajectory > 0) return run_trajectory(m, a, name);
+  if (a.trajectory < 0) throw std::invalid_argument("--trajectory: the end time must be positive");
   const OperatingPoint op = operating_point(m, a.op, a.independent);
   LinearizeOptions opt;
   opt.method = method_of(a.method);
@@ -107,6 +156,8 @@ void add_linearize(CLI::App& app) {
   cmd->add_option("--mat-version", a->mat_version, "5 | 7.3")->capture_default_str();
   cmd->add_option("--independent", a->independent, "closed loops: independent coordinate names")->delimiter(',');
   cmd->add_option("--set", a->set, "NAME=VALUE: set a joint coordinate of the initial state (repeatable)");
+  cmd->add_option("--trajectory", a->trajectory, "T: linearize along a simulation from 0 to T (the model's controller in the loop, if any) instead of at one point");
+  cmd->add_option("--trajectory-step", a->trajectory_step, "DT: spacing of the points along the trajectory (default: the model's output_step)");
   cmd->add_option("--name", a->name, "plant name (default: the model name as a MATLAB identifier)");
   cmd->callback([a] { set_exit_code(run_guarded([&] { run(*a); })); });
 }

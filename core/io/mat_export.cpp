@@ -206,6 +206,15 @@ VarPtr double_var(const char* name, const Eigen::MatrixXd& m) {
   return checked(Mat_VarCreate(name, MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims, const_cast<double*>(m.data()), 0), name);
 }
 
+// rows x cols x N, slice k = pages[k] (MATLAB's A(:,:,k))
+VarPtr double3_var(const char* name, const std::vector<Eigen::MatrixXd>& pages, Eigen::Index rows, Eigen::Index cols) {
+  std::vector<double> data;
+  data.reserve(static_cast<std::size_t>(rows * cols) * pages.size());
+  for (const Eigen::MatrixXd& p : pages) data.insert(data.end(), p.data(), p.data() + p.size());
+  size_t dims[3] = {static_cast<size_t>(rows), static_cast<size_t>(cols), pages.size()};
+  return checked(Mat_VarCreate(name, MAT_C_DOUBLE, MAT_T_DOUBLE, 3, dims, data.data(), 0), name);
+}
+
 // '' is 0x0 as in MATLAB; otherwise a 1xN row of UTF-16 code units
 VarPtr char_var(const char* name, const std::string& s) {
   std::u16string u = utf16(s);
@@ -626,6 +635,88 @@ MatVariables read_mat_file(const std::string& path) {
     out.matrices[name] = std::move(m);
   }
   return out;
+}
+
+// ---------------------------------------------------------------- trajectories
+
+namespace {
+
+std::string trajectory_script(const LinearSystem& s, const std::string& name, std::size_t samples) {
+  std::ostringstream m;
+  m << "% " << name << ".m - linearizations along a trajectory, exported by codyna " << s.codyna_version << "\n"
+    << "%\n% Model: " << one_line(s.model_name) << "  (" << one_line(s.model_file) << ")\n"
+    << "% " << samples << " operating points along a simulation, at the times in t (" << one_line(s.method) << " linearization).\n"
+    << "% About the k-th point, with deviations from x0(:,k), u0(:,k), y0(:,k):\n"
+    << "%   d(dx)/dt = xdot0(:,k) + A(:,:,k) dx + B(:,:,k) du,   dy = C(:,:,k) dx + D(:,:,k) du\n"
+    << "% plant_at(k) returns the named state-space model at point k (when ss() exists).\n\n"
+    << "codyna_here = fileparts(mfilename('fullpath'));\n"
+    << "load(fullfile(codyna_here, '" << name << ".mat'));\n"
+    << "if exist('OCTAVE_VERSION', 'builtin')\n  try\n    pkg load control\n  catch\n  end\nend\n"
+    << "plant_inputs = input_names;\nplant_outputs = output_names;\n"
+    << "if exist('ss') >= 2\n"
+    << "  plant_at = @(k) ss(A(:,:,k), B(:,:,k), C(:,:,k), D(:,:,k), 'StateName', state_names, "
+       "'InputName', input_names, 'OutputName', output_names);\n"
+    << "end\n"
+    << "fprintf('%s: %d linearizations of model %s from t = %g to %g s, %d states, %d inputs, %d outputs.\\n', ...\n"
+    << "        '" << name << "', numel(t), '" << one_line(s.model_name) << "', t(1), t(end), size(A, 1), size(B, 2), size(C, 1));\n"
+    << "clear codyna_here\n";
+  return m.str();
+}
+
+}  // namespace
+
+ExportPaths export_trajectory(const std::vector<LinearSystem>& systems, const std::vector<double>& times,
+                              const std::string& dir, const std::string& name) {
+  const std::string base = (std::filesystem::path(dir) / name).string();
+  const ExportPaths paths{base + ".mat", base + ".m"};
+  if (matlab_identifier(name) != name)
+    throw std::runtime_error(paths.mat_file + ": '" + name + "' is not a valid MATLAB identifier or is reserved" +
+                             " (use '" + matlab_identifier(name) + "')");
+  if (systems.empty() || systems.size() != times.size())
+    throw std::runtime_error(paths.mat_file + ": expected one linearization per time");
+  std::vector<LinearSystem> s;
+  for (const LinearSystem& sys : systems) s.push_back(completed_plant(sys, paths.mat_file));
+  const Eigen::Index nx = s[0].nx(), nu = s[0].nu(), ny = s[0].ny();
+  for (const LinearSystem& x : s)
+    if (x.nx() != nx || x.nu() != nu || x.ny() != ny || x.state_names != s[0].state_names)
+      throw std::runtime_error(paths.mat_file + ": the linearizations differ in size or state order");
+  auto pages = [&](auto get) {
+    std::vector<Eigen::MatrixXd> p;
+    for (const LinearSystem& x : s) p.push_back(get(x));
+    return p;
+  };
+  auto columns = [&](auto get, Eigen::Index rows) {
+    Eigen::MatrixXd M(rows, static_cast<Eigen::Index>(s.size()));
+    for (std::size_t k = 0; k < s.size(); ++k) M.col(static_cast<Eigen::Index>(k)) = get(s[k]);
+    return M;
+  };
+  AtomicFile mat(paths.mat_file);
+  {
+    MatWriter w(mat.temp_path(), MatVersion::V5, paths.mat_file);
+    w.write(double3_var("A", pages([](const LinearSystem& x) { return x.A; }), nx, nx));
+    w.write(double3_var("B", pages([](const LinearSystem& x) { return x.B; }), nx, nu));
+    w.write(double3_var("C", pages([](const LinearSystem& x) { return x.C; }), ny, nx));
+    w.write(double3_var("D", pages([](const LinearSystem& x) { return x.D; }), ny, nu));
+    w.write(double_var("x0", columns([](const LinearSystem& x) { return x.x0; }, nx)));
+    w.write(double_var("u0", columns([](const LinearSystem& x) { return x.u0; }, nu)));
+    w.write(double_var("y0", columns([](const LinearSystem& x) { return x.y0; }, ny)));
+    w.write(double_var("xdot0", columns([](const LinearSystem& x) { return x.xdot0; }, nx)));
+    w.write(double_var("t", Eigen::Map<const Eigen::VectorXd>(times.data(), static_cast<Eigen::Index>(times.size()))));
+    w.write(double_var("Ts", Eigen::MatrixXd::Zero(1, 1)));
+    for (const auto& l : name_lists(s[0])) w.write(cellstr_var(l.var, *l.list));
+    w.write(info_var(s[0], name));
+    w.close();
+  }
+  AtomicFile m(paths.m_file);
+  {
+    std::ofstream out(m.temp_path(), std::ios::binary | std::ios::trunc);
+    out << trajectory_script(s[0], name, s.size());
+    out.close();
+    if (!out) throw std::runtime_error(paths.m_file + ": cannot write " + m.temp_path());
+  }
+  mat.commit();
+  m.commit();
+  return paths;
 }
 
 }  // namespace codyna

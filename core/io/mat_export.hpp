@@ -51,6 +51,13 @@ struct ExportPaths {
 ExportPaths export_plant(const LinearSystem& sys, const std::string& dir, const std::string& name,
                          MatVersion v = MatVersion::V5);
 
+// Linearizations along a trajectory (same state order, one per time): DIR/NAME.mat
+// (MAT v5) holds A (nx x nx x N), B, C, D likewise, x0, u0, y0, xdot0 (one column per
+// point), t (N x 1), Ts = 0, the name and unit lists and info; DIR/NAME.m loads it and
+// defines plant_at(k), the named ss model at point k, when ss() exists. Atomic.
+ExportPaths export_trajectory(const std::vector<LinearSystem>& systems, const std::vector<double>& times,
+                              const std::string& dir, const std::string& name);
+
 // A valid MATLAB (and Octave) identifier that is also safe as a script name:
 // characters other than [A-Za-z0-9_] become '_' ("cart-pendulum 2" ->
 // "cart_pendulum_2"); not starting with a letter -> prefix "m_"; at most 63

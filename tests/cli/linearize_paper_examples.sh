@@ -13,6 +13,7 @@ fail() { echo "FAIL: $*"; exit 1; }
 "$codyna" linearize "$src/examples/cart_pendulum.json" --operating-point equilibrium --out "$work/v5" > "$work/cart.txt"
 "$codyna" linearize "$src/examples/cart_pendulum.json" --operating-point equilibrium --mat-version 7.3 --out "$work/v73" > /dev/null
 grep -q "wrote $work/v5/pendulum.mat" "$work/pendulum.txt" || fail "pendulum export not reported"
+"$codyna" linearize "$src/examples/pendulum.json" --trajectory 2 --trajectory-step 0.1 --out "$work/traj" > /dev/null
 [ -f "$work/v5/cart_pendulum.m" ] || fail "cart_pendulum.m missing"
 
 # bad input: clear message, non-zero exit, no file
@@ -33,6 +34,11 @@ assert(isequal(sys.inputname, {'torque'}) && isequal(sys.outputname, {'theta'}))
 e = sort(real(eig(sys.a)));
 assert(max(abs(e - [-sqrt(3*g/4); sqrt(3*g/4)])) < 1e-10);
 K1 = lqr(sys, eye(2), 1);
+% linearizations along the PD trajectory: A(2,1,k) = 3g/(2l) sin(theta(t_k)) at every point
+T = load(fullfile(work, 'traj', 'pendulum.mat'));
+assert(isequal(size(T.A), [2 2 21]) && numel(T.t) == 21);
+assert(max(abs(squeeze(T.A(2,1,:)) - 3*g/4 * sin(T.x0(1,:)'))) < 1e-10);
+run(fullfile(work, 'traj', 'pendulum.m')); s5 = plant_at(5); assert(abs(s5.a(2,1) - T.A(2,1,5)) < 1e-15);
 assert(all(real(eig(sys.a - sys.b*K1)) < 0));
 clear A B C D sys
 % paper 4.2: cart 20 kg, rod 10 kg / 2 m, upright
