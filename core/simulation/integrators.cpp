@@ -72,7 +72,14 @@ class SundialsBase : public Integrator {
     me->last_message_ = std::string(function) + ": " + msg;
   }
 
-  // counters of the solver runs before the last re-initialization
+  // statistics: the runs before the last re-initialization (whose counters
+  // SUNDIALS resets) plus the current run's
+  void add_stats(SolverStats& s) const override {
+    add_done(s);
+    counters(s);
+    s.projections += projections_;
+  }
+  virtual void counters(SolverStats& s) const = 0;  // the current run's (reset by a re-initialization)
   void add_done(SolverStats& s) const {
     s.steps += done_.steps;
     s.rhs_evals += done_.rhs_evals;
@@ -85,6 +92,7 @@ class SundialsBase : public Integrator {
   ClosedLoopSystem& sys_;
   IntegratorSettings set_;
   SolverStats done_;
+  long projections_ = 0;  // done inside the solver (CVODE's projection hook); never reset
   SUNContext ctx_ = nullptr;
   N_Vector y_ = nullptr, yp_ = nullptr, id_ = nullptr;
   SUNMatrix A_ = nullptr;
@@ -136,12 +144,7 @@ class Cvode final : public SundialsBase {
   }
   Eigen::VectorXd state() const override { return view(y_); }
   bool projects() const override { return bdf_ && sys_.model().nc > 0; }
-  void add_stats(SolverStats& s) const override {
-    add_done(s);
-    counters(s);
-    s.projections += projections_;
-  }
-  void counters(SolverStats& s) const {
+  void counters(SolverStats& s) const override {
     long v = 0;
     CVodeGetNumSteps(mem_, &v), s.steps += v;
     CVodeGetNumRhsEvals(mem_, &v), s.rhs_evals += v;
@@ -170,7 +173,6 @@ class Cvode final : public SundialsBase {
     });
   }
   bool bdf_;
-  long projections_ = 0;
 };
 
 class Erk final : public SundialsBase {
@@ -203,11 +205,7 @@ class Erk final : public SundialsBase {
     if (flag < 0) fail("ARKODE", flag, t_);
   }
   Eigen::VectorXd state() const override { return view(y_); }
-  void add_stats(SolverStats& s) const override {
-    add_done(s);
-    counters(s);
-  }
-  void counters(SolverStats& s) const {
+  void counters(SolverStats& s) const override {
     long v = 0;
     ERKStepGetNumSteps(mem_, &v), s.steps += v;
     ERKStepGetNumRhsEvals(mem_, &v), s.rhs_evals += v;
@@ -262,11 +260,7 @@ class Ida final : public SundialsBase {
     if (flag < 0) fail("IDA", flag, t_);
   }
   Eigen::VectorXd state() const override { return view(y_).head(sys_.ode_size()); }
-  void add_stats(SolverStats& s) const override {
-    add_done(s);
-    counters(s);
-  }
-  void counters(SolverStats& s) const {
+  void counters(SolverStats& s) const override {
     long v = 0;
     IDAGetNumSteps(mem_, &v), s.steps += v;
     IDAGetNumResEvals(mem_, &v), s.rhs_evals += v;
