@@ -1,4 +1,5 @@
 #include <Eigen/Eigenvalues>
+#include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -9,6 +10,7 @@
 #include "analysis/modal.hpp"
 #include "analysis/operating_point.hpp"
 #include "commands.hpp"
+#include "io/model_file.hpp"
 #include "common.hpp"
 #include "io/mat_export.hpp"
 #include "simulation/model_controller.hpp"
@@ -23,6 +25,7 @@ struct LinearizeArgs {
   std::string model, out, op = "equilibrium", method = "exact", mat_version = "5", name;
   double discrete = 0.0, trajectory = 0.0, trajectory_step = 0.0;
   std::vector<std::string> independent, set;
+  const CLI::App* cmd = nullptr;  // to tell given flags (they override the file's analysis section)
 };
 
 void print_matrix(const char* label, const Eigen::MatrixXd& M, const std::vector<std::string>& rows,
@@ -51,8 +54,8 @@ JacobianMethod method_of(const std::string& s) {
 // --trajectory: simulate (with the model's controller, if it declares one) and linearize
 // the plant about every output sample
 void run_trajectory(const Model& m, const LinearizeArgs& a, const std::string& name) {
-  if (a.discrete != 0) throw std::invalid_argument("--trajectory: export is continuous-time only (drop --discrete)");
-  if (a.mat_version != "5") throw std::invalid_argument("--trajectory: export is MAT v5 only");
+  if (m.spec.analysis.discrete != 0) throw std::invalid_argument("--trajectory: export is continuous-time only (drop --discrete)");
+  if (m.spec.analysis.mat_version != "5") throw std::invalid_argument("--trajectory: export is MAT v5 only");
   SimulationOptions o;
   o.integrator.method = m.spec.solver.integrator;
   o.integrator.rtol = m.spec.solver.rtol;
@@ -69,8 +72,8 @@ void run_trajectory(const Model& m, const LinearizeArgs& a, const std::string& n
   const SimulationResult r = simulate(m, controller.get(), plant.get(), o);
   if (!r.completed) throw std::runtime_error("--trajectory: the simulation failed: " + r.failure);
   LinearizeOptions lo;
-  lo.method = method_of(a.method);
-  lo.independent = a.independent;
+  lo.method = method_of(m.spec.analysis.method);
+  lo.independent = m.spec.analysis.independent;
   const std::vector<Linearization> lin = linearize_along(m, r, lo);
   std::vector<LinearSystem> systems;
   for (const Linearization& l : lin) systems.push_back(l.system);
@@ -91,25 +94,45 @@ void run_trajectory(const Model& m, const LinearizeArgs& a, const std::string& n
   std::cout << "\nwrote " << p.mat_file << "\nwrote " << p.m_file << "\n";
 }
 
+// the model file's study, with the flags given on the command line on top
+ModelSpec study_of(const LinearizeArgs& a) {
+  ModelSpec spec = load_spec(a.model);
+  StudySpec& s = spec.analysis;
+  if (given(a.cmd, "--operating-point")) s.operating_point = a.op;
+  if (given(a.cmd, "--method")) s.method = a.method;
+  if (given(a.cmd, "--discrete")) {
+    if (!(a.discrete >= 0) || !std::isfinite(a.discrete))
+      throw std::invalid_argument("--discrete: the sample time must be positive (0 = continuous)");
+    s.discrete = a.discrete;
+  }
+  if (given(a.cmd, "--mat-version")) {
+    if (a.mat_version != "5" && a.mat_version != "7.3") throw std::invalid_argument("--mat-version: expected 5 or 7.3");
+    s.mat_version = a.mat_version;
+  }
+  if (given(a.cmd, "--independent")) s.independent = a.independent;
+  if (given(a.cmd, "--name")) {
+    if (a.name != matlab_identifier(a.name))
+      throw std::invalid_argument("--name " + a.name + ": not a valid MATLAB identifier (try " + matlab_identifier(a.name) + ")");
+    s.export_name = a.name;
+  }
+  if (given(a.cmd, "--method")) method_of(a.method);  // a clear message for a bad flag
+  apply_set(s, a.set);
+  return spec;
+}
+
 void run(const LinearizeArgs& a) {
-  const Model m = with_settings(load_model(a.model), a.set);
-  const std::string name = a.name.empty() ? matlab_identifier(m.name) : a.name;
-  if (name != matlab_identifier(name))
-    throw std::invalid_argument("--name " + name + ": not a valid MATLAB identifier (try " + matlab_identifier(name) + ")");
+  const Model m = study_model(study_of(a), a.model);
+  const std::string name = study_export_name(m);
   if (m.plant_inputs.empty() && m.plant_outputs.empty())
     std::cerr << "codyna: warning: the model selects no Plant/In or Plant/Out; exporting the state equations only\n";
   if (a.trajectory > 0) return run_trajectory(m, a, name);
   if (a.trajectory < 0) throw std::invalid_argument("--trajectory: the end time must be positive");
-  const OperatingPoint op = operating_point(m, a.op, a.independent);
+  const StudyLinearization sl = study_linearize(m);
+  const OperatingPoint& op = sl.op;
+  const Linearization& lin = sl.lin;
+  const LinearSystem& sys = sl.system;
   LinearizeOptions opt;
-  opt.method = method_of(a.method);
-  opt.independent = a.independent;
-  const Linearization lin = linearize(m, op, opt);
-  LinearSystem sys = lin.system;
-  if (a.discrete > 0) sys = discretize_zoh(sys, a.discrete);
-  else if (a.discrete < 0) throw std::invalid_argument("--discrete: the sample time must be positive");
-  const MatVersion version = a.mat_version == "7.3" ? MatVersion::V73 : MatVersion::V5;
-  if (a.mat_version != "5" && a.mat_version != "7.3") throw std::invalid_argument("--mat-version: expected 5 or 7.3");
+  opt.method = method_of(m.spec.analysis.method);
 
   std::cout << "model            " << m.name << " (" << m.dof() << " DOF)\n"
             << "operating point  " << op.kind;
@@ -138,8 +161,7 @@ void run(const LinearizeArgs& a) {
   print_matrix("D", sys.D, sys.output_names, sys.input_names);
   std::cout << "\n" << format_modes(modal_analysis(sys)) << "\n";
 
-  std::filesystem::create_directories(a.out);
-  const ExportPaths p = export_plant(sys, a.out, name, version);
+  const ExportPaths p = study_export(m, sys, a.out);
   std::cout << "wrote " << p.mat_file << "\nwrote " << p.m_file << "\n";
 }
 
@@ -159,6 +181,7 @@ void add_linearize(CLI::App& app) {
   cmd->add_option("--trajectory", a->trajectory, "T: linearize along a simulation from 0 to T (the model's controller in the loop, if any) instead of at one point");
   cmd->add_option("--trajectory-step", a->trajectory_step, "DT: spacing of the points along the trajectory (default: the model's output_step)");
   cmd->add_option("--name", a->name, "plant name (default: the model name as a MATLAB identifier)");
+  a->cmd = cmd;
   cmd->callback([a] { set_exit_code(run_guarded([&] { run(*a); })); });
 }
 

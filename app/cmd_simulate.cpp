@@ -22,20 +22,11 @@ namespace {
 struct SimulateArgs {
   std::string model, out, csv, controller, op = "equilibrium", integrator;
   bool lqr = false, compare_linear = false, quiet = false, open_loop = false;
-  bool op_given = false;  // --operating-point on the command line overrides the model controller's
   std::vector<double> q_weights, r_weights;
   double t_end = 0, rtol = 0, atol = 0, max_step = -1, output_step = 0;
   std::vector<std::string> independent, set;
+  const CLI::App* cmd = nullptr;  // to tell given flags (they override the file's analysis and solver sections)
 };
-
-Eigen::MatrixXd diagonal(const std::vector<double>& w, int n, const char* what) {
-  if (w.empty()) return Eigen::MatrixXd::Identity(n, n);
-  if (static_cast<int>(w.size()) != n)
-    throw std::invalid_argument(std::string(what) + ": expected " + std::to_string(n) + " weights, got " + std::to_string(w.size()));
-  for (double x : w)
-    if (!(x >= 0)) throw std::invalid_argument(std::string(what) + ": weights must be >= 0");
-  return Eigen::Map<const Eigen::VectorXd>(w.data(), n).asDiagonal();
-}
 
 std::string row(const Eigen::MatrixXd& M, int r) {
   std::ostringstream os;
@@ -90,52 +81,58 @@ void summary(const SimulationResult& r, const Model& m, const LinearPlant* plant
   }
 }
 
-void run(const SimulateArgs& a) {
-  const Model m = with_settings(load_model(a.model), a.set);
+// the model file's study and solver settings, with the flags given on the command line on top
+ModelSpec study_of(const SimulateArgs& a) {
+  ModelSpec spec = load_spec(a.model);
+  StudySpec& s = spec.analysis;
   if (!a.controller.empty() + a.lqr + a.open_loop > 1)
     throw std::invalid_argument("--controller, --lqr and --open-loop: choose one");
-  // the model's own controller, unless the command line names another (or none)
-  const bool from_model = a.controller.empty() && !a.lqr && !a.open_loop && has_model_controller(m);
-  const bool need_plant = a.lqr || !a.controller.empty() || a.compare_linear || from_model;
-  std::unique_ptr<LinearPlant> plant;
-  if (from_model && !a.op_given && a.independent.empty()) {
-    plant = std::make_unique<LinearPlant>(controller_plant(m));
-  } else if (need_plant) {
-    if (m.plant_inputs.empty()) throw std::invalid_argument(a.model + ": a controller needs Plant/In actuators (plant.inputs)");
-    plant = std::make_unique<LinearPlant>();
-    plant->op = operating_point(m, a.op, a.independent);
-    LinearizeOptions lo;
-    lo.independent = a.independent;
-    plant->lin = linearize(m, plant->op, lo);
+  if (!a.controller.empty()) {
+    s.controller = "file";
+    s.controller_file = std::filesystem::absolute(a.controller).string();  // a flag's path is relative to here
   }
-  std::unique_ptr<Controller> controller;
-  if (from_model) {
-    controller = make_model_controller(m, *plant);
-    std::cout << "controller from the model file: " << controller->describe() << " (about the " << plant->op.kind
-              << " point)\n";
-  } else if (a.lqr) {
-    const LinearSystem& s = plant->lin.system;
-    const LqrResult d = lqr(s.A, s.B, diagonal(a.q_weights, s.nx(), "--q-weights"), diagonal(a.r_weights, s.nu(), "--r-weights"));
-    std::cout << "LQR about the " << plant->op.kind << " point, states (" ;
-    for (std::size_t k = 0; k < s.state_names.size(); ++k) std::cout << (k ? ", " : "") << s.state_names[k];
-    std::cout << "):\n";
-    for (int r = 0; r < d.K.rows(); ++r) std::cout << "K(" << s.input_names[r] << ") = [" << row(d.K, r) << "]\n";
-    controller = make_state_feedback(d.K, s.u0);
-  } else if (!a.controller.empty()) {
-    const LinearSystem& s = plant->lin.system;
-    controller = load_controller(a.controller, s.nx(), s.nu(), s.ny(), s.y0, s.u0);
-    std::cout << "controller from " << a.controller << ": " << controller->describe() << "\n";
+  if (a.lqr) s.controller = "lqr";
+  if (a.open_loop) s.controller = "none";
+  if (given(a.cmd, "--q-weights")) s.q_weights = a.q_weights;
+  if (given(a.cmd, "--r-weights")) s.r_weights = a.r_weights;
+  if (given(a.cmd, "--operating-point")) {
+    s.operating_point = a.op;
+    // the command line's point also overrides where the model's own controller is linearized
+    if (spec.controller.type != ControllerType::None) spec.controller.operating_point = a.op;
   }
+  if (given(a.cmd, "--independent")) s.independent = a.independent;
+  if (a.compare_linear) s.compare_linear = true;
+  apply_set(s, a.set);
+  SolverSpec& sp = spec.solver;
+  if (!a.integrator.empty()) sp.integrator = a.integrator;
+  if (a.rtol > 0) sp.rtol = a.rtol;
+  if (a.atol > 0) sp.atol = a.atol;
+  if (a.max_step >= 0) sp.max_step = a.max_step;
+  if (a.t_end > 0) sp.t_end = a.t_end;
+  if (a.output_step > 0) sp.output_step = a.output_step;
+  return spec;
+}
 
-  SimulationOptions o;
-  const SolverSpec& sp = m.spec.solver;
-  o.integrator.method = a.integrator.empty() ? sp.integrator : a.integrator;
-  o.integrator.rtol = a.rtol > 0 ? a.rtol : sp.rtol;
-  o.integrator.atol = a.atol > 0 ? a.atol : sp.atol;
-  o.integrator.max_step = a.max_step >= 0 ? a.max_step : sp.max_step;
-  o.t_end = a.t_end > 0 ? a.t_end : sp.t_end;
-  o.output_step = a.output_step > 0 ? a.output_step : sp.output_step;
-  o.compare_linear = a.compare_linear && plant;
+void run(const SimulateArgs& a) {
+  const Model m = study_model(study_of(a), a.model);
+  const StudySimulation setup = study_simulation(m);
+  const LinearPlant* plant = setup.plant.get();
+  const SimulationOptions& o = setup.options;
+  if (setup.controller) {
+    const std::string& src = m.spec.analysis.controller;
+    if (src == "lqr") {
+      const LinearSystem& s = plant->lin.system;
+      std::cout << "LQR about the " << plant->op.kind << " point, states (";
+      for (std::size_t k = 0; k < s.state_names.size(); ++k) std::cout << (k ? ", " : "") << s.state_names[k];
+      std::cout << "):\n";
+      for (int r = 0; r < setup.lqr_gain.rows(); ++r) std::cout << "K(" << s.input_names[r] << ") = [" << row(setup.lqr_gain, r) << "]\n";
+    } else if (src == "file") {
+      std::cout << "controller from " << a.controller << ": " << setup.controller->describe() << "\n";
+    } else {
+      std::cout << "controller from the model file: " << setup.controller->describe() << " (about the " << plant->op.kind
+                << " point)\n";
+    }
+  }
 
   // check the output paths before spending time on the run
   for (const std::string& p : {a.out, a.csv}) {
@@ -156,18 +153,11 @@ void run(const SimulateArgs& a) {
       std::fprintf(stderr, "\r[%s%s] %3d%%  t = %.3f s", std::string(filled, '#').c_str(), std::string(w - filled, '.').c_str(), pct, t);
       std::fflush(stderr);
     };
-  const SimulationResult r = simulate(m, controller.get(), plant.get(), o, cb);
+  const SimulationResult r = study_simulate(m, setup, cb);
   if (bar) std::fprintf(stderr, "\n");
-  SimulationResult out = r;
-  out.model_file = a.model;
-  std::ostringstream settings;
-  settings << "{\"integrator\": \"" << o.integrator.method << "\", \"rtol\": " << o.integrator.rtol << ", \"atol\": "
-           << o.integrator.atol << ", \"max_step\": " << o.integrator.max_step << ", \"t_end\": " << o.t_end
-           << ", \"output_step\": " << o.output_step << ", \"operating_point\": \"" << (plant ? plant->op.kind : "") << "\"}";
-  out.settings_json = settings.str();
-  write_results_hdf5(out, a.out);
-  if (!a.csv.empty()) write_results_csv(out, a.csv);
-  summary(r, m, plant.get());
+  write_results_hdf5(r, a.out);
+  if (!a.csv.empty()) write_results_csv(r, a.csv);
+  summary(r, m, plant);
   std::cout << "wrote " << a.out << (a.csv.empty() ? "" : "\nwrote " + a.csv) << "\n";
   if (!r.completed && !r.cancelled) throw std::runtime_error("the solver failed; the partial result is in " + a.out);
 }
@@ -196,8 +186,8 @@ void add_simulate(CLI::App& app) {
   cmd->add_option("--independent", a->independent, "closed loops: independent coordinate names")->delimiter(',');
   cmd->add_option("--set", a->set, "NAME=VALUE: set a joint coordinate of the initial state (repeatable)");
   cmd->add_flag("--quiet", a->quiet, "no progress bar");
+  a->cmd = cmd;
   cmd->callback([a, cmd] {
-    a->op_given = cmd->count("--operating-point") > 0;
     set_exit_code(run_guarded([&] { run(*a); }));
   });
 }

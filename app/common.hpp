@@ -1,27 +1,30 @@
-// Shared by the subcommands: loading a model with file-attributed errors and
-// turning exceptions into messages and exit codes.
+// Shared by the subcommands: loading a model with file-attributed errors,
+// turning flags into the study's choices (the flags override the model file's
+// "analysis" section), and turning exceptions into messages and exit codes.
+// What the study means is decided in core (study/workflow.hpp), not here.
 #pragma once
 
+#include <CLI/CLI.hpp>
 #include <functional>
 #include <string>
-
 #include <vector>
 
-#include "analysis/operating_point.hpp"
 #include "model/compile.hpp"
+#include "study/workflow.hpp"
 
 namespace codyna::cli {
 
 // load + compile; ModelError names the file
 Model load_model(const std::string& path);
 
-// applies --set NAME=VALUE (joint coordinates of the initial state), then re-assembles loops
-Model with_settings(Model m, const std::vector<std::string>& set);
+// reads the model file (errors name it)
+ModelSpec load_spec(const std::string& path);
 
-// --operating-point: initial | equilibrium | trim | time=T (the state the simulation reaches
-// at T with the actuators at their nominal values and the model's solver settings).
-// An equilibrium that cannot be found is an error, not a silent best effort.
-OperatingPoint operating_point(const Model& m, const std::string& which, const std::vector<std::string>& independent);
+// --set NAME=VALUE ... added to the study's coordinates (a name given again replaces its value)
+void apply_set(StudySpec& study, const std::vector<std::string>& set);
+
+// true when the option was given on the command line (so it overrides the file)
+bool given(const CLI::App* cmd, const std::string& option);
 
 // runs f; prints "codyna: error: ..." for exceptions and returns the exit code
 // (0 ok, 1 bad input such as a ModelError or std::invalid_argument, 2 other failures)

@@ -10,6 +10,10 @@ PKGS=(
   nlohmann-json3-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
   libmujoco-dev  # the MuJoCo peer test (tests/peers_mujoco); the build skips it without
   octave octave-control liboctave-dev python3 python3-scipy python3-h5py python3-numpy
+  # the GUI (codyna-gui) and its tests: Qt 6 widgets, OpenGL, Charts, SVG export,
+  # and a virtual X server with Mesa's software OpenGL for the rendering tests
+  qt6-base-dev qt6-base-dev-tools libqt6opengl6-dev qt6-charts-dev qt6-svg-dev
+  libgl-dev xvfb xauth libgl1-mesa-dri
 )
 
 missing=()

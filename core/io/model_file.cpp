@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -893,6 +894,76 @@ const Schema<SolverSpec>& schema<SolverSpec>() {
   return s;
 }
 
+// One of `words`, or the operating-point form "time=T".
+std::string read_word(const Node& n, const std::vector<std::string>& words, const char* what) {
+  const std::string s = read_string(n);
+  if (std::find(words.begin(), words.end(), s) == words.end()) {
+    std::vector<std::string_view> v(words.begin(), words.end());
+    n.fail("unknown " + std::string(what) + " " + quote(s) + " (expected one of: " + join(v) + ")");
+  }
+  return s;
+}
+
+std::string read_study_operating_point(const Node& n) {
+  const std::string s = read_string(n);
+  if (s == "initial" || s == "equilibrium" || s == "trim") return s;
+  if (s.rfind("time=", 0) == 0) {
+    char* end = nullptr;
+    const double t = std::strtod(s.c_str() + 5, &end);
+    if (end != s.c_str() + 5 && *end == 0 && std::isfinite(t) && t >= 0) return s;
+  }
+  n.fail("unknown operating point " + quote(s) + " (expected one of: initial, equilibrium, trim, time=T with T >= 0 seconds)");
+}
+
+std::vector<std::pair<std::string, double>> read_set(const Node& n) {
+  const Object o(n);
+  std::vector<std::pair<std::string, double>> out;
+  for (const auto& item : n.value().items()) out.emplace_back(item.key(), read_number(n.member(item.key())));
+  return out;
+}
+
+ojson encode_set(const std::vector<std::pair<std::string, double>>& set) {
+  ojson j = ojson::object();
+  for (const auto& [name, value] : set) j[name] = value;
+  return j;
+}
+
+template <>
+const Schema<StudySpec>& schema<StudySpec>() {
+  using T = StudySpec;
+  static const Schema<T> s{{
+      field("disabled_effects", &T::disabled_effects, read_names),
+      field("operating_point", &T::operating_point, read_study_operating_point),
+      field("set", &T::set, read_set, encode_set),
+      field("independent", &T::independent, read_names),
+      field("method", &T::method, [](const Node& n) { return read_word(n, study_methods(), "method"); }),
+      field("discrete", &T::discrete,
+            [](const Node& n) {
+              const double Ts = read_number(n);
+              if (Ts < 0) n.expected("a sample time >= 0 (0 = continuous)");
+              return Ts;
+            },
+            [](double Ts) { return Ts > 0 ? ojson(Ts) : ojson(); }),
+      field("mat_version", &T::mat_version, [](const Node& n) { return read_word(n, {"5", "7.3"}, "MAT version"); }),
+      field("export_name", &T::export_name, read_string, encode_optional_text),
+      field("export_dir", &T::export_dir, read_string, encode_optional_text),
+      field("controller", &T::controller, [](const Node& n) { return read_word(n, study_controllers(), "controller source"); }),
+      field("controller_file", &T::controller_file, read_string, encode_optional_text),
+      field("q_weights", &T::q_weights, [](const Node& n) { return read_weights(n, false); }),
+      field("r_weights", &T::r_weights, [](const Node& n) { return read_weights(n, true); }),
+      field("compare_linear", &T::compare_linear,
+            [](const Node& n) {
+              if (!n.value().is_boolean()) n.expected("true or false");
+              return n.value().get<bool>();
+            },
+            [](bool b) { return b ? ojson(true) : ojson(); }),
+  }};
+  return s;
+}
+
+// A study with every choice at its default is left out of the file.
+ojson write_study(const StudySpec& a) { return a == StudySpec{} ? ojson() : write_struct(a); }
+
 template <>
 const Schema<ModelSpec>& schema<ModelSpec>() {
   static const Schema<ModelSpec> s{{
@@ -914,6 +985,7 @@ const Schema<ModelSpec>& schema<ModelSpec>() {
       struct_field("plant", &ModelSpec::plant),
       field("controller", &ModelSpec::controller, read_struct<ControllerSpec>, write_controller),
       struct_field("solver", &ModelSpec::solver),
+      field("analysis", &ModelSpec::analysis, read_struct<StudySpec>, write_study),
   }};
   return s;
 }

@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "model/study_spec.hpp"
+
 namespace codyna {
 
 inline constexpr const char* kGroundName = "ground";
@@ -220,6 +222,7 @@ struct ModelSpec {
   PlantSpec plant;
   ControllerSpec controller;  // type None: no controller
   SolverSpec solver;
+  StudySpec analysis;         // the study's choices (operating point, method, controller source, ...)
 };
 
 // Sizes of a joint type: configuration (nq) and velocity (nv).

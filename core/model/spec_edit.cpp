@@ -1,0 +1,295 @@
+#include "model/spec_edit.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace codyna {
+
+namespace {
+
+template <class F>
+decltype(auto) visit_list(ModelSpec& s, ElementKind k, F&& f) {
+  switch (k) {
+    case ElementKind::Body: return f(s.bodies);
+    case ElementKind::Joint: return f(s.joints);
+    case ElementKind::Constraint: return f(s.constraints);
+    case ElementKind::Effect: return f(s.effects);
+    case ElementKind::Actuator: return f(s.actuators);
+    case ElementKind::Sensor: return f(s.sensors);
+  }
+  throw std::logic_error("element kind");
+}
+
+template <class F>
+decltype(auto) visit_list(const ModelSpec& s, ElementKind k, F&& f) {
+  return visit_list(const_cast<ModelSpec&>(s), k, [&](const auto& v) -> decltype(auto) { return f(v); });
+}
+
+void check_index(const ModelSpec& s, ElementKind k, int i) {
+  if (i < 0 || i >= element_count(s, k))
+    throw std::out_of_range(std::string("no ") + to_string(k) + " at index " + std::to_string(i));
+}
+
+// name == old, or a coordinate of it ("old.x")
+bool names_coordinate_of(const std::string& name, const std::string& old) {
+  return name == old || (name.size() > old.size() && name.compare(0, old.size(), old) == 0 && name[old.size()] == '.');
+}
+
+std::string renamed_coordinate(const std::string& name, const std::string& old, const std::string& now) {
+  return names_coordinate_of(name, old) ? now + name.substr(old.size()) : name;
+}
+
+template <class F>
+void for_each_body_ref(ModelSpec& s, F&& f) {  // f(std::string& ref, const std::string& where)
+  for (auto& j : s.joints) {
+    f(j.parent, "joint " + j.name + ": parent");
+    f(j.child, "joint " + j.name + ": child");
+  }
+  for (auto& c : s.constraints) {
+    f(c.body_a, "constraint " + c.name + ": body_a");
+    f(c.body_b, "constraint " + c.name + ": body_b");
+  }
+  for (auto& e : s.effects) {
+    if (e.type == EffectType::SpringDamper) {
+      f(e.body_a, "effect " + e.name + ": body_a");
+      f(e.body_b, "effect " + e.name + ": body_b");
+    } else if (e.type == EffectType::BodyForce) {
+      f(e.body_a, "effect " + e.name + ": body");
+    }
+  }
+  for (auto& a : s.actuators)
+    if (a.type == ActuatorType::BodyForce) f(a.body, "actuator " + a.name + ": body");
+  for (auto& x : s.sensors) {
+    switch (x.type) {
+      case SensorType::PointPosition:
+      case SensorType::PointVelocity:
+        f(x.body, "sensor " + x.name + ": body");
+        f(x.frame, "sensor " + x.name + ": frame");
+        break;
+      case SensorType::BodyAngle: f(x.body, "sensor " + x.name + ": body"); break;
+      case SensorType::Distance:
+        f(x.body_a, "sensor " + x.name + ": body_a");
+        f(x.body_b, "sensor " + x.name + ": body_b");
+        break;
+      default: break;
+    }
+  }
+}
+
+template <class F>
+void for_each_joint_ref(ModelSpec& s, F&& f) {
+  for (auto& e : s.effects)
+    if (e.type == EffectType::JointSpringDamper || e.type == EffectType::JointFriction) f(e.joint, "effect " + e.name + ": joint");
+  for (auto& a : s.actuators)
+    if (a.type == ActuatorType::JointForce) f(a.joint, "actuator " + a.name + ": joint");
+  for (auto& x : s.sensors)
+    if (x.type == SensorType::JointPosition || x.type == SensorType::JointVelocity) f(x.joint, "sensor " + x.name + ": joint");
+}
+
+}  // namespace
+
+const char* to_string(ElementKind k) {
+  switch (k) {
+    case ElementKind::Body: return "body";
+    case ElementKind::Joint: return "joint";
+    case ElementKind::Constraint: return "constraint";
+    case ElementKind::Effect: return "effect";
+    case ElementKind::Actuator: return "actuator";
+    case ElementKind::Sensor: return "sensor";
+  }
+  return "?";
+}
+
+const char* section_of(ElementKind k) {
+  switch (k) {
+    case ElementKind::Body: return "bodies";
+    case ElementKind::Joint: return "joints";
+    case ElementKind::Constraint: return "constraints";
+    case ElementKind::Effect: return "effects";
+    case ElementKind::Actuator: return "actuators";
+    case ElementKind::Sensor: return "sensors";
+  }
+  return "?";
+}
+
+std::optional<ElementKind> kind_of_section(const std::string& section) {
+  for (ElementKind k : kElementKinds)
+    if (section == section_of(k)) return k;
+  return std::nullopt;
+}
+
+int element_count(const ModelSpec& s, ElementKind k) {
+  return visit_list(s, k, [](const auto& v) { return static_cast<int>(v.size()); });
+}
+
+const std::string& element_name(const ModelSpec& s, ElementKind k, int i) {
+  check_index(s, k, i);
+  return visit_list(s, k, [i](const auto& v) -> const std::string& { return v[i].name; });
+}
+
+std::vector<std::string> element_names(const ModelSpec& s, ElementKind k) {
+  return visit_list(s, k, [](const auto& v) {
+    std::vector<std::string> n;
+    for (const auto& e : v) n.push_back(e.name);
+    return n;
+  });
+}
+
+int find_element(const ModelSpec& s, ElementKind k, const std::string& name) {
+  const auto names = element_names(s, k);
+  const auto it = std::find(names.begin(), names.end(), name);
+  return it == names.end() ? -1 : static_cast<int>(it - names.begin());
+}
+
+std::string unique_name(const ModelSpec& s, ElementKind k, const std::string& base) {
+  auto taken = [&](const std::string& n) { return find_element(s, k, n) >= 0 || (k == ElementKind::Body && n == kGroundName); };
+  if (!taken(base)) return base;
+  for (int i = 2;; ++i)
+    if (!taken(base + "_" + std::to_string(i))) return base + "_" + std::to_string(i);
+}
+
+std::optional<ElementRef> element_at_path(const std::string& path) {
+  // "/section/index[/field...]"
+  if (path.size() < 2 || path[0] != '/') return std::nullopt;
+  const auto a = path.find('/', 1);
+  if (a == std::string::npos) return std::nullopt;
+  const auto kind = kind_of_section(path.substr(1, a - 1));
+  if (!kind) return std::nullopt;
+  const auto b = path.find('/', a + 1);
+  const std::string idx = path.substr(a + 1, b == std::string::npos ? std::string::npos : b - a - 1);
+  if (idx.empty() || !std::all_of(idx.begin(), idx.end(), [](char c) { return c >= '0' && c <= '9'; }) || idx.size() > 9)
+    return std::nullopt;
+  ElementRef r{*kind, std::stoi(idx), b == std::string::npos ? std::string() : path.substr(b + 1)};
+  return r;
+}
+
+std::vector<std::string> references_to(const ModelSpec& spec, ElementKind k, const std::string& name) {
+  ModelSpec s = spec;  // the visitors take mutable references; nothing is changed
+  std::vector<std::string> out;
+  auto collect = [&](std::string& ref, const std::string& where) {
+    if (ref == name) out.push_back(where);
+  };
+  switch (k) {
+    case ElementKind::Body: for_each_body_ref(s, collect); break;
+    case ElementKind::Joint:
+      for_each_joint_ref(s, collect);
+      for (const auto& [n, v] : s.analysis.set)
+        if (names_coordinate_of(n, name)) out.push_back("analysis: coordinate set " + n);
+      for (const auto& n : s.analysis.independent)
+        if (names_coordinate_of(n, name)) out.push_back("analysis: independent coordinate " + n);
+      break;
+    case ElementKind::Actuator:
+      if (std::count(s.plant.inputs.begin(), s.plant.inputs.end(), name)) out.push_back("Plant/In");
+      break;
+    case ElementKind::Sensor:
+      if (std::count(s.plant.outputs.begin(), s.plant.outputs.end(), name)) out.push_back("Plant/Out");
+      break;
+    case ElementKind::Effect:
+      if (std::count(s.analysis.disabled_effects.begin(), s.analysis.disabled_effects.end(), name))
+        out.push_back("analysis: disabled effects");
+      break;
+    case ElementKind::Constraint: break;
+  }
+  return out;
+}
+
+void rename_element(ModelSpec& s, ElementKind k, int index, const std::string& now) {
+  check_index(s, k, index);
+  const std::string old = element_name(s, k, index);
+  if (now == old) return;
+  if (now.empty()) throw std::invalid_argument(std::string("a ") + to_string(k) + " needs a name");
+  if (k == ElementKind::Body && now == kGroundName) throw std::invalid_argument("\"ground\" is the name of the fixed world body");
+  if (find_element(s, k, now) >= 0)
+    throw std::invalid_argument(std::string("another ") + to_string(k) + " is already named \"" + now + "\"");
+  auto swap = [&](std::string& ref, const std::string&) {
+    if (ref == old) ref = now;
+  };
+  switch (k) {
+    case ElementKind::Body: for_each_body_ref(s, swap); break;
+    case ElementKind::Joint:
+      for_each_joint_ref(s, swap);
+      for (auto& [n, v] : s.analysis.set) n = renamed_coordinate(n, old, now);
+      for (auto& n : s.analysis.independent) n = renamed_coordinate(n, old, now);
+      break;
+    case ElementKind::Actuator: std::replace(s.plant.inputs.begin(), s.plant.inputs.end(), old, now); break;
+    case ElementKind::Sensor: std::replace(s.plant.outputs.begin(), s.plant.outputs.end(), old, now); break;
+    case ElementKind::Effect:
+      std::replace(s.analysis.disabled_effects.begin(), s.analysis.disabled_effects.end(), old, now);
+      break;
+    case ElementKind::Constraint: break;
+  }
+  visit_list(s, k, [&](auto& v) { v[index].name = now; });
+}
+
+int add_element(ModelSpec& s, ElementKind k) {
+  switch (k) {
+    case ElementKind::Body: {
+      BodySpec b;
+      b.name = unique_name(s, k, "body");
+      b.mass = 1.0;
+      b.inertia = Eigen::Matrix3d::Identity() * 0.01;
+      s.bodies.push_back(b);
+      break;
+    }
+    case ElementKind::Joint: {
+      JointSpec j;
+      j.name = unique_name(s, k, "joint");
+      j.parent = kGroundName;
+      j.child = s.bodies.empty() ? std::string() : s.bodies.back().name;
+      s.joints.push_back(j);
+      break;
+    }
+    case ElementKind::Constraint: {
+      ConstraintSpec c;
+      c.name = unique_name(s, k, "closure");
+      c.body_a = kGroundName;
+      c.body_b = s.bodies.empty() ? std::string(kGroundName) : s.bodies.back().name;
+      s.constraints.push_back(c);
+      break;
+    }
+    case ElementKind::Effect: {
+      EffectSpec e;
+      e.name = unique_name(s, k, "gravity");
+      s.effects.push_back(e);
+      break;
+    }
+    case ElementKind::Actuator: {
+      ActuatorSpec a;
+      a.name = unique_name(s, k, "motor");
+      a.joint = s.joints.empty() ? std::string() : s.joints.front().name;
+      s.actuators.push_back(a);
+      break;
+    }
+    case ElementKind::Sensor: {
+      SensorSpec x;
+      x.name = unique_name(s, k, "sensor");
+      x.joint = s.joints.empty() ? std::string() : s.joints.front().name;
+      s.sensors.push_back(x);
+      break;
+    }
+  }
+  return element_count(s, k) - 1;
+}
+
+int duplicate_element(ModelSpec& s, ElementKind k, int index) {
+  check_index(s, k, index);
+  const std::string name = unique_name(s, k, element_name(s, k, index) + "_copy");
+  visit_list(s, k, [&](auto& v) {
+    auto copy = v[index];
+    copy.name = name;
+    v.push_back(copy);
+  });
+  return element_count(s, k) - 1;
+}
+
+void remove_element(ModelSpec& s, ElementKind k, int index) {
+  check_index(s, k, index);
+  const std::string name = element_name(s, k, index);
+  auto drop = [&](std::vector<std::string>& list) { list.erase(std::remove(list.begin(), list.end(), name), list.end()); };
+  if (k == ElementKind::Actuator) drop(s.plant.inputs);
+  if (k == ElementKind::Sensor) drop(s.plant.outputs);
+  if (k == ElementKind::Effect) drop(s.analysis.disabled_effects);
+  visit_list(s, k, [&](auto& v) { v.erase(v.begin() + index); });
+}
+
+}  // namespace codyna

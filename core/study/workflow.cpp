@@ -1,0 +1,220 @@
+#include "study/workflow.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+#include <stdexcept>
+
+#include "analysis/discretize.hpp"
+#include "control/lqr.hpp"
+#include "dynamics/assembly.hpp"
+#include "model/compile.hpp"
+#include "model/errors.hpp"
+#include "simulation/model_controller.hpp"
+
+namespace codyna {
+
+namespace {
+
+std::string listed(const std::vector<std::string>& names) {
+  std::string all;
+  for (const auto& n : names) all += (all.empty() ? "" : ", ") + n;
+  return all.empty() ? "none" : all;
+}
+
+[[noreturn]] void fail(const Model& m, const std::string& field, const std::string& what) {
+  throw ModelError(m.source_file, "/analysis/" + field, what);
+}
+
+JacobianMethod method_of(const Model& m) {
+  const std::string& s = m.spec.analysis.method;
+  if (s == "exact") return JacobianMethod::Exact;
+  if (s == "fd-forward") return JacobianMethod::ForwardDifference;
+  if (s == "fd-central") return JacobianMethod::CentralDifference;
+  fail(m, "method", "unknown method \"" + s + "\" (expected one of: " + listed(study_methods()) + ")");
+}
+
+SimulationOptions solver_options(const Model& m) {
+  SimulationOptions o;
+  const SolverSpec& sp = m.spec.solver;
+  o.integrator.method = sp.integrator;
+  o.integrator.rtol = sp.rtol;
+  o.integrator.atol = sp.atol;
+  o.integrator.max_step = sp.max_step;
+  o.t_end = sp.t_end;
+  o.output_step = sp.output_step;
+  return o;
+}
+
+Eigen::MatrixXd diagonal(const Model& m, const std::vector<double>& w, int n, const char* field) {
+  if (w.empty()) return Eigen::MatrixXd::Identity(n, n);
+  if (static_cast<int>(w.size()) != n)
+    fail(m, field, "expected " + std::to_string(n) + " weights (one per " + (n && field[0] == 'q' ? "state" : "input") +
+                       "), got " + std::to_string(w.size()));
+  return Eigen::Map<const Eigen::VectorXd>(w.data(), n).asDiagonal();
+}
+
+}  // namespace
+
+Model study_model(const ModelSpec& spec_in, const std::string& file) {
+  ModelSpec spec = spec_in;
+  const StudySpec& s = spec.analysis;
+  // effects switched off for this study are left out of the compiled model
+  for (std::size_t k = 0; k < s.disabled_effects.size(); ++k) {
+    const std::string& name = s.disabled_effects[k];
+    const auto it = std::find_if(spec.effects.begin(), spec.effects.end(), [&](const EffectSpec& e) { return e.name == name; });
+    if (it == spec.effects.end()) {
+      std::vector<std::string> names;
+      for (const auto& e : spec_in.effects) names.push_back(e.name);
+      throw ModelError(file, "/analysis/disabled_effects/" + std::to_string(k),
+                       "no effect named \"" + name + "\" (effects: " + listed(names) + ")");
+    }
+    spec.effects.erase(it);
+  }
+  Model m = compile(spec, file);
+  m.spec.analysis = s;  // compile keeps the spec; the study travels with it
+  if (s.set.empty()) return m;
+  for (const auto& [name, value] : s.set) {
+    if (!std::isfinite(value)) fail(m, "set/" + name, "expected a finite number");
+    const auto it = std::find(m.q_names.begin(), m.q_names.end(), name);
+    if (it == m.q_names.end()) fail(m, "set/" + name, "unknown coordinate \"" + name + "\" (coordinates: " + listed(m.q_names) + ")");
+    m.q0[it - m.q_names.begin()] = value;
+  }
+  const AssemblyResult r = assemble(m, m.q0, m.v0);
+  if (!r.converged) fail(m, "set", "the loops cannot be assembled with the coordinates set");
+  m.q0 = r.q;
+  m.v0 = r.v;
+  return m;
+}
+
+OperatingPoint study_operating_point(const Model& m, const std::string& which_in) {
+  const StudySpec& s = m.spec.analysis;
+  const std::string which = which_in.empty() ? s.operating_point : which_in;
+  const OperatingPoint start = initial_point(m);
+  if (which == "initial") return start;
+  if (which == "equilibrium") {
+    const OperatingPoint op = static_equilibrium(m, start, s.independent);
+    if (!(op.residual < 1e-8)) {
+      std::ostringstream os;
+      os << "no static equilibrium found near the initial state (accelerations " << op.residual << " left after "
+         << op.iterations << " iterations); choose the operating point initial, trim or time=T";
+      fail(m, "operating_point", os.str());
+    }
+    return op;
+  }
+  if (which == "trim") return trim(m, start, s.independent);
+  if (which.rfind("time=", 0) == 0) {
+    char* end = nullptr;
+    const double t = std::strtod(which.c_str() + 5, &end);
+    if (end == which.c_str() + 5 || *end != 0 || !std::isfinite(t) || t < 0)
+      fail(m, "operating_point", "\"" + which + "\": expected time=T with T >= 0 seconds");
+    // the state the simulation reaches at t with the actuators at their nominal values (no controller)
+    if (t == 0) return snapshot_point(m, 0.0, m.q0, m.v0, start.u);
+    SimulationOptions o = solver_options(m);
+    o.t_end = t;
+    o.output_step = t;
+    const SimulationResult r = simulate(m, nullptr, nullptr, o);
+    if (!r.completed) throw std::runtime_error("operating point " + which + ": the simulation failed: " + r.failure);
+    const int last = r.samples() - 1;
+    return snapshot_point(m, t, r.q.row(last).transpose(), r.v.row(last).transpose(), start.u);
+  }
+  fail(m, "operating_point", "unknown operating point \"" + which + "\" (expected one of: initial, equilibrium, trim, time=T)");
+}
+
+StudyLinearization study_linearize(const Model& m) {
+  const StudySpec& s = m.spec.analysis;
+  StudyLinearization out;
+  LinearizeOptions o;
+  o.method = method_of(m);
+  o.independent = s.independent;
+  if (!(s.discrete >= 0) || !std::isfinite(s.discrete)) fail(m, "discrete", "expected a sample time >= 0 (0 = continuous)");
+  out.op = study_operating_point(m);
+  out.lin = linearize(m, out.op, o);
+  out.system = s.discrete > 0 ? discretize_zoh(out.lin.system, s.discrete) : out.lin.system;
+  return out;
+}
+
+std::string study_export_name(const Model& m) {
+  const std::string& given = m.spec.analysis.export_name;
+  if (given.empty()) return matlab_identifier(m.name);
+  if (given != matlab_identifier(given))
+    fail(m, "export_name", "\"" + given + "\" is not a valid MATLAB identifier (try " + matlab_identifier(given) + ")");
+  return given;
+}
+
+std::string study_path(const Model& m, const std::string& path) {
+  const std::filesystem::path p(path);
+  if (p.empty() || p.is_absolute() || m.source_file.empty()) return path;
+  return (std::filesystem::path(m.source_file).parent_path() / p).lexically_normal().string();
+}
+
+ExportPaths study_export(const Model& m, const LinearSystem& sys, const std::string& dir_in) {
+  const StudySpec& s = m.spec.analysis;
+  const std::string dir = dir_in.empty() ? study_path(m, s.export_dir) : dir_in;
+  if (dir.empty()) fail(m, "export_dir", "no folder to export to (choose one)");
+  if (s.mat_version != "5" && s.mat_version != "7.3") fail(m, "mat_version", "expected 5 or 7.3");
+  const std::string name = study_export_name(m);
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw std::runtime_error(dir + ": cannot create the export folder: " + ec.message());
+  return export_plant(sys, dir, name, s.mat_version == "7.3" ? MatVersion::V73 : MatVersion::V5);
+}
+
+StudySimulation study_simulation(const Model& m) {
+  const StudySpec& s = m.spec.analysis;
+  StudySimulation out;
+  out.options = solver_options(m);
+  out.options.compare_linear = s.compare_linear;
+  const std::string& src = s.controller;
+  if (std::find(study_controllers().begin(), study_controllers().end(), src) == study_controllers().end())
+    fail(m, "controller", "unknown controller source \"" + src + "\" (expected one of: " + listed(study_controllers()) + ")");
+  const bool from_model = src == "model" && has_model_controller(m);
+  const bool need_plant = from_model || src == "lqr" || src == "file" || s.compare_linear;
+  if (need_plant) {
+    if ((src == "lqr" || src == "file" || from_model) && m.plant_inputs.empty())
+      throw ModelError(m.source_file, "/plant/inputs", "a controller needs Plant/In actuators");
+    auto plant = std::make_shared<LinearPlant>();
+    // a model's controller is linearized where it was designed; the others where the study says
+    plant->op = study_operating_point(m, from_model ? m.spec.controller.operating_point : std::string());
+    LinearizeOptions lo;
+    lo.independent = s.independent;
+    plant->lin = linearize(m, plant->op, lo);
+    out.plant = plant;
+  }
+  if (from_model) {
+    out.controller = make_model_controller(m, *out.plant);
+    out.controller_source = std::string("the model file's ") + to_string(m.spec.controller.type) + " controller";
+  } else if (src == "lqr") {
+    const LinearSystem& sys = out.plant->lin.system;
+    const LqrResult d = lqr(sys.A, sys.B, diagonal(m, s.q_weights, sys.nx(), "q_weights"),
+                            diagonal(m, s.r_weights, sys.nu(), "r_weights"));
+    out.lqr_gain = d.K;
+    out.controller = make_state_feedback(d.K, sys.u0);
+    out.controller_source = "lqr";
+  } else if (src == "file") {
+    if (s.controller_file.empty()) fail(m, "controller_file", "the controller source is a file, but none is named");
+    const LinearSystem& sys = out.plant->lin.system;
+    out.controller = load_controller(study_path(m, s.controller_file), sys.nx(), sys.nu(), sys.ny(), sys.y0, sys.u0);
+    out.controller_source = s.controller_file;
+  } else {
+    out.controller_source = "none";
+  }
+  if (out.options.compare_linear && !out.plant) out.options.compare_linear = false;
+  return out;
+}
+
+SimulationResult study_simulate(const Model& m, const StudySimulation& setup, const SimulationCallbacks& cb) {
+  SimulationResult r = simulate(m, setup.controller.get(), setup.plant.get(), setup.options, cb);
+  r.model_file = m.source_file;
+  std::ostringstream settings;
+  const SimulationOptions& o = setup.options;
+  settings << "{\"integrator\": \"" << o.integrator.method << "\", \"rtol\": " << o.integrator.rtol << ", \"atol\": "
+           << o.integrator.atol << ", \"max_step\": " << o.integrator.max_step << ", \"t_end\": " << o.t_end
+           << ", \"output_step\": " << o.output_step << ", \"operating_point\": \""
+           << (setup.plant ? setup.plant->op.kind : "") << "\", \"controller\": \"" << setup.controller_source << "\"}";
+  r.settings_json = settings.str();
+  return r;
+}
+
+}  // namespace codyna

@@ -1,0 +1,66 @@
+// The workflow of one study (model/study_spec.hpp), one function per step:
+//
+//   study_model            the model as this study sees it: disabled effects left
+//                          out, coordinates set, loops re-assembled
+//   study_operating_point  initial / equilibrium / trim / time=T
+//   study_linearize        A, B, C, D there (exact or finite differences, ZOH on request)
+//   study_export           NAME.mat + NAME.m
+//   study_simulation       the controller and plant a closed-loop run needs, and
+//   study_simulate         the run itself (callbacks for progress, samples, cancel)
+//
+// `codyna linearize|simulate` and codyna-gui both fill a StudySpec (the file's
+// "analysis" section, then flags or widgets) and call these; neither decides
+// anything the other would have to repeat. Bad choices throw ModelError naming
+// the file and the field ("/analysis/operating_point") or std::invalid_argument.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "analysis/linearize.hpp"
+#include "analysis/operating_point.hpp"
+#include "io/mat_export.hpp"
+#include "model/model.hpp"
+#include "simulation/controller.hpp"
+#include "simulation/simulator.hpp"
+
+namespace codyna {
+
+// `file` is where the spec was read (for messages and relative paths); may be "".
+Model study_model(const ModelSpec& spec, const std::string& file = "");
+
+// The operating point the study asks for (`which` overrides study.operating_point
+// when not empty). An equilibrium that cannot be found is an error, not a best effort.
+OperatingPoint study_operating_point(const Model& model, const std::string& which = "");
+
+struct StudyLinearization {
+  OperatingPoint op;
+  Linearization lin;    // continuous
+  LinearSystem system;  // what is exported: lin.system, or its ZOH form when study.discrete > 0
+};
+
+StudyLinearization study_linearize(const Model& model);
+
+// The plant's export name: study.export_name, or the model name as a MATLAB identifier.
+std::string study_export_name(const Model& model);
+
+// `dir` empty: study.export_dir (relative to the model file's folder); created if missing.
+ExportPaths study_export(const Model& model, const LinearSystem& system, const std::string& dir = "");
+
+// A path of the study (controller file, export folder) resolved against the model file's folder.
+std::string study_path(const Model& model, const std::string& path);
+
+struct StudySimulation {
+  std::shared_ptr<const LinearPlant> plant;      // null when nothing needs one
+  std::shared_ptr<const Controller> controller;  // null: open loop (actuators at u0)
+  SimulationOptions options;
+  std::string controller_source;                 // "the model file's pid controller", "lqr", "K.mat", "none"
+  Eigen::MatrixXd lqr_gain;                      // the gain designed, when the source is "lqr"
+};
+
+// Controller and linear plant of the run (linearizing once if anything needs it).
+StudySimulation study_simulation(const Model& model);
+
+SimulationResult study_simulate(const Model& model, const StudySimulation& setup, const SimulationCallbacks& cb = {});
+
+}  // namespace codyna

@@ -1,0 +1,161 @@
+// The study workflow (study/workflow.hpp): the choices of the "analysis" section
+// run through the same functions the CLI and the GUI call.
+#include "study/workflow.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "control/lqr.hpp"
+#include "io/model_file.hpp"
+#include "model/errors.hpp"
+#include "test_util.hpp"
+
+using namespace codyna;
+
+namespace {
+
+ModelSpec example_spec(const std::string& name) { return load_model_spec(example_path(name)); }
+
+// expects a ModelError whose field path is `path`
+template <class F>
+void expect_model_error_at(F&& f, const std::string& path, const std::string& phrase) {
+  try {
+    f();
+    FAIL() << "no error, expected one at " << path;
+  } catch (const ModelError& e) {
+    EXPECT_EQ(e.path(), path) << e.what();
+    EXPECT_NE(std::string(e.what()).find(phrase), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+
+TEST(Workflow, StudyRoundTripsThroughTheModelFile) {
+  ModelSpec spec = example_spec("cart_pendulum.json");
+  StudySpec& s = spec.analysis;
+  s.disabled_effects = {"gravity"};
+  s.operating_point = "time=0.25";
+  s.set = {{"rod_pivot", 0.125}, {"cart_slider", -0.5}};
+  s.independent = {"rod_pivot"};
+  s.method = "fd-central";
+  s.discrete = 0.01;
+  s.mat_version = "7.3";
+  s.export_name = "cart";
+  s.export_dir = "out/plant";
+  s.controller = "file";
+  s.controller_file = "K.mat";
+  s.q_weights = {1, 2, 3, 4};
+  s.r_weights = {0.5};
+  s.compare_linear = true;
+  const auto dir = std::filesystem::temp_directory_path() / "codyna_workflow_test";
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "study.json").string();
+  save_model_spec(spec, path);
+  const ModelSpec back = load_model_spec(path);
+  EXPECT_EQ(back.analysis, s);
+  // a default study is not written at all
+  save_model_spec(example_spec("pendulum.json"), path);
+  EXPECT_EQ(load_model_spec(path).analysis, StudySpec{});
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Workflow, BadStudyFieldsNameTheirPath) {
+  const std::string text = R"({"name": "p", "bodies": [{"name": "b", "mass": 1, "inertia": [1, 1, 1, 0, 0, 0]}],
+    "joints": [{"name": "j", "type": "revolute", "parent": "ground", "child": "b"}], "analysis": {"method": "spline"}})";
+  expect_model_error_at([&] { parse_model_spec_text(text, "m.json"); }, "/analysis/method", "unknown method \"spline\"");
+  std::string t2 = text;
+  t2.replace(t2.find("\"method\": \"spline\""), 18, "\"operating_point\": \"time=-1\"");
+  expect_model_error_at([&] { parse_model_spec_text(t2, "m.json"); }, "/analysis/operating_point", "time=T");
+}
+
+TEST(Workflow, DisabledEffectsAreLeftOutOfTheModel) {
+  ModelSpec spec = example_spec("pendulum.json");
+  spec.analysis.operating_point = "initial";
+  const Model with = study_model(spec);
+  EXPECT_TRUE(with.has_gravity);
+  spec.analysis.disabled_effects = {"gravity"};
+  const Model without = study_model(spec);
+  EXPECT_FALSE(without.has_gravity);
+  // the paper's pendulum: A(2,1) = (3g/(2l)) sin(theta0) with gravity, 0 without; B unchanged
+  const StudyLinearization a = study_linearize(with), b = study_linearize(without);
+  const double theta0 = with.q0[0];
+  EXPECT_NEAR(a.system.A(1, 0), 3 * 9.81 / (2 * 2.0) * std::sin(theta0), 1e-10);
+  EXPECT_EQ(b.system.A(1, 0), 0.0);
+  EXPECT_NEAR(b.system.B(1, 0), a.system.B(1, 0), 1e-15);
+  spec.analysis.disabled_effects = {"wind"};
+  expect_model_error_at([&] { study_model(spec, "p.json"); }, "/analysis/disabled_effects/0", "no effect named \"wind\"");
+}
+
+TEST(Workflow, SetCoordinatesAndOperatingPoints) {
+  ModelSpec spec = example_spec("pendulum.json");
+  spec.analysis.set = {{"pivot", 1.0}};
+  spec.analysis.operating_point = "initial";
+  const Model m = study_model(spec);
+  EXPECT_EQ(m.q0[0], 1.0);
+  EXPECT_EQ(study_operating_point(m).q[0], 1.0);
+  // equilibrium of the hanging/upright pendulum: theta = +-90 deg
+  const OperatingPoint eq = study_operating_point(m, "equilibrium");
+  EXPECT_NEAR(std::abs(std::remainder(eq.q[0], M_PI)), M_PI / 2, 1e-9);
+  spec.analysis.set = {{"no_such_joint", 1.0}};
+  expect_model_error_at([&] { study_model(spec); }, "/analysis/set/no_such_joint", "coordinates: pivot");
+  spec.analysis.set.clear();
+  spec.analysis.operating_point = "sideways";
+  expect_model_error_at([&] { study_operating_point(study_model(spec)); }, "/analysis/operating_point", "unknown operating point");
+}
+
+TEST(Workflow, LinearizeAndExportFollowTheStudy) {
+  ModelSpec spec = example_spec("cart_pendulum.json");
+  spec.analysis.operating_point = "equilibrium";
+  spec.analysis.discrete = 0.05;
+  spec.analysis.export_name = "cart_plant";
+  const Model m = study_model(spec, example_path("cart_pendulum.json"));
+  const StudyLinearization l = study_linearize(m);
+  EXPECT_EQ(l.system.Ts, 0.05);
+  EXPECT_EQ(l.lin.system.Ts, 0.0);
+  // the paper's cart-pendulum about the upright position
+  const double m2 = 20, m3 = 10, l3 = 2, g = 9.81;
+  EXPECT_NEAR(std::abs(l.lin.system.A(3, 2)), 6 * (m2 + m3) * g / ((4 * m2 + m3) * l3), 1e-9);
+  const auto dir = std::filesystem::temp_directory_path() / "codyna_workflow_export";
+  std::filesystem::remove_all(dir);
+  const ExportPaths p = study_export(m, l.system, dir.string());
+  EXPECT_EQ(p.mat_file, (dir / "cart_plant.mat").string());
+  const MatVariables v = read_mat_file(p.mat_file);
+  EXPECT_EQ(v.matrices.at("Ts")(0, 0), 0.05);
+  EXPECT_TRUE(MatrixNear(v.matrices.at("A"), l.system.A, 0.0));
+  std::filesystem::remove_all(dir);
+  spec.analysis.export_name = "2bad";
+  expect_model_error_at([&] { study_export_name(study_model(spec)); }, "/analysis/export_name", "m_2bad");
+}
+
+TEST(Workflow, SimulationControllerSources) {
+  ModelSpec spec = example_spec("cart_pendulum.json");
+  spec.solver.t_end = 0.2;
+  spec.analysis.controller = "lqr";
+  spec.analysis.q_weights = {10, 100, 1, 1};
+  spec.analysis.r_weights = {0.01};
+  const Model m = study_model(spec);
+  const StudySimulation s = study_simulation(m);
+  ASSERT_TRUE(s.plant && s.controller);
+  const LinearSystem& sys = s.plant->lin.system;
+  Eigen::MatrixXd Q = Eigen::Vector4d(10, 100, 1, 1).asDiagonal(), R = Eigen::MatrixXd::Constant(1, 1, 0.01);
+  EXPECT_TRUE(MatrixNear(s.lqr_gain, lqr(sys.A, sys.B, Q, R).K, 1e-12));
+  const SimulationResult r = study_simulate(m, s);
+  EXPECT_TRUE(r.completed);
+  EXPECT_NE(r.settings_json.find("\"controller\": \"lqr\""), std::string::npos);
+  // "none": open loop even though the model declares a controller
+  spec.analysis.controller = "none";
+  const StudySimulation open = study_simulation(study_model(spec));
+  EXPECT_FALSE(open.controller);
+  EXPECT_FALSE(open.plant);
+  // "model": the file's LQR, designed about its equilibrium
+  spec.analysis.controller = "model";
+  const StudySimulation own = study_simulation(study_model(spec));
+  ASSERT_TRUE(own.controller);
+  EXPECT_EQ(own.plant->op.kind, "equilibrium");
+  spec.analysis.controller = "file";
+  expect_model_error_at([&] { study_simulation(study_model(spec)); }, "/analysis/controller_file", "none is named");
+  spec.analysis.controller = "lqr";
+  spec.analysis.q_weights = {1, 2};
+  expect_model_error_at([&] { study_simulation(study_model(spec)); }, "/analysis/q_weights", "expected 4 weights");
+}
