@@ -8,6 +8,7 @@
 #include "test_util.hpp"
 
 using namespace codyna;
+using namespace codyna::test;
 
 TEST(SpecEdit, RenameBodyUpdatesJointsAndSensors) {
   ModelSpec s = load_model_spec(example_path("cart_pendulum.json"));

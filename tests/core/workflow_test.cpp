@@ -12,6 +12,7 @@
 #include "test_util.hpp"
 
 using namespace codyna;
+using namespace codyna::test;
 
 namespace {
 
@@ -36,7 +37,7 @@ TEST(Workflow, StudyRoundTripsThroughTheModelFile) {
   StudySpec& s = spec.analysis;
   s.disabled_effects = {"gravity"};
   s.operating_point = "time=0.25";
-  s.set = {{"rod_pivot", 0.125}, {"cart_slider", -0.5}};
+  s.set = {{"cart_slider", -0.5}, {"rod_pivot", 0.125}};  // the reader gives them in name order
   s.independent = {"rod_pivot"};
   s.method = "fd-central";
   s.discrete = 0.01;
@@ -115,7 +116,10 @@ TEST(Workflow, LinearizeAndExportFollowTheStudy) {
   EXPECT_EQ(l.lin.system.Ts, 0.0);
   // the paper's cart-pendulum about the upright position
   const double m2 = 20, m3 = 10, l3 = 2, g = 9.81;
-  EXPECT_NEAR(std::abs(l.lin.system.A(3, 2)), 6 * (m2 + m3) * g / ((4 * m2 + m3) * l3), 1e-9);
+  const auto& names = l.lin.system.state_names;
+  const auto at = [&](const std::string& n) { return static_cast<int>(std::find(names.begin(), names.end(), n) - names.begin()); };
+  ASSERT_LT(at("rod_pivot_dot"), 4);
+  EXPECT_NEAR(l.lin.system.A(at("rod_pivot_dot"), at("rod_pivot")), 6 * (m2 + m3) * g / ((4 * m2 + m3) * l3), 1e-9);
   const auto dir = std::filesystem::temp_directory_path() / "codyna_workflow_export";
   std::filesystem::remove_all(dir);
   const ExportPaths p = study_export(m, l.system, dir.string());

@@ -1,0 +1,165 @@
+#include "gui/document.hpp"
+
+#include <QFileInfo>
+#include <QUndoCommand>
+#include <nlohmann/json.hpp>
+
+#include "io/model_file.hpp"
+#include "model/errors.hpp"
+#include "study/workflow.hpp"
+
+namespace codyna::gui {
+
+QString qs(const std::string& s) { return QString::fromStdString(s); }
+std::string ss(const QString& s) { return s.toStdString(); }
+
+namespace {
+
+// Before and after of one edit: the spec is small, so whole copies keep undo simple and exact.
+class SpecCommand : public QUndoCommand {
+ public:
+  SpecCommand(Document* doc, ModelSpec before, ModelSpec after, const QString& text, int key)
+      : QUndoCommand(text), doc_(doc), before_(std::move(before)), after_(std::move(after)), key_(key) {}
+  void undo() override { doc_->restore(before_); }
+  void redo() override { doc_->restore(after_); }
+  int id() const override { return key_; }
+  bool mergeWith(const QUndoCommand* other) override {
+    const auto* o = static_cast<const SpecCommand*>(other);
+    if (o->key_ != key_ || key_ < 0) return false;
+    after_ = o->after_;
+    return true;
+  }
+
+ private:
+  Document* doc_;
+  ModelSpec before_, after_;
+  int key_;
+};
+
+bool same(const ModelSpec& a, const ModelSpec& b) { return to_json(a) == to_json(b); }
+
+}  // namespace
+
+Document::Document(QObject* parent) : QObject(parent) {
+  connect(&undo_, &QUndoStack::cleanChanged, this, &Document::fileChanged);
+  recompile();
+}
+
+QString Document::displayName() const { return path_.isEmpty() ? QStringLiteral("untitled") : QFileInfo(path_).fileName(); }
+
+void Document::recompile() {
+  QString text, path;
+  try {
+    model_ = std::make_shared<const Model>(study_model(spec_, ss(path_)));
+  } catch (const ModelError& e) {
+    model_.reset();
+    text = qs(e.what());
+    path = qs(e.path());
+  } catch (const std::exception& e) {
+    model_.reset();
+    text = qs(e.what());
+  }
+  const bool changed = text != error_ || path != error_path_;
+  error_ = text;
+  error_path_ = path;
+  emit modelChanged();
+  if (changed || !text.isEmpty()) emit errorChanged(error_, error_path_);
+}
+
+void Document::restore(const ModelSpec& spec) {
+  spec_ = spec;
+  emit specChanged();
+  recompile();
+}
+
+bool Document::edit(const QString& text, const std::function<void(ModelSpec&)>& change, QString* error, int mergeKey) {
+  ModelSpec next = spec_;
+  try {
+    change(next);
+  } catch (const std::exception& e) {
+    if (error) *error = qs(e.what());
+    return false;
+  }
+  if (same(next, spec_)) return true;
+  undo_.push(new SpecCommand(this, spec_, std::move(next), text, mergeKey));  // push() runs redo()
+  return true;
+}
+
+bool Document::rename(ElementKind k, int index, const QString& name, QString* error) {
+  const QString text = QStringLiteral("Rename %1 to %2").arg(to_string(k), name);
+  return edit(text, [&](ModelSpec& s) { rename_element(s, k, index, ss(name)); }, error);
+}
+
+static std::vector<std::string> to_std(const QStringList& l) {
+  std::vector<std::string> v;
+  for (const QString& s : l) v.push_back(ss(s));
+  return v;
+}
+
+bool Document::setPlantInputs(const QStringList& names) {
+  return edit(tr("Change Plant/In"), [&](ModelSpec& s) { s.plant.inputs = to_std(names); });
+}
+
+bool Document::setPlantOutputs(const QStringList& names) {
+  return edit(tr("Change Plant/Out"), [&](ModelSpec& s) { s.plant.outputs = to_std(names); });
+}
+
+bool Document::setStudy(const StudySpec& study, const QString& text, int mergeKey) {
+  return edit(text, [&](ModelSpec& s) { s.analysis = study; }, nullptr, mergeKey);
+}
+
+bool Document::setSolver(const SolverSpec& solver, const QString& text, int mergeKey) {
+  return edit(text, [&](ModelSpec& s) { s.solver = solver; }, nullptr, mergeKey);
+}
+
+bool Document::load(const QString& path, QString* error) {
+  ModelSpec spec;
+  try {
+    spec = load_model_spec(ss(path));
+  } catch (const std::exception& e) {
+    if (error) *error = qs(e.what());
+    return false;  // the open document stays as it was
+  }
+  path_ = QFileInfo(path).absoluteFilePath();
+  undo_.clear();
+  restore(spec);
+  undo_.setClean();
+  emit fileChanged();
+  return true;
+}
+
+bool Document::save(QString* error) {
+  if (path_.isEmpty()) {
+    if (error) *error = tr("the model has no file yet: use Save As");
+    return false;
+  }
+  return saveAs(path_, error);
+}
+
+bool Document::saveAs(const QString& path, QString* error) {
+  try {
+    save_model_spec(spec_, ss(path));
+  } catch (const std::exception& e) {
+    if (error) *error = qs(e.what());
+    return false;  // still modified
+  }
+  const QString abs = QFileInfo(path).absoluteFilePath();
+  const bool moved = abs != path_;
+  path_ = abs;
+  undo_.setClean();
+  if (moved) recompile();  // relative paths of the study now resolve against the new folder
+  emit fileChanged();
+  return true;
+}
+
+void Document::clear() {
+  path_.clear();
+  undo_.clear();
+  ModelSpec empty;
+  empty.name = "untitled";
+  restore(empty);
+  undo_.setClean();
+  emit fileChanged();
+}
+
+}  // namespace codyna::gui

@@ -1,0 +1,521 @@
+#include "gui/linearize_view.hpp"
+
+#include <QComboBox>
+#include <QDir>
+#include <QDoubleSpinBox>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QFormLayout>
+#include <QGroupBox>
+#include <QHBoxLayout>
+#include <QHeaderView>
+#include <QItemSelectionModel>
+#include <QLabel>
+#include <QLineEdit>
+#include <QListWidget>
+#include <QPushButton>
+#include <QSignalBlocker>
+#include <QSplitter>
+#include <QTabWidget>
+#include <QTableView>
+#include <QTableWidget>
+#include <QVBoxLayout>
+#include <cmath>
+#include <filesystem>
+
+#include "gui/document.hpp"
+#include "gui/matrix_models.hpp"
+#include "gui/pole_map.hpp"
+
+namespace codyna::gui {
+
+namespace {
+
+// merge keys of the spin boxes (consecutive steps of one spin box are one undo step)
+constexpr int kMergeOpTime = 0x4c5a01;
+constexpr int kMergeTs = 0x4c5a02;
+
+QStringList qlist(const std::vector<std::string>& v) {
+  QStringList l;
+  l.reserve(static_cast<qsizetype>(v.size()));
+  for (const auto& s : v) l << qs(s);
+  return l;
+}
+
+QString num(double x) { return QString::number(x, 'g', 6); }
+
+}  // namespace
+
+LinearizeView::LinearizeView(Document* doc, QWidget* parent) : QWidget(parent), doc_(doc) {
+  qRegisterMetaType<Eigen::VectorXcd>("Eigen::VectorXcd");
+  qRegisterMetaType<std::complex<double>>("std::complex<double>");
+  buildUi();
+  connect(doc_, &Document::specChanged, this, &LinearizeView::refreshFromDocument);
+  connect(doc_, &Document::modelChanged, this, [this] {
+    refreshIndependent();
+    updateStaleness();
+  });
+  refreshFromDocument();
+  refreshIndependent();
+  updateStaleness();
+}
+
+LinearizeView::~LinearizeView() = default;
+
+void LinearizeView::buildUi() {
+  // ---- study settings
+  auto* settings = new QGroupBox(tr("Linearization"), this);
+  auto* form = new QFormLayout(settings);
+
+  op_combo_ = new QComboBox(settings);
+  op_combo_->addItem(tr("initial (the model's initial state)"), QStringLiteral("initial"));
+  op_combo_->addItem(tr("equilibrium (static, at rest)"), QStringLiteral("equilibrium"));
+  op_combo_->addItem(tr("trim (inputs that hold the initial configuration)"), QStringLiteral("trim"));
+  op_combo_->addItem(tr("time=T (state of an open-loop run at T)"), QStringLiteral("time"));
+  op_time_ = new QDoubleSpinBox(settings);
+  op_time_->setRange(0.0, 1e6);
+  op_time_->setDecimals(4);
+  op_time_->setSingleStep(0.1);
+  op_time_->setSuffix(QStringLiteral(" s"));
+  op_time_->setKeyboardTracking(false);
+  op_time_->setPrefix(QStringLiteral("T = "));
+  auto* op_row = new QHBoxLayout;
+  op_row->addWidget(op_combo_, 1);
+  op_row->addWidget(op_time_);
+  form->addRow(tr("Operating point"), op_row);
+
+  method_combo_ = new QComboBox(settings);
+  method_combo_->addItem(tr("exact (automatic differentiation)"), QStringLiteral("exact"));
+  method_combo_->addItem(tr("fd-forward (forward differences)"), QStringLiteral("fd-forward"));
+  method_combo_->addItem(tr("fd-central (central differences)"), QStringLiteral("fd-central"));
+  form->addRow(tr("Jacobians"), method_combo_);
+
+  ts_spin_ = new QDoubleSpinBox(settings);
+  ts_spin_->setRange(0.0, 1e3);
+  ts_spin_->setDecimals(6);
+  ts_spin_->setSingleStep(0.001);
+  ts_spin_->setSpecialValueText(tr("continuous"));
+  ts_spin_->setSuffix(QStringLiteral(" s"));
+  ts_spin_->setKeyboardTracking(false);
+  ts_spin_->setToolTip(tr("Sample time of an exact zero-order-hold discrete model; 0 = continuous"));
+  form->addRow(tr("Sample time Ts"), ts_spin_);
+
+  mat_combo_ = new QComboBox(settings);
+  mat_combo_->addItem(tr("MAT v5 (MATLAB, Octave, SciPy)"), QStringLiteral("5"));
+  mat_combo_->addItem(tr("MAT v7.3 (HDF5)"), QStringLiteral("7.3"));
+  form->addRow(tr("MAT version"), mat_combo_);
+
+  export_dir_ = new QLineEdit(settings);
+  export_dir_->setPlaceholderText(tr("asked at export"));
+  export_dir_->setToolTip(tr("Folder of NAME.mat + NAME.m; a relative path is relative to the model file"));
+  export_browse_ = new QPushButton(tr("…"), settings);
+  export_browse_->setToolTip(tr("Choose the export folder"));
+  auto* dir_row = new QHBoxLayout;
+  dir_row->addWidget(export_dir_, 1);
+  dir_row->addWidget(export_browse_);
+  form->addRow(tr("Export folder"), dir_row);
+
+  export_name_ = new QLineEdit(settings);
+  export_name_->setToolTip(tr("Plant name (a MATLAB identifier); empty = the model name"));
+  form->addRow(tr("Plant name"), export_name_);
+
+  independent_box_ = new QGroupBox(tr("Independent coordinates"), this);
+  independent_box_->setToolTip(tr("Closed loops: the coordinates kept as states; none checked = automatic choice"));
+  auto* ind_layout = new QVBoxLayout(independent_box_);
+  independent_ = new QListWidget(independent_box_);
+  independent_->setMaximumHeight(120);
+  ind_layout->addWidget(independent_);
+
+  linearize_button_ = new QPushButton(tr("Linearize"), this);
+  linearize_button_->setDefault(true);
+  export_button_ = new QPushButton(tr("Export…"), this);
+  export_button_->setToolTip(tr("Write NAME.mat + NAME.m (as codyna linearize --out DIR)"));
+  auto* buttons = new QHBoxLayout;
+  buttons->addWidget(linearize_button_);
+  buttons->addWidget(export_button_);
+  buttons->addStretch(1);
+
+  // ---- results
+  op_label_ = new QLabel(tr("Not linearized yet."), this);
+  op_label_->setWordWrap(true);
+  op_label_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  stale_label_ = new QLabel(tr("<i>The model or the study changed since: linearize again.</i>"), this);
+  stale_label_->setVisible(false);
+
+  tabs_ = new QTabWidget(this);
+  const char* names[4] = {"A", "B", "C", "D"};
+  for (int k = 0; k < 4; ++k) {
+    matrix_models_[k] = new MatrixTableModel(this);
+    matrix_views_[k] = new QTableView(tabs_);
+    matrix_views_[k]->setModel(matrix_models_[k]);
+    matrix_views_[k]->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
+    matrix_views_[k]->setObjectName(QStringLiteral("matrix_%1").arg(QLatin1String(names[k])));
+    tabs_->addTab(matrix_views_[k], QLatin1String(names[k]));
+  }
+  offsets_ = new QTableWidget(0, 4, tabs_);
+  offsets_->setHorizontalHeaderLabels({tr("Vector"), tr("Name"), tr("Value"), tr("Unit")});
+  offsets_->verticalHeader()->setVisible(false);
+  offsets_->setEditTriggers(QAbstractItemView::NoEditTriggers);
+  offsets_->horizontalHeader()->setStretchLastSection(true);
+  tabs_->addTab(offsets_, tr("Offsets x0, u0, y0"));
+
+  mode_model_ = new ModeTableModel(this);
+  mode_view_ = new QTableView(this);
+  mode_view_->setModel(mode_model_);
+  mode_view_->setSelectionBehavior(QAbstractItemView::SelectRows);
+  mode_view_->setSelectionMode(QAbstractItemView::SingleSelection);
+  mode_view_->horizontalHeader()->setStretchLastSection(true);
+  mode_view_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
+  pole_map_ = new PoleMap(this);
+
+  auto* modes_split = new QSplitter(Qt::Horizontal, this);
+  modes_split->addWidget(mode_view_);
+  modes_split->addWidget(pole_map_);
+  modes_split->setStretchFactor(0, 3);
+  modes_split->setStretchFactor(1, 2);
+
+  auto* results = new QWidget(this);
+  auto* res_layout = new QVBoxLayout(results);
+  res_layout->setContentsMargins(0, 0, 0, 0);
+  res_layout->addWidget(op_label_);
+  res_layout->addWidget(stale_label_);
+  res_layout->addWidget(tabs_, 1);
+
+  auto* vsplit = new QSplitter(Qt::Vertical, this);
+  vsplit->addWidget(results);
+  vsplit->addWidget(modes_split);
+
+  auto* left = new QVBoxLayout;
+  left->addWidget(settings);
+  left->addWidget(independent_box_);
+  left->addLayout(buttons);
+  left->addStretch(1);
+  auto* layout = new QHBoxLayout(this);
+  layout->addLayout(left, 0);
+  layout->addWidget(vsplit, 1);
+
+  // ---- widgets -> study (each change one undo step)
+  connect(op_combo_, &QComboBox::currentIndexChanged, this, [this] { opChanged(); });
+  connect(op_time_, &QDoubleSpinBox::valueChanged, this, [this] { opChanged(); });
+  connect(method_combo_, &QComboBox::currentIndexChanged, this, [this](int i) {
+    if (i < 0) return;
+    const std::string m = ss(method_combo_->itemData(i).toString());
+    writeStudy([&](StudySpec& s) { s.method = m; }, tr("Change the Jacobian method"));
+  });
+  connect(ts_spin_, &QDoubleSpinBox::valueChanged, this, [this](double v) {
+    writeStudy([&](StudySpec& s) { s.discrete = v; }, tr("Change the sample time"), kMergeTs);
+  });
+  connect(mat_combo_, &QComboBox::currentIndexChanged, this, [this](int i) {
+    if (i < 0) return;
+    const std::string v = ss(mat_combo_->itemData(i).toString());
+    writeStudy([&](StudySpec& s) { s.mat_version = v; }, tr("Change the MAT version"));
+  });
+  connect(export_dir_, &QLineEdit::editingFinished, this, [this] {
+    const std::string v = ss(export_dir_->text().trimmed());
+    writeStudy([&](StudySpec& s) { s.export_dir = v; }, tr("Change the export folder"));
+  });
+  connect(export_name_, &QLineEdit::editingFinished, this, [this] {
+    const std::string v = ss(export_name_->text().trimmed());
+    writeStudy([&](StudySpec& s) { s.export_name = v; }, tr("Change the plant name"));
+  });
+  connect(export_browse_, &QPushButton::clicked, this, &LinearizeView::browseExport);
+  connect(independent_, &QListWidget::itemChanged, this, &LinearizeView::independentChanged);
+
+  connect(linearize_button_, &QPushButton::clicked, this, [this] { linearize(); });
+  connect(export_button_, &QPushButton::clicked, this, [this] {
+    if (export_dir_->text().trimmed().isEmpty()) {
+      browseExport();
+      if (export_dir_->text().trimmed().isEmpty()) return;  // cancelled
+    }
+    QString err;
+    exportTo(QString(), &err);  // the study's folder (message() reports errors)
+  });
+
+  // ---- mode selection, kept in sync between the table and the pole map
+  connect(mode_view_->selectionModel(), &QItemSelectionModel::currentRowChanged, this,
+          [this] { modeRowChanged(); });
+  connect(pole_map_, &PoleMap::modeSelected, this, &LinearizeView::poleClicked);
+}
+
+void LinearizeView::writeStudy(const std::function<void(StudySpec&)>& change, const QString& text, int mergeKey) {
+  if (syncing_) return;
+  StudySpec s = doc_->spec().analysis;
+  change(s);
+  if (s == doc_->spec().analysis) return;
+  doc_->setStudy(s, text, mergeKey);
+}
+
+void LinearizeView::opChanged() {
+  const QString kind = op_combo_->currentData().toString();
+  op_time_->setEnabled(kind == QLatin1String("time"));
+  if (kind.isEmpty()) return;
+  std::string op = ss(kind);
+  int key = -1;
+  if (kind == QLatin1String("time")) {
+    op = "time=" + ss(QString::number(op_time_->value(), 'g', 15));
+    if (doc_->spec().analysis.operating_point.rfind("time=", 0) == 0) key = kMergeOpTime;  // stepping T
+  }
+  writeStudy([&](StudySpec& s) { s.operating_point = op; }, tr("Change the operating point"), key);
+}
+
+void LinearizeView::refreshFromDocument() {
+  syncing_ = true;
+  const StudySpec& s = doc_->spec().analysis;
+  {
+    const QSignalBlocker b1(op_combo_), b2(op_time_);
+    const QString op = qs(s.operating_point);
+    if (op.startsWith(QLatin1String("time="))) {
+      op_combo_->setCurrentIndex(op_combo_->findData(QStringLiteral("time")));
+      bool ok = false;
+      const double t = op.mid(5).toDouble(&ok);
+      if (ok) op_time_->setValue(t);
+    } else {
+      op_combo_->setCurrentIndex(op_combo_->findData(op));  // -1 for an unknown word (compile reports it)
+    }
+    op_time_->setEnabled(op_combo_->currentData().toString() == QLatin1String("time"));
+  }
+  {
+    const QSignalBlocker b(method_combo_);
+    method_combo_->setCurrentIndex(method_combo_->findData(qs(s.method)));
+  }
+  {
+    const QSignalBlocker b(ts_spin_);
+    ts_spin_->setValue(s.discrete);
+  }
+  {
+    const QSignalBlocker b(mat_combo_);
+    mat_combo_->setCurrentIndex(mat_combo_->findData(qs(s.mat_version)));
+  }
+  {
+    const QSignalBlocker b(export_dir_);
+    if (export_dir_->text() != qs(s.export_dir)) export_dir_->setText(qs(s.export_dir));
+  }
+  {
+    const QSignalBlocker b(export_name_);
+    if (export_name_->text() != qs(s.export_name)) export_name_->setText(qs(s.export_name));
+    export_name_->setPlaceholderText(qs(matlab_identifier(doc_->spec().name)));
+  }
+  syncing_ = false;
+  refreshIndependent();
+}
+
+void LinearizeView::refreshIndependent() {
+  const std::shared_ptr<const Model> m = doc_->model();
+  if (!m) {
+    independent_box_->setEnabled(false);
+    return;
+  }
+  independent_box_->setEnabled(true);
+  const bool closed = !m->constraints.empty() || m->dof() < m->nv;
+  independent_box_->setVisible(closed);
+  if (!closed) return;
+  independent_box_->setTitle(tr("Independent coordinates (%1 DOF; none checked = automatic)").arg(m->dof()));
+  syncing_ = true;
+  const QSignalBlocker b(independent_);
+  const QStringList names = qlist(m->v_names);
+  bool same = independent_->count() == names.size();
+  for (int i = 0; same && i < names.size(); ++i) same = independent_->item(i)->text() == names[i];
+  if (!same) {
+    independent_->clear();
+    for (const QString& n : names) {
+      auto* item = new QListWidgetItem(n, independent_);
+      item->setFlags(Qt::ItemIsEnabled | Qt::ItemIsUserCheckable | Qt::ItemIsSelectable);
+    }
+  }
+  const auto& chosen = doc_->spec().analysis.independent;
+  for (int i = 0; i < independent_->count(); ++i) {
+    const bool on = std::find(chosen.begin(), chosen.end(), ss(independent_->item(i)->text())) != chosen.end();
+    independent_->item(i)->setCheckState(on ? Qt::Checked : Qt::Unchecked);
+  }
+  syncing_ = false;
+}
+
+void LinearizeView::independentChanged(QListWidgetItem*) {
+  if (syncing_) return;
+  std::vector<std::string> names;
+  for (int i = 0; i < independent_->count(); ++i)
+    if (independent_->item(i)->checkState() == Qt::Checked) names.push_back(ss(independent_->item(i)->text()));
+  writeStudy([&](StudySpec& s) { s.independent = names; }, tr("Change the independent coordinates"));
+}
+
+void LinearizeView::browseExport() {
+  const std::shared_ptr<const Model> m = doc_->model();
+  const QString modelDir = doc_->filePath().isEmpty() ? QDir::currentPath() : QFileInfo(doc_->filePath()).absolutePath();
+  QString start = export_dir_->text().trimmed();
+  if (start.isEmpty()) start = modelDir;
+  else if (QDir::isRelativePath(start)) start = QDir(modelDir).absoluteFilePath(start);
+  const QString dir = QFileDialog::getExistingDirectory(this, tr("Export folder"), start);
+  if (dir.isEmpty()) return;
+  // inside the model's folder: stored relative to the model file, so the study moves with it
+  QString stored = dir;
+  if (!doc_->filePath().isEmpty()) {
+    const QString rel = QDir(modelDir).relativeFilePath(dir);
+    if (!rel.startsWith(QLatin1String(".."))) stored = rel.isEmpty() ? QStringLiteral(".") : rel;
+  }
+  export_dir_->setText(stored);
+  const std::string v = ss(stored);
+  writeStudy([&](StudySpec& s) { s.export_dir = v; }, tr("Change the export folder"));
+}
+
+bool LinearizeView::linearize() {
+  const std::shared_ptr<const Model> m = doc_->model();
+  if (!m) {
+    emit message(tr("Linearize: the model does not compile: %1").arg(doc_->errorText()));
+    return false;
+  }
+  try {
+    StudyLinearization r = study_linearize(*m);
+    ModalAnalysis modal;
+    try {
+      modal = modal_analysis(r.system);
+    } catch (const std::exception& e) {
+      emit message(tr("Linearize: no modal analysis: %1").arg(qs(e.what())));
+    }
+    result_ = std::move(r);
+    result_model_ = m;
+    modal_ = std::move(modal);
+  } catch (const std::exception& e) {
+    emit message(tr("Linearize: %1").arg(qs(e.what())));
+    updateStaleness();
+    return false;
+  }
+  showResult();
+  updateStaleness();
+  emit linearized();
+  return true;
+}
+
+bool LinearizeView::isStale() const { return !result_ || result_model_ != doc_->model(); }
+
+void LinearizeView::updateStaleness() { stale_label_->setVisible(result_ && isStale()); }
+
+void LinearizeView::showResult() {
+  const StudyLinearization& r = *result_;
+  const LinearSystem& s = r.system;
+  const QStringList xs = qlist(s.state_names), us = qlist(s.input_names), ys = qlist(s.output_names);
+  const QStringList xu = qlist(s.state_units), uu = qlist(s.input_units), yu = qlist(s.output_units);
+  matrix_models_[0]->setMatrix(s.A, xs, xs, xu, xu);
+  matrix_models_[1]->setMatrix(s.B, xs, us, xu, uu);
+  matrix_models_[2]->setMatrix(s.C, ys, xs, yu, xu);
+  matrix_models_[3]->setMatrix(s.D, ys, us, yu, uu);
+  tabs_->setTabText(0, QStringLiteral("A (%1 x %2)").arg(s.A.rows()).arg(s.A.cols()));
+  tabs_->setTabText(1, QStringLiteral("B (%1 x %2)").arg(s.B.rows()).arg(s.B.cols()));
+  tabs_->setTabText(2, QStringLiteral("C (%1 x %2)").arg(s.C.rows()).arg(s.C.cols()));
+  tabs_->setTabText(3, QStringLiteral("D (%1 x %2)").arg(s.D.rows()).arg(s.D.cols()));
+
+  // offsets
+  offsets_->setRowCount(0);
+  auto add = [this](const QString& vec, const std::vector<std::string>& names, const std::vector<std::string>& units,
+                    const Eigen::VectorXd& v) {
+    for (Eigen::Index i = 0; i < v.size(); ++i) {
+      const int row = offsets_->rowCount();
+      offsets_->insertRow(row);
+      offsets_->setItem(row, 0, new QTableWidgetItem(vec));
+      offsets_->setItem(row, 1, new QTableWidgetItem(i < static_cast<Eigen::Index>(names.size()) ? qs(names[i]) : QString::number(i + 1)));
+      auto* value = new QTableWidgetItem(QString::number(v[i], 'g', 10));
+      value->setToolTip(QString::number(v[i], 'g', 17));
+      value->setData(Qt::UserRole, v[i]);
+      offsets_->setItem(row, 2, value);
+      offsets_->setItem(row, 3, new QTableWidgetItem(i < static_cast<Eigen::Index>(units.size()) ? qs(units[i]) : QString()));
+    }
+  };
+  std::vector<std::string> rate_units;
+  for (const auto& u : s.state_units) rate_units.push_back(u.empty() ? "1/s" : u + "/s");
+  add(QStringLiteral("x0"), s.state_names, s.state_units, s.x0);
+  add(QStringLiteral("u0"), s.input_names, s.input_units, s.u0);
+  add(QStringLiteral("y0"), s.output_names, s.output_units, s.y0);
+  add(QStringLiteral("xdot0"), s.state_names, rate_units, s.xdot0);
+  offsets_->resizeColumnsToContents();
+
+  // operating point and provenance
+  QString text = tr("<b>Operating point</b> %1").arg(qs(r.op.kind).toHtmlEscaped());
+  if (r.op.kind == "equilibrium" || r.op.kind == "trim")
+    text += tr(" (residual %1, %2 iterations)").arg(num(r.op.residual)).arg(r.op.iterations);
+  if (r.op.kind.rfind("time=", 0) == 0) text += tr(" (t = %1 s)").arg(num(r.op.t));
+  text += tr(" &nbsp; <b>Jacobians</b> %1").arg(qs(s.method));
+  if (r.lin.fd_error > 0) text += tr(" (max relative difference from exact %1)").arg(num(r.lin.fd_error));
+  text += s.Ts > 0 ? tr(" &nbsp; <b>discrete</b>, Ts = %1 s (zero-order hold)").arg(num(s.Ts))
+                   : tr(" &nbsp; <b>continuous</b>");
+  text += tr(" &nbsp; %1 states, %2 inputs, %3 outputs").arg(s.nx()).arg(s.nu()).arg(s.ny());
+  if (!r.lin.partition.dependent.empty() && result_model_) {
+    QStringList ind;
+    for (int i : r.lin.partition.independent) ind << qs(result_model_->v_names[i]);
+    text += tr("<br><b>Independent coordinates</b> %1").arg(ind.join(QStringLiteral(", ")).toHtmlEscaped());
+  }
+  op_label_->setText(text);
+
+  // modes
+  selected_mode_ = -1;
+  syncing_ = true;
+  mode_model_->setModes(modal_);
+  pole_map_->setModes(modal_);
+  syncing_ = false;
+}
+
+void LinearizeView::modeRowChanged() {
+  if (syncing_) return;
+  const QModelIndex cur = mode_view_->selectionModel()->currentIndex();
+  if (!cur.isValid()) return;
+  bool ok = false;
+  const int index = mode_model_->index(cur.row(), ModeTableModel::Eigenvalue).data(Qt::UserRole).toInt(&ok);
+  if (!ok) return;
+  pole_map_->selectMode(index);
+  announceMode(index);
+}
+
+void LinearizeView::poleClicked(int index) {
+  if (syncing_) return;
+  selectMode(index);
+}
+
+void LinearizeView::selectMode(int index) {
+  if (index < 0 || index >= static_cast<int>(modal_.modes.size())) {
+    syncing_ = true;
+    mode_view_->clearSelection();
+    pole_map_->selectMode(-1);
+    selected_mode_ = -1;
+    syncing_ = false;
+    return;
+  }
+  syncing_ = true;
+  for (int row = 0; row < mode_model_->rowCount(); ++row) {
+    const QModelIndex i = mode_model_->index(row, ModeTableModel::Eigenvalue);
+    if (i.data(Qt::UserRole).toInt() == index) {
+      mode_view_->selectionModel()->setCurrentIndex(
+          i, QItemSelectionModel::ClearAndSelect | QItemSelectionModel::Rows);
+      mode_view_->scrollTo(i);
+      break;
+    }
+  }
+  pole_map_->selectMode(index);
+  syncing_ = false;
+  announceMode(index);
+}
+
+void LinearizeView::announceMode(int index) {
+  if (index < 0 || index >= static_cast<int>(modal_.modes.size())) return;
+  selected_mode_ = index;
+  const Mode& m = modal_.modes[index];
+  emit modeSelected(index, m.shape, m.s);
+}
+
+bool LinearizeView::exportTo(const QString& dir, QString* error) {
+  auto fail = [&](const QString& why) {
+    if (error) *error = why;
+    emit message(tr("Export: %1").arg(why));
+    return false;
+  };
+  if (isStale() && !linearize()) return fail(tr("the model could not be linearized"));
+  try {
+    std::string target = ss(dir);
+    if (!target.empty()) target = study_path(*result_model_, target);  // relative: to the model file
+    const ExportPaths p = study_export(*result_model_, result_->system, target);
+    const QString mat = qs(p.mat_file), m = qs(p.m_file);
+    emit exported(mat, m);
+    return true;
+  } catch (const std::exception& e) {
+    return fail(qs(e.what()));
+  }
+}
+
+}  // namespace codyna::gui

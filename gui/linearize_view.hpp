@@ -1,0 +1,152 @@
+// LinearizeView: the "Linearize" page of codyna-gui.
+//
+// The widgets at the top are the study's linearization choices (the model
+// file's "analysis" section, StudySpec): operating point (initial,
+// equilibrium, trim, time=T), Jacobian method, sample time Ts (0 =
+// continuous), MAT version, export folder and name, and for closed loops the
+// independent coordinates. Every change is written through
+// Document::setStudy (one undo step; spin boxes merge while they are
+// stepped), and the widgets follow the Document (undo, redo, load).
+//
+// "Linearize" calls study_linearize() on the document's model, as
+// `codyna linearize` does, and shows the operating point, A, B, C, D with their
+// names, the offsets x0, u0, y0, xdot0, the modes (ModeTableModel) and the
+// pole map. A mode selected in the table or on the pole map (kept in sync)
+// is announced by modeSelected() for the 3-D view. "Export…" (and exportTo())
+// writes NAME.mat + NAME.m through study_export(), the code of
+// `codyna linearize --out DIR`, re-linearizing first when the shown result is
+// out of date.
+#pragma once
+
+#include <Eigen/Core>
+#include <QMetaType>
+#include <QString>
+#include <QWidget>
+#include <complex>
+#include <functional>
+#include <memory>
+#include <optional>
+
+#include "analysis/modal.hpp"
+#include "model/model.hpp"
+#include "study/workflow.hpp"
+
+QT_BEGIN_NAMESPACE
+class QCheckBox;
+class QComboBox;
+class QDoubleSpinBox;
+class QLabel;
+class QLineEdit;
+class QListWidget;
+class QListWidgetItem;
+class QPushButton;
+class QTabWidget;
+class QTableView;
+class QTableWidget;
+class QGroupBox;
+QT_END_NAMESPACE
+
+namespace codyna::gui {
+
+class Document;
+class MatrixTableModel;
+class ModeTableModel;
+class PoleMap;
+
+class LinearizeView : public QWidget {
+  Q_OBJECT
+ public:
+  explicit LinearizeView(Document* doc, QWidget* parent = nullptr);
+  ~LinearizeView() override;
+
+  // Linearizes the document's current model with its study (the button does this).
+  // On failure: false, message() emitted, the old result (if any) kept but marked stale.
+  bool linearize();
+  // Writes NAME.mat + NAME.m into `dir` ("" = the study's export folder, relative
+  // to the model file), re-linearizing if the result is stale; emits exported().
+  bool exportTo(const QString& dir, QString* error = nullptr);
+
+  // The last linearization, or null. isStale(): the document changed since.
+  const codyna::StudyLinearization* result() const { return result_ ? &*result_ : nullptr; }
+  const codyna::ModalAnalysis& modes() const { return modal_; }
+  bool isStale() const;
+
+  // Selects mode `index` in the table and the pole map and emits modeSelected
+  // (-1 clears the selection, without a signal).
+  void selectMode(int index);
+  int selectedMode() const { return selected_mode_; }
+
+  // The widgets, for the main window and tests.
+  QComboBox* operatingPointCombo() const { return op_combo_; }
+  QDoubleSpinBox* operatingTimeSpin() const { return op_time_; }
+  QComboBox* methodCombo() const { return method_combo_; }
+  QDoubleSpinBox* sampleTimeSpin() const { return ts_spin_; }
+  QComboBox* matVersionCombo() const { return mat_combo_; }
+  QLineEdit* exportDirEdit() const { return export_dir_; }
+  QLineEdit* exportNameEdit() const { return export_name_; }
+  QListWidget* independentList() const { return independent_; }
+  QPushButton* linearizeButton() const { return linearize_button_; }
+  QPushButton* exportButton() const { return export_button_; }
+  // A, B, C, D (k = 0..3)
+  QTableView* matrixView(int k) const { return matrix_views_[k]; }
+  MatrixTableModel* matrixModel(int k) const { return matrix_models_[k]; }
+  QTableView* modeView() const { return mode_view_; }
+  ModeTableModel* modeModel() const { return mode_model_; }
+  PoleMap* poleMap() const { return pole_map_; }
+  QLabel* operatingPointLabel() const { return op_label_; }
+
+ signals:
+  // a mode was selected (table or pole map): its index in modes(), its shape (state order) and s
+  void modeSelected(int index, const Eigen::VectorXcd& shape, std::complex<double> s);
+  void linearized();
+  void exported(const QString& matFile, const QString& mFile);
+  void message(const QString& text);  // errors and notes for the message dock
+
+ private:
+  void buildUi();
+  void refreshFromDocument();  // study -> widgets
+  void refreshIndependent();   // coordinates of the model (closed loops only)
+  void writeStudy(const std::function<void(codyna::StudySpec&)>& change, const QString& text, int mergeKey = -1);
+  void opChanged();
+  void independentChanged(QListWidgetItem* item);
+  void showResult();
+  void updateStaleness();
+  void modeRowChanged();
+  void poleClicked(int index);
+  void announceMode(int index);
+  void browseExport();
+
+  Document* doc_;
+  std::optional<codyna::StudyLinearization> result_;
+  std::shared_ptr<const codyna::Model> result_model_;  // the model result_ was computed on
+  codyna::ModalAnalysis modal_;
+  int selected_mode_ = -1;
+  bool syncing_ = false;
+
+  QComboBox* op_combo_ = nullptr;
+  QDoubleSpinBox* op_time_ = nullptr;
+  QComboBox* method_combo_ = nullptr;
+  QDoubleSpinBox* ts_spin_ = nullptr;
+  QComboBox* mat_combo_ = nullptr;
+  QLineEdit* export_dir_ = nullptr;
+  QLineEdit* export_name_ = nullptr;
+  QPushButton* export_browse_ = nullptr;
+  QGroupBox* independent_box_ = nullptr;
+  QListWidget* independent_ = nullptr;
+  QPushButton* linearize_button_ = nullptr;
+  QPushButton* export_button_ = nullptr;
+  QLabel* op_label_ = nullptr;
+  QLabel* stale_label_ = nullptr;
+  QTabWidget* tabs_ = nullptr;
+  QTableView* matrix_views_[4] = {};
+  MatrixTableModel* matrix_models_[4] = {};
+  QTableWidget* offsets_ = nullptr;
+  QTableView* mode_view_ = nullptr;
+  ModeTableModel* mode_model_ = nullptr;
+  PoleMap* pole_map_ = nullptr;
+};
+
+}  // namespace codyna::gui
+
+Q_DECLARE_METATYPE(Eigen::VectorXcd)
+Q_DECLARE_METATYPE(std::complex<double>)

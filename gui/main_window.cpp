@@ -1,0 +1,510 @@
+#include "gui/main_window.hpp"
+
+#include <QAction>
+#include <QApplication>
+#include <QCloseEvent>
+#include <QComboBox>
+#include <QDateTime>
+#include <QDockWidget>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QHBoxLayout>
+#include <QHeaderView>
+#include <QLabel>
+#include <QMenuBar>
+#include <QMessageBox>
+#include <QPlainTextEdit>
+#include <QPushButton>
+#include <QSettings>
+#include <QSlider>
+#include <QSplitter>
+#include <QStatusBar>
+#include <QTabWidget>
+#include <QToolBar>
+#include <QTreeView>
+#include <QVBoxLayout>
+#include <cmath>
+
+#include "dynamics/assembly.hpp"
+#include "gui/linearize_view.hpp"
+#include "gui/plant_panel.hpp"
+#include "gui/property_editor.hpp"
+#include "gui/result_plots.hpp"
+#include "gui/simulate_view.hpp"
+#include "gui/view3d.hpp"
+#include "simulation/result.hpp"
+
+namespace codyna::gui {
+
+namespace {
+constexpr int kMaxRecent = 8;
+constexpr int kFrameMs = 33;
+const char* kFilter = "codyna models (*.json);;All files (*)";
+}  // namespace
+
+MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document(this)) {
+  setObjectName("codynaMainWindow");
+  resize(1500, 950);
+
+  // centre: 3-D view with playback, and below it the Linearize / Simulate views
+  view_ = new View3D(this);
+  slider_ = new QSlider(Qt::Horizontal, this);
+  slider_->setObjectName("playbackSlider");
+  slider_->setRange(0, 0);
+  slider_->setEnabled(false);
+  play_ = new QPushButton(tr("Play"), this);
+  play_->setObjectName("playButton");
+  play_->setEnabled(false);
+  speed_ = new QComboBox(this);
+  for (double s : {0.1, 0.25, 0.5, 1.0, 2.0, 4.0}) speed_->addItem(QStringLiteral("%1x").arg(s), s);
+  speed_->setCurrentIndex(3);
+  time_label_ = new QLabel(tr("no result"), this);
+  time_label_->setMinimumWidth(120);
+  auto* playback = new QHBoxLayout;
+  playback->addWidget(play_);
+  playback->addWidget(slider_, 1);
+  playback->addWidget(time_label_);
+  playback->addWidget(new QLabel(tr("speed"), this));
+  playback->addWidget(speed_);
+  auto* top = new QWidget(this);
+  auto* top_lay = new QVBoxLayout(top);
+  top_lay->setContentsMargins(0, 0, 0, 0);
+  top_lay->addWidget(view_, 1);
+  top_lay->addLayout(playback);
+
+  lin_view_ = new LinearizeView(doc_, this);
+  sim_view_ = new SimulateView(doc_, this);
+  tabs_ = new QTabWidget(this);
+  tabs_->addTab(lin_view_, tr("Linearize"));
+  tabs_->addTab(sim_view_, tr("Simulate"));
+  auto* centre = new QSplitter(Qt::Vertical, this);
+  centre->addWidget(top);
+  centre->addWidget(tabs_);
+  centre->setStretchFactor(0, 1);
+  centre->setStretchFactor(1, 1);
+  setCentralWidget(centre);
+
+  // left: model tree + properties
+  tree_model_ = new ModelTreeModel(doc_, this);
+  tree_ = new QTreeView(this);
+  tree_->setObjectName("modelTree");
+  tree_->setModel(tree_model_);
+  tree_->setEditTriggers(QAbstractItemView::EditKeyPressed | QAbstractItemView::DoubleClicked);
+  tree_->header()->setSectionResizeMode(0, QHeaderView::ResizeToContents);
+  props_ = new PropertyEditor(doc_, this);
+  auto* left = new QSplitter(Qt::Vertical, this);
+  left->addWidget(tree_);
+  left->addWidget(props_);
+  auto* left_dock = new QDockWidget(tr("Model"), this);
+  left_dock->setObjectName("modelDock");
+  left_dock->setWidget(left);
+  addDockWidget(Qt::LeftDockWidgetArea, left_dock);
+
+  // right: the Control Plant/In and Plant/Out panels
+  plant_in_ = new PlantPanel(doc_, PlantSide::In, this);
+  plant_out_ = new PlantPanel(doc_, PlantSide::Out, this);
+  auto* in_dock = new QDockWidget(tr("Control Plant/In"), this);
+  in_dock->setObjectName("plantInDock");
+  in_dock->setWidget(plant_in_);
+  auto* out_dock = new QDockWidget(tr("Plant/Out"), this);
+  out_dock->setObjectName("plantOutDock");
+  out_dock->setWidget(plant_out_);
+  addDockWidget(Qt::RightDockWidgetArea, in_dock);
+  addDockWidget(Qt::RightDockWidgetArea, out_dock);
+
+  // bottom: messages
+  messages_ = new QPlainTextEdit(this);
+  messages_->setObjectName("messages");
+  messages_->setReadOnly(true);
+  messages_->setMaximumBlockCount(2000);
+  auto* msg_dock = new QDockWidget(tr("Messages"), this);
+  msg_dock->setObjectName("messageDock");
+  msg_dock->setWidget(messages_);
+  addDockWidget(Qt::BottomDockWidgetArea, msg_dock);
+  resizeDocks({left_dock, in_dock}, {330, 380}, Qt::Horizontal);
+  resizeDocks({msg_dock}, {90}, Qt::Vertical);
+
+  buildMenus();
+
+  connect(doc_, &Document::fileChanged, this, &MainWindow::updateTitle);
+  connect(doc_, &Document::modelChanged, this, &MainWindow::onModelChanged);
+  connect(doc_, &Document::errorChanged, this, [this](const QString& text, const QString& path) {
+    if (text.isEmpty()) return;
+    message(text, true);
+    if (const auto ref = element_at_path(ss(path))) {
+      selectElement(ElementId{ref->kind, ref->index});
+      props_->markField(qs(ref->field), text);
+    }
+  });
+  connect(doc_, &Document::specChanged, this, [this] {
+    // the tree was reset: keep the property editor's element selected
+    if (const auto id = props_->element()) tree_->setCurrentIndex(tree_model_->indexOf(*id));
+  });
+  connect(tree_->selectionModel(), &QItemSelectionModel::currentChanged, this, [this](const QModelIndex& cur) {
+    const auto id = tree_model_->elementAt(cur);
+    if (id != props_->element()) props_->setElement(id);
+    QString body;
+    if (id && id->kind == ElementKind::Body) body = qs(doc_->spec().bodies[id->index].name);
+    if (id && id->kind == ElementKind::Joint) body = qs(doc_->spec().joints[id->index].child);
+    view_->setHighlight(body);
+  });
+  connect(tree_model_, &ModelTreeModel::renameFailed, this, [this](const QString& m) { message(m, true); });
+  connect(props_, &PropertyEditor::message, this, [this](const QString& m) { message(m, true); });
+  connect(view_, &View3D::bodyPicked, this, [this](const QString& name) {
+    const int k = find_element(doc_->spec(), ElementKind::Body, ss(name));
+    if (k >= 0) selectElement(ElementId{ElementKind::Body, k});
+  });
+  connect(lin_view_, &LinearizeView::message, this, [this](const QString& m) { message(m); });
+  connect(lin_view_, &LinearizeView::exported, this, [this](const QString& mat, const QString& m) {
+    const QString text = tr("Exported %1 and %2").arg(mat, m);
+    message(text);
+    statusBar()->showMessage(text, 15000);
+  });
+  connect(lin_view_, &LinearizeView::modeSelected, this,
+          [this](int index, const Eigen::VectorXcd& shape, std::complex<double>) { animateMode(index, shape); });
+  connect(sim_view_, &SimulateView::message, this, [this](const QString& m) { message(m); });
+  connect(sim_view_, &SimulateView::runFinished, this, &MainWindow::onResult);
+  connect(sim_view_, &SimulateView::runStarted, this, [this] { animateMode(-1, {}); });
+
+  connect(slider_, &QSlider::valueChanged, this, [this](int k) {
+    if (result_ && k >= 0 && k < result_->samples()) setPlaybackTime(result_->t[k]);
+  });
+  connect(play_, &QPushButton::clicked, this, [this] { setPlaying(!isPlaying()); });
+  anim_.setInterval(kFrameMs);
+  connect(&anim_, &QTimer::timeout, this, &MainWindow::stepAnimation);
+
+  rebuildRecentMenu();
+  updateTitle();
+  statusBar()->showMessage(tr("Open a model (File > Open) to begin"));
+}
+
+MainWindow::~MainWindow() {
+  anim_.stop();
+  sim_view_->cancel();
+}
+
+void MainWindow::buildMenus() {
+  QMenu* file = menuBar()->addMenu(tr("&File"));
+  QAction* a_new = file->addAction(tr("&New"), this, [this] { newModel(); });
+  a_new->setShortcut(QKeySequence::New);
+  QAction* a_open = file->addAction(tr("&Open..."), this, [this] {
+    const QString p = chooseFile(tr("Open model"), QFileInfo(doc_->filePath()).absolutePath(), kFilter, false);
+    if (!p.isEmpty()) openFile(p);
+  });
+  a_open->setShortcut(QKeySequence::Open);
+  recent_menu_ = file->addMenu(tr("Open &Recent"));
+  QAction* a_save = file->addAction(tr("&Save"), this, [this] { saveFile(); });
+  a_save->setShortcut(QKeySequence::Save);
+  QAction* a_save_as = file->addAction(tr("Save &As..."), this, [this] {
+    const QString p = chooseFile(tr("Save model as"), doc_->filePath(), kFilter, true);
+    if (!p.isEmpty()) saveFileAs(p);
+  });
+  a_save_as->setShortcut(QKeySequence::SaveAs);
+  file->addSeparator();
+  QAction* a_export = file->addAction(tr("&Export plant (NAME.m + NAME.mat)..."), this, [this] {
+    const QString d = QFileDialog::getExistingDirectory(this, tr("Export plant to folder"), QFileInfo(doc_->filePath()).absolutePath());
+    if (!d.isEmpty()) exportPlant(d);
+  });
+  a_export->setShortcut(QKeySequence(Qt::CTRL | Qt::Key_E));
+  file->addSeparator();
+  QAction* a_quit = file->addAction(tr("&Quit"), this, &QWidget::close);
+  a_quit->setShortcut(QKeySequence::Quit);
+
+  QMenu* edit = menuBar()->addMenu(tr("&Edit"));
+  QAction* undo = doc_->undoStack()->createUndoAction(this, tr("&Undo"));
+  undo->setShortcut(QKeySequence::Undo);
+  QAction* redo = doc_->undoStack()->createRedoAction(this, tr("&Redo"));
+  redo->setShortcut(QKeySequence::Redo);
+  edit->addAction(undo);
+  edit->addAction(redo);
+  edit->addSeparator();
+  QMenu* add = edit->addMenu(tr("&Add"));
+  for (ElementKind k : kElementKinds) add->addAction(tr("Add %1").arg(to_string(k)), this, [this, k] { addElement(k); });
+  edit->addAction(tr("&Duplicate"), this, [this] { duplicateSelected(); })->setShortcut(QKeySequence(Qt::CTRL | Qt::Key_D));
+  edit->addAction(tr("Re&name"), this, [this] {
+    if (tree_->currentIndex().isValid()) tree_->edit(tree_->currentIndex().siblingAtColumn(0));
+  })->setShortcut(QKeySequence(Qt::Key_F2));
+  edit->addAction(tr("Re&move"), this, [this] { removeSelected(); })->setShortcut(QKeySequence::Delete);
+
+  QMenu* view = menuBar()->addMenu(tr("&View"));
+  view->addAction(tr("&Fit 3-D view"), this, [this] { view_->fitView(); })->setShortcut(QKeySequence(Qt::Key_F));
+  view->addAction(tr("&Reset 3-D view"), this, [this] { view_->resetView(); });
+  QAction* frames = view->addAction(tr("Show &frames and joint axes"));
+  frames->setCheckable(true);
+  frames->setChecked(true);
+  connect(frames, &QAction::toggled, view_, &View3D::setShowFrames);
+
+  QToolBar* tb = addToolBar(tr("Main"));
+  tb->setObjectName("mainToolbar");
+  tb->addAction(a_open);
+  tb->addAction(a_save);
+  tb->addAction(undo);
+  tb->addAction(redo);
+  tb->addAction(a_export);
+}
+
+int MainWindow::ask(const QString& title, const QString& text, int buttons) {
+  if (ask_) return ask_(title, text, buttons);
+  return QMessageBox::question(this, title, text, QMessageBox::StandardButtons(buttons));
+}
+
+QString MainWindow::chooseFile(const QString& title, const QString& dir, const QString& filter, bool save) {
+  if (file_) return file_(title, dir, filter, save);
+  return save ? QFileDialog::getSaveFileName(this, title, dir, filter) : QFileDialog::getOpenFileName(this, title, dir, filter);
+}
+
+void MainWindow::message(const QString& text, bool error) {
+  const QString stamp = QDateTime::currentDateTime().toString("HH:mm:ss");
+  messages_->appendPlainText(QStringLiteral("[%1] %2%3").arg(stamp, error ? tr("error: ") : QString(), text));
+  statusBar()->showMessage(error ? tr("Error: %1").arg(text.section('\n', 0, 0)) : text.section('\n', 0, 0), 15000);
+}
+
+void MainWindow::updateTitle() {
+  setWindowTitle(QStringLiteral("%1[*] - codyna").arg(doc_->displayName()));
+  setWindowModified(doc_->isModified());
+}
+
+bool MainWindow::maybeSave() {
+  if (!doc_->isModified()) return true;
+  const int b = ask(tr("Unsaved changes"), tr("%1 has unsaved changes. Save them?").arg(doc_->displayName()),
+                    QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel);
+  if (b == QMessageBox::Cancel) return false;
+  if (b == QMessageBox::Discard) return true;
+  if (doc_->filePath().isEmpty()) {
+    const QString p = chooseFile(tr("Save model as"), QString(), kFilter, true);
+    return !p.isEmpty() && saveFileAs(p);
+  }
+  return saveFile();
+}
+
+bool MainWindow::openFile(const QString& path) {
+  if (!maybeSave()) return false;
+  sim_view_->cancel();
+  QString error;
+  if (!doc_->load(path, &error)) {
+    message(tr("Cannot open %1: %2").arg(path, error), true);
+    return false;
+  }
+  addRecent(doc_->filePath());
+  result_.reset();
+  slider_->setRange(0, 0);
+  slider_->setEnabled(false);
+  play_->setEnabled(false);
+  time_label_->setText(tr("no result"));
+  view_->fitView();
+  message(tr("Opened %1").arg(doc_->filePath()));
+  return true;
+}
+
+bool MainWindow::saveFile() {
+  if (doc_->filePath().isEmpty()) {
+    const QString p = chooseFile(tr("Save model as"), QString(), kFilter, true);
+    return !p.isEmpty() && saveFileAs(p);
+  }
+  QString error;
+  if (!doc_->save(&error)) {
+    message(tr("Not saved: %1").arg(error), true);
+    return false;
+  }
+  message(tr("Saved %1").arg(doc_->filePath()));
+  return true;
+}
+
+bool MainWindow::saveFileAs(const QString& path) {
+  QString error;
+  if (!doc_->saveAs(path, &error)) {
+    message(tr("Not saved: %1").arg(error), true);
+    return false;
+  }
+  addRecent(doc_->filePath());
+  message(tr("Saved %1").arg(doc_->filePath()));
+  return true;
+}
+
+bool MainWindow::newModel() {
+  if (!maybeSave()) return false;
+  sim_view_->cancel();
+  doc_->clear();
+  return true;
+}
+
+bool MainWindow::exportPlant(const QString& dir) {
+  QString error;
+  if (!lin_view_->exportTo(dir, &error)) {
+    message(tr("Export failed: %1").arg(error), true);
+    return false;
+  }
+  return true;
+}
+
+QStringList MainWindow::recentFiles() const { return QSettings().value("recentFiles").toStringList(); }
+
+void MainWindow::addRecent(const QString& path) {
+  QStringList l = recentFiles();
+  l.removeAll(path);
+  l.prepend(path);
+  while (l.size() > kMaxRecent) l.removeLast();
+  QSettings().setValue("recentFiles", l);
+  rebuildRecentMenu();
+}
+
+void MainWindow::rebuildRecentMenu() {
+  if (!recent_menu_) return;
+  recent_menu_->clear();
+  for (const QString& p : recentFiles()) recent_menu_->addAction(p, this, [this, p] { openFile(p); });
+  recent_menu_->setEnabled(!recent_menu_->isEmpty());
+}
+
+void MainWindow::closeEvent(QCloseEvent* e) {
+  if (!maybeSave()) return e->ignore();
+  anim_.stop();
+  sim_view_->cancel();
+  e->accept();
+}
+
+void MainWindow::selectElement(std::optional<ElementId> id) {
+  if (!id) {
+    tree_->clearSelection();
+    props_->setElement(std::nullopt);
+    return;
+  }
+  const QModelIndex i = tree_model_->indexOf(*id);
+  tree_->expand(i.parent());
+  tree_->setCurrentIndex(i);
+  tree_->scrollTo(i);
+}
+
+std::optional<ElementId> MainWindow::selectedElement() const { return tree_model_->elementAt(tree_->currentIndex()); }
+
+bool MainWindow::removeSelected() {
+  const auto id = selectedElement();
+  if (!id) return false;
+  const std::string name = element_name(doc_->spec(), id->kind, id->index);
+  const auto refs = references_to(doc_->spec(), id->kind, name);
+  if (!refs.empty()) {
+    QStringList l;
+    for (const auto& r : refs) l << "  " + qs(r);
+    const int b = ask(tr("Remove %1").arg(qs(name)),
+                      tr("%1 %2 is referenced by:\n%3\nRemove it anyway?").arg(to_string(id->kind), qs(name), l.join('\n')),
+                      QMessageBox::Yes | QMessageBox::No);
+    if (b != QMessageBox::Yes) return false;
+  }
+  props_->setElement(std::nullopt);
+  return doc_->edit(tr("Remove %1").arg(qs(name)), [&](ModelSpec& s) { remove_element(s, id->kind, id->index); });
+}
+
+bool MainWindow::duplicateSelected() {
+  const auto id = selectedElement();
+  if (!id) return false;
+  int made = -1;
+  const bool ok = doc_->edit(tr("Duplicate %1").arg(qs(element_name(doc_->spec(), id->kind, id->index))),
+                             [&](ModelSpec& s) { made = duplicate_element(s, id->kind, id->index); });
+  if (ok && made >= 0) selectElement(ElementId{id->kind, made});
+  return ok;
+}
+
+bool MainWindow::addElement(ElementKind k) {
+  int made = -1;
+  const bool ok = doc_->edit(tr("Add %1").arg(to_string(k)), [&](ModelSpec& s) { made = add_element(s, k); });
+  if (ok && made >= 0) selectElement(ElementId{k, made});
+  return ok;
+}
+
+void MainWindow::onModelChanged() {
+  animateMode(-1, {});
+  view_->setModel(doc_->model());
+  if (!doc_->model()) statusBar()->showMessage(tr("The model does not compile: %1").arg(doc_->errorText().section('\n', 0, 0)));
+}
+
+void MainWindow::onResult(std::shared_ptr<const SimulationResult> r) {
+  result_ = std::move(r);
+  const int n = result_ ? result_->samples() : 0;
+  slider_->setRange(0, std::max(0, n - 1));
+  slider_->setEnabled(n > 0);
+  play_->setEnabled(n > 1);
+  if (n > 0) {
+    slider_->setValue(n - 1);
+    setPlaybackTime(result_->t.back());
+  }
+}
+
+void MainWindow::setPlaybackTime(double t) {
+  if (!result_ || result_->samples() == 0) return;
+  const auto& ts = result_->t;
+  const auto it = std::lower_bound(ts.begin(), ts.end(), t);
+  const int k = std::clamp(static_cast<int>(it - ts.begin()), 0, result_->samples() - 1);
+  play_t_ = ts[k];
+  const auto model = doc_->model();
+  if (model && result_->q.cols() == model->nq) view_->setConfiguration(result_->q.row(k).transpose());
+  sim_view_->plots()->setTimeCursor(play_t_);
+  time_label_->setText(QStringLiteral("t = %1 s").arg(play_t_, 0, 'f', 3));
+  if (slider_->value() != k) {
+    const QSignalBlocker block(slider_);
+    slider_->setValue(k);
+  }
+}
+
+void MainWindow::setPlaying(bool on) {
+  if (on && (!result_ || result_->samples() < 2)) on = false;
+  if (on) {
+    mode_ = -1;
+    if (play_t_ >= result_->t.back()) setPlaybackTime(result_->t.front());
+    anim_.start();
+  } else if (mode_ < 0) {
+    anim_.stop();
+  }
+  play_->setText(on ? tr("Pause") : tr("Play"));
+}
+
+bool MainWindow::isPlaying() const { return anim_.isActive() && mode_ < 0; }
+
+void MainWindow::animateMode(int index, const Eigen::VectorXcd& shape) {
+  mode_ = index;
+  mode_shape_ = shape;
+  mode_phase_ = 0;
+  if (index >= 0) {
+    play_->setText(tr("Play"));
+    anim_.start();
+  } else {
+    anim_.stop();
+    play_->setText(tr("Play"));
+    if (const auto m = doc_->model()) view_->setConfiguration(m->q0);
+  }
+}
+
+bool MainWindow::isAnimatingMode() const { return anim_.isActive() && mode_ >= 0; }
+
+void MainWindow::stepAnimation() {
+  if (mode_ < 0) {
+    // playback: advance by the frame time times the speed
+    if (!result_ || result_->samples() < 2) return setPlaying(false);
+    const double t = play_t_ + kFrameMs * 1e-3 * speed_->currentData().toDouble();
+    if (t >= result_->t.back()) {
+      setPlaybackTime(result_->t.back());
+      return setPlaying(false);
+    }
+    return setPlaybackTime(t);
+  }
+  // mode shape: the linearization's operating point plus Re(shape e^{i phase}) on the position
+  // states that are joint coordinates, loops re-assembled
+  const auto model = doc_->model();
+  const auto* lin = lin_view_->result();
+  if (!model || !lin) return;
+  mode_phase_ += 2 * M_PI * kFrameMs / 1500.0;  // one period in 1.5 s whatever the frequency
+  const auto& names = lin->system.state_names;
+  const int npos = static_cast<int>(names.size()) / 2;
+  Eigen::VectorXd q = lin->op.q;
+  const double amp = 0.3 / std::max(1e-12, mode_shape_.head(std::min<int>(npos, mode_shape_.size())).cwiseAbs().maxCoeff());
+  const std::complex<double> rot = std::polar(1.0, mode_phase_);
+  for (int k = 0; k < npos && k < mode_shape_.size(); ++k) {
+    const auto it = std::find(model->q_names.begin(), model->q_names.end(), names[k]);
+    if (it != model->q_names.end()) q[it - model->q_names.begin()] += amp * (mode_shape_[k] * rot).real();
+  }
+  if (model->nc > 0) {
+    const AssemblyResult r = assemble(*model, q, Eigen::VectorXd::Zero(model->nv));
+    if (r.converged) q = r.q;
+  }
+  view_->setConfiguration(q);
+}
+
+}  // namespace codyna::gui

@@ -1,0 +1,132 @@
+// MainWindow: codyna-gui's window. Model tree and property editor (left), the
+// 3-D view with playback (centre), the Linearize and Simulate views (below it),
+// the Control Plant/In and Plant/Out panels (right), messages (bottom).
+// Every edit goes through the Document's undo stack; unsaved changes are never
+// dropped silently (the guard asks on New, Open and Quit).
+#pragma once
+
+#include <QMainWindow>
+#include <QTimer>
+#include <complex>
+#include <functional>
+#include <memory>
+
+#include "gui/document.hpp"
+#include "gui/model_tree.hpp"
+
+class QTreeView;
+class QPlainTextEdit;
+class QSlider;
+class QPushButton;
+class QComboBox;
+class QLabel;
+class QTabWidget;
+class QMenu;
+
+namespace codyna {
+struct SimulationResult;
+}
+
+namespace codyna::gui {
+
+class View3D;
+class PropertyEditor;
+class PlantPanel;
+class LinearizeView;
+class SimulateView;
+
+class MainWindow : public QMainWindow {
+  Q_OBJECT
+ public:
+  explicit MainWindow(QWidget* parent = nullptr);
+  ~MainWindow() override;
+
+  Document* document() { return doc_; }
+  View3D* view3d() { return view_; }
+  QTreeView* modelTree() { return tree_; }
+  ModelTreeModel* treeModel() { return tree_model_; }
+  PropertyEditor* propertyEditor() { return props_; }
+  PlantPanel* plantInPanel() { return plant_in_; }
+  PlantPanel* plantOutPanel() { return plant_out_; }
+  LinearizeView* linearizeView() { return lin_view_; }
+  SimulateView* simulateView() { return sim_view_; }
+  QTabWidget* analysisTabs() { return tabs_; }
+  QPlainTextEdit* messages() { return messages_; }
+  QSlider* playbackSlider() { return slider_; }
+
+  // File operations (the menu's actions call these; tests too). openFile() checks
+  // for unsaved changes first; a file that does not load leaves the document as it was.
+  bool openFile(const QString& path);
+  bool saveFile();
+  bool saveFileAs(const QString& path);
+  bool newModel();
+  bool exportPlant(const QString& dir);  // NAME.m + NAME.mat through core's study_export
+
+  // Asks before unsaved changes are lost: true when it may go on (saved or discarded).
+  bool maybeSave();
+
+  // Dialogs go through these hooks so that tests answer them without a modal loop.
+  // question: returns QMessageBox::StandardButton; file: returns a path ("" = cancelled).
+  using QuestionHook = std::function<int(const QString& title, const QString& text, int buttons)>;
+  using FileHook = std::function<QString(const QString& title, const QString& dir, const QString& filter, bool save)>;
+  void setQuestionHook(QuestionHook h) { ask_ = std::move(h); }
+  void setFileHook(FileHook h) { file_ = std::move(h); }
+
+  void selectElement(std::optional<ElementId> id);
+  std::optional<ElementId> selectedElement() const;
+  bool removeSelected();     // asks first when other elements refer to it
+  bool duplicateSelected();
+  bool addElement(ElementKind k);
+
+  // playback of the last simulation result in the 3-D view
+  void setPlaybackTime(double t);
+  double playbackTime() const { return play_t_; }
+  void setPlaying(bool on);
+  bool isPlaying() const;
+  // mode shape animation (from the Linearize view); index -1 stops it
+  void animateMode(int index, const Eigen::VectorXcd& shape);
+  bool isAnimatingMode() const;
+
+  QStringList recentFiles() const;
+  void message(const QString& text, bool error = false);
+
+ protected:
+  void closeEvent(QCloseEvent* e) override;
+
+ private:
+  void buildMenus();
+  void updateTitle();
+  void addRecent(const QString& path);
+  void rebuildRecentMenu();
+  void onModelChanged();
+  void onResult(std::shared_ptr<const SimulationResult> r);
+  void stepAnimation();
+  int ask(const QString& title, const QString& text, int buttons);
+  QString chooseFile(const QString& title, const QString& dir, const QString& filter, bool save);
+
+  Document* doc_;
+  ModelTreeModel* tree_model_;
+  QTreeView* tree_;
+  PropertyEditor* props_;
+  PlantPanel *plant_in_, *plant_out_;
+  View3D* view_;
+  LinearizeView* lin_view_;
+  SimulateView* sim_view_;
+  QTabWidget* tabs_;
+  QPlainTextEdit* messages_;
+  QSlider* slider_;
+  QPushButton* play_;
+  QComboBox* speed_;
+  QLabel* time_label_;
+  QMenu* recent_menu_ = nullptr;
+  QTimer anim_;
+  std::shared_ptr<const SimulationResult> result_;
+  double play_t_ = 0;
+  int mode_ = -1;
+  Eigen::VectorXcd mode_shape_;
+  double mode_phase_ = 0;
+  QuestionHook ask_;
+  FileHook file_;
+};
+
+}  // namespace codyna::gui

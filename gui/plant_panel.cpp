@@ -1,0 +1,199 @@
+#include "gui/plant_panel.hpp"
+
+#include <QHBoxLayout>
+#include <QHeaderView>
+#include <QLabel>
+#include <QMimeData>
+#include <QPushButton>
+#include <QTreeView>
+#include <QVBoxLayout>
+
+namespace codyna::gui {
+
+namespace {
+const char* kMime = "application/x-codyna-plant-row";
+
+QString limit_text(const std::optional<double>& x) { return x ? QString::number(*x) : QStringLiteral("-"); }
+}  // namespace
+
+PlantListModel::PlantListModel(Document* doc, PlantSide side, QObject* parent)
+    : QAbstractTableModel(parent), doc_(doc), side_(side) {
+  connect(doc, &Document::specChanged, this, [this] {
+    beginResetModel();
+    endResetModel();
+  });
+}
+
+QStringList PlantListModel::candidates() const {
+  QStringList l;
+  if (side_ == PlantSide::In)
+    for (const auto& a : doc_->spec().actuators) l << qs(a.name);
+  else
+    for (const auto& s : doc_->spec().sensors) l << qs(s.name);
+  return l;
+}
+
+QStringList PlantListModel::selected() const {
+  QStringList l;
+  for (const auto& n : side_ == PlantSide::In ? doc_->spec().plant.inputs : doc_->spec().plant.outputs) l << qs(n);
+  return l;
+}
+
+QStringList PlantListModel::rows() const {
+  QStringList l = selected();
+  for (const QString& c : candidates())
+    if (!l.contains(c)) l << c;
+  return l;
+}
+
+int PlantListModel::rowCount(const QModelIndex& parent) const { return parent.isValid() ? 0 : static_cast<int>(rows().size()); }
+int PlantListModel::columnCount(const QModelIndex& parent) const { return parent.isValid() ? 0 : (side_ == PlantSide::In ? 6 : 4); }
+
+QVariant PlantListModel::headerData(int section, Qt::Orientation o, int role) const {
+  if (role != Qt::DisplayRole) return {};
+  if (o == Qt::Vertical) return section < selected().size() ? QVariant(QString::number(section + 1)) : QVariant();
+  static const QStringList in{tr("Input"), tr("Type"), tr("Unit"), tr("Nominal u0"), tr("Min"), tr("Max")};
+  static const QStringList out{tr("Output"), tr("Type"), tr("Unit"), tr("Measures")};
+  const QStringList& h = side_ == PlantSide::In ? in : out;
+  return section < h.size() ? h[section] : QVariant();
+}
+
+QVariant PlantListModel::data(const QModelIndex& index, int role) const {
+  const QStringList r = rows();
+  if (!index.isValid() || index.row() >= r.size()) return {};
+  const QString name = r[index.row()];
+  const bool on = selected().contains(name);
+  const ModelSpec& s = doc_->spec();
+  if (role == Qt::CheckStateRole && index.column() == 0) return on ? Qt::Checked : Qt::Unchecked;
+  if (role == Qt::ForegroundRole && !on) return QColor(Qt::gray);
+  if (role != Qt::DisplayRole && role != Qt::ToolTipRole) return {};
+  if (side_ == PlantSide::In) {
+    const int k = find_element(s, ElementKind::Actuator, ss(name));
+    if (k < 0) return index.column() == 0 ? QVariant(name + tr(" (missing)")) : QVariant();
+    const ActuatorSpec& a = s.actuators[k];
+    switch (index.column()) {
+      case 0: return on ? QStringLiteral("u%1  %2").arg(index.row() + 1).arg(name) : name;
+      case 1: return QStringLiteral("%1 on %2").arg(to_string(a.type), qs(a.type == ActuatorType::JointForce ? a.joint : a.body));
+      case 2: return qs(a.unit.empty() ? (a.type == ActuatorType::JointForce ? "N | N m" : "N") : a.unit);
+      case 3: return a.u0;
+      case 4: return limit_text(a.min);
+      case 5: return limit_text(a.max);
+    }
+  } else {
+    const int k = find_element(s, ElementKind::Sensor, ss(name));
+    if (k < 0) return index.column() == 0 ? QVariant(name + tr(" (missing)")) : QVariant();
+    const SensorSpec& x = s.sensors[k];
+    switch (index.column()) {
+      case 0: return on ? QStringLiteral("y%1  %2").arg(index.row() + 1).arg(name) : name;
+      case 1: return qs(to_string(x.type));
+      case 2: return qs(x.unit);
+      case 3: return qs(!x.joint.empty() && (x.type == SensorType::JointPosition || x.type == SensorType::JointVelocity) ? x.joint
+                        : x.type == SensorType::Distance ? x.body_a + " - " + x.body_b : x.body);
+    }
+  }
+  return {};
+}
+
+bool PlantListModel::setChecked(const QString& name, bool on) {
+  QStringList sel = selected();
+  if (on == sel.contains(name)) return true;
+  if (on) sel << name;
+  else sel.removeAll(name);
+  return side_ == PlantSide::In ? doc_->setPlantInputs(sel) : doc_->setPlantOutputs(sel);
+}
+
+bool PlantListModel::setData(const QModelIndex& index, const QVariant& value, int role) {
+  if (role != Qt::CheckStateRole || index.column() != 0) return false;
+  return setChecked(rows().value(index.row()), value.toInt() == Qt::Checked);
+}
+
+Qt::ItemFlags PlantListModel::flags(const QModelIndex& index) const {
+  if (!index.isValid()) return Qt::ItemIsDropEnabled;
+  Qt::ItemFlags f = Qt::ItemIsEnabled | Qt::ItemIsSelectable;
+  if (index.column() == 0) f |= Qt::ItemIsUserCheckable;
+  if (index.row() < selected().size()) f |= Qt::ItemIsDragEnabled;
+  return f;
+}
+
+bool PlantListModel::moveSelected(int from, int to) {
+  QStringList sel = selected();
+  if (from < 0 || from >= sel.size()) return false;
+  to = std::clamp(to, 0, static_cast<int>(sel.size()) - 1);
+  if (from == to) return true;
+  sel.move(from, to);
+  return side_ == PlantSide::In ? doc_->setPlantInputs(sel) : doc_->setPlantOutputs(sel);
+}
+
+Qt::DropActions PlantListModel::supportedDropActions() const { return Qt::MoveAction; }
+QStringList PlantListModel::mimeTypes() const { return {kMime}; }
+
+QMimeData* PlantListModel::mimeData(const QModelIndexList& indexes) const {
+  if (indexes.isEmpty()) return nullptr;
+  auto* m = new QMimeData;
+  m->setData(kMime, QByteArray::number(indexes.first().row()));
+  return m;
+}
+
+bool PlantListModel::dropMimeData(const QMimeData* data, Qt::DropAction, int row, int, const QModelIndex& parent) {
+  if (!data || !data->hasFormat(kMime)) return false;
+  const int from = data->data(kMime).toInt();
+  int to = row >= 0 ? row : parent.isValid() ? parent.row() : static_cast<int>(selected().size());
+  if (to > from) --to;  // the row is removed before it is inserted
+  moveSelected(from, to);
+  return false;  // the Document has done the move: the view must not remove anything
+}
+
+PlantPanel::PlantPanel(Document* doc, PlantSide side, QWidget* parent) : QWidget(parent), doc_(doc), side_(side) {
+  model_ = new PlantListModel(doc, side, this);
+  view_ = new QTreeView(this);
+  view_->setObjectName(side == PlantSide::In ? "plantInView" : "plantOutView");
+  view_->setModel(model_);
+  view_->setRootIsDecorated(false);
+  view_->setDragDropMode(QAbstractItemView::InternalMove);
+  view_->setDragEnabled(true);
+  view_->setAcceptDrops(true);
+  view_->setDropIndicatorShown(true);
+  view_->setSelectionMode(QAbstractItemView::SingleSelection);
+  view_->header()->setSectionResizeMode(QHeaderView::ResizeToContents);
+  up_ = new QPushButton(tr("Up"), this);
+  down_ = new QPushButton(tr("Down"), this);
+  up_->setObjectName("up");
+  down_->setObjectName("down");
+  summary_ = new QLabel(this);
+  summary_->setWordWrap(true);
+  auto* buttons = new QHBoxLayout;
+  buttons->addWidget(up_);
+  buttons->addWidget(down_);
+  buttons->addStretch(1);
+  auto* lay = new QVBoxLayout(this);
+  lay->setContentsMargins(4, 4, 4, 4);
+  auto* hint = new QLabel(side == PlantSide::In ? tr("Tick the actuators that are the plant's inputs u; drag or Up/Down to order them.")
+                                                : tr("Tick the sensors that are the plant's outputs y; drag or Up/Down to order them."),
+                          this);
+  hint->setWordWrap(true);
+  lay->addWidget(hint);
+  lay->addWidget(view_, 1);
+  lay->addLayout(buttons);
+  lay->addWidget(summary_);
+  connect(up_, &QPushButton::clicked, this, [this] { moveCurrent(-1); });
+  connect(down_, &QPushButton::clicked, this, [this] { moveCurrent(+1); });
+  auto refresh = [this] {
+    const QStringList sel = model_->selected();
+    summary_->setText((side_ == PlantSide::In ? tr("u = [%1]") : tr("y = [%1]")).arg(sel.join(", ")));
+  };
+  connect(doc, &Document::specChanged, this, refresh);
+  refresh();
+}
+
+void PlantPanel::moveCurrent(int delta) {
+  const QModelIndex cur = view_->currentIndex();
+  if (!cur.isValid()) return;
+  const QString name = model_->rows().value(cur.row());
+  const int from = static_cast<int>(model_->selected().indexOf(name));
+  if (from < 0) return;
+  model_->moveSelected(from, from + delta);
+  const int now = static_cast<int>(model_->rows().indexOf(name));
+  view_->setCurrentIndex(model_->index(now, 0));
+}
+
+}  // namespace codyna::gui

@@ -1,0 +1,52 @@
+// PropertyEditor: the fields of one element, typed (numbers, vectors, matrices,
+// names of other elements, the type, switches), with units. An edit is applied
+// by writing the element's field into the model's JSON form and reading it back
+// through core's strict reader, so every value is checked exactly as a model
+// file is; a rejected value is marked and reported, the Document keeps its spec.
+// A name edit renames through the Document (references follow).
+#pragma once
+
+#include <QWidget>
+#include <map>
+#include <optional>
+
+#include "gui/model_tree.hpp"
+
+class QFormLayout;
+class QLabel;
+
+namespace codyna::gui {
+
+class PropertyEditor : public QWidget {
+  Q_OBJECT
+ public:
+  explicit PropertyEditor(Document* doc, QWidget* parent = nullptr);
+  void setElement(std::optional<ElementId> id);
+  std::optional<ElementId> element() const { return id_; }
+
+  // marks a field (its key path below the element, e.g. "parent" or "parent_frame/position") as wrong
+  void markField(const QString& field, const QString& message);
+  QString markedField() const { return marked_; }
+  QWidget* editorFor(const QString& field) const;  // for tests: the editor of a field
+
+  // applies `text` as the new value of `field` (what typing + Enter does); false with *error when rejected
+  bool applyText(const QString& field, const QString& text, QString* error = nullptr);
+
+  static QString unitOf(const QString& key);
+
+ signals:
+  void message(const QString& text);
+
+ private:
+  void rebuild();
+  void refreshMarks();
+  QFormLayout* form_ = nullptr;
+  QLabel* title_ = nullptr;
+  QWidget* body_ = nullptr;
+  Document* doc_;
+  std::optional<ElementId> id_;
+  std::map<QString, QWidget*> editors_;
+  QString marked_;
+};
+
+}  // namespace codyna::gui

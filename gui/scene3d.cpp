@@ -1,0 +1,737 @@
+#include "gui/scene3d.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <functional>
+#include <limits>
+
+#include "dynamics/kinematics.hpp"
+
+namespace codyna::gui {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+Eigen::Affine3d toAffine(const SE3& X) {
+  Eigen::Affine3d A = Eigen::Affine3d::Identity();
+  A.linear() = X.R;
+  A.translation() = X.p;
+  return A;
+}
+
+Eigen::Affine3d toAffine(const FrameSpec& F) {
+  Eigen::Affine3d A = Eigen::Affine3d::Identity();
+  A.linear() = F.rotation;
+  A.translation() = F.position;
+  return A;
+}
+
+// unit cylinder from a to b with the given radius
+Eigen::Affine3d segment(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius) {
+  const Eigen::Vector3d d = b - a;
+  const double len = d.norm();
+  Eigen::Affine3d A = Eigen::Affine3d::Identity();
+  A.translation() = 0.5 * (a + b);
+  if (len > 0) A.linear() = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), d / len).toRotationMatrix();
+  A.linear() = A.linear() * Eigen::Vector3d(radius, radius, len).asDiagonal();
+  return A;
+}
+
+// arrow item (unit arrow spans z in [-0.5, 0.5]) centred at p along unit axis a
+// (thickness scales the unit arrow's cross-section, like its length for an ordinary arrow)
+Eigen::Affine3d arrowAt(const Eigen::Vector3d& p, const Eigen::Vector3d& a, double length, double thickness) {
+  Eigen::Affine3d A = Eigen::Affine3d::Identity();
+  A.translation() = p;
+  A.linear() = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), a.normalized()).toRotationMatrix() *
+               Eigen::Vector3d(thickness, thickness, length).asDiagonal();
+  return A;
+}
+
+// box around a unit primitive
+Eigen::AlignedBox3d primBox(Prim p) {
+  switch (p) {
+    case Prim::Box: return {Eigen::Vector3d::Constant(-0.5), Eigen::Vector3d::Constant(0.5)};
+    case Prim::Cylinder: return {Eigen::Vector3d(-1, -1, -0.5), Eigen::Vector3d(1, 1, 0.5)};
+    case Prim::Sphere: return {Eigen::Vector3d::Constant(-1), Eigen::Vector3d::Constant(1)};
+    case Prim::Cone: return {Eigen::Vector3d(-1, -1, 0), Eigen::Vector3d(1, 1, 1)};
+    case Prim::Arrow: return {Eigen::Vector3d(-0.1, -0.1, -0.5), Eigen::Vector3d(0.1, 0.1, 0.5)};
+    case Prim::Triad: return {Eigen::Vector3d::Constant(-0.1), Eigen::Vector3d::Constant(1)};
+  }
+  return {Eigen::Vector3d::Constant(-1), Eigen::Vector3d::Constant(1)};
+}
+
+std::array<Eigen::Vector3d, 8> corners(Prim p, const Eigen::Affine3d& T) {
+  const Eigen::AlignedBox3d b = primBox(p);
+  std::array<Eigen::Vector3d, 8> c;
+  for (int k = 0; k < 8; ++k) c[k] = T * b.corner(static_cast<Eigen::AlignedBox3d::CornerType>(k));
+  return c;
+}
+
+// a horizontal direction for "front": world z unless up is (nearly) z, then -y
+Eigen::Vector3d frontFor(const Eigen::Vector3d& up) {
+  Eigen::Vector3d pref = std::abs(up.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d(0, -1, 0);
+  return (pref - pref.dot(up) * up).normalized();
+}
+
+// 1, 2 or 5 times a power of ten, at least x
+double niceStep(double x) {
+  const double e = std::pow(10.0, std::floor(std::log10(x)));
+  for (double m : {1.0, 2.0, 5.0, 10.0})
+    if (m * e >= x * (1 - 1e-9)) return m * e;
+  return 10 * e;
+}
+
+const std::array<Eigen::Vector4f, 6> kPalette = {{
+    {0.25f, 0.45f, 0.80f, 1.0f},
+    {0.90f, 0.55f, 0.15f, 1.0f},
+    {0.25f, 0.65f, 0.30f, 1.0f},
+    {0.75f, 0.25f, 0.25f, 1.0f},
+    {0.55f, 0.35f, 0.70f, 1.0f},
+    {0.20f, 0.60f, 0.65f, 1.0f},
+}};
+
+
+}  // namespace
+
+// ---- meshes ----
+
+void Mesh::addVertex(const Eigen::Vector3f& p, const Eigen::Vector3f& n, const Eigen::Vector3f& c) {
+  data.insert(data.end(), {p.x(), p.y(), p.z(), n.x(), n.y(), n.z(), c.x(), c.y(), c.z()});
+}
+
+void Mesh::append(const Mesh& other, const Eigen::Affine3f& T, const Eigen::Vector3f& color) {
+  const Eigen::Matrix3f N = T.linear().inverse().transpose();
+  for (int v = 0; v < other.vertexCount(); ++v) {
+    const float* s = &other.data[static_cast<size_t>(v) * kStride];
+    const Eigen::Vector3f p = T * Eigen::Vector3f(s[0], s[1], s[2]);
+    const Eigen::Vector3f n = (N * Eigen::Vector3f(s[3], s[4], s[5])).normalized();
+    addVertex(p, n, color.x() >= 0 ? color : Eigen::Vector3f(s[6], s[7], s[8]));
+  }
+}
+
+Mesh unitBox() {
+  Mesh m;
+  const Eigen::Vector3f white(1, 1, 1);
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int sgn : {-1, 1}) {
+      Eigen::Vector3f n = Eigen::Vector3f::Zero();
+      n[axis] = static_cast<float>(sgn);
+      // two in-face directions, ordered so that u x v = n (counter-clockwise from outside)
+      Eigen::Vector3f u = Eigen::Vector3f::Zero(), v;
+      u[(axis + 1) % 3] = 1;
+      v = n.cross(u);
+      const Eigen::Vector3f c = 0.5f * n;
+      const Eigen::Vector3f q[4] = {c - 0.5f * u - 0.5f * v, c + 0.5f * u - 0.5f * v, c + 0.5f * u + 0.5f * v,
+                                    c - 0.5f * u + 0.5f * v};
+      for (int k : {0, 1, 2, 0, 2, 3}) m.addVertex(q[k], n, white);
+    }
+  }
+  return m;
+}
+
+Mesh unitCylinder(int segments) {
+  Mesh m;
+  const Eigen::Vector3f white(1, 1, 1), up(0, 0, 1), down(0, 0, -1);
+  for (int i = 0; i < segments; ++i) {
+    const float a0 = static_cast<float>(2 * kPi * i / segments), a1 = static_cast<float>(2 * kPi * (i + 1) / segments);
+    const Eigen::Vector3f n0(std::cos(a0), std::sin(a0), 0), n1(std::cos(a1), std::sin(a1), 0);
+    const Eigen::Vector3f b0 = n0 + 0.5f * down, b1 = n1 + 0.5f * down, t0 = n0 + 0.5f * up, t1 = n1 + 0.5f * up;
+    m.addVertex(b0, n0, white), m.addVertex(b1, n1, white), m.addVertex(t1, n1, white);
+    m.addVertex(b0, n0, white), m.addVertex(t1, n1, white), m.addVertex(t0, n0, white);
+    m.addVertex(0.5f * up, up, white), m.addVertex(t0, up, white), m.addVertex(t1, up, white);
+    m.addVertex(0.5f * down, down, white), m.addVertex(b1, down, white), m.addVertex(b0, down, white);
+  }
+  return m;
+}
+
+Mesh unitSphere(int segments, int rings) {
+  Mesh m;
+  const Eigen::Vector3f white(1, 1, 1);
+  auto at = [&](int i, int j) {
+    const double th = kPi * j / rings, ph = 2 * kPi * i / segments;
+    return Eigen::Vector3f(static_cast<float>(std::sin(th) * std::cos(ph)), static_cast<float>(std::sin(th) * std::sin(ph)),
+                           static_cast<float>(std::cos(th)));
+  };
+  for (int j = 0; j < rings; ++j) {
+    for (int i = 0; i < segments; ++i) {
+      const Eigen::Vector3f a = at(i, j), b = at(i, j + 1), c = at(i + 1, j + 1), d = at(i + 1, j);
+      if (j > 0) m.addVertex(a, a, white), m.addVertex(b, b, white), m.addVertex(d, d, white);
+      if (j < rings - 1) m.addVertex(b, b, white), m.addVertex(c, c, white), m.addVertex(d, d, white);
+    }
+  }
+  return m;
+}
+
+Mesh unitCone(int segments) {
+  Mesh m;
+  const Eigen::Vector3f white(1, 1, 1), apex(0, 0, 1), down(0, 0, -1);
+  const float s = static_cast<float>(1 / std::sqrt(2.0));
+  for (int i = 0; i < segments; ++i) {
+    const float a0 = static_cast<float>(2 * kPi * i / segments), a1 = static_cast<float>(2 * kPi * (i + 1) / segments);
+    const float am = 0.5f * (a0 + a1);
+    const Eigen::Vector3f p0(std::cos(a0), std::sin(a0), 0), p1(std::cos(a1), std::sin(a1), 0);
+    m.addVertex(p0, Eigen::Vector3f(s * std::cos(a0), s * std::sin(a0), s), white);
+    m.addVertex(p1, Eigen::Vector3f(s * std::cos(a1), s * std::sin(a1), s), white);
+    m.addVertex(apex, Eigen::Vector3f(s * std::cos(am), s * std::sin(am), s), white);
+    m.addVertex(Eigen::Vector3f::Zero(), down, white), m.addVertex(p1, down, white), m.addVertex(p0, down, white);
+  }
+  return m;
+}
+
+Mesh arrowMesh(int segments) {
+  const Mesh cyl = unitCylinder(segments), cone = unitCone(segments);
+  Mesh m;
+  const float shaft = 0.78f;  // z from -0.5 to 0.28, then the head
+  Eigen::Affine3f T = Eigen::Affine3f::Identity();
+  T.translate(Eigen::Vector3f(0, 0, -0.5f + 0.5f * shaft));
+  T.scale(Eigen::Vector3f(0.022f, 0.022f, shaft));
+  m.append(cyl, T);
+  T = Eigen::Affine3f::Identity();
+  T.translate(Eigen::Vector3f(0, 0, -0.5f + shaft));
+  T.scale(Eigen::Vector3f(0.06f, 0.06f, 1.0f - shaft));
+  m.append(cone, T);
+  return m;
+}
+
+Mesh triadMesh(int segments) {
+  const Mesh arrow = arrowMesh(segments);
+  Mesh m;
+  const Eigen::Vector3f colors[3] = {{0.90f, 0.15f, 0.15f}, {0.15f, 0.72f, 0.15f}, {0.15f, 0.30f, 0.95f}};
+  const Eigen::Matrix3f rot[3] = {
+      Eigen::AngleAxisf(static_cast<float>(kPi / 2), Eigen::Vector3f::UnitY()).toRotationMatrix(),
+      Eigen::AngleAxisf(static_cast<float>(-kPi / 2), Eigen::Vector3f::UnitX()).toRotationMatrix(),
+      Eigen::Matrix3f::Identity()};
+  for (int k = 0; k < 3; ++k) {
+    Eigen::Affine3f T = Eigen::Affine3f::Identity();
+    T.linear() = rot[k] * Eigen::Vector3f(1.4f, 1.4f, 1.0f).asDiagonal();  // thicker than a joint axis, length 1
+    T.translation() = rot[k] * Eigen::Vector3f(0, 0, 0.5f);
+    m.append(arrow, T, colors[k]);
+  }
+  return m;
+}
+
+// ---- picking ----
+
+double intersect(Prim prim, const Eigen::Affine3d& world, const Ray& ray) {
+  if (std::abs(world.linear().determinant()) < 1e-30) return -1;
+  const Eigen::Affine3d inv = world.inverse(Eigen::Affine);
+  const Eigen::Vector3d o = inv * ray.origin, d = inv.linear() * ray.dir;
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  switch (prim) {
+    case Prim::Box: {
+      double t0 = -inf, t1 = inf;
+      for (int k = 0; k < 3; ++k) {
+        if (std::abs(d[k]) < 1e-300) {
+          if (std::abs(o[k]) > 0.5) return -1;
+          continue;
+        }
+        double a = (-0.5 - o[k]) / d[k], b = (0.5 - o[k]) / d[k];
+        if (a > b) std::swap(a, b);
+        t0 = std::max(t0, a), t1 = std::min(t1, b);
+      }
+      if (t0 > t1 || t1 < 0) return -1;
+      return std::max(t0, 0.0);
+    }
+    case Prim::Sphere: {
+      const double a = d.dot(d), b = 2 * o.dot(d), c = o.dot(o) - 1;
+      const double disc = b * b - 4 * a * c;
+      if (disc < 0) return -1;
+      const double s = std::sqrt(disc), t0 = (-b - s) / (2 * a), t1 = (-b + s) / (2 * a);
+      if (t1 < 0) return -1;
+      return std::max(t0, 0.0);
+    }
+    case Prim::Cylinder: {
+      double best = inf;
+      if (o.head<2>().squaredNorm() <= 1 && std::abs(o.z()) <= 0.5) return 0;  // starts inside
+      const double a = d.x() * d.x() + d.y() * d.y(), b = 2 * (o.x() * d.x() + o.y() * d.y()),
+                   c = o.x() * o.x() + o.y() * o.y() - 1;
+      if (a > 1e-300) {
+        const double disc = b * b - 4 * a * c;
+        if (disc >= 0) {
+          for (double t : {(-b - std::sqrt(disc)) / (2 * a), (-b + std::sqrt(disc)) / (2 * a)})
+            if (t >= 0 && std::abs(o.z() + t * d.z()) <= 0.5) best = std::min(best, t);
+        }
+      }
+      if (std::abs(d.z()) > 1e-300) {
+        for (double zc : {-0.5, 0.5}) {
+          const double t = (zc - o.z()) / d.z();
+          if (t >= 0 && (o.head<2>() + t * d.head<2>()).squaredNorm() <= 1) best = std::min(best, t);
+        }
+      }
+      return best < inf ? best : -1;
+    }
+    default:
+      return -1;
+  }
+}
+
+// ---- scene ----
+
+void Scene::build(const Model* model) {
+  model_ = model;
+  items_.clear();
+  up_ = Eigen::Vector3d::UnitY();
+  length_ = 1.0;
+  if (!model) {
+    grid_center_.setZero();
+    grid_half_ = 2.0, grid_step_ = 0.5;
+    return;
+  }
+  const Model& m = *model;
+  if (m.has_gravity && m.gravity.norm() > 0) up_ = -m.gravity.normalized();
+
+  Data data(m);
+  forward_kinematics(m, data, m.q0);
+
+  // declared shapes
+  std::vector<bool> has_shapes(m.nbodies, false);
+  for (int i = 1; i < m.nbodies; ++i) {
+    const int k = m.body_spec_index[i];
+    if (k < 0 || k >= static_cast<int>(m.spec.bodies.size())) continue;
+    for (const ShapeSpec& s : m.spec.bodies[k].shapes) {
+      Item it;
+      it.body = i;
+      it.color = s.color.cast<float>();
+      const Eigen::Affine3d F = toAffine(s.frame);
+      switch (s.type) {
+        case ShapeType::Box:
+          it.prim = Prim::Box;
+          it.local = F * Eigen::Scaling(s.size.cwiseMax(1e-9));
+          break;
+        case ShapeType::Cylinder:
+          it.prim = Prim::Cylinder;
+          it.local = F * Eigen::Scaling(s.radius, s.radius, s.length);
+          break;
+        case ShapeType::Sphere:
+          it.prim = Prim::Sphere;
+          it.local = F * Eigen::Scaling(s.radius, s.radius, s.radius);
+          break;
+      }
+      items_.push_back(it);
+      has_shapes[i] = true;
+    }
+  }
+
+  // a provisional size from where the joints are, for bodies that have nothing else
+  Eigen::AlignedBox3d joints_box;
+  joints_box.extend(Eigen::Vector3d::Zero());
+  for (int i = 1; i < m.nbodies; ++i) {
+    joints_box.extend(data.oMi[i].p);
+    joints_box.extend(data.oMi[i].act_point(m.com[i]));
+  }
+  length_ = std::max(joints_box.diagonal().norm(), 1e-3);
+  for (int i = 1; i < m.nbodies; ++i)
+    if (!has_shapes[i]) addDefaultLook(i);
+
+  update(data.oMi);
+  const Eigen::AlignedBox3d box = bounds();
+  length_ = std::max(box.diagonal().norm(), 1e-6);
+  const double L = length_;
+
+  // body sizes in their own frames, for overlay sizes
+  std::vector<double> size(m.nbodies, 0.0);
+  for (const Item& it : items_)
+    for (const auto& c : corners(it.prim, it.local)) size[it.body] = std::max(size[it.body], c.norm());
+  for (int i = 1; i < m.nbodies; ++i) {
+    size[i] = std::max(size[i], m.joints[i].X_CM.p.norm());
+    for (int c = i + 1; c < m.nbodies; ++c)
+      if (m.parent[c] == i) size[i] = std::max(size[i], m.joints[c].X_PF.p.norm());
+  }
+
+  // ground anchors where joints and loop closures meet the ground
+  auto anchor = [&](const Eigen::Vector3d& p, const Eigen::Matrix3d& R, double s) {
+    Item it;
+    it.kind = ItemKind::Anchor;
+    it.prim = Prim::Box;
+    it.body = 0;
+    it.local = Eigen::Affine3d::Identity();
+    it.local.translation() = p;
+    it.local.linear() = R * s;
+    it.color = {0.36f, 0.37f, 0.40f, 1.0f};
+    items_.push_back(it);
+  };
+  // a block a little larger than the ball of the body at that point, so that it shows
+  auto anchorSize = [&](int body, const Eigen::Vector3d& p_body) {
+    double ball = 0;
+    for (const Item& it : items_)
+      if (it.kind == ItemKind::Shape && it.body == body && it.prim == Prim::Sphere &&
+          (it.local.translation() - p_body).norm() < 1e-9)
+        ball = std::max(ball, it.local.linear().col(0).norm());
+    return std::clamp(std::max(2.4 * ball, 0.04 * L), 0.01 * L, 0.1 * L);
+  };
+  for (int i = 1; i < m.nbodies; ++i)
+    if (m.parent[i] == 0) anchor(m.joints[i].X_PF.p, m.joints[i].X_PF.R, anchorSize(i, m.joints[i].X_CM.p));
+  for (const ConstraintModel& c : m.constraints) {
+    if (c.body_a == 0) anchor(c.point_a, Eigen::Matrix3d::Identity(), anchorSize(c.body_b, c.point_b));
+    if (c.body_b == 0) anchor(c.point_b, Eigen::Matrix3d::Identity(), anchorSize(c.body_a, c.point_a));
+  }
+  for (const SpringDamperModel& sp : m.springs) {
+    if (sp.body_a == 0) anchor(sp.point_a, Eigen::Matrix3d::Identity(), 0.5 * anchorSize(sp.body_b, sp.point_b));
+    if (sp.body_b == 0) anchor(sp.point_b, Eigen::Matrix3d::Identity(), 0.5 * anchorSize(sp.body_a, sp.point_a));
+  }
+
+  // springs
+  for (const SpringDamperModel& s : m.springs) {
+    Item it;
+    it.kind = ItemKind::Spring;
+    it.prim = Prim::Cylinder;
+    it.body = s.body_a, it.body_b = s.body_b;
+    it.point_a = s.point_a, it.point_b = s.point_b;
+    it.thickness = 0.004 * L;
+    it.color = {0.30f, 0.30f, 0.32f, 1.0f};
+    items_.push_back(it);
+  }
+
+  // joint axes (on the parent's joint frame F; a universal's second axis on the child's M)
+  const Eigen::Vector4f revolute_color{0.95f, 0.80f, 0.10f, 1.0f}, slide_color{0.85f, 0.20f, 0.75f, 1.0f};
+  for (int i = 1; i < m.nbodies; ++i) {
+    const JointModel& j = m.joints[i];
+    const double thick = std::clamp(0.6 * size[i], 0.06 * L, 0.2 * L);
+    double len = thick;
+    if (j.type == JointType::Prismatic || j.type == JointType::Cylindrical)
+      len = std::min(std::max(2.5 * size[i], 0.4 * L), L);  // a rail that reaches out of the slider
+    auto axis = [&](int body, const SE3& X, const Eigen::Vector3d& a, const Eigen::Vector4f& color) {
+      Item it;
+      it.kind = ItemKind::Axis;
+      it.prim = Prim::Arrow;
+      it.body = body;
+      it.local = arrowAt(X.p, X.R * a, len, thick);
+      it.color = color;
+      items_.push_back(it);
+    };
+    switch (j.type) {
+      case JointType::Revolute: axis(j.parent, j.X_PF, j.axis, revolute_color); break;
+      case JointType::Prismatic: axis(j.parent, j.X_PF, j.axis, slide_color); break;
+      case JointType::Cylindrical:
+        axis(j.parent, j.X_PF, j.axis, slide_color);
+        break;
+      case JointType::Universal:
+        axis(j.parent, j.X_PF, j.axis, revolute_color);
+        axis(i, j.X_CM, j.axis2, revolute_color);
+        break;
+      default: break;
+    }
+  }
+
+  // body frames, and the world frame
+  for (int i = 0; i < m.nbodies; ++i) {
+    Item it;
+    it.kind = ItemKind::Frame;
+    it.prim = Prim::Triad;
+    it.body = i;
+    const double len = i == 0 ? 0.08 * L : std::clamp(0.4 * size[i], 0.03 * L, 0.1 * L);
+    it.local = Eigen::Affine3d(Eigen::Scaling(len));
+    it.color = {1, 1, 1, 1};
+    items_.push_back(it);
+  }
+
+  update(data.oMi);
+  placeGrid(data.oMi);
+}
+
+void Scene::addDefaultLook(int i) {
+  const Model& m = *model_;
+  const Eigen::Vector3d com = m.com[i];
+  const Eigen::Vector3d inboard = m.joints[i].X_CM.p;
+  std::vector<Eigen::Vector3d> ends;  // link ends other than the inboard joint
+  for (int c = i + 1; c < m.nbodies; ++c)
+    if (m.parent[c] == i) ends.push_back(m.joints[c].X_PF.p);
+  for (const ConstraintModel& c : m.constraints) {
+    if (c.body_a == i) ends.push_back(c.point_a);
+    if (c.body_b == i) ends.push_back(c.point_b);
+  }
+  double extent = (inboard - com).norm();
+  for (const auto& e : ends) extent = std::max({extent, (e - com).norm(), (e - inboard).norm()});
+
+  double r_ball;
+  if (extent > 1e-9) {
+    r_ball = 0.12 * extent;
+  } else {
+    // nothing to connect: a ball of the body's radius of gyration, else a share of the scene
+    const int k = m.body_spec_index[i];
+    const double mass = m.mass[i];
+    const double trace = k >= 0 ? m.spec.bodies[k].inertia.trace() : 0.0;
+    r_ball = (mass > 0 && trace > 0) ? std::sqrt(2.5 * trace / 3.0 / mass) : 0.05 * length_;
+  }
+  const double r_link = 0.3 * r_ball;
+  const Eigen::Vector4f color = kPalette[static_cast<size_t>(i - 1) % kPalette.size()];
+
+  auto add = [&](Prim p, const Eigen::Affine3d& local, const Eigen::Vector4f& c) {
+    Item it;
+    it.body = i;
+    it.prim = p;
+    it.local = local;
+    it.color = c;
+    items_.push_back(it);
+  };
+  Eigen::Affine3d ball = Eigen::Affine3d::Identity();
+  ball.translation() = com;
+  ball.linear() *= r_ball;
+  add(Prim::Sphere, ball, color);
+  const Eigen::Vector4f pin{0.5f, 0.5f, 0.55f, 1.0f};
+  for (const auto& e : ends) {
+    if ((e - inboard).norm() < 1e-9) continue;
+    add(Prim::Cylinder, segment(inboard, e, r_link), color);
+    Eigen::Affine3d knob = Eigen::Affine3d::Identity();
+    knob.translation() = e;
+    knob.linear() *= 1.6 * r_link;
+    add(Prim::Sphere, knob, pin);
+  }
+  if ((com - inboard).norm() > r_ball) add(Prim::Cylinder, segment(inboard, com, r_link), color);
+  if (extent > 1e-9) {
+    Eigen::Affine3d knob = Eigen::Affine3d::Identity();
+    knob.translation() = inboard;
+    knob.linear() *= 1.6 * r_link;
+    add(Prim::Sphere, knob, pin);
+  }
+}
+
+void Scene::update(const std::vector<SE3>& oMi) {
+  for (Item& it : items_) {
+    if (it.kind == ItemKind::Spring) {
+      const Eigen::Vector3d a = oMi[it.body].act_point(it.point_a), b = oMi[it.body_b].act_point(it.point_b);
+      it.world = segment(a, b, it.thickness);
+      continue;
+    }
+    it.world = toAffine(oMi[it.body]) * it.local;
+  }
+}
+
+Eigen::AlignedBox3d Scene::bounds() const {
+  Eigen::AlignedBox3d box;
+  for (const Item& it : items_) {
+    if (it.kind != ItemKind::Shape && it.kind != ItemKind::Anchor && it.kind != ItemKind::Spring) continue;
+    for (const auto& c : corners(it.prim, it.world)) box.extend(c);
+  }
+  if (box.isEmpty()) {
+    box.extend(Eigen::Vector3d::Constant(-1));
+    box.extend(Eigen::Vector3d::Constant(1));
+  }
+  return box;
+}
+
+Eigen::AlignedBox3d Scene::viewBounds(bool overlays) const {
+  Eigen::AlignedBox3d box = bounds();
+  if (!model_) return box;
+  if (overlays)
+    for (const Item& it : items_)
+      if (it.kind == ItemKind::Axis || it.kind == ItemKind::Frame)
+        for (const auto& c : corners(it.prim, it.world)) box.extend(c);
+  const double h = grid_center_.dot(up_);
+  Eigen::AlignedBox3d out = box;
+  for (int k = 0; k < 8; ++k) {
+    const Eigen::Vector3d c = box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(k));
+    out.extend(c - (c.dot(up_) - h) * up_);
+  }
+  return out;
+}
+
+int Scene::pick(const Ray& ray, double* distance) const {
+  int best = -1;
+  double best_t = std::numeric_limits<double>::infinity();
+  for (const Item& it : items_) {
+    if (it.kind != ItemKind::Shape && it.kind != ItemKind::Anchor) continue;  // anchors hide what is behind them
+    const double t = intersect(it.prim, it.world, ray);
+    // ties go to the later item, as with the depth test (GL_LEQUAL) in drawing order
+    if (t >= 0 && t <= best_t) best_t = t, best = it.body;
+  }
+  if (distance) *distance = best >= 0 ? best_t : -1;
+  return best;
+}
+
+bool Scene::bodyAnchor(int body, Eigen::Vector3d* point) const {
+  double best = -1;
+  for (const Item& it : items_) {
+    if (it.kind != ItemKind::Shape || it.body != body) continue;
+    const double v = std::abs(it.world.linear().determinant()) * (it.prim == Prim::Box ? 1.0 : kPi);
+    if (v > best) best = v, *point = it.world.translation();
+  }
+  return best >= 0;
+}
+
+void Scene::placeGrid(const std::vector<SE3>& oMi) {
+  const Model& m = *model_;
+  const Eigen::AlignedBox3d box = bounds();
+  const double L = length_;
+  double low = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 8; ++k) low = std::min(low, box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(k)).dot(up_));
+
+  // how far each subtree reaches from its inboard joint, so that the grid
+  // stays under the mechanism as it swings (a bound: loops reach less)
+  std::vector<double> reach(m.nbodies, 0.0);
+  for (const Item& it : items_)
+    if (it.kind == ItemKind::Shape && it.body > 0)
+      for (const auto& c : corners(it.prim, it.local))
+        reach[it.body] = std::max(reach[it.body], (c - m.joints[it.body].X_CM.p).norm());
+  for (int i = m.nbodies - 1; i >= 1; --i) {
+    const int p = m.parent[i];
+    if (p > 0) reach[p] = std::max(reach[p], (m.joints[i].X_PF.p - m.joints[p].X_CM.p).norm() + reach[i]);
+  }
+  // the lowest point each root subtree can reach: its own geometry exactly as
+  // the root joint moves it, deeper subtrees as spheres of their reach
+  double bound = low;
+  for (int i = 1; i < m.nbodies; ++i) {
+    if (m.parent[i] != 0) continue;
+    const JointModel& j = m.joints[i];
+    const Eigen::Vector3d J = j.X_PF.p, a = j.X_PF.R * j.axis;
+    const double a_up = a.dot(up_), across = std::sqrt(std::max(0.0, 1 - a_up * a_up));
+    std::function<double(const Eigen::Vector3d&)> lowest;  // lowest height of a point of body i (world, at q0)
+    switch (j.type) {
+      case JointType::Revolute:
+        lowest = [&](const Eigen::Vector3d& x) {
+          const double s = (x - J).dot(a);
+          return J.dot(up_) + s * a_up - ((x - J) - s * a).norm() * across;
+        };
+        break;
+      case JointType::Fixed:
+        lowest = [&](const Eigen::Vector3d& x) { return x.dot(up_); };
+        break;
+      case JointType::Prismatic:
+        if (std::abs(a_up) > 1e-9) continue;  // slides up and down without bound: trust q0
+        lowest = [&](const Eigen::Vector3d& x) { return x.dot(up_); };
+        break;
+      case JointType::Spherical:
+      case JointType::Universal:
+      case JointType::Cylindrical:
+        bound = std::min(bound, J.dot(up_) - reach[i]);
+        continue;
+      default:
+        continue;  // free, planar: no useful bound
+    }
+    for (const Item& it : items_)
+      if (it.kind == ItemKind::Shape && it.body == i)
+        for (const auto& c : corners(it.prim, it.world)) bound = std::min(bound, lowest(c));
+    for (int c = i + 1; c < m.nbodies; ++c)
+      if (m.parent[c] == i) bound = std::min(bound, lowest(oMi[i].act_point(m.joints[c].X_PF.p)) - reach[c]);
+  }
+  // loops keep links from hanging at full reach, so trust the bound less there
+  const double slack = m.constraints.empty() ? 1.2 : 0.5;
+  const double height = std::min(low, std::max(bound, low - slack * L)) - 0.02 * L;
+
+  // centre under the mechanism, snapped to the grid so that lines go through the world origin
+  grid_step_ = niceStep(L / 8);
+  const double extent = std::max(0.75 * L, 4 * grid_step_);
+  grid_half_ = grid_step_ * std::ceil(extent / grid_step_);
+  const Eigen::Vector3d e1 = frontFor(up_), e2 = up_.cross(e1);
+  const Eigen::Vector3d c = box.center();
+  const double c1 = grid_step_ * std::round(c.dot(e1) / grid_step_), c2 = grid_step_ * std::round(c.dot(e2) / grid_step_);
+  grid_center_ = c1 * e1 + c2 * e2 + height * up_;
+}
+
+std::vector<float> Scene::gridLines() const {
+  std::vector<float> v;
+  const Eigen::Vector3d e1 = frontFor(up_), e2 = up_.cross(e1);
+  const int n = static_cast<int>(std::lround(grid_half_ / grid_step_));
+  const double o1 = grid_center_.dot(e1), o2 = grid_center_.dot(e2);
+  auto put = [&](const Eigen::Vector3d& p, const Eigen::Vector3f& c) {
+    v.insert(v.end(), {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()), c.x(), c.y(), c.z()});
+  };
+  const Eigen::Vector3f minor(0.66f, 0.68f, 0.72f), major(0.50f, 0.52f, 0.57f);
+  for (int k = -n; k <= n; ++k) {
+    for (int dir = 0; dir < 2; ++dir) {
+      const Eigen::Vector3d a = dir == 0 ? e1 : e2, b = dir == 0 ? e2 : e1;  // line along b at offset k along a
+      const double along_a = (dir == 0 ? o1 : o2) + k * grid_step_;
+      const long idx = std::lround(along_a / grid_step_);
+      const Eigen::Vector3f& col = idx % 5 == 0 ? major : minor;
+      const Eigen::Vector3d base = grid_center_ + k * grid_step_ * a;
+      put(base - grid_half_ * b, col);
+      put(base + grid_half_ * b, col);
+    }
+  }
+  return v;
+}
+
+// ---- camera ----
+
+void Camera::setUp(const Eigen::Vector3d& u) {
+  up = u.normalized();
+  front = frontFor(up);
+}
+
+Eigen::Vector3d Camera::eye() const { return target - distance * forward(); }
+
+Eigen::Vector3d Camera::forward() const {
+  const Eigen::Vector3d side = up.cross(front);
+  const Eigen::Vector3d to_eye =
+      std::cos(pitch) * (std::cos(yaw) * front + std::sin(yaw) * side) + std::sin(pitch) * up;
+  return -to_eye.normalized();
+}
+
+Eigen::Vector3d Camera::right() const { return forward().cross(up).normalized(); }
+
+Eigen::Vector3d Camera::screenUp() const { return right().cross(forward()); }
+
+Eigen::Matrix4d Camera::viewMatrix() const {
+  const Eigen::Vector3d f = forward(), r = right(), u = screenUp(), e = eye();
+  Eigen::Matrix4d V = Eigen::Matrix4d::Identity();
+  V.block<1, 3>(0, 0) = r.transpose();
+  V.block<1, 3>(1, 0) = u.transpose();
+  V.block<1, 3>(2, 0) = -f.transpose();
+  V(0, 3) = -r.dot(e), V(1, 3) = -u.dot(e), V(2, 3) = f.dot(e);
+  return V;
+}
+
+double Camera::farPlane() const { return distance + 2.5 * scene_radius; }
+
+double Camera::nearPlane() const { return std::max(distance - 2.5 * scene_radius, farPlane() * 1e-3); }
+
+Eigen::Matrix4d Camera::projectionMatrix() const {
+  const double n = nearPlane(), f = farPlane();
+  const double t = 1.0 / std::tan(fovy / 2), aspect = double(std::max(width, 1)) / std::max(height, 1);
+  Eigen::Matrix4d P = Eigen::Matrix4d::Zero();
+  P(0, 0) = t / aspect;
+  P(1, 1) = t;
+  P(2, 2) = (f + n) / (n - f);
+  P(2, 3) = 2 * f * n / (n - f);
+  P(3, 2) = -1;
+  return P;
+}
+
+bool Camera::project(const Eigen::Vector3d& world, Eigen::Vector2d* pixel) const {
+  const Eigen::Vector3d d = world - eye();
+  const double z = d.dot(forward());
+  if (z <= 1e-12) return false;
+  const double th = std::tan(fovy / 2), aspect = double(std::max(width, 1)) / std::max(height, 1);
+  const double xn = d.dot(right()) / z / (th * aspect), yn = d.dot(screenUp()) / z / th;
+  *pixel = {(xn + 1) / 2 * width, (1 - yn) / 2 * height};
+  return true;
+}
+
+Ray Camera::rayAt(double px, double py) const {
+  const double th = std::tan(fovy / 2), aspect = double(std::max(width, 1)) / std::max(height, 1);
+  const double xn = 2 * px / std::max(width, 1) - 1, yn = 1 - 2 * py / std::max(height, 1);
+  Ray r;
+  r.origin = eye();
+  r.dir = (forward() + xn * th * aspect * right() + yn * th * screenUp()).normalized();
+  return r;
+}
+
+void Camera::fit(const Eigen::AlignedBox3d& box) {
+  target = box.center();
+  const double th_y = std::tan(fovy / 2), th_x = th_y * double(std::max(width, 1)) / std::max(height, 1);
+  const Eigen::Vector3d f = forward(), r = right(), u = screenUp();
+  // each corner must be inside the frustum: |x| <= (d - z) tan, z towards the eye
+  double d = 1e-6;
+  for (int k = 0; k < 8; ++k) {
+    const Eigen::Vector3d c = box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(k)) - target;
+    const double x = c.dot(r), y = c.dot(u), z = -c.dot(f);
+    d = std::max({d, std::abs(x) / th_x + z, std::abs(y) / th_y + z});
+  }
+  distance = 1.06 * d + 1e-9;  // a small margin
+}
+
+void Camera::orbit(double dx_px, double dy_px) {
+  yaw -= 0.008 * dx_px;
+  pitch = std::clamp(pitch + 0.008 * dy_px, -1.55, 1.55);
+}
+
+void Camera::pan(double dx_px, double dy_px) {
+  const double per_px = 2 * distance * std::tan(fovy / 2) / std::max(height, 1);
+  target += per_px * (-dx_px * right() + dy_px * screenUp());
+}
+
+void Camera::zoom(double steps) { distance = std::max(distance * std::pow(0.85, steps), 1e-9); }
+
+}  // namespace codyna::gui

@@ -1,0 +1,145 @@
+// Scene3D: what the 3-D view draws and picks, without Qt or OpenGL.
+//
+// - Mesh: unit primitives (box, cylinder, sphere, cone, arrow, triad) as
+//   triangle lists; every drawn object is one of them under an affine map.
+// - Scene: the items of a Model (its declared shapes, or a default look for
+//   bodies without shapes, joint axes, body triads, springs, ground anchors)
+//   with their world transforms for one configuration, a ground grid and
+//   ray picking against the same transforms that are drawn.
+// - Camera: an orbit camera (yaw about "up", pitch above the ground plane)
+//   with projection to pixels and the pixel ray, for drawing and picking.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+#include "model/data.hpp"
+#include "model/model.hpp"
+
+namespace codyna::gui {
+
+// interleaved triangle vertices: x y z, nx ny nz, r g b
+struct Mesh {
+  static constexpr int kStride = 9;
+  std::vector<float> data;
+  int vertexCount() const { return static_cast<int>(data.size()) / kStride; }
+  void addVertex(const Eigen::Vector3f& p, const Eigen::Vector3f& n, const Eigen::Vector3f& c);
+  // appends `other` mapped by T (normals by T's inverse transpose), recoloured when `color` has x >= 0
+  void append(const Mesh& other, const Eigen::Affine3f& T, const Eigen::Vector3f& color = Eigen::Vector3f(-1, 0, 0));
+};
+
+Mesh unitBox();                        // [-0.5, 0.5]^3
+Mesh unitCylinder(int segments);       // radius 1, z in [-0.5, 0.5], capped
+Mesh unitSphere(int segments, int rings);  // radius 1
+Mesh unitCone(int segments);           // base radius 1 at z = 0, apex at z = 1
+Mesh arrowMesh(int segments);          // z in [-0.5, 0.5], tip at +z, radius ~0.06 (length 1)
+Mesh triadMesh(int segments);          // red x, green y, blue z arrows of length 1 from the origin
+
+enum class Prim { Box, Cylinder, Sphere, Cone, Arrow, Triad };
+
+enum class ItemKind {
+  Shape,    // body geometry (declared or default); pickable
+  Anchor,   // ground pivots; drawn, not pickable
+  Axis,     // joint axis arrow (overlay)
+  Frame,    // body frame triad (overlay)
+  Spring,   // spring-damper between two bodies
+};
+
+struct Item {
+  ItemKind kind = ItemKind::Shape;
+  Prim prim = Prim::Box;
+  int body = 0;                       // model body index (0 = ground)
+  Eigen::Affine3d local = Eigen::Affine3d::Identity();  // unit primitive -> body frame
+  Eigen::Affine3d world = Eigen::Affine3d::Identity();  // unit primitive -> world (update())
+  Eigen::Vector4f color{0.7f, 0.7f, 0.75f, 1.0f};
+  // springs only: end points on body (a = `body`) and body_b
+  int body_b = 0;
+  Eigen::Vector3d point_a = Eigen::Vector3d::Zero(), point_b = Eigen::Vector3d::Zero();
+  double thickness = 0.0;
+};
+
+struct Ray {
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  Eigen::Vector3d dir = Eigen::Vector3d::UnitZ();  // unit
+};
+
+// distance along `ray` to the unit primitive under `world`, or a negative value on a miss
+double intersect(Prim prim, const Eigen::Affine3d& world, const Ray& ray);
+
+class Scene {
+ public:
+  // builds the items of `model` (nullptr: empty) and places them at model->q0
+  void build(const Model* model);
+  // recomputes the world transforms from body poses (oMi of forward_kinematics)
+  void update(const std::vector<SE3>& oMi);
+
+  const Model* model() const { return model_; }
+  const std::vector<Item>& items() const { return items_; }
+  double length() const { return length_; }      // characteristic size of the mechanism
+  Eigen::Vector3d up() const { return up_; }     // -gravity, or +y
+
+  // world box of the shapes and anchors as placed now
+  Eigen::AlignedBox3d bounds() const;
+  // bounds() (and the overlays) with its shadow on the grid: what fitting the view frames
+  Eigen::AlignedBox3d viewBounds(bool overlays) const;
+  // nearest body hit by the ray: body index, 0 for a ground anchor, -1 for the background
+  int pick(const Ray& ray, double* distance = nullptr) const;
+  // a world point guaranteed on a body's geometry (centre of its largest shape); false if none
+  bool bodyAnchor(int body, Eigen::Vector3d* point) const;
+
+  // ground grid: square of half-size gridHalf() centred at gridCenter(), normal up(), line spacing gridStep()
+  Eigen::Vector3d gridCenter() const { return grid_center_; }
+  double gridHalf() const { return grid_half_; }
+  double gridStep() const { return grid_step_; }
+  // line vertices of the grid (x y z r g b pairs)
+  std::vector<float> gridLines() const;
+
+ private:
+  void addDefaultLook(int body);
+  void placeGrid(const std::vector<SE3>& oMi);
+
+  const Model* model_ = nullptr;
+  std::vector<Item> items_;
+  double length_ = 1.0;
+  Eigen::Vector3d up_ = Eigen::Vector3d::UnitY();
+  Eigen::Vector3d grid_center_ = Eigen::Vector3d::Zero();
+  double grid_half_ = 2.0, grid_step_ = 0.5;
+};
+
+// Orbit camera. Pixel coordinates are widget coordinates: x right, y down.
+struct Camera {
+  Eigen::Vector3d target = Eigen::Vector3d::Zero();
+  Eigen::Vector3d up = Eigen::Vector3d::UnitY();     // world up (unit)
+  Eigen::Vector3d front = Eigen::Vector3d::UnitZ();  // horizontal direction to the eye at yaw 0 (unit, _|_ up)
+  double distance = 5.0;
+  double yaw = 0.0, pitch = 0.0;   // rad; pitch > 0 looks down on the ground
+  double fovy = 0.61;              // rad (35 degrees)
+  int width = 640, height = 480;   // viewport, pixels
+  double scene_radius = 1.0;       // for the clip planes
+
+  static constexpr double kDefaultYaw = 0.45, kDefaultPitch = 0.35;
+
+  void setUp(const Eigen::Vector3d& u);  // also picks `front`
+  Eigen::Vector3d eye() const;
+  Eigen::Vector3d forward() const;       // unit, eye -> target
+  Eigen::Vector3d right() const;         // unit, screen x
+  Eigen::Vector3d screenUp() const;      // unit, screen -y
+  Eigen::Matrix4d viewMatrix() const;
+  Eigen::Matrix4d projectionMatrix() const;
+  double nearPlane() const;
+  double farPlane() const;
+
+  // pixel position of a world point; false when behind the eye
+  bool project(const Eigen::Vector3d& world, Eigen::Vector2d* pixel) const;
+  Ray rayAt(double px, double py) const;
+
+  // frames a world box (whole box visible whatever the aspect ratio)
+  void fit(const Eigen::AlignedBox3d& box);
+  void orbit(double dx_px, double dy_px);
+  void pan(double dx_px, double dy_px);
+  void zoom(double steps);  // > 0: closer
+};
+
+}  // namespace codyna::gui

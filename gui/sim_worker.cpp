@@ -1,0 +1,132 @@
+#include "gui/sim_worker.hpp"
+
+#include <exception>
+#include <utility>
+
+#include "study/workflow.hpp"
+
+namespace codyna::gui {
+
+SimWorker::SimWorker(QObject* parent) : QObject(parent) {
+  qRegisterMetaType<codyna::gui::SampleBatch>("codyna::gui::SampleBatch");
+  qRegisterMetaType<std::shared_ptr<const codyna::SimulationResult>>("std::shared_ptr<const codyna::SimulationResult>");
+}
+
+SimWorker::~SimWorker() {
+  if (thread_) {
+    cancel_.store(true);
+    thread_->wait();  // what it posted to this object is dropped with it
+    delete thread_;
+  }
+}
+
+bool SimWorker::start(std::shared_ptr<const codyna::Model> model) {
+  if (running_ || !model) return false;
+  if (thread_) {  // the last run's thread has posted finished() and is about to end
+    thread_->wait();
+    delete thread_;
+    thread_ = nullptr;
+  }
+  cancel_.store(false);
+  integrator_thread_.store(nullptr);
+  running_ = true;
+  batches_ = 0;
+  wall_time_ = 0;
+  controller_source_.clear();
+  pending_.clear();
+  last_t_ = 0;
+  t_end_ = model->spec.solver.t_end;
+  thread_ = QThread::create([this, model] { runJob(model); });
+  thread_->setObjectName(QStringLiteral("codyna-simulation"));
+  emit started();
+  thread_->start();
+  return true;
+}
+
+void SimWorker::cancel() {
+  if (running_) cancel_.store(true);
+}
+
+// ---- worker thread ----
+
+void SimWorker::postBatch(bool force) {
+  if (!force && since_post_.elapsed() < batch_ms_) return;
+  SampleBatch batch;
+  batch.swap(pending_);
+  const double t = last_t_, tEnd = t_end_;
+  since_post_.restart();
+  QMetaObject::invokeMethod(
+      this,
+      [this, batch = std::move(batch), t, tEnd] {
+        ++batches_;
+        if (!batch.isEmpty()) emit samples(batch);
+        emit progress(t, tEnd);
+      },
+      Qt::QueuedConnection);
+}
+
+void SimWorker::runJob(std::shared_ptr<const codyna::Model> model) {
+  QElapsedTimer wall;
+  wall.start();
+  auto fail = [this](const QString& message) {
+    QMetaObject::invokeMethod(
+        this,
+        [this, message] {
+          running_ = false;
+          emit failed(message);
+        },
+        Qt::QueuedConnection);
+  };
+
+  codyna::StudySimulation setup;
+  try {
+    setup = codyna::study_simulation(*model);
+  } catch (const std::exception& e) {
+    return fail(QString::fromStdString(e.what()));
+  } catch (...) {
+    return fail(QStringLiteral("the simulation setup failed (unknown error)"));
+  }
+  const QString source = QString::fromStdString(setup.controller_source);
+  QMetaObject::invokeMethod(
+      this,
+      [this, source] {
+        controller_source_ = source;
+        emit setupDone(source);
+      },
+      Qt::QueuedConnection);
+
+  t_end_ = setup.options.t_end;
+  last_t_ = setup.options.t0;
+  since_post_.start();
+  codyna::SimulationCallbacks cb;
+  cb.cancel = &cancel_;
+  // record() in the simulator calls on_sample, then progress, for every output time
+  cb.on_sample = [this](const codyna::Snapshot& s) { pending_.push_back(s); };
+  cb.progress = [this](double t, double tEnd) {
+    integrator_thread_.store(QThread::currentThread());
+    last_t_ = t;
+    t_end_ = tEnd;
+    postBatch(false);
+  };
+
+  std::shared_ptr<const codyna::SimulationResult> result;
+  try {
+    result = std::make_shared<const codyna::SimulationResult>(codyna::study_simulate(*model, setup, cb));
+  } catch (const std::exception& e) {
+    return fail(QString::fromStdString(e.what()));
+  } catch (...) {
+    return fail(QStringLiteral("the simulation failed (unknown error)"));
+  }
+  postBatch(true);  // the rest, before finished()
+  const double seconds = wall.nsecsElapsed() * 1e-9;
+  QMetaObject::invokeMethod(
+      this,
+      [this, result, seconds] {
+        wall_time_ = seconds;
+        running_ = false;
+        emit finished(result);
+      },
+      Qt::QueuedConnection);
+}
+
+}  // namespace codyna::gui

@@ -1,0 +1,638 @@
+#include "gui/simulate_view.hpp"
+
+#include <QCheckBox>
+#include <QComboBox>
+#include <QDir>
+#include <QDoubleSpinBox>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QFormLayout>
+#include <QGroupBox>
+#include <QHBoxLayout>
+#include <QHeaderView>
+#include <QLabel>
+#include <QLineEdit>
+#include <QProgressBar>
+#include <QPushButton>
+#include <QRegularExpression>
+#include <QSignalBlocker>
+#include <QSplitter>
+#include <QStackedWidget>
+#include <QTableWidget>
+#include <QVBoxLayout>
+#include <algorithm>
+#include <cmath>
+
+#include "gui/document.hpp"
+#include "gui/result_plots.hpp"
+#include "io/results_file.hpp"
+#include "model/model_spec.hpp"
+
+namespace codyna::gui {
+
+namespace {
+
+constexpr int kMergeTEnd = 0x53490001;
+constexpr int kMergeOutputStep = 0x53490002;
+// points per plotted series while a run is live (ResultPlots decimates beyond it):
+// a Qt Charts redraw costs ~10 us per point on the GUI thread, so the live view
+// stays light; the finished result is shown at the plots' own limit
+constexpr int kLivePlotPoints = 2000;
+
+const char* const kIntegrators[] = {"ida", "cvode-bdf", "cvode-adams", "arkode", "rk4"};
+
+QString num(double x, int digits = 6) { return QString::number(x, 'g', digits); }
+
+QString joinNumbers(const std::vector<double>& v) {
+  QStringList l;
+  for (double x : v) l << QString::number(x, 'g', 15);
+  return l.join(QStringLiteral(", "));
+}
+
+// "10, 100 1;1" -> numbers; false on anything else
+bool parseNumbers(const QString& text, std::vector<double>* out) {
+  out->clear();
+  const QStringList parts = text.split(QRegularExpression(QStringLiteral("[,;\\s]+")), Qt::SkipEmptyParts);
+  for (const QString& p : parts) {
+    bool ok = false;
+    const double x = p.toDouble(&ok);
+    if (!ok || !std::isfinite(x)) return false;
+    out->push_back(x);
+  }
+  return true;
+}
+
+QString matrixText(const Eigen::MatrixXd& M) {
+  QStringList rows;
+  for (Eigen::Index r = 0; r < M.rows(); ++r) {
+    QStringList cols;
+    for (Eigen::Index c = 0; c < M.cols(); ++c) cols << num(M(r, c), 4);
+    rows << cols.join(QLatin1Char(' '));
+  }
+  return QLatin1Char('[') + rows.join(QStringLiteral("; ")) + QLatin1Char(']');
+}
+
+QString describeController(const ModelSpec& s) {
+  const ControllerSpec& c = s.controller;
+  const QString at = QObject::tr("about the %1 point").arg(qs(c.operating_point));
+  switch (c.type) {
+    case ControllerType::None:
+      return QObject::tr("The model file declares no controller: the run is open loop (actuators at their nominal values).");
+    case ControllerType::Pid: {
+      QString t = QObject::tr("PID on Plant/Out, %1: u = u0 + Kp (r - y) + Ki \u222b(r - y) - Kd dy/dt, r = %2.")
+                      .arg(at, c.setpoint.size() ? matrixText(c.setpoint.transpose()) : QObject::tr("y0"));
+      return t + QObject::tr(" Gains (Plant/In x Plant/Out):");
+    }
+    case ControllerType::StateFeedback:
+      return QObject::tr("State feedback u = u0 - K (x - x0), %1, K = %2.").arg(at, matrixText(c.K));
+    case ControllerType::Lti:
+      return QObject::tr("LTI controller with %1 states, %2, %3.")
+          .arg(c.Ac.rows())
+          .arg(c.Ts > 0 ? QObject::tr("sampled (Ts = %1 s, zero-order hold)").arg(num(c.Ts)) : QObject::tr("continuous"))
+          .arg(at);
+    case ControllerType::Lqr:
+      return QObject::tr("LQR designed on the plant linearized %1; Q = diag(%2), R = diag(%3).")
+          .arg(at, c.q_weights.empty() ? QObject::tr("1 ... 1") : joinNumbers(c.q_weights),
+               c.r_weights.empty() ? QObject::tr("1 ... 1") : joinNumbers(c.r_weights));
+  }
+  return {};
+}
+
+}  // namespace
+
+SimulateView::SimulateView(Document* doc, QWidget* parent) : QWidget(parent), doc_(doc) {
+  worker_ = new SimWorker(this);
+  buildUi();
+  connect(worker_, &SimWorker::samples, this, &SimulateView::onSamples);
+  connect(worker_, &SimWorker::progress, this, &SimulateView::onProgress);
+  connect(worker_, &SimWorker::finished, this, &SimulateView::onFinished);
+  connect(worker_, &SimWorker::failed, this, &SimulateView::onFailed);
+  connect(worker_, &SimWorker::setupDone, this, [this](const QString& source) {
+    status_ = tr("running (controller: %1)…").arg(source);
+    status_label_->setText(status_);
+  });
+  connect(doc_, &Document::specChanged, this, &SimulateView::refreshFromDocument);
+  refreshFromDocument();
+  setRunning(false);
+}
+
+SimulateView::~SimulateView() {
+  // the worker (a child) cancels and joins its thread in its destructor; disconnect
+  // first so that nothing it still delivers reaches this half-destroyed widget
+  worker_->disconnect(this);
+}
+
+void SimulateView::buildUi() {
+  // ---- controller
+  auto* ctrl_box = new QGroupBox(tr("Controller"), this);
+  auto* ctrl_layout = new QVBoxLayout(ctrl_box);
+  controller_combo_ = new QComboBox(ctrl_box);
+  controller_combo_->addItem(tr("None (open loop)"), QStringLiteral("none"));
+  controller_combo_->addItem(tr("The model file's controller"), QStringLiteral("model"));
+  controller_combo_->addItem(tr("From a .mat file (K, Kp/Ki/Kd or Ac..Dc)"), QStringLiteral("file"));
+  controller_combo_->addItem(tr("LQR designed on the linearized plant"), QStringLiteral("lqr"));
+  ctrl_layout->addWidget(controller_combo_);
+  controller_pages_ = new QStackedWidget(ctrl_box);
+  ctrl_layout->addWidget(controller_pages_);
+
+  auto* none_page = new QLabel(tr("Actuators at their nominal values u0."), controller_pages_);
+  none_page->setWordWrap(true);
+  controller_pages_->addWidget(none_page);
+
+  auto* model_page = new QWidget(controller_pages_);
+  auto* model_layout = new QVBoxLayout(model_page);
+  model_layout->setContentsMargins(0, 0, 0, 0);
+  controller_desc_ = new QLabel(model_page);
+  controller_desc_->setWordWrap(true);
+  pid_table_ = new QTableWidget(model_page);
+  pid_table_->setMaximumHeight(130);
+  pid_table_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
+  pid_table_->setToolTip(tr("PID gains: one row per Plant/In, one column per Plant/Out for each of Kp, Ki, Kd"));
+  model_layout->addWidget(controller_desc_);
+  model_layout->addWidget(pid_table_);
+  controller_pages_->addWidget(model_page);
+
+  auto* file_page = new QWidget(controller_pages_);
+  auto* file_layout = new QHBoxLayout(file_page);
+  file_layout->setContentsMargins(0, 0, 0, 0);
+  file_edit_ = new QLineEdit(file_page);
+  file_edit_->setPlaceholderText(tr("controller.mat (relative to the model file)"));
+  file_browse_ = new QPushButton(tr("…"), file_page);
+  file_layout->addWidget(file_edit_, 1);
+  file_layout->addWidget(file_browse_);
+  controller_pages_->addWidget(file_page);
+
+  auto* lqr_page = new QWidget(controller_pages_);
+  auto* lqr_form = new QFormLayout(lqr_page);
+  lqr_form->setContentsMargins(0, 0, 0, 0);
+  q_weights_ = new QLineEdit(lqr_page);
+  q_weights_->setPlaceholderText(tr("identity"));
+  r_weights_ = new QLineEdit(lqr_page);
+  r_weights_->setPlaceholderText(tr("identity"));
+  lqr_hint_ = new QLabel(lqr_page);
+  lqr_hint_->setWordWrap(true);
+  lqr_form->addRow(tr("Q diagonal"), q_weights_);
+  lqr_form->addRow(tr("R diagonal"), r_weights_);
+  lqr_form->addRow(lqr_hint_);
+  controller_pages_->addWidget(lqr_page);
+
+  // ---- solver
+  auto* solver_box = new QGroupBox(tr("Simulation"), this);
+  auto* form = new QFormLayout(solver_box);
+  t_end_ = new QDoubleSpinBox(solver_box);
+  t_end_->setRange(1e-6, 1e7);
+  t_end_->setDecimals(4);
+  t_end_->setSuffix(QStringLiteral(" s"));
+  t_end_->setKeyboardTracking(false);
+  form->addRow(tr("End time"), t_end_);
+  output_step_ = new QDoubleSpinBox(solver_box);
+  output_step_->setRange(1e-6, 1e5);
+  output_step_->setDecimals(6);
+  output_step_->setSingleStep(0.001);
+  output_step_->setSuffix(QStringLiteral(" s"));
+  output_step_->setKeyboardTracking(false);
+  form->addRow(tr("Output step"), output_step_);
+  integrator_ = new QComboBox(solver_box);
+  for (const char* name : kIntegrators) integrator_->addItem(QLatin1String(name), QLatin1String(name));
+  form->addRow(tr("Integrator"), integrator_);
+  rtol_ = new QLineEdit(solver_box);
+  atol_ = new QLineEdit(solver_box);
+  form->addRow(tr("Relative tolerance"), rtol_);
+  form->addRow(tr("Absolute tolerance"), atol_);
+  compare_linear_ = new QCheckBox(tr("Compare with the linear closed loop"), solver_box);
+  form->addRow(compare_linear_);
+
+  // ---- run
+  run_button_ = new QPushButton(tr("Run"), this);
+  run_button_->setDefault(true);
+  cancel_button_ = new QPushButton(tr("Cancel"), this);
+  progress_ = new QProgressBar(this);
+  progress_->setRange(0, 1000);
+  progress_->setTextVisible(false);
+  status_label_ = new QLabel(tr("Not run yet."), this);
+  status_label_->setWordWrap(true);
+  status_label_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  save_results_ = new QPushButton(tr("Save results…"), this);
+  save_plot_ = new QPushButton(tr("Save plot…"), this);
+  auto* run_row = new QHBoxLayout;
+  run_row->addWidget(run_button_);
+  run_row->addWidget(cancel_button_);
+  auto* save_row = new QHBoxLayout;
+  save_row->addWidget(save_results_);
+  save_row->addWidget(save_plot_);
+
+  auto* left = new QWidget(this);
+  auto* left_layout = new QVBoxLayout(left);
+  left_layout->addWidget(ctrl_box);
+  left_layout->addWidget(solver_box);
+  left_layout->addLayout(run_row);
+  left_layout->addWidget(progress_);
+  left_layout->addWidget(status_label_);
+  left_layout->addLayout(save_row);
+  left_layout->addStretch(1);
+
+  plots_ = new ResultPlots(this);
+  auto* split = new QSplitter(Qt::Horizontal, this);
+  split->addWidget(left);
+  split->addWidget(plots_);
+  split->setStretchFactor(0, 0);
+  split->setStretchFactor(1, 1);
+  auto* layout = new QHBoxLayout(this);
+  layout->setContentsMargins(0, 0, 0, 0);
+  layout->addWidget(split);
+
+  // ---- widgets -> document
+  connect(controller_combo_, &QComboBox::currentIndexChanged, this, [this](int i) {
+    controller_pages_->setCurrentIndex(std::max(0, i));
+    if (i < 0) return;
+    const std::string c = ss(controller_combo_->itemData(i).toString());
+    writeStudy([&](StudySpec& s) { s.controller = c; }, tr("Change the controller"));
+  });
+  connect(pid_table_, &QTableWidget::cellChanged, this, &SimulateView::pidEdited);
+  connect(file_edit_, &QLineEdit::editingFinished, this, [this] {
+    const std::string f = ss(file_edit_->text().trimmed());
+    writeStudy([&](StudySpec& s) { s.controller_file = f; }, tr("Change the controller file"));
+  });
+  connect(file_browse_, &QPushButton::clicked, this, &SimulateView::browseControllerFile);
+  connect(q_weights_, &QLineEdit::editingFinished, this, [this] { weightsEdited(true); });
+  connect(r_weights_, &QLineEdit::editingFinished, this, [this] { weightsEdited(false); });
+  connect(t_end_, &QDoubleSpinBox::valueChanged, this, [this](double v) {
+    writeSolver([&](SolverSpec& s) { s.t_end = v; }, tr("Change the end time"), kMergeTEnd);
+  });
+  connect(output_step_, &QDoubleSpinBox::valueChanged, this, [this](double v) {
+    writeSolver([&](SolverSpec& s) { s.output_step = v; }, tr("Change the output step"), kMergeOutputStep);
+  });
+  connect(integrator_, &QComboBox::currentIndexChanged, this, [this](int i) {
+    if (i < 0) return;
+    const std::string m = ss(integrator_->itemData(i).toString());
+    writeSolver([&](SolverSpec& s) { s.integrator = m; }, tr("Change the integrator"));
+  });
+  connect(rtol_, &QLineEdit::editingFinished, this, [this] { toleranceEdited(true); });
+  connect(atol_, &QLineEdit::editingFinished, this, [this] { toleranceEdited(false); });
+  connect(compare_linear_, &QCheckBox::toggled, this, [this](bool on) {
+    writeStudy([&](StudySpec& s) { s.compare_linear = on; }, on ? tr("Compare with the linear loop") : tr("Do not compare with the linear loop"));
+  });
+
+  connect(run_button_, &QPushButton::clicked, this, &SimulateView::run);
+  connect(cancel_button_, &QPushButton::clicked, this, &SimulateView::cancel);
+  connect(save_results_, &QPushButton::clicked, this, &SimulateView::saveResultsDialog);
+  connect(save_plot_, &QPushButton::clicked, this, &SimulateView::savePlotDialog);
+}
+
+// ---------------------------------------------------------------------------
+// document <-> widgets
+
+void SimulateView::writeStudy(const std::function<void(StudySpec&)>& change, const QString& text, int mergeKey) {
+  if (syncing_) return;
+  StudySpec s = doc_->spec().analysis;
+  change(s);
+  if (s == doc_->spec().analysis) return;
+  doc_->setStudy(s, text, mergeKey);
+}
+
+void SimulateView::writeSolver(const std::function<void(SolverSpec&)>& change, const QString& text, int mergeKey) {
+  if (syncing_) return;
+  SolverSpec s = doc_->spec().solver;
+  change(s);
+  const SolverSpec& o = doc_->spec().solver;
+  if (s.integrator == o.integrator && s.rtol == o.rtol && s.atol == o.atol && s.t_end == o.t_end &&
+      s.output_step == o.output_step && s.max_step == o.max_step)
+    return;
+  doc_->setSolver(s, text, mergeKey);
+}
+
+void SimulateView::refreshFromDocument() {
+  syncing_ = true;
+  const ModelSpec& spec = doc_->spec();
+  const StudySpec& st = spec.analysis;
+  const SolverSpec& so = spec.solver;
+  {
+    const QSignalBlocker b(controller_combo_);
+    const int i = controller_combo_->findData(qs(st.controller));
+    controller_combo_->setCurrentIndex(i);
+    controller_pages_->setCurrentIndex(std::max(0, i));
+  }
+  {
+    const QSignalBlocker b(file_edit_);
+    if (file_edit_->text() != qs(st.controller_file)) file_edit_->setText(qs(st.controller_file));
+  }
+  {
+    const QSignalBlocker b1(q_weights_), b2(r_weights_);
+    q_weights_->setText(joinNumbers(st.q_weights));
+    r_weights_->setText(joinNumbers(st.r_weights));
+  }
+  {
+    const QSignalBlocker b1(t_end_), b2(output_step_), b3(integrator_), b4(rtol_), b5(atol_), b6(compare_linear_);
+    t_end_->setValue(so.t_end);
+    output_step_->setValue(so.output_step);
+    int i = integrator_->findData(qs(so.integrator));
+    if (i < 0) {  // not one of ours (the run reports it): shown as it is
+      integrator_->addItem(qs(so.integrator), qs(so.integrator));
+      i = integrator_->count() - 1;
+    }
+    integrator_->setCurrentIndex(i);
+    rtol_->setText(num(so.rtol));
+    atol_->setText(num(so.atol));
+    compare_linear_->setChecked(st.compare_linear);
+  }
+  const int dof2 = doc_->model() ? 2 * doc_->model()->dof() : -1;
+  const int nu = static_cast<int>(spec.plant.inputs.size());
+  lqr_hint_->setText(dof2 >= 0 ? tr("Q: %1 weights in state order (positions, then velocities); R: %2 weights, one per "
+                                    "Plant/In. Empty = identity.")
+                                     .arg(dof2)
+                                     .arg(nu)
+                               : tr("Q: one weight per state; R: one per Plant/In. Empty = identity."));
+  syncing_ = false;
+  refreshController();
+}
+
+void SimulateView::refreshController() {
+  const ModelSpec& spec = doc_->spec();
+  const ControllerSpec& c = spec.controller;
+  controller_desc_->setText(describeController(spec));
+  const bool pid = c.type == ControllerType::Pid;
+  pid_table_->setVisible(pid);
+  if (!pid) return;
+  syncing_ = true;
+  const QSignalBlocker b(pid_table_);
+  const int nu = static_cast<int>(spec.plant.inputs.size()), ny = static_cast<int>(spec.plant.outputs.size());
+  pid_table_->clear();
+  pid_table_->setRowCount(nu);
+  pid_table_->setColumnCount(3 * ny);
+  QStringList rows, cols;
+  for (const auto& n : spec.plant.inputs) rows << qs(n);
+  const char* gains[3] = {"Kp", "Ki", "Kd"};
+  const Eigen::MatrixXd* mats[3] = {&c.kp, &c.ki, &c.kd};
+  for (int g = 0; g < 3; ++g)
+    for (const auto& n : spec.plant.outputs) cols << QStringLiteral("%1: %2").arg(QLatin1String(gains[g]), qs(n));
+  pid_table_->setVerticalHeaderLabels(rows);
+  pid_table_->setHorizontalHeaderLabels(cols);
+  for (int g = 0; g < 3; ++g) {
+    const Eigen::MatrixXd& M = *mats[g];
+    for (int r = 0; r < nu; ++r)
+      for (int k = 0; k < ny; ++k) {
+        const bool set = r < M.rows() && k < M.cols();
+        auto* item = new QTableWidgetItem(set ? QString::number(M(r, k), 'g', 12) : QStringLiteral("0"));
+        if (!set) item->setForeground(Qt::gray);
+        pid_table_->setItem(r, g * ny + k, item);
+      }
+  }
+  syncing_ = false;
+}
+
+void SimulateView::pidEdited(int row, int column) {
+  if (syncing_) return;
+  const ModelSpec& spec = doc_->spec();
+  const int nu = static_cast<int>(spec.plant.inputs.size()), ny = static_cast<int>(spec.plant.outputs.size());
+  if (ny == 0 || row < 0 || row >= nu) return;
+  const int g = column / ny, k = column % ny;
+  bool ok = false;
+  const double v = pid_table_->item(row, column)->text().trimmed().toDouble(&ok);
+  if (!ok || !std::isfinite(v)) {
+    emit message(tr("PID gain: \"%1\" is not a number").arg(pid_table_->item(row, column)->text()));
+    refreshController();
+    return;
+  }
+  const char* names[3] = {"Kp", "Ki", "Kd"};
+  QString error;
+  const bool done = doc_->edit(
+      tr("Change %1(%2, %3)").arg(QLatin1String(names[g]), qs(spec.plant.inputs[row]), qs(spec.plant.outputs[k])),
+      [&](ModelSpec& s) {
+        Eigen::MatrixXd& M = g == 0 ? s.controller.kp : g == 1 ? s.controller.ki : s.controller.kd;
+        if (M.rows() != nu || M.cols() != ny) {  // empty (no such action) or stale size: zeros, keeping what fits
+          Eigen::MatrixXd R = Eigen::MatrixXd::Zero(nu, ny);
+          const Eigen::Index rr = std::min<Eigen::Index>(M.rows(), nu), cc = std::min<Eigen::Index>(M.cols(), ny);
+          R.topLeftCorner(rr, cc) = M.topLeftCorner(rr, cc);
+          M = R;
+        }
+        M(row, k) = v;
+      },
+      &error);
+  if (!done) {
+    emit message(tr("PID gain: %1").arg(error));
+    refreshController();
+  }
+}
+
+void SimulateView::browseControllerFile() {
+  const QString modelDir = doc_->filePath().isEmpty() ? QDir::currentPath() : QFileInfo(doc_->filePath()).absolutePath();
+  const QString f = QFileDialog::getOpenFileName(this, tr("Controller"), modelDir, tr("MAT files (*.mat);;All files (*)"));
+  if (f.isEmpty()) return;
+  QString stored = f;
+  if (!doc_->filePath().isEmpty()) {
+    const QString rel = QDir(modelDir).relativeFilePath(f);
+    if (!rel.startsWith(QLatin1String(".."))) stored = rel;
+  }
+  file_edit_->setText(stored);
+  const std::string v = ss(stored);
+  writeStudy(
+      [&](StudySpec& s) {
+        s.controller_file = v;
+        s.controller = "file";
+      },
+      tr("Change the controller file"));
+}
+
+void SimulateView::weightsEdited(bool q) {
+  QLineEdit* e = q ? q_weights_ : r_weights_;
+  std::vector<double> w;
+  if (!parseNumbers(e->text(), &w) || std::any_of(w.begin(), w.end(), [](double x) { return x < 0; })) {
+    emit message(tr("%1 weights: expected non-negative numbers separated by commas").arg(q ? "Q" : "R"));
+    refreshFromDocument();
+    return;
+  }
+  writeStudy(
+      [&](StudySpec& s) { (q ? s.q_weights : s.r_weights) = w; },
+      q ? tr("Change the LQR state weights") : tr("Change the LQR input weights"));
+}
+
+void SimulateView::toleranceEdited(bool relative) {
+  QLineEdit* e = relative ? rtol_ : atol_;
+  bool ok = false;
+  const double v = e->text().trimmed().toDouble(&ok);
+  if (!ok || !(v > 0) || !std::isfinite(v)) {
+    emit message(tr("%1 tolerance: expected a positive number").arg(relative ? tr("Relative") : tr("Absolute")));
+    refreshFromDocument();
+    return;
+  }
+  writeSolver([&](SolverSpec& s) { (relative ? s.rtol : s.atol) = v; },
+              relative ? tr("Change the relative tolerance") : tr("Change the absolute tolerance"));
+}
+
+// ---------------------------------------------------------------------------
+// running
+
+bool SimulateView::isRunning() const { return worker_->isRunning(); }
+
+void SimulateView::setRunning(bool running) {
+  run_button_->setEnabled(!running);
+  cancel_button_->setEnabled(running);
+  save_results_->setEnabled(!running && result_ != nullptr);
+  save_plot_->setEnabled(!running);
+}
+
+void SimulateView::run() {
+  if (worker_->isRunning()) return;
+  const std::shared_ptr<const Model> m = doc_->model();
+  if (!m) {
+    status_ = tr("Cannot run: the model does not compile: %1").arg(doc_->errorText());
+    status_label_->setText(status_);
+    emit message(status_);
+    return;
+  }
+  result_.reset();
+  result_model_ = m;
+  plant_inputs_ = m->plant_inputs;
+  QStringList in, inUnits, out, outUnits;
+  for (int k : m->plant_inputs) {
+    in << qs(m->actuators[k].name);
+    inUnits << qs(m->actuators[k].unit);
+  }
+  for (int k : m->plant_outputs) {
+    out << qs(m->sensors[k].name);
+    outUnits << qs(m->sensors[k].unit);
+  }
+  plots_->reset(in, inUnits, out, outUnits, m->spec.solver.t_end);
+  if (!live_limit_) {
+    final_plot_points_ = plots_->maxPlotPoints();
+    live_limit_ = true;
+  }
+  plots_->setMaxPlotPoints(std::min(kLivePlotPoints, final_plot_points_));
+  progress_->setValue(0);
+  if (!worker_->start(m)) return;
+  status_ = tr("running: setting up the controller…");
+  status_label_->setText(status_);
+  setRunning(true);
+  emit runStarted();
+}
+
+void SimulateView::cancel() {
+  if (!worker_->isRunning()) return;
+  worker_->cancel();
+  status_ = tr("cancelling…");
+  status_label_->setText(status_);
+}
+
+void SimulateView::onSamples(const SampleBatch& batch) {
+  const Eigen::Index nin = static_cast<Eigen::Index>(plant_inputs_.size());
+  Eigen::VectorXd u(nin);
+  for (const Snapshot& s : batch) {
+    for (Eigen::Index k = 0; k < nin; ++k) {
+      const int c = plant_inputs_[k];
+      u[k] = c < s.u.size() ? s.u[c] : std::nan("");
+    }
+    plots_->appendSample(s.t, u, s.y);
+  }
+}
+
+void SimulateView::onProgress(double t, double tEnd) {
+  if (tEnd > 0) progress_->setValue(static_cast<int>(std::clamp(1000.0 * t / tEnd, 0.0, 1000.0)));
+  if (!worker_->cancelRequested()) {
+    status_ = tr("running: t = %1 s of %2 s").arg(num(t, 4), num(tEnd));
+    status_label_->setText(status_);
+  }
+}
+
+void SimulateView::restorePlotLimit() {
+  if (!live_limit_) return;
+  live_limit_ = false;
+  plots_->reset({}, {}, {}, {}, 1.0);  // empty first, so that the limit change redraws nothing
+  plots_->setMaxPlotPoints(final_plot_points_);
+}
+
+void SimulateView::onFinished(std::shared_ptr<const SimulationResult> r) {
+  result_ = r;
+  restorePlotLimit();
+  plots_->setResult(*r, plant_inputs_);
+  const int N = r->samples();
+  const double tLast = N ? r->t.back() : 0.0;
+  QString head;
+  if (r->completed) {
+    head = tr("completed: t = 0 .. %1 s").arg(num(tLast));
+    progress_->setValue(1000);
+  } else if (r->cancelled) {
+    head = tr("cancelled at t = %1 s").arg(num(tLast));
+  } else {
+    head = tr("failed: %1").arg(qs(r->failure));
+  }
+  status_ = tr("%1; %2 samples, %3 steps (%4), wall time %5 s; controller: %6")
+                .arg(head)
+                .arg(N)
+                .arg(r->stats.steps)
+                .arg(qs(r->stats.integrator))
+                .arg(num(worker_->wallTime(), 3))
+                .arg(qs(r->controller.empty() ? worker_->controllerSource().toStdString() : r->controller));
+  status_label_->setText(status_);
+  setRunning(false);
+  emit message(tr("Simulation %1").arg(status_));
+  emit runFinished(r);
+}
+
+void SimulateView::onFailed(const QString& why) {
+  result_.reset();
+  restorePlotLimit();
+  status_ = tr("failed: %1").arg(why);
+  status_label_->setText(status_);
+  setRunning(false);
+  emit message(tr("Simulation %1").arg(status_));
+  emit runFinished(nullptr);
+}
+
+QString SimulateView::statusText() const { return status_; }
+
+// ---------------------------------------------------------------------------
+// saving
+
+bool SimulateView::saveResults(const QString& path, QString* error) {
+  auto fail = [&](const QString& why) {
+    if (error) *error = why;
+    emit message(tr("Save results: %1").arg(why));
+    return false;
+  };
+  if (!result_) return fail(tr("no results to save (run a simulation first)"));
+  const QString suffix = QFileInfo(path).suffix().toLower();
+  try {
+    if (suffix == QLatin1String("h5") || suffix == QLatin1String("hdf5"))
+      write_results_hdf5(*result_, ss(path));
+    else if (suffix == QLatin1String("csv"))
+      write_results_csv(*result_, ss(path));
+    else
+      return fail(tr("%1: choose .h5 (HDF5) or .csv").arg(path));
+  } catch (const std::exception& e) {
+    return fail(qs(e.what()));
+  }
+  emit message(tr("Wrote %1").arg(path));
+  return true;
+}
+
+bool SimulateView::savePlot(const QString& path, QString* error) {
+  QString why;
+  if (!plots_->saveImage(path, &why)) {
+    if (error) *error = why;
+    emit message(tr("Save plot: %1").arg(why));
+    return false;
+  }
+  emit message(tr("Wrote %1").arg(path));
+  return true;
+}
+
+void SimulateView::saveResultsDialog() {
+  const QString dir = doc_->filePath().isEmpty() ? QDir::currentPath() : QFileInfo(doc_->filePath()).absolutePath();
+  QString selected;
+  const QString path = QFileDialog::getSaveFileName(this, tr("Save results"),
+                                                    QDir(dir).filePath(qs(doc_->spec().name) + QStringLiteral(".h5")),
+                                                    tr("HDF5 (*.h5 *.hdf5);;CSV (*.csv)"), &selected);
+  if (path.isEmpty()) return;
+  saveResults(path);
+}
+
+void SimulateView::savePlotDialog() {
+  const QString dir = doc_->filePath().isEmpty() ? QDir::currentPath() : QFileInfo(doc_->filePath()).absolutePath();
+  const QString path = QFileDialog::getSaveFileName(this, tr("Save plot"),
+                                                    QDir(dir).filePath(qs(doc_->spec().name) + QStringLiteral(".png")),
+                                                    tr("PNG image (*.png);;SVG image (*.svg)"));
+  if (path.isEmpty()) return;
+  savePlot(path);
+}
+
+}  // namespace codyna::gui

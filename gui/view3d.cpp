@@ -1,0 +1,550 @@
+#include "gui/view3d.hpp"
+
+#include <QElapsedTimer>
+#include <QGuiApplication>
+#include <QKeyEvent>
+#include <QLabel>
+#include <QMouseEvent>
+#include <QOffscreenSurface>
+#include <QOpenGLBuffer>
+#include <QOpenGLContext>
+#include <QOpenGLExtraFunctions>
+#include <QOpenGLShaderProgram>
+#include <QOpenGLVertexArrayObject>
+#include <QOpenGLWidget>
+#include <QVBoxLayout>
+#include <QWheelEvent>
+#include <algorithm>
+#include <array>
+#include <memory>
+
+#include "dynamics/kinematics.hpp"
+
+namespace codyna::gui {
+
+namespace {
+
+QSurfaceFormat requestedFormat() {
+  QSurfaceFormat f;
+  f.setRenderableType(QSurfaceFormat::OpenGL);
+  f.setVersion(3, 3);
+  f.setProfile(QSurfaceFormat::CoreProfile);
+  f.setDepthBufferSize(24);
+  // 4x multisampling; CODYNA_VIEW_SAMPLES=0 halves the frame time on software GL
+  bool set = false;
+  const int samples = qEnvironmentVariableIntValue("CODYNA_VIEW_SAMPLES", &set);
+  f.setSamples(set ? std::clamp(samples, 0, 16) : 4);
+  return f;
+}
+
+struct Probe {
+  bool ok = false;
+  QString reason;
+};
+
+Probe probeOpenGL() {
+  Probe r;
+  const QString platform = QGuiApplication::platformName();
+  if (platform == QLatin1String("offscreen") || platform == QLatin1String("minimal")) {
+    // these platforms have no usable GL here, and a QOpenGLWidget on them crashes when grabbed
+    r.reason = QStringLiteral("no OpenGL context on this display (platform %1)").arg(platform);
+    return r;
+  }
+  QOpenGLContext ctx;
+  ctx.setFormat(requestedFormat());
+  if (!ctx.create()) {
+    r.reason = QStringLiteral("no OpenGL context on this display (platform %1)").arg(platform);
+    return r;
+  }
+  QOffscreenSurface surface;
+  surface.setFormat(ctx.format());
+  surface.create();
+  if (!surface.isValid() || !ctx.makeCurrent(&surface)) {
+    r.reason = QStringLiteral("an OpenGL context cannot be made current (platform %1)").arg(platform);
+    return r;
+  }
+  const auto v = ctx.format().version();
+  if (v < qMakePair(3, 3)) {
+    r.reason = QStringLiteral("OpenGL %1.%2 found, 3.3 needed").arg(v.first).arg(v.second);
+  } else {
+    r.ok = true;
+  }
+  ctx.doneCurrent();
+  return r;
+}
+
+const Probe* cachedProbe() {
+  static Probe probe;
+  static bool done = false;
+  if (!done) {
+    if (!qobject_cast<QGuiApplication*>(QCoreApplication::instance())) return nullptr;  // ask again later
+    probe = probeOpenGL();
+    done = true;
+  }
+  return &probe;
+}
+
+const char* kVertexShader = R"(#version 330 core
+layout(location = 0) in vec3 aPos;
+layout(location = 1) in vec3 aNormal;
+layout(location = 2) in vec3 aColor;
+uniform mat4 uMvp;
+uniform mat4 uModelView;
+uniform mat3 uNormalMat;
+out vec3 vNormal;
+out vec3 vColor;
+out vec3 vPos;
+void main() {
+  vNormal = uNormalMat * aNormal;
+  vColor = aColor;
+  vPos = (uModelView * vec4(aPos, 1.0)).xyz;
+  gl_Position = uMvp * vec4(aPos, 1.0);
+}
+)";
+
+// lambert from a key and a fill light fixed to the camera, ambient, a faint highlight
+const char* kFragmentShader = R"(#version 330 core
+in vec3 vNormal;
+in vec3 vColor;
+in vec3 vPos;
+uniform vec4 uColor;
+uniform int uLit;
+uniform float uHighlight;
+out vec4 fragColor;
+void main() {
+  vec3 base = mix(uColor.rgb * vColor, vec3(1.0, 0.5, 0.0), uHighlight);
+  if (uLit == 0) { fragColor = vec4(base, uColor.a); return; }
+  vec3 v = normalize(-vPos);
+  vec3 n = normalize(vNormal);
+  if (dot(n, v) < 0.0) n = -n;  // two-sided: mirrored frames and cut-open views stay lit
+  vec3 key = normalize(vec3(-0.35, 0.75, 0.55));
+  vec3 fill = normalize(vec3(0.6, -0.3, 0.75));
+  float diffuse = 0.62 * max(dot(n, key), 0.0) + 0.28 * max(dot(n, fill), 0.0);
+  float spec = 0.18 * pow(max(dot(n, normalize(key + v)), 0.0), 48.0);
+  // a highlighted body is also brighter, so that an orange body still stands out
+  fragColor = vec4(base * (0.32 + 0.45 * uHighlight + diffuse) + vec3(spec), uColor.a);
+}
+)";
+
+Eigen::Matrix4f toGL(const Eigen::Matrix4d& m) { return m.cast<float>(); }
+
+}  // namespace
+
+// ---- the OpenGL canvas (only made when openGLAvailable()) ----
+
+class GLCanvas : public QOpenGLWidget, protected QOpenGLExtraFunctions {
+ public:
+  explicit GLCanvas(View3D* owner) : QOpenGLWidget(owner), owner_(owner) {
+    setFormat(requestedFormat());
+    setMinimumSize(64, 64);
+  }
+  ~GLCanvas() override {
+    disconnect(context_gone_);
+    cleanup();
+  }
+  void gridChanged() { grid_dirty_ = true; }
+
+ protected:
+  void initializeGL() override {
+    // moving the widget to another window gives it a new context: start over then
+    disconnect(context_gone_);
+    context_gone_ = connect(context(), &QOpenGLContext::aboutToBeDestroyed, this, [this] { cleanup(); });
+    initializeOpenGLFunctions();
+    program_ = std::make_unique<QOpenGLShaderProgram>();
+    program_->addShaderFromSourceCode(QOpenGLShader::Vertex, kVertexShader);
+    program_->addShaderFromSourceCode(QOpenGLShader::Fragment, kFragmentShader);
+    if (!program_->link()) {
+      qWarning("View3D: shader link failed: %s", qPrintable(program_->log()));
+      return;
+    }
+    u_mvp_ = program_->uniformLocation("uMvp");
+    u_mv_ = program_->uniformLocation("uModelView");
+    u_nrm_ = program_->uniformLocation("uNormalMat");
+    u_color_ = program_->uniformLocation("uColor");
+    u_lit_ = program_->uniformLocation("uLit");
+    u_hl_ = program_->uniformLocation("uHighlight");
+
+    // 24 segments keep software rendering quick and cylinders round enough
+    upload(prims_[int(Prim::Box)], unitBox().data, true);
+    upload(prims_[int(Prim::Cylinder)], unitCylinder(28).data, true);
+    upload(prims_[int(Prim::Sphere)], unitSphere(28, 14).data, true);
+    upload(prims_[int(Prim::Cone)], unitCone(24).data, true);
+    upload(prims_[int(Prim::Arrow)], arrowMesh(10).data, true);
+    upload(prims_[int(Prim::Triad)], triadMesh(8).data, true);  // small and many: few segments
+
+    // vertical gradient, light at the bottom so the grid reads as a floor
+    const float top[3] = {0.74f, 0.79f, 0.86f}, bottom[3] = {0.95f, 0.955f, 0.965f};
+    std::vector<float> bg;
+    auto corner = [&](float x, float y) {
+      const float* c = y > 0 ? top : bottom;
+      bg.insert(bg.end(), {x, y, 0.0f, c[0], c[1], c[2]});
+    };
+    for (auto [x, y] : {std::pair{-1.f, -1.f}, {1.f, -1.f}, {1.f, 1.f}, {-1.f, -1.f}, {1.f, 1.f}, {-1.f, 1.f}})
+      corner(x, y);
+    upload(background_, bg, false);
+    grid_dirty_ = true;
+    ready_ = true;
+  }
+
+  void paintGL() override {
+    QElapsedTimer timer;
+    timer.start();
+    const qreal dpr = devicePixelRatioF();
+    glViewport(0, 0, int(width() * dpr), int(height() * dpr));
+    glClearColor(0.9f, 0.9f, 0.92f, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    if (!ready_) return;
+
+    owner_->syncViewport();
+    const Camera& cam = owner_->camera_;
+    const Scene& scene = owner_->scene_;
+    const Eigen::Matrix4f V = toGL(cam.viewMatrix()), P = toGL(cam.projectionMatrix()), PV = P * V;
+
+    program_->bind();
+    const Eigen::Matrix4f I4 = Eigen::Matrix4f::Identity();
+    const Eigen::Matrix3f I3 = Eigen::Matrix3f::Identity();
+
+    glDisable(GL_DEPTH_TEST);
+    setTransform(I4, I4, I3);
+    setLook(Eigen::Vector4f::Ones(), false, 0.0f);
+    draw(background_, GL_TRIANGLES);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LEQUAL);
+
+    if (owner_->show_grid_) {
+      if (grid_dirty_) {
+        upload(grid_, scene.gridLines(), false);
+        grid_dirty_ = false;
+      }
+      setTransform(PV, V, I3);
+      draw(grid_, GL_LINES);
+    }
+
+    const int hl = owner_->highlight_body_;
+    auto drawItems = [&](bool overlays, float alpha) {
+      for (const Item& it : scene.items()) {
+        if ((it.kind == ItemKind::Axis || it.kind == ItemKind::Frame) != overlays) continue;
+        const Eigen::Matrix4f MV = V * it.world.matrix().cast<float>();
+        const Eigen::Matrix3f A = MV.topLeftCorner<3, 3>();
+        if (std::abs(A.determinant()) < 1e-30f) continue;  // degenerate (zero-length spring)
+        setTransform(P * MV, MV, A.inverse().transpose());
+        Eigen::Vector4f color = it.color;
+        color[3] *= alpha;
+        setLook(color, true, it.kind == ItemKind::Shape && it.body == hl && hl > 0 ? 0.65f : 0.0f);
+        draw(prims_[int(it.prim)], GL_TRIANGLES);
+      }
+    };
+    drawItems(false, 1.0f);
+    if (owner_->show_frames_) {
+      // frames and axes often sit inside bodies: show their hidden parts faintly first
+      glDepthFunc(GL_GREATER);
+      glDepthMask(GL_FALSE);
+      glEnable(GL_BLEND);
+      glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+      drawItems(true, 0.4f);
+      glDisable(GL_BLEND);
+      glDepthMask(GL_TRUE);
+      glDepthFunc(GL_LEQUAL);
+      drawItems(true, 1.0f);
+    }
+    program_->release();
+
+    glFinish();
+    owner_->last_frame_ms_ = timer.nsecsElapsed() * 1e-6;
+    ++owner_->frames_;
+  }
+
+ private:
+  struct GpuMesh {
+    QOpenGLVertexArrayObject vao;
+    QOpenGLBuffer vbo;
+    int count = 0;
+  };
+
+  // with normals: x y z nx ny nz r g b; without: x y z r g b (lines, background)
+  void upload(GpuMesh& g, const std::vector<float>& data, bool with_normals) {
+    const int stride = with_normals ? 9 : 6;
+    if (!g.vao.isCreated()) g.vao.create();
+    g.vao.bind();
+    if (!g.vbo.isCreated()) g.vbo.create();
+    g.vbo.bind();
+    g.vbo.allocate(data.data(), int(data.size() * sizeof(float)));
+    const GLsizei bytes = GLsizei(stride * sizeof(float));
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, bytes, nullptr);
+    if (with_normals) {
+      glEnableVertexAttribArray(1);
+      glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, bytes, reinterpret_cast<void*>(3 * sizeof(float)));
+    } else {
+      glDisableVertexAttribArray(1);
+    }
+    glEnableVertexAttribArray(2);
+    glVertexAttribPointer(2, 3, GL_FLOAT, GL_FALSE, bytes,
+                          reinterpret_cast<void*>((with_normals ? 6 : 3) * sizeof(float)));
+    g.vao.release();
+    g.vbo.release();
+    g.count = int(data.size()) / stride;
+  }
+
+  void destroy(GpuMesh& g) {
+    g.vbo.destroy();
+    g.vao.destroy();
+    g.count = 0;
+  }
+
+  void cleanup() {
+    if (!program_) return;
+    makeCurrent();
+    for (auto& g : prims_) destroy(g);
+    destroy(grid_);
+    destroy(background_);
+    program_.reset();
+    ready_ = false;
+    doneCurrent();
+  }
+
+  void setTransform(const Eigen::Matrix4f& mvp, const Eigen::Matrix4f& mv, const Eigen::Matrix3f& normal) {
+    glUniformMatrix4fv(u_mvp_, 1, GL_FALSE, mvp.data());
+    glUniformMatrix4fv(u_mv_, 1, GL_FALSE, mv.data());
+    glUniformMatrix3fv(u_nrm_, 1, GL_FALSE, normal.data());
+  }
+
+  void setLook(const Eigen::Vector4f& color, bool lit, float highlight) {
+    glUniform4f(u_color_, color[0], color[1], color[2], color[3]);
+    glUniform1i(u_lit_, lit ? 1 : 0);
+    glUniform1f(u_hl_, highlight);
+  }
+
+  void draw(GpuMesh& g, GLenum mode) {
+    if (g.count == 0) return;
+    g.vao.bind();
+    glDrawArrays(mode, 0, g.count);
+    g.vao.release();
+  }
+
+  View3D* owner_;
+  std::unique_ptr<QOpenGLShaderProgram> program_;
+  QMetaObject::Connection context_gone_;
+  std::array<GpuMesh, 6> prims_;
+  GpuMesh grid_, background_;
+  bool grid_dirty_ = true, ready_ = false;
+  int u_mvp_ = -1, u_mv_ = -1, u_nrm_ = -1, u_color_ = -1, u_lit_ = -1, u_hl_ = -1;
+};
+
+// ---- View3D ----
+
+View3D::View3D(QWidget* parent) : QWidget(parent) {
+  auto* layout = new QVBoxLayout(this);
+  layout->setContentsMargins(0, 0, 0, 0);
+  setFocusPolicy(Qt::StrongFocus);
+  setMinimumSize(120, 90);
+  if (openGLAvailable()) {
+    canvas_ = new GLCanvas(this);
+    layout->addWidget(canvas_);
+  } else {
+    placeholder_ = new QLabel(QStringLiteral("3-D view unavailable: %1").arg(openGLUnavailableReason()), this);
+    placeholder_->setObjectName(QStringLiteral("view3dPlaceholder"));
+    placeholder_->setAlignment(Qt::AlignCenter);
+    placeholder_->setWordWrap(true);
+    placeholder_->setAutoFillBackground(true);
+    QPalette pal = placeholder_->palette();
+    pal.setColor(QPalette::Window, QColor(222, 227, 234));
+    pal.setColor(QPalette::WindowText, QColor(70, 75, 85));
+    placeholder_->setPalette(pal);
+    layout->addWidget(placeholder_);
+  }
+  scene_.build(nullptr);
+  camera_.setUp(scene_.up());
+  camera_.yaw = Camera::kDefaultYaw, camera_.pitch = Camera::kDefaultPitch;
+  syncViewport();
+  updateSceneRadius();
+  camera_.fit(scene_.bounds());
+}
+
+View3D::~View3D() = default;
+
+bool View3D::openGLAvailable() {
+  const Probe* p = cachedProbe();
+  return p && p->ok;
+}
+
+QString View3D::openGLUnavailableReason() {
+  const Probe* p = cachedProbe();
+  if (!p) return QStringLiteral("no QGuiApplication");
+  return p->ok ? QString() : p->reason;
+}
+
+bool View3D::hasGL() const { return canvas_ != nullptr; }
+
+void View3D::setModel(std::shared_ptr<const codyna::Model> model) {
+  model_ = std::move(model);
+  data_ = model_ ? std::make_unique<codyna::Data>(*model_) : nullptr;
+  q_ = model_ ? model_->q0 : Eigen::VectorXd();
+  scene_.build(model_.get());
+  if (model_ && q_.size() == model_->nq) {
+    forward_kinematics(*model_, *data_, q_);
+    scene_.update(data_->oMi);
+  }
+  highlight_body_ = model_ ? model_->find_body(highlight_.toStdString()) : -1;
+  camera_.setUp(scene_.up());
+  updateSceneRadius();
+  // a new model (not an edit of the current one) gets a fresh view
+  const std::string key = model_ ? model_->source_file + "\n" + model_->name : std::string();
+  if (model_ && key != fitted_for_) {
+    fitted_for_ = key;
+    resetView();
+  }
+  if (canvas_) canvas_->gridChanged();
+  requestPaint();
+}
+
+void View3D::setConfiguration(const Eigen::VectorXd& q) {
+  if (!model_ || q.size() != model_->nq) return;
+  q_ = q;
+  forward_kinematics(*model_, *data_, q_);
+  scene_.update(data_->oMi);
+  requestPaint();
+}
+
+void View3D::setHighlight(const QString& bodyName) {
+  highlight_ = bodyName;
+  highlight_body_ = model_ && !bodyName.isEmpty() ? model_->find_body(bodyName.toStdString()) : -1;
+  requestPaint();
+}
+
+void View3D::setShowFrames(bool on) {
+  show_frames_ = on;
+  requestPaint();
+}
+
+void View3D::setShowGrid(bool on) {
+  show_grid_ = on;
+  requestPaint();
+}
+
+void View3D::fitView() {
+  syncViewport();
+  camera_.fit(scene_.viewBounds(show_frames_));
+  updateSceneRadius();
+  auto_fit_ = true;
+  requestPaint();
+}
+
+void View3D::resetView() {
+  camera_.yaw = Camera::kDefaultYaw;
+  camera_.pitch = Camera::kDefaultPitch;
+  fitView();
+}
+
+QString View3D::pickBody(QPoint pos) const {
+  Camera cam = camera_;
+  cam.width = width(), cam.height = height();
+  const int body = scene_.pick(cam.rayAt(pos.x() + 0.5, pos.y() + 0.5));
+  if (!model_ || body <= 0) return {};
+  return QString::fromStdString(model_->body_names[body]);
+}
+
+bool View3D::bodyScreenPos(const QString& bodyName, QPointF* pos) const {
+  if (!model_) return false;
+  const int body = model_->find_body(bodyName.toStdString());
+  Eigen::Vector3d p;
+  if (body <= 0 || !scene_.bodyAnchor(body, &p)) return false;
+  Camera cam = camera_;
+  cam.width = width(), cam.height = height();
+  Eigen::Vector2d px;
+  if (!cam.project(p, &px)) return false;
+  *pos = QPointF(px.x(), px.y());
+  return true;
+}
+
+QImage View3D::grabImage() {
+  if (canvas_) {
+    QImage img = canvas_->grabFramebuffer();
+    if (!img.isNull()) return img;
+  }
+  return grab().toImage();
+}
+
+void View3D::resizeEvent(QResizeEvent* e) {
+  QWidget::resizeEvent(e);
+  syncViewport();
+  if (auto_fit_) fitView();  // the first layout pass gives the real aspect ratio
+}
+
+void View3D::syncViewport() {
+  camera_.width = std::max(width(), 1);
+  camera_.height = std::max(height(), 1);
+}
+
+void View3D::updateSceneRadius() {
+  Eigen::AlignedBox3d box = scene_.bounds();
+  const Eigen::Vector3d c = scene_.gridCenter(), u = scene_.up();
+  const Eigen::Vector3d e1 = camera_.front, e2 = u.cross(e1);
+  const double h = scene_.gridHalf();
+  for (int i : {-1, 1})
+    for (int j : {-1, 1}) box.extend(c + h * (i * e1 + j * e2));
+  camera_.scene_radius = std::max(0.5 * box.diagonal().norm(), 1e-9) + (box.center() - camera_.target).norm();
+}
+
+void View3D::requestPaint() {
+  if (canvas_) canvas_->update();
+}
+
+// ---- input ----
+
+void View3D::mousePressEvent(QMouseEvent* e) {
+  press_pos_ = last_pos_ = e->position().toPoint();
+  pressed_ = true;
+  dragged_ = false;
+  e->accept();
+}
+
+void View3D::mouseMoveEvent(QMouseEvent* e) {
+  if (!pressed_) return;
+  const QPoint p = e->position().toPoint();
+  if ((p - press_pos_).manhattanLength() > 3) dragged_ = true;
+  if (!dragged_) return;
+  const QPoint d = p - last_pos_;
+  last_pos_ = p;
+  const bool pan = (e->buttons() & Qt::MiddleButton) ||
+                   ((e->buttons() & Qt::LeftButton) && (e->modifiers() & Qt::ShiftModifier));
+  if (pan) {
+    camera_.pan(d.x(), d.y());
+  } else if (e->buttons() & Qt::LeftButton) {
+    camera_.orbit(d.x(), d.y());
+  } else if (e->buttons() & Qt::RightButton) {
+    camera_.zoom(-d.y() / 40.0);
+  } else {
+    return;
+  }
+  auto_fit_ = false;
+  updateSceneRadius();
+  requestPaint();
+}
+
+void View3D::mouseReleaseEvent(QMouseEvent* e) {
+  if (pressed_ && !dragged_ && e->button() == Qt::LeftButton) emit bodyPicked(pickBody(e->position().toPoint()));
+  pressed_ = false;
+}
+
+void View3D::mouseDoubleClickEvent(QMouseEvent* e) {
+  if (e->button() == Qt::LeftButton && pickBody(e->position().toPoint()).isEmpty()) fitView();
+}
+
+void View3D::wheelEvent(QWheelEvent* e) {
+  camera_.zoom(e->angleDelta().y() / 120.0);
+  auto_fit_ = false;
+  updateSceneRadius();
+  requestPaint();
+  e->accept();
+}
+
+void View3D::keyPressEvent(QKeyEvent* e) {
+  if (e->key() == Qt::Key_F) {
+    fitView();
+    return;
+  }
+  QWidget::keyPressEvent(e);
+}
+
+}  // namespace codyna::gui

@@ -1,0 +1,120 @@
+// View3D: the 3-D view of a mechanism.
+//
+// Draws the bodies of a Model at a configuration q (declared shapes, or a
+// default ball-and-link look for bodies without shapes), joint axes, body
+// frames, ground anchors, springs and a ground grid normal to "up"
+// (-gravity, else +y), with an orbit camera:
+//   left drag: orbit    middle drag or shift + left drag: pan    wheel: zoom
+//   F or double click on the background: fit    left click: pick a body
+//
+// OpenGL is probed once before any QOpenGLWidget exists; without it (e.g.
+// QT_QPA_PLATFORM=offscreen) the view shows a placeholder label instead and
+// everything else (camera, picking, projection) still works on the CPU.
+#pragma once
+
+#include <QImage>
+#include <QPoint>
+#include <QPointF>
+#include <QString>
+#include <QWidget>
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+
+#include "gui/scene3d.hpp"
+#include "model/data.hpp"
+#include "model/model.hpp"
+
+class QLabel;
+
+namespace codyna::gui {
+
+class GLCanvas;
+
+class View3D : public QWidget {
+  Q_OBJECT
+
+ public:
+  explicit View3D(QWidget* parent = nullptr);
+  ~View3D() override;
+
+  // true when an OpenGL 3.3 context can be made current on this platform;
+  // probed once per process (needs a QGuiApplication), false under offscreen
+  static bool openGLAvailable();
+  // why not, for the placeholder ("" when available)
+  static QString openGLUnavailableReason();
+  bool hasGL() const;
+
+  // nullptr: empty scene. The camera is fitted when the first model arrives
+  // (or one from another file / with another name); an edited model keeps it.
+  void setModel(std::shared_ptr<const codyna::Model> model);
+  std::shared_ptr<const codyna::Model> model() const { return model_; }
+  // nq values; draws the mechanism there (setModel starts at m.q0). Cheap:
+  // forward kinematics and item transforms only. Wrong sizes are ignored.
+  void setConfiguration(const Eigen::VectorXd& q);
+  const Eigen::VectorXd& configuration() const { return q_; }
+  void setHighlight(const QString& bodyName);  // "" none
+  QString highlight() const { return highlight_; }
+  void setShowFrames(bool on);                 // body triads and joint axes, default on
+  bool showFrames() const { return show_frames_; }
+  void setShowGrid(bool on);                   // ground grid, default on
+  bool showGrid() const { return show_grid_; }
+
+  void fitView();    // frame the whole mechanism, keep the orbit angles
+  void resetView();  // default orbit angles, then fit
+
+  // The body under widget position `pos` (widget pixels), "" for background or
+  // ground. Ray cast on the CPU against the drawn shapes; works with or
+  // without OpenGL, for the current camera and widget size.
+  QString pickBody(QPoint pos) const;
+  // where a point of the body's geometry (centre of its largest shape) appears
+  // in widget pixels; false when the body is unknown or behind the camera
+  bool bodyScreenPos(const QString& bodyName, QPointF* pos) const;
+
+  const Camera& camera() const { return camera_; }
+  const Scene& scene() const { return scene_; }
+
+  // what is shown: the GL framebuffer with hasGL(), else the placeholder's grab()
+  QImage grabImage();
+  double lastFrameMs() const { return last_frame_ms_; }  // CPU time of the last paint, after glFinish
+  int framesDrawn() const { return frames_; }
+
+ signals:
+  void bodyPicked(const QString& bodyName);  // click without drag: body name, "" on background
+
+ protected:
+  void resizeEvent(QResizeEvent* e) override;
+  // the canvas and the placeholder ignore input, so it reaches these
+  void mousePressEvent(QMouseEvent* e) override;
+  void mouseMoveEvent(QMouseEvent* e) override;
+  void mouseReleaseEvent(QMouseEvent* e) override;
+  void mouseDoubleClickEvent(QMouseEvent* e) override;
+  void wheelEvent(QWheelEvent* e) override;
+  void keyPressEvent(QKeyEvent* e) override;
+
+ private:
+  friend class GLCanvas;
+  void syncViewport();
+  void updateSceneRadius();
+  void requestPaint();
+
+  std::shared_ptr<const codyna::Model> model_;
+  std::unique_ptr<codyna::Data> data_;
+  Eigen::VectorXd q_;
+  Scene scene_;
+  Camera camera_;
+  QString highlight_;
+  int highlight_body_ = -1;
+  bool show_frames_ = true, show_grid_ = true;
+  std::string fitted_for_;   // source file and name of the model the camera was fitted to
+  bool auto_fit_ = true;      // refit on resize until the user moves the camera
+
+  GLCanvas* canvas_ = nullptr;
+  QLabel* placeholder_ = nullptr;
+  QPoint press_pos_, last_pos_;
+  bool pressed_ = false, dragged_ = false;
+  double last_frame_ms_ = 0.0;
+  int frames_ = 0;
+};
+
+}  // namespace codyna::gui

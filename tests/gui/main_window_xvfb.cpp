@@ -1,0 +1,189 @@
+// codyna-gui rendered for real (xvfb-run, Mesa's software OpenGL): the main window
+// of every example with the mechanism in the 3-D view, the panels, the linearize
+// view with its pole map, a simulation plot and a playback frame, written as PNGs
+// under build/screenshots. A blank 3-D view fails (pixel statistics, not file existence).
+#include <QDir>
+#include <QCheckBox>
+#include <QComboBox>
+#include <QElapsedTimer>
+#include <QDockWidget>
+#include <QScreen>
+#include <QSet>
+#include <QSignalSpy>
+#include <QTabWidget>
+#include <QTableView>
+#include <QTest>
+#include <QWindow>
+
+#include "gui/linearize_view.hpp"
+#include "gui/main_window.hpp"
+#include "gui/pole_map.hpp"
+#include "gui/result_plots.hpp"
+#include "gui/simulate_view.hpp"
+#include "gui/view3d.hpp"
+#include "simulation/result.hpp"
+
+using namespace codyna;
+using namespace codyna::gui;
+
+namespace {
+
+const QString kShots = QStringLiteral(CODYNA_SCREENSHOT_DIR);
+
+// what a person sees: the X server's pixels of the window (GL content included)
+QImage screenOf(QWidget* w) {
+  QCoreApplication::processEvents();
+  return w->window()->windowHandle()->screen()->grabWindow(w->winId()).toImage().convertToFormat(QImage::Format_RGB32);
+}
+
+QImage screenOfChild(QWidget* top, QWidget* child) {
+  const QImage all = screenOf(top);
+  const QPoint p = child->mapTo(top, QPoint(0, 0));
+  return all.copy(QRect(p, child->size()));
+}
+
+struct Stats {
+  double foreground = 0;  // fraction of pixels away from the most common colour
+  int colours = 0;
+};
+
+Stats stats(const QImage& img) {
+  QHash<QRgb, int> count;
+  for (int y = 0; y < img.height(); y += 2)
+    for (int x = 0; x < img.width(); x += 2) ++count[img.pixel(x, y) & 0xffffff];
+  QRgb bg = 0;
+  int most = 0, total = 0;
+  for (auto it = count.begin(); it != count.end(); ++it) {
+    total += it.value();
+    if (it.value() > most) most = it.value(), bg = it.key();
+  }
+  int far = 0;
+  for (int y = 0; y < img.height(); y += 2)
+    for (int x = 0; x < img.width(); x += 2) {
+      const QRgb c = img.pixel(x, y);
+      const int d = std::abs(qRed(c) - qRed(bg)) + std::abs(qGreen(c) - qGreen(bg)) + std::abs(qBlue(c) - qBlue(bg));
+      if (d > 60) ++far;
+    }
+  return {total ? double(far) / total : 0.0, static_cast<int>(count.size())};
+}
+
+double difference(const QImage& a, const QImage& b) {
+  if (a.size() != b.size()) return 1.0;
+  long diff = 0, n = 0;
+  for (int y = 0; y < a.height(); y += 2)
+    for (int x = 0; x < a.width(); x += 2, ++n) {
+      const QRgb p = a.pixel(x, y), q = b.pixel(x, y);
+      if (std::abs(qRed(p) - qRed(q)) + std::abs(qGreen(p) - qGreen(q)) + std::abs(qBlue(p) - qBlue(q)) > 30) ++diff;
+    }
+  return double(diff) / n;
+}
+
+void save(const QImage& img, const QString& name) {
+  QDir().mkpath(kShots);
+  QVERIFY2(img.save(kShots + "/" + name), qPrintable(name));
+}
+
+bool waitFor(const std::function<bool()>& done, int ms = 120000) {
+  QElapsedTimer t;
+  t.start();
+  while (!done() && t.elapsed() < ms) QTest::qWait(20);
+  return done();
+}
+
+}  // namespace
+
+class MainWindowXvfb : public QObject {
+  Q_OBJECT
+ private slots:
+  void initTestCase() {
+    QCoreApplication::setOrganizationName("codyna-test");
+    QCoreApplication::setApplicationName("main_window_xvfb");
+    QVERIFY2(View3D::openGLAvailable(), "OpenGL is expected under xvfb-run with Mesa");
+  }
+
+  void everyExampleShowsItsMechanism_data() {
+    QTest::addColumn<QString>("file");
+    const QStringList files = QDir(CODYNA_EXAMPLES_DIR).entryList({"*.json"}, QDir::Files, QDir::Name);
+    QVERIFY(files.size() >= 8);
+    for (const QString& f : files) QTest::newRow(qPrintable(f)) << f;
+  }
+
+  void everyExampleShowsItsMechanism() {
+    QFETCH(QString, file);
+    MainWindow w;
+    w.resize(1500, 950);
+    w.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&w));
+    QVERIFY(w.openFile(QStringLiteral(CODYNA_EXAMPLES_DIR "/") + file));
+    QTest::qWait(300);
+    QVERIFY(w.view3d()->hasGL());
+    const QImage view = screenOfChild(&w, w.view3d());
+    const Stats s = stats(view);
+    QVERIFY2(s.foreground > 0.01, qPrintable(QString("%1: only %2 of the 3-D view differs from the background").arg(file).arg(s.foreground)));
+    QVERIFY2(s.colours > 50, qPrintable(QString("%1: %2 colours").arg(file).arg(s.colours)));
+    save(screenOf(&w), "main_" + QFileInfo(file).baseName() + ".png");
+    w.document()->undoStack()->setClean();
+  }
+
+  void cartPendulumWorkflow() {
+    MainWindow w;
+    w.resize(1500, 950);
+    w.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&w));
+    QVERIFY(w.openFile(QStringLiteral(CODYNA_EXAMPLES_DIR "/cart_pendulum.json")));
+    QTest::qWait(300);
+    save(screenOf(&w), "main_window.png");
+    // the two panels
+    for (const char* dock : {"plantInDock", "plantOutDock"}) {
+      auto* d = w.findChild<QDockWidget*>(dock);
+      QVERIFY(d);
+      save(screenOfChild(&w, d), QString(dock).replace("Dock", "_panel.png"));
+    }
+    const QImage rest = screenOfChild(&w, w.view3d());
+
+    // linearize at equilibrium, select the unstable mode: the pole map and the mode animation
+    LinearizeView* lv = w.linearizeView();
+    lv->operatingPointCombo()->setCurrentIndex(lv->operatingPointCombo()->findText("equilibrium", Qt::MatchContains));
+    QVERIFY(lv->linearize());
+    int unstable = -1;
+    for (int k = 0; k < static_cast<int>(lv->modes().modes.size()); ++k)
+      if (lv->modes().modes[k].eigenvalue.real() > 0.1) unstable = k;
+    QVERIFY(unstable >= 0);
+    lv->selectMode(unstable);
+    QVERIFY(w.isAnimatingMode());
+    QTest::qWait(400);
+    const QImage moving = screenOfChild(&w, w.view3d());
+    QVERIFY2(difference(rest, moving) > 0.002, "the mode shape animation moves the mechanism");
+    save(screenOf(&w), "linearize_view.png");
+    save(screenOfChild(&w, lv->poleMap()), "pole_map.png");
+    lv->selectMode(-1);
+    w.animateMode(-1, {});
+
+    // simulate the model's LQR from its initial offset, with the linear prediction
+    SimulateView* sv = w.simulateView();
+    w.analysisTabs()->setCurrentWidget(sv);
+    sv->compareLinearCheck()->setChecked(true);
+    QSignalSpy done(sv, &SimulateView::runFinished);
+    sv->run();
+    QVERIFY(waitFor([&] { return done.count() == 1; }));
+    QVERIFY(sv->result() && sv->result()->completed);
+    QTest::qWait(300);
+    save(screenOf(&w), "simulate_view.png");
+    save(screenOfChild(&w, sv->plots()), "simulation_plot.png");
+    const Stats ps = stats(screenOfChild(&w, sv->plots()));
+    QVERIFY2(ps.foreground > 0.01, "the plot shows curves");
+
+    // a playback frame early in the run differs from the end
+    w.setPlaybackTime(0.3);
+    QTest::qWait(200);
+    const QImage early = screenOfChild(&w, w.view3d());
+    save(screenOf(&w), "playback_frame.png");
+    w.setPlaybackTime(sv->result()->t.back());
+    QTest::qWait(200);
+    QVERIFY2(difference(early, screenOfChild(&w, w.view3d())) > 0.001, "playback moves the mechanism");
+    w.document()->undoStack()->setClean();
+  }
+};
+
+QTEST_MAIN(MainWindowXvfb)
+#include "main_window_xvfb.moc"

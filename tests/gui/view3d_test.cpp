@@ -1,0 +1,393 @@
+// View3D without OpenGL (QT_QPA_PLATFORM=offscreen): the placeholder, the
+// public API on every example, and the CPU side (camera, scene, picking).
+#include <QApplication>
+#include <QDir>
+#include <QLabel>
+#include <QSignalSpy>
+#include <QtTest>
+#include <cmath>
+
+#include "gui/scene3d.hpp"
+#include "gui/view3d.hpp"
+#include "dynamics/kinematics.hpp"
+#include "io/model_file.hpp"
+#include "model/compile.hpp"
+
+using codyna::gui::Camera;
+using codyna::gui::ItemKind;
+using codyna::gui::Prim;
+using codyna::gui::Ray;
+using codyna::gui::Scene;
+using codyna::gui::View3D;
+
+namespace {
+
+std::shared_ptr<const codyna::Model> loadExample(const QString& file) {
+  const std::string path = QDir(CODYNA_EXAMPLES_DIR).filePath(file).toStdString();
+  return std::make_shared<const codyna::Model>(codyna::compile(codyna::load_model_spec(path), path));
+}
+
+QStringList exampleFiles() { return QDir(CODYNA_EXAMPLES_DIR).entryList({"*.json"}, QDir::Files, QDir::Name); }
+
+// a configuration away from q0: revolute-like coordinates turned, quaternions tilted
+Eigen::VectorXd perturbed(const codyna::Model& m, double amount) {
+  Eigen::VectorXd q = m.q0;
+  for (int i = 1; i < m.nbodies; ++i) {
+    const auto& j = m.joints[i];
+    if (j.type == codyna::JointType::Spherical) {
+      const Eigen::Quaterniond r(Eigen::AngleAxisd(amount, Eigen::Vector3d::UnitX()));
+      const Eigen::Quaterniond q0(q[j.idx_q], q[j.idx_q + 1], q[j.idx_q + 2], q[j.idx_q + 3]);
+      const Eigen::Quaterniond qn = q0 * r;
+      q.segment<4>(j.idx_q) << qn.w(), qn.x(), qn.y(), qn.z();
+    } else if (j.type != codyna::JointType::Free) {
+      for (int k = 0; k < j.nq; ++k) q[j.idx_q + k] += amount;
+    }
+  }
+  return q;
+}
+
+std::string bodyName(const codyna::Model& m, int i) { return m.body_names[static_cast<size_t>(i)]; }
+
+}  // namespace
+
+class View3DTest : public QObject {
+  Q_OBJECT
+
+ private slots:
+  void noOpenGLOffscreen() {
+    QCOMPARE(QGuiApplication::platformName(), QStringLiteral("offscreen"));
+    QVERIFY(!View3D::openGLAvailable());
+    QVERIFY(!View3D::openGLAvailable());  // cached, same answer
+    QVERIFY(View3D::openGLUnavailableReason().contains("platform offscreen"));
+    View3D view;
+    QVERIFY(!view.hasGL());
+    auto* label = view.findChild<QLabel*>("view3dPlaceholder");
+    QVERIFY(label);
+    QVERIFY(label->text().startsWith("3-D view unavailable: no OpenGL context"));
+    view.resize(400, 300);
+    view.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&view));
+    QVERIFY(label->isVisible());
+    QCOMPARE(label->geometry(), view.rect());
+    const QImage img = view.grabImage();
+    QVERIFY(!img.isNull());
+    QCOMPARE(img.size(), QSize(400, 300) * view.devicePixelRatio());
+  }
+
+  void everyExampleRunsThroughTheApi() {
+    View3D view;
+    view.resize(640, 480);
+    view.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&view));
+    const QStringList files = exampleFiles();
+    QVERIFY(files.size() >= 8);
+    for (const QString& f : files) {
+      auto m = loadExample(f);
+      view.setModel(m);
+      QCOMPARE(view.configuration().size(), m->nq);
+      QVERIFY(view.scene().items().size() >= static_cast<size_t>(m->nbodies - 1));
+      // every moving body has something pickable
+      for (int i = 1; i < m->nbodies; ++i) {
+        QPointF p;
+        QVERIFY2(view.bodyScreenPos(QString::fromStdString(bodyName(*m, i)), &p), qPrintable(f));
+      }
+      view.setConfiguration(perturbed(*m, 0.3));
+      view.setHighlight(QString::fromStdString(bodyName(*m, 1)));
+      QCOMPARE(view.highlight(), QString::fromStdString(bodyName(*m, 1)));
+      view.setShowFrames(false);
+      view.fitView();
+      view.setShowFrames(true);
+      view.resetView();
+      view.setHighlight("");
+      QVERIFY(!view.grabImage().isNull());
+      // the whole mechanism is in the picture after a fit
+      const Eigen::AlignedBox3d box = view.scene().bounds();
+      for (int k = 0; k < 8; ++k) {
+        Eigen::Vector2d px;
+        QVERIFY(view.camera().project(box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(k)), &px));
+        QVERIFY2(px.x() >= 0 && px.x() <= 640 && px.y() >= 0 && px.y() <= 480, qPrintable(f));
+      }
+    }
+    view.setModel(nullptr);
+    QVERIFY(view.scene().items().empty());
+    view.setConfiguration(Eigen::VectorXd::Zero(3));  // ignored, no model
+    QCOMPARE(view.configuration().size(), 0);
+    QVERIFY(view.pickBody(QPoint(320, 240)).isEmpty());
+    QVERIFY(!view.grabImage().isNull());
+  }
+
+  void wrongSizeConfigurationIsIgnored() {
+    View3D view;
+    auto m = loadExample("double_pendulum.json");
+    view.setModel(m);
+    view.setConfiguration(Eigen::VectorXd::Constant(m->nq + 1, 0.7));
+    QCOMPARE(view.configuration(), m->q0);
+  }
+
+  void cameraRoundTrip() {
+    Camera cam;
+    cam.setUp(Eigen::Vector3d(0, 0, 2));
+    QVERIFY(cam.up.isApprox(Eigen::Vector3d::UnitZ()));
+    QVERIFY(std::abs(cam.front.dot(cam.up)) < 1e-12);
+    cam.target = {1, 2, 3};
+    cam.distance = 7;
+    cam.yaw = 0.3, cam.pitch = 0.4;
+    cam.width = 800, cam.height = 600;
+    // target on the optical axis at -distance, centre of the viewport
+    const Eigen::Vector4d t = cam.viewMatrix() * Eigen::Vector4d(1, 2, 3, 1);
+    QVERIFY((t.head<3>() - Eigen::Vector3d(0, 0, -7)).norm() < 1e-12);
+    Eigen::Vector2d px;
+    QVERIFY(cam.project(cam.target, &px));
+    QVERIFY((px - Eigen::Vector2d(400, 300)).norm() < 1e-9);
+    // pixel -> ray -> point -> pixel
+    for (auto [x, y] : {std::pair{10.0, 20.0}, {799.0, 1.0}, {400.5, 599.0}}) {
+      const Ray r = cam.rayAt(x, y);
+      QVERIFY(cam.project(r.origin + 5.0 * r.dir, &px));
+      QVERIFY((px - Eigen::Vector2d(x, y)).norm() < 1e-8);
+    }
+    // the projection matrix agrees with project()
+    const Eigen::Vector3d w(1.5, 1.0, 2.2);
+    const Eigen::Vector4d c = cam.projectionMatrix() * cam.viewMatrix() * w.homogeneous();
+    QVERIFY(cam.project(w, &px));
+    QVERIFY(std::abs((c.x() / c.w() + 1) / 2 * 800 - px.x()) < 1e-8);
+    QVERIFY(std::abs((1 - c.y() / c.w()) / 2 * 600 - px.y()) < 1e-8);
+    // points in front of the camera stay behind the near plane
+    QVERIFY(cam.nearPlane() > 0 && cam.nearPlane() < cam.farPlane());
+    // up on screen is world up when looking level
+    cam.pitch = 0;
+    QVERIFY(cam.screenUp().isApprox(cam.up, 1e-12));
+    // orbit changes angles, pan moves the target in the screen plane, zoom the distance
+    const Eigen::Vector3d before = cam.target;
+    cam.pan(10, 0);
+    QVERIFY(std::abs((cam.target - before).dot(cam.forward())) < 1e-12);
+    QVERIFY((cam.target - before).dot(cam.right()) < 0);  // drag right: the scene follows the mouse
+    const double d = cam.distance;
+    cam.zoom(1);
+    QVERIFY(cam.distance < d);
+    cam.orbit(0, 1e6);
+    QVERIFY(cam.pitch < 1.5708);
+  }
+
+  void primitiveIntersections() {
+    Ray r;
+    r.origin = {0, 0, 10};
+    r.dir = {0, 0, -1};
+    Eigen::Affine3d T = Eigen::Affine3d::Identity();
+    T.translation() = Eigen::Vector3d(0, 0, 1);
+    T.linear() = Eigen::Vector3d(2, 2, 4).asDiagonal();
+    QCOMPARE(codyna::gui::intersect(Prim::Box, T, r), 7.0);       // top face at z = 3
+    QCOMPARE(codyna::gui::intersect(Prim::Cylinder, T, r), 7.0);  // cap at z = 3
+    QCOMPARE(codyna::gui::intersect(Prim::Sphere, T, r), 5.0);    // ellipsoid top at z = 5
+    r.origin = {10, 0, 1};
+    r.dir = {-1, 0, 0};
+    QCOMPARE(codyna::gui::intersect(Prim::Box, T, r), 9.0);
+    QCOMPARE(codyna::gui::intersect(Prim::Cylinder, T, r), 8.0);  // side at x = 2
+    r.origin = {10, 2.5, 1};                                       // passes beside all three
+    QVERIFY(codyna::gui::intersect(Prim::Box, T, r) < 0);
+    QVERIFY(codyna::gui::intersect(Prim::Cylinder, T, r) < 0);
+    QVERIFY(codyna::gui::intersect(Prim::Sphere, T, r) < 0);
+    r.origin = {10, 1.9, 1};  // beside the box (|y| <= 1), through the round ones (radius 2)
+    QVERIFY(codyna::gui::intersect(Prim::Box, T, r) < 0);
+    QVERIFY(std::abs(codyna::gui::intersect(Prim::Cylinder, T, r) - (10 - std::sqrt(4 - 1.9 * 1.9))) < 1e-12);
+    QVERIFY(std::abs(codyna::gui::intersect(Prim::Sphere, T, r) - (10 - std::sqrt(4 - 1.9 * 1.9))) < 1e-12);
+    r.origin = {-10, 0, 1};                                        // pointing away
+    QVERIFY(codyna::gui::intersect(Prim::Box, T, r) < 0);
+  }
+
+  void pickingOnThePendulum() {
+    View3D view;
+    view.resize(800, 600);
+    view.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&view));
+    auto m = loadExample("pendulum.json");
+    view.setModel(m);
+    QPointF p;
+    QVERIFY(view.bodyScreenPos("rod", &p));
+    QVERIFY(view.rect().contains(p.toPoint()));
+    QCOMPARE(view.pickBody(p.toPoint()), QStringLiteral("rod"));
+    QCOMPARE(view.pickBody(QPoint(3, 3)), QString());
+    QCOMPARE(view.pickBody(QPoint(796, 596)), QString());
+    QVERIFY(!view.bodyScreenPos("nonexistent", &p));
+    QVERIFY(!view.bodyScreenPos("ground", &p));
+
+    // the rod moves with the configuration: its old place becomes background
+    QVERIFY(view.bodyScreenPos("rod", &p));
+    const QPoint old = p.toPoint();
+    Eigen::VectorXd q = m->q0;
+    q[0] -= 2.0;
+    view.setConfiguration(q);
+    QPointF p2;
+    QVERIFY(view.bodyScreenPos("rod", &p2));
+    QVERIFY((p2 - p).manhattanLength() > 50);
+    QCOMPARE(view.pickBody(p2.toPoint()), QStringLiteral("rod"));
+    QCOMPARE(view.pickBody(old), QString());
+
+    // clicks: a body, then the background; a drag orbits and picks nothing
+    QSignalSpy spy(&view, &View3D::bodyPicked);
+    QTest::mouseClick(&view, Qt::LeftButton, {}, p2.toPoint());
+    QCOMPARE(spy.count(), 1);
+    QCOMPARE(spy.at(0).at(0).toString(), QStringLiteral("rod"));
+    QTest::mouseClick(&view, Qt::LeftButton, {}, QPoint(5, 5));
+    QCOMPARE(spy.count(), 2);
+    QCOMPARE(spy.at(1).at(0).toString(), QString());
+    const double yaw = view.camera().yaw;
+    QTest::mousePress(&view, Qt::LeftButton, {}, QPoint(100, 100));
+    QTest::mouseMove(&view, QPoint(160, 110));
+    QTest::mouseMove(&view, QPoint(220, 120));
+    QTest::mouseRelease(&view, Qt::LeftButton, {}, QPoint(220, 120));
+    QCOMPARE(spy.count(), 2);
+    QVERIFY(std::abs(view.camera().yaw - yaw) > 0.5);
+
+    // F refits after a zoom
+    view.fitView();
+    const double fitted = view.camera().distance;
+    QWheelEvent wheel(QPointF(400, 300), view.mapToGlobal(QPointF(400, 300)), QPoint(), QPoint(0, 240), Qt::NoButton,
+                      Qt::NoModifier, Qt::NoScrollPhase, false);
+    QApplication::sendEvent(&view, &wheel);
+    QVERIFY(view.camera().distance < 0.8 * fitted);
+    QTest::keyClick(&view, Qt::Key_F);
+    QVERIFY(std::abs(view.camera().distance - fitted) < 1e-9 * fitted);
+  }
+
+  // on every example, the visible point of each body picks that body unless something is in front of it
+  void pickingEveryBody() {
+    View3D view;
+    view.resize(800, 600);
+    view.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&view));
+    for (const QString& f : exampleFiles()) {
+      auto m = loadExample(f);
+      view.setModel(m);
+      int exact = 0;
+      for (int i = 1; i < m->nbodies; ++i) {
+        const QString name = QString::fromStdString(bodyName(*m, i));
+        QPointF p;
+        QVERIFY(view.bodyScreenPos(name, &p));
+        const QString got = view.pickBody(p.toPoint());
+        QVERIFY2(!got.isEmpty(), qPrintable(f + ": " + name));
+        if (got == name) ++exact;
+      }
+      // occlusion is the exception
+      QVERIFY2(exact * 4 >= (m->nbodies - 1) * 3, qPrintable(f));
+    }
+  }
+
+  // the grid lies under the mechanism, also as the pendulums swing
+  void gridUnderTheMechanism() {
+    for (const char* f : {"pendulum.json", "double_pendulum.json", "iftomm_a01_pendulum.json", "cart_pendulum.json"}) {
+      auto m = loadExample(f);
+      Scene scene;
+      scene.build(m.get());
+      QVERIFY(scene.up().isApprox(Eigen::Vector3d::UnitY()));
+      const double h = scene.gridCenter().dot(scene.up());
+      codyna::Data d(*m);
+      for (double a = -3.1; a <= 3.1; a += 0.2) {
+        Eigen::VectorXd q = m->q0;
+        for (int k = 0; k < m->nq; ++k)
+          if (m->joints[static_cast<size_t>(k + 1)].type == codyna::JointType::Revolute) q[k] = a * (k + 1);
+        codyna::forward_kinematics(*m, d, q);
+        scene.update(d.oMi);
+        QVERIFY2(scene.bounds().min().y() > h, f);
+      }
+      // and not absurdly far below
+      QVERIFY(h > scene.bounds().min().y() - 1.5 * scene.length());
+    }
+    // up follows gravity: the heavy top has g along -z
+    auto top = loadExample("heavy_top.json");
+    Scene scene;
+    scene.build(top.get());
+    QVERIFY(scene.up().isApprox(Eigen::Vector3d::UnitZ()));
+    QVERIFY(scene.gridCenter().z() < scene.bounds().min().z());
+    QVERIFY(scene.gridStep() > 0 && scene.gridHalf() >= 4 * scene.gridStep());
+    QCOMPARE(static_cast<int>(scene.gridLines().size()) % 12, 0);
+  }
+
+  // bodies without shapes get a ball and links, which pick; overlays follow the joint types
+  void defaultLookForShapelessBodies() {
+    codyna::ModelSpec spec;
+    spec.name = "bare";
+    for (int i = 0; i < 3; ++i) {
+      codyna::BodySpec b;
+      b.name = std::string("b").append(std::to_string(i));
+      b.mass = 1;
+      b.com = {0.5, 0, 0};
+      b.inertia = Eigen::Matrix3d::Identity() * 0.01;
+      spec.bodies.push_back(b);
+      codyna::JointSpec j;
+      j.name = std::string("j").append(std::to_string(i));
+      j.type = i == 1 ? codyna::JointType::Prismatic : codyna::JointType::Revolute;
+      j.parent = i == 0 ? std::string("ground") : std::string("b").append(std::to_string(i - 1));
+      j.child = b.name;
+      j.parent_frame.position = i == 0 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(1, 0, 0);
+      j.axis = i == 1 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitZ();
+      spec.joints.push_back(j);
+    }
+    codyna::BodySpec lone;  // free-floating, nothing to connect
+    lone.name = "lone";
+    lone.mass = 2;
+    lone.inertia = Eigen::Matrix3d::Identity() * 0.02;
+    spec.bodies.push_back(lone);
+    codyna::JointSpec free;
+    free.name = "jf";
+    free.type = codyna::JointType::Free;
+    free.parent = "ground";
+    free.child = "lone";
+    free.q0 = (Eigen::VectorXd(7) << 0, -1, 0, 1, 0, 0, 0).finished();
+    spec.joints.push_back(free);
+    auto m = std::make_shared<const codyna::Model>(codyna::compile(spec));
+
+    Scene scene;
+    scene.build(m.get());
+    int shapes[5] = {0, 0, 0, 0, 0}, axes = 0, frames = 0, anchors = 0;
+    for (const auto& it : scene.items()) {
+      if (it.kind == ItemKind::Shape) ++shapes[it.body];
+      axes += it.kind == ItemKind::Axis;
+      frames += it.kind == ItemKind::Frame;
+      anchors += it.kind == ItemKind::Anchor;
+    }
+    QCOMPARE(shapes[0], 0);
+    for (int i = 1; i <= 4; ++i) QVERIFY2(shapes[i] >= 1, qPrintable(QString::number(i)));
+    QVERIFY(shapes[1] >= 3);    // ball, link to the next joint, knobs
+    QCOMPARE(axes, 3);          // two revolute, one prismatic; none for the free joint
+    QCOMPARE(frames, 5);        // the world and four bodies
+    QCOMPARE(anchors, 2);       // joints on the ground
+    Eigen::Vector3d p;
+    QVERIFY(scene.bodyAnchor(m->find_body("lone"), &p));
+    QVERIFY((p - Eigen::Vector3d(0, -1, 0)).norm() < 1e-12);
+    // the lone ball has the radius of gyration: sqrt(2.5 * 0.02 / 2)
+    double r = 0;
+    for (const auto& it : scene.items())
+      if (it.kind == ItemKind::Shape && it.body == m->find_body("lone")) r = it.world.linear()(0, 0);
+    QVERIFY(std::abs(r - std::sqrt(0.025)) < 1e-12);
+
+    View3D view;
+    view.resize(600, 400);
+    view.setModel(m);
+    for (const char* name : {"b0", "b1", "b2", "lone"}) {
+      QPointF q;
+      QVERIFY(view.bodyScreenPos(name, &q));
+      QVERIFY2(!view.pickBody(q.toPoint()).isEmpty(), name);
+    }
+  }
+
+  // an edited model (same file and name) keeps the camera; another model is framed anew
+  void cameraKeptOnEdit() {
+    View3D view;
+    view.resize(640, 480);
+    view.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&view));
+    view.setModel(loadExample("four_bar.json"));
+    QTest::mousePress(&view, Qt::LeftButton, {}, QPoint(100, 100));
+    QTest::mouseMove(&view, QPoint(200, 150));
+    QTest::mouseRelease(&view, Qt::LeftButton, {}, QPoint(200, 150));
+    const double yaw = view.camera().yaw;
+    QVERIFY(std::abs(yaw - Camera::kDefaultYaw) > 0.3);
+    view.setModel(loadExample("four_bar.json"));
+    QCOMPARE(view.camera().yaw, yaw);
+    view.setModel(loadExample("pendulum.json"));
+    QCOMPARE(view.camera().yaw, Camera::kDefaultYaw);
+  }
+};
+
+QTEST_MAIN(View3DTest)
+#include "view3d_test.moc"

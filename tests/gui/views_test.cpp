@@ -1,0 +1,589 @@
+// The Linearize and Simulate views and the simulation worker, through their real
+// widgets, offscreen (QT_QPA_PLATFORM=offscreen):
+//  - the study widgets write the Document (one undo step each) and follow it back;
+//  - Linearize at the cart-pendulum's upright equilibrium gives the paper's closed
+//    form; mode selection is shared by the table and the pole map and announced;
+//  - Export writes what `codyna linearize --out DIR` writes (byte-equal NAME.m,
+//    equal matrices in NAME.mat);
+//  - a run plots exactly the simulated samples, the integrator runs on the worker
+//    thread, batches arrive at a bounded rate and lose nothing; cancel keeps the
+//    partial result; a failing setup is reported, not a crash; results save.
+#include <QCheckBox>
+#include <QComboBox>
+#include <QDoubleSpinBox>
+#include <QElapsedTimer>
+#include <QFile>
+#include <QFileInfo>
+#include <QLabel>
+#include <QLineEdit>
+#include <QListWidget>
+#include <QProcess>
+#include <QProgressBar>
+#include <QPushButton>
+#include <QSignalSpy>
+#include <QTableView>
+#include <QTableWidget>
+#include <QTemporaryDir>
+#include <QTest>
+#include <QThread>
+#include <QUndoStack>
+#include <cmath>
+#include <functional>
+
+#include "gui/document.hpp"
+#include "gui/linearize_view.hpp"
+#include "gui/matrix_models.hpp"
+#include "gui/pole_map.hpp"
+#include "gui/result_plots.hpp"
+#include "gui/sim_worker.hpp"
+#include "gui/simulate_view.hpp"
+#include "io/mat_export.hpp"
+#include "io/results_file.hpp"
+
+using namespace codyna;
+using namespace codyna::gui;
+
+namespace {
+
+const QString kCart = QStringLiteral(CODYNA_EXAMPLES_DIR "/cart_pendulum.json");
+const QString kBricard = QStringLiteral(CODYNA_EXAMPLES_DIR "/bricard.json");
+const QString kFourBar = QStringLiteral(CODYNA_EXAMPLES_DIR "/four_bar.json");
+
+bool waitFor(const std::function<bool()>& done, int ms = 60000) {
+  QElapsedTimer t;
+  t.start();
+  while (!done() && t.elapsed() < ms) QTest::qWait(10);
+  return done();
+}
+
+int headerRow(const QAbstractItemModel* m, const QString& name, Qt::Orientation o) {
+  const int n = o == Qt::Vertical ? m->rowCount() : m->columnCount();
+  for (int i = 0; i < n; ++i)
+    if (m->headerData(i, o, Qt::DisplayRole).toString() == name) return i;
+  return -1;
+}
+
+double entry(const MatrixTableModel* m, const QString& row, const QString& col) {
+  const int r = headerRow(m, row, Qt::Vertical), c = col.isEmpty() ? 0 : headerRow(m, col, Qt::Horizontal);
+  if (r < 0 || c < 0) return std::nan("");
+  return m->data(m->index(r, c), Qt::UserRole).toDouble();
+}
+
+bool relClose(double a, double b, double rel = 1e-9) { return std::abs(a - b) <= rel * std::abs(b); }
+
+const BodySpec& body(const ModelSpec& s, const std::string& name) {
+  for (const auto& b : s.bodies)
+    if (b.name == name) return b;
+  throw std::runtime_error("no body " + name);
+}
+
+void setLine(QLineEdit* e, const QString& text) {
+  e->setText(text);
+  emit e->editingFinished();
+}
+
+QByteArray readAll(const QString& path) {
+  QFile f(path);
+  return f.open(QIODevice::ReadOnly) ? f.readAll() : QByteArray();
+}
+
+}  // namespace
+
+class ViewsTest : public QObject {
+  Q_OBJECT
+  QTemporaryDir tmp;
+
+ private slots:
+  void initTestCase() { QVERIFY(tmp.isValid()); }
+
+  // ---------------------------------------------------------------- Linearize
+
+  void linearizeGivesThePapersClosedForm() {
+    Document doc;
+    QString err;
+    QVERIFY2(doc.load(kCart, &err), qPrintable(err));
+    LinearizeView view(&doc);
+    view.resize(1400, 900);
+    view.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&view));
+
+    // the paper's values, as the example file has them
+    const ModelSpec& spec = doc.spec();
+    const double m2 = body(spec, "cart").mass, m3 = body(spec, "rod").mass, l3 = 2 * body(spec, "rod").com.y();
+    const double g = -spec.effects.at(0).g.y();
+    QCOMPARE(m2, 20.0);
+    QCOMPARE(m3, 10.0);
+    QCOMPARE(l3, 2.0);
+    QCOMPARE(g, 9.81);
+
+    // operating point through the combo: initial, then equilibrium (each one undo step)
+    QComboBox* op = view.operatingPointCombo();
+    const int before = doc.undoStack()->count();
+    op->setCurrentIndex(op->findData("initial"));
+    QCOMPARE(doc.spec().analysis.operating_point, std::string("initial"));
+    op->setCurrentIndex(op->findData("equilibrium"));
+    QCOMPARE(doc.spec().analysis.operating_point, std::string("equilibrium"));
+    QCOMPARE(doc.undoStack()->count(), before + 2);
+
+    QSignalSpy linearized(&view, &LinearizeView::linearized);
+    QTest::mouseClick(view.linearizeButton(), Qt::LeftButton);
+    QCOMPARE(linearized.count(), 1);
+    QVERIFY(view.result());
+    QVERIFY(!view.isStale());
+    QCOMPARE(view.result()->op.kind, std::string("equilibrium"));
+    QVERIFY(view.operatingPointLabel()->text().contains("equilibrium"));
+
+    // A, B as shown in the tables, found by state names
+    const MatrixTableModel* A = view.matrixModel(0);
+    const MatrixTableModel* B = view.matrixModel(1);
+    QCOMPARE(A->rowCount(), 4);
+    QCOMPARE(A->columnCount(), 4);
+    const double den = 4 * m2 + m3;
+    const double a23 = entry(A, "cart_slider_dot", "rod_pivot"), a43 = entry(A, "rod_pivot_dot", "rod_pivot");
+    QVERIFY2(relClose(a23, -3 * m3 * g / den), qPrintable(QString::number(a23, 'g', 17)));
+    QVERIFY2(relClose(a43, 6 * (m2 + m3) * g / (den * l3)), qPrintable(QString::number(a43, 'g', 17)));
+    QVERIFY(relClose(entry(B, "cart_slider_dot", "force"), 4 / den));
+    QVERIFY(relClose(entry(B, "rod_pivot_dot", "force"), -6 / (l3 * den)));
+    QVERIFY(std::abs(entry(A, "cart_slider_dot", "cart_slider")) < 1e-12);  // a neutral cart position
+    QCOMPARE(view.matrixModel(2)->rowCount(), 2);                         // C: h, theta
+    QCOMPARE(view.matrixModel(3)->columnCount(), 1);                      // D: 1 input
+
+    // the result follows the document: a change marks it stale, undo does not bring it back
+    view.methodCombo()->setCurrentIndex(view.methodCombo()->findData("fd-central"));
+    QCOMPARE(doc.spec().analysis.method, std::string("fd-central"));
+    QVERIFY(view.isStale());
+    doc.undoStack()->undo();
+    QCOMPARE(doc.spec().analysis.method, std::string("exact"));
+    QCOMPARE(view.methodCombo()->currentData().toString(), QString("exact"));
+  }
+
+  void modeSelectionIsSharedByTheTableAndThePoleMap() {
+    Document doc;
+    QVERIFY(doc.load(kCart));
+    LinearizeView view(&doc);
+    view.resize(1400, 900);
+    view.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&view));
+    QVERIFY(view.linearize());
+    const int n = static_cast<int>(view.modes().modes.size());
+    QCOMPARE(n, 4);
+    QCOMPARE(view.modeModel()->rowCount(), 4);
+    QCOMPARE(view.poleMap()->poleCount(), 4);
+
+    QSignalSpy spy(&view, &LinearizeView::modeSelected);
+    // a click on the last row of the mode table
+    QTableView* table = view.modeView();
+    const QModelIndex last = view.modeModel()->index(n - 1, 1);
+    table->scrollTo(last);
+    QTest::mouseClick(table->viewport(), Qt::LeftButton, {}, table->visualRect(last).center());
+    QCOMPARE(spy.count(), 1);
+    const int idx = spy.at(0).at(0).toInt();
+    QCOMPARE(idx, view.modeModel()->index(n - 1, 0).data(Qt::UserRole).toInt());
+    const auto shape = spy.at(0).at(1).value<Eigen::VectorXcd>();
+    const auto s = spy.at(0).at(2).value<std::complex<double>>();
+    QCOMPARE(shape.size(), 4);
+    QVERIFY((shape - view.modes().modes[idx].shape).norm() == 0.0);
+    QCOMPARE(s, view.modes().modes[idx].s);
+    QCOMPARE(view.poleMap()->selectedMode(), idx);
+    QCOMPARE(view.selectedMode(), idx);
+
+    // a click on another pole selects its row
+    const int other = idx == 0 ? 1 : 0;
+    // the four poles of the upright pendulum are distinct points (+-sqrt, 0, 0 are two at 0: pick a non-zero one)
+    int target = -1;
+    for (int i = 0; i < n && target < 0; ++i)
+      if (i != idx && std::abs(view.modes().modes[i].eigenvalue) > 1e-6 &&
+          view.poleMap()->poleAt(view.poleMap()->poleWidgetPosition(i), 3) == i)
+        target = i;
+    if (target < 0) target = other;
+    QTest::mouseClick(view.poleMap(), Qt::LeftButton, {}, view.poleMap()->poleWidgetPosition(target));
+    QCOMPARE(spy.count(), 2);
+    QCOMPARE(spy.at(1).at(0).toInt(), target);
+    QCOMPARE(view.modeView()->selectionModel()->currentIndex().row(), target);
+    QCOMPARE(view.selectedMode(), target);
+
+    // programmatic selection keeps both in sync too
+    view.selectMode(idx);
+    QCOMPARE(spy.count(), 3);
+    QCOMPARE(view.poleMap()->selectedMode(), idx);
+    QCOMPARE(view.modeView()->selectionModel()->currentIndex().row(), idx);
+  }
+
+  void exportEqualsTheCommandLine() {
+    Document doc;
+    QVERIFY(doc.load(kCart));
+    LinearizeView view(&doc);
+    view.show();
+    QVERIFY(QFileInfo::exists(CODYNA_CLI));
+    const QString guiDir = tmp.filePath("gui_export"), cliDir = tmp.filePath("cli_export");
+    QSignalSpy exported(&view, &LinearizeView::exported);
+    QString err;
+    QVERIFY2(view.exportTo(guiDir, &err), qPrintable(err));  // stale (never linearized): linearizes first
+    QVERIFY(view.result());
+    QCOMPARE(exported.count(), 1);
+    QCOMPARE(exported.at(0).at(0).toString(), guiDir + "/cart_pendulum.mat");
+    QCOMPARE(exported.at(0).at(1).toString(), guiDir + "/cart_pendulum.m");
+
+    QProcess cli;
+    cli.start(CODYNA_CLI, {"linearize", QFileInfo(kCart).absoluteFilePath(), "--out", cliDir});
+    QVERIFY(cli.waitForFinished(120000));
+    QVERIFY2(cli.exitCode() == 0, cli.readAllStandardError().constData());
+
+    const QByteArray ma = readAll(guiDir + "/cart_pendulum.m"), mb = readAll(cliDir + "/cart_pendulum.m");
+    QVERIFY(!ma.isEmpty());
+    QCOMPARE(ma, mb);
+    const MatVariables a = read_mat_file((guiDir + "/cart_pendulum.mat").toStdString());
+    const MatVariables b = read_mat_file((cliDir + "/cart_pendulum.mat").toStdString());
+    for (const char* k : {"A", "B", "C", "D", "x0", "u0", "y0", "xdot0", "Ts"}) {
+      QVERIFY2(a.matrices.count(k) && b.matrices.count(k), k);
+      QVERIFY2(a.matrices.at(k).rows() == b.matrices.at(k).rows() && a.matrices.at(k).cols() == b.matrices.at(k).cols(), k);
+      QVERIFY2(a.matrices.at(k) == b.matrices.at(k), k);
+    }
+    QCOMPARE(a.matrices.at("A").rows(), 4);
+    QCOMPARE(a.strings.at("state_names"), b.strings.at("state_names"));
+    QCOMPARE(a.strings.at("output_names"), b.strings.at("output_names"));
+    // the exported A is the one shown
+    QVERIFY(a.matrices.at("A") == view.matrixModel(0)->matrix());
+
+    // a study change makes the shown result stale: export linearizes again, with Ts
+    view.sampleTimeSpin()->setValue(0.01);
+    QCOMPARE(doc.spec().analysis.discrete, 0.01);
+    QVERIFY(view.isStale());
+    const QString zohDir = tmp.filePath("zoh_export");
+    QVERIFY(view.exportTo(zohDir, &err));
+    QVERIFY(!view.isStale());
+    QCOMPARE(view.result()->system.Ts, 0.01);
+    QCOMPARE(read_mat_file((zohDir + "/cart_pendulum.mat").toStdString()).matrices.at("Ts")(0, 0), 0.01);
+    QVERIFY(view.poleMap()->isDiscrete());
+
+    // a failing export says why
+    QFile blocker(tmp.filePath("not_a_dir"));
+    QVERIFY(blocker.open(QIODevice::WriteOnly));
+    blocker.close();
+    QSignalSpy messages(&view, &LinearizeView::message);
+    QVERIFY(!view.exportTo(tmp.filePath("not_a_dir/sub"), &err));
+    QVERIFY(!err.isEmpty());
+    QVERIFY(messages.count() >= 1);
+  }
+
+  void linearizeWidgetsWriteTheStudyAndFollowUndo() {
+    Document doc;
+    QVERIFY(doc.load(kCart));
+    LinearizeView view(&doc);
+    view.show();
+    QUndoStack* undo = doc.undoStack();
+    const StudySpec original = doc.spec().analysis;
+    const int base = undo->count();
+
+    // spin box steps merge into one undo step
+    view.sampleTimeSpin()->setValue(0.1);
+    view.sampleTimeSpin()->setValue(0.2);
+    QCOMPARE(doc.spec().analysis.discrete, 0.2);
+    QCOMPARE(undo->count(), base + 1);
+
+    view.matVersionCombo()->setCurrentIndex(view.matVersionCombo()->findData("7.3"));
+    QCOMPARE(doc.spec().analysis.mat_version, std::string("7.3"));
+    view.operatingPointCombo()->setCurrentIndex(view.operatingPointCombo()->findData("time"));
+    view.operatingTimeSpin()->setValue(1.5);
+    QCOMPARE(doc.spec().analysis.operating_point, std::string("time=1.5"));
+    QVERIFY(view.operatingTimeSpin()->isEnabled());
+    setLine(view.exportDirEdit(), "out/plant");
+    QCOMPARE(doc.spec().analysis.export_dir, std::string("out/plant"));
+    setLine(view.exportNameEdit(), "cartpole");
+    QCOMPARE(doc.spec().analysis.export_name, std::string("cartpole"));
+    QVERIFY(!view.independentList()->isVisibleTo(&view));  // a tree: no choice of coordinates
+
+    // undo all: the document and the widgets are back
+    while (undo->count() > base && undo->canUndo() && undo->index() > base) undo->undo();
+    QCOMPARE(doc.spec().analysis, original);
+    QCOMPARE(view.sampleTimeSpin()->value(), 0.0);
+    QCOMPARE(view.matVersionCombo()->currentData().toString(), QString("5"));
+    QCOMPARE(view.operatingPointCombo()->currentData().toString(), QString("equilibrium"));
+    QVERIFY(!view.operatingTimeSpin()->isEnabled());
+    QCOMPARE(view.exportDirEdit()->text(), QString());
+    // and redo brings the time point back into the widgets
+    while (undo->canRedo()) undo->redo();
+    QCOMPARE(view.operatingPointCombo()->currentData().toString(), QString("time"));
+    QCOMPARE(view.operatingTimeSpin()->value(), 1.5);
+    QCOMPARE(view.exportNameEdit()->text(), QString("cartpole"));
+  }
+
+  void closedLoopsOfferTheIndependentCoordinates() {
+    Document doc;
+    QVERIFY(doc.load(kFourBar));
+    QVERIFY(doc.model());
+    LinearizeView view(&doc);
+    view.show();
+    QListWidget* list = view.independentList();
+    QVERIFY(list->isVisibleTo(&view));
+    const std::vector<std::string> names = doc.model()->v_names;  // a copy: each edit recompiles the model
+    QCOMPARE(list->count(), static_cast<int>(names.size()));
+    QCOMPARE(doc.model()->dof(), 1);
+    // choose the last coordinate as the independent one (a user's click on its check box)
+    const QString chosen = QString::fromStdString(names.back());
+    QListWidgetItem* item = list->item(list->count() - 1);
+    QCOMPARE(item->text(), chosen);
+    item->setCheckState(Qt::Checked);
+    QCOMPARE(doc.spec().analysis.independent, std::vector<std::string>{names.back()});
+    view.operatingPointCombo()->setCurrentIndex(view.operatingPointCombo()->findData("initial"));
+    QVERIFY(view.linearize());
+    QCOMPARE(view.result()->system.state_names.at(0), names.back());
+    QCOMPARE(view.matrixModel(0)->headerData(0, Qt::Vertical).toString(), chosen);
+    doc.undoStack()->undo();  // operating point
+    doc.undoStack()->undo();  // independent
+    QVERIFY(doc.spec().analysis.independent.empty());
+    QCOMPARE(list->item(list->count() - 1)->checkState(), Qt::Unchecked);
+  }
+
+  // ---------------------------------------------------------------- Simulate
+
+  void runPlotsExactlyTheSimulatedSamples() {
+    Document doc;
+    QVERIFY(doc.load(kCart));
+    SimulateView view(&doc);
+    view.resize(1400, 900);
+    view.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&view));
+    view.endTimeSpin()->setValue(0.5);
+    QCOMPARE(doc.spec().solver.t_end, 0.5);
+
+    // what the worker delivers live, batch by batch
+    std::vector<double> liveT;
+    std::vector<Eigen::VectorXd> liveY;
+    connect(view.worker(), &SimWorker::samples, this, [&](const SampleBatch& b) {
+      for (const Snapshot& s : b) {
+        liveT.push_back(s.t);
+        liveY.push_back(s.y);
+      }
+    });
+    QSignalSpy started(&view, &SimulateView::runStarted);
+    QSignalSpy finished(&view, &SimulateView::runFinished);
+    QSignalSpy batches(view.worker(), &SimWorker::samples);
+    view.run();
+    QCOMPARE(started.count(), 1);
+    QVERIFY(view.isRunning());
+    QVERIFY(!view.runButton()->isEnabled());
+    QVERIFY(view.cancelButton()->isEnabled());
+    QVERIFY(waitFor([&] { return finished.count() == 1; }));
+    QVERIFY(!view.isRunning());
+
+    const auto r = view.result();
+    QVERIFY(r);
+    QCOMPARE(finished.at(0).at(0).value<std::shared_ptr<const SimulationResult>>(), r);
+    QVERIFY(r->completed);
+    QCOMPARE(r->samples(), 51);
+    QCOMPARE(r->t.back(), 0.5);
+    QCOMPARE(view.progressBar()->value(), view.progressBar()->maximum());
+    QVERIFY(view.statusText().contains("completed"));
+
+    // the integrator ran on the worker thread, not on the GUI thread
+    QVERIFY(view.worker()->integratorThread() != nullptr);
+    QVERIFY(view.worker()->integratorThread() != QThread::currentThread());
+    QVERIFY(view.worker()->integratorThread() != qApp->thread());
+    QCOMPARE(view.worker()->integratorThread(), view.worker()->workerThread());
+
+    // batched: nothing lost, in order, at most one emission per 50 ms (+ the last)
+    QCOMPARE(static_cast<int>(liveT.size()), r->samples());
+    for (int i = 0; i < r->samples(); ++i) {
+      QCOMPARE(liveT[i], r->t[i]);
+      QVERIFY(liveY[i] == r->y.row(i).transpose());
+    }
+    QVERIFY(batches.count() >= 1);
+    QVERIFY2(batches.count() <= 2 + static_cast<int>(view.worker()->wallTime() / 0.05),
+             qPrintable(QString("%1 batches in %2 s").arg(batches.count()).arg(view.worker()->wallTime())));
+
+    // the plots hold exactly the samples (outputs and the Plant/In column of u)
+    view.plots()->flush();
+    QCOMPARE(view.plots()->outputSeriesCount(), static_cast<int>(r->y.cols()));
+    for (int k = 0; k < static_cast<int>(r->y.cols()); ++k) {
+      const QList<QPointF> p = view.plots()->outputPoints(k);
+      QCOMPARE(p.size(), r->samples());
+      for (int i = 0; i < r->samples(); ++i) {
+        QCOMPARE(p[i].x(), r->t[i]);
+        QCOMPARE(p[i].y(), r->y(i, k));
+      }
+    }
+    const int uc = doc.model()->plant_inputs.at(0);
+    const QList<QPointF> u = view.plots()->inputPoints(0);
+    QCOMPARE(u.size(), r->samples());
+    for (int i = 0; i < r->samples(); ++i) QCOMPARE(u[i].y(), r->u(i, uc));
+    QVERIFY(view.plots()->redrawCount() > 0);
+
+    // results files through core's writers
+    QString err;
+    const QString h5 = tmp.filePath("run.h5"), csv = tmp.filePath("run.csv");
+    QVERIFY2(view.saveResults(h5, &err), qPrintable(err));
+    QVERIFY2(view.saveResults(csv, &err), qPrintable(err));
+    const SimulationResult back = read_results_hdf5(h5.toStdString());
+    QCOMPARE(back.samples(), r->samples());
+    QVERIFY(back.y == r->y);
+    QCOMPARE(readAll(csv).count('\n'), r->samples() + 1);
+    QVERIFY(!view.saveResults(tmp.filePath("run.txt"), &err));
+    QVERIFY(err.contains(".h5"));
+    QVERIFY2(view.savePlot(tmp.filePath("plot.png"), &err), qPrintable(err));
+    QVERIFY(QFileInfo(tmp.filePath("plot.png")).size() > 0);
+  }
+
+  void lqrWithTheLinearComparisonIsPlottedToo() {
+    Document doc;
+    QVERIFY(doc.load(kCart));
+    SimulateView view(&doc);
+    view.show();
+    view.controllerCombo()->setCurrentIndex(view.controllerCombo()->findData("lqr"));
+    setLine(view.qWeightsEdit(), "10, 100, 1, 1");
+    setLine(view.rWeightsEdit(), "0.01");
+    QTest::mouseClick(view.compareLinearCheck(), Qt::LeftButton);
+    QVERIFY(doc.spec().analysis.compare_linear);
+    view.endTimeSpin()->setValue(1.0);
+    QSignalSpy finished(&view, &SimulateView::runFinished);
+    QTest::mouseClick(view.runButton(), Qt::LeftButton);
+    QVERIFY(waitFor([&] { return finished.count() == 1; }));
+    const auto r = view.result();
+    QVERIFY(r && r->completed);
+    QCOMPARE(view.worker()->controllerSource(), QString("lqr"));
+    QCOMPARE(r->y_linear.rows(), r->y.rows());
+    QCOMPARE(view.plots()->linearPoints(1).size(), r->samples());
+    // the LQR brings theta (0.1 rad at the start) back toward upright
+    QVERIFY(std::abs(r->y(r->samples() - 1, 1)) < 0.5 * std::abs(r->y(0, 1)));
+  }
+
+  void cancelKeepsThePartialResult() {
+    Document doc;
+    QVERIFY(doc.load(kBricard));
+    SimulateView view(&doc);
+    view.show();
+    view.endTimeSpin()->setValue(1000);
+    QCOMPARE(doc.spec().solver.t_end, 1000.0);
+    QSignalSpy progress(view.worker(), &SimWorker::progress);
+    QSignalSpy finished(&view, &SimulateView::runFinished);
+    view.run();
+    QVERIFY(waitFor([&] { return view.progressBar()->value() > 0 || (!progress.isEmpty() && progress.last().at(0).toDouble() > 0.5); }));
+    QVERIFY(view.isRunning());
+    QTest::mouseClick(view.cancelButton(), Qt::LeftButton);
+    QVERIFY(waitFor([&] { return finished.count() == 1; }, 30000));
+    const auto r = view.result();
+    QVERIFY(r);
+    QVERIFY(r->cancelled);
+    QVERIFY(!r->completed);
+    QVERIFY(r->samples() > 1);
+    QVERIFY(r->t.back() < 1000.0);
+    QVERIFY(r->t.back() > 0.0);
+    QVERIFY(view.statusText().contains("cancelled at t ="));
+    view.plots()->flush();
+    QCOMPARE(view.plots()->outputPoints(0).size(), std::min(r->samples(), view.plots()->maxPlotPoints()));
+    QVERIFY(view.runButton()->isEnabled());
+    QVERIFY(!view.cancelButton()->isEnabled());
+  }
+
+  void failingSetupIsReportedNotFatal() {
+    Document doc;
+    QVERIFY(doc.load(kCart));
+    SimulateView view(&doc);
+    view.controllerCombo()->setCurrentIndex(view.controllerCombo()->findData("file"));
+    setLine(view.controllerFileEdit(), "no_such_controller.mat");
+    QCOMPARE(doc.spec().analysis.controller_file, std::string("no_such_controller.mat"));
+    QSignalSpy failed(view.worker(), &SimWorker::failed);
+    QSignalSpy finished(&view, &SimulateView::runFinished);
+    QSignalSpy messages(&view, &SimulateView::message);
+    view.run();
+    QVERIFY(waitFor([&] { return finished.count() == 1; }));
+    QCOMPARE(failed.count(), 1);
+    QVERIFY(!finished.at(0).at(0).value<std::shared_ptr<const SimulationResult>>());
+    QVERIFY(!view.result());
+    QVERIFY(view.statusText().startsWith("failed"));
+    QVERIFY(view.statusText().contains("no_such_controller.mat"));
+    QVERIFY(messages.count() >= 1);
+    QString err;
+    QVERIFY(!view.saveResults(tmp.filePath("none.h5"), &err));
+    // the worker is usable again
+    view.controllerCombo()->setCurrentIndex(view.controllerCombo()->findData("none"));
+    view.endTimeSpin()->setValue(0.1);
+    view.run();
+    QVERIFY(waitFor([&] { return finished.count() == 2; }));
+    QVERIFY(view.result() && view.result()->completed);
+  }
+
+  void simulateWidgetsWriteTheStudyAndFollowUndo() {
+    Document doc;
+    QVERIFY(doc.load(kCart));
+    SimulateView view(&doc);
+    view.show();
+    QUndoStack* undo = doc.undoStack();
+    const ModelSpec original = doc.spec();
+    const int base = undo->index();
+
+    view.controllerCombo()->setCurrentIndex(view.controllerCombo()->findData("lqr"));
+    QCOMPARE(doc.spec().analysis.controller, std::string("lqr"));
+    setLine(view.qWeightsEdit(), "1 2 3 4");
+    QCOMPARE(doc.spec().analysis.q_weights, (std::vector<double>{1, 2, 3, 4}));
+    setLine(view.rWeightsEdit(), "nonsense");  // refused, the field shows the study again
+    QVERIFY(doc.spec().analysis.r_weights.empty());
+    QCOMPARE(view.rWeightsEdit()->text(), QString());
+    view.integratorCombo()->setCurrentIndex(view.integratorCombo()->findData("cvode-bdf"));
+    QCOMPARE(doc.spec().solver.integrator, std::string("cvode-bdf"));
+    setLine(view.rtolEdit(), "1e-6");
+    QCOMPARE(doc.spec().solver.rtol, 1e-6);
+    setLine(view.atolEdit(), "-1");  // refused
+    QCOMPARE(doc.spec().solver.atol, original.solver.atol);
+    view.outputStepSpin()->setValue(0.02);
+    view.outputStepSpin()->setValue(0.05);  // merged with the step before
+    QCOMPARE(doc.spec().solver.output_step, 0.05);
+    view.compareLinearCheck()->setChecked(true);
+    QVERIFY(doc.spec().analysis.compare_linear);
+    QCOMPARE(undo->index(), base + 6);
+
+    undo->undo();
+    QVERIFY(!doc.spec().analysis.compare_linear);
+    QVERIFY(!view.compareLinearCheck()->isChecked());
+    undo->undo();
+    QCOMPARE(doc.spec().solver.output_step, original.solver.output_step);
+    QCOMPARE(view.outputStepSpin()->value(), original.solver.output_step);
+    undo->undo();
+    QCOMPARE(view.rtolEdit()->text().toDouble(), original.solver.rtol);
+    while (undo->index() > base) undo->undo();
+    QCOMPARE(doc.spec().analysis, original.analysis);
+    QCOMPARE(view.controllerCombo()->currentData().toString(), QString("model"));
+    QCOMPARE(view.integratorCombo()->currentData().toString(), QString("ida"));
+    QCOMPARE(view.qWeightsEdit()->text(), QString());
+
+    // the model file's controller is described (an LQR here)
+    QVERIFY(view.controllerDescription()->text().contains("LQR"));
+    QVERIFY(!view.pidTable()->isVisibleTo(&view));
+  }
+
+  void pidGainsAreEditableInTheTable() {
+    Document doc;
+    QVERIFY(doc.load(kCart));
+    QVERIFY(doc.edit("PID", [](ModelSpec& s) {
+      s.controller = ControllerSpec{};
+      s.controller.type = ControllerType::Pid;
+      s.controller.kp = Eigen::MatrixXd(1, 2);
+      s.controller.kp << -5, 300;
+    }));
+    SimulateView view(&doc);
+    view.show();
+    QTableWidget* t = view.pidTable();
+    QVERIFY(t->isVisibleTo(&view));
+    QCOMPARE(t->rowCount(), 1);
+    QCOMPARE(t->columnCount(), 6);  // Kp, Ki, Kd x (h, theta)
+    QCOMPARE(t->horizontalHeaderItem(1)->text(), QString("Kp: theta"));
+    QCOMPARE(t->item(0, 1)->text().toDouble(), 300.0);
+    QVERIFY(view.controllerDescription()->text().contains("PID"));
+    const int base = doc.undoStack()->index();
+    t->item(0, 5)->setText("25");  // Kd on theta: from none to a 1 x 2 matrix
+    QCOMPARE(doc.spec().controller.kd.rows(), 1);
+    QCOMPARE(doc.spec().controller.kd.cols(), 2);
+    QCOMPARE(doc.spec().controller.kd(0, 1), 25.0);
+    QCOMPARE(doc.spec().controller.kd(0, 0), 0.0);
+    QCOMPARE(doc.undoStack()->index(), base + 1);
+    t->item(0, 0)->setText("oops");  // refused and shown as before
+    QCOMPARE(doc.spec().controller.kp(0, 0), -5.0);
+    QCOMPARE(t->item(0, 0)->text().toDouble(), -5.0);
+    doc.undoStack()->undo();
+    QCOMPARE(doc.spec().controller.kd.size(), 0);
+    QCOMPARE(t->item(0, 5)->text().toDouble(), 0.0);
+  }
+};
+
+QTEST_MAIN(ViewsTest)
+#include "views_test.moc"
