@@ -82,6 +82,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
   centre->addWidget(tabs_);
   centre->setStretchFactor(0, 1);
   centre->setStretchFactor(1, 1);
+  centre->setSizes({470, 430});
   setCentralWidget(centre);
 
   // left: model tree + properties
@@ -91,6 +92,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
   tree_->setModel(tree_model_);
   tree_->setEditTriggers(QAbstractItemView::EditKeyPressed | QAbstractItemView::DoubleClicked);
   tree_->header()->setSectionResizeMode(0, QHeaderView::ResizeToContents);
+  connect(tree_model_, &QAbstractItemModel::modelReset, tree_, &QTreeView::expandAll);
   props_ = new PropertyEditor(doc_, this);
   auto* left = new QSplitter(Qt::Vertical, this);
   left->addWidget(tree_);
