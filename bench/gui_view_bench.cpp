@@ -10,6 +10,8 @@
 #include <QElapsedTimer>
 #include <QFileInfo>
 #include <QOpenGLWidget>
+
+#include "gui/main_window.hpp"
 #include <QWindow>
 #include <algorithm>
 #include <cmath>
@@ -162,5 +164,29 @@ int main(int argc, char** argv) {
   for (const Row& r : rows)
     std::printf("%-22s %6d %6d %10.2f %10.2f %10.2f %10.2f %8.1f\n", r.name.c_str(), r.bodies, r.items, r.paint_med,
                 r.paint_p90, r.frame_med, r.frame_p90, r.setq_us);
+
+  // opening time: File > Open in the main window until the 3-D view has drawn the model
+  std::printf("\nopening an example in codyna-gui (load, compile, tree, panels, first 3-D frame), median of 5\n");
+  std::printf("%-22s %10s\n", "model", "ms");
+  for (const QString& f : dir.entryList({"*.json"}, QDir::Files, QDir::Name)) {
+    std::vector<double> ms;
+    for (int k = 0; k < 5; ++k) {
+      codyna::gui::MainWindow w;
+      w.resize(1500, 950);
+      w.show();
+      QElapsedTimer wait;
+      wait.start();
+      while (!(w.windowHandle() && w.windowHandle()->isExposed()) && wait.elapsed() < 5000)
+        QApplication::processEvents(QEventLoop::AllEvents, 20);
+      QApplication::processEvents();
+      const int before = w.view3d()->framesDrawn();
+      QElapsedTimer t;
+      t.start();
+      if (!w.openFile(dir.filePath(f))) return 1;
+      while (w.view3d()->framesDrawn() == before && t.elapsed() < 10000) QApplication::processEvents();
+      ms.push_back(t.nsecsElapsed() * 1e-6);
+    }
+    std::printf("%-22s %10.1f\n", QFileInfo(f).completeBaseName().toStdString().c_str(), percentile(ms, 0.5));
+  }
   return 0;
 }
