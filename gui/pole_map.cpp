@@ -1,5 +1,7 @@
 #include "gui/pole_map.hpp"
 
+#include "gui/image_export.hpp"
+
 #include <QBuffer>
 #include <QChart>
 #include <QChartView>
@@ -405,42 +407,14 @@ QString PoleMap::poleText(int index) const {
 }
 
 bool PoleMap::saveImage(const QString& path, QString* error) {
-  const auto fail = [&](const QString& why) {
-    if (error) *error = why;
-    return false;
-  };
-  const QString suffix = QFileInfo(path).suffix().toLower();
-  if (suffix != QLatin1String("png") && suffix != QLatin1String("svg"))
-    return fail(QStringLiteral("%1: unknown image type (use .png or .svg)").arg(path));
+  if (!is_image_path(path)) return save_widget_image(this, path, {}, {}, error);  // the error message
   ensurePolished();
   if (layout()) layout()->activate();
   QCoreApplication::sendPostedEvents(nullptr, QEvent::LayoutRequest);
-  QByteArray bytes;
-  QBuffer buffer(&bytes);
-  buffer.open(QIODevice::WriteOnly);
-  if (suffix == QLatin1String("png")) {
-    const QPixmap pixmap = grab();
-    if (pixmap.isNull() || !pixmap.save(&buffer, "PNG")) return fail(QStringLiteral("%1: cannot render the pole map").arg(path));
-  } else {
-    QSvgGenerator svg;
-    svg.setOutputDevice(&buffer);
-    svg.setSize(size());
-    svg.setViewBox(QRect(QPoint(0, 0), size()));
-    svg.setTitle(QStringLiteral("codyna pole map"));
-    QPainter painter;
-    if (!painter.begin(&svg)) return fail(QStringLiteral("%1: cannot start the SVG output").arg(path));
-    painter.setRenderHint(QPainter::Antialiasing);
-    painter.fillRect(rect(), Qt::white);
+  return save_widget_image(this, path, QStringLiteral("codyna pole map"), [this](QPainter& painter) {
     view_->render(&painter, QRectF(QRect(view_->mapTo(this, QPoint(0, 0)), view_->size())), view_->viewport()->rect());
     if (legend_->isVisibleTo(this)) legend_->render(&painter, legend_->mapTo(this, QPoint(0, 0)));
-    painter.end();
-  }
-  buffer.close();
-  QSaveFile file(path);
-  if (!file.open(QIODevice::WriteOnly)) return fail(QStringLiteral("%1: %2").arg(path, file.errorString()));
-  if (file.write(bytes) != bytes.size() || !file.commit())
-    return fail(QStringLiteral("%1: %2").arg(path, file.errorString()));
-  return true;
+  }, error);
 }
 
 }  // namespace codyna::gui

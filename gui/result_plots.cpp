@@ -1,5 +1,7 @@
 #include "gui/result_plots.hpp"
 
+#include "gui/image_export.hpp"
+
 #include <QApplication>
 #include <QBuffer>
 #include <QChart>
@@ -510,13 +512,7 @@ QList<QPointF> ResultPlots::linearPoints(int k) const {
 }
 
 bool ResultPlots::saveImage(const QString& path, QString* error) {
-  const auto fail = [&](const QString& why) {
-    if (error) *error = why;
-    return false;
-  };
-  const QString suffix = QFileInfo(path).suffix().toLower();
-  if (suffix != QLatin1String("png") && suffix != QLatin1String("svg"))
-    return fail(QStringLiteral("%1: unknown image type (use .png or .svg)").arg(path));
+  if (!is_image_path(path)) return save_widget_image(this, path, {}, {}, error);  // the error message
   flush();
   ensurePolished();
   if (layout()) layout()->activate();
@@ -526,36 +522,13 @@ bool ResultPlots::saveImage(const QString& path, QString* error) {
     if (!alignPlotAreas() && pass > 0) break;
   }
 
-  QByteArray bytes;
-  QBuffer buffer(&bytes);
-  buffer.open(QIODevice::WriteOnly);
-  if (suffix == QLatin1String("png")) {
-    const QPixmap pixmap = grab();
-    if (pixmap.isNull() || !pixmap.save(&buffer, "PNG")) return fail(QStringLiteral("%1: cannot render the plots").arg(path));
-  } else {
-    QSvgGenerator svg;
-    svg.setOutputDevice(&buffer);
-    svg.setSize(size());
-    svg.setViewBox(QRect(QPoint(0, 0), size()));
-    svg.setTitle(QStringLiteral("codyna simulation plots"));
-    svg.setDescription(QStringLiteral("Plant/In and Plant/Out against time"));
-    QPainter painter;
-    if (!painter.begin(&svg)) return fail(QStringLiteral("%1: cannot start the SVG output").arg(path));
-    painter.setRenderHint(QPainter::Antialiasing);
-    painter.fillRect(rect(), Qt::white);
+  return save_widget_image(this, path, QStringLiteral("codyna simulation plots"), [this](QPainter& painter) {
     for (const Panel* p : {&in_, &out_}) {
       if (!p->view->isVisibleTo(this)) continue;
       const QRect target(p->view->mapTo(this, QPoint(0, 0)), p->view->size());
       p->view->render(&painter, QRectF(target), p->view->viewport()->rect());
     }
-    painter.end();
-  }
-  buffer.close();
-  QSaveFile file(path);
-  if (!file.open(QIODevice::WriteOnly)) return fail(QStringLiteral("%1: %2").arg(path, file.errorString()));
-  if (file.write(bytes) != bytes.size() || !file.commit())
-    return fail(QStringLiteral("%1: %2").arg(path, file.errorString()));
-  return true;
+  }, error);
 }
 
 }  // namespace codyna::gui

@@ -1,0 +1,51 @@
+#include "gui/image_export.hpp"
+
+#include <QBuffer>
+#include <QFileInfo>
+#include <QPainter>
+#include <QPixmap>
+#include <QSaveFile>
+#include <QSvgGenerator>
+#include <QWidget>
+
+namespace codyna::gui {
+
+bool is_image_path(const QString& path) {
+  const QString suffix = QFileInfo(path).suffix().toLower();
+  return suffix == QLatin1String("png") || suffix == QLatin1String("svg");
+}
+
+bool save_widget_image(QWidget* w, const QString& path, const QString& title,
+                       const std::function<void(QPainter&)>& paint_svg, QString* error) {
+  const auto fail = [&](const QString& why) {
+    if (error) *error = QStringLiteral("%1: %2").arg(path, why);
+    return false;
+  };
+  if (!is_image_path(path)) return fail(QStringLiteral("unknown image type (use .png or .svg)"));
+  QByteArray bytes;
+  QBuffer buffer(&bytes);
+  buffer.open(QIODevice::WriteOnly);
+  if (QFileInfo(path).suffix().toLower() == QLatin1String("png")) {
+    const QPixmap pixmap = w->grab();
+    if (pixmap.isNull() || !pixmap.save(&buffer, "PNG")) return fail(QStringLiteral("cannot render %1").arg(title));
+  } else {
+    QSvgGenerator svg;
+    svg.setOutputDevice(&buffer);
+    svg.setSize(w->size());
+    svg.setViewBox(QRect(QPoint(0, 0), w->size()));
+    svg.setTitle(title);
+    QPainter painter;
+    if (!painter.begin(&svg)) return fail(QStringLiteral("cannot start the SVG output"));
+    painter.setRenderHint(QPainter::Antialiasing);
+    painter.fillRect(w->rect(), Qt::white);
+    paint_svg(painter);
+    painter.end();
+  }
+  buffer.close();
+  QSaveFile file(path);
+  if (!file.open(QIODevice::WriteOnly)) return fail(file.errorString());
+  if (file.write(bytes) != bytes.size() || !file.commit()) return fail(file.errorString());
+  return true;
+}
+
+}  // namespace codyna::gui
