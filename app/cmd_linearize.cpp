@@ -11,6 +11,7 @@
 #include "analysis/operating_point.hpp"
 #include "commands.hpp"
 #include "io/model_file.hpp"
+#include "io/output_guard.hpp"
 #include "common.hpp"
 #include "io/mat_export.hpp"
 #include "simulation/model_controller.hpp"
@@ -63,6 +64,16 @@ void run_trajectory(const Model& m, const LinearizeArgs& a, const std::string& n
   o.integrator.max_step = m.spec.solver.max_step;
   o.t_end = a.trajectory;
   o.output_step = a.trajectory_step > 0 ? a.trajectory_step : m.spec.solver.output_step;
+  if (!std::isfinite(a.trajectory) || (given(a.cmd, "--trajectory-step") && !(a.trajectory_step > 0 && std::isfinite(a.trajectory_step))))
+    throw std::invalid_argument("--trajectory, --trajectory-step: expected finite numbers of seconds > 0");
+  const double points = a.trajectory / o.output_step + 1;
+  if (points > 100000)
+    throw std::invalid_argument("--trajectory " + std::to_string(a.trajectory) + " with a step of " +
+                                std::to_string(o.output_step) + " s gives " + std::to_string(static_cast<long long>(points)) +
+                                " linearizations (at most 100000): raise --trajectory-step");
+  const std::filesystem::path base = std::filesystem::path(a.out) / name;
+  guard_output(base.string() + ".mat", OutputKind::PlantMat, {a.model});
+  guard_output(base.string() + ".m", OutputKind::PlantScript, {a.model});
   std::unique_ptr<LinearPlant> plant;
   std::unique_ptr<Controller> controller;
   if (has_model_controller(m)) {
@@ -125,8 +136,16 @@ void run(const LinearizeArgs& a) {
   const std::string name = study_export_name(m);
   if (m.plant_inputs.empty() && m.plant_outputs.empty())
     std::cerr << "codyna: warning: the model selects no Plant/In or Plant/Out; exporting the state equations only\n";
-  if (a.trajectory > 0) return run_trajectory(m, a, name);
-  if (a.trajectory < 0) throw std::invalid_argument("--trajectory: the end time must be positive");
+  if (given(a.cmd, "--trajectory")) {
+    if (!(a.trajectory > 0) || !std::isfinite(a.trajectory))
+      throw std::invalid_argument("--trajectory: expected an end time of seconds > 0");
+    return run_trajectory(m, a, name);
+  }
+  {  // an export that would replace the model (or a file codyna did not write) fails before the work
+    const std::filesystem::path base = std::filesystem::path(a.out) / name;
+    guard_output(base.string() + ".mat", OutputKind::PlantMat, {a.model});
+    guard_output(base.string() + ".m", OutputKind::PlantScript, {a.model});
+  }
   const StudyLinearization sl = study_linearize(m);
   const OperatingPoint& op = sl.op;
   const Linearization& lin = sl.lin;

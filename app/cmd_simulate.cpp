@@ -11,6 +11,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "control/lqr.hpp"
+#include "io/output_guard.hpp"
 #include "io/results_file.hpp"
 #include "simulation/model_controller.hpp"
 #include "simulation/simulator.hpp"
@@ -24,6 +25,7 @@ struct SimulateArgs {
   bool lqr = false, compare_linear = false, quiet = false, open_loop = false;
   std::vector<double> q_weights, r_weights;
   double t_end = 0, rtol = 0, atol = 0, max_step = -1, output_step = 0;
+  double max_samples = 1e7, divergence_bound = 1e8;
   std::vector<std::string> independent, set;
   const CLI::App* cmd = nullptr;  // to tell given flags (they override the file's analysis and solver sections)
 };
@@ -104,18 +106,38 @@ ModelSpec study_of(const SimulateArgs& a) {
   if (a.compare_linear) s.compare_linear = true;
   apply_set(s, a.set);
   SolverSpec& sp = spec.solver;
+  // each number given is checked where it enters, with its flag named
+  const auto check = [&](const char* flag, double x, bool ok, const char* expected) {
+    if (!given(a.cmd, flag)) return false;
+    if (!std::isfinite(x) || !ok)
+      throw std::invalid_argument(std::string(flag) + " " + std::to_string(x) + ": expected " + expected);
+    return true;
+  };
   if (!a.integrator.empty()) sp.integrator = a.integrator;
-  if (a.rtol > 0) sp.rtol = a.rtol;
-  if (a.atol > 0) sp.atol = a.atol;
-  if (a.max_step >= 0) sp.max_step = a.max_step;
-  if (a.t_end > 0) sp.t_end = a.t_end;
-  if (a.output_step > 0) sp.output_step = a.output_step;
+  if (check("--rtol", a.rtol, a.rtol > 0 && a.rtol < 1, "a number in (0, 1)")) sp.rtol = a.rtol;
+  if (check("--atol", a.atol, a.atol > 0, "a number > 0")) sp.atol = a.atol;
+  if (check("--max-step", a.max_step, a.max_step >= 0, "a number >= 0 (0 = no limit)")) sp.max_step = a.max_step;
+  if (check("--t-end", a.t_end, a.t_end > 0, "a number of seconds > 0")) sp.t_end = a.t_end;
+  if (check("--output-step", a.output_step, a.output_step > 0, "a number of seconds > 0")) sp.output_step = a.output_step;
+  check("--max-samples", a.max_samples, a.max_samples >= 1, "a number >= 1");
+  check("--divergence-bound", a.divergence_bound, a.divergence_bound > 0, "a number > 0");
   return spec;
 }
 
 void run(const SimulateArgs& a) {
   const Model m = study_model(study_of(a), a.model);
-  const StudySimulation setup = study_simulation(m);
+  // outputs that would replace the model, the controller file or a file codyna did not write are refused
+  // before any work
+  const std::vector<std::string> inputs{a.model, a.controller};
+  guard_output(a.out, OutputKind::ResultsHdf5, inputs);
+  if (!a.csv.empty()) {
+    guard_output(a.csv, OutputKind::ResultsCsv, inputs);
+    if (a.csv == a.out || same_file(a.csv, a.out))
+      throw std::invalid_argument("--csv " + a.csv + ": the same file as --out");
+  }
+  StudySimulation setup = study_simulation(m);
+  setup.options.max_samples = a.max_samples;
+  setup.options.divergence_bound = a.divergence_bound;
   const LinearPlant* plant = setup.plant.get();
   const SimulationOptions& o = setup.options;
   if (setup.controller) {
@@ -159,7 +181,7 @@ void run(const SimulateArgs& a) {
   if (!a.csv.empty()) write_results_csv(r, a.csv);
   summary(r, m, plant);
   std::cout << "wrote " << a.out << (a.csv.empty() ? "" : "\nwrote " + a.csv) << "\n";
-  if (!r.completed && !r.cancelled) throw std::runtime_error("the solver failed; the partial result is in " + a.out);
+  if (!r.completed && !r.cancelled) throw std::runtime_error("the run failed at " + r.failure + "; the partial result is in " + a.out);
 }
 
 }  // namespace
@@ -186,6 +208,8 @@ void add_simulate(CLI::App& app) {
   cmd->add_option("--independent", a->independent, "closed loops: independent coordinate names")->delimiter(',');
   cmd->add_option("--set", a->set, "NAME=VALUE: set a joint coordinate of the initial state (repeatable)");
   cmd->add_flag("--quiet", a->quiet, "no progress bar");
+  cmd->add_option("--max-samples", a->max_samples, "refuse runs that would record more output samples")->capture_default_str();
+  cmd->add_option("--divergence-bound", a->divergence_bound, "end the run when a state entry grows past this")->capture_default_str();
   a->cmd = cmd;
   cmd->callback([a, cmd] {
     set_exit_code(run_guarded([&] { run(*a); }));

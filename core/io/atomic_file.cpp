@@ -1,10 +1,13 @@
 #include "io/atomic_file.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
+#include <cstdlib>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -34,6 +37,48 @@ mode_t current_umask() {
   return 022;
 }
 
+// Temporary files being written, for remove_temporary_files() (signal handlers):
+// fixed slots, so the handler needs neither locks nor allocation.
+constexpr int kSlots = 16;
+constexpr int kPathMax = 4096;
+char g_temp[kSlots][kPathMax];
+std::atomic<bool> g_used[kSlots];
+
+int register_temp(const std::string& path) {
+  if (path.size() >= kPathMax) return -1;
+  for (int i = 0; i < kSlots; ++i) {
+    bool expected = false;
+    if (g_used[i].compare_exchange_strong(expected, true)) {
+      std::memcpy(g_temp[i], path.c_str(), path.size() + 1);
+      return i;
+    }
+  }
+  return -1;
+}
+
+void unregister_temp(int slot) {
+  if (slot >= 0) g_used[slot].store(false);
+}
+
+// ".NAME.tmp-PID-XXXXXX" files of the same target left by a process that no longer
+// runs (killed while writing) are removed before a new write.
+void remove_stale_temporaries(const std::string& dir, const std::string& name) {
+  const std::string prefix = "." + name + ".tmp-";
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string f = entry.path().filename().string();
+    if (f.rfind(prefix, 0) != 0) continue;
+    const std::string rest = f.substr(prefix.size());
+    const auto dash = rest.find('-');
+    if (dash == std::string::npos || dash == 0) continue;  // not ours (older files have no pid)
+    char* end = nullptr;
+    const long pid = std::strtol(rest.c_str(), &end, 10);
+    if (end != rest.c_str() + dash || pid <= 0) continue;
+    if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;  // its writer still runs
+    std::filesystem::remove(entry.path(), ec);
+  }
+}
+
 std::string parent_dir(const std::string& path) {
   auto dir = std::filesystem::path(path).parent_path();
   return dir.empty() ? std::string(".") : dir.string();
@@ -56,24 +101,34 @@ AtomicFile::AtomicFile(std::string target) : target_(std::move(target)) {
   // fail now rather than at the rename, after other files may have been committed
   std::error_code ec;
   if (std::filesystem::is_directory(target_, ec)) throw std::runtime_error(target_ + ": is a directory");
-  std::string pattern = parent_dir(target_) + "/." + name + ".tmp-XXXXXX";
+  remove_stale_temporaries(parent_dir(target_), name);
+  std::string pattern = parent_dir(target_) + "/." + name + ".tmp-" + std::to_string(::getpid()) + "-XXXXXX";
   std::vector<char> buf(pattern.begin(), pattern.end());
   buf.push_back('\0');
   int fd = ::mkstemp(buf.data());
   if (fd < 0) throw os_error(target_, "cannot create a temporary file in " + parent_dir(target_), errno);
   temp_ = buf.data();
+  slot_ = register_temp(temp_);
   // mkstemp makes the file private (0600); give it the mode a plain open() would.
   int rc = ::fchmod(fd, 0666 & ~current_umask());
   int err = errno;
   ::close(fd);
   if (rc != 0) {
     std::remove(temp_.c_str());
+    unregister_temp(slot_);
+    slot_ = -1;
     throw os_error(target_, "cannot set the mode of " + temp_, err);
   }
 }
 
 AtomicFile::~AtomicFile() {
   if (!committed_) std::remove(temp_.c_str());
+  unregister_temp(slot_);
+}
+
+void remove_temporary_files() {
+  for (int i = 0; i < kSlots; ++i)
+    if (g_used[i].load()) ::unlink(g_temp[i]);
 }
 
 void AtomicFile::commit() {

@@ -37,7 +37,14 @@ class AtomicFile {
  private:
   std::string target_, temp_;
   bool committed_ = false;
+  int slot_ = -1;  // in the table remove_temporary_files() reads
 };
+
+// Removes the temporary files of every AtomicFile still being written. Async-signal-safe
+// (unlink only): a front end's SIGINT/SIGTERM handler calls it before the process ends, so
+// an interrupted write leaves nothing behind. (After kill -9, the next write of the same
+// target removes the leftovers of writers that no longer run.)
+void remove_temporary_files();
 
 // Writes `content` to `path` through an AtomicFile.
 void write_file_atomically(const std::string& path, std::string_view content);

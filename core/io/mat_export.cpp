@@ -1,5 +1,7 @@
 #include "io/mat_export.hpp"
 
+#include "io/output_guard.hpp"
+
 #include <matio.h>
 
 #include <algorithm>
@@ -485,6 +487,8 @@ ExportPaths export_plant(const LinearSystem& sys, const std::string& dir, const 
   if (matlab_identifier(name) != name)
     throw std::runtime_error(paths.mat_file + ": '" + name + "' is not a valid MATLAB identifier or is reserved" +
                              " (use '" + matlab_identifier(name) + "')");
+  guard_output(paths.mat_file, OutputKind::PlantMat, {sys.model_file});
+  guard_output(paths.m_file, OutputKind::PlantScript, {sys.model_file});
   const LinearSystem s = completed_plant(sys, paths.mat_file);
   const std::string script = plant_script(s, name, v);
 
@@ -674,6 +678,8 @@ ExportPaths export_trajectory(const std::vector<LinearSystem>& systems, const st
                              " (use '" + matlab_identifier(name) + "')");
   if (systems.empty() || systems.size() != times.size())
     throw std::runtime_error(paths.mat_file + ": expected one linearization per time");
+  guard_output(paths.mat_file, OutputKind::PlantMat, {systems[0].model_file});
+  guard_output(paths.m_file, OutputKind::PlantScript, {systems[0].model_file});
   std::vector<LinearSystem> s;
   for (const LinearSystem& sys : systems) s.push_back(completed_plant(sys, paths.mat_file));
   const Eigen::Index nx = s[0].nx(), nu = s[0].nu(), ny = s[0].ny();

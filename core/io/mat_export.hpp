@@ -43,7 +43,9 @@ struct ExportPaths {
 // the .mat first. NAME must already be what matlab_identifier(NAME) returns.
 // Empty offsets count as zeros, an empty D as zeros(ny, nu), empty name lists
 // as x1.., u1.., y1.., empty unit lists as ''. Throws std::runtime_error naming
-// the file and the reason (bad NAME, sizes that do not fit, NaN/Inf entries, a
+// the file and the reason, or std::invalid_argument when a path may not be
+// written (io/output_guard.hpp: it is the model file, or a file codyna did not
+// write) (bad NAME, sizes that do not fit, NaN/Inf entries, a
 // directory that is missing or not writable, a failed write); nothing is then
 // left behind, and existing files of that name are untouched. (Both files are
 // complete before the two renames; only a failure of the second rename, after

@@ -1,5 +1,7 @@
 #include "io/results_file.hpp"
 
+#include "io/output_guard.hpp"
+
 #include <hdf5.h>
 
 #include <algorithm>
@@ -479,6 +481,7 @@ void append_csv_line(std::string& line, std::size_t count, AppendField append_fi
 }  // namespace
 
 void write_results_hdf5(const SimulationResult& r, const std::string& path) {
+  guard_output(path, OutputKind::ResultsHdf5, {r.model_file});
   require_consistent(r, path);
   AtomicFile out(path);
   try {
@@ -494,6 +497,7 @@ void write_results_hdf5(const SimulationResult& r, const std::string& path) {
 }
 
 void write_results_csv(const SimulationResult& r, const std::string& path) {
+  guard_output(path, OutputKind::ResultsCsv, {r.model_file});
   require_consistent(r, path);
   const std::vector<CsvColumn> columns = csv_columns(r);
   AtomicFile out(path);

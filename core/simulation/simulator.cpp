@@ -99,8 +99,39 @@ std::vector<Eigen::VectorXd> linear_run(const Model& model, const Controller* ct
 
 SimulationResult simulate(const Model& model, const Controller* controller, const LinearPlant* plant,
                           const SimulationOptions& o, const SimulationCallbacks& cb) {
-  if (!(o.t_end > o.t0)) throw std::invalid_argument("simulate: t_end must be after t0");
-  if (!(o.output_step > 0)) throw std::invalid_argument("simulate: output_step must be positive");
+  if (!std::isfinite(o.t0) || !std::isfinite(o.t_end) || !(o.t_end > o.t0))
+    throw std::invalid_argument("simulate: the end time must be a finite number after the start time");
+  if (!std::isfinite(o.output_step) || !(o.output_step > 0))
+    throw std::invalid_argument("simulate: the output step must be a finite number > 0");
+  // the work is bounded before it starts: a run that would not end or not fit is refused with the numbers
+  const double samples = (o.t_end - o.t0) / o.output_step + 1;
+  if (samples > o.max_samples) {
+    std::ostringstream os;
+    os << "simulate: " << (o.t_end - o.t0) << " s at an output step of " << o.output_step << " s would record "
+       << samples << " samples, more than the limit of " << o.max_samples
+       << " (raise the output step, or the limit: --max-samples)";
+    throw std::invalid_argument(os.str());
+  }
+  const IntegratorSettings& is = o.integrator;
+  if (!(is.rtol > 0 && is.rtol < 1) || !(is.atol > 0 && std::isfinite(is.atol)))
+    throw std::invalid_argument("simulate: tolerances must be finite: rtol in (0, 1), atol > 0");
+  if (!(is.max_step >= 0) || !std::isfinite(is.max_step))
+    throw std::invalid_argument("simulate: the largest step must be a finite number >= 0 (0 = no limit)");
+  if (is.method == "rk4" && is.max_step > 0 && (o.t_end - o.t0) / is.max_step > 1e9) {
+    std::ostringstream os;
+    os << "simulate: rk4 with a step of " << is.max_step << " s over " << (o.t_end - o.t0) << " s would take "
+       << (o.t_end - o.t0) / is.max_step << " steps (more than 1e9): raise the step";
+    throw std::invalid_argument(os.str());
+  }
+  if (controller && controller->sample_time() > 0 && (o.t_end - o.t0) / controller->sample_time() > o.max_samples * 100.0) {
+    std::ostringstream os;
+    os << "simulate: the controller's sample time " << controller->sample_time() << " s gives "
+       << (o.t_end - o.t0) / controller->sample_time() << " samples over the run, more than 100 times the sample limit";
+    throw std::invalid_argument(os.str());
+  }
+  if (model.dof() == 0)
+    throw std::invalid_argument("simulate: the model has no degrees of freedom (every body is fixed or locked by its loops): "
+                                "nothing moves, nothing to simulate");
   if (controller && controller->needs_state() && !plant)
     throw std::invalid_argument("simulate: state feedback needs the linearized plant it was designed on");
   const auto wall0 = std::chrono::steady_clock::now();
@@ -192,6 +223,19 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
     }
     t = target;
     y = integrator->state();
+    // a run that diverges ends here, with the reason, instead of the solver spinning
+    Eigen::Index worst = 0;
+    const double largest = y.size() ? y.cwiseAbs().maxCoeff(&worst) : 0.0;
+    if (!std::isfinite(largest) || largest > o.divergence_bound) {
+      std::ostringstream os;
+      const std::string what = worst < model.nq ? model.q_names[worst]
+                               : worst < model.nq + model.nv ? model.v_names[worst - model.nq] + " (rate)"
+                                                             : "controller state " + std::to_string(worst - model.nq - model.nv);
+      os << "t = " << t << " s: diverged: " << what << " = " << y[worst] << " is past the bound "
+         << o.divergence_bound << " (the last sane sample is at t = " << (rec.t.empty() ? o.t0 : rec.t.back()) << " s)";
+      r.failure = os.str();
+      break;
+    }
     bool restart = false;
     if (model.nc && !integrator->projects() && sys.project(y, o.projection_tolerance)) {
       ++r.stats.projections;

@@ -28,6 +28,8 @@ struct SimulationOptions {
                                        // project when max |phi| (or max |Jc v| / max(1, |v|)) exceeds it
   Baumgarte stabilization{};           // optional, on the acceleration-level constraints
   bool compare_linear = false;         // also run the linear closed loop (needs a plant)
+  double max_samples = 1e7;            // a run recording more output samples is refused before it starts
+  double divergence_bound = 1e8;       // a state entry (q, v, controller) past this, or not finite, ends the run
 };
 
 // What a sample callback gets: copies, safe to hand to another thread.

@@ -1,0 +1,96 @@
+#!/usr/bin/env bash
+# Regression tests for bad input and faults at the command line: a user's model is
+# never overwritten, every number is checked where it enters, runs that would not end
+# are refused before they start, divergence ends early, exit codes are 0, 1 or 2.
+# Usage: bad_input.sh CODYNA SOURCE_DIR WORK_DIR
+set -uo pipefail
+codyna="$1"; src="$2"; work="$3"
+rm -rf "$work"; mkdir -p "$work"; cd "$work"
+fails=0
+fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+
+# expect CODE PHRASE -- command...: the exit code and a phrase of stderr
+expect() {
+  local code="$1" phrase="$2"; shift 3
+  "$@" > out.txt 2> err.txt
+  local rc=$?
+  [ "$rc" -eq "$code" ] || fail "$* exited $rc, expected $code: $(cat err.txt)"
+  grep -qF -- "$phrase" err.txt || fail "$*: stderr lacks \"$phrase\": $(cat err.txt)"
+}
+
+cp "$src/examples/pendulum.json" model.json
+sum0=$(sha256sum model.json | cut -d' ' -f1)
+
+# the model is never an output: directly, through a symlink, a hard link, as CSV, or as NAME.m
+expect 1 "the input file" -- "$codyna" simulate model.json --out model.json --quiet
+ln -s model.json link.h5
+expect 1 "the input file" -- "$codyna" simulate model.json --out link.h5 --quiet
+ln model.json hard.csv
+expect 1 "the input file" -- "$codyna" simulate model.json --out r.h5 --csv hard.csv --quiet
+cp model.json pendulum.m
+expect 1 "the input file" -- "$codyna" linearize pendulum.m --out .
+[ "$(sha256sum model.json | cut -d' ' -f1)" = "$sum0" ] || fail "model.json changed"
+[ "$(sha256sum pendulum.m | cut -d' ' -f1)" = "$sum0" ] || fail "pendulum.m changed"
+# a file codyna did not write is not replaced either
+echo "my notes" > notes.csv
+expect 1 "never replaces a file it did not write" -- "$codyna" simulate model.json --out r.h5 --csv notes.csv --quiet
+[ "$(cat notes.csv)" = "my notes" ] || fail "notes.csv changed"
+[ ! -e r.h5 ] || fail "r.h5 written although the run was refused"
+expect 1 "the same file as --out" -- "$codyna" simulate model.json --out same.out --csv same.out --quiet
+
+# numbers checked where they enter, with the flag named
+for flag in "--t-end nan" "--t-end inf" "--t-end -5" "--rtol -1" "--rtol 2" "--atol nan" "--max-step -1" "--output-step 0"; do
+  set -- $flag
+  expect 1 "$1" -- "$codyna" simulate model.json --out r.h5 --quiet $flag
+done
+expect 1 "time=T" -- "$codyna" linearize model.json --out lin --operating-point time=inf
+expect 1 "expected a finite number" -- "$codyna" linearize model.json --out lin --set pivot=inf
+# runs that would not end are refused before they start, with the number and the flag that raises the bound
+start=$(date +%s)
+expect 1 "--max-samples" -- "$codyna" simulate model.json --out r.h5 --quiet --t-end 1e9
+expect 1 "--max-samples" -- "$codyna" simulate model.json --out r.h5 --quiet --output-step 1e-12
+expect 1 "1e9" -- "$codyna" simulate model.json --out r.h5 --quiet --integrator rk4 --max-step 1e-12
+expect 1 "--trajectory-step" -- "$codyna" linearize model.json --out lin --trajectory 1e9
+[ $(( $(date +%s) - start )) -lt 20 ] || fail "refusing the runs took more than 20 s"
+
+# a degenerate mechanism: refused clearly by simulate, never a crash
+python3 - "$src/examples/pendulum.json" > fixed.json <<'PY'
+import json, sys
+m = json.load(open(sys.argv[1]))
+m["joints"][0]["type"] = "fixed"
+for k in ("axis", "q0", "v0"): m["joints"][0].pop(k, None)
+m.pop("controller", None); m["actuators"] = []; m["sensors"] = []; m["plant"] = {"inputs": [], "outputs": []}
+json.dump(m, sys.stdout)
+PY
+for integ in ida cvode-bdf rk4; do
+  expect 1 "no degrees of freedom" -- "$codyna" simulate fixed.json --out f.h5 --quiet --integrator $integ
+done
+
+# divergence ends the run early, with the reason and the partial result (exit 2)
+python3 - "$src/examples/pendulum.json" > unstable.json <<'PY'
+import json, sys
+m = json.load(open(sys.argv[1]))
+m["controller"]["kp"] = [[-1e9]]
+m["controller"].pop("kd", None); m["controller"].pop("ki", None)
+json.dump(m, sys.stdout)
+PY
+start=$(date +%s)
+expect 2 "diverged" -- "$codyna" simulate unstable.json --out u.h5 --quiet --t-end 100
+[ $(( $(date +%s) - start )) -lt 20 ] || fail "the diverging run took more than 20 s"
+[ -s u.h5 ] || fail "no partial result after divergence"
+
+# exit codes: argument errors are 1, an unknown command is named with the list
+expect 1 "unknown command \"frobnicate\"" -- "$codyna" frobnicate
+expect 1 "commands: info, linearize, simulate" -- "$codyna" frobnicate
+expect 1 "--no-such-flag" -- "$codyna" simulate model.json --out r.h5 --no-such-flag
+expect 1 "model is required" -- "$codyna" simulate
+
+# SIGTERM during a long run leaves no temporary file behind
+"$codyna" simulate model.json --out long.h5 --csv long.csv --quiet --t-end 20000 --output-step 0.002 > /dev/null 2>&1 &
+pid=$!
+sleep 2
+kill -TERM $pid 2>/dev/null
+wait $pid 2>/dev/null
+ls -a | grep -q "\.tmp-" && fail "temporary files left after SIGTERM: $(ls -a | grep tmp-)"
+
+if [ "$fails" -eq 0 ]; then echo "bad_input: all checks passed"; else echo "bad_input: $fails failed"; exit 1; fi
