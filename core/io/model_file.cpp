@@ -111,9 +111,15 @@ class Object {
   Node n_;
 };
 
+// A finite number of sane magnitude: nothing in a mechanism model needs more than
+// 1e15 (in SI units), and larger values only overflow later, far from their field.
+constexpr double kLargest = 1e15;
+
 double read_number(const Node& n) {
   if (!n.value().is_number() || !std::isfinite(n.value().get<double>())) n.expected("a number");
-  return n.value().get<double>();
+  const double x = n.value().get<double>();
+  if (std::abs(x) > kLargest) n.expected("a number of magnitude at most 1e15");
+  return x;
 }
 
 // Integral values written as 2.0 are accepted too.
@@ -152,6 +158,12 @@ Eigen::VectorXd read_numbers(const Node& n, std::size_t size) {
 }
 
 Eigen::Vector3d read_vec3(const Node& n) { return read_numbers(n, 3); }
+
+double read_positive_length(const Node& n) {
+  const double x = read_number(n);
+  if (!(x > 0)) n.expected("a length > 0 (m)");
+  return x;
+}
 
 Eigen::Matrix3d read_matrix3(const Node& n) {
   if (!n.value().is_array() || n.value().size() != 3) n.expected("a 3x3 array (3 rows of 3 numbers)");
@@ -587,9 +599,13 @@ const Schema<ShapeSpec>& schema<ShapeSpec>() {
   static const Schema<ShapeSpec> s{
       {
           type_field<ShapeSpec>("shape type", shape_type_from_string),
-          field("size", &ShapeSpec::size, read_vec3),
-          field("radius", &ShapeSpec::radius, read_number),
-          field("length", &ShapeSpec::length, read_number),
+          field("size", &ShapeSpec::size, [](const Node& n) {
+            const Eigen::Vector3d v = read_vec3(n);
+            if (!(v.minCoeff() > 0)) n.expected("three edge lengths > 0 (m)");
+            return v;
+          }),
+          field("radius", &ShapeSpec::radius, read_positive_length),
+          field("length", &ShapeSpec::length, read_positive_length),
           struct_field("frame", &ShapeSpec::frame),
           field("color", &ShapeSpec::color, read_color),
       },
@@ -883,13 +899,21 @@ ojson write_controller(const ControllerSpec& c) {
 
 template <>
 const Schema<SolverSpec>& schema<SolverSpec>() {
+  // each number in its range, so a run never starts from nonsense (the work bounds are checked when it starts)
+  const auto in_range = [](bool (*ok)(double), const char* expected) {
+    return [ok, expected](const Node& n) {
+      const double x = read_number(n);
+      if (!ok(x)) n.expected(expected);
+      return x;
+    };
+  };
   static const Schema<SolverSpec> s{{
       field("integrator", &SolverSpec::integrator, read_string),
-      field("rtol", &SolverSpec::rtol, read_number),
-      field("atol", &SolverSpec::atol, read_number),
-      field("t_end", &SolverSpec::t_end, read_number),
-      field("output_step", &SolverSpec::output_step, read_number),
-      field("max_step", &SolverSpec::max_step, read_number),
+      field("rtol", &SolverSpec::rtol, in_range([](double x) { return x > 0 && x < 1; }, "a relative tolerance in (0, 1)")),
+      field("atol", &SolverSpec::atol, in_range([](double x) { return x > 0; }, "an absolute tolerance > 0")),
+      field("t_end", &SolverSpec::t_end, in_range([](double x) { return x > 0; }, "an end time > 0 (s)")),
+      field("output_step", &SolverSpec::output_step, in_range([](double x) { return x > 0; }, "an output step > 0 (s)")),
+      field("max_step", &SolverSpec::max_step, in_range([](double x) { return x >= 0; }, "a largest step >= 0 (s; 0 = no limit)")),
   }};
   return s;
 }

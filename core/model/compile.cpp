@@ -103,6 +103,22 @@ class Compiler {
   }
 
   void check_bodies() {
+    // masses and inertias far below the model's own scale are typing slips (or denormals), not physics
+    double heaviest = 0, largest_moment = 0;
+    for (const BodySpec& b : spec_.bodies) {
+      if (std::isfinite(b.mass)) heaviest = std::max(heaviest, b.mass);
+      if (b.inertia.allFinite()) largest_moment = std::max(largest_moment, b.inertia.diagonal().cwiseAbs().maxCoeff());
+    }
+    for (std::size_t i = 0; i < spec_.bodies.size(); ++i) {
+      const BodySpec& b = spec_.bodies[i];
+      const std::string p = at("bodies", i);
+      if (b.mass > 0 && b.mass < std::max(1e-12 * heaviest, 1e-30))
+        fail(p + "/mass", "a mass of " + fmt(b.mass) + " kg is absurdly small beside the heaviest body (" + fmt(heaviest) +
+                              " kg): give it a real mass, or 0 for a massless link");
+      if (b.mass > 0 && b.inertia.allFinite() && b.inertia.diagonal().cwiseAbs().maxCoeff() < std::max(1e-15 * largest_moment, 1e-40))
+        fail(p + "/inertia", "principal moments this small (" + fmt(b.inertia.diagonal().maxCoeff()) +
+                                 " kg m^2) beside the model's largest (" + fmt(largest_moment) + ") are not a rigid body's");
+    }
     for (std::size_t i = 0; i < spec_.bodies.size(); ++i) {
       const BodySpec& b = spec_.bodies[i];
       const std::string p = at("bodies", i);

@@ -76,7 +76,8 @@ Model study_model(const ModelSpec& spec_in, const std::string& file) {
   m.spec.analysis = s;  // compile keeps the spec; the study travels with it
   if (s.set.empty()) return m;
   for (const auto& [name, value] : s.set) {
-    if (!std::isfinite(value)) fail(m, "set/" + name, "expected a finite number");
+    if (!std::isfinite(value) || std::abs(value) > 1e6)
+      fail(m, "set/" + name, "expected a finite number of magnitude at most 1e6 (m or rad)");
     const auto it = std::find(m.q_names.begin(), m.q_names.end(), name);
     if (it == m.q_names.end()) fail(m, "set/" + name, "unknown coordinate \"" + name + "\" (coordinates: " + listed(m.q_names) + ")");
     m.q0[it - m.q_names.begin()] = value;

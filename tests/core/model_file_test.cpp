@@ -1,5 +1,7 @@
 #include "io/model_file.hpp"
 
+#include "model/compile.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -695,7 +697,7 @@ TEST(ModelFile, RoundTripOfBuiltSpecIsBitExact) {
     j.parent_frame.position = w * 1e-7;
     j.q0.resize(7);
     j.q0 << w, q.w(), q.x(), q.y(), q.z();
-    j.v0 = Eigen::VectorXd::Random(6) * 1e300;
+    j.v0 = Eigen::VectorXd::Random(6) * 1e14;
     m.joints.push_back(j);
   }
   // a sampled lti controller with awkward numbers
@@ -703,7 +705,7 @@ TEST(ModelFile, RoundTripOfBuiltSpecIsBitExact) {
   c.type = ControllerType::Lti;
   c.Ac = Eigen::MatrixXd::Random(3, 3) / 3;
   c.Bc = Eigen::MatrixXd::Random(3, 2) * 1e-300;
-  c.Cc = Eigen::MatrixXd::Random(4, 3) * 1e300;
+  c.Cc = Eigen::MatrixXd::Random(4, 3) * 1e14;
   c.Dc = Eigen::MatrixXd::Random(4, 2) / 7;
   c.Ts = 1.0 / 3;
   c.operating_point = "initial";
@@ -722,7 +724,7 @@ TEST(ModelFile, RoundTripOfBuiltSpecIsBitExact) {
   ModelSpec lqr = m;
   lqr.controller = {};
   lqr.controller.type = ControllerType::Lqr;
-  lqr.controller.q_weights = {1.0 / 3, 0.0, 1e-300, 1e300};
+  lqr.controller.q_weights = {1.0 / 3, 0.0, 1e-300, 1e14};
   lqr.controller.r_weights = {2.0 / 3};
   lqr.controller.operating_point = "trim";
   expect_same(parse(to_json(lqr).dump()), lqr);
@@ -1026,3 +1028,37 @@ TEST(ModelFileErrors, FileNotFound) {
 
 }  // namespace
 }  // namespace codyna
+
+// Absurd numbers are refused where they enter, with the field's path (reliability issue).
+TEST(ModelFileErrors, AbsurdNumbersAreRefusedWithTheirPath) {
+  const auto pendulum = [](const std::string& body_extra, const std::string& top_extra = "") {
+    return R"({"name": "p", "bodies": [{"name": "b", "mass": 1, "inertia": [1, 1, 1, 0, 0, 0])" + body_extra +
+           R"(}], "joints": [{"name": "j", "type": "revolute", "parent": "ground", "child": "b"}])" + top_extra + "}";
+  };
+  const auto error_of = [](const std::string& text) -> std::string {
+    try {
+      codyna::compile(codyna::parse_model_spec_text(text, "m.json"), "m.json");
+    } catch (const codyna::ModelError& e) {
+      return e.path() + ": " + e.detail();
+    }
+    return "";
+  };
+  EXPECT_EQ(error_of(pendulum(R"(, "com": [0, 1e308, 0])")), "/bodies/0/com/1: expected a number of magnitude at most 1e15, got number 1e+308");
+  EXPECT_NE(error_of(pendulum(R"(, "shapes": [{"type": "sphere", "radius": -0.1}])")).find("/bodies/0/shapes/0/radius: expected a length > 0"), std::string::npos);
+  EXPECT_NE(error_of(pendulum(R"(, "shapes": [{"type": "box", "size": [1, 0, 1]}])")).find("/bodies/0/shapes/0/size"), std::string::npos);
+  EXPECT_NE(error_of(pendulum("", R"(, "solver": {"t_end": -5})")).find("/solver/t_end: expected an end time > 0"), std::string::npos);
+  EXPECT_NE(error_of(pendulum("", R"(, "solver": {"rtol": 2})")).find("/solver/rtol"), std::string::npos);
+  // a denormal mass, and a 1e-300 inertia, beside a real body
+  const std::string two = R"({"name": "p", "bodies": [{"name": "a", "mass": 1, "inertia": [1, 1, 1, 0, 0, 0]},
+      {"name": "b", "mass": 1e-310, "inertia": [1, 1, 1, 0, 0, 0]}],
+      "joints": [{"name": "j", "type": "revolute", "parent": "ground", "child": "a"},
+                 {"name": "k", "type": "revolute", "parent": "a", "child": "b"}]})";
+  EXPECT_NE(error_of(two).find("/bodies/1/mass: a mass of"), std::string::npos) << error_of(two);
+  std::string tiny = two;
+  tiny.replace(tiny.find("1e-310, \"inertia\": [1, 1, 1"), 29, "1, \"inertia\": [1e-300, 1e-300, 1e-300");
+  EXPECT_NE(error_of(tiny).find("/bodies/1/inertia"), std::string::npos) << error_of(tiny);
+  // the axis [0, 0, 1e308] that once loaded, saved and failed to load again is now refused at once
+  EXPECT_NE(error_of(R"({"name": "p", "bodies": [{"name": "b", "mass": 1, "inertia": [1, 1, 1, 0, 0, 0]}],
+      "joints": [{"name": "j", "type": "revolute", "parent": "ground", "child": "b", "axis": [0, 0, 1e308]}]})")
+                .find("/joints/0/axis/2"), std::string::npos);
+}
