@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cassert>
+#include <sys/stat.h>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -114,6 +116,7 @@ class Object {
 // A finite number of sane magnitude: nothing in a mechanism model needs more than
 // 1e15 (in SI units), and larger values only overflow later, far from their field.
 constexpr double kLargest = 1e15;
+constexpr long kMaxModelBytes = 256L << 20;  // 256 MiB: far beyond any mechanism, far below memory
 
 double read_number(const Node& n) {
   if (!n.value().is_number() || !std::isfinite(n.value().get<double>())) n.expected("a number");
@@ -1083,11 +1086,22 @@ ModelSpec parse_model_spec_text(const std::string& text, const std::string& file
 }
 
 ModelSpec load_model_spec(const std::string& path) {
+  // only regular files of a model's size: a FIFO would block, /dev/zero would never end
+  struct stat st{};
+  if (::stat(path.c_str(), &st) != 0) throw ModelError(path, "", "cannot open file: " + error_text(errno));
+  if (S_ISDIR(st.st_mode)) throw ModelError(path, "", "is a directory, not a model file");
+  if (!S_ISREG(st.st_mode)) throw ModelError(path, "", "is not a regular file (a FIFO, socket or device): not a model file");
+  if (st.st_size > kMaxModelBytes)
+    throw ModelError(path, "", "is " + std::to_string(st.st_size) + " bytes, more than a model file's limit of " +
+                                   std::to_string(kMaxModelBytes));
   File f(std::fopen(path.c_str(), "rb"));
   if (!f) throw ModelError(path, "", "cannot open file: " + error_text(errno));
   std::string text;
   char buffer[1 << 16];
-  while (const std::size_t n = std::fread(buffer, 1, sizeof buffer, f.get())) text.append(buffer, n);
+  while (const std::size_t n = std::fread(buffer, 1, sizeof buffer, f.get())) {
+    text.append(buffer, n);
+    if (text.size() > static_cast<std::size_t>(kMaxModelBytes)) throw ModelError(path, "", "grew past a model file's size limit while read");
+  }
   if (std::ferror(f.get())) throw ModelError(path, "", "cannot read file: " + error_text(errno));
   return parse_model_spec_text(text, path);
 }

@@ -128,6 +128,12 @@ std::unique_ptr<Controller> load_controller(const std::string& path, int nx, int
     throw std::invalid_argument(e.what());
   }
   const auto& m = vars.matrices;
+  // a controller variable that is there but not a real 2-D matrix is named with the reason
+  for (const SkippedVariable& v : vars.skipped)
+    for (const char* n : {"K", "Kp", "Ki", "Kd", "r", "Ac", "Bc", "Cc", "Dc", "Ts"})
+      if (v.name == n)
+        throw std::invalid_argument(path + ": the variable " + v.name + " cannot be used (" + v.reason + ")" +
+                                    "; a controller needs real, full, 2-D double matrices (save them with save -v7)");
   auto has = [&](const char* n) { return m.count(n) > 0; };
   auto get = [&](const char* n, Eigen::Index rows, Eigen::Index cols) {
     const Eigen::MatrixXd& M = m.at(n);
@@ -151,8 +157,9 @@ std::unique_ptr<Controller> load_controller(const std::string& path, int nx, int
   }
   std::string found;
   for (const auto& [k, v] : m) found += (found.empty() ? "" : ", ") + k;
+  for (const SkippedVariable& v : vars.skipped) found += (found.empty() ? "" : ", ") + v.name + " (" + v.reason + ", not read)";
   throw std::invalid_argument(path + ": no controller found: expected K (state feedback), Kp [Ki Kd] (PID) or Ac Bc Cc Dc "
-                              "(LTI); the file holds " + (found.empty() ? std::string("no numeric variables") : found));
+                              "(LTI); the file holds " + (found.empty() ? std::string("no variable codyna can read (is it truncated or corrupt?)") : found));
 }
 
 }  // namespace codyna

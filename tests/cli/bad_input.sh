@@ -93,4 +93,25 @@ kill -TERM $pid 2>/dev/null
 wait $pid 2>/dev/null
 ls -a | grep -q "\.tmp-" && fail "temporary files left after SIGTERM: $(ls -a | grep tmp-)"
 
+# model paths that are not model files: never a hang or a bad_alloc
+mkfifo model.fifo
+start=$(date +%s)
+expect 1 "not a regular file" -- timeout 20 "$codyna" info model.fifo
+expect 1 "not a regular file" -- timeout 20 "$codyna" info /dev/zero
+expect 1 "is a directory" -- "$codyna" info .
+[ $(( $(date +%s) - start )) -lt 10 ] || fail "refusing a FIFO or /dev/zero took too long"
+
+# controller files whose K is not a real 2-D matrix say so (Octave writes them)
+if command -v octave-cli > /dev/null; then
+  octave-cli --no-gui --quiet --eval "K = [1+2i 3 4 5]; save('-v7','kc.mat','K'); K = sparse([1 2 3 4]); save('-v7','ks.mat','K'); K = ones(1,4,2); save('-v7','k3.mat','K');" > /dev/null 2>&1
+  cp "$src/examples/cart_pendulum.json" cart.json
+  expect 1 "K cannot be used (complex)" -- "$codyna" simulate cart.json --controller kc.mat --out k.h5 --quiet
+  expect 1 "K cannot be used (sparse" -- "$codyna" simulate cart.json --controller ks.mat --out k.h5 --quiet
+  expect 1 "K cannot be used (3-D" -- "$codyna" simulate cart.json --controller k3.mat --out k.h5 --quiet
+  head -c 150 kc.mat > truncated.mat
+  expect 1 "truncated or corrupt" -- "$codyna" simulate cart.json --controller truncated.mat --out k.h5 --quiet
+else
+  echo "bad_input: octave-cli not found, controller-file checks skipped"
+fi
+
 if [ "$fails" -eq 0 ]; then echo "bad_input: all checks passed"; else echo "bad_input: $fails failed"; exit 1; fi
