@@ -50,7 +50,7 @@ void SimWorker::cancel() {
 // ---- worker thread ----
 
 void SimWorker::postBatch(bool force) {
-  if (!force && since_post_.elapsed() < batch_ms_) return;
+  if (!force && since_post_.elapsed() < batch_ms_.load()) return;
   SampleBatch batch;
   batch.swap(pending_);
   const double t = last_t_, tEnd = t_end_;

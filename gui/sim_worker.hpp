@@ -63,8 +63,8 @@ class SimWorker : public QObject {
   // How many samples() emissions the last run made (for the benchmark and tests).
   int batchCount() const { return batches_; }
 
-  int batchIntervalMs() const { return batch_ms_; }
-  void setBatchIntervalMs(int ms) { batch_ms_ = ms < 1 ? 1 : ms; }
+  int batchIntervalMs() const { return batch_ms_.load(); }
+  void setBatchIntervalMs(int ms) { batch_ms_.store(ms < 1 ? 1 : ms); }
 
  signals:
   void started();
@@ -85,7 +85,7 @@ class SimWorker : public QObject {
   std::atomic<bool> cancel_{false};
   std::atomic<QThread*> integrator_thread_{nullptr};
   bool running_ = false;
-  int batch_ms_ = 50;
+  std::atomic<int> batch_ms_{50};  // read by the worker thread
   int batches_ = 0;
   double wall_time_ = 0;
   QString controller_source_;

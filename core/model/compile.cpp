@@ -571,17 +571,39 @@ class Compiler {
     m_.redundant_rows = rows.redundant;
   }
 
+  // The tree's mass matrix is positive definite exactly when every joint's articulated
+  // inertia D_i = S_i^T IA_i S_i is: one backward pass, O(n), instead of an O(n^3) eigen
+  // decomposition. Scale-aware: D_i is judged against the same joint's composite (rigid
+  // subtree) inertia S_i^T Ic_i S_i, so a long chain whose mass matrix spans many decades
+  // passes while a coordinate that truly moves nothing fails.
   void check_mass_matrix() {
     if (m_.nv == 0) return;
     Data d(m_);
-    const Eigen::MatrixXd M = crba<double>(m_, d, m_.q0);
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(M);
-    const double top = std::max(es.eigenvalues().maxCoeff(), 1e-300);
-    if (es.eigenvalues()[0] > 1e-12 * top) return;
-    Eigen::Index k;
-    es.eigenvectors().col(0).cwiseAbs().maxCoeff(&k);
-    fail("/bodies", "the mass matrix is singular at the initial state: coordinate " + quoted(m_.v_names[k]) +
-                        " moves no mass or inertia (give the bodies it moves mass and inertia)");
+    forward_kinematics<double>(m_, d, m_.q0);
+    std::vector<Mat6T<double>> IA(m_.inertia.begin(), m_.inertia.end()), Ic = IA;
+    for (int i = m_.nbodies - 1; i >= 1; --i) {
+      const JointModel& j = m_.joints[i];
+      const Mat6T<double> Xi = d.liMi[i].inverse().motion_matrix();
+      Mat6T<double> Ia = IA[i];
+      if (j.nv > 0) {
+        const Mat6xT<double>& S = d.Sb[i];
+        const Eigen::MatrixXd U = IA[i] * S;
+        const Eigen::MatrixXd D = S.transpose() * U;
+        const Eigen::MatrixXd Dc = S.transpose() * Ic[i] * S;
+        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(D);
+        const double reference = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Dc).eigenvalues().maxCoeff();
+        if (!(es.eigenvalues()[0] > 1e-12 * reference) || !(reference > 0)) {
+          Eigen::Index k;
+          es.eigenvectors().col(0).cwiseAbs().maxCoeff(&k);
+          fail("/bodies", "the mass matrix is singular at the initial state: coordinate " +
+                              quoted(m_.v_names[j.idx_v + k]) + " moves no mass or inertia (give the bodies it moves mass and inertia)");
+        }
+        Ia -= U * D.inverse() * U.transpose();
+      }
+      const int p = j.parent;
+      IA[p] += Xi.transpose() * Ia * Xi;
+      Ic[p] += Xi.transpose() * Ic[i] * Xi;
+    }
   }
 
   const ModelSpec& spec_;

@@ -23,7 +23,7 @@ DataT<S>::DataT(const Model& model) {
   c.assign(nb, Vec6T<S>::Zero());
   Ic.assign(nb, Mat6T<S>::Zero());
   tau = VecXT<S>::Zero(model.nv);
-  M = MatXT<S>::Zero(model.nv, model.nv);
+  // M [nv x nv] is sized by crba() when a mass matrix is asked for: ABA and kinematics never need it
   nle = VecXT<S>::Zero(model.nv);
   Q = VecXT<S>::Zero(model.nv);
   qdd = VecXT<S>::Zero(model.nv);

@@ -29,7 +29,7 @@ struct DataT {
   std::vector<Vec6T<S>> f;       // [nbodies] rnea: force transmitted by joint i, body coordinates
 
   VecXT<S> tau;                  // [nv] rnea output
-  MatXT<S> M;                    // [nv x nv] crba output (symmetric, full)
+  MatXT<S> M;                    // [nv x nv] crba output (symmetric, full); empty until crba runs
   VecXT<S> nle;                  // [nv] nonlinear effects: coriolis, centrifugal, gravity
   VecXT<S> Q;                    // [nv] generalized applied forces (effects + actuators)
   std::vector<Vec6T<S>> fext;    // [nbodies] external body forces, body coordinates (effects workspace)

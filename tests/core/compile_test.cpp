@@ -153,5 +153,34 @@ TEST(CompileErrors, UnknownIntegrator) {
   expect_error(s, "/solver/integrator", "unknown integrator");
 }
 
+
+// A long chain whose mass matrix spans many decades is a valid model (the singularity
+// check is per joint and scale-aware), and a coordinate that moves nothing is still refused.
+TEST(CompileErrors, LongChainIsNotSingularButAMasslessTipIs) {
+  ModelSpec s;
+  s.name = "chain";
+  const int n = 1500;
+  for (int i = 0; i < n; ++i) {
+    BodySpec b;
+    b.name = "b" + std::to_string(i);
+    b.mass = 1;
+    b.com = Eigen::Vector3d(0.5, 0, 0);
+    b.inertia = Eigen::Vector3d(0.01, 0.1, 0.1).asDiagonal();
+    s.bodies.push_back(b);
+    JointSpec j;
+    j.name = "j" + std::to_string(i);
+    j.parent = i ? "b" + std::to_string(i - 1) : "ground";
+    j.child = b.name;
+    j.axis = i % 2 ? Eigen::Vector3d::UnitY() : Eigen::Vector3d::UnitZ();
+    j.parent_frame.position = Eigen::Vector3d(i ? 1.0 : 0.0, 0, 0);
+    s.joints.push_back(j);
+  }
+  const Model m = compile(s);
+  EXPECT_EQ(m.dof(), n);
+  s.bodies.back().mass = 0;
+  s.bodies.back().inertia.setZero();
+  expect_error(s, "/bodies", "coordinate \"j1499\" moves no mass");
+}
+
 }  // namespace
 }  // namespace codyna
