@@ -82,7 +82,8 @@ class ResultPlots : public QWidget {
   // suffix. On failure returns false and says why in *error.
   bool saveImage(const QString& path, QString* error = nullptr);
 
-  // Maximum points per plotted series before decimation (default 20000).
+  // Maximum points per plotted series before decimation (default 4000: two per pixel of a wide
+  // chart; min and max of each bucket are kept, so no peak is lost and a redraw stays short).
   int maxPlotPoints() const { return max_points_; }
   void setMaxPlotPoints(int n);
 
@@ -133,7 +134,7 @@ class ResultPlots : public QWidget {
   bool dirty_ = false;
   int refresh_ms_ = 100;
   int redraws_ = 0;
-  int max_points_ = 20000;
+  int max_points_ = 4000;
   double t_end_ = 1.0;
   double t_max_seen_ = 0.0;
   double cursor_t_;
