@@ -185,13 +185,17 @@ void LinearizeView::buildUi() {
   vsplit->addWidget(results);
   vsplit->addWidget(modes_split);
 
-  auto* left = new QVBoxLayout;
+  // the settings keep a narrow column: the matrices, modes and pole map need the room
+  auto* left_widget = new QWidget(this);
+  left_widget->setMaximumWidth(330);
+  auto* left = new QVBoxLayout(left_widget);
+  left->setContentsMargins(0, 0, 0, 0);
   left->addWidget(settings);
   left->addWidget(independent_box_);
   left->addLayout(buttons);
   left->addStretch(1);
   auto* layout = new QHBoxLayout(this);
-  layout->addLayout(left, 0);
+  layout->addWidget(left_widget, 0);
   layout->addWidget(vsplit, 1);
 
   // ---- widgets -> study (each change one undo step)

@@ -44,7 +44,7 @@ const char* kFilter = "codyna models (*.json);;All files (*)";
 
 MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document(this)) {
   setObjectName("codynaMainWindow");
-  resize(1500, 950);
+  resize(1600, 1000);
 
   // centre: 3-D view with playback, and below it the Linearize / Simulate views
   view_ = new View3D(this);
@@ -123,7 +123,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
   msg_dock->setObjectName("messageDock");
   msg_dock->setWidget(messages_);
   addDockWidget(Qt::BottomDockWidgetArea, msg_dock);
-  resizeDocks({left_dock, in_dock}, {330, 380}, Qt::Horizontal);
+  resizeDocks({left_dock, in_dock}, {270, 330}, Qt::Horizontal);
   resizeDocks({msg_dock}, {90}, Qt::Vertical);
 
   buildMenus();

@@ -111,7 +111,7 @@ class MainWindowXvfb : public QObject {
   void everyExampleShowsItsMechanism() {
     QFETCH(QString, file);
     MainWindow w;
-    w.resize(1500, 950);
+    w.resize(1600, 1000);
     w.show();
     QVERIFY(QTest::qWaitForWindowExposed(&w));
     QVERIFY(w.openFile(QStringLiteral(CODYNA_EXAMPLES_DIR "/") + file));
@@ -127,7 +127,7 @@ class MainWindowXvfb : public QObject {
 
   void cartPendulumWorkflow() {
     MainWindow w;
-    w.resize(1500, 950);
+    w.resize(1600, 1000);
     w.show();
     QVERIFY(QTest::qWaitForWindowExposed(&w));
     QVERIFY(w.openFile(QStringLiteral(CODYNA_EXAMPLES_DIR "/cart_pendulum.json")));
