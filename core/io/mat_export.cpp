@@ -1,5 +1,6 @@
 #include "io/mat_export.hpp"
 
+#include "io/hdf5_quiet.hpp"
 #include "io/output_guard.hpp"
 
 #include <matio.h>
@@ -493,7 +494,10 @@ ExportPaths export_plant(const LinearSystem& sys, const std::string& dir, const 
   const std::string script = plant_script(s, name, v);
 
   AtomicFile mat(paths.mat_file);
-  write_plant_mat(s, name, mat.temp_path(), v, paths.mat_file);
+  {
+    const QuietHdf5 quiet;  // a v7.3 file is HDF5: failures are reported here, not printed by the library
+    write_plant_mat(s, name, mat.temp_path(), v, paths.mat_file);
+  }
   AtomicFile m(paths.m_file);
   {
     std::ofstream out(m.temp_path(), std::ios::binary | std::ios::trunc);

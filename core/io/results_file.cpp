@@ -1,5 +1,6 @@
 #include "io/results_file.hpp"
 
+#include "io/hdf5_quiet.hpp"
 #include "io/output_guard.hpp"
 
 #include <hdf5.h>
@@ -150,20 +151,6 @@ void check(herr_t rc, const std::string& what) {
 }
 
 // HDF5 prints its error stack to stderr by default; here failures become exceptions instead.
-class QuietHdf5 {
- public:
-  QuietHdf5() {
-    H5Eget_auto2(H5E_DEFAULT, &func_, &data_);
-    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  }
-  ~QuietHdf5() { H5Eset_auto2(H5E_DEFAULT, func_, data_); }
-  QuietHdf5(const QuietHdf5&) = delete;
-  QuietHdf5& operator=(const QuietHdf5&) = delete;
-
- private:
-  H5E_auto2_t func_ = nullptr;
-  void* data_ = nullptr;
-};
 
 // An HDF5 identifier closed on destruction; a negative id (a failed call) throws.
 class Handle {

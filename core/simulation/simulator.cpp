@@ -117,10 +117,10 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
     throw std::invalid_argument("simulate: tolerances must be finite: rtol in (0, 1), atol > 0");
   if (!(is.max_step >= 0) || !std::isfinite(is.max_step))
     throw std::invalid_argument("simulate: the largest step must be a finite number >= 0 (0 = no limit)");
-  if (is.method == "rk4" && is.max_step > 0 && (o.t_end - o.t0) / is.max_step > 1e9) {
+  if (is.max_step > 0 && (o.t_end - o.t0) / is.max_step > 1e9) {
     std::ostringstream os;
-    os << "simulate: rk4 with a step of " << is.max_step << " s over " << (o.t_end - o.t0) << " s would take "
-       << (o.t_end - o.t0) / is.max_step << " steps (more than 1e9): raise the step";
+    os << "simulate: a largest step of " << is.max_step << " s over " << (o.t_end - o.t0) << " s means at least "
+       << (o.t_end - o.t0) / is.max_step << " steps (more than 1e9): raise the step (--max-step)";
     throw std::invalid_argument(os.str());
   }
   if (controller && controller->sample_time() > 0 && (o.t_end - o.t0) / controller->sample_time() > o.max_samples * 100.0) {
