@@ -177,8 +177,7 @@ void run(const SimulateArgs& a) {
     };
   const SimulationResult r = study_simulate(m, setup, cb);
   if (bar) std::fprintf(stderr, "\n");
-  write_results_hdf5(r, a.out);
-  if (!a.csv.empty()) write_results_csv(r, a.csv);
+  write_results(r, a.out, a.csv);
   summary(r, m, plant);
   std::cout << "wrote " << a.out << (a.csv.empty() ? "" : "\nwrote " + a.csv) << "\n";
   if (!r.completed && !r.cancelled) throw std::runtime_error("the run failed at " + r.failure + "; the partial result is in " + a.out);

@@ -467,42 +467,65 @@ void append_csv_line(std::string& line, std::size_t count, AppendField append_fi
 
 }  // namespace
 
+namespace {
+
+void fill_hdf5(const SimulationResult& r, const std::string& path, const std::string& temp) {
+  try {
+    const QuietHdf5 quiet;
+    Handle file(H5Fcreate(temp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose, "cannot create " + temp);
+    write_contents(file, r);
+    file.close("cannot finish " + temp);
+  } catch (const FileError& e) {
+    throw std::runtime_error(path + ": " + e.what());
+  }
+}
+
+void fill_csv(const SimulationResult& r, const std::string& path, const std::string& temp) {
+  const std::vector<CsvColumn> columns = csv_columns(r);
+  std::ofstream stream(temp, std::ios::binary | std::ios::trunc);
+  std::string line;
+  const auto write_line = [&](auto append_field) {
+    line.clear();
+    append_csv_line(line, columns.size(), append_field);
+    stream.write(line.data(), static_cast<std::streamsize>(line.size()));
+  };
+  write_line([&](std::string& l, std::size_t c) { append_csv_field(l, columns[c].header); });
+  for (std::size_t i = 0; i < r.t.size() && stream; ++i)
+    write_line([&](std::string& l, std::size_t c) { append_number(l, columns[c].values[i]); });
+  stream.close();
+  if (!stream) throw std::runtime_error(path + ": cannot write " + temp);
+}
+
+}  // namespace
+
 void write_results_hdf5(const SimulationResult& r, const std::string& path) {
   guard_output(path, OutputKind::ResultsHdf5, {r.model_file});
   require_consistent(r, path);
   AtomicFile out(path);
-  try {
-    const QuietHdf5 quiet;
-    Handle file(H5Fcreate(out.temp_path().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose,
-                "cannot create " + out.temp_path());
-    write_contents(file, r);
-    file.close("cannot finish " + out.temp_path());
-  } catch (const FileError& e) {
-    throw std::runtime_error(path + ": " + e.what());
-  }
+  fill_hdf5(r, path, out.temp_path());
   out.commit();
 }
 
 void write_results_csv(const SimulationResult& r, const std::string& path) {
   guard_output(path, OutputKind::ResultsCsv, {r.model_file});
   require_consistent(r, path);
-  const std::vector<CsvColumn> columns = csv_columns(r);
   AtomicFile out(path);
-  {
-    std::ofstream stream(out.temp_path(), std::ios::binary | std::ios::trunc);
-    std::string line;
-    const auto write_line = [&](auto append_field) {
-      line.clear();
-      append_csv_line(line, columns.size(), append_field);
-      stream.write(line.data(), static_cast<std::streamsize>(line.size()));
-    };
-    write_line([&](std::string& l, std::size_t c) { append_csv_field(l, columns[c].header); });
-    for (std::size_t i = 0; i < r.t.size() && stream; ++i)
-      write_line([&](std::string& l, std::size_t c) { append_number(l, columns[c].values[i]); });
-    stream.close();
-    if (!stream) throw std::runtime_error(path + ": cannot write " + out.temp_path());
-  }
+  fill_csv(r, path, out.temp_path());
   out.commit();
+}
+
+void write_results(const SimulationResult& r, const std::string& hdf5_path, const std::string& csv_path) {
+  if (csv_path.empty()) return write_results_hdf5(r, hdf5_path);
+  guard_output(hdf5_path, OutputKind::ResultsHdf5, {r.model_file});
+  guard_output(csv_path, OutputKind::ResultsCsv, {r.model_file});
+  require_consistent(r, hdf5_path);
+  // both complete before either is renamed into place: an interrupted run never leaves a
+  // new .h5 beside an old .csv
+  AtomicFile h5(hdf5_path), csv(csv_path);
+  fill_hdf5(r, hdf5_path, h5.temp_path());
+  fill_csv(r, csv_path, csv.temp_path());
+  h5.commit();
+  csv.commit();
 }
 
 SimulationResult read_results_hdf5(const std::string& path) {

@@ -76,6 +76,11 @@ void write_results_hdf5(const SimulationResult& r, const std::string& path);
 // file only. Atomic and throwing like write_results_hdf5.
 void write_results_csv(const SimulationResult& r, const std::string& path);
 
+// Both at once (csv_path may be ""): both files are written completely before either
+// replaces an old one, so an interrupted run leaves the old pair or the new pair
+// (only a failure between the two renames could mix them).
+void write_results(const SimulationResult& r, const std::string& hdf5_path, const std::string& csv_path);
+
 // Reads what write_results_hdf5 wrote; the result equals the one written
 // (bit for bit), except that a y_linear without columns comes back 0 x 0 and
 // any other matrix without columns comes back N x 0. Throws std::runtime_error naming `path` and

@@ -117,3 +117,20 @@ TEST(AtomicFileLeftovers, SignalHandlerRemovesTemporariesInProgress) {
   EXPECT_FALSE(fs::exists(f.temp_path()));
   EXPECT_FALSE(fs::exists(d / "big.h5"));
 }
+
+TEST(ResultsPair, AFailedCsvKeepsTheOldHdf5) {
+  Dir d;
+  SimulationResult r = tiny_result("");
+  write_results(r, d / "r.h5", d / "r.csv");
+  const std::string old_h5 = read(d / "r.h5");
+  r.t = {0.0, 0.5};
+  r.q = r.v = r.u = r.y = r.xc = Eigen::MatrixXd(2, 0);
+  r.kinetic_energy = r.potential_energy = r.constraint_violation = r.velocity_violation = {0.0, 1.0};
+  // the CSV cannot be written (its folder is missing): nothing is replaced
+  EXPECT_THROW(write_results(r, d / "r.h5", d / "missing/r.csv"), std::runtime_error);
+  EXPECT_EQ(read(d / "r.h5"), old_h5);
+  // both can: both are new
+  write_results(r, d / "r.h5", d / "r.csv");
+  EXPECT_EQ(read_results_hdf5(d / "r.h5").samples(), 2);
+  EXPECT_NE(read(d / "r.csv").find("0.5"), std::string::npos);
+}
