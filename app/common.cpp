@@ -7,9 +7,13 @@
 
 namespace codyna::cli {
 
-Model load_model(const std::string& path) { return compile(load_model_spec(path), path); }
+Model load_model(const std::string& path) { return compile(load_spec(path), path); }
 
-ModelSpec load_spec(const std::string& path) { return load_model_spec(path); }
+ModelSpec load_spec(const std::string& path) {
+  ModelSpec spec = load_model_spec(path);
+  for (const std::string& n : spec.notes) std::cerr << "codyna: note: " << n << "\n";
+  return spec;
+}
 
 void apply_set(StudySpec& study, const std::vector<std::string>& set) {
   for (const std::string& s : set) {

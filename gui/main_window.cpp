@@ -295,6 +295,7 @@ bool MainWindow::openFile(const QString& path) {
   time_label_->setText(tr("no result"));
   view_->fitView();
   message(tr("Opened %1").arg(doc_->filePath()));
+  for (const std::string& n : doc_->spec().notes) message(tr("note: %1").arg(qs(n)));
   return true;
 }
 

@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 #include <string_view>
 #include <system_error>
@@ -74,6 +75,7 @@ class Node {
   Node(const json& j, std::string path, const std::string& file) : j_(&j), path_(std::move(path)), file_(&file) {}
 
   const json& value() const { return *j_; }
+  std::string where() const { return (file_->empty() ? "" : *file_ + ": ") + (path_.empty() ? "/" : path_); }
   Node element(std::size_t i) const { return Node((*j_)[i], path_ + "/" + std::to_string(i), *file_); }
   Node member(const std::string& key) const { return Node(j_->at(key), path_ + "/" + pointer_token(key), *file_); }
 
@@ -184,10 +186,20 @@ bool normalize(Eigen::Ref<Eigen::VectorXd> v) {
   return true;
 }
 
-// An axis or direction: a non-zero vec3, normalized.
+// What the reader changed while reading one file (ModelSpec::notes); set by parse_model_spec.
+thread_local std::vector<std::string>* g_notes = nullptr;
+
+// An axis or direction: a non-zero vec3, normalized (with a note when it was not of unit length).
 Eigen::Vector3d read_direction(const Node& n) {
   Eigen::Vector3d v = read_vec3(n);
+  const double length = v.norm();
   if (!normalize(v)) n.fail("expected a non-zero vector, got " + dump(n.value()));
+  if (g_notes && std::abs(length - 1.0) > 1e-9) {
+    std::ostringstream os;
+    os.precision(6);
+    os << n.where() << ": the direction " << dump(n.value()) << " has length " << length << "; it is used normalized";
+    g_notes->push_back(os.str());
+  }
   return v;
 }
 
@@ -1070,7 +1082,14 @@ std::string error_text(int err) { return std::generic_category().message(err); }
 }  // namespace
 
 ModelSpec parse_model_spec(const nlohmann::json& j, const std::string& file_label) {
-  return read_struct<ModelSpec>(Node(j, "", file_label));
+  std::vector<std::string> notes;
+  g_notes = &notes;
+  struct Reset {
+    ~Reset() { g_notes = nullptr; }
+  } reset;
+  ModelSpec spec = read_struct<ModelSpec>(Node(j, "", file_label));
+  spec.notes = std::move(notes);
+  return spec;
 }
 
 ModelSpec parse_model_spec_text(const std::string& text, const std::string& file_label) {

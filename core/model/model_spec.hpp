@@ -223,6 +223,10 @@ struct ModelSpec {
   ControllerSpec controller;  // type None: no controller
   SolverSpec solver;
   StudySpec analysis;         // the study's choices (operating point, method, controller source, ...)
+
+  // What the reader changed or assumed while reading a file ("FILE: /joints/0/axis: ... used
+  // normalized"): for the front ends to show; never written back.
+  std::vector<std::string> notes;
 };
 
 // Sizes of a joint type: configuration (nq) and velocity (nv).

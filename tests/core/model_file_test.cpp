@@ -1062,3 +1062,18 @@ TEST(ModelFileErrors, AbsurdNumbersAreRefusedWithTheirPath) {
       "joints": [{"name": "j", "type": "revolute", "parent": "ground", "child": "b", "axis": [0, 0, 1e308]}]})")
                 .find("/joints/0/axis/2"), std::string::npos);
 }
+
+// A direction that is not of unit length is used normalized, and the reader says so.
+TEST(ModelFile, NonUnitAxisIsNormalizedWithANote) {
+  const codyna::ModelSpec s = codyna::parse_model_spec_text(
+      R"({"name": "p", "bodies": [{"name": "b", "mass": 1, "inertia": [1, 1, 1, 0, 0, 0]}],
+          "joints": [{"name": "j", "type": "revolute", "parent": "ground", "child": "b", "axis": [1, 0, 1]}]})", "m.json");
+  EXPECT_NEAR(s.joints[0].axis.norm(), 1.0, 1e-15);
+  ASSERT_EQ(s.notes.size(), 1u);
+  EXPECT_NE(s.notes[0].find("m.json: /joints/0/axis"), std::string::npos) << s.notes[0];
+  EXPECT_NE(s.notes[0].find("length 1.41421"), std::string::npos) << s.notes[0];
+  // unit axes say nothing, and notes are never written back
+  const codyna::ModelSpec again = codyna::parse_model_spec(codyna::to_json(s), "again.json");
+  EXPECT_TRUE(again.notes.empty());
+  EXPECT_EQ(codyna::to_json(s).dump().find("notes"), std::string::npos);
+}
