@@ -1094,12 +1094,41 @@ ModelSpec parse_model_spec(const nlohmann::json& j, const std::string& file_labe
 
 ModelSpec parse_model_spec_text(const std::string& text, const std::string& file_label) {
   json j;
+  // the path of the value being read, so that a JSON error inside a field (a number that
+  // overflows a double) is reported with the field's path as well as its line and column
+  struct Frame {
+    bool array = false;
+    std::size_t index = 0;
+    std::string key;
+  };
+  std::vector<Frame> frames;
+  const auto path_of = [](const std::vector<Frame>& fs) {
+    std::string path;
+    for (const Frame& f : fs) path += "/" + (f.array ? std::to_string(f.index) : pointer_token(f.key));
+    return path;
+  };
+  const auto track = [&](int, json::parse_event_t event, json& parsed) {
+    switch (event) {
+      case json::parse_event_t::object_start: frames.push_back({false, 0, {}}); break;
+      case json::parse_event_t::array_start: frames.push_back({true, 0, {}}); break;
+      case json::parse_event_t::key: if (!frames.empty()) frames.back().key = parsed.get<std::string>(); break;
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end:
+        if (!frames.empty()) frames.pop_back();
+        [[fallthrough]];
+      case json::parse_event_t::value:
+        if (!frames.empty() && frames.back().array) ++frames.back().index;
+        break;
+    }
+    return true;
+  };
   try {
-    j = json::parse(text);
+    j = json::parse(text, track);
   } catch (const json::parse_error& e) {
+    // a syntax error is located by line and column (the path of an unfinished value would mislead)
     throw ModelError(file_label, "", "invalid JSON at " + location(text, e.byte) + ": " + reason(e));
-  } catch (const json::exception& e) {
-    throw ModelError(file_label, "", "invalid JSON: " + reason(e));
+  } catch (const json::exception& e) {  // e.g. a number that overflows a double
+    throw ModelError(file_label, path_of(frames), "invalid JSON: " + reason(e) + " (numbers must fit a double)");
   }
   return parse_model_spec(j, file_label);
 }

@@ -1077,3 +1077,18 @@ TEST(ModelFile, NonUnitAxisIsNormalizedWithANote) {
   EXPECT_TRUE(again.notes.empty());
   EXPECT_EQ(codyna::to_json(s).dump().find("notes"), std::string::npos);
 }
+
+// A number that overflows a double is reported with its field's path.
+TEST(ModelFileErrors, OverflowingNumberNamesItsField) {
+  const auto path_of = [](const std::string& text) -> std::string {
+    try {
+      codyna::parse_model_spec_text(text, "m.json");
+    } catch (const codyna::ModelError& e) {
+      return e.path() + ": " + e.detail();
+    }
+    return "";
+  };
+  EXPECT_EQ(path_of(R"({"name": "p", "bodies": [{"name": "b", "mass": 1e309}], "joints": []})").substr(0, 16), "/bodies/0/mass: ");
+  EXPECT_EQ(path_of(R"({"name": "p", "bodies": [{"name": "b", "mass": 1, "com": [0, 1, )" + std::string(400, '9') +
+                    "]}], \"joints\": []}").substr(0, 16), "/bodies/0/com/2:");
+}
