@@ -10,6 +10,7 @@
 #include "analysis/modal.hpp"
 #include "analysis/operating_point.hpp"
 #include "commands.hpp"
+#include "control/controllability.hpp"
 #include "io/model_file.hpp"
 #include "io/output_guard.hpp"
 #include "common.hpp"
@@ -179,6 +180,11 @@ void run(const LinearizeArgs& a) {
   print_matrix("C", sys.C, sys.output_names, sys.state_names);
   print_matrix("D", sys.D, sys.output_names, sys.input_names);
   std::cout << "\n" << format_modes(modal_analysis(sys)) << "\n";
+  // what the inputs cannot move and the outputs cannot see, named (continuous plant)
+  const LinearSystem& c = lin.system;
+  const auto uc = uncontrollable_modes(c.A, c.B, c.state_names), uo = unobservable_modes(c.A, c.C, c.state_names);
+  std::cout << "controllable     " << (uc.empty() ? std::string("yes, every mode") : "no: " + describe(uc)) << "\n"
+            << "observable       " << (uo.empty() ? std::string("yes, every mode") : "no: " + describe(uo)) << "\n\n";
 
   const ExportPaths p = study_export(m, sys, a.out);
   std::cout << "wrote " << p.mat_file << "\nwrote " << p.m_file << "\n";

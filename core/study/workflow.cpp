@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "analysis/discretize.hpp"
+#include "control/controllability.hpp"
 #include "control/lqr.hpp"
 #include "dynamics/assembly.hpp"
 #include "model/compile.hpp"
@@ -53,6 +54,18 @@ Eigen::MatrixXd diagonal(const Model& m, const std::vector<double>& w, int n, co
     fail(m, field, "expected " + std::to_string(n) + " weights (one per " + (n && field[0] == 'q' ? "state" : "input") +
                        "), got " + std::to_string(w.size()));
   return Eigen::Map<const Eigen::VectorXd>(w.data(), n).asDiagonal();
+}
+
+// An LQR needs every mode that does not decay by itself to be movable by the inputs; say which are not.
+void require_stabilizable(const Model& m, const LinearSystem& sys) {
+  std::vector<HiddenMode> bad;
+  const double scale = std::max(1.0, sys.A.norm());
+  for (const HiddenMode& h : uncontrollable_modes(sys.A, sys.B, sys.state_names))
+    if (h.eigenvalue.real() >= -1e-9 * scale) bad.push_back(h);
+  if (bad.empty()) return;
+  throw std::invalid_argument((m.source_file.empty() ? std::string() : m.source_file + ": ") +
+                              "lqr: the plant is not stabilizable: the Plant/In inputs cannot move " + describe(bad) +
+                              " (add an input that acts on them, or hold them with a joint spring or damper)");
 }
 
 }  // namespace
@@ -184,10 +197,12 @@ StudySimulation study_simulation(const Model& m) {
     out.plant = plant;
   }
   if (from_model) {
+    if (m.spec.controller.type == ControllerType::Lqr) require_stabilizable(m, out.plant->lin.system);
     out.controller = make_model_controller(m, *out.plant);
     out.controller_source = std::string("the model file's ") + to_string(m.spec.controller.type) + " controller";
   } else if (src == "lqr") {
     const LinearSystem& sys = out.plant->lin.system;
+    require_stabilizable(m, sys);
     const LqrResult d = lqr(sys.A, sys.B, diagonal(m, s.q_weights, sys.nx(), "q_weights"),
                             diagonal(m, s.r_weights, sys.nu(), "r_weights"));
     out.lqr_gain = d.K;

@@ -163,3 +163,30 @@ TEST(Workflow, SimulationControllerSources) {
   spec.analysis.q_weights = {1, 2};
   expect_model_error_at([&] { study_simulation(study_model(spec)); }, "/analysis/q_weights", "expected 4 weights");
 }
+
+// Uncontrollable parts are named, not discovered later: a second pendulum that no input
+// drives makes an LQR impossible, and the message names its states.
+TEST(Workflow, LqrOnAnUnstabilizablePlantNamesTheModes) {
+  ModelSpec spec = example_spec("pendulum.json");
+  BodySpec rod2 = spec.bodies[0];
+  rod2.name = "rod2";
+  spec.bodies.push_back(rod2);
+  JointSpec pivot2 = spec.joints[0];
+  pivot2.name = "pivot2";
+  pivot2.child = "rod2";
+  pivot2.parent_frame.position += Eigen::Vector3d(0, 0, 1);
+  spec.joints.push_back(pivot2);
+  spec.analysis.controller = "lqr";
+  spec.analysis.operating_point = "initial";
+  spec.controller = ControllerSpec{};
+  const Model m = study_model(spec);
+  try {
+    study_simulation(m);
+    FAIL() << "an LQR was designed for an unstabilizable plant";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("not stabilizable"), std::string::npos) << what;
+    EXPECT_NE(what.find("pivot2"), std::string::npos) << what;
+    EXPECT_EQ(what.find("(pivot,"), std::string::npos) << what;  // the driven pendulum is not blamed
+  }
+}
