@@ -137,6 +137,10 @@ void run(const LinearizeArgs& a) {
   const std::string name = study_export_name(m);
   if (m.plant_inputs.empty() && m.plant_outputs.empty())
     std::cerr << "codyna: warning: the model selects no Plant/In or Plant/Out; exporting the state equations only\n";
+  else if (m.plant_inputs.empty())
+    std::cerr << "codyna: warning: the model selects no Plant/In (plant.inputs): B and D have no columns, no controller can act\n";
+  else if (m.plant_outputs.empty())
+    std::cerr << "codyna: warning: the model selects no Plant/Out (plant.outputs): C and D have no rows\n";
   if (given(a.cmd, "--trajectory")) {
     if (!(a.trajectory > 0) || !std::isfinite(a.trajectory))
       throw std::invalid_argument("--trajectory: expected an end time of seconds > 0");

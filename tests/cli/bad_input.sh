@@ -82,6 +82,26 @@ expect 2 "diverged" -- "$codyna" simulate unstable.json --out u.h5 --quiet --t-e
 [ $(( $(date +%s) - start )) -lt 20 ] || fail "the diverging run took more than 20 s"
 [ -s u.h5 ] || fail "no partial result after divergence"
 
+# a model controller declared about an equilibrium that does not exist is refused, as linearize refuses it
+python3 - "$src/examples/pendulum.json" > noeq.json <<'PY'
+import json, sys
+m = json.load(open(sys.argv[1]))
+for e in m["effects"]:
+    if e["type"] == "gravity": e["g"] = [0, 0, 0]
+m["effects"].append({"name": "push", "type": "body_force", "body": m["bodies"][0]["name"], "force": [0, 0, 0], "torque": [0, 0, 5]})
+m["controller"] = {"type": "lqr", "operating_point": "equilibrium"}
+json.dump(m, sys.stdout)
+PY
+expect 1 "no static equilibrium" -- "$codyna" simulate noeq.json --out noeq.h5 --quiet
+expect 1 "no static equilibrium" -- "$codyna" linearize noeq.json --out lin
+# an empty Plant/In is said
+python3 - "$src/examples/pendulum.json" > noin.json <<'PY'
+import json, sys
+m = json.load(open(sys.argv[1])); m["plant"]["inputs"] = []; m.pop("controller", None)
+json.dump(m, sys.stdout)
+PY
+expect 0 "no Plant/In" -- "$codyna" linearize noin.json --out lin --operating-point initial
+
 # exit codes: argument errors are 1, an unknown command is named with the list
 expect 1 "unknown command \"frobnicate\"" -- "$codyna" frobnicate
 expect 1 "commands: info, linearize, simulate" -- "$codyna" frobnicate
