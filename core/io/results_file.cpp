@@ -141,6 +141,12 @@ std::string hdf5_reason() {
         return 0;
       },
       &reason);
+  // a failed system call: HDF5's text carries a time stamp, the file descriptor, buffer
+  // addresses, ... and the one thing a user needs, the system's message
+  const std::string key = "error message = '";
+  if (const auto a = reason.find(key); a != std::string::npos)
+    if (const auto b = reason.find('\'', a + key.size()); b != std::string::npos)
+      return reason.substr(a + key.size(), b - a - key.size());
   return reason.empty() ? "HDF5 error" : reason;
 }
 
