@@ -37,7 +37,9 @@ AssemblyResult assemble(const Model& model, const Eigen::VectorXd& q_guess, cons
   for (r.iterations = 0; r.iterations < opt.max_iterations; ++r.iterations) {
     if (phi.lpNorm<Eigen::Infinity>() <= opt.tolerance) break;
     constraint_terms<double>(model, d, r.q, zero_v);
-    const Eigen::VectorXd step = -min_norm_solve(d.Jc, phi);
+    Eigen::MatrixXd J = d.Jc;
+    for (int k : opt.locked_positions) J.col(k).setZero();  // a zero column gets a zero step (minimum norm)
+    const Eigen::VectorXd step = -min_norm_solve(J, phi);
     double t = 1.0;
     bool improved = false;
     for (int k = 0; k < 30; ++k, t *= 0.5) {
@@ -58,7 +60,9 @@ AssemblyResult assemble(const Model& model, const Eigen::VectorXd& q_guess, cons
   if (phi.size()) phi.cwiseAbs().maxCoeff(&r.worst_row);
   constraint_terms<double>(model, d, r.q, zero_v);
   const Eigen::MatrixXd J = d.Jc;
-  r.v = r.v - min_norm_solve(J, J * r.v);
+  Eigen::MatrixXd J_free = J;
+  for (int k : opt.locked_velocities) J_free.col(k).setZero();
+  r.v = r.v - min_norm_solve(J_free, J * r.v);
   r.velocity_residual = (J * r.v).lpNorm<Eigen::Infinity>();
   r.converged = r.position_residual <= std::max(opt.tolerance, 1e-10) && r.velocity_residual <= 1e-8 * (1.0 + r.v.norm());
   return r;

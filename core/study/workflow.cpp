@@ -88,15 +88,55 @@ Model study_model(const ModelSpec& spec_in, const std::string& file) {
   Model m = compile(spec, file);
   m.spec.analysis = s;  // compile keeps the spec; the study travels with it
   if (s.set.empty()) return m;
+  // coordinates set by the user are held exactly while the loops are closed (Adams' locked
+  // initial conditions); positions by q name, rates by "NAME_dot" or a rate's own name
+  AssemblyOptions hold;
+  std::vector<std::pair<std::string, double>> positions;  // what was asked, to check it afterwards
+  const auto joint_of_q = [&](int iq) {
+    for (int i = 1; i < m.nbodies; ++i)
+      if (iq >= m.joints[i].idx_q && iq < m.joints[i].idx_q + m.joints[i].nq) return i;
+    return 0;
+  };
   for (const auto& [name, value] : s.set) {
     if (!std::isfinite(value) || std::abs(value) > 1e6)
-      fail(m, "set/" + name, "expected a finite number of magnitude at most 1e6 (m or rad)");
-    const auto it = std::find(m.q_names.begin(), m.q_names.end(), name);
-    if (it == m.q_names.end()) fail(m, "set/" + name, "unknown coordinate \"" + name + "\" (coordinates: " + listed(m.q_names) + ")");
-    m.q0[it - m.q_names.begin()] = value;
+      fail(m, "set/" + name, "expected a finite number of magnitude at most 1e6 (m, rad, m/s or rad/s)");
+    if (const auto it = std::find(m.q_names.begin(), m.q_names.end(), name); it != m.q_names.end()) {
+      const int iq = static_cast<int>(it - m.q_names.begin());
+      const JointModel& j = m.joints[joint_of_q(iq)];
+      m.q0[iq] = value;
+      if (j.nq == j.nv) {
+        hold.locked_positions.push_back(j.idx_v + iq - j.idx_q);
+      } else {  // a quaternion or a free joint's position: hold the whole joint
+        for (int k = 0; k < j.nv; ++k) hold.locked_positions.push_back(j.idx_v + k);
+      }
+      positions.emplace_back(name, value);
+      continue;
+    }
+    std::string rate = name;
+    if (rate.size() > 4 && rate.compare(rate.size() - 4, 4, "_dot") == 0) rate.resize(rate.size() - 4);
+    const auto iv = std::find(m.v_names.begin(), m.v_names.end(), rate);
+    if (iv == m.v_names.end() || (rate == name && std::count(m.q_names.begin(), m.q_names.end(), name)))
+      fail(m, "set/" + name, "unknown coordinate \"" + name + "\" (positions: " + listed(m.q_names) + "; rates: " +
+                                 listed(m.v_names) + ", or a position's name with _dot)");
+    m.v0[iv - m.v_names.begin()] = value;
+    hold.locked_velocities.push_back(static_cast<int>(iv - m.v_names.begin()));
   }
-  const AssemblyResult r = assemble(m, m.q0, m.v0);
-  if (!r.converged) fail(m, "set", "the loops cannot be assembled with the coordinates set");
+  const AssemblyResult r = assemble(m, m.q0, m.v0, hold);
+  if (!r.converged) {
+    // say which values cannot be held, and where the loops would put them
+    const AssemblyResult free = assemble(m, m.q0, m.v0);
+    std::ostringstream os;
+    os.precision(8);
+    os << "the coordinates set cannot all be held: the loops close only to a residual of " << r.position_residual
+       << " (velocities " << r.velocity_residual << ")";
+    if (free.converged)
+      for (const auto& [name, value] : positions) {
+        const double there = free.q[std::find(m.q_names.begin(), m.q_names.end(), name) - m.q_names.begin()];
+        os << "; closing them freely puts " << name << " at " << there << " (" << value << " asked, off by "
+           << there - value << ")";
+      }
+    fail(m, "set", os.str());
+  }
   m.q0 = r.q;
   m.v0 = r.v;
   return m;

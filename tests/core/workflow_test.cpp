@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "control/lqr.hpp"
+#include "dynamics/constraints.hpp"
 #include "io/model_file.hpp"
 #include "model/errors.hpp"
 #include "test_util.hpp"
@@ -99,7 +100,7 @@ TEST(Workflow, SetCoordinatesAndOperatingPoints) {
   const OperatingPoint eq = study_operating_point(m, "equilibrium");
   EXPECT_NEAR(std::abs(std::remainder(eq.q[0], M_PI)), M_PI / 2, 1e-9);
   spec.analysis.set = {{"no_such_joint", 1.0}};
-  expect_model_error_at([&] { study_model(spec); }, "/analysis/set/no_such_joint", "coordinates: pivot");
+  expect_model_error_at([&] { study_model(spec); }, "/analysis/set/no_such_joint", "positions: pivot");
   spec.analysis.set.clear();
   spec.analysis.operating_point = "sideways";
   expect_model_error_at([&] { study_operating_point(study_model(spec)); }, "/analysis/operating_point", "unknown operating point");
@@ -189,4 +190,32 @@ TEST(Workflow, LqrOnAnUnstabilizablePlantNamesTheModes) {
     EXPECT_NE(what.find("pivot2"), std::string::npos) << what;
     EXPECT_EQ(what.find("(pivot,"), std::string::npos) << what;  // the driven pendulum is not blamed
   }
+}
+
+// Coordinates the user sets are held exactly while the loops close (the four-bar's crank,
+// coupler or rocker angle, and a rate); values that cannot all be held are refused with
+// where the loops would put them.
+TEST(Workflow, SetCoordinatesAreHeldExactlyOnClosedLoops) {
+  for (const std::string name : {"pivot_A", "pivot_B", "pivot_D"}) {
+    ModelSpec spec = example_spec("four_bar.json");
+    spec.analysis.set = {{name, 1.3}};
+    const Model m = study_model(spec);
+    const int iq = static_cast<int>(std::find(m.q_names.begin(), m.q_names.end(), name) - m.q_names.begin());
+    EXPECT_EQ(m.q0[iq], 1.3) << name;
+    Data d(m);
+    EXPECT_LT(constraint_residual<double>(m, d, m.q0).lpNorm<Eigen::Infinity>(), 1e-10) << name;
+  }
+  ModelSpec spec = example_spec("four_bar.json");
+  spec.analysis.set = {{"pivot_A_dot", 0.5}};
+  const Model m = study_model(spec);
+  const int iv = static_cast<int>(std::find(m.v_names.begin(), m.v_names.end(), "pivot_A") - m.v_names.begin());
+  EXPECT_EQ(m.v0[iv], 0.5);
+  Data d(m);
+  constraint_terms<double>(m, d, m.q0, m.v0);
+  EXPECT_LT((d.Jc * m.v0).lpNorm<Eigen::Infinity>(), 1e-10);
+  EXPECT_GT(m.v0.cwiseAbs().maxCoeff(), 0.5 - 1e-12);  // the others follow
+  spec.analysis.set = {{"pivot_A", 1.3}, {"pivot_D", 0.2}};
+  expect_model_error_at([&] { study_model(spec); }, "/analysis/set", "closing them freely puts pivot_A at");
+  spec.analysis.set = {{"pivot_Q_dot", 1.0}};
+  expect_model_error_at([&] { study_model(spec); }, "/analysis/set/pivot_Q_dot", "rates: pivot_A");
 }
