@@ -101,6 +101,16 @@ OperatingPoint trim(const Model& model, const OperatingPoint& start, const std::
   for (std::size_t k = 0; k < model.plant_inputs.size(); ++k) op.u[model.plant_inputs[k]] = u[k];
   const Eigen::VectorXd r = rest_accelerations(f, Eigen::VectorXd::Zero(n), u);
   op.residual = r.size() ? r.lpNorm<Eigen::Infinity>() : 0.0;
+  // a holding input beyond its actuator's limits cannot hold the configuration: say which binds
+  std::ostringstream bound;
+  for (int k : model.plant_inputs) {
+    const ActuatorModel& a = model.actuators[k];
+    if (op.u[k] > a.max) bound << (bound.tellp() ? "; " : "") << a.name << " = " << op.u[k] << " is above its max " << a.max;
+    if (op.u[k] < a.min) bound << (bound.tellp() ? "; " : "") << a.name << " = " << op.u[k] << " is below its min " << a.min;
+  }
+  if (bound.tellp())
+    throw std::invalid_argument("trim: holding this configuration needs inputs beyond their limits: " + bound.str() +
+                                " (raise the limits, add inputs, or trim another configuration)");
   return op;
 }
 

@@ -219,3 +219,25 @@ TEST(Workflow, SetCoordinatesAreHeldExactlyOnClosedLoops) {
   spec.analysis.set = {{"pivot_Q_dot", 1.0}};
   expect_model_error_at([&] { study_model(spec); }, "/analysis/set/pivot_Q_dot", "rates: pivot_A");
 }
+
+// A trim against a binding actuator limit fails naming the limit, instead of reporting an
+// input the actuator cannot give.
+TEST(Workflow, TrimAgainstABindingLimitNamesIt) {
+  ModelSpec spec = example_spec("pendulum.json");
+  spec.analysis.operating_point = "trim";
+  spec.analysis.set = {{"pivot", 0.3}};  // held near horizontal: needs about m g l/2 cos(0.3) = 93.7 N m
+  const Model free = study_model(spec);
+  const OperatingPoint op = study_operating_point(free);
+  const double needed = op.u[free.find_actuator("torque")];
+  EXPECT_NEAR(needed, 10 * 9.81 * 1.0 * std::cos(0.3), 1e-9);
+  spec.actuators[0].max = 50;
+  spec.actuators[0].min = -50;
+  const Model limited = study_model(spec);
+  try {
+    study_operating_point(limited);
+    FAIL() << "a trim beyond the limit was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("torque = 93.7"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("above its max 50"), std::string::npos) << e.what();
+  }
+}
