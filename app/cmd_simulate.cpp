@@ -125,7 +125,9 @@ ModelSpec study_of(const SimulateArgs& a) {
 }
 
 void run(const SimulateArgs& a) {
-  const Model m = study_model(study_of(a), a.model);
+  const ModelSpec spec = study_of(a);
+  const Model m = study_model(spec, a.model);
+  for (std::size_t k = spec.notes.size(); k < m.spec.notes.size(); ++k) std::cerr << "codyna: note: " << m.spec.notes[k] << "\n";
   // outputs that would replace the model, the controller file or a file codyna did not write are refused
   // before any work
   const std::vector<std::string> inputs{a.model, a.controller};

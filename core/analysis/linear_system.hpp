@@ -25,6 +25,10 @@ struct LinearSystem {
   std::string method;            // "exact", "fd-forward", "fd-central"
   double time = 0.0;             // time of the operating point
   std::string codyna_version;
+  // the study choices that define this plant (JSON: operating_point, set, independent,
+  // disabled_effects), exported as codyna_study so that a controller saved with it comes
+  // back to the same plant; "" when the plant was not linearized through a study
+  std::string study;
 
   int nx() const { return static_cast<int>(A.rows()); }
   int nu() const { return static_cast<int>(B.cols()); }

@@ -310,6 +310,7 @@ void write_plant_mat(const LinearSystem& s, const std::string& name, const std::
     if (v == MatVersion::V73) w.write(char_matrix_var((std::string(l.var) + "_char").c_str(), *l.list));
   }
   w.write(info_var(s, name));
+  if (!s.study.empty()) w.write(char_var("codyna_study", s.study));
   w.close();
 }
 
@@ -364,7 +365,11 @@ std::string header_comment(const LinearSystem& s, const std::string& name, MatVe
     << signal_table(s.state_names, s.state_units) << "%\n"
     << "% Runs as it is in MATLAB and GNU Octave: loads " << name << ".mat from this script's\n"
     << "% folder and, when ss() exists (Control System Toolbox; Octave's control package,\n"
-    << "% loaded here when installed), builds the named state-space model sys.\n";
+    << "% loaded here when installed), builds the named state-space model sys.\n"
+    << (s.study.empty() ? std::string()
+                        : "%\n% A controller designed here comes back to codyna with its operating point and state\n"
+                          "% order when saved with them:  save('-v7', 'K.mat', 'K', 'codyna_study', 'state_names')\n"
+                          "% (codyna simulate MODEL --controller K.mat then needs no other flag).\n");
   if (v == MatVersion::V73)
     h << "% This is a MAT v7.3 file. Octave cannot read its cell arrays, so each name list\n"
       << "% is also stored as a blank-padded char matrix (state_names_char, ...) and this\n"

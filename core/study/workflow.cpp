@@ -6,6 +6,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <nlohmann/json.hpp>
+
 #include "analysis/discretize.hpp"
 #include "control/controllability.hpp"
 #include "control/lqr.hpp"
@@ -17,6 +19,20 @@
 namespace codyna {
 
 namespace {
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string all;
+  for (const auto& n : names) all += (all.empty() ? "" : ", ") + n;
+  return all;
+}
+
+MatVariables read_mat_file_or_invalid(const std::string& path) {
+  try {
+    return read_mat_file(path);
+  } catch (const std::runtime_error& e) {
+    throw std::invalid_argument(e.what());
+  }
+}
 
 std::string listed(const std::vector<std::string>& names) {
   std::string all;
@@ -56,6 +72,18 @@ Eigen::MatrixXd diagonal(const Model& m, const std::vector<double>& w, int n, co
   return Eigen::Map<const Eigen::VectorXd>(w.data(), n).asDiagonal();
 }
 
+// The study choices that define a plant, as the JSON text exported with it (codyna_study).
+std::string plant_study_json(const StudySpec& s, const std::string& operating_point) {
+  nlohmann::ordered_json j;
+  j["operating_point"] = operating_point;
+  nlohmann::ordered_json set = nlohmann::ordered_json::object();
+  for (const auto& [name, value] : s.set) set[name] = value;
+  j["set"] = set;
+  j["independent"] = s.independent;
+  j["disabled_effects"] = s.disabled_effects;
+  return j.dump();
+}
+
 // An LQR needs every mode that does not decay by itself to be movable by the inputs; say which are not.
 void require_stabilizable(const Model& m, const LinearSystem& sys) {
   std::vector<HiddenMode> bad;
@@ -70,8 +98,41 @@ void require_stabilizable(const Model& m, const LinearSystem& sys) {
 
 }  // namespace
 
+bool adopt_controller_study(ModelSpec& spec, const std::string& file) {
+  StudySpec& s = spec.analysis;
+  if (s.controller != "file" || s.controller_file.empty()) return false;
+  Model where;  // only for study_path's folder
+  where.source_file = file;
+  const std::string path = study_path(where, s.controller_file);
+  MatVariables vars;
+  try {
+    vars = read_mat_file(path);
+  } catch (const std::exception&) {
+    return false;  // reported when the controller is loaded
+  }
+  const auto it = vars.strings.find("codyna_study");
+  if (it == vars.strings.end() || it->second.empty()) return false;
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(it->second.front());
+    const std::string before = s.operating_point;
+    s.operating_point = j.at("operating_point").get<std::string>();
+    s.set.clear();
+    for (const auto& [name, value] : j.at("set").items()) s.set.emplace_back(name, value.get<double>());
+    s.independent = j.at("independent").get<std::vector<std::string>>();
+    s.disabled_effects = j.at("disabled_effects").get<std::vector<std::string>>();
+    spec.notes.push_back(path + ": the controller was designed about the " + s.operating_point +
+                         " point of its export (coordinates set, independent coordinates and effects as there)" +
+                         (before != s.operating_point ? "; using that point instead of " + before : std::string()));
+  } catch (const nlohmann::json::exception& e) {
+    throw std::invalid_argument(path + ": codyna_study is not what codyna exports: " + e.what());
+  }
+  return true;
+}
+
 Model study_model(const ModelSpec& spec_in, const std::string& file) {
   ModelSpec spec = spec_in;
+  adopt_controller_study(spec, file);
   const StudySpec& s = spec.analysis;
   // effects switched off for this study are left out of the compiled model
   for (std::size_t k = 0; k < s.disabled_effects.size(); ++k) {
@@ -185,6 +246,7 @@ StudyLinearization study_linearize(const Model& m) {
   if (!(s.discrete >= 0) || !std::isfinite(s.discrete)) fail(m, "discrete", "expected a sample time >= 0 (0 = continuous)");
   out.op = study_operating_point(m);
   out.lin = linearize(m, out.op, o);
+  out.lin.system.study = plant_study_json(s, s.operating_point);
   out.system = s.discrete > 0 ? discretize_zoh(out.lin.system, s.discrete) : out.lin.system;
   return out;
 }
@@ -230,10 +292,12 @@ StudySimulation study_simulation(const Model& m) {
       throw ModelError(m.source_file, "/plant/inputs", "a controller needs Plant/In actuators");
     auto plant = std::make_shared<LinearPlant>();
     // a model's controller is linearized where it was designed; the others where the study says
-    plant->op = study_operating_point(m, from_model ? m.spec.controller.operating_point : std::string());
+    const std::string point = from_model ? m.spec.controller.operating_point : s.operating_point;
+    plant->op = study_operating_point(m, point);
     LinearizeOptions lo;
     lo.independent = s.independent;
     plant->lin = linearize(m, plant->op, lo);
+    plant->lin.system.study = plant_study_json(s, point);
     out.plant = plant;
   }
   if (from_model) {
@@ -251,7 +315,17 @@ StudySimulation study_simulation(const Model& m) {
   } else if (src == "file") {
     if (s.controller_file.empty()) fail(m, "controller_file", "the controller source is a file, but none is named");
     const LinearSystem& sys = out.plant->lin.system;
-    out.controller = load_controller(study_path(m, s.controller_file), sys.nx(), sys.nu(), sys.ny(), sys.y0, sys.u0);
+    const std::string path = study_path(m, s.controller_file);
+    // a controller saved with the export's lists must fit this plant by name, not only by size
+    const MatVariables vars = read_mat_file_or_invalid(path);
+    for (const auto& [list, names] : {std::pair{"state_names", &sys.state_names}, std::pair{"input_names", &sys.input_names},
+                                      std::pair{"output_names", &sys.output_names}}) {
+      const auto it = vars.strings.find(list);
+      if (it != vars.strings.end() && it->second != *names)
+        throw std::invalid_argument(path + ": the controller was designed for " + list + " (" + joined(it->second) +
+                                    ") but this plant has (" + joined(*names) + "): it belongs to another plant or state order");
+    }
+    out.controller = load_controller(path, sys.nx(), sys.nu(), sys.ny(), sys.y0, sys.u0);
     out.controller_source = s.controller_file;
   } else {
     out.controller_source = "none";

@@ -27,7 +27,16 @@
 namespace codyna {
 
 // `file` is where the spec was read (for messages and relative paths); may be "".
+// A controller file saved with its export's codyna_study brings its operating point along:
+// see adopt_controller_study, which study_model applies first.
 Model study_model(const ModelSpec& spec, const std::string& file = "");
+
+// When the study's controller is a .mat that holds codyna_study (what NAME.m's export
+// puts in the workspace; save it with K), that study's operating point, coordinates set,
+// independent coordinates and disabled effects replace the spec's, and a note says so
+// (spec.notes): the offsets follow the controller without the user repeating flags.
+// Returns true when it did.
+bool adopt_controller_study(ModelSpec& spec, const std::string& file);
 
 // The operating point the study asks for (`which` overrides study.operating_point
 // when not empty). An equilibrium that cannot be found is an error, not a best effort.
