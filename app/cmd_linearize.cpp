@@ -34,6 +34,7 @@ void print_matrix(const char* label, const Eigen::MatrixXd& M, const std::vector
                   const std::vector<std::string>& cols) {
   std::cout << label << " (" << M.rows() << " x " << M.cols() << ")\n";
   if (M.size() == 0) return;
+  const double scale = M.cwiseAbs().maxCoeff();
   std::size_t w = 8;
   for (const auto& r : rows) w = std::max(w, r.size() + 1);
   std::cout << std::setw(static_cast<int>(w)) << "";
@@ -41,7 +42,11 @@ void print_matrix(const char* label, const Eigen::MatrixXd& M, const std::vector
   std::cout << "\n";
   for (Eigen::Index i = 0; i < M.rows(); ++i) {
     std::cout << std::left << std::setw(static_cast<int>(w)) << rows[i] << std::right;
-    for (Eigen::Index j = 0; j < M.cols(); ++j) std::cout << std::setw(14) << std::setprecision(6) << M(i, j);
+    for (Eigen::Index j = 0; j < M.cols(); ++j) {
+      // round-off (an entry 1e-14 of the largest, e.g. 1e-44 beside 7.4) is printed as 0; the export keeps it
+      const double x = std::abs(M(i, j)) <= 1e-14 * scale ? 0.0 : M(i, j);
+      std::cout << std::setw(14) << std::setprecision(6) << x;
+    }
     std::cout << "\n";
   }
 }

@@ -51,8 +51,9 @@ void summary(const SimulationResult& r, const Model& m, const LinearPlant* plant
   for (int k = 0; k < r.y.cols(); ++k) {
     const double y0 = plant ? plant->lin.system.y0[k] : r.y(0, k);
     std::cout << "output " << std::left << std::setw(10) << r.output_names[k] << std::right << " start "
-              << std::setw(11) << r.y(0, k) << "  end " << std::setw(11) << r.y(N - 1, k) << "  (operating point "
-              << y0 << ") [" << r.output_units[k] << "]\n";
+              << std::setw(11) << r.y(0, k) << "  end " << std::setw(11) << r.y(N - 1, k) << "  ("
+              << (plant ? "y0 at the " + plant->op.kind + " point: " : std::string("start: ")) << y0 << ") ["
+              << r.output_units[k] << "]\n";
   }
   for (int k : m.plant_inputs)
     std::cout << "input  " << std::left << std::setw(10) << m.actuators[k].name << std::right << " max |u| "

@@ -95,7 +95,8 @@ std::string format_modes(const ModalAnalysis& m) {
     const Mode& mode = m.modes[k];
     std::snprintf(line, sizeof line, "%-3zu %-28s %-*s%-13.6g %-13.6g %-9.4f ", k + 1,
                   format_complex(mode.eigenvalue).c_str(), s_width, discrete ? format_complex(mode.s).c_str() : "",
-                  mode.natural_frequency, mode.natural_frequency / (2.0 * std::numbers::pi), mode.damping_ratio);
+                  mode.natural_frequency, mode.natural_frequency / (2.0 * std::numbers::pi),
+                  std::abs(mode.damping_ratio) < 5e-5 ? 0.0 : mode.damping_ratio);  // no "-0.0000"
     out += std::string(line) + dominant_states(m, mode.shape) + "\n";
   }
   if (discrete) {
