@@ -58,6 +58,9 @@ void summary(const SimulationResult& r, const Model& m, const LinearPlant* plant
   for (int k : m.plant_inputs)
     std::cout << "input  " << std::left << std::setw(10) << m.actuators[k].name << std::right << " max |u| "
               << r.u.col(k).cwiseAbs().maxCoeff() << " [" << m.actuators[k].unit << "]\n";
+  for (const Saturation& s : saturation_report(m, r))
+    std::cout << "saturation       " << s.actuator << " at its limit from t = " << s.first << " s: " << s.at_max
+              << " s at max, " << s.at_min << " s at min\n";
   const double E0 = r.kinetic_energy[0] + r.potential_energy[0], E1 = r.kinetic_energy[N - 1] + r.potential_energy[N - 1];
   std::cout << "energy           " << E0 << " -> " << E1 << " J\n";
   if (m.nc) {

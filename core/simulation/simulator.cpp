@@ -298,3 +298,32 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
 }
 
 }  // namespace codyna
+
+namespace codyna {
+
+std::vector<Saturation> saturation_report(const Model& model, const SimulationResult& r) {
+  std::vector<Saturation> out;
+  const int N = r.samples();
+  if (N == 0 || r.u.cols() != model.nu()) return out;
+  for (int k = 0; k < model.nu(); ++k) {
+    const ActuatorModel& a = model.actuators[k];
+    if (!std::isfinite(a.max) && !std::isfinite(a.min)) continue;
+    Saturation s;
+    s.actuator = a.name;
+    bool any = false;
+    for (int i = 0; i < N; ++i) {
+      const double dt = i + 1 < N ? r.t[i + 1] - r.t[i] : 0.0;
+      const double u = r.u(i, k);
+      const double tol = 1e-12 * std::max(1.0, std::abs(u));
+      const bool hi = std::isfinite(a.max) && u >= a.max - tol, lo = std::isfinite(a.min) && u <= a.min + tol;
+      if (!hi && !lo) continue;
+      if (!any) s.first = r.t[i];
+      any = true;
+      (hi ? s.at_max : s.at_min) += dt;
+    }
+    if (any) out.push_back(s);
+  }
+  return out;
+}
+
+}  // namespace codyna

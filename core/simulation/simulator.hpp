@@ -53,4 +53,13 @@ struct LinearPlant {
 SimulationResult simulate(const Model& model, const Controller* controller, const LinearPlant* plant,
                           const SimulationOptions& options, const SimulationCallbacks& callbacks = {});
 
+// Actuators that sat at a limit during a run: how long (summed over the output samples
+// at the limit, each counting one output interval) and from when. Empty when none did.
+struct Saturation {
+  std::string actuator;
+  double at_max = 0, at_min = 0;  // seconds
+  double first = 0;               // time of the first sample at a limit
+};
+std::vector<Saturation> saturation_report(const Model& model, const SimulationResult& result);
+
 }  // namespace codyna

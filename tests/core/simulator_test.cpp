@@ -7,6 +7,8 @@
 #include <iostream>
 
 #include "analysis/operating_point.hpp"
+#include "io/model_file.hpp"
+#include "model/compile.hpp"
 #include "test_util.hpp"
 
 namespace codyna {
@@ -301,6 +303,35 @@ TEST(Simulate, ActuatorLimitsSaturateTheCommand) {
   EXPECT_DOUBLE_EQ(r.u(0, 0), 20.0);                 // clamped at the start (unclamped: 38.07)
   EXPECT_LE(r.u.cwiseAbs().maxCoeff(), 20.0 + 1e-12);
   EXPECT_NEAR(r.y(r.samples() - 1, 0), M_PI / 2, 0.5 * deg);
+}
+
+}  // namespace
+}  // namespace codyna
+
+namespace codyna {
+namespace {
+
+// Saturation that binds is reported: which actuator, how long, from when.
+TEST(Simulate, SaturationThatBindsIsReported) {
+  ModelSpec spec = load_model_spec(test::example_path("pendulum.json"));
+  spec.actuators[0].max = 20;
+  spec.actuators[0].min = -20;
+  const Model m = compile(spec);
+  const LinearPlant p = plant_at_equilibrium(m);
+  // a stiff P gain from the 10 degree offset asks for far more than 20 N m at first
+  const auto pd = make_pid(Eigen::MatrixXd::Constant(1, 1, 500), Eigen::MatrixXd(), Eigen::MatrixXd::Constant(1, 1, 100),
+                           p.lin.system.y0, p.lin.system.u0);
+  const SimulationResult r = simulate(m, pd.get(), &p, options("ida", 3.0));
+  ASSERT_TRUE(r.completed) << r.failure;
+  EXPECT_LE(r.u.col(0).maxCoeff(), 20.0 + 1e-12);
+  const auto sat = saturation_report(m, r);
+  ASSERT_EQ(sat.size(), 1u);
+  EXPECT_EQ(sat[0].actuator, "torque");
+  EXPECT_EQ(sat[0].first, 0.0);
+  EXPECT_GT(sat[0].at_max + sat[0].at_min, 0.05);
+  EXPECT_LT(sat[0].at_max + sat[0].at_min, 3.0);
+  // without limits nothing is reported
+  EXPECT_TRUE(saturation_report(test::load_example("pendulum.json"), r).empty());
 }
 
 }  // namespace
