@@ -500,6 +500,9 @@ struct Schema {
   }
 };
 
+// a typed element whose type is a plain word (a reference signal's "step", ...)
+[[maybe_unused]] const char* to_string(const std::string& word) { return word.c_str(); }
+
 template <class S>
 concept Typed = requires(S s) { s.type; };
 
@@ -968,6 +971,54 @@ ojson encode_set(const std::vector<std::pair<std::string, double>>& set) {
 }
 
 template <>
+const Schema<SignalSpec>& schema<SignalSpec>() {
+  using T = SignalSpec;
+  static const Schema<T> s{
+      {
+          field("output", &T::output, read_string, Need::Required),
+          field("type", &T::type, [](const Node& n) { return read_word(n, signal_types(), "signal type"); }, Need::Required),
+          field("time", &T::time, [](const Node& n) {
+            const double x = read_number(n);
+            if (x < 0) n.expected("a time >= 0 (s)");
+            return x;
+          }),
+          field("value", &T::value, read_number),
+          field("slope", &T::slope, read_number),
+          field("amplitude", &T::amplitude, read_number),
+          field("frequency", &T::frequency, [](const Node& n) {
+            const double x = read_number(n);
+            if (x < 0) n.expected("a frequency >= 0 (Hz)");
+            return x;
+          }),
+          field("phase", &T::phase, read_number),
+          field("points", &T::points,
+                [](const Node& n) {
+                  std::vector<std::pair<double, double>> p;
+                  for (const Node& e : read_elements(n)) {
+                    const Eigen::VectorXd v = read_numbers(e, 2);
+                    if (!p.empty() && !(v[0] > p.back().first)) e.expected("times that increase along the table");
+                    p.emplace_back(v[0], v[1]);
+                  }
+                  if (p.empty()) n.expected("at least one [t, r] point");
+                  return p;
+                },
+                [](const std::vector<std::pair<double, double>>& p) {
+                  ojson a = ojson::array();
+                  for (const auto& [t, r] : p) a.push_back(ojson::array({t, r}));
+                  return a;
+                }),
+      },
+      "reference",
+      [](const T& x) -> std::vector<std::string_view> {
+        if (x.type == "step") return {"output", "type", "time", "value"};
+        if (x.type == "ramp") return {"output", "type", "time", "slope"};
+        if (x.type == "sine") return {"output", "type", "time", "amplitude", "frequency", "phase"};
+        return {"output", "type", "points"};
+      }};
+  return s;
+}
+
+template <>
 const Schema<StudySpec>& schema<StudySpec>() {
   using T = StudySpec;
   static const Schema<T> s{{
@@ -990,6 +1041,7 @@ const Schema<StudySpec>& schema<StudySpec>() {
       field("controller_file", &T::controller_file, read_string, encode_optional_text),
       field("q_weights", &T::q_weights, [](const Node& n) { return read_weights(n, false); }),
       field("r_weights", &T::r_weights, [](const Node& n) { return read_weights(n, true); }),
+      list_field("references", &T::references),
       field("compare_linear", &T::compare_linear,
             [](const Node& n) {
               if (!n.value().is_boolean()) n.expected("true or false");

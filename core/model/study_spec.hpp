@@ -6,11 +6,33 @@
 // when it runs (unknown names are errors there, with the field's path).
 #pragma once
 
+#include <cmath>
+#include <numbers>
 #include <string>
 #include <utility>
 #include <vector>
 
 namespace codyna {
+
+// A reference signal r(t) for one Plant/Out output, in the output's unit. Before `time`
+// it is the operating point's y0; after it:
+//   step   value                                  (an absolute value, not an increment)
+//   ramp   y0 + slope (t - time)
+//   sine   y0 + amplitude sin(2 pi frequency (t - time) + phase)
+//   table  piecewise linear through points [[t, r], ...], held beyond the ends
+struct SignalSpec {
+  std::string output;         // Plant/Out name
+  std::string type = "step";  // step | ramp | sine | table
+  double time = 0.0;          // s
+  double value = 0.0;         // step
+  double slope = 0.0;         // ramp, unit/s
+  double amplitude = 0.0, frequency = 0.0, phase = 0.0;  // sine: unit, Hz, rad
+  std::vector<std::pair<double, double>> points;         // table: (t, r), t increasing
+  bool operator==(const SignalSpec&) const = default;
+};
+
+// r(t) of a signal about the base value y0
+double signal_value(const SignalSpec& s, double t, double y0);
 
 struct StudySpec {
   // effects (ModelSpec::effects, by name) switched off for this study: they are
@@ -37,6 +59,9 @@ struct StudySpec {
   std::string controller_file;       // "file": a .mat (K, Kp/Ki/Kd or Ac/Bc/Cc/Dc); relative = to the model file
   std::vector<double> q_weights, r_weights;  // "lqr": diagonals of Q (nx) and R (nu); empty = identity
   bool compare_linear = false;       // also run the linear closed loop beside the nonlinear one
+  // time-varying references on Plant/Out outputs (the others stay at y0); every controller
+  // type follows them: PID acts on r - y, state feedback adds Nbar (r - y0), LTI sees y - r
+  std::vector<SignalSpec> references;
 
   bool operator==(const StudySpec&) const = default;
 };
@@ -46,9 +71,32 @@ inline const std::vector<std::string>& study_methods() {
   static const std::vector<std::string> v{"exact", "fd-forward", "fd-central"};
   return v;
 }
+inline const std::vector<std::string>& signal_types() {
+  static const std::vector<std::string> v{"step", "ramp", "sine", "table"};
+  return v;
+}
 inline const std::vector<std::string>& study_controllers() {
   static const std::vector<std::string> v{"model", "none", "lqr", "file"};
   return v;
+}
+
+inline double signal_value(const SignalSpec& s, double t, double y0) {
+  if (s.type == "table") {
+    const auto& p = s.points;
+    if (p.empty()) return y0;
+    if (t <= p.front().first) return p.front().second;
+    for (std::size_t k = 1; k < p.size(); ++k)
+      if (t <= p[k].first) {
+        const double a = (t - p[k - 1].first) / (p[k].first - p[k - 1].first);
+        return p[k - 1].second + a * (p[k].second - p[k - 1].second);
+      }
+    return p.back().second;
+  }
+  if (t < s.time) return y0;
+  if (s.type == "step") return s.value;
+  if (s.type == "ramp") return y0 + s.slope * (t - s.time);
+  if (s.type == "sine") return y0 + s.amplitude * std::sin(2 * std::numbers::pi * s.frequency * (t - s.time) + s.phase);
+  return y0;
 }
 
 }  // namespace codyna

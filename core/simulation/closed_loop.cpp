@@ -28,6 +28,7 @@ ClosedLoopSystem::ClosedLoopSystem(const Model& model, const Controller* control
 ControllerInput ClosedLoopSystem::measure(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v) const {
   ControllerInput in;
   in.t = t;
+  if (reference_) in.r = reference_(t);
   const auto& out = model_.plant_outputs;
   if (controller_ && controller_->needs_rates()) {
     // outputs and their rates in one pass: q(s) = q (+) s v, derivative at s = 0

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <memory>
 #include <optional>
 
@@ -41,6 +42,8 @@ class ClosedLoopSystem {
   // the Plant/In values held until changed: by a discrete controller at its samples,
   // or from outside when there is no controller (co-simulation, Stepper)
   void set_held(const Eigen::VectorXd& u_plant) { held_ = u_plant; }
+  // r(t) for the Plant/Out outputs, handed to the controller (empty: its own setpoint)
+  void set_reference(std::function<Eigen::VectorXd(double)> r) { reference_ = std::move(r); }
 
   ControllerInput measure(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v) const;
   // every actuator's value at a state (controller output on Plant/In, saturated)
@@ -71,6 +74,7 @@ class ClosedLoopSystem {
   const PlantFunction* plant_;
   Eigen::VectorXd x_ref_, u_nominal_;
   std::optional<Eigen::VectorXd> held_;
+  std::function<Eigen::VectorXd(double)> reference_;
   Baumgarte stab_;
   int continuous_states_ = 0;
   std::vector<int> rows_;  // DAE form: constraint rows carrying multipliers

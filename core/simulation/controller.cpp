@@ -1,5 +1,8 @@
 #include "simulation/controller.hpp"
 
+#include <Eigen/LU>
+#include <Eigen/SVD>
+
 #include <sstream>
 #include <stdexcept>
 
@@ -22,13 +25,15 @@ class Pid final : public Controller {
   int nxc() const override { return Ki_.size() ? static_cast<int>(r_.size()) : 0; }
   bool needs_rates() const override { return Kd_.size() > 0; }
   Eigen::VectorXd output(const ControllerInput& in, const Eigen::VectorXd& xc) const override {
-    Eigen::VectorXd u = u0_ + Kp_ * (r_ - in.y);
+    const Eigen::VectorXd& r = in.r.size() ? in.r : r_;
+    Eigen::VectorXd u = u0_ + Kp_ * (r - in.y);
     if (Ki_.size()) u += Ki_ * xc;
     if (Kd_.size()) u -= Kd_ * in.ydot;
     return u;
   }
   Eigen::VectorXd update(const ControllerInput& in, const Eigen::VectorXd&) const override {
-    return Ki_.size() ? Eigen::VectorXd(r_ - in.y) : Eigen::VectorXd();
+    const Eigen::VectorXd& r = in.r.size() ? in.r : r_;
+    return Ki_.size() ? Eigen::VectorXd(r - in.y) : Eigen::VectorXd();
   }
   std::vector<std::string> state_names() const override {
     std::vector<std::string> n;
@@ -46,14 +51,23 @@ class Pid final : public Controller {
 
 class StateFeedback final : public Controller {
  public:
-  StateFeedback(Eigen::MatrixXd K, Eigen::VectorXd u0) : K_(std::move(K)), u0_(std::move(u0)) {}
+  StateFeedback(Eigen::MatrixXd K, Eigen::VectorXd u0, Eigen::MatrixXd Nbar, Eigen::VectorXd y0)
+      : K_(std::move(K)), u0_(std::move(u0)), Nbar_(std::move(Nbar)), y0_(std::move(y0)) {}
   bool needs_state() const override { return true; }
-  Eigen::VectorXd output(const ControllerInput& in, const Eigen::VectorXd&) const override { return u0_ - K_ * in.x; }
-  std::string describe() const override { return "state feedback u = u0 - K (x - x0)"; }
+  Eigen::VectorXd output(const ControllerInput& in, const Eigen::VectorXd&) const override {
+    if (Nbar_.size() && in.r.size()) return u0_ - K_ * in.x + Nbar_ * (in.r - y0_);
+    return u0_ - K_ * in.x;
+  }
+  std::string describe() const override {
+    return Nbar_.size() ? "state feedback u = u0 - K (x - x0) + Nbar (r - y0)" : "state feedback u = u0 - K (x - x0)";
+  }
+  const Eigen::MatrixXd* gain() const override { return &K_; }
 
  private:
   Eigen::MatrixXd K_;
   Eigen::VectorXd u0_;
+  Eigen::MatrixXd Nbar_;
+  Eigen::VectorXd y0_;
 };
 
 class Lti final : public Controller {
@@ -65,10 +79,10 @@ class Lti final : public Controller {
   int nxc() const override { return static_cast<int>(Ac_.rows()); }
   double sample_time() const override { return Ts_; }
   Eigen::VectorXd output(const ControllerInput& in, const Eigen::VectorXd& xc) const override {
-    return u0_ + Cc_ * xc + Dc_ * (in.y - y0_);
+    return u0_ + Cc_ * xc + Dc_ * (in.y - (in.r.size() ? in.r : y0_));
   }
   Eigen::VectorXd update(const ControllerInput& in, const Eigen::VectorXd& xc) const override {
-    return Ac_ * xc + Bc_ * (in.y - y0_);
+    return Ac_ * xc + Bc_ * (in.y - (in.r.size() ? in.r : y0_));
   }
   std::string describe() const override {
     std::ostringstream os;
@@ -102,9 +116,31 @@ std::unique_ptr<Controller> make_pid(const Eigen::MatrixXd& Kp, const Eigen::Mat
   return std::make_unique<Pid>(Kp, Ki, Kd, r, u0);
 }
 
-std::unique_ptr<Controller> make_state_feedback(const Eigen::MatrixXd& K, const Eigen::VectorXd& u0) {
+std::unique_ptr<Controller> make_state_feedback(const Eigen::MatrixXd& K, const Eigen::VectorXd& u0,
+                                                const Eigen::MatrixXd& Nbar, const Eigen::VectorXd& y0) {
   if (K.rows() != u0.size()) throw std::invalid_argument("state feedback: K has " + std::to_string(K.rows()) + " rows, the plant " + std::to_string(u0.size()) + " inputs");
-  return std::make_unique<StateFeedback>(K, u0);
+  if (Nbar.size() && (Nbar.rows() != u0.size() || Nbar.cols() != y0.size()))
+    throw std::invalid_argument("state feedback: Nbar must be nu x ny");
+  return std::make_unique<StateFeedback>(K, u0, Nbar, y0);
+}
+
+Eigen::MatrixXd reference_gain(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& C,
+                               const Eigen::MatrixXd& K, const std::vector<int>& tracked) {
+  const Eigen::MatrixXd Acl = A - B * K;
+  Eigen::FullPivLU<Eigen::MatrixXd> lu(Acl);
+  if (!lu.isInvertible())
+    throw std::invalid_argument("reference feed-forward: A - B K is singular (the closed loop has a pole at 0)");
+  Eigen::MatrixXd Ct(static_cast<Eigen::Index>(tracked.size()), C.cols());
+  for (std::size_t i = 0; i < tracked.size(); ++i) Ct.row(i) = C.row(tracked[i]);
+  const Eigen::MatrixXd G = -Ct * lu.solve(B);  // dc gain from u to the tracked outputs
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(G, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  if (svd.rank() < static_cast<Eigen::Index>(tracked.size()))
+    throw std::invalid_argument("reference feed-forward: the inputs cannot hold the tracked outputs at independent values "
+                                "(track fewer outputs than there are inputs)");
+  const Eigen::MatrixXd pinv = svd.solve(Eigen::MatrixXd::Identity(G.rows(), G.rows()));
+  Eigen::MatrixXd Nbar = Eigen::MatrixXd::Zero(B.cols(), C.rows());
+  for (std::size_t i = 0; i < tracked.size(); ++i) Nbar.col(tracked[i]) = pinv.col(static_cast<Eigen::Index>(i));
+  return Nbar;
 }
 
 std::unique_ptr<Controller> make_lti(const Eigen::MatrixXd& Ac, const Eigen::MatrixXd& Bc, const Eigen::MatrixXd& Cc,

@@ -27,6 +27,7 @@ struct ControllerInput {
   Eigen::VectorXd y;     // plant outputs [ny]
   Eigen::VectorXd ydot;  // their rates at constant velocity [ny] (exact for position outputs)
   Eigen::VectorXd x;     // plant state deviation x - x0 in minimal coordinates [nx] (state feedback only)
+  Eigen::VectorXd r;     // reference for the outputs at t [ny]; empty: the controller's own (setpoint, or y0)
 };
 
 class Controller {
@@ -44,14 +45,26 @@ class Controller {
   }
   virtual std::vector<std::string> state_names() const;
   virtual std::string describe() const = 0;
+  // state feedback: its gain K (nu x nx); nullptr for other controllers
+  virtual const Eigen::MatrixXd* gain() const { return nullptr; }
 };
 
 // gains are (nu x ny); empty Ki / Kd mean no integral / derivative action; r defaults to y0
 std::unique_ptr<Controller> make_pid(const Eigen::MatrixXd& Kp, const Eigen::MatrixXd& Ki, const Eigen::MatrixXd& Kd,
                                      const Eigen::VectorXd& r, const Eigen::VectorXd& u0);
 
-// K is (nu x nx), same state order as the export; x0/u0 are the operating point's
-std::unique_ptr<Controller> make_state_feedback(const Eigen::MatrixXd& K, const Eigen::VectorXd& u0);
+// K is (nu x nx), same state order as the export; x0/u0 are the operating point's.
+// With a reference r(t) on the outputs, Nbar (nu x ny) feeds it forward:
+//   u = u0 - K (x - x0) + Nbar (r - y0)
+std::unique_ptr<Controller> make_state_feedback(const Eigen::MatrixXd& K, const Eigen::VectorXd& u0,
+                                                const Eigen::MatrixXd& Nbar = {}, const Eigen::VectorXd& y0 = {});
+
+// The feed-forward gain that makes the outputs `tracked` (indices into y) of the linear closed
+// loop dx' = (A - B K) dx + B Nbar dr follow a constant reference with no steady-state error:
+// Nbar(:, tracked) = pinv(-C_t (A - B K)^-1 B), other columns zero. Throws std::invalid_argument
+// when A - B K is singular (the loop is not stable) or the tracked outputs cannot be reached.
+Eigen::MatrixXd reference_gain(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& C,
+                               const Eigen::MatrixXd& K, const std::vector<int>& tracked);
 
 std::unique_ptr<Controller> make_lti(const Eigen::MatrixXd& Ac, const Eigen::MatrixXd& Bc, const Eigen::MatrixXd& Cc,
                                      const Eigen::MatrixXd& Dc, double Ts, const Eigen::VectorXd& y0,

@@ -31,7 +31,9 @@ struct Recorder {
 // the linear closed loop: dx' = xdot0 + A dx + B du, y = y0 + C dx + D du, same controller,
 // integrated by RK4 with 20 substeps per output step (events at controller samples)
 std::vector<Eigen::VectorXd> linear_run(const Model& model, const Controller* ctrl, const LinearPlant& plant,
-                                        const std::vector<double>& times, const Eigen::VectorXd& dx0) {
+                                        const std::vector<double>& times, const Eigen::VectorXd& dx0,
+                                        const std::function<Eigen::VectorXd(double)>& reference) {
+  double now = times.front();  // the time the stages below are evaluated at (for the reference)
   const LinearSystem& s = plant.lin.system;
   const int nx = s.nx(), nz = nx / 2;
   const bool discrete = ctrl && ctrl->sample_time() > 0;
@@ -39,6 +41,8 @@ std::vector<Eigen::VectorXd> linear_run(const Model& model, const Controller* ct
   Eigen::VectorXd held = s.u0, xcd = Eigen::VectorXd::Zero(discrete ? nxc : 0);
   auto measure = [&](const Eigen::VectorXd& dx, const Eigen::VectorXd& du) {
     ControllerInput in;
+    in.t = now;
+    if (reference) in.r = reference(now);
     in.y = s.y0 + s.C * dx + s.D * du;
     Eigen::VectorXd rate = Eigen::VectorXd::Zero(nx);  // constant-velocity rate, as for the nonlinear plant
     rate.head(nz) = dx.tail(nz) + s.xdot0.head(nz);
@@ -84,12 +88,20 @@ std::vector<Eigen::VectorXd> linear_run(const Model& model, const Controller* ct
       const int n = 20;
       const double h = (target - t) / n;
       for (int k = 0; k < n; ++k) {
-        const Eigen::VectorXd k1 = f(z), k2 = f(z + h / 2 * k1), k3 = f(z + h / 2 * k2), k4 = f(z + h * k3);
+        const double tk = t + k * h;
+        now = tk;
+        const Eigen::VectorXd k1 = f(z);
+        now = tk + h / 2;
+        const Eigen::VectorXd k2 = f(z + h / 2 * k1), k3 = f(z + h / 2 * k2);
+        now = tk + h;
+        const Eigen::VectorXd k4 = f(z + h * k3);
         z += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
       }
       t = target;
+      now = t;
       if (discrete && t >= next_sample - 1e-12) sample();
     }
+    now = t;
     record();
   }
   return out;
@@ -145,6 +157,7 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
   }
   const Eigen::VectorXd u_nominal = plant ? plant->op.u : model.u_nominal();
   ClosedLoopSystem sys(model, controller, pf ? &*pf : nullptr, x_ref, u_nominal, o.stabilization);
+  if (o.reference) sys.set_reference(o.reference);
 
   // initial state, on the constraint manifold
   Eigen::VectorXd q0 = o.q0.size() ? o.q0 : model.q0, v0 = o.v0.size() ? o.v0 : model.v0;
@@ -289,7 +302,7 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
 
   if (o.compare_linear && plant && N > 0) {
     const Eigen::VectorXd dx0 = pf->qv_to_state(q0, v0) - x_ref;
-    const auto lin = linear_run(model, controller, *plant, rec.t, dx0);
+    const auto lin = linear_run(model, controller, *plant, rec.t, dx0, o.reference);
     r.y_linear = Recorder::stack(lin, r.y.cols());
   }
   r.stats.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

@@ -29,7 +29,10 @@ struct SimulationOptions {
   Baumgarte stabilization{};           // optional, on the acceleration-level constraints
   bool compare_linear = false;         // also run the linear closed loop (needs a plant)
   double max_samples = 1e7;            // a run recording more output samples is refused before it starts
-  double divergence_bound = 1e8;       // a state entry (q, v, controller) past this, or not finite, ends the run
+  double divergence_bound = 1e8;
+  // r(t) for the Plant/Out outputs (ny values), for every controller type (docs/simulation.md:
+  // PID acts on r - y, state feedback adds Nbar (r - y0), LTI sees y - r); empty: none
+  std::function<Eigen::VectorXd(double)> reference;       // a state entry (q, v, controller) past this, or not finite, ends the run
 };
 
 // What a sample callback gets: copies, safe to hand to another thread.

@@ -96,6 +96,37 @@ void require_stabilizable(const Model& m, const LinearSystem& sys) {
                               " (add an input that acts on them, or hold them with a joint spring or damper)");
 }
 
+// r(t) on the Plant/Out outputs for the run; state feedback gets its Nbar feed-forward
+void attach_references(const Model& m, StudySimulation& out) {
+  const StudySpec& s = m.spec.analysis;
+  if (!out.plant || !out.controller)
+    fail(m, "references", "a reference needs a controller to follow it (the controller source is \"" + s.controller + "\")");
+  const LinearSystem& sys = out.plant->lin.system;
+  std::vector<std::pair<int, SignalSpec>> signals;
+  std::vector<int> tracked;
+  for (std::size_t k = 0; k < s.references.size(); ++k) {
+    const auto it = std::find(sys.output_names.begin(), sys.output_names.end(), s.references[k].output);
+    if (it == sys.output_names.end())
+      fail(m, "references/" + std::to_string(k) + "/output",
+           "\"" + s.references[k].output + "\" is not a Plant/Out output (outputs: " + listed(sys.output_names) + ")");
+    const int i = static_cast<int>(it - sys.output_names.begin());
+    if (std::find(tracked.begin(), tracked.end(), i) != tracked.end())
+      fail(m, "references/" + std::to_string(k) + "/output", "a second reference for \"" + s.references[k].output + "\"");
+    tracked.push_back(i);
+    signals.emplace_back(i, s.references[k]);
+  }
+  const Eigen::VectorXd y0 = sys.y0;
+  out.options.reference = [y0, signals](double t) {
+    Eigen::VectorXd r = y0;
+    for (const auto& [i, sig] : signals) r[i] = signal_value(sig, t, y0[i]);
+    return r;
+  };
+  if (const Eigen::MatrixXd* K = out.controller->gain()) {
+    const Eigen::MatrixXd Nbar = reference_gain(sys.A, sys.B, sys.C, *K, tracked);
+    out.controller = make_state_feedback(*K, sys.u0, Nbar, sys.y0);
+  }
+}
+
 }  // namespace
 
 bool adopt_controller_study(ModelSpec& spec, const std::string& file) {
@@ -330,6 +361,7 @@ StudySimulation study_simulation(const Model& m) {
   } else {
     out.controller_source = "none";
   }
+  if (!s.references.empty()) attach_references(m, out);
   if (out.options.compare_linear && !out.plant) out.options.compare_linear = false;
   return out;
 }

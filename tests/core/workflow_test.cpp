@@ -50,6 +50,15 @@ TEST(Workflow, StudyRoundTripsThroughTheModelFile) {
   s.q_weights = {1, 2, 3, 4};
   s.r_weights = {0.5};
   s.compare_linear = true;
+  SignalSpec ramp, table;
+  ramp.output = "h";
+  ramp.type = "ramp";
+  ramp.time = 1.5;
+  ramp.slope = 0.25;
+  table.output = "theta";
+  table.type = "table";
+  table.points = {{0, 0}, {1, 0.1}, {2.5, -0.05}};
+  s.references = {ramp, table};
   const auto dir = std::filesystem::temp_directory_path() / "codyna_workflow_test";
   std::filesystem::create_directories(dir);
   const std::string path = (dir / "study.json").string();
@@ -240,4 +249,74 @@ TEST(Workflow, TrimAgainstABindingLimitNamesIt) {
     EXPECT_NE(std::string(e.what()).find("torque = 93.7"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("above its max 50"), std::string::npos) << e.what();
   }
+}
+
+// A step reference on the cart position is followed by the nonlinear cart-pendulum, with no
+// steady-state error, under LQR with the Nbar feed-forward and under PID (the same gains as
+// PD on the outputs); the rod ends upright.
+TEST(Workflow, StepReferenceOnTheCartIsFollowedByLqrAndPid) {
+  ModelSpec spec = example_spec("cart_pendulum.json");
+  spec.solver.t_end = 25;
+  spec.analysis.set = {{"rod_pivot", 0.0}};  // start upright at rest: only the step moves it
+  spec.solver.rtol = 1e-10;
+  spec.solver.atol = 1e-12;
+  SignalSpec step;
+  step.output = "h";
+  step.type = "step";
+  step.time = 0.5;
+  step.value = 0.5;
+  spec.analysis.references = {step};
+  spec.analysis.controller = "lqr";
+  spec.analysis.q_weights = {10, 100, 1, 1};
+  spec.analysis.r_weights = {0.01};
+  const Model m = study_model(spec);
+  const StudySimulation lqr_setup = study_simulation(m);
+  EXPECT_NE(lqr_setup.controller->describe().find("Nbar"), std::string::npos);
+  const SimulationResult a = study_simulate(m, lqr_setup);
+  ASSERT_TRUE(a.completed) << a.failure;
+  const int N = a.samples();
+  EXPECT_NEAR(a.y(N - 1, 0), 0.5, 1e-6);  // h
+  EXPECT_NEAR(a.y(N - 1, 1), 0.0, 1e-6);  // theta
+  EXPECT_NEAR(a.y(40, 0), 0.0, 1e-9);     // nothing moves before the step (t = 0.4 s)
+  EXPECT_LT(a.y(100, 0), 0.0);            // the cart first backs off to tip the rod (non-minimum phase)
+  EXPECT_GT(a.y(500, 0), 0.25);           // then goes to the reference
+  // PID with the LQR's gains split over the outputs (h, theta) and their rates
+  const Eigen::MatrixXd K = lqr_setup.lqr_gain;
+  ControllerSpec pid;
+  pid.type = ControllerType::Pid;
+  pid.kp = Eigen::MatrixXd(1, 2);
+  pid.kd = Eigen::MatrixXd(1, 2);
+  pid.kp << K(0, 0), K(0, 1);
+  pid.kd << K(0, 2), K(0, 3);
+  spec.controller = pid;
+  spec.analysis.controller = "model";
+  const Model mp = study_model(spec);
+  const SimulationResult b = study_simulate(mp, study_simulation(mp));
+  ASSERT_TRUE(b.completed) << b.failure;
+  EXPECT_NEAR(b.y(b.samples() - 1, 0), 0.5, 1e-6);
+  EXPECT_NEAR(b.y(b.samples() - 1, 1), 0.0, 1e-6);
+  // a reference on an output the plant does not have is named
+  spec.analysis.references[0].output = "x";
+  expect_model_error_at([&] { study_simulation(study_model(spec)); }, "/analysis/references/0/output", "not a Plant/Out output");
+}
+
+TEST(Workflow, SignalShapes) {
+  SignalSpec s;
+  s.time = 1;
+  s.type = "step";
+  s.value = 2;
+  EXPECT_EQ(signal_value(s, 0.5, 0.3), 0.3);
+  EXPECT_EQ(signal_value(s, 1.0, 0.3), 2.0);
+  s.type = "ramp";
+  s.slope = 0.5;
+  EXPECT_DOUBLE_EQ(signal_value(s, 3.0, 0.3), 1.3);
+  s.type = "sine";
+  s.amplitude = 2;
+  s.frequency = 0.25;
+  EXPECT_NEAR(signal_value(s, 2.0, 0.3), 2.3, 1e-15);
+  s.type = "table";
+  s.points = {{0, 0}, {2, 4}, {3, 4}};
+  EXPECT_EQ(signal_value(s, 1.0, 9), 2.0);
+  EXPECT_EQ(signal_value(s, 5.0, 9), 4.0);
+  EXPECT_EQ(signal_value(s, -1.0, 9), 0.0);
 }
