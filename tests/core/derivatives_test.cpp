@@ -4,6 +4,7 @@
 // line, the analytic one uses world-frame recursions of its own).
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <random>
 
 #include "analysis/linearize.hpp"
@@ -172,6 +173,53 @@ TEST(TreeDerivatives, ForwardDynamicsEffectsSensorsMatchAutodiff) {
       EXPECT_LT(rel_err(td.dy_dv, jac(y, nv, nv)), 1e-12) << "seed " << seed;
     }
   }
+}
+
+}  // namespace
+}  // namespace codyna
+
+namespace codyna {
+namespace {
+
+// linearize()'s exact Jacobian (analytic on trees) against autodiff of the plant function
+void expect_plant_agrees(const Model& m, const OperatingPoint& op, const std::string& label) {
+  const CoordinatePartition part = partition_coordinates(m, op.q);
+  const PlantFunction f(m, op.q, op.u, part);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(f.nx());
+  for (int k = 0; k < f.nz(); ++k) x[f.nz() + k] = op.v[part.independent[k]];
+  Eigen::VectorXd u(f.nu());
+  for (int k = 0; k < f.nu(); ++k) u[k] = op.u[m.plant_inputs[k]];
+  Eigen::MatrixXd J;
+  ASSERT_EQ(f.analytic_jacobian(x, u, J), m.nc == 0) << label;
+  const Eigen::MatrixXd Jad = plant_jacobian_autodiff(f, x, u);
+  const Eigen::MatrixXd Jex = plant_jacobian(f, x, u, JacobianMethod::Exact);
+  EXPECT_LT(rel_err(Jex, Jad), 1e-12) << label;
+  // a second call reuses the workspace and gives the same numbers
+  const Eigen::MatrixXd Jex2 = plant_jacobian(f, x, u, JacobianMethod::Exact);
+  EXPECT_EQ((Jex2 - Jex).cwiseAbs().maxCoeff(), 0.0) << label;
+}
+
+TEST(TreeDerivatives, PlantJacobianMatchesAutodiffOnRandomTrees) {
+  for (unsigned seed : {21u, 22u, 23u}) {
+    const Model m = compile(rich_tree(seed));
+    std::mt19937 rng(seed);
+    OperatingPoint op = initial_point(m);
+    op.q = test::random_q(m, rng);
+    op.v = test::random_v(m, rng, 1.5);  // moving: rotation tangents couple to the velocities
+    op.u = test::random_v(m, rng, 1.0).head(m.nu());
+    expect_plant_agrees(m, op, "rich tree " + std::to_string(seed));
+  }
+}
+
+TEST(TreeDerivatives, PlantJacobianMatchesAutodiffOnEveryExample) {
+  int trees = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(CODYNA_EXAMPLES_DIR)) {
+    if (entry.path().extension() != ".json") continue;
+    const Model m = test::load_example(entry.path().filename().string());
+    trees += m.nc == 0;
+    expect_plant_agrees(m, initial_point(m), entry.path().filename().string());
+  }
+  EXPECT_GE(trees, 2);
 }
 
 }  // namespace
