@@ -1,11 +1,11 @@
 #include "dynamics/derivatives.hpp"
 
 #include <unsupported/Eigen/AutoDiff>
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
 #include "dynamics/crba.hpp"
-#include "dynamics/effects.hpp"
 #include "dynamics/kinematics.hpp"
 
 namespace codyna {
@@ -280,6 +280,10 @@ void TreeDerivatives::add_body_wrench(int body, const Vec6& w, const Eigen::Matr
     const Unit& un = units_[u];
     return S_[un.body].middleCols(un.iv - m_.joints[un.body].idx_v, un.n);
   };
+  for (int pj : path) {
+    const Unit& uj = units_[pj];
+    Q.segment(uj.iv, uj.n).noalias() += S_of(pj).transpose() * w;
+  }
   // the wrench's own joint columns turn with the coordinates above them
   for (std::size_t pi = 0; pi < path.size(); ++pi) {
     const Unit& up = units_[path[pi]];
@@ -320,15 +324,20 @@ void TreeDerivatives::add_body_wrench(int body, const Vec6& w, const Eigen::Matr
 
 void TreeDerivatives::applied_force_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& v,
                                                 const Eigen::VectorXd& u) {
-  Q = applied_forces<double>(m_, d_, q, v, u);
+  // the same forces as applied_forces(), with their derivatives
+  Q.setZero();
   dQ_dq.setZero();
   dQ_dv.setZero();
   dQ_du.setZero();
   for (const JointSpringModel& s : m_.joint_springs) {
+    Q[s.iv] -= s.stiffness * (q[s.iq] - s.rest_position) + s.damping * v[s.iv];
     dQ_dq(s.iv, s.iv) -= s.stiffness;
     dQ_dv(s.iv, s.iv) -= s.damping;
   }
-  for (const JointSpringModel& s : m_.joint_frictions) dQ_dv(s.iv, s.iv) -= s.damping;
+  for (const JointSpringModel& s : m_.joint_frictions) {
+    Q[s.iv] -= s.damping * v[s.iv];
+    dQ_dv(s.iv, s.iv) -= s.damping;
+  }
 
   Vec6 w;
   Eigen::Matrix<double, 6, 24> dw;
@@ -361,6 +370,7 @@ void TreeDerivatives::applied_force_derivatives(const Eigen::VectorXd& q, const 
   for (int k = 0; k < m_.nu(); ++k) {
     const ActuatorModel& act = m_.actuators[k];
     if (act.type == ActuatorType::JointForce) {
+      Q[act.iv] += act.gain * u[k];
       dQ_du(act.iv, k) += act.gain;
       continue;
     }
@@ -476,7 +486,12 @@ void TreeDerivatives::compute(const Eigen::VectorXd& q, const Eigen::VectorXd& v
   rhs_.leftCols(nv) = dQ_dq - dtau_dq;
   rhs_.middleCols(nv, nv) = dQ_dv - dtau_dv;
   rhs_.rightCols(nu) = dQ_du;
-  llt_.solveInPlace(rhs_);
+  // in panels of columns: Eigen's blocked triangular solves then keep their
+  // packing buffers on the stack (a heap allocation above 128 KiB)
+  for (Eigen::Index c0 = 0; c0 < rhs_.cols(); c0 += 48) {
+    auto panel = rhs_.middleCols(c0, std::min<Eigen::Index>(48, rhs_.cols() - c0));
+    llt_.solveInPlace(panel);
+  }
   dqdd_dq = rhs_.leftCols(nv);
   dqdd_dv = rhs_.middleCols(nv, nv);
   dqdd_du = rhs_.rightCols(nu);
