@@ -5,7 +5,6 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "dynamics/crba.hpp"
 #include "dynamics/kinematics.hpp"
 
 namespace codyna {
@@ -132,6 +131,11 @@ TreeDerivatives::TreeDerivatives(const Model& model) : m_(model), d_(model) {
   P_.assign(nu, Mat6::Zero());
   R_.assign(nu, Mat6::Zero());
   below_.assign(nb, 0);
+  Icom_.assign(nb, Mat3::Zero());
+  for (int i = 1; i < nb; ++i) {
+    const Mat3 cx = skew<double>(model.com[i]);
+    Icom_[i] = model.inertia[i].topLeftCorner<3, 3>() - model.mass[i] * cx * cx.transpose();
+  }
   qdd.setZero(nv);
   qdd_zero_.setZero(nv);
   tau.setZero(nv);
@@ -151,62 +155,71 @@ TreeDerivatives::TreeDerivatives(const Model& model) : m_(model), d_(model) {
 }
 
 // positions and velocities: world motion subspaces, inertias and unit velocities
-void TreeDerivatives::world_kinematics(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd* a) {
+void TreeDerivatives::world_kinematics(const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
   forward_kinematics<double>(m_, d_, q, v);
-  const Eigen::VectorXd& acc = a ? *a : qdd_zero_;
-  Vec6 A0 = Vec6::Zero();
-  if (m_.has_gravity) A0.tail<3>() = -m_.gravity;
   for (int i = 1; i < m_.nbodies; ++i) {
     const JointModel& j = m_.joints[i];
     const SE3& g = d_.oMi[i];
     S_[i].resize(6, j.nv);
     for (int c = 0; c < j.nv; ++c) S_[i].col(c) = g.act_motion(Vec6(d_.Sb[i].col(c)));
-    const Mat6 Xinv = g.inverse().motion_matrix();
-    I_[i].noalias() = Xinv.transpose() * m_.inertia[i] * Xinv;
+    // world spatial inertia about the world origin, from mass, com and rotational inertia
+    const double mass = m_.mass[i];
+    const Vec3 cw = g.act_point(m_.com[i]);
+    const Mat3 cx = skew<double>(cw);
+    Mat6& I = I_[i];
+    I.topLeftCorner<3, 3>().noalias() = g.R * Icom_[i] * g.R.transpose();
+    I.topLeftCorner<3, 3>().noalias() += mass * cx * cx.transpose();
+    I.topRightCorner<3, 3>() = mass * cx;
+    I.bottomLeftCorner<3, 3>() = mass * cx.transpose();
+    I.bottomRightCorner<3, 3>() = mass * Mat3::Identity();
     const int p = j.parent;
     Vec6 Vp = p > 0 ? V_[p] : Vec6::Zero();
+    for (int u = unit_begin_[i]; u < unit_end_[i]; ++u) {
+      const Unit& un = units_[u];
+      Vpar_[u] = Vp;
+      Vp.noalias() += S_[i].middleCols(un.iv - j.idx_v, un.n) * v.segment(un.iv, un.n);
+      Vu_[u] = Vp;
+    }
+    V_[i] = Vp;
+  }
+}
+
+// accelerations for joint accelerations a (gravity enters as A_0 = -g)
+void TreeDerivatives::accelerations(const Eigen::VectorXd& v, const Eigen::VectorXd& a) {
+  Vec6 A0 = Vec6::Zero();
+  if (m_.has_gravity) A0.tail<3>() = -m_.gravity;
+  for (int i = 1; i < m_.nbodies; ++i) {
+    const JointModel& j = m_.joints[i];
+    const int p = j.parent;
     Vec6 Ap = p > 0 ? A_[p] : A0;
     for (int u = unit_begin_[i]; u < unit_end_[i]; ++u) {
       const Unit& un = units_[u];
       const auto Su = S_[i].middleCols(un.iv - j.idx_v, un.n);
-      Vpar_[u] = Vp;
       Apar_[u] = Ap;
       const Vec6 vJ = Su * v.segment(un.iv, un.n);
-      Vp += vJ;
-      Ap += Su * acc.segment(un.iv, un.n) + crm(Vp, vJ);
-      Vu_[u] = Vp;
+      Ap.noalias() += Su * a.segment(un.iv, un.n);
+      Ap += crm(Vu_[u], vJ);
     }
-    V_[i] = Vp;
     A_[i] = Ap;
   }
 }
 
-// world RNEA with the accelerations of world_kinematics: composites and tau
-void TreeDerivatives::rnea_pass() {
+// subtree composites of inertia, momentum and Coriolis inertia; the unit rows P, R
+void TreeDerivatives::composites() {
   for (int i = 1; i < m_.nbodies; ++i) {
-    const Vec6 h = I_[i] * V_[i];
     Ic_[i] = I_[i];
-    hc_[i] = h;
-    F_[i] = I_[i] * A_[i] + crf(V_[i], h);
+    hc_[i].noalias() = I_[i] * V_[i];
     Bc_[i] = coriolis_inertia(V_[i], I_[i]);
   }
   for (int i = m_.nbodies - 1; i > 0; --i) {
-    const JointModel& j = m_.joints[i];
-    if (j.nv > 0) tau.segment(j.idx_v, j.nv).noalias() = S_[i].transpose() * F_[i];
-    const int p = j.parent;
+    const int p = m_.parent[i];
     if (p > 0) {
       Ic_[p] += Ic_[i];
       hc_[p] += hc_[i];
-      F_[p] += F_[i];
       Bc_[p] += Bc_[i];
     }
   }
-}
-
-void TreeDerivatives::differentiate_rnea() {
-  const int nb = m_.nbodies;
-  // per unit: P = S^T Ic and R = S^T (Bc + H(hc)) of its body's subtree
-  for (int i = 1; i < nb; ++i) {
+  for (int i = 1; i < m_.nbodies; ++i) {
     if (unit_begin_[i] == unit_end_[i]) continue;
     Mat6 BH = Bc_[i];
     add_momentum_operator(hc_[i], BH);
@@ -218,6 +231,41 @@ void TreeDerivatives::differentiate_rnea() {
       R_[u].topRows(un.n).noalias() = Su.transpose() * BH;
     }
   }
+}
+
+// body forces of the RNEA and their subtree sums; tau = S^T F
+void TreeDerivatives::forces() {
+  for (int i = 1; i < m_.nbodies; ++i) {
+    const Vec6 h = I_[i] * V_[i];
+    F_[i].noalias() = I_[i] * A_[i];
+    F_[i] += crf(V_[i], h);
+  }
+  for (int i = m_.nbodies - 1; i > 0; --i) {
+    const JointModel& j = m_.joints[i];
+    if (j.nv > 0) tau.segment(j.idx_v, j.nv).noalias() = S_[i].transpose() * F_[i];
+    const int p = j.parent;
+    if (p > 0) F_[p] += F_[i];
+  }
+}
+
+// M(i, j) = S_i^T Ic_i S_j for unit j at or above unit i
+void TreeDerivatives::mass_matrix() {
+  for (int i = 1; i < m_.nbodies; ++i) {
+    for (int ui = unit_begin_[i]; ui < unit_end_[i]; ++ui) {
+      const Unit& a = units_[ui];
+      for (int uj : path_[i]) {
+        const Unit& b = units_[uj];
+        const auto Sj = S_[b.body].middleCols(b.iv - m_.joints[b.body].idx_v, b.n);
+        M.block(a.iv, b.iv, a.n, b.n).noalias() = P_[ui].topRows(a.n) * Sj;
+        if (uj != ui) M.block(b.iv, a.iv, b.n, a.n) = M.block(a.iv, b.iv, a.n, b.n).transpose();
+        if (uj == ui) break;
+      }
+    }
+  }
+}
+
+void TreeDerivatives::differentiate_rnea() {
+  const int nb = m_.nbodies;
   dtau_dq.setZero();  // units in other branches do not depend on each other
   dtau_dv.setZero();
   for (int i = 1; i < nb; ++i) {
@@ -265,8 +313,10 @@ void TreeDerivatives::differentiate_rnea() {
 }
 
 void TreeDerivatives::rnea_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& a) {
-  world_kinematics(q, v, &a);
-  rnea_pass();
+  world_kinematics(q, v);
+  accelerations(v, a);
+  composites();
+  forces();
   differentiate_rnea();
 }
 
@@ -469,19 +519,21 @@ void TreeDerivatives::compute(const Eigen::VectorXd& q, const Eigen::VectorXd& v
                               const std::vector<int>& outputs) {
   const int nv = m_.nv, nu = m_.nu();
   // bias forces at qdd = 0, applied forces, mass matrix
-  world_kinematics(q, v, nullptr);
-  rnea_pass();
+  world_kinematics(q, v);
+  accelerations(v, qdd_zero_);
+  composites();
+  forces();
   scratch_ = tau;
   applied_force_derivatives(q, v, u_all);
-  M = crba<double>(m_, d_, q);
+  mass_matrix();
   llt_.compute(M);
   if (llt_.info() != Eigen::Success)
     throw std::runtime_error("the mass matrix is not positive definite at this configuration");
   qdd = Q - scratch_;
   llt_.solveInPlace(qdd);
   // inverse dynamics at the true accelerations, and its derivatives
-  world_kinematics(q, v, &qdd);
-  rnea_pass();
+  accelerations(v, qdd);
+  forces();
   differentiate_rnea();
   rhs_.leftCols(nv) = dQ_dq - dtau_dq;
   rhs_.middleCols(nv, nv) = dQ_dv - dtau_dv;

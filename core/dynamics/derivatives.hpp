@@ -76,8 +76,11 @@ class TreeDerivatives {
     int iv = 0;    // first velocity index
     int n = 0;     // columns
   };
-  void world_kinematics(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd* a);
-  void rnea_pass();
+  void world_kinematics(const Eigen::VectorXd& q, const Eigen::VectorXd& v);  // S, I, V
+  void accelerations(const Eigen::VectorXd& v, const Eigen::VectorXd& a);     // A
+  void composites();                                                           // Ic, hc, Bc, P, R
+  void forces();                                                               // F, tau
+  void mass_matrix();                                                          // M from P and S
   void differentiate_rnea();
   void applied_force_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& u);
   void add_body_wrench(int body, const Vec6T<double>& w, const Eigen::Matrix<double, 6, 24>& dw, int body_a,
@@ -96,6 +99,7 @@ class TreeDerivatives {
   std::vector<Vec6T<double>> V_, A_;             // [nbodies]
   std::vector<Vec6T<double>> Vpar_, Apar_, Vu_;  // [units] velocity/acceleration the unit moves from; after it
   std::vector<Mat6T<double>> I_, Ic_, Bc_;       // [nbodies]
+  std::vector<Eigen::Matrix3d> Icom_;            // [nbodies] rotational inertia about the com, body axes
   std::vector<Vec6T<double>> hc_, F_;            // [nbodies]
   std::vector<Mat6T<double>> P_, R_;             // [units] rows S^T Ic and S^T (Bc + H(hc)), padded to 6
   std::vector<char> below_;                      // [nbodies] scratch: in the subtree of a body
