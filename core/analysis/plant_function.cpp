@@ -4,6 +4,7 @@
 #include <Eigen/QR>
 #include <algorithm>
 #include <set>
+#include <type_traits>
 #include <stdexcept>
 
 #include "dynamics/assembly.hpp"
@@ -124,8 +125,35 @@ Eigen::VectorXd PlantFunction::solve_dependent(const Eigen::VectorXd& z) const {
   return r;
 }
 
+void PlantFunction::eval_tree(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd& xdot,
+                              Eigen::VectorXd& y) const {
+  const Model& m = model_;
+  const int n = nz();
+  if (!ws_.data) ws_.data = std::make_unique<Data>(m);
+  Data& d = *ws_.data;
+  ws_.dq = x.head(n);  // a tree: every coordinate is independent, in order
+  ws_.w = x.tail(n);
+  integrate_into<double>(m, q_ref_, ws_.dq, ws_.q);
+  ws_.u_all = u_all_;
+  for (int k = 0; k < nu(); ++k) ws_.u_all[m.plant_inputs[k]] = u[k];
+  const Eigen::VectorXd& qdd = forward_dynamics<double>(m, d, ws_.q, ws_.w, ws_.u_all);
+  tangent_rate_into<double>(m, ws_.dq, ws_.w, ws_.rate);
+  if (xdot.size() != 2 * n) xdot.resize(2 * n);
+  xdot.head(n) = ws_.rate;
+  xdot.tail(n) = qdd;
+  // forward_dynamics left the kinematics of (q, v) in d
+  if (y.size() != ny()) y.resize(ny());
+  for (int k = 0; k < ny(); ++k) y[k] = sensor_value<double>(m, d, m.sensors[m.plant_outputs[k]], ws_.q, ws_.w);
+}
+
 template <class S>
 void PlantFunction::eval(const VecXT<S>& x, const VecXT<S>& u, VecXT<S>& xdot, VecXT<S>& y) const {
+  if constexpr (std::is_same_v<S, double>) {
+    if (part_.dependent.empty() && model_.nc == 0) {
+      eval_tree(x, u, xdot, y);
+      return;
+    }
+  }
   const Model& m = model_;
   const int n = nz(), nd = static_cast<int>(part_.dependent.size());
   const auto& ind = part_.independent;

@@ -78,12 +78,16 @@ class PlantFunction {
   std::vector<int> rows_;  // constraint rows independent at q_ref
 
   // workspace of analytic_jacobian, made on first use; a copy starts without one
+  // eval<double> on a tree, into the workspace (no heap after the first call)
+  void eval_tree(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd& xdot, Eigen::VectorXd& y) const;
+
   struct Workspace {
     std::unique_ptr<TreeDerivatives> td;
-    Eigen::VectorXd v, u_all;
+    std::unique_ptr<Data> data;
+    Eigen::VectorXd v, u_all, dq, q, w, rate;
     Workspace();
     Workspace(const Workspace&);
-    Workspace& operator=(const Workspace&);
+    Workspace& operator=(const Workspace&);  // the copy makes its own
     ~Workspace();
   };
   mutable Workspace ws_;
