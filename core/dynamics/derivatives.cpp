@@ -92,7 +92,7 @@ void wrench_value(const Vec3A& x, const Vec3A& F, const Vec3A& T, Vec6& w, Eigen
 
 bool TreeDerivatives::supports(const Model& model) { return model.nc == 0; }
 
-TreeDerivatives::TreeDerivatives(const Model& model) : m_(model), d_(model) {
+TreeDerivatives::TreeDerivatives(const Model& model) : m_(model), d_(model), llt_(model.nv) {
   if (model.nc != 0) throw std::invalid_argument("TreeDerivatives: the model has loop closures");
   const int nb = model.nbodies, nv = model.nv;
   unit_begin_.assign(nb, 0);
@@ -151,7 +151,6 @@ TreeDerivatives::TreeDerivatives(const Model& model) : m_(model), d_(model) {
   M.setZero(nv, nv);
   rhs_.setZero(nv, 2 * nv + model.nu());
   scratch_.setZero(nv);
-  llt_ = Eigen::LLT<Eigen::MatrixXd>(nv);
 }
 
 // positions and velocities: world motion subspaces, inertias and unit velocities
