@@ -23,6 +23,7 @@ struct Recorder {
 
   static Eigen::MatrixXd stack(const std::vector<Eigen::VectorXd>& rows, Eigen::Index cols) {
     Eigen::MatrixXd M(static_cast<Eigen::Index>(rows.size()), cols);
+    if (cols == 0) return M;  // no data to take rows of (row() of a null buffer is pointer arithmetic on null)
     for (std::size_t i = 0; i < rows.size(); ++i) M.row(i) = rows[i].transpose();
     return M;
   }
