@@ -17,7 +17,9 @@
 #include <memory>
 #include <string>
 
+#include "analysis/closed_loop_linear.hpp"
 #include "analysis/linearize.hpp"
+#include "analysis/modal.hpp"
 #include "analysis/operating_point.hpp"
 #include "io/mat_export.hpp"
 #include "model/model.hpp"
@@ -71,5 +73,24 @@ struct StudySimulation {
 StudySimulation study_simulation(const Model& model);
 
 SimulationResult study_simulate(const Model& model, const StudySimulation& setup, const SimulationCallbacks& cb = {});
+
+// The linear closed loop of the study's plant and controller (analysis/closed_loop_linear.hpp):
+// the plant and controller study_simulation makes (same operating point, same Nbar), the
+// study's disturbance actuators as extra inputs, the poles, and the step and frequency
+// responses on the grids of study.closed_loop (automatic where 0). A state feedback whose
+// study names no reference gets Nbar for the first min(nu, ny) Plant/Out outputs (a note says so).
+struct StudyClosedLoop {
+  StudySimulation setup;
+  ClosedLoopLinear loop;
+  ModalAnalysis poles;
+  StepResponse step;
+  FrequencyResponse frequency;
+  std::vector<std::string> notes;
+};
+StudyClosedLoop study_closed_loop(const Model& model);
+
+// Writes DIR/NAME_cl.mat + NAME_cl.m (Acl, Bcl, Ccl, Dcl with names; io/mat_export.hpp) and the
+// curves DIR/NAME_cl_step.csv, DIR/NAME_cl_freq.csv; NAME is study_export_name. Returns the paths.
+std::vector<std::string> study_export_closed_loop(const Model& model, const StudyClosedLoop& cl, const std::string& dir = "");
 
 }  // namespace codyna
