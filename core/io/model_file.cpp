@@ -1072,7 +1072,7 @@ const Schema<ClosedLoopSpec>& schema<ClosedLoopSpec>() {
     };
   };
   static const Schema<T> s{{
-      field("enabled", &T::enabled, read_bool),
+      field("enabled", &T::enabled, read_bool, [](bool b) { return ojson(b); }),
       field("step_time", &T::step_time, at_least(0.0, "a time >= 0 (s; 0 = from the slowest pole)")),
       field("step_points", &T::step_points, count(2, 1000000, "an integer from 2 to 1000000")),
       field("frequency_min", &T::frequency_min, at_least(0.0, "a frequency >= 0 (rad/s; 0 = from the poles)")),
@@ -1115,6 +1115,7 @@ const Schema<StudySpec>& schema<StudySpec>() {
       field("controller_file", &T::controller_file, read_string, encode_optional_text),
       field("q_weights", &T::q_weights, [](const Node& n) { return read_weights(n, false); }),
       field("r_weights", &T::r_weights, [](const Node& n) { return read_weights(n, true); }),
+      field("lqr_controllable_part", &T::lqr_controllable_part, read_bool, [](bool b) { return b ? ojson(true) : ojson(); }),
       list_field("references", &T::references),
       field("compare_linear", &T::compare_linear, read_bool, [](bool b) { return b ? ojson(true) : ojson(); }),
       list_field("disturbances", &T::disturbances),

@@ -81,6 +81,10 @@ struct StudySpec {
   std::string controller = "model";  // "model" (the model file's controller, if any), "none", "lqr", "file"
   std::string controller_file;       // "file": a .mat (K, Kp/Ki/Kd or Ac/Bc/Cc/Dc); relative = to the model file
   std::vector<double> q_weights, r_weights;  // "lqr": diagonals of Q (nx) and R (nu); empty = identity
+  // "lqr" on a plant that is not stabilizable: design on the controllable part only
+  // (control/lqr_controllable.hpp); the modes the inputs cannot move are named and stay as
+  // they are. Off by default: without it such a plant is an error that names those modes.
+  bool lqr_controllable_part = false;
   bool compare_linear = false;       // also run the linear closed loop beside the nonlinear one
   // time-varying references on Plant/Out outputs (the others stay at y0); every controller
   // type follows them: PID acts on r - y, state feedback adds Nbar (r - y0), LTI sees y - r

@@ -11,6 +11,7 @@
 #include "analysis/discretize.hpp"
 #include "control/controllability.hpp"
 #include "control/lqr.hpp"
+#include "control/lqr_controllable.hpp"
 #include "dynamics/assembly.hpp"
 #include "io/curves_file.hpp"
 #include "io/output_guard.hpp"
@@ -96,7 +97,9 @@ void require_stabilizable(const Model& m, const LinearSystem& sys) {
   if (bad.empty()) return;
   throw std::invalid_argument((m.source_file.empty() ? std::string() : m.source_file + ": ") +
                               "lqr: the plant is not stabilizable: the Plant/In inputs cannot move " + describe(bad) +
-                              " (add an input that acts on them, or hold them with a joint spring or damper)");
+                              " (add an input that acts on them, or hold them with a joint spring or damper; or design "
+                              "on the controllable part only: \"lqr_controllable_part\": true in the analysis section, "
+                              "codyna simulate --lqr-controllable-part)");
 }
 
 // A signal as the run uses it: a "file" signal read into its points (a table); a file that
@@ -417,11 +420,33 @@ StudySimulation study_simulation(const Model& m) {
     out.controller_source = std::string("the model file's ") + to_string(m.spec.controller.type) + " controller";
   } else if (src == "lqr") {
     const LinearSystem& sys = out.plant->lin.system;
-    require_stabilizable(m, sys);
-    const LqrResult d = lqr(sys.A, sys.B, diagonal(m, s.q_weights, sys.nx(), "q_weights"),
-                            diagonal(m, s.r_weights, sys.nu(), "r_weights"));
-    out.lqr_gain = d.K;
-    out.controller = make_state_feedback(d.K, sys.u0);
+    const Eigen::MatrixXd Q = diagonal(m, s.q_weights, sys.nx(), "q_weights");
+    const Eigen::MatrixXd R = diagonal(m, s.r_weights, sys.nu(), "r_weights");
+    if (s.lqr_controllable_part) {
+      // the modes no input moves are named and left as they are; the rest is designed on
+      out.uncontrollable = uncontrollable_modes(sys.A, sys.B, sys.state_names);
+      const ControllablePartLqr d = lqr_controllable_part(sys.A, sys.B, Q, R);
+      out.lqr_gain = d.lqr.K;
+      out.lqr_poles = d.lqr.closed_loop_poles;
+      if (!out.uncontrollable.empty()) {
+        std::string note = "lqr on the controllable part (" + std::to_string(d.Tc.cols()) + " of " +
+                           std::to_string(sys.nx()) + " states): the Plant/In inputs cannot move " +
+                           describe(out.uncontrollable) + "; these poles stay where they are";
+        const double scale = std::max(1.0, sys.A.norm());
+        for (const HiddenMode& h : out.uncontrollable)
+          if (h.eigenvalue.real() > 1e-9 * scale) {
+            note += " (one of them is unstable: the loop is not stable)";
+            break;
+          }
+        out.notes.push_back(note);
+      }
+    } else {
+      require_stabilizable(m, sys);
+      const LqrResult d = lqr(sys.A, sys.B, Q, R);
+      out.lqr_gain = d.K;
+      out.lqr_poles = d.closed_loop_poles;
+    }
+    out.controller = make_state_feedback(out.lqr_gain, sys.u0);
     out.controller_source = "lqr";
   } else if (src == "file") {
     if (s.controller_file.empty()) fail(m, "controller_file", "the controller source is a file, but none is named");

@@ -21,6 +21,7 @@
 #include "analysis/linearize.hpp"
 #include "analysis/modal.hpp"
 #include "analysis/operating_point.hpp"
+#include "control/controllability.hpp"
 #include "io/mat_export.hpp"
 #include "model/model.hpp"
 #include "simulation/controller.hpp"
@@ -67,6 +68,9 @@ struct StudySimulation {
   SimulationOptions options;
   std::string controller_source;                 // "the model file's pid controller", "lqr", "K.mat", "none"
   Eigen::MatrixXd lqr_gain;                      // the gain designed, when the source is "lqr"
+  Eigen::VectorXcd lqr_poles;                    // eig(A - B lqr_gain), when the source is "lqr"
+  std::vector<HiddenMode> uncontrollable;        // lqr_controllable_part: the modes left as they are
+  std::vector<std::string> notes;                // what a front end should tell the user
 };
 
 // Controller and linear plant of the run (linearizing once if anything needs it).
