@@ -1,0 +1,114 @@
+#!/usr/bin/env bash
+# The exported linear closed loop (codyna linearize --closed-loop) read by GNU Octave:
+# the cart-pendulum with codyna's LQR. Octave designs its own K = lqr(A, B, Q, R) on the
+# exported plant and checks Acl = A - B K, the poles poles_cl = eig(A - B K), and that
+# Octave's step() of ss(Acl, Bcl, Ccl, Dcl) equals the step curves codyna wrote
+# (NAME_cl_step.csv) to 1e-8 of their largest value. A PID loop from a model file is
+# checked against a closed loop Octave builds by hand from the plant and the gains.
+# usage: closed_loop_octave.sh CODYNA SOURCE_DIR WORK_DIR
+set -euo pipefail
+codyna=$1 src=$2 work=$3
+rm -rf "$work" && mkdir -p "$work"
+fail() { echo "FAIL: $*"; exit 1; }
+command -v octave-cli > /dev/null || { echo "octave-cli not installed: closed-loop export check skipped"; exit 0; }
+octave-cli --no-gui --quiet --eval "pkg load control" > /dev/null 2>&1 || { echo "octave control package missing: closed-loop export check skipped"; exit 0; }
+model="$src/examples/cart_pendulum.json"
+
+"$codyna" linearize "$model" --operating-point equilibrium --lqr --q-weights 10,100,1,1 --r-weights 0.01 \
+  --closed-loop --out "$work" > "$work/lin.txt" 2> "$work/lin.err" || { cat "$work/lin.txt" "$work/lin.err"; fail "linearize --closed-loop"; }
+for f in cart_pendulum.mat cart_pendulum.m cart_pendulum_cl.mat cart_pendulum_cl.m cart_pendulum_cl_step.csv cart_pendulum_cl_freq.csv; do
+  [ -s "$work/$f" ] || fail "$f not written"
+done
+grep -q "Nbar tracks h" "$work/lin.err" || { cat "$work/lin.err"; fail "no note on which output Nbar tracks"; }
+
+cat > "$work/check.m" <<'OCT'
+pkg load control
+run(fullfile(work, 'cart_pendulum.m'));      % A B C D of the plant
+run(fullfile(work, 'cart_pendulum_cl.m'));   % Acl ... and sys_cl
+K = lqr(A, B, diag([10 100 1 1]), 0.01);
+e_A = norm(Acl - (A - B * K), 'fro') / norm(A - B * K, 'fro');
+p = eig(A - B * K);
+pc = complex(poles_cl(:, 1), poles_cl(:, 2));
+[~, i1] = sort(real(p) + 1e-3 * imag(p)); [~, i2] = sort(real(pc) + 1e-3 * imag(pc));
+e_p = max(abs(p(i1) - pc(i2))) / max(abs(p));
+assert(isequal(input_names_cl(:)', {'r_h', 'r_theta'}), 'input names');
+assert(isequal(output_names_cl(:)', {'h', 'theta', 'u_force'}), 'output names');
+% Octave's step on codyna's time grid, against codyna's curves (inputs outer, outputs inner)
+y = step(sys_cl, t_step);                       % nt x ny x nu
+csv = dlmread(fullfile(work, 'cart_pendulum_cl_step.csv'), ',', 1, 0);
+assert(max(abs(csv(:, 1) - t_step)) < 1e-12, 'time grid');
+ny = size(Ccl, 1); nu = size(Bcl, 2);
+e_s = 0;
+for j = 1:nu
+  for i = 1:ny
+    e_s = max(e_s, max(abs(csv(:, 1 + (j - 1) * ny + i) - y(:, i, j))));
+  end
+end
+e_s = e_s / max(abs(y(:)));
+% the reference gain: unit DC gain from r_h to h (Nbar), none to theta
+dc = Dcl - Ccl * (Acl \ Bcl);
+printf('CL_NUMBERS e_A=%.3g e_poles=%.3g e_step=%.3g dc_h=%.15g dc_theta=%.3g\n', e_A, e_p, e_s, dc(1, 1), dc(2, 1));
+assert(e_A < 1e-8, 'Acl vs A - B K');
+assert(e_p < 1e-8, 'poles vs eig(A - B K)');
+assert(e_s < 1e-8, 'step response vs Octave step');
+assert(abs(dc(1, 1) - 1) < 1e-9 && abs(dc(2, 1)) < 1e-9, 'DC gain');
+printf('CODYNA_CL_OK\n');
+OCT
+(cd "$work" && octave-cli --no-gui --quiet --eval "work='$work'; source('$work/check.m');" > "$work/octave.txt" 2>&1) \
+  || { cat "$work/octave.txt"; fail "octave check of the LQR closed loop failed"; }
+grep -q CODYNA_CL_OK "$work/octave.txt" || { cat "$work/octave.txt"; fail "octave did not finish"; }
+grep CL_NUMBERS "$work/octave.txt"
+
+# a PID loop on a spring-mass, from the model file: Octave closes the loop by hand
+# (x = [pos; vel; xi], u = kp (r - y) + ki xi - kd y', xi' = r - y; poles -1, -2, -3) and
+# compares the matrices, the poles and Octave's step with codyna's curves
+mkdir -p "$work/pid"
+cat > "$work/pid/slider.json" <<'JSON'
+{"codyna_model": 1, "name": "slider",
+ "bodies": [{"name": "block", "mass": 2, "inertia": [0.1, 0.1, 0.1]}],
+ "joints": [{"name": "x", "type": "prismatic", "parent": "ground", "child": "block", "axis": [1, 0, 0]}],
+ "effects": [{"name": "spring", "type": "joint_spring_damper", "joint": "x", "stiffness": 3, "damping": 0.5}],
+ "actuators": [{"name": "force", "type": "joint_force", "joint": "x", "unit": "N"}],
+ "sensors": [{"name": "pos", "type": "joint_position", "joint": "x", "unit": "m"}],
+ "plant": {"inputs": ["force"], "outputs": ["pos"]},
+ "controller": {"type": "pid", "kp": [[19]], "ki": [[12]], "kd": [[11.5]], "operating_point": "initial"},
+ "analysis": {"operating_point": "initial", "closed_loop": {"enabled": true, "step_time": 10, "step_points": 201}}}
+JSON
+"$codyna" linearize "$work/pid/slider.json" --out "$work/pid" > "$work/pid/lin.txt" 2>&1 || { cat "$work/pid/lin.txt"; fail "linearize of the PI loop"; }
+cat > "$work/pid/check.m" <<'OCT'
+pkg load control
+run(fullfile(work, 'slider.m'));
+run(fullfile(work, 'slider_cl.m'));
+kp = 19; ki = 12; kd = 11.5;
+assert(isequal(C, [1 0]), 'C');
+Cv = [0 1];   % the output's rate: the velocity state
+Ah = [A - B * (kp * C + kd * Cv), B * ki; -C, 0];
+Bh = [B * kp; 1];
+Ch = [C, 0; -(kp * C + kd * Cv), ki];
+Dh = [0; kp];
+assert(max(abs(sort(eig(Ah)) - [-3; -2; -1])) < 1e-12, 'PID poles -1, -2, -3');
+e_A = norm(Acl - Ah, 'fro') / norm(Ah, 'fro');
+y = step(ss(Ah, Bh, Ch, Dh), t_step);
+csv = dlmread(fullfile(work, 'slider_cl_step.csv'), ',', 1, 0);
+e_s = max(max(abs(csv(:, 2:3) - y))) / max(abs(y(:)));
+p = sort(real(eig(Ah))); pc = sort(poles_cl(:, 1));
+assert(max(abs(poles_cl(:, 2))) == 0, 'real poles');
+e_p = max(abs(p - pc)) / max(abs(p));
+printf('PI_NUMBERS e_A=%.3g e_poles=%.3g e_step=%.3g\n', e_A, e_p, e_s);
+assert(e_A < 1e-12 && e_p < 1e-10 && e_s < 1e-8, 'PI loop');
+printf('CODYNA_PI_OK\n');
+OCT
+(cd "$work/pid" && octave-cli --no-gui --quiet --eval "work='$work/pid'; source('$work/pid/check.m');" > "$work/pid/octave.txt" 2>&1) \
+  || { cat "$work/pid/octave.txt"; fail "octave check of the PI loop failed"; }
+grep -q CODYNA_PI_OK "$work/pid/octave.txt" || { cat "$work/pid/octave.txt"; fail "octave did not finish the PI check"; }
+grep PI_NUMBERS "$work/pid/octave.txt"
+
+# --closed-loop without a controller is an error (exit code 1) naming the field
+grep -v '"controller"' "$work/pid/slider.json" > "$work/pid/bare.json"
+set +e
+"$codyna" linearize "$work/pid/bare.json" --closed-loop --out "$work/none" > "$work/none.txt" 2>&1
+rc=$?
+set -e
+[ $rc -eq 1 ] || { cat "$work/none.txt"; fail "closed loop without a controller: exit code $rc, expected 1"; }
+grep -q "/analysis/controller: the closed loop needs a controller" "$work/none.txt" || { cat "$work/none.txt"; fail "no clear message without a controller"; }
+echo "closed-loop export: OK"
