@@ -88,11 +88,22 @@ std::string plant_study_json(const StudySpec& s, const std::string& operating_po
   return j.dump();
 }
 
+// The modes the inputs cannot move; an eigenvalue within round-off of 0 is reported as 0 (a
+// double pole at 0, the free yaw of a spherical pendulum, comes out of the eigen decomposition
+// split by about sqrt(eps ||A||))
+std::vector<HiddenMode> uncontrollable(const LinearSystem& sys) {
+  std::vector<HiddenMode> modes = uncontrollable_modes(sys.A, sys.B, sys.state_names);
+  const double tiny = 1.5e-8 * std::max(1.0, sys.A.norm());
+  for (HiddenMode& h : modes)
+    if (std::abs(h.eigenvalue) < tiny) h.eigenvalue = 0.0;
+  return modes;
+}
+
 // An LQR needs every mode that does not decay by itself to be movable by the inputs; say which are not.
 void require_stabilizable(const Model& m, const LinearSystem& sys) {
   std::vector<HiddenMode> bad;
   const double scale = std::max(1.0, sys.A.norm());
-  for (const HiddenMode& h : uncontrollable_modes(sys.A, sys.B, sys.state_names))
+  for (const HiddenMode& h : uncontrollable(sys))
     if (h.eigenvalue.real() >= -1e-9 * scale) bad.push_back(h);
   if (bad.empty()) return;
   throw std::invalid_argument((m.source_file.empty() ? std::string() : m.source_file + ": ") +
@@ -424,7 +435,7 @@ StudySimulation study_simulation(const Model& m) {
     const Eigen::MatrixXd R = diagonal(m, s.r_weights, sys.nu(), "r_weights");
     if (s.lqr_controllable_part) {
       // the modes no input moves are named and left as they are; the rest is designed on
-      out.uncontrollable = uncontrollable_modes(sys.A, sys.B, sys.state_names);
+      out.uncontrollable = uncontrollable(sys);
       const ControllablePartLqr d = lqr_controllable_part(sys.A, sys.B, Q, R);
       out.lqr_gain = d.lqr.K;
       out.lqr_poles = d.lqr.closed_loop_poles;

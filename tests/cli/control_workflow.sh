@@ -116,17 +116,30 @@ PY
 
 # ---- LQR on the controllable part of a spherical pendulum
 sp="$src/tests/data/spherical_pendulum.json"
-expect_error 1 "not stabilizable: the Plant/In inputs cannot move lambda = " \
+expect_error 1 "not stabilizable: the Plant/In inputs cannot move lambda = 0 (ball.wz); lambda = 0 (ball.wz)" \
   "$codyna" simulate "$sp" --lqr --quiet --out "$work/sp.h5"
 grep -qF -- "--lqr-controllable-part" "$work/out.txt" || fail "the refusal does not say how to design on the controllable part"
 grep -qF "(ball.wz)" "$work/out.txt" || { cat "$work/out.txt"; fail "the refusal does not name the yaw rate ball.wz"; }
 "$codyna" simulate "$sp" --lqr --lqr-controllable-part --quiet --out "$work/sp.h5" > "$work/sp.txt" 2> "$work/sp.err" \
   || { cat "$work/sp.txt" "$work/sp.err"; fail "simulate --lqr --lqr-controllable-part"; }
-grep -q "codyna: note: lqr on the controllable part (4 of 6 states): the Plant/In inputs cannot move lambda = " "$work/sp.err" \
+grep -qF "codyna: note: lqr on the controllable part (4 of 6 states): the Plant/In inputs cannot move lambda = 0 (ball.wz); lambda = 0 (ball.wz); these poles stay where they are" "$work/sp.err" \
   || { cat "$work/sp.err"; fail "no note on the controllable part"; }
 grep -qF "(ball.wz)" "$work/sp.err" || { cat "$work/sp.err"; fail "no note naming the yaw rate ball.wz"; }
 x_end=$(end_of "$work/sp.txt" tip_x) y_end=$(end_of "$work/sp.txt" tip_y)
 "$PY" -c "x=float('$x_end'); y=float('$y_end'); assert abs(x) < 1e-4 and abs(y) < 1e-4, (x, y); print(f'SPHERICAL_OK tip at the end ({x:.2g}, {y:.2g}) m')" \
   || { cat "$work/sp.txt"; fail "the tilt is not stabilized"; }
+# the same design as a linear closed loop: four tilt poles moved, the yaw's two left at 0
+"$codyna" linearize "$sp" --lqr --lqr-controllable-part --closed-loop --out "$work/sp_cl" > "$work/sp_cl.txt" 2> "$work/sp_cl.err" \
+  || { cat "$work/sp_cl.txt" "$work/sp_cl.err"; fail "linearize --lqr --lqr-controllable-part --closed-loop"; }
+[ -s "$work/sp_cl/spherical_pendulum_cl.mat" ] || fail "spherical_pendulum_cl.mat not written"
+grep -qF "lqr on the controllable part (4 of 6 states)" "$work/sp_cl.err" || { cat "$work/sp_cl.err"; fail "no note from linearize"; }
+"$PY" - "$work/sp_cl.txt" <<'PY'
+import re, sys
+text = open(sys.argv[1]).read().split("closed loop ", 1)[1]
+re_parts = [float(m.group(1)) for m in re.finditer(r"^\d+\s+(\S+) [+-] \S+j", text, re.M)]
+assert len(re_parts) == 6, re_parts
+assert sum(abs(x) < 1e-8 for x in re_parts) == 2 and sum(x < -0.5 for x in re_parts) == 4, re_parts
+print("SPHERICAL_CL_OK real parts", re_parts)
+PY
 expect_error 1 "--lqr-controllable-part: goes with --lqr" "$codyna" simulate "$sp" --lqr-controllable-part --quiet --out "$work/sp2.h5"
 echo "control workflow: OK"

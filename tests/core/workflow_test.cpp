@@ -222,6 +222,17 @@ TEST(Workflow, LqrOnAnUnstabilizablePlantNamesTheModes) {
     EXPECT_NE(what.find("pivot2"), std::string::npos) << what;
     EXPECT_EQ(what.find("(pivot,"), std::string::npos) << what;  // the driven pendulum is not blamed
   }
+  // designed on the controllable part anyway: the note says that what is left is unstable
+  spec.analysis.lqr_controllable_part = true;
+  const StudySimulation s = study_simulation(study_model(spec));
+  ASSERT_EQ(s.notes.size(), 1u);
+  std::printf("%s\n", s.notes[0].c_str());
+  EXPECT_NE(s.notes[0].find("lqr on the controllable part (2 of 4 states)"), std::string::npos) << s.notes[0];
+  EXPECT_NE(s.notes[0].find("(pivot2"), std::string::npos) << s.notes[0];
+  EXPECT_NE(s.notes[0].find("(one of them is unstable: the loop is not stable)"), std::string::npos) << s.notes[0];
+  bool unstable = false;
+  for (const HiddenMode& h : s.uncontrollable) unstable = unstable || h.eigenvalue.real() > 0;
+  EXPECT_TRUE(unstable);
 }
 
 // Coordinates the user sets are held exactly while the loops close (the four-bar's crank,
@@ -358,7 +369,8 @@ TEST(Workflow, LqrOnTheControllablePartOfASphericalPendulum) {
     FAIL() << "an LQR was designed for a plant that is not stabilizable";
   } catch (const std::invalid_argument& e) {
     const std::string what = e.what();
-    EXPECT_NE(what.find("not stabilizable: the Plant/In inputs cannot move lambda = "), std::string::npos) << what;
+    EXPECT_NE(what.find("not stabilizable: the Plant/In inputs cannot move lambda = 0 (ball.wz); lambda = 0 (ball.wz) ("),
+              std::string::npos) << what;
     EXPECT_NE(what.find("(ball.wz)"), std::string::npos) << what;  // the yaw rate, by name
     for (const char* tilt : {"ball.rx", "ball.ry", "ball.wx", "ball.wy"}) EXPECT_EQ(what.find(tilt), std::string::npos) << what;
     EXPECT_NE(what.find("\"lqr_controllable_part\": true"), std::string::npos) << what;
@@ -370,12 +382,13 @@ TEST(Workflow, LqrOnTheControllablePartOfASphericalPendulum) {
   ASSERT_EQ(sys.nx(), 6);
   ASSERT_FALSE(setup.uncontrollable.empty());
   for (const HiddenMode& h : setup.uncontrollable) {
-    // a double eigenvalue at 0 (yaw angle and rate), split to +-1.5e-9 by round-off
-    EXPECT_LT(std::abs(h.eigenvalue), 1e-8);
+    // a double eigenvalue at 0 (yaw angle and rate), split to +-1.5e-9 by round-off: said as 0
+    EXPECT_EQ(h.eigenvalue, 0.0);
     EXPECT_EQ(h.states, std::vector<std::string>{"ball.wz"});
   }
   ASSERT_EQ(setup.notes.size(), 1u);
-  EXPECT_NE(setup.notes[0].find("lqr on the controllable part (4 of 6 states)"), std::string::npos) << setup.notes[0];
+  EXPECT_EQ(setup.notes[0], "lqr on the controllable part (4 of 6 states): the Plant/In inputs cannot move lambda = 0 "
+                            "(ball.wz); lambda = 0 (ball.wz); these poles stay where they are");
   std::printf("%s\n", setup.notes[0].c_str());
   // the closed loop: four stable tilt poles, the yaw's two at 0; the design's poles are eig(A - B K)
   const Eigen::VectorXcd p = Eigen::MatrixXd(sys.A - sys.B * setup.lqr_gain).eigenvalues();
