@@ -549,3 +549,34 @@ TEST(ClosedLoopLinear, PidRejectsAConstantDisturbance) {
   EXPECT_NEAR(r.u(N - 1, iforce), -d, 1e-4);
   EXPECT_NEAR(r.xc(N - 1, 0), -d / kKi, 1e-5);
 }
+
+// The automatic grids: the step responses last 8 / (the slowest decay rate) within [1, 1000] s
+// (10 s when nothing decays); the frequencies run from a decade below the slowest pole's
+// frequency to a decade above the fastest, out to whole decades, capped at pi / Ts when discrete
+TEST(ClosedLoopLinear, DefaultGrids) {
+  auto poles = [](std::vector<double> p, double Ts = 0) {
+    ModalAnalysis a;
+    a.Ts = Ts;
+    for (double x : p) {
+      Mode md;
+      md.eigenvalue = md.s = x;
+      md.natural_frequency = std::abs(x);
+      a.modes.push_back(md);
+    }
+    return a;
+  };
+  EXPECT_DOUBLE_EQ(default_step_time(poles({-0.5, -20})), 16.0);
+  EXPECT_DOUBLE_EQ(default_step_time(poles({-100})), 1.0);
+  EXPECT_DOUBLE_EQ(default_step_time(poles({-0.001})), 1000.0);
+  EXPECT_DOUBLE_EQ(default_step_time(poles({0.0, 2.0})), 10.0);
+  EXPECT_EQ(default_frequency_range(poles({-0.5, -20}), 0), std::make_pair(0.01, 1000.0));
+  EXPECT_EQ(default_frequency_range(poles({0.0}), 0), std::make_pair(0.01, 100.0));
+  const auto [lo, hi] = default_frequency_range(poles({-0.5, -20}), 0.01);
+  EXPECT_EQ(lo, 0.01);
+  EXPECT_DOUBLE_EQ(hi, std::numbers::pi / 0.01);
+  const std::vector<double> w = log_grid(0.1, 1000, 5);
+  ASSERT_EQ(w.size(), 5u);
+  for (int k = 0; k < 5; ++k) EXPECT_NEAR(w[k], std::pow(10.0, k - 1), 1e-12 * w[k]);
+  EXPECT_THROW(log_grid(0, 1, 5), std::invalid_argument);
+  EXPECT_THROW(step_response(LinearSystem{}, -1, 5), std::invalid_argument);
+}
