@@ -183,6 +183,12 @@ void run(const LinearizeArgs& a) {
     const std::filesystem::path base = std::filesystem::path(a.out) / name;
     guard_output(base.string() + ".mat", OutputKind::PlantMat, {a.model});
     guard_output(base.string() + ".m", OutputKind::PlantScript, {a.model});
+    if (m.spec.analysis.closed_loop.enabled) {
+      guard_output(base.string() + "_cl.mat", OutputKind::PlantMat, {a.model});
+      guard_output(base.string() + "_cl.m", OutputKind::PlantScript, {a.model});
+      guard_output(base.string() + "_cl_step.csv", OutputKind::CurvesCsv, {a.model});
+      guard_output(base.string() + "_cl_freq.csv", OutputKind::CurvesCsv, {a.model});
+    }
   }
   const StudyLinearization sl = study_linearize(m);
   const OperatingPoint& op = sl.op;

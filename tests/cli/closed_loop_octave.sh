@@ -45,12 +45,32 @@ for j = 1:nu
   end
 end
 e_s = e_s / max(abs(y(:)));
+% the frequency curves against H(jw) = Ccl (jw I - Acl)^-1 Bcl + Dcl evaluated here
+fr = dlmread(fullfile(work, 'cart_pendulum_cl_freq.csv'), ',', 1, 0);
+assert(max(abs(fr(:, 1) - w_freq)) < 1e-12 * max(w_freq), 'frequency grid');
+e_m = 0; e_ph = 0;
+for k = 1:numel(w_freq)
+  H = Ccl * ((1i * w_freq(k) * eye(size(Acl)) - Acl) \ Bcl) + Dcl;
+  for j = 1:nu
+    for i = 1:ny
+      c = 2 + 2 * ((j - 1) * ny + (i - 1));
+      if abs(H(i, j)) == 0, continue; end
+      e_m = max(e_m, abs(fr(k, c) - abs(H(i, j))) / abs(H(i, j)));
+      d = fr(k, c + 1) - angle(H(i, j)) * 180 / pi;
+      e_ph = max(e_ph, abs(d - 360 * round(d / 360)));   % the CSV's phase is unwrapped
+    end
+  end
+end
+% the offsets: the plant's operating point, the references' base y0, the efforts' u0
+assert(isequal(x0_cl, x0) && isequal(u0_cl, y0) && isequal(y0_cl, [y0; u0]), 'offsets');
+assert(isequal(state_names_cl(:)', state_names(:)'), 'state names');
 % the reference gain: unit DC gain from r_h to h (Nbar), none to theta
 dc = Dcl - Ccl * (Acl \ Bcl);
-printf('CL_NUMBERS e_A=%.3g e_poles=%.3g e_step=%.3g dc_h=%.15g dc_theta=%.3g\n', e_A, e_p, e_s, dc(1, 1), dc(2, 1));
+printf('CL_NUMBERS e_A=%.3g e_poles=%.3g e_step=%.3g e_mag=%.3g e_phase_deg=%.3g dc_h=%.15g dc_theta=%.3g\n', e_A, e_p, e_s, e_m, e_ph, dc(1, 1), dc(2, 1));
 assert(e_A < 1e-8, 'Acl vs A - B K');
 assert(e_p < 1e-8, 'poles vs eig(A - B K)');
 assert(e_s < 1e-8, 'step response vs Octave step');
+assert(e_m < 1e-10 && e_ph < 1e-8, 'frequency response vs H(jw)');
 assert(abs(dc(1, 1) - 1) < 1e-9 && abs(dc(2, 1)) < 1e-9, 'DC gain');
 printf('CODYNA_CL_OK\n');
 OCT
@@ -58,6 +78,20 @@ OCT
   || { cat "$work/octave.txt"; fail "octave check of the LQR closed loop failed"; }
 grep -q CODYNA_CL_OK "$work/octave.txt" || { cat "$work/octave.txt"; fail "octave did not finish"; }
 grep CL_NUMBERS "$work/octave.txt"
+
+# a second export replaces codyna's own files; a file codyna did not write is never replaced
+"$codyna" linearize "$model" --operating-point equilibrium --lqr --closed-loop --out "$work" > /dev/null 2>&1 || fail "second export"
+echo "my notes" > "$work/cart_pendulum_cl_freq.csv"
+rm "$work/cart_pendulum.mat"   # refused before any work: the plant is not written either
+set +e
+"$codyna" linearize "$model" --operating-point equilibrium --lqr --closed-loop --out "$work" > "$work/guard.txt" 2>&1
+rc=$?
+set -e
+[ $rc -ne 0 ] || fail "a foreign cart_pendulum_cl_freq.csv was replaced"
+grep -q "cart_pendulum_cl_freq.csv" "$work/guard.txt" || { cat "$work/guard.txt"; fail "the refusal does not name the file"; }
+[ "$(cat "$work/cart_pendulum_cl_freq.csv")" = "my notes" ] || fail "the foreign file was changed"
+[ ! -e "$work/cart_pendulum.mat" ] || fail "the plant was exported before the refusal"
+echo "guard: exit $rc, $(head -c 200 "$work/guard.txt")"
 
 # a PID loop on a spring-mass, from the model file: Octave closes the loop by hand
 # (x = [pos; vel; xi], u = kp (r - y) + ki xi - kd y', xi' = r - y; poles -1, -2, -3) and
