@@ -9,6 +9,7 @@
 
 #include <Eigen/LU>
 #include <unsupported/Eigen/MatrixFunctions>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -37,9 +38,11 @@ std::string write_text(const std::string& name, const std::string& text) {
 }
 
 // named double matrices in a MAT v5 file, written by matio directly
-std::string write_mat(const std::string& name, const std::vector<std::pair<std::string, Eigen::MatrixXd>>& vars) {
+std::string write_mat(const std::string& name, const std::vector<std::pair<std::string, Eigen::MatrixXd>>& vars,
+                      mat_ft version = MAT_FT_MAT5) {
   const std::string path = temp_dir() + "/" + name;
-  std::unique_ptr<mat_t, int (*)(mat_t*)> f(Mat_CreateVer(path.c_str(), nullptr, MAT_FT_MAT5), Mat_Close);
+  std::filesystem::remove(path);
+  std::unique_ptr<mat_t, int (*)(mat_t*)> f(Mat_CreateVer(path.c_str(), nullptr, version), Mat_Close);
   EXPECT_TRUE(f);
   for (const auto& [n, M] : vars) {
     size_t dims[2] = {static_cast<size_t>(M.rows()), static_cast<size_t>(M.cols())};
@@ -72,6 +75,8 @@ TEST(SignalFile, CsvAndMatGiveTheSamePoints) {
   v << 0, 0, 0.2, 0.1;
   const std::string mat = write_mat("ref.mat", {{"t", t}, {"value", v}});
   EXPECT_EQ(read_signal_file(mat), kPoints);
+  const std::string mat73 = write_mat("ref73.mat", {{"t", t}, {"value", v}}, MAT_FT_MAT73);
+  EXPECT_EQ(read_signal_file(mat73), kPoints);
 }
 
 // piecewise linear through the points, held beyond the ends
@@ -113,6 +118,9 @@ TEST(SignalFile, BadFilesNameTheFileColumnAndWhatWasExpected) {
   Eigen::MatrixXd tb = t;
   tb(2) = 0.5;
   expect(write_mat("back.mat", {{"t", tb}, {"value", v}}), "variable t, row 3: the time 0.5 is not after the previous one (1)");
+  Eigen::MatrixXd vn = v;
+  vn(1) = std::nan("");
+  expect(write_mat("nan.mat", {{"t", t}, {"value", vn}}), "variable value, row 2: not a finite number");
   expect(write_text("garbage.mat", "not a mat file"), "");
 }
 
