@@ -25,7 +25,7 @@ namespace codyna::cli {
 namespace {
 
 struct LinearizeArgs {
-  std::string model, out, op = "equilibrium", method = "exact", mat_version = "5", name;
+  std::string model, out, op = "equilibrium", method = "exact", mat_version = "5", name, controller;
   double discrete = 0.0, trajectory = 0.0, trajectory_step = 0.0;
   bool closed_loop = false, lqr = false, lqr_controllable_part = false;
   std::vector<double> q_weights, r_weights;
@@ -153,7 +153,14 @@ ModelSpec study_of(const LinearizeArgs& a) {
   }
   if (given(a.cmd, "--method")) method_of(a.method);  // a clear message for a bad flag
   if (a.closed_loop) s.closed_loop.enabled = true;
+  if (a.lqr && !a.controller.empty()) throw std::invalid_argument("--controller and --lqr: choose one");
+  if ((a.lqr || !a.controller.empty()) && !a.closed_loop && !s.closed_loop.enabled)
+    throw std::invalid_argument(std::string(a.lqr ? "--lqr" : "--controller") + ": a controller is used by --closed-loop only (add it)");
   if (a.lqr) s.controller = "lqr";
+  if (!a.controller.empty()) {
+    s.controller = "file";
+    s.controller_file = std::filesystem::absolute(a.controller).string();  // a flag's path is relative to here
+  }
   if (given(a.cmd, "--q-weights")) s.q_weights = a.q_weights;
   if (given(a.cmd, "--r-weights")) s.r_weights = a.r_weights;
   if (a.lqr_controllable_part) {
@@ -252,6 +259,7 @@ void add_linearize(CLI::App& app) {
   cmd->add_option("--name", a->name, "plant name (default: the model name as a MATLAB identifier)");
   cmd->add_flag("--closed-loop", a->closed_loop, "also export the linear closed loop with the study's controller: NAME_cl.mat + NAME_cl.m, NAME_cl_step.csv, NAME_cl_freq.csv");
   cmd->add_flag("--lqr", a->lqr, "the closed loop's controller: an LQR designed on this plant");
+  cmd->add_option("--controller", a->controller, "the closed loop's controller: a .mat with K, Kp/Ki/Kd or Ac,Bc,Cc,Dc[,Ts] (as simulate --controller)");
   cmd->add_flag("--lqr-controllable-part", a->lqr_controllable_part, "with --lqr on a plant that is not stabilizable: design on the controllable part");
   cmd->add_option("--q-weights", a->q_weights, "LQR state weights (diagonal of Q), in state order")->delimiter(',');
   cmd->add_option("--r-weights", a->r_weights, "LQR input weights (diagonal of R)")->delimiter(',');

@@ -79,6 +79,27 @@ OCT
 grep -q CODYNA_CL_OK "$work/octave.txt" || { cat "$work/octave.txt"; fail "octave did not finish"; }
 grep CL_NUMBERS "$work/octave.txt"
 
+# a controller from Octave: K saved by Octave, the loop exported by codyna --controller K.mat
+# is A - B K with that very K
+mkdir -p "$work/fromfile"
+(cd "$work" && octave-cli --no-gui --quiet --eval "pkg load control; run(fullfile('$work', 'cart_pendulum.m')); K = lqr(A, B, diag([1 50 1 1]), 0.1); save('-v7', fullfile('$work', 'fromfile', 'K.mat'), 'K'); printf('K_SAVED\n');" > "$work/fromfile/octave.txt" 2>&1) || true
+grep -q K_SAVED "$work/fromfile/octave.txt" || { cat "$work/fromfile/octave.txt"; fail "octave could not save K"; }
+"$codyna" linearize "$model" --operating-point equilibrium --controller "$work/fromfile/K.mat" --closed-loop --out "$work/fromfile" \
+  > "$work/fromfile/lin.txt" 2>&1 || { cat "$work/fromfile/lin.txt"; fail "linearize --controller K.mat --closed-loop"; }
+cat > "$work/fromfile/check.m" <<'OCT'
+run(fullfile(work, 'cart_pendulum.m'));
+run(fullfile(work, 'cart_pendulum_cl.m'));
+load(fullfile(work, 'K.mat'));
+e = norm(Acl - (A - B * K), 'fro') / norm(A - B * K, 'fro');
+printf('FILE_K_NUMBERS e_A=%.3g\n', e);
+assert(e < 1e-14, 'Acl vs A - B K with the file K');
+printf('CODYNA_FILE_OK\n');
+OCT
+(cd "$work/fromfile" && octave-cli --no-gui --quiet --eval "work='$work/fromfile'; source('$work/fromfile/check.m');" > "$work/fromfile/check.txt" 2>&1) \
+  || { cat "$work/fromfile/check.txt"; fail "octave check of the loop with a K file failed"; }
+grep -q CODYNA_FILE_OK "$work/fromfile/check.txt" || { cat "$work/fromfile/check.txt"; fail "octave did not finish the K file check"; }
+grep FILE_K_NUMBERS "$work/fromfile/check.txt"
+
 # a second export replaces codyna's own files; a file codyna did not write is never replaced
 "$codyna" linearize "$model" --operating-point equilibrium --lqr --closed-loop --out "$work" > /dev/null 2>&1 || fail "second export"
 echo "my notes" > "$work/cart_pendulum_cl_freq.csv"
