@@ -158,6 +158,41 @@ OCT
 grep -q CODYNA_PI_OK "$work/pid/octave.txt" || { cat "$work/pid/octave.txt"; fail "octave did not finish the PI check"; }
 grep PI_NUMBERS "$work/pid/octave.txt"
 
+# a sampled LTI controller (Ts = 0.05 s, a discrete PD: u[k] = -110 e[k] + 100 e[k-1], e = y - r):
+# the loop is discrete, around the plant's ZOH model; Octave discretizes the plant with c2d and
+# closes the loop by hand
+mkdir -p "$work/lti"
+sed 's/"controller": {"type": "pid", [^}]*}/"controller": {"type": "lti", "Ac": [[0]], "Bc": [[1]], "Cc": [[100]], "Dc": [[-110]], "Ts": 0.05, "operating_point": "initial"}/' \
+  "$work/pid/slider.json" | sed 's/"step_points": 201/"step_points": 2/' > "$work/lti/slider.json"
+grep -q '"type": "lti"' "$work/lti/slider.json" || fail "the LTI model was not written"
+"$codyna" linearize "$work/lti/slider.json" --out "$work/lti" > "$work/lti/lin.txt" 2>&1 || { cat "$work/lti/lin.txt"; fail "linearize of the sampled loop"; }
+cat > "$work/lti/check.m" <<'OCT'
+pkg load control
+run(fullfile(work, 'slider.m'));
+run(fullfile(work, 'slider_cl.m'));
+Ts = 0.05; Ac = 0; Bc = 1; Cc = 100; Dc = -110;
+assert(Ts_cl == Ts, 'Ts_cl');
+[Ad, Bd] = ssdata(c2d(ss(A, B, C, D), Ts, 'zoh'));
+Ah = [Ad + Bd * Dc * C, Bd * Cc; Bc * C, Ac];
+Bh = [-Bd * Dc; -Bc];
+Ch = [C, 0; Dc * C, Cc];
+Dh = [0; -Dc];
+e_A = norm(Acl - Ah, 'fro') / norm(Ah, 'fro');
+e_B = norm(Bcl - Bh, 'fro') / norm(Bh, 'fro');
+assert(numel(t_step) == 201 && max(abs(diff(t_step) - Ts)) < 1e-12, 'samples of the discrete loop');
+y = step(ss(Ah, Bh, Ch, Dh, Ts), t_step);
+csv = dlmread(fullfile(work, 'slider_cl_step.csv'), ',', 1, 0);
+e_s = max(max(abs(csv(:, 2:3) - y))) / max(abs(y(:)));
+printf('LTI_NUMBERS e_A=%.3g e_B=%.3g e_step=%.3g max|z|=%.6f\n', e_A, e_B, e_s, max(abs(eig(Ah))));
+assert(e_A < 1e-12 && e_B < 1e-12 && e_s < 1e-8, 'sampled loop');
+assert(max(abs(eig(Ah))) < 0.93 && max(abs(complex(poles_cl(:, 1), poles_cl(:, 2)) - 0)) < 0.93, 'a stable discrete loop');
+printf('CODYNA_LTI_OK\n');
+OCT
+(cd "$work/lti" && octave-cli --no-gui --quiet --eval "work='$work/lti'; source('$work/lti/check.m');" > "$work/lti/octave.txt" 2>&1) \
+  || { cat "$work/lti/octave.txt"; fail "octave check of the sampled loop failed"; }
+grep -q CODYNA_LTI_OK "$work/lti/octave.txt" || { cat "$work/lti/octave.txt"; fail "octave did not finish the sampled loop check"; }
+grep LTI_NUMBERS "$work/lti/octave.txt"
+
 # --closed-loop without a controller is an error (exit code 1) naming the field
 grep -v '"controller"' "$work/pid/slider.json" > "$work/pid/bare.json"
 set +e
