@@ -6,6 +6,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <filesystem>
+#include <tuple>
 
 #include "control/lqr.hpp"
 #include "dynamics/constraints.hpp"
@@ -101,6 +102,27 @@ TEST(Workflow, BadStudyFieldsNameTheirPath) {
   std::string t2 = text;
   t2.replace(t2.find("\"method\": \"spline\""), 18, "\"operating_point\": \"time=-1\"");
   expect_model_error_at([&] { parse_model_spec_text(t2, "m.json"); }, "/analysis/operating_point", "time=T");
+  // the control workflow's fields
+  const auto with = [&](const std::string& analysis) {
+    std::string t = text;
+    t.replace(t.find("{\"method\": \"spline\"}"), 20, analysis);
+    return t;
+  };
+  const std::vector<std::tuple<std::string, std::string, std::string>> bad{
+      {R"({"anti_windup": "clamp"})", "/analysis/anti_windup", "unknown anti-windup method \"clamp\""},
+      {R"({"tracking_time": -1})", "/analysis/tracking_time", "a time constant > 0 (s)"},
+      {R"({"lqr_controllable_part": 1})", "/analysis/lqr_controllable_part", "true or false"},
+      {R"({"closed_loop": {"step_points": 1}})", "/analysis/closed_loop/step_points", "an integer from 2 to 1000000"},
+      {R"({"closed_loop": {"frequency_min": 10, "frequency_max": 1}})", "/analysis/closed_loop/frequency_max",
+       "a frequency above frequency_min 10"},
+      {R"({"closed_loop": {"enabled": "yes"}})", "/analysis/closed_loop/enabled", "true or false"},
+      {R"({"disturbances": [{"type": "step", "time": 0, "value": 1}]})", "/analysis/disturbances/0", "actuator"},
+      {R"({"references": [{"output": "y", "type": "file"}]})", "/analysis/references/0", "file"},
+      {R"({"references": [{"output": "y", "type": "file", "file": ""}]})", "/analysis/references/0/file",
+       "a file name (CSV or .mat)"},
+  };
+  for (const auto& [analysis, path, phrase] : bad)
+    expect_model_error_at([&] { parse_model_spec_text(with(analysis), "m.json"); }, path, phrase);
 }
 
 TEST(Workflow, DisabledEffectsAreLeftOutOfTheModel) {
