@@ -206,3 +206,55 @@ TEST(SignalFile, BadReferenceFileIsAnErrorAtTheField) {
         << e.what();
   }
 }
+
+// A disturbance read from a file is the same signal as the table it holds: the push on the block
+// takes the file's values (interpolated) at every sample, and the run is identical to the run
+// with the table written in the model; a bad file is an error at the disturbance's field
+TEST(SignalFile, DisturbanceFromAFile) {
+  write_text("push.csv", "t,push\n0,0\n2,0\n2.5,1\n4,-0.5\n");
+  auto spec_with = [](const std::string& disturbance) {
+    ModelSpec spec = slider_pi("ref_follow.csv");
+    ActuatorSpec push;
+    push.name = "push";
+    push.type = ActuatorType::JointForce;
+    push.joint = "x";
+    push.unit = "N";
+    spec.actuators.push_back(push);
+    const std::string text = R"({"name": "d", "bodies": [{"name": "b", "mass": 1, "inertia": [1, 1, 1]}],
+      "joints": [{"name": "j", "type": "prismatic", "parent": "ground", "child": "b"}],
+      "actuators": [{"name": "push", "type": "joint_force", "joint": "j"}],
+      "analysis": {"disturbances": [)" + disturbance + "]}}";
+    spec.analysis.disturbances = parse_model_spec_text(text, "d.json").analysis.disturbances;
+    return spec;
+  };
+  write_text("ref_follow.csv", "t,pos\n0,0\n1,0\n3,0.2\n4,0.1\n");
+  const std::string dir = temp_dir() + "/slider.json";
+  const Model from_file = study_model(spec_with(R"({"actuator": "push", "type": "file", "file": "push.csv"})"), dir);
+  const Model from_table =
+      study_model(spec_with(R"({"actuator": "push", "type": "table", "points": [[0, 0], [2, 0], [2.5, 1], [4, -0.5]]})"), dir);
+  const SimulationResult a = study_simulate(from_file, study_simulation(from_file));
+  const SimulationResult b = study_simulate(from_table, study_simulation(from_table));
+  ASSERT_TRUE(a.completed && b.completed);
+  const int ipush = 1;
+  ASSERT_EQ(a.input_names[ipush], "push");
+  for (int k = 0; k < a.samples(); ++k) {
+    const double t = a.t[k];
+    const double d = t <= 2 ? 0 : t <= 2.5 ? (t - 2) / 0.5 : t <= 4 ? 1 - 1.5 * (t - 2.5) / 1.5 : -0.5;
+    EXPECT_NEAR(a.u(k, ipush), d, 1e-14) << t;
+  }
+  EXPECT_EQ(a.y, b.y);
+  EXPECT_GT((a.y - study_simulate(study_model(slider_pi("ref_follow.csv"), dir), study_simulation(study_model(slider_pi("ref_follow.csv"), dir))).y)
+                .cwiseAbs()
+                .maxCoeff(),
+            1e-3);  // the push does move the block
+  write_text("push_bad.csv", "t,push\n0,0\n0,1\n");
+  try {
+    study_simulation(study_model(spec_with(R"({"actuator": "push", "type": "file", "file": "push_bad.csv"})"), dir));
+    FAIL() << "no error";
+  } catch (const ModelError& e) {
+    EXPECT_EQ(e.path(), "/analysis/disturbances/0/file");
+    EXPECT_NE(std::string(e.what()).find("push_bad.csv: row 2 (line 3), column t: the time 0 is not after the previous one (0)"),
+              std::string::npos)
+        << e.what();
+  }
+}
