@@ -580,3 +580,28 @@ TEST(ClosedLoopLinear, DefaultGrids) {
   EXPECT_THROW(log_grid(0, 1, 5), std::invalid_argument);
   EXPECT_THROW(step_response(LinearSystem{}, -1, 5), std::invalid_argument);
 }
+
+// A disturbed actuator keeps its limits: a 0.5 N step on "push" limited to 0.3 N pushes with
+// 0.3 N, and the PID's force settles at -0.3 N
+TEST(ClosedLoopLinear, DisturbanceIsLimitedLikeAnyActuator) {
+  ModelSpec spec = slider_pid();
+  for (ActuatorSpec& a : spec.actuators)
+    if (a.name == "push") a.max = 0.3;
+  DisturbanceSpec dist;
+  dist.actuator = "push";
+  dist.type = "step";
+  dist.time = 1;
+  dist.value = 0.5;
+  spec.analysis.disturbances = {dist};
+  spec.solver.t_end = 15;
+  spec.solver.output_step = 0.05;
+  spec.solver.rtol = 1e-10;
+  spec.solver.atol = 1e-12;
+  const Model m = study_model(spec);
+  const SimulationResult r = study_simulate(m, study_simulation(m));
+  ASSERT_TRUE(r.completed) << r.failure;
+  const int N = r.samples(), ipush = index_of(r.input_names, "push"), iforce = index_of(r.input_names, "force");
+  for (int k = 0; k < N; ++k) EXPECT_EQ(r.u(k, ipush), r.t[k] < 1 ? 0.0 : 0.3) << r.t[k];
+  EXPECT_NEAR(r.u(N - 1, iforce), -0.3, 1e-5);
+  EXPECT_NEAR(r.y(N - 1, 0), 0.0, 1e-6);
+}
