@@ -69,6 +69,8 @@ printf 't,pos\n0,0\n1,zero\n' > "$work/ref/bad.csv"
 slider bad.csv > "$work/ref/bad.json"
 expect_error 1 "/analysis/references/0/file: $work/ref/bad.csv: row 2 (line 3), column pos: expected a number, got \"zero\"" \
   "$codyna" simulate "$work/ref/bad.json" --quiet --out "$work/ref/x.h5"
+expect_error 1 "/analysis/references/0/file: $work/ref/bad.csv: row 2 (line 3), column pos: expected a number, got \"zero\"" \
+  "$codyna" linearize "$work/ref/bad.json" --closed-loop --out "$work/ref/lin_bad"
 slider missing.csv > "$work/ref/missing.json"
 expect_error 1 "missing.csv: no such file" "$codyna" simulate "$work/ref/missing.json" --quiet --out "$work/ref/x.h5"
 [ ! -e "$work/ref/x.h5" ] || fail "a results file was written for a bad reference"
