@@ -72,10 +72,16 @@ ClosedLoopLinear close_loop(const LinearSystem& plant_in, const LinearLaw& law, 
   Eigen::FullPivLU<Eigen::MatrixXd> lu(L);
   if (nu > 0 && !lu.isInvertible())
     throw std::invalid_argument("closed loop: the algebraic loop through the plant's D and the controller's feedthrough is singular (I - Dy D)");
-  const Eigen::MatrixXd Ux = nu ? Eigen::MatrixXd(lu.solve(Dx + law.Dy * C)) : Eigen::MatrixXd::Zero(0, nx);
-  const Eigen::MatrixXd Uc = nu ? Eigen::MatrixXd(lu.solve(law.Ck)) : Eigen::MatrixXd::Zero(0, nxc);
-  const Eigen::MatrixXd Ur = nu ? Eigen::MatrixXd(lu.solve(law.Dr)) : Eigen::MatrixXd::Zero(0, ny);
-  const Eigen::MatrixXd Uw = nu ? Eigen::MatrixXd(lu.solve(law.Dy * Dw)) : Eigen::MatrixXd::Zero(0, nd);
+  // M X = R; an empty side (no controller states, no disturbances) is not handed to Eigen's
+  // triangular solve, which would bind a reference to its null data (UBSan)
+  const auto solve = [&](const Eigen::MatrixXd& R) -> Eigen::MatrixXd {
+    if (nu == 0 || R.cols() == 0) return Eigen::MatrixXd::Zero(nu, R.cols());
+    return lu.solve(R);
+  };
+  const Eigen::MatrixXd Ux = solve(Dx + law.Dy * C);
+  const Eigen::MatrixXd Uc = solve(law.Ck);
+  const Eigen::MatrixXd Ur = solve(law.Dr);
+  const Eigen::MatrixXd Uw = solve(law.Dy * Dw);
   // dy = Yx dx + Yc xc + Yr dr + Yw dw
   const Eigen::MatrixXd Yx = C + D * Ux, Yc = D * Uc, Yr = D * Ur, Yw = Dw + D * Uw;
 

@@ -400,6 +400,16 @@ TEST(ClosedLoopLinear, DisturbanceStepMatchesTheLinearPrediction) {
     EXPECT_EQ(e.path(), "/analysis/disturbances/0/actuator");
     EXPECT_NE(std::string(e.what()).find("Plant/In"), std::string::npos) << e.what();
   }
+  spec.analysis.disturbances[0].actuator = "push";
+  spec.analysis.disturbances.push_back(spec.analysis.disturbances[0]);
+  try {
+    study_simulation(study_model(spec));
+    FAIL() << "no error";
+  } catch (const ModelError& e) {
+    EXPECT_EQ(e.path(), "/analysis/disturbances/1/actuator");
+    EXPECT_NE(std::string(e.what()).find("a second disturbance on \"push\""), std::string::npos) << e.what();
+  }
+  spec.analysis.disturbances.pop_back();
   spec.analysis.disturbances[0].actuator = "wind";
   try {
     study_simulation(study_model(spec));
