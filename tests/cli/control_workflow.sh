@@ -143,6 +143,7 @@ assert len(re_parts) == 6, re_parts
 assert sum(abs(x) < 1e-8 for x in re_parts) == 2 and sum(x < -0.5 for x in re_parts) == 4, re_parts
 print("SPHERICAL_CL_OK real parts", re_parts)
 PY
+expect_error 1 "--closed-loop: not along a --trajectory (one operating point)" "$codyna" linearize "$sp" --lqr --lqr-controllable-part --closed-loop --trajectory 1 --out "$work/sp_x"
 expect_error 1 "--lqr: a controller is used by --closed-loop only (add it)" "$codyna" linearize "$sp" --lqr --out "$work/sp_x"
 expect_error 1 "--controller and --lqr: choose one" "$codyna" linearize "$sp" --lqr --controller K.mat --closed-loop --out "$work/sp_x"
 expect_error 1 "--lqr-controllable-part: goes with --lqr" "$codyna" simulate "$sp" --lqr-controllable-part --quiet --out "$work/sp2.h5"
