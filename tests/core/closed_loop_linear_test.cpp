@@ -615,3 +615,74 @@ TEST(ClosedLoopLinear, DisturbanceIsLimitedLikeAnyActuator) {
   EXPECT_NEAR(r.u(N - 1, iforce), -0.3, 1e-5);
   EXPECT_NEAR(r.y(N - 1, 0), 0.0, 1e-6);
 }
+
+// close_loop on its own, with everything a plant can have: a random plant with feedthrough D
+// (so the algebraic loop u = ... + Dy D u is there), a dynamic LTI controller with feedthrough,
+// and disturbance columns. Checked in the frequency domain against the loop composed from
+// transfer functions: y = P u + Pw w, u = K (y - r)  =>  y = (I - P K)^-1 (Pw w - P K r), u = K (y - r)
+TEST(ClosedLoopLinear, AlgebraicLoopMatchesTransferFunctionComposition) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> g;
+  auto random = [&](int r, int c) {
+    Eigen::MatrixXd M(r, c);
+    for (int i = 0; i < r; ++i)
+      for (int j = 0; j < c; ++j) M(i, j) = g(rng);
+    return M;
+  };
+  const int nx = 4, nu = 2, ny = 2, nd = 1, nxc = 3;
+  LinearSystem p;
+  p.A = random(nx, nx) - 3 * Eigen::MatrixXd::Identity(nx, nx);
+  p.B = random(nx, nu);
+  p.C = random(ny, nx);
+  p.D = 0.3 * random(ny, nu);
+  p.state_names = {"a", "b", "a_dot", "b_dot"};
+  p.input_names = {"u1", "u2"};
+  p.output_names = {"y1", "y2"};
+  LinearLaw law;
+  law.Ak = random(nxc, nxc) - 2 * Eigen::MatrixXd::Identity(nxc, nxc);
+  law.By = random(nxc, ny);
+  law.Br = -law.By;
+  law.Bx = Eigen::MatrixXd::Zero(nxc, nx);
+  law.Bv = Eigen::MatrixXd::Zero(nxc, ny);
+  law.Ck = random(nu, nxc);
+  law.Dy = 0.5 * random(nu, ny);
+  law.Dr = -law.Dy;
+  law.Dx = Eigen::MatrixXd::Zero(nu, nx);
+  law.Dv = Eigen::MatrixXd::Zero(nu, ny);
+  DisturbanceInputs w;
+  w.Bw = random(nx, nd);
+  w.Dw = random(ny, nd);
+  w.names = {"gust"};
+  const ClosedLoopLinear cl = close_loop(p, law, w);
+  const LinearSystem& s = cl.system;
+  ASSERT_EQ(s.input_names, (std::vector<std::string>{"r_y1", "r_y2", "d_gust"}));
+  ASSERT_EQ(s.output_names, (std::vector<std::string>{"y1", "y2", "u_u1", "u_u2"}));
+  const std::vector<double> freqs{0.0, 0.1, 1.0, 7.0, 100.0};
+  const FrequencyResponse f = frequency_response(s, freqs);
+  auto tf = [](const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& C, const Eigen::MatrixXd& D, cd x) {
+    const Eigen::MatrixXcd M = x * Eigen::MatrixXcd::Identity(A.rows(), A.cols()) - A.cast<cd>();
+    return Eigen::MatrixXcd(C.cast<cd>() * M.fullPivLu().solve(B.cast<cd>()) + D.cast<cd>());
+  };
+  double worst = 0;
+  for (std::size_t k = 0; k < freqs.size(); ++k) {
+    const cd x(0, freqs[k]);
+    const Eigen::MatrixXcd P = tf(p.A, p.B, p.C, p.D, x), Pw = tf(p.A, w.Bw, p.C, w.Dw, x);
+    const Eigen::MatrixXcd K = tf(law.Ak, law.By, law.Ck, law.Dy, x);
+    const Eigen::MatrixXcd S = (Eigen::MatrixXcd::Identity(ny, ny) - P * K).inverse();
+    Eigen::MatrixXcd H(ny + nu, ny + nd);
+    H.topLeftCorner(ny, ny) = -S * P * K;                       // r -> y
+    H.topRightCorner(ny, nd) = S * Pw;                          // w -> y
+    H.bottomLeftCorner(nu, ny) = K * (H.topLeftCorner(ny, ny) - Eigen::MatrixXcd::Identity(ny, ny));  // r -> u
+    H.bottomRightCorner(nu, nd) = K * H.topRightCorner(ny, nd);  // w -> u
+    worst = std::max(worst, (f.H[k] - H).cwiseAbs().maxCoeff() / H.cwiseAbs().maxCoeff());
+  }
+  std::printf("closed loop with D and controller feedthrough vs transfer functions: %.3g\n", worst);
+  EXPECT_LT(worst, 1e-12);
+  // a singular algebraic loop (I - Dy D = 0) is refused
+  LinearSystem q = p;
+  q.D = Eigen::MatrixXd::Identity(ny, nu);
+  LinearLaw l2 = law;
+  l2.Dy = Eigen::MatrixXd::Identity(nu, ny);
+  l2.Dr = -l2.Dy;
+  EXPECT_THROW(close_loop(q, l2, w), std::invalid_argument);
+}
