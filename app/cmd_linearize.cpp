@@ -18,14 +18,17 @@
 #include "simulation/model_controller.hpp"
 #include "simulation/simulator.hpp"
 #include "simulation/trajectory_linearization.hpp"
+#include "study/workflow.hpp"
 
 namespace codyna::cli {
 
 namespace {
 
 struct LinearizeArgs {
-  std::string model, out, op = "equilibrium", method = "exact", mat_version = "5", name;
+  std::string model, out, op = "equilibrium", method = "exact", mat_version = "5", name, controller;
   double discrete = 0.0, trajectory = 0.0, trajectory_step = 0.0;
+  bool closed_loop = false, lqr = false, lqr_controllable_part = false;
+  std::vector<double> q_weights, r_weights;
   std::vector<std::string> independent, set;
   const CLI::App* cmd = nullptr;  // to tell given flags (they override the file's analysis section)
 };
@@ -111,6 +114,22 @@ void run_trajectory(const Model& m, const LinearizeArgs& a, const std::string& n
   std::cout << "\nwrote " << p.mat_file << "\nwrote " << p.m_file << "\n";
 }
 
+// the study's controller around the plant: NAME_cl.{mat,m} and the step and frequency curves
+void run_closed_loop(const Model& m, const LinearizeArgs& a) {
+  const StudyClosedLoop cl = study_closed_loop(m);
+  for (const std::string& n : cl.setup.notes) std::cerr << "codyna: note: " << n << "\n";
+  for (const std::string& n : cl.notes) std::cerr << "codyna: note: closed loop: " << n << "\n";
+  const LinearSystem& s = cl.loop.system;
+  std::cout << "\nclosed loop      " << cl.loop.controller << " (" << cl.setup.controller_source << "), "
+            << s.nx() << " states, " << (s.Ts > 0 ? "discrete, Ts = " + std::to_string(s.Ts) : std::string("continuous")) << "\n"
+            << "inputs           ";
+  for (std::size_t k = 0; k < s.input_names.size(); ++k) std::cout << (k ? ", " : "") << s.input_names[k];
+  std::cout << "\noutputs          ";
+  for (std::size_t k = 0; k < s.output_names.size(); ++k) std::cout << (k ? ", " : "") << s.output_names[k];
+  std::cout << "\n\n" << format_modes(cl.poles) << "\n";
+  for (const std::string& f : study_export_closed_loop(m, cl, a.out)) std::cout << "wrote " << f << "\n";
+}
+
 // the model file's study, with the flags given on the command line on top
 ModelSpec study_of(const LinearizeArgs& a) {
   ModelSpec spec = load_spec(a.model);
@@ -133,6 +152,21 @@ ModelSpec study_of(const LinearizeArgs& a) {
     s.export_name = a.name;
   }
   if (given(a.cmd, "--method")) method_of(a.method);  // a clear message for a bad flag
+  if (a.closed_loop) s.closed_loop.enabled = true;
+  if (a.lqr && !a.controller.empty()) throw std::invalid_argument("--controller and --lqr: choose one");
+  if ((a.lqr || !a.controller.empty()) && !a.closed_loop && !s.closed_loop.enabled)
+    throw std::invalid_argument(std::string(a.lqr ? "--lqr" : "--controller") + ": a controller is used by --closed-loop only (add it)");
+  if (a.lqr) s.controller = "lqr";
+  if (!a.controller.empty()) {
+    s.controller = "file";
+    s.controller_file = std::filesystem::absolute(a.controller).string();  // a flag's path is relative to here
+  }
+  if (given(a.cmd, "--q-weights")) s.q_weights = a.q_weights;
+  if (given(a.cmd, "--r-weights")) s.r_weights = a.r_weights;
+  if (a.lqr_controllable_part) {
+    if (s.controller != "lqr") throw std::invalid_argument("--lqr-controllable-part: goes with --lqr (or \"controller\": \"lqr\" in the study)");
+    s.lqr_controllable_part = true;
+  }
   apply_set(s, a.set);
   return spec;
 }
@@ -149,12 +183,19 @@ void run(const LinearizeArgs& a) {
   if (given(a.cmd, "--trajectory")) {
     if (!(a.trajectory > 0) || !std::isfinite(a.trajectory))
       throw std::invalid_argument("--trajectory: expected an end time of seconds > 0");
+    if (m.spec.analysis.closed_loop.enabled) throw std::invalid_argument("--closed-loop: not along a --trajectory (one operating point)");
     return run_trajectory(m, a, name);
   }
   {  // an export that would replace the model (or a file codyna did not write) fails before the work
     const std::filesystem::path base = std::filesystem::path(a.out) / name;
     guard_output(base.string() + ".mat", OutputKind::PlantMat, {a.model});
     guard_output(base.string() + ".m", OutputKind::PlantScript, {a.model});
+    if (m.spec.analysis.closed_loop.enabled) {
+      guard_output(base.string() + "_cl.mat", OutputKind::PlantMat, {a.model});
+      guard_output(base.string() + "_cl.m", OutputKind::PlantScript, {a.model});
+      guard_output(base.string() + "_cl_step.csv", OutputKind::CurvesCsv, {a.model});
+      guard_output(base.string() + "_cl_freq.csv", OutputKind::CurvesCsv, {a.model});
+    }
   }
   const StudyLinearization sl = study_linearize(m);
   const OperatingPoint& op = sl.op;
@@ -197,6 +238,7 @@ void run(const LinearizeArgs& a) {
 
   const ExportPaths p = study_export(m, sys, a.out);
   std::cout << "wrote " << p.mat_file << "\nwrote " << p.m_file << "\n";
+  if (m.spec.analysis.closed_loop.enabled) run_closed_loop(m, a);
 }
 
 }  // namespace
@@ -215,6 +257,12 @@ void add_linearize(CLI::App& app) {
   cmd->add_option("--trajectory", a->trajectory, "T: linearize along a simulation from 0 to T (the model's controller in the loop, if any) instead of at one point");
   cmd->add_option("--trajectory-step", a->trajectory_step, "DT: spacing of the points along the trajectory (default: the model's output_step)");
   cmd->add_option("--name", a->name, "plant name (default: the model name as a MATLAB identifier)");
+  cmd->add_flag("--closed-loop", a->closed_loop, "also export the linear closed loop with the study's controller: NAME_cl.mat + NAME_cl.m, NAME_cl_step.csv, NAME_cl_freq.csv");
+  cmd->add_flag("--lqr", a->lqr, "the closed loop's controller: an LQR designed on this plant");
+  cmd->add_option("--controller", a->controller, "the closed loop's controller: a .mat with K, Kp/Ki/Kd or Ac,Bc,Cc,Dc[,Ts] (as simulate --controller)");
+  cmd->add_flag("--lqr-controllable-part", a->lqr_controllable_part, "with --lqr on a plant that is not stabilizable: design on the controllable part");
+  cmd->add_option("--q-weights", a->q_weights, "LQR state weights (diagonal of Q), in state order")->delimiter(',');
+  cmd->add_option("--r-weights", a->r_weights, "LQR input weights (diagonal of R)")->delimiter(',');
   a->cmd = cmd;
   cmd->callback([a] { set_exit_code(run_guarded([&] { run(*a); })); });
 }

@@ -22,7 +22,7 @@ namespace {
 
 struct SimulateArgs {
   std::string model, out, csv, controller, op = "equilibrium", integrator;
-  bool lqr = false, compare_linear = false, quiet = false, open_loop = false;
+  bool lqr = false, lqr_controllable_part = false, compare_linear = false, quiet = false, open_loop = false;
   std::vector<double> q_weights, r_weights;
   double t_end = 0, rtol = 0, atol = 0, max_step = -1, output_step = 0;
   double max_samples = 1e7, divergence_bound = 1e8;
@@ -99,6 +99,10 @@ ModelSpec study_of(const SimulateArgs& a) {
   }
   if (a.lqr) s.controller = "lqr";
   if (a.open_loop) s.controller = "none";
+  if (a.lqr_controllable_part) {
+    if (s.controller != "lqr") throw std::invalid_argument("--lqr-controllable-part: goes with --lqr (or \"controller\": \"lqr\" in the study)");
+    s.lqr_controllable_part = true;
+  }
   if (given(a.cmd, "--q-weights")) s.q_weights = a.q_weights;
   if (given(a.cmd, "--r-weights")) s.r_weights = a.r_weights;
   if (given(a.cmd, "--operating-point")) {
@@ -142,6 +146,7 @@ void run(const SimulateArgs& a) {
       throw std::invalid_argument("--csv " + a.csv + ": the same file as --out");
   }
   StudySimulation setup = study_simulation(m);
+  for (const std::string& n : setup.notes) std::cerr << "codyna: note: " << n << "\n";
   setup.options.max_samples = a.max_samples;
   setup.options.divergence_bound = a.divergence_bound;
   const LinearPlant* plant = setup.plant.get();
@@ -154,6 +159,11 @@ void run(const SimulateArgs& a) {
       for (std::size_t k = 0; k < s.state_names.size(); ++k) std::cout << (k ? ", " : "") << s.state_names[k];
       std::cout << "):\n";
       for (int r = 0; r < setup.lqr_gain.rows(); ++r) std::cout << "K(" << s.input_names[r] << ") = [" << row(setup.lqr_gain, r) << "]\n";
+      std::cout << "closed-loop poles";
+      for (Eigen::Index k = 0; k < setup.lqr_poles.size(); ++k)
+        std::cout << (k ? ", " : " ") << setup.lqr_poles[k].real() << (setup.lqr_poles[k].imag() < 0 ? "-" : "+")
+                  << std::abs(setup.lqr_poles[k].imag()) << "i";
+      std::cout << "\n";
     } else if (src == "file") {
       std::cout << "controller from " << a.controller << ": " << setup.controller->describe() << "\n";
     } else {
@@ -200,6 +210,7 @@ void add_simulate(CLI::App& app) {
   cmd->add_option("--controller", a->controller, "controller .mat: K (state feedback), Kp/Ki/Kd (PID) or Ac,Bc,Cc,Dc[,Ts] (LTI); default: the model file's controller, if any");
   cmd->add_flag("--open-loop", a->open_loop, "ignore the model's controller: actuators at their nominal values");
   cmd->add_flag("--lqr", a->lqr, "design an LQR state feedback on the linearized plant and use it");
+  cmd->add_flag("--lqr-controllable-part", a->lqr_controllable_part, "with --lqr on a plant that is not stabilizable: design on the controllable part, leaving the modes no input moves (named) as they are");
   cmd->add_option("--q-weights", a->q_weights, "LQR state weights (diagonal of Q), in state order")->delimiter(',');
   cmd->add_option("--r-weights", a->r_weights, "LQR input weights (diagonal of R)")->delimiter(',');
   cmd->add_option("--operating-point", a->op, "where the controller's plant is linearized: initial | equilibrium | trim | time=T")->capture_default_str();

@@ -33,6 +33,7 @@ bool SimWorker::start(std::shared_ptr<const codyna::Model> model) {
   batches_ = 0;
   wall_time_ = 0;
   controller_source_.clear();
+  notes_.clear();
   pending_.clear();
   last_t_ = 0;
   t_end_ = model->spec.solver.t_end;
@@ -87,10 +88,13 @@ void SimWorker::runJob(std::shared_ptr<const codyna::Model> model) {
     return fail(QStringLiteral("the simulation setup failed (unknown error)"));
   }
   const QString source = QString::fromStdString(setup.controller_source);
+  QStringList notes;
+  for (const std::string& n : setup.notes) notes << QString::fromStdString(n);
   QMetaObject::invokeMethod(
       this,
-      [this, source] {
+      [this, source, notes] {
         controller_source_ = source;
+        notes_ = notes;
         emit setupDone(source);
       },
       Qt::QueuedConnection);

@@ -23,6 +23,7 @@
 #include <QMetaType>
 #include <QObject>
 #include <QString>
+#include <QStringList>
 #include <QThread>
 #include <QVector>
 #include <atomic>
@@ -58,6 +59,9 @@ class SimWorker : public QObject {
 
   // What the last run's setup chose ("lqr", "the model file's pid controller", ...).
   QString controllerSource() const { return controller_source_; }
+  // What the last run's setup says the user should know (an LQR on the controllable part
+  // names the modes it leaves as they are); set before setupDone().
+  QStringList notes() const { return notes_; }
   // Wall time of the last run, setup included (seconds).
   double wallTime() const { return wall_time_; }
   // How many samples() emissions the last run made (for the benchmark and tests).
@@ -89,6 +93,7 @@ class SimWorker : public QObject {
   int batches_ = 0;
   double wall_time_ = 0;
   QString controller_source_;
+  QStringList notes_;
 
   // worker-thread side of the batching (only the worker thread touches these during a run)
   SampleBatch pending_;

@@ -110,6 +110,7 @@ SimulateView::SimulateView(Document* doc, QWidget* parent) : QWidget(parent), do
   connect(worker_, &SimWorker::setupDone, this, [this](const QString& source) {
     status_ = tr("running (controller: %1)…").arg(source);
     status_label_->setText(status_);
+    for (const QString& n : worker_->notes()) emit message(tr("note: %1").arg(n));
   });
   connect(doc_, &Document::specChanged, this, &SimulateView::refreshFromDocument);
   refreshFromDocument();
@@ -562,6 +563,7 @@ void SimulateView::onFinished(std::shared_ptr<const SimulationResult> r) {
                 .arg(qs(r->stats.integrator))
                 .arg(num(worker_->wallTime(), 3))
                 .arg(qs(r->controller.empty() ? worker_->controllerSource().toStdString() : r->controller));
+  for (const QString& n : worker_->notes()) status_ += tr("; note: %1").arg(n);
   status_label_->setText(status_);
   setRunning(false);
   emit message(tr("Simulation %1").arg(status_));

@@ -734,4 +734,114 @@ ExportPaths export_trajectory(const std::vector<LinearSystem>& systems, const st
   return paths;
 }
 
+// ---------------------------------------------------------------- closed loops
+
+namespace {
+
+std::vector<std::string> padded(std::vector<std::string> u, std::size_t n) {
+  u.resize(n);
+  return u;
+}
+
+std::string closed_loop_script(const ClosedLoopLinear& cl, const std::string& name) {
+  const LinearSystem& s = cl.system;
+  std::ostringstream m;
+  m << "% " << name << ".m - linear closed loop exported by codyna " << one_line(s.codyna_version) << "\n"
+    << "%\n"
+    << "% Model:            " << one_line(s.model_name) << (s.model_file.empty() ? "" : "  (" + one_line(s.model_file) + ")") << "\n"
+    << "% Operating point:  " << one_line(s.operating_point) << "\n"
+    << "% Controller:       " << one_line(cl.controller) << "\n"
+    << "% Time:             " << (s.Ts > 0 ? "discrete, Ts = " + number(s.Ts) + " s (plant by zero-order hold)" : std::string("continuous"))
+    << "\n%\n"
+    << "% The plant linearized about its operating point with the controller's law, no saturation:\n"
+    << (s.Ts > 0 ? "%   xcl[k+1] = Acl xcl[k] + Bcl w[k]\n" : "%   d(xcl)/dt = Acl xcl + Bcl w\n")
+    << "%   z = Ccl xcl + Dcl w\n"
+    << "% xcl = [plant state deviations; controller states], w = [references r - y0; disturbances],\n"
+    << "% z = [outputs y - y0; actuator efforts u - u0]. Signs as in the simulation: PID acts on r - y,\n"
+    << "% state feedback u = u0 - K dx + Nbar (r - y0), an LTI controller sees y - r.\n"
+    << "%\n% Inputs (input_names_cl):\n" << signal_table(s.input_names, padded(s.input_units, s.input_names.size()))
+    << "% Outputs (output_names_cl):\n" << signal_table(s.output_names, padded(s.output_units, s.output_names.size()))
+    << "% States (state_names_cl):\n" << signal_table(s.state_names, padded(s.state_units, s.state_names.size()))
+    << "%\n% poles_cl: [real, imag, natural frequency (rad/s), damping] per pole; t_step and w_freq are\n"
+    << "% the grids of the curves codyna wrote beside this file (" << name << "_step.csv, " << name << "_freq.csv).\n\n"
+    << "codyna_here = fileparts(mfilename('fullpath'));\n"
+    << "load(fullfile(codyna_here, '" << name << ".mat'));\n"
+    << "if exist('OCTAVE_VERSION', 'builtin')\n  try\n    pkg load control\n  catch\n  end\nend\n"
+    << "sys_cl = [];\n"
+    << "codyna_note = '';\n"
+    << "if exist('ss') >= 2\n"
+    << "  if Ts_cl > 0\n    sys_cl = ss(Acl, Bcl, Ccl, Dcl, Ts_cl);\n  else\n    sys_cl = ss(Acl, Bcl, Ccl, Dcl);\n  end\n"
+    << "  sys_cl.StateName = state_names_cl;\n  sys_cl.InputName = input_names_cl;\n  sys_cl.OutputName = output_names_cl;\n"
+    << "  codyna_note = '; the named state-space model is sys_cl';\n"
+    << "end\n"
+    << "fprintf('%s: linear closed loop of model %s, %d states, %d inputs, %d outputs%s.\\n', '" << name << "', "
+    << quoted(or_unset(s.model_name)) << ", size(Acl, 1), size(Bcl, 2), size(Ccl, 1), codyna_note);\n"
+    << "clear codyna_here codyna_note\n";
+  return m.str();
+}
+
+}  // namespace
+
+ExportPaths export_closed_loop(const ClosedLoopLinear& cl, const ModalAnalysis& poles, const std::vector<double>& t_step,
+                               const std::vector<double>& w_freq, const std::string& dir, const std::string& name) {
+  const std::string base = (std::filesystem::path(dir) / name).string();
+  const ExportPaths paths{base + ".mat", base + ".m"};
+  if (matlab_identifier(name) != name)
+    throw std::runtime_error(paths.mat_file + ": '" + name + "' is not a valid MATLAB identifier or is reserved" +
+                             " (use '" + matlab_identifier(name) + "')");
+  const LinearSystem& s = cl.system;
+  guard_output(paths.mat_file, OutputKind::PlantMat, {s.model_file});
+  guard_output(paths.m_file, OutputKind::PlantScript, {s.model_file});
+  for (const auto& [what, M] : {std::pair{"Acl", &s.A}, std::pair{"Bcl", &s.B}, std::pair{"Ccl", &s.C}, std::pair{"Dcl", &s.D}})
+    if (!M->allFinite()) throw std::runtime_error(paths.mat_file + ": " + what + " has NaN or Inf entries");
+  Eigen::MatrixXd P(static_cast<Eigen::Index>(poles.modes.size()), 4);
+  for (std::size_t k = 0; k < poles.modes.size(); ++k) {
+    const Mode& md = poles.modes[k];
+    P.row(static_cast<Eigen::Index>(k)) << md.eigenvalue.real(), md.eigenvalue.imag(), md.natural_frequency, md.damping_ratio;
+  }
+  auto column = [](const std::vector<double>& v) {
+    return Eigen::MatrixXd(Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size())));
+  };
+  AtomicFile mat(paths.mat_file);
+  {
+    MatWriter w(mat.temp_path(), MatVersion::V5, paths.mat_file);
+    w.write(double_var("Acl", s.A));
+    w.write(double_var("Bcl", s.B));
+    w.write(double_var("Ccl", s.C));
+    w.write(double_var("Dcl", s.D));
+    w.write(double_var("Ts_cl", Eigen::MatrixXd::Constant(1, 1, s.Ts)));
+    w.write(double_var("x0_cl", s.x0));
+    w.write(double_var("u0_cl", s.u0));
+    w.write(double_var("y0_cl", s.y0));
+    w.write(cellstr_var("state_names_cl", s.state_names));
+    w.write(cellstr_var("input_names_cl", s.input_names));
+    w.write(cellstr_var("output_names_cl", s.output_names));
+    w.write(cellstr_var("state_units_cl", padded(s.state_units, s.state_names.size())));
+    w.write(cellstr_var("input_units_cl", padded(s.input_units, s.input_names.size())));
+    w.write(cellstr_var("output_units_cl", padded(s.output_units, s.output_names.size())));
+    w.write(double_var("poles_cl", P));
+    w.write(double_var("t_step", column(t_step)));
+    w.write(double_var("w_freq", column(w_freq)));
+    std::vector<Field> fields;
+    fields.emplace_back("name", char_var(nullptr, name));
+    fields.emplace_back("model_name", char_var(nullptr, s.model_name));
+    fields.emplace_back("model_file", char_var(nullptr, s.model_file));
+    fields.emplace_back("operating_point", char_var(nullptr, s.operating_point));
+    fields.emplace_back("controller", char_var(nullptr, cl.controller));
+    fields.emplace_back("codyna_version", char_var(nullptr, s.codyna_version));
+    w.write(struct_var("info_cl", std::move(fields)));
+    w.close();
+  }
+  AtomicFile m(paths.m_file);
+  {
+    std::ofstream out(m.temp_path(), std::ios::binary | std::ios::trunc);
+    out << closed_loop_script(cl, name);
+    out.close();
+    if (!out) throw std::runtime_error(paths.m_file + ": cannot write " + m.temp_path());
+  }
+  mat.commit();
+  m.commit();
+  return paths;
+}
+
 }  // namespace codyna

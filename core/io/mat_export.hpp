@@ -29,7 +29,9 @@
 #include <string>
 #include <vector>
 
+#include "analysis/closed_loop_linear.hpp"
 #include "analysis/linear_system.hpp"
+#include "analysis/modal.hpp"
 
 namespace codyna {
 
@@ -59,6 +61,17 @@ ExportPaths export_plant(const LinearSystem& sys, const std::string& dir, const 
 // defines plant_at(k), the named ss model at point k, when ss() exists. Atomic.
 ExportPaths export_trajectory(const std::vector<LinearSystem>& systems, const std::vector<double>& times,
                               const std::string& dir, const std::string& name);
+
+// The linear closed loop (analysis/closed_loop_linear.hpp) of a plant NAME: DIR/NAME.mat (MAT v5;
+// NAME is the plant's export name + "_cl") holds Acl, Bcl, Ccl, Dcl, Ts_cl, the lists
+// state_names_cl, input_names_cl, output_names_cl (and *_units_cl), the offsets x0_cl, u0_cl
+// (the inputs' base values: y0, then the disturbed actuators' nominal values), y0_cl ([y0; u0]),
+// poles_cl (n x 4: real, imaginary part, natural frequency rad/s, damping), the grids t_step
+// and w_freq of the curves, and info_cl (model, operating point, controller, codyna version);
+// DIR/NAME.m loads it and builds the named model sys_cl when ss() exists. Atomic, guarded as
+// export_plant is.
+ExportPaths export_closed_loop(const ClosedLoopLinear& cl, const ModalAnalysis& poles, const std::vector<double>& t_step,
+                               const std::vector<double>& w_freq, const std::string& dir, const std::string& name);
 
 // A valid MATLAB (and Octave) identifier that is also safe as a script name:
 // characters other than [A-Za-z0-9_] become '_' ("cart-pendulum 2" ->

@@ -991,6 +991,13 @@ const Schema<SignalSpec>& schema<SignalSpec>() {
             return x;
           }),
           field("phase", &T::phase, read_number),
+          field("file", &T::file,
+                [](const Node& n) {
+                  const std::string f = read_string(n);
+                  if (f.empty()) n.expected("a file name (CSV or .mat)");
+                  return f;
+                },
+                Need::Required),
           field("points", &T::points,
                 [](const Node& n) {
                   std::vector<std::pair<double, double>> p;
@@ -1013,10 +1020,77 @@ const Schema<SignalSpec>& schema<SignalSpec>() {
         if (x.type == "step") return {"output", "type", "time", "value"};
         if (x.type == "ramp") return {"output", "type", "time", "slope"};
         if (x.type == "sine") return {"output", "type", "time", "amplitude", "frequency", "phase"};
+        if (x.type == "file") return {"output", "type", "file"};
         return {"output", "type", "points"};
       }};
   return s;
 }
+
+// A disturbance is a signal on an actuator: the signal's fields, "actuator" in place of "output".
+template <>
+const Schema<DisturbanceSpec>& schema<DisturbanceSpec>() {
+  using T = DisturbanceSpec;
+  static const Schema<T> s = [] {
+    Schema<T> d;
+    d.kind = "disturbance";
+    d.fields.push_back(field("actuator", &T::actuator, read_string, Need::Required));
+    for (const Field<SignalSpec>& f : schema<SignalSpec>().fields) {
+      if (f.key == "output") continue;
+      d.fields.push_back({f.key, f.need, [r = f.read](const Node& n, T& x) { r(n, x); },
+                          [w = f.write](ojson& j, const T& x) { w(j, x); }});
+    }
+    d.keys = [](const T& x) {
+      std::vector<std::string_view> k = schema<SignalSpec>().keys_of(x);
+      std::replace(k.begin(), k.end(), std::string_view("output"), std::string_view("actuator"));
+      return k;
+    };
+    return d;
+  }();
+  return s;
+}
+
+bool read_bool(const Node& n) {
+  if (!n.value().is_boolean()) n.expected("true or false");
+  return n.value().get<bool>();
+}
+
+template <>
+const Schema<ClosedLoopSpec>& schema<ClosedLoopSpec>() {
+  using T = ClosedLoopSpec;
+  const auto at_least = [](double lowest, const char* expected) {
+    return [lowest, expected](const Node& n) {
+      const double x = read_number(n);
+      if (!(x >= lowest)) n.expected(expected);
+      return x;
+    };
+  };
+  const auto count = [](int lowest, int highest, const char* expected) {
+    return [lowest, highest, expected](const Node& n) {
+      const int k = read_integer(n);
+      if (k < lowest || k > highest) n.expected(expected);
+      return k;
+    };
+  };
+  static const Schema<T> s{{
+      field("enabled", &T::enabled, read_bool, [](bool b) { return ojson(b); }),
+      field("step_time", &T::step_time, at_least(0.0, "a time >= 0 (s; 0 = from the slowest pole)")),
+      field("step_points", &T::step_points, count(2, 1000000, "an integer from 2 to 1000000")),
+      field("frequency_min", &T::frequency_min, at_least(0.0, "a frequency >= 0 (rad/s; 0 = from the poles)")),
+      {"frequency_max", Need::Optional,
+       [](const Node& n, T& c) {
+         c.frequency_max = read_number(n);
+         if (!(c.frequency_max >= 0)) n.expected("a frequency >= 0 (rad/s; 0 = from the poles)");
+         if (c.frequency_max > 0 && c.frequency_min > 0 && !(c.frequency_max > c.frequency_min))
+           n.expected("a frequency above frequency_min " + dump(c.frequency_min));
+       },
+       [](ojson& j, const T& c) { j["frequency_max"] = c.frequency_max; }},
+      field("frequency_points", &T::frequency_points, count(2, 100000, "an integer from 2 to 100000")),
+  }};
+  return s;
+}
+
+// A default closed-loop analysis is left out of the file.
+ojson write_closed_loop(const ClosedLoopSpec& c) { return c == ClosedLoopSpec{} ? ojson() : write_struct(c); }
 
 template <>
 const Schema<StudySpec>& schema<StudySpec>() {
@@ -1041,13 +1115,21 @@ const Schema<StudySpec>& schema<StudySpec>() {
       field("controller_file", &T::controller_file, read_string, encode_optional_text),
       field("q_weights", &T::q_weights, [](const Node& n) { return read_weights(n, false); }),
       field("r_weights", &T::r_weights, [](const Node& n) { return read_weights(n, true); }),
+      field("lqr_controllable_part", &T::lqr_controllable_part, read_bool, [](bool b) { return b ? ojson(true) : ojson(); }),
       list_field("references", &T::references),
-      field("compare_linear", &T::compare_linear,
+      field("compare_linear", &T::compare_linear, read_bool, [](bool b) { return b ? ojson(true) : ojson(); }),
+      list_field("disturbances", &T::disturbances),
+      field("anti_windup", &T::anti_windup,
+            [](const Node& n) { return read_word(n, anti_windup_methods(), "anti-windup method"); },
+            [](const std::string& a) { return a == "none" ? ojson() : ojson(a); }),
+      field("tracking_time", &T::tracking_time,
             [](const Node& n) {
-              if (!n.value().is_boolean()) n.expected("true or false");
-              return n.value().get<bool>();
+              const double x = read_number(n);
+              if (!(x > 0)) n.expected("a time constant > 0 (s)");
+              return x;
             },
-            [](bool b) { return b ? ojson(true) : ojson(); }),
+            [](double x) { return x > 0 ? ojson(x) : ojson(); }),
+      field("closed_loop", &T::closed_loop, read_struct<ClosedLoopSpec>, write_closed_loop),
   }};
   return s;
 }

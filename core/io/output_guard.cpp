@@ -32,6 +32,8 @@ bool written_by_codyna(const std::string& path, OutputKind k) {
       // the header row of a codyna results table: "t,..."
       return starts_with(h, "t,") || starts_with(h, "\"t\",");
     }
+    case OutputKind::CurvesCsv:
+      return starts_with(h, "t,") || starts_with(h, "w,");
     case OutputKind::PlantMat:
       return (starts_with(h, "MATLAB 5.0 MAT-file") || starts_with(h, "MATLAB 7.3 MAT-file")) &&
              h.find("codyna") != std::string::npos;
@@ -55,6 +57,7 @@ const char* describe(OutputKind k) {
   switch (k) {
     case OutputKind::ResultsHdf5: return "an HDF5 results file";
     case OutputKind::ResultsCsv: return "a CSV results file";
+    case OutputKind::CurvesCsv: return "a CSV of closed-loop responses";
     case OutputKind::PlantMat: return "a plant .mat export";
     case OutputKind::PlantScript: return "a plant .m export";
   }

@@ -19,6 +19,7 @@ enum class OutputKind {
   ResultsCsv,   // simulation results as CSV (write_results_csv)
   PlantMat,     // NAME.mat of an export (MAT v5 or v7.3)
   PlantScript,  // NAME.m of an export
+  CurvesCsv,    // step or frequency responses of a closed loop (io/curves_file.hpp)
 };
 
 const char* describe(OutputKind k);  // "an HDF5 results file", ...

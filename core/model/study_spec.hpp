@@ -20,15 +20,38 @@ namespace codyna {
 //   ramp   y0 + slope (t - time)
 //   sine   y0 + amplitude sin(2 pi frequency (t - time) + phase)
 //   table  piecewise linear through points [[t, r], ...], held beyond the ends
+//   file   a table read from `file` (io/signal_file.hpp: CSV t,value with a header, or a
+//          .mat with vectors t and value); the workflow reads it into `points` when it runs
 struct SignalSpec {
-  std::string output;         // Plant/Out name
-  std::string type = "step";  // step | ramp | sine | table
+  std::string output;         // Plant/Out name (references)
+  std::string type = "step";  // step | ramp | sine | table | file
   double time = 0.0;          // s
   double value = 0.0;         // step
   double slope = 0.0;         // ramp, unit/s
   double amplitude = 0.0, frequency = 0.0, phase = 0.0;  // sine: unit, Hz, rad
   std::vector<std::pair<double, double>> points;         // table: (t, r), t increasing
+  std::string file;           // file: the time series; relative = to the model file's folder
   bool operator==(const SignalSpec&) const = default;
+};
+
+// A disturbance d(t) added to an actuator that is not a Plant/In input (a force on the cart
+// of a pendulum): the actuator's value is u0 + d(t), then limited to its [min, max] like any
+// actuator's. d(t) is the signal about a base of 0: a step of `value` adds `value` after `time`.
+struct DisturbanceSpec : SignalSpec {
+  std::string actuator;       // actuator name (not Plant/In)
+  bool operator==(const DisturbanceSpec&) const = default;
+};
+
+// The linear closed-loop analysis (analysis/closed_loop_linear.hpp): the plant and the
+// study's controller as one linear system, its poles, step and frequency responses.
+struct ClosedLoopSpec {
+  bool enabled = false;          // `codyna linearize` also exports NAME_cl.{m,mat} and the curves
+  double step_time = 0.0;        // s, end of the step responses; 0 = from the slowest pole
+  int step_points = 501;         // samples of each step response (>= 2)
+  double frequency_min = 0.0;    // rad/s, log grid of the frequency responses; 0 = from the poles
+  double frequency_max = 0.0;    // rad/s; 0 = from the poles
+  int frequency_points = 200;    // (>= 2)
+  bool operator==(const ClosedLoopSpec&) const = default;
 };
 
 // r(t) of a signal about the base value y0
@@ -58,10 +81,23 @@ struct StudySpec {
   std::string controller = "model";  // "model" (the model file's controller, if any), "none", "lqr", "file"
   std::string controller_file;       // "file": a .mat (K, Kp/Ki/Kd or Ac/Bc/Cc/Dc); relative = to the model file
   std::vector<double> q_weights, r_weights;  // "lqr": diagonals of Q (nx) and R (nu); empty = identity
+  // "lqr" on a plant that is not stabilizable: design on the controllable part only
+  // (control/lqr_controllable.hpp); the modes the inputs cannot move are named and stay as
+  // they are. Off by default: without it such a plant is an error that names those modes.
+  bool lqr_controllable_part = false;
   bool compare_linear = false;       // also run the linear closed loop beside the nonlinear one
   // time-varying references on Plant/Out outputs (the others stay at y0); every controller
   // type follows them: PID acts on r - y, state feedback adds Nbar (r - y0), LTI sees y - r
   std::vector<SignalSpec> references;
+  // disturbances d(t) added to actuators that are not Plant/In (in the nonlinear run and,
+  // through those actuators' B and D columns, in the linear comparison and closed loop)
+  std::vector<DisturbanceSpec> disturbances;
+  // PID anti-windup when an actuator sits at its min/max: "none" (the default: the integral
+  // runs on), "back_calculation" (dxi/dt = r - y + pinv(Ki) (u_applied - u) / tracking_time)
+  // or "conditional" (an integral is held while it would drive a saturated input further)
+  std::string anti_windup = "none";
+  double tracking_time = 0.0;        // s, > 0: back_calculation's time constant
+  ClosedLoopSpec closed_loop;
 
   bool operator==(const StudySpec&) const = default;
 };
@@ -72,7 +108,11 @@ inline const std::vector<std::string>& study_methods() {
   return v;
 }
 inline const std::vector<std::string>& signal_types() {
-  static const std::vector<std::string> v{"step", "ramp", "sine", "table"};
+  static const std::vector<std::string> v{"step", "ramp", "sine", "table", "file"};
+  return v;
+}
+inline const std::vector<std::string>& anti_windup_methods() {
+  static const std::vector<std::string> v{"none", "back_calculation", "conditional"};
   return v;
 }
 inline const std::vector<std::string>& study_controllers() {
@@ -81,7 +121,7 @@ inline const std::vector<std::string>& study_controllers() {
 }
 
 inline double signal_value(const SignalSpec& s, double t, double y0) {
-  if (s.type == "table") {
+  if (s.type == "table" || s.type == "file") {
     const auto& p = s.points;
     if (p.empty()) return y0;
     if (t <= p.front().first) return p.front().second;

@@ -64,6 +64,7 @@ Eigen::VectorXd ClosedLoopSystem::saturate(Eigen::VectorXd u) const {
 Eigen::VectorXd ClosedLoopSystem::inputs(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
                                          const Eigen::VectorXd& xc) const {
   Eigen::VectorXd u = u_nominal_;
+  if (disturbance_) u += disturbance_(t);
   Eigen::VectorXd up;
   if (!controller_ || controller_->sample_time() > 0) {
     // held values: a discrete controller's last output, or inputs set from outside (co-simulation)
@@ -84,7 +85,15 @@ void ClosedLoopSystem::rhs(double t, const Eigen::VectorXd& y, Eigen::VectorXd& 
   ydot.resize(ode_size());
   ydot.head(nq) = qdot<double>(model_, q, v);
   ydot.segment(nq, nv) = forward_dynamics<double>(model_, data_, q, v, u, stab_);
-  if (nx) ydot.tail(nx) = controller_->update(measure(t, q, v), xc);
+  if (nx) ydot.tail(nx) = controller_rates(t, q, v, xc, u);
+}
+
+Eigen::VectorXd ClosedLoopSystem::controller_rates(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+                                                   const Eigen::VectorXd& xc, const Eigen::VectorXd& u) const {
+  ControllerInput in = measure(t, q, v);
+  in.u.resize(static_cast<Eigen::Index>(model_.plant_inputs.size()));
+  for (std::size_t k = 0; k < model_.plant_inputs.size(); ++k) in.u[k] = u[model_.plant_inputs[k]];
+  return controller_->update(in, xc);
 }
 
 void ClosedLoopSystem::residual(double t, const Eigen::VectorXd& Y, const Eigen::VectorXd& Yp, Eigen::VectorXd& F) {
@@ -111,7 +120,7 @@ void ClosedLoopSystem::residual(double t, const Eigen::VectorXd& Y, const Eigen:
     }
   }
   F.segment(nq, nv) = dyn;
-  if (nx) F.segment(nq + nv, nx) = Yp.segment(nq + nv, nx) - controller_->update(measure(t, q, v), xc);
+  if (nx) F.segment(nq + nv, nx) = Yp.segment(nq + nv, nx) - controller_rates(t, q, v, xc, u);
 }
 
 void ClosedLoopSystem::consistent(double t, const Eigen::VectorXd& y, Eigen::VectorXd& Y, Eigen::VectorXd& Yp) {

@@ -44,6 +44,9 @@ class ClosedLoopSystem {
   void set_held(const Eigen::VectorXd& u_plant) { held_ = u_plant; }
   // r(t) for the Plant/Out outputs, handed to the controller (empty: its own setpoint)
   void set_reference(std::function<Eigen::VectorXd(double)> r) { reference_ = std::move(r); }
+  // d(t) added to the actuators' nominal values (one entry per actuator, Model::actuators;
+  // the Plant/In entries are replaced by the controller's output anyway)
+  void set_disturbance(std::function<Eigen::VectorXd(double)> d) { disturbance_ = std::move(d); }
 
   ControllerInput measure(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v) const;
   // every actuator's value at a state (controller output on Plant/In, saturated)
@@ -74,7 +77,10 @@ class ClosedLoopSystem {
   const PlantFunction* plant_;
   Eigen::VectorXd x_ref_, u_nominal_;
   std::optional<Eigen::VectorXd> held_;
-  std::function<Eigen::VectorXd(double)> reference_;
+  std::function<Eigen::VectorXd(double)> reference_, disturbance_;
+  // the controller's state equation, told the Plant/In values applied (after saturation) in u
+  Eigen::VectorXd controller_rates(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+                                   const Eigen::VectorXd& xc, const Eigen::VectorXd& u) const;
   Baumgarte stab_;
   int continuous_states_ = 0;
   std::vector<int> rows_;  // DAE form: constraint rows carrying multipliers

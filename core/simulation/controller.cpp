@@ -1,8 +1,10 @@
 #include "simulation/controller.hpp"
 
 #include <Eigen/LU>
+#include <Eigen/QR>
 #include <Eigen/SVD>
 
+#include <cmath>
 #include <sstream>
 #include <stdexcept>
 
@@ -20,20 +22,36 @@ namespace {
 
 class Pid final : public Controller {
  public:
-  Pid(Eigen::MatrixXd Kp, Eigen::MatrixXd Ki, Eigen::MatrixXd Kd, Eigen::VectorXd r, Eigen::VectorXd u0)
-      : Kp_(std::move(Kp)), Ki_(std::move(Ki)), Kd_(std::move(Kd)), r_(std::move(r)), u0_(std::move(u0)) {}
-  int nxc() const override { return Ki_.size() ? static_cast<int>(r_.size()) : 0; }
-  bool needs_rates() const override { return Kd_.size() > 0; }
+  explicit Pid(PidGains g) : g_(std::move(g)) {
+    if (g_.anti_windup.method == AntiWindup::Method::BackCalculation) {
+      Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(g_.Ki);
+      Kaw_ = cod.pseudoInverse() / g_.anti_windup.tracking_time;  // ny x nu
+    }
+  }
+  int nxc() const override { return g_.Ki.size() ? static_cast<int>(g_.r.size()) : 0; }
+  bool needs_rates() const override { return g_.Kd.size() > 0; }
   Eigen::VectorXd output(const ControllerInput& in, const Eigen::VectorXd& xc) const override {
-    const Eigen::VectorXd& r = in.r.size() ? in.r : r_;
-    Eigen::VectorXd u = u0_ + Kp_ * (r - in.y);
-    if (Ki_.size()) u += Ki_ * xc;
-    if (Kd_.size()) u -= Kd_ * in.ydot;
+    const Eigen::VectorXd& r = in.r.size() ? in.r : g_.r;
+    Eigen::VectorXd u = g_.u0 + g_.Kp * (r - in.y);
+    if (g_.Ki.size()) u += g_.Ki * xc;
+    if (g_.Kd.size()) u -= g_.Kd * in.ydot;
     return u;
   }
-  Eigen::VectorXd update(const ControllerInput& in, const Eigen::VectorXd&) const override {
-    const Eigen::VectorXd& r = in.r.size() ? in.r : r_;
-    return Ki_.size() ? Eigen::VectorXd(r - in.y) : Eigen::VectorXd();
+  Eigen::VectorXd update(const ControllerInput& in, const Eigen::VectorXd& xc) const override {
+    if (!g_.Ki.size()) return Eigen::VectorXd();
+    const Eigen::VectorXd& r = in.r.size() ? in.r : g_.r;
+    Eigen::VectorXd e = r - in.y;
+    if (g_.anti_windup.method == AntiWindup::Method::None || in.u.size() != g_.u0.size()) return e;
+    const Eigen::VectorXd excess = output(in, xc) - in.u;  // > 0: the input sits at its max, < 0: at its min
+    if (g_.anti_windup.method == AntiWindup::Method::BackCalculation) return e - Kaw_ * excess;
+    // conditional integration: an integral that would push a saturated input further is held
+    for (Eigen::Index j = 0; j < e.size(); ++j)
+      for (Eigen::Index i = 0; i < excess.size(); ++i)
+        if (excess[i] != 0 && g_.Ki(i, j) * e[j] * excess[i] > 0) {
+          e[j] = 0;
+          break;
+        }
+    return e;
   }
   std::vector<std::string> state_names() const override {
     std::vector<std::string> n;
@@ -41,12 +59,37 @@ class Pid final : public Controller {
     return n;
   }
   std::string describe() const override {
-    return std::string("P") + (Ki_.size() ? "I" : "") + (Kd_.size() ? "D" : "") + " on the plant outputs";
+    std::string d = std::string("P") + (g_.Ki.size() ? "I" : "") + (g_.Kd.size() ? "D" : "") + " on the plant outputs";
+    if (g_.anti_windup.method == AntiWindup::Method::BackCalculation) {
+      std::ostringstream os;
+      os << ", anti-windup by back-calculation (tracking time " << g_.anti_windup.tracking_time << " s)";
+      d += os.str();
+    } else if (g_.anti_windup.method == AntiWindup::Method::Conditional) {
+      d += ", anti-windup by conditional integration";
+    }
+    return d;
+  }
+  const PidGains* pid() const override { return &g_; }
+  std::optional<LinearLaw> linear_law(int nx, int ny) const override {
+    const Eigen::Index nu = g_.u0.size(), n = nxc();
+    if (g_.r.size() != ny) return std::nullopt;
+    LinearLaw l;
+    l.Ak = Eigen::MatrixXd::Zero(n, n);
+    l.Bx = Eigen::MatrixXd::Zero(n, nx);
+    l.By = -Eigen::MatrixXd::Identity(n, ny);
+    l.Bv = Eigen::MatrixXd::Zero(n, ny);
+    l.Br = Eigen::MatrixXd::Identity(n, ny);
+    l.Ck = g_.Ki.size() ? g_.Ki : Eigen::MatrixXd::Zero(nu, 0);
+    l.Dx = Eigen::MatrixXd::Zero(nu, nx);
+    l.Dy = -g_.Kp;
+    l.Dv = g_.Kd.size() ? Eigen::MatrixXd(-g_.Kd) : Eigen::MatrixXd::Zero(nu, ny);
+    l.Dr = g_.Kp;
+    return l;
   }
 
  private:
-  Eigen::MatrixXd Kp_, Ki_, Kd_;
-  Eigen::VectorXd r_, u0_;
+  PidGains g_;
+  Eigen::MatrixXd Kaw_;
 };
 
 class StateFeedback final : public Controller {
@@ -62,6 +105,19 @@ class StateFeedback final : public Controller {
     return Nbar_.size() ? "state feedback u = u0 - K (x - x0) + Nbar (r - y0)" : "state feedback u = u0 - K (x - x0)";
   }
   const Eigen::MatrixXd* gain() const override { return &K_; }
+  std::optional<LinearLaw> linear_law(int nx, int ny) const override {
+    if (K_.cols() != nx || (Nbar_.size() && Nbar_.cols() != ny)) return std::nullopt;
+    const Eigen::Index nu = K_.rows();
+    LinearLaw l;
+    l.Ak = Eigen::MatrixXd::Zero(0, 0);
+    l.Bx = Eigen::MatrixXd::Zero(0, nx);
+    l.By = l.Bv = l.Br = Eigen::MatrixXd::Zero(0, ny);
+    l.Ck = Eigen::MatrixXd::Zero(nu, 0);
+    l.Dx = -K_;
+    l.Dy = l.Dv = Eigen::MatrixXd::Zero(nu, ny);
+    l.Dr = Nbar_.size() ? Nbar_ : Eigen::MatrixXd::Zero(nu, ny);
+    return l;
+  }
 
  private:
   Eigen::MatrixXd K_;
@@ -83,6 +139,23 @@ class Lti final : public Controller {
   }
   Eigen::VectorXd update(const ControllerInput& in, const Eigen::VectorXd& xc) const override {
     return Ac_ * xc + Bc_ * (in.y - (in.r.size() ? in.r : y0_));
+  }
+  std::optional<LinearLaw> linear_law(int nx, int ny) const override {
+    const Eigen::Index n = nxc();
+    if (y0_.size() != ny) return std::nullopt;
+    LinearLaw l;
+    l.Ak = Ac_;
+    l.Bx = Eigen::MatrixXd::Zero(n, nx);
+    l.By = Bc_;
+    l.Bv = Eigen::MatrixXd::Zero(n, ny);
+    l.Br = -Bc_;
+    l.Ck = Cc_;
+    l.Dx = Eigen::MatrixXd::Zero(u0_.size(), nx);
+    l.Dy = Dc_;
+    l.Dv = Eigen::MatrixXd::Zero(u0_.size(), ny);
+    l.Dr = -Dc_;
+    l.Ts = Ts_;
+    return l;
   }
   std::string describe() const override {
     std::ostringstream os;
@@ -108,12 +181,16 @@ void check_size(const std::string& file, const char* name, const Eigen::MatrixXd
 }  // namespace
 
 std::unique_ptr<Controller> make_pid(const Eigen::MatrixXd& Kp, const Eigen::MatrixXd& Ki, const Eigen::MatrixXd& Kd,
-                                     const Eigen::VectorXd& r, const Eigen::VectorXd& u0) {
+                                     const Eigen::VectorXd& r, const Eigen::VectorXd& u0, const AntiWindup& aw) {
   const Eigen::Index nu = u0.size(), ny = r.size();
   check_size("PID", "Kp", Kp, nu, ny);
   if (Ki.size()) check_size("PID", "Ki", Ki, nu, ny);
   if (Kd.size()) check_size("PID", "Kd", Kd, nu, ny);
-  return std::make_unique<Pid>(Kp, Ki, Kd, r, u0);
+  if (aw.method != AntiWindup::Method::None && !Ki.size())
+    throw std::invalid_argument("PID anti-windup: the controller has no integral action (no Ki), nothing can wind up");
+  if (aw.method == AntiWindup::Method::BackCalculation && !(aw.tracking_time > 0 && std::isfinite(aw.tracking_time)))
+    throw std::invalid_argument("PID anti-windup by back-calculation: the tracking time must be a number of seconds > 0");
+  return std::make_unique<Pid>(PidGains{Kp, Ki, Kd, r, u0, aw});
 }
 
 std::unique_ptr<Controller> make_state_feedback(const Eigen::MatrixXd& K, const Eigen::VectorXd& u0,

@@ -2,7 +2,8 @@
 // (Plant/Out, and for state feedback the plant state in the export's order)
 // to the Plant/In actuator values:
 //   PID           u = u0 + Kp (r - y) + Ki xi - Kd dy/dt,   dxi/dt = r - y
-//                 (the paper's u = k (y0 - y) with derivative action on the measurement)
+//                 (the paper's u = k (y0 - y) with derivative action on the measurement);
+//                 with anti-windup (AntiWindup) the integral is corrected while an input saturates
 //   state feedback u = u0 - K (x - x0)    x in the state order of the linearization/export
 //   LTI           dxc/dt = Ac xc + Bc (y - y0),  u = u0 + Cc xc + Dc (y - y0)
 //                 or, with Ts > 0, sampled with zero-order hold:
@@ -13,9 +14,11 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "analysis/closed_loop_linear.hpp"
 #include "analysis/plant_function.hpp"
 #include "model/model.hpp"
 
@@ -28,6 +31,21 @@ struct ControllerInput {
   Eigen::VectorXd ydot;  // their rates at constant velocity [ny] (exact for position outputs)
   Eigen::VectorXd x;     // plant state deviation x - x0 in minimal coordinates [nx] (state feedback only)
   Eigen::VectorXd r;     // reference for the outputs at t [ny]; empty: the controller's own (setpoint, or y0)
+  Eigen::VectorXd u;     // the Plant/In values applied at t, after saturation [nu]; empty: not known
+                         // (anti-windup then does nothing)
+};
+
+// PID anti-windup (docs/simulation.md): what the integral does while an input is at its limit
+struct AntiWindup {
+  enum class Method { None, BackCalculation, Conditional } method = Method::None;
+  double tracking_time = 0.0;  // s, back-calculation: dxi/dt = r - y + pinv(Ki) (u_applied - u) / tracking_time
+};
+
+// PID gains as made (Controller::pid)
+struct PidGains {
+  Eigen::MatrixXd Kp, Ki, Kd;
+  Eigen::VectorXd r, u0;
+  AntiWindup anti_windup;
 };
 
 class Controller {
@@ -47,11 +65,17 @@ class Controller {
   virtual std::string describe() const = 0;
   // state feedback: its gain K (nu x nx); nullptr for other controllers
   virtual const Eigen::MatrixXd* gain() const { return nullptr; }
+  // PID: its gains; nullptr for other controllers
+  virtual const PidGains* pid() const { return nullptr; }
+  // the law as linear maps for a plant of nx states and ny outputs (LinearLaw); nullopt when
+  // it has none or does not fit those sizes
+  virtual std::optional<LinearLaw> linear_law(int nx, int ny) const { return std::nullopt; }
 };
 
-// gains are (nu x ny); empty Ki / Kd mean no integral / derivative action; r defaults to y0
+// gains are (nu x ny); empty Ki / Kd mean no integral / derivative action; r defaults to y0.
+// Anti-windup needs Ki; back-calculation a tracking time > 0 (std::invalid_argument otherwise).
 std::unique_ptr<Controller> make_pid(const Eigen::MatrixXd& Kp, const Eigen::MatrixXd& Ki, const Eigen::MatrixXd& Kd,
-                                     const Eigen::VectorXd& r, const Eigen::VectorXd& u0);
+                                     const Eigen::VectorXd& r, const Eigen::VectorXd& u0, const AntiWindup& aw = {});
 
 // K is (nu x nx), same state order as the export; x0/u0 are the operating point's.
 // With a reference r(t) on the outputs, Nbar (nu x ny) feeds it forward:

@@ -33,18 +33,29 @@ struct Recorder {
 // integrated by RK4 with 20 substeps per output step (events at controller samples)
 std::vector<Eigen::VectorXd> linear_run(const Model& model, const Controller* ctrl, const LinearPlant& plant,
                                         const std::vector<double>& times, const Eigen::VectorXd& dx0,
-                                        const std::function<Eigen::VectorXd(double)>& reference) {
+                                        const std::function<Eigen::VectorXd(double)>& reference,
+                                        const std::function<Eigen::VectorXd(double)>& disturbance) {
   double now = times.front();  // the time the stages below are evaluated at (for the reference)
   const LinearSystem& s = plant.lin.system;
   const int nx = s.nx(), nz = nx / 2;
   const bool discrete = ctrl && ctrl->sample_time() > 0;
   const int nxc = ctrl ? ctrl->nxc() : 0;
   Eigen::VectorXd held = s.u0, xcd = Eigen::VectorXd::Zero(discrete ? nxc : 0);
+  const int nd = disturbance ? static_cast<int>(plant.disturbance_actuators.size()) : 0;
+  // the disturbance inputs at `now`, through their B and D columns
+  auto dw = [&]() {
+    Eigen::VectorXd d(nd);
+    if (nd == 0) return d;
+    const Eigen::VectorXd all = disturbance(now);
+    for (int k = 0; k < nd; ++k) d[k] = all[plant.disturbance_actuators[k]];
+    return d;
+  };
   auto measure = [&](const Eigen::VectorXd& dx, const Eigen::VectorXd& du) {
     ControllerInput in;
     in.t = now;
     if (reference) in.r = reference(now);
     in.y = s.y0 + s.C * dx + s.D * du;
+    if (nd) in.y += plant.Dw * dw();
     Eigen::VectorXd rate = Eigen::VectorXd::Zero(nx);  // constant-velocity rate, as for the nonlinear plant
     rate.head(nz) = dx.tail(nz) + s.xdot0.head(nz);
     in.ydot = s.C * rate;
@@ -66,7 +77,12 @@ std::vector<Eigen::VectorXd> linear_run(const Model& model, const Controller* ct
     const Eigen::VectorXd du = input(dx, xc) - s.u0;
     Eigen::VectorXd r(nx + nc);
     r.head(nx) = s.xdot0 + s.A * dx + s.B * du;
-    if (nc) r.tail(nc) = ctrl->update(measure(dx, du), xc);
+    if (nd) r.head(nx) += plant.Bw * dw();
+    if (nc) {
+      ControllerInput in = measure(dx, du);
+      in.u = s.u0 + du;  // the inputs applied (saturated), for anti-windup
+      r.tail(nc) = ctrl->update(in, xc);
+    }
     return r;
   };
   Eigen::VectorXd z = Eigen::VectorXd::Zero(nx + nc);
@@ -81,7 +97,11 @@ std::vector<Eigen::VectorXd> linear_run(const Model& model, const Controller* ct
     next_sample += Ts;
   };
   if (discrete) sample();
-  auto record = [&]() { out.push_back(s.y0 + s.C * z.head(nx) + s.D * (input(z.head(nx), z.tail(nc)) - s.u0)); };
+  auto record = [&]() {
+    Eigen::VectorXd y = s.y0 + s.C * z.head(nx) + s.D * (input(z.head(nx), z.tail(nc)) - s.u0);
+    if (nd) y += plant.Dw * dw();
+    out.push_back(y);
+  };
   record();
   for (std::size_t i = 1; i < times.size(); ++i) {
     while (t < times[i] - 1e-12) {
@@ -159,6 +179,7 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
   const Eigen::VectorXd u_nominal = plant ? plant->op.u : model.u_nominal();
   ClosedLoopSystem sys(model, controller, pf ? &*pf : nullptr, x_ref, u_nominal, o.stabilization);
   if (o.reference) sys.set_reference(o.reference);
+  if (o.disturbance) sys.set_disturbance(o.disturbance);
 
   // initial state, on the constraint manifold
   Eigen::VectorXd q0 = o.q0.size() ? o.q0 : model.q0, v0 = o.v0.size() ? o.v0 : model.v0;
@@ -303,7 +324,7 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
 
   if (o.compare_linear && plant && N > 0) {
     const Eigen::VectorXd dx0 = pf->qv_to_state(q0, v0) - x_ref;
-    const auto lin = linear_run(model, controller, *plant, rec.t, dx0, o.reference);
+    const auto lin = linear_run(model, controller, *plant, rec.t, dx0, o.reference, o.disturbance);
     r.y_linear = Recorder::stack(lin, r.y.cols());
   }
   r.stats.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

@@ -33,6 +33,10 @@ struct SimulationOptions {
   // r(t) for the Plant/Out outputs (ny values), for every controller type (docs/simulation.md:
   // PID acts on r - y, state feedback adds Nbar (r - y0), LTI sees y - r); empty: none
   std::function<Eigen::VectorXd(double)> reference;       // a state entry (q, v, controller) past this, or not finite, ends the run
+  // d(t) added to the actuators' nominal values, one entry per actuator (Model::actuators; zero
+  // for those not disturbed); the linear comparison adds LinearPlant::Bw/Dw times the entries of
+  // LinearPlant::disturbance_actuators; empty: none
+  std::function<Eigen::VectorXd(double)> disturbance;
 };
 
 // What a sample callback gets: copies, safe to hand to another thread.
@@ -51,6 +55,10 @@ struct SimulationCallbacks {
 struct LinearPlant {
   OperatingPoint op;
   Linearization lin;
+  // disturbance inputs (actuators that are not Plant/In): their columns of B and D in the
+  // same linearization, in the order of disturbance_actuators (indices into Model::actuators)
+  std::vector<int> disturbance_actuators;
+  Eigen::MatrixXd Bw, Dw;  // nx x nd, ny x nd
 };
 
 SimulationResult simulate(const Model& model, const Controller* controller, const LinearPlant* plant,

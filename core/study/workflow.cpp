@@ -11,7 +11,11 @@
 #include "analysis/discretize.hpp"
 #include "control/controllability.hpp"
 #include "control/lqr.hpp"
+#include "control/lqr_controllable.hpp"
 #include "dynamics/assembly.hpp"
+#include "io/curves_file.hpp"
+#include "io/output_guard.hpp"
+#include "io/signal_file.hpp"
 #include "model/compile.hpp"
 #include "model/errors.hpp"
 #include "simulation/model_controller.hpp"
@@ -84,16 +88,106 @@ std::string plant_study_json(const StudySpec& s, const std::string& operating_po
   return j.dump();
 }
 
+// The modes the inputs cannot move; an eigenvalue within round-off of 0 is reported as 0 (a
+// double pole at 0, the free yaw of a spherical pendulum, comes out of the eigen decomposition
+// split by about sqrt(eps ||A||))
+std::vector<HiddenMode> uncontrollable(const LinearSystem& sys) {
+  std::vector<HiddenMode> modes = uncontrollable_modes(sys.A, sys.B, sys.state_names);
+  const double tiny = 1.5e-8 * std::max(1.0, sys.A.norm());
+  for (HiddenMode& h : modes)
+    if (std::abs(h.eigenvalue) < tiny) h.eigenvalue = 0.0;
+  return modes;
+}
+
 // An LQR needs every mode that does not decay by itself to be movable by the inputs; say which are not.
 void require_stabilizable(const Model& m, const LinearSystem& sys) {
   std::vector<HiddenMode> bad;
   const double scale = std::max(1.0, sys.A.norm());
-  for (const HiddenMode& h : uncontrollable_modes(sys.A, sys.B, sys.state_names))
+  for (const HiddenMode& h : uncontrollable(sys))
     if (h.eigenvalue.real() >= -1e-9 * scale) bad.push_back(h);
   if (bad.empty()) return;
   throw std::invalid_argument((m.source_file.empty() ? std::string() : m.source_file + ": ") +
                               "lqr: the plant is not stabilizable: the Plant/In inputs cannot move " + describe(bad) +
-                              " (add an input that acts on them, or hold them with a joint spring or damper)");
+                              " (add an input that acts on them, or hold them with a joint spring or damper; or design "
+                              "on the controllable part only: \"lqr_controllable_part\": true in the analysis section, "
+                              "codyna simulate --lqr-controllable-part)");
+}
+
+// A signal as the run uses it: a "file" signal read into its points (a table); a file that
+// cannot be used is a ModelError at the signal's field, with the file's own message
+SignalSpec resolved(const Model& m, const SignalSpec& s, const std::string& field) {
+  if (s.type != "file") return s;
+  SignalSpec r = s;
+  try {
+    r.points = read_signal_file(study_path(m, s.file));
+  } catch (const std::invalid_argument& e) {
+    fail(m, field + "/file", e.what());
+  }
+  return r;
+}
+
+// d(t) on actuators that are not Plant/In: in the nonlinear run, and through their own B and D
+// columns (the plant linearized with them as extra inputs) in the linear comparison
+void attach_disturbances(const Model& m, StudySimulation& out) {
+  const StudySpec& s = m.spec.analysis;
+  if (s.disturbances.empty()) return;
+  std::vector<std::pair<int, SignalSpec>> signals;
+  std::vector<int> actuators;
+  std::vector<std::string> names;
+  for (const auto& a : m.actuators) names.push_back(a.name);
+  for (std::size_t k = 0; k < s.disturbances.size(); ++k) {
+    const DisturbanceSpec& d = s.disturbances[k];
+    const std::string field = "disturbances/" + std::to_string(k);
+    const auto it = std::find(names.begin(), names.end(), d.actuator);
+    if (it == names.end())
+      fail(m, field + "/actuator", "no actuator named \"" + d.actuator + "\" (actuators: " + listed(names) + ")");
+    const int i = static_cast<int>(it - names.begin());
+    if (std::find(m.plant_inputs.begin(), m.plant_inputs.end(), i) != m.plant_inputs.end())
+      fail(m, field + "/actuator", "\"" + d.actuator + "\" is a Plant/In input, driven by the controller; a disturbance " +
+                                       "goes on an actuator that is not (add one, e.g. a body_force on the same body)");
+    if (std::find(actuators.begin(), actuators.end(), i) != actuators.end())
+      fail(m, field + "/actuator", "a second disturbance on \"" + d.actuator + "\"");
+    actuators.push_back(i);
+    signals.emplace_back(i, resolved(m, d, field));
+  }
+  const int nu = m.nu();
+  out.options.disturbance = [nu, signals](double t) {
+    Eigen::VectorXd d = Eigen::VectorXd::Zero(nu);
+    for (const auto& [i, sig] : signals) d[i] += signal_value(sig, t, 0.0);
+    return d;
+  };
+  if (!out.plant) return;
+  // the same linearization with the disturbed actuators as extra inputs: their B and D columns
+  Model wide = m;
+  wide.plant_inputs.insert(wide.plant_inputs.end(), actuators.begin(), actuators.end());
+  LinearizeOptions lo;
+  lo.independent = s.independent;
+  const Linearization l = linearize(wide, out.plant->op, lo);
+  auto plant = std::make_shared<LinearPlant>(*out.plant);
+  const int nd = static_cast<int>(actuators.size());
+  plant->disturbance_actuators = actuators;
+  plant->Bw = l.system.B.rightCols(nd);
+  plant->Dw = l.system.D.rightCols(nd);
+  out.plant = plant;
+}
+
+// PID anti-windup, from the study, on whichever PID the study runs
+void attach_anti_windup(const Model& m, StudySimulation& out) {
+  const StudySpec& s = m.spec.analysis;
+  AntiWindup aw;
+  if (s.anti_windup == "none") return;
+  if (s.anti_windup == "back_calculation") aw.method = AntiWindup::Method::BackCalculation;
+  else if (s.anti_windup == "conditional") aw.method = AntiWindup::Method::Conditional;
+  else fail(m, "anti_windup", "unknown anti-windup method \"" + s.anti_windup + "\" (expected one of: " + listed(anti_windup_methods()) + ")");
+  aw.tracking_time = s.tracking_time;
+  if (aw.method == AntiWindup::Method::BackCalculation && !(s.tracking_time > 0 && std::isfinite(s.tracking_time)))
+    fail(m, "tracking_time", "back_calculation needs a tracking time > 0 (s), e.g. the integral time kp/ki");
+  const PidGains* g = out.controller ? out.controller->pid() : nullptr;
+  if (!g)
+    fail(m, "anti_windup", "applies to a PID controller; the study's controller is " +
+                               (out.controller ? out.controller->describe() : std::string("none")));
+  if (!g->Ki.size()) fail(m, "anti_windup", "the PID controller has no integral action (ki): nothing winds up");
+  out.controller = make_pid(g->Kp, g->Ki, g->Kd, g->r, g->u0, aw);
 }
 
 // r(t) on the Plant/Out outputs for the run; state feedback gets its Nbar feed-forward
@@ -113,7 +207,7 @@ void attach_references(const Model& m, StudySimulation& out) {
     if (std::find(tracked.begin(), tracked.end(), i) != tracked.end())
       fail(m, "references/" + std::to_string(k) + "/output", "a second reference for \"" + s.references[k].output + "\"");
     tracked.push_back(i);
-    signals.emplace_back(i, s.references[k]);
+    signals.emplace_back(i, resolved(m, s.references[k], "references/" + std::to_string(k)));
   }
   const Eigen::VectorXd y0 = sys.y0;
   out.options.reference = [y0, signals](double t) {
@@ -337,11 +431,33 @@ StudySimulation study_simulation(const Model& m) {
     out.controller_source = std::string("the model file's ") + to_string(m.spec.controller.type) + " controller";
   } else if (src == "lqr") {
     const LinearSystem& sys = out.plant->lin.system;
-    require_stabilizable(m, sys);
-    const LqrResult d = lqr(sys.A, sys.B, diagonal(m, s.q_weights, sys.nx(), "q_weights"),
-                            diagonal(m, s.r_weights, sys.nu(), "r_weights"));
-    out.lqr_gain = d.K;
-    out.controller = make_state_feedback(d.K, sys.u0);
+    const Eigen::MatrixXd Q = diagonal(m, s.q_weights, sys.nx(), "q_weights");
+    const Eigen::MatrixXd R = diagonal(m, s.r_weights, sys.nu(), "r_weights");
+    if (s.lqr_controllable_part) {
+      // the modes no input moves are named and left as they are; the rest is designed on
+      out.uncontrollable = uncontrollable(sys);
+      const ControllablePartLqr d = lqr_controllable_part(sys.A, sys.B, Q, R);
+      out.lqr_gain = d.lqr.K;
+      out.lqr_poles = d.lqr.closed_loop_poles;
+      if (!out.uncontrollable.empty()) {
+        std::string note = "lqr on the controllable part (" + std::to_string(d.Tc.cols()) + " of " +
+                           std::to_string(sys.nx()) + " states): the Plant/In inputs cannot move " +
+                           describe(out.uncontrollable) + "; these poles stay where they are";
+        const double scale = std::max(1.0, sys.A.norm());
+        for (const HiddenMode& h : out.uncontrollable)
+          if (h.eigenvalue.real() > 1e-9 * scale) {
+            note += " (one of them is unstable: the loop is not stable)";
+            break;
+          }
+        out.notes.push_back(note);
+      }
+    } else {
+      require_stabilizable(m, sys);
+      const LqrResult d = lqr(sys.A, sys.B, Q, R);
+      out.lqr_gain = d.K;
+      out.lqr_poles = d.closed_loop_poles;
+    }
+    out.controller = make_state_feedback(out.lqr_gain, sys.u0);
     out.controller_source = "lqr";
   } else if (src == "file") {
     if (s.controller_file.empty()) fail(m, "controller_file", "the controller source is a file, but none is named");
@@ -361,7 +477,9 @@ StudySimulation study_simulation(const Model& m) {
   } else {
     out.controller_source = "none";
   }
+  attach_anti_windup(m, out);
   if (!s.references.empty()) attach_references(m, out);
+  attach_disturbances(m, out);
   if (out.options.compare_linear && !out.plant) out.options.compare_linear = false;
   return out;
 }
@@ -377,6 +495,87 @@ SimulationResult study_simulate(const Model& m, const StudySimulation& setup, co
            << (setup.plant ? setup.plant->op.kind : "") << "\", \"controller\": \"" << setup.controller_source << "\"}";
   r.settings_json = settings.str();
   return r;
+}
+
+StudyClosedLoop study_closed_loop(const Model& m) {
+  const StudySpec& st = m.spec.analysis;
+  StudyClosedLoop r;
+  r.setup = study_simulation(m);
+  if (!r.setup.controller || !r.setup.plant)
+    fail(m, "controller", "the closed loop needs a controller: the controller source is \"" + st.controller + "\"" +
+                              (st.controller == "model" ? " and the model file declares none" : std::string()) +
+                              " (choose lqr, file, or give the model a controller)");
+  const LinearPlant& plant = *r.setup.plant;
+  const LinearSystem& sys = plant.lin.system;
+  std::shared_ptr<const Controller> ctrl = r.setup.controller;
+  // a state feedback with no reference in the study: Nbar for the first outputs, so that the
+  // reference inputs of the loop mean what they would in a run with references there
+  if (const Eigen::MatrixXd* K = ctrl->gain(); K && st.references.empty() && sys.ny() > 0) {
+    std::vector<int> tracked;
+    std::string names;
+    for (int k = 0; k < std::min(sys.nu(), sys.ny()); ++k) {
+      tracked.push_back(k);
+      names += (names.empty() ? "" : ", ") + sys.output_names[k];
+    }
+    try {
+      ctrl = make_state_feedback(*K, sys.u0, reference_gain(sys.A, sys.B, sys.C, *K, tracked), sys.y0);
+      r.notes.push_back("the study names no reference: the state feedback's Nbar tracks " + names +
+                        " (the first Plant/Out outputs, one per input); the other references have no effect");
+    } catch (const std::invalid_argument& e) {
+      r.notes.push_back(std::string("no Nbar feed-forward (") + e.what() + "): the references have no effect");
+    }
+  }
+  DisturbanceInputs w;
+  w.Bw = plant.Bw.size() ? plant.Bw : Eigen::MatrixXd::Zero(sys.nx(), 0);
+  w.Dw = plant.Dw.size() ? plant.Dw : Eigen::MatrixXd::Zero(sys.ny(), 0);
+  if (w.Bw.cols() != w.Dw.cols()) w.Dw = Eigen::MatrixXd::Zero(sys.ny(), w.Bw.cols());
+  w.nominal.resize(static_cast<Eigen::Index>(plant.disturbance_actuators.size()));
+  for (std::size_t k = 0; k < plant.disturbance_actuators.size(); ++k) {
+    const ActuatorModel& a = m.actuators[plant.disturbance_actuators[k]];
+    w.names.push_back(a.name);
+    w.units.push_back(a.unit);
+    w.nominal[static_cast<Eigen::Index>(k)] = plant.op.u[plant.disturbance_actuators[k]];
+  }
+  const std::optional<LinearLaw> law = ctrl->linear_law(sys.nx(), sys.ny());
+  if (!law) throw std::invalid_argument("closed loop: the controller (" + ctrl->describe() + ") has no linear form for this plant");
+  r.loop = close_loop(sys, *law, w, ctrl->state_names(), ctrl->describe());
+  r.poles = modal_analysis(r.loop.system);
+  if (sys.xdot0.size() && sys.xdot0.cwiseAbs().maxCoeff() > 1e-9 * std::max(1.0, sys.A.norm()))
+    r.notes.push_back("the operating point is not an equilibrium (xdot0 is not zero): the loop describes deviations "
+                      "about a moving point, the responses leave out xdot0");
+  const ClosedLoopSpec& c = st.closed_loop;
+  if (c.step_points < 2) fail(m, "closed_loop/step_points", "expected at least 2 points");
+  if (c.frequency_points < 2) fail(m, "closed_loop/frequency_points", "expected at least 2 points");
+  const double t_end = c.step_time > 0 ? c.step_time : default_step_time(r.poles);
+  r.step = step_response(r.loop.system, t_end, c.step_points);
+  auto [w_min, w_max] = default_frequency_range(r.poles, r.loop.system.Ts);
+  if (c.frequency_min > 0) w_min = c.frequency_min;
+  if (c.frequency_max > 0) w_max = c.frequency_max;
+  if (!(w_max > w_min)) {
+    std::ostringstream os;
+    os << "the frequency range is empty (" << w_min << " .. " << w_max << " rad/s): choose frequency_max above frequency_min";
+    fail(m, "closed_loop/frequency_max", os.str());
+  }
+  r.frequency = frequency_response(r.loop.system, log_grid(w_min, w_max, c.frequency_points));
+  return r;
+}
+
+std::vector<std::string> study_export_closed_loop(const Model& m, const StudyClosedLoop& cl, const std::string& dir_in) {
+  const StudySpec& s = m.spec.analysis;
+  const std::string dir = dir_in.empty() ? study_path(m, s.export_dir) : dir_in;
+  if (dir.empty()) fail(m, "export_dir", "no folder to export to (choose one)");
+  const std::string name = study_export_name(m) + "_cl";
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw std::runtime_error(dir + ": cannot create the export folder: " + ec.message());
+  const std::filesystem::path base = std::filesystem::path(dir) / name;
+  const std::string step = base.string() + "_step.csv", freq = base.string() + "_freq.csv";
+  guard_output(step, OutputKind::CurvesCsv, {m.source_file});
+  guard_output(freq, OutputKind::CurvesCsv, {m.source_file});
+  const ExportPaths p = export_closed_loop(cl.loop, cl.poles, cl.step.t, cl.frequency.w, dir, name);
+  write_step_csv(cl.loop, cl.step, step);
+  write_frequency_csv(cl.loop, cl.frequency, freq);
+  return {p.mat_file, p.m_file, step, freq};
 }
 
 }  // namespace codyna

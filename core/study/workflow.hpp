@@ -17,8 +17,11 @@
 #include <memory>
 #include <string>
 
+#include "analysis/closed_loop_linear.hpp"
 #include "analysis/linearize.hpp"
+#include "analysis/modal.hpp"
 #include "analysis/operating_point.hpp"
+#include "control/controllability.hpp"
 #include "io/mat_export.hpp"
 #include "model/model.hpp"
 #include "simulation/controller.hpp"
@@ -65,11 +68,33 @@ struct StudySimulation {
   SimulationOptions options;
   std::string controller_source;                 // "the model file's pid controller", "lqr", "K.mat", "none"
   Eigen::MatrixXd lqr_gain;                      // the gain designed, when the source is "lqr"
+  Eigen::VectorXcd lqr_poles;                    // eig(A - B lqr_gain), when the source is "lqr"
+  std::vector<HiddenMode> uncontrollable;        // lqr_controllable_part: the modes left as they are
+  std::vector<std::string> notes;                // what a front end should tell the user
 };
 
 // Controller and linear plant of the run (linearizing once if anything needs it).
 StudySimulation study_simulation(const Model& model);
 
 SimulationResult study_simulate(const Model& model, const StudySimulation& setup, const SimulationCallbacks& cb = {});
+
+// The linear closed loop of the study's plant and controller (analysis/closed_loop_linear.hpp):
+// the plant and controller study_simulation makes (same operating point, same Nbar), the
+// study's disturbance actuators as extra inputs, the poles, and the step and frequency
+// responses on the grids of study.closed_loop (automatic where 0). A state feedback whose
+// study names no reference gets Nbar for the first min(nu, ny) Plant/Out outputs (a note says so).
+struct StudyClosedLoop {
+  StudySimulation setup;
+  ClosedLoopLinear loop;
+  ModalAnalysis poles;
+  StepResponse step;
+  FrequencyResponse frequency;
+  std::vector<std::string> notes;
+};
+StudyClosedLoop study_closed_loop(const Model& model);
+
+// Writes DIR/NAME_cl.mat + NAME_cl.m (Acl, Bcl, Ccl, Dcl with names; io/mat_export.hpp) and the
+// curves DIR/NAME_cl_step.csv, DIR/NAME_cl_freq.csv; NAME is study_export_name. Returns the paths.
+std::vector<std::string> study_export_closed_loop(const Model& model, const StudyClosedLoop& cl, const std::string& dir = "");
 
 }  // namespace codyna

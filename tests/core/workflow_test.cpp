@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <filesystem>
+#include <tuple>
 
 #include "control/lqr.hpp"
 #include "dynamics/constraints.hpp"
@@ -58,7 +60,29 @@ TEST(Workflow, StudyRoundTripsThroughTheModelFile) {
   table.output = "theta";
   table.type = "table";
   table.points = {{0, 0}, {1, 0.1}, {2.5, -0.05}};
+  SignalSpec from_file;
+  from_file.output = "theta";
+  from_file.type = "file";
+  from_file.file = "theta_ref.csv";
   s.references = {ramp, table};
+  s.references.push_back(from_file);
+  DisturbanceSpec push;
+  push.actuator = "push";
+  push.type = "sine";
+  push.time = 2;
+  push.amplitude = 3;
+  push.frequency = 0.5;
+  push.phase = 0.25;
+  s.disturbances = {push};
+  s.anti_windup = "back_calculation";
+  s.tracking_time = 0.3;
+  s.lqr_controllable_part = true;
+  s.closed_loop.enabled = true;
+  s.closed_loop.step_time = 7;
+  s.closed_loop.step_points = 71;
+  s.closed_loop.frequency_min = 0.1;
+  s.closed_loop.frequency_max = 50;
+  s.closed_loop.frequency_points = 33;
   const auto dir = std::filesystem::temp_directory_path() / "codyna_workflow_test";
   std::filesystem::create_directories(dir);
   const std::string path = (dir / "study.json").string();
@@ -78,6 +102,27 @@ TEST(Workflow, BadStudyFieldsNameTheirPath) {
   std::string t2 = text;
   t2.replace(t2.find("\"method\": \"spline\""), 18, "\"operating_point\": \"time=-1\"");
   expect_model_error_at([&] { parse_model_spec_text(t2, "m.json"); }, "/analysis/operating_point", "time=T");
+  // the control workflow's fields
+  const auto with = [&](const std::string& analysis) {
+    std::string t = text;
+    t.replace(t.find("{\"method\": \"spline\"}"), 20, analysis);
+    return t;
+  };
+  const std::vector<std::tuple<std::string, std::string, std::string>> bad{
+      {R"({"anti_windup": "clamp"})", "/analysis/anti_windup", "unknown anti-windup method \"clamp\""},
+      {R"({"tracking_time": -1})", "/analysis/tracking_time", "a time constant > 0 (s)"},
+      {R"({"lqr_controllable_part": 1})", "/analysis/lqr_controllable_part", "true or false"},
+      {R"({"closed_loop": {"step_points": 1}})", "/analysis/closed_loop/step_points", "an integer from 2 to 1000000"},
+      {R"({"closed_loop": {"frequency_min": 10, "frequency_max": 1}})", "/analysis/closed_loop/frequency_max",
+       "a frequency above frequency_min 10"},
+      {R"({"closed_loop": {"enabled": "yes"}})", "/analysis/closed_loop/enabled", "true or false"},
+      {R"({"disturbances": [{"type": "step", "time": 0, "value": 1}]})", "/analysis/disturbances/0", "actuator"},
+      {R"({"references": [{"output": "y", "type": "file"}]})", "/analysis/references/0", "file"},
+      {R"({"references": [{"output": "y", "type": "file", "file": ""}]})", "/analysis/references/0/file",
+       "a file name (CSV or .mat)"},
+  };
+  for (const auto& [analysis, path, phrase] : bad)
+    expect_model_error_at([&] { parse_model_spec_text(with(analysis), "m.json"); }, path, phrase);
 }
 
 TEST(Workflow, DisabledEffectsAreLeftOutOfTheModel) {
@@ -199,6 +244,17 @@ TEST(Workflow, LqrOnAnUnstabilizablePlantNamesTheModes) {
     EXPECT_NE(what.find("pivot2"), std::string::npos) << what;
     EXPECT_EQ(what.find("(pivot,"), std::string::npos) << what;  // the driven pendulum is not blamed
   }
+  // designed on the controllable part anyway: the note says that what is left is unstable
+  spec.analysis.lqr_controllable_part = true;
+  const StudySimulation s = study_simulation(study_model(spec));
+  ASSERT_EQ(s.notes.size(), 1u);
+  std::printf("%s\n", s.notes[0].c_str());
+  EXPECT_NE(s.notes[0].find("lqr on the controllable part (2 of 4 states)"), std::string::npos) << s.notes[0];
+  EXPECT_NE(s.notes[0].find("(pivot2"), std::string::npos) << s.notes[0];
+  EXPECT_NE(s.notes[0].find("(one of them is unstable: the loop is not stable)"), std::string::npos) << s.notes[0];
+  bool unstable = false;
+  for (const HiddenMode& h : s.uncontrollable) unstable = unstable || h.eigenvalue.real() > 0;
+  EXPECT_TRUE(unstable);
 }
 
 // Coordinates the user sets are held exactly while the loops close (the four-bar's crank,
@@ -319,4 +375,70 @@ TEST(Workflow, SignalShapes) {
   EXPECT_EQ(signal_value(s, 1.0, 9), 2.0);
   EXPECT_EQ(signal_value(s, 5.0, 9), 4.0);
   EXPECT_EQ(signal_value(s, -1.0, 9), 0.0);
+}
+
+// An inverted spherical pendulum (tests/data/spherical_pendulum.json) with two horizontal forces at
+// its tip: upright, no input turns the rod about the vertical, so the yaw is uncontrollable (a
+// double pole at 0). An LQR alone is refused, naming the yaw; with lqr_controllable_part the design
+// covers the four tilt states, the yaw's poles stay at 0, and the nonlinear run from a tilt of
+// 0.1 rad about x and 0.05 rad about y comes upright.
+TEST(Workflow, LqrOnTheControllablePartOfASphericalPendulum) {
+  const std::string path = std::string(CODYNA_TEST_DATA_DIR) + "/spherical_pendulum.json";
+  ModelSpec spec = load_model_spec(path);
+  spec.analysis.controller = "lqr";
+  try {
+    study_simulation(study_model(spec, path));
+    FAIL() << "an LQR was designed for a plant that is not stabilizable";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("not stabilizable: the Plant/In inputs cannot move lambda = 0 (ball.wz); lambda = 0 (ball.wz) ("),
+              std::string::npos) << what;
+    EXPECT_NE(what.find("(ball.wz)"), std::string::npos) << what;  // the yaw rate, by name
+    for (const char* tilt : {"ball.rx", "ball.ry", "ball.wx", "ball.wy"}) EXPECT_EQ(what.find(tilt), std::string::npos) << what;
+    EXPECT_NE(what.find("\"lqr_controllable_part\": true"), std::string::npos) << what;
+  }
+  spec.analysis.lqr_controllable_part = true;
+  const Model m = study_model(spec, path);
+  const StudySimulation setup = study_simulation(m);
+  const LinearSystem& sys = setup.plant->lin.system;
+  ASSERT_EQ(sys.nx(), 6);
+  ASSERT_FALSE(setup.uncontrollable.empty());
+  for (const HiddenMode& h : setup.uncontrollable) {
+    // a double eigenvalue at 0 (yaw angle and rate), split to +-1.5e-9 by round-off: said as 0
+    EXPECT_EQ(h.eigenvalue, 0.0);
+    EXPECT_EQ(h.states, std::vector<std::string>{"ball.wz"});
+  }
+  ASSERT_EQ(setup.notes.size(), 1u);
+  EXPECT_EQ(setup.notes[0], "lqr on the controllable part (4 of 6 states): the Plant/In inputs cannot move lambda = 0 "
+                            "(ball.wz); lambda = 0 (ball.wz); these poles stay where they are");
+  std::printf("%s\n", setup.notes[0].c_str());
+  // the closed loop: four stable tilt poles, the yaw's two at 0; the design's poles are eig(A - B K)
+  const Eigen::VectorXcd p = Eigen::MatrixXd(sys.A - sys.B * setup.lqr_gain).eigenvalues();
+  int at_zero = 0;
+  for (Eigen::Index k = 0; k < p.size(); ++k) {
+    if (std::abs(p[k]) < 1e-7) {
+      ++at_zero;
+    } else {
+      EXPECT_LT(p[k].real(), -0.5) << p[k];
+    }
+  }
+  EXPECT_EQ(at_zero, 2);
+  ASSERT_EQ(setup.lqr_poles.size(), 6);
+  for (Eigen::Index k = 0; k < p.size(); ++k) {
+    double nearest = 1e300;
+    for (Eigen::Index j = 0; j < 6; ++j) nearest = std::min(nearest, std::abs(p[k] - setup.lqr_poles[j]));
+    EXPECT_LT(nearest, 1e-7);
+  }
+  // the gain does not act on the yaw states (K Tu = 0 up to round-off)
+  for (Eigen::Index j = 0; j < 6; ++j)
+    if (sys.state_names[j].find("z") != std::string::npos) {
+      EXPECT_LT(setup.lqr_gain.col(j).cwiseAbs().maxCoeff(), 1e-9 * setup.lqr_gain.cwiseAbs().maxCoeff()) << sys.state_names[j];
+    }
+  const SimulationResult r = study_simulate(m, setup);
+  ASSERT_TRUE(r.completed) << r.failure;
+  const int N = r.samples();
+  std::printf("spherical pendulum: tip (%.3g, %.3g) m at 0 s, (%.3g, %.3g) m at %.1f s, max |u| %.3g N\n", r.y(0, 0), r.y(0, 1),
+              r.y(N - 1, 0), r.y(N - 1, 1), r.t.back(), r.u.cwiseAbs().maxCoeff());
+  EXPECT_GT(std::hypot(r.y(0, 0), r.y(0, 1)), 0.1);
+  for (int k = N - 100; k < N; ++k) EXPECT_LT(std::hypot(r.y(k, 0), r.y(k, 1)), 1e-4) << r.t[k];
 }

@@ -447,6 +447,33 @@ class ViewsTest : public QObject {
     QVERIFY(std::abs(r->y(r->samples() - 1, 1)) < 0.5 * std::abs(r->y(0, 1)));
   }
 
+  // An LQR on the controllable part of the spherical pendulum (the study field set through the
+  // Document): the run stabilizes the tilt, and the note naming the yaw reaches the status line
+  // and the messages
+  void lqrOnTheControllablePartSaysWhatItLeaves() {
+    Document doc;
+    QVERIFY(doc.load(QStringLiteral(CODYNA_TEST_DATA_DIR "/spherical_pendulum.json")));
+    StudySpec study = doc.spec().analysis;
+    study.controller = "lqr";
+    study.lqr_controllable_part = true;
+    QVERIFY(doc.setStudy(study));
+    SimulateView view(&doc);
+    view.show();
+    QSignalSpy messages(&view, &SimulateView::message);
+    QSignalSpy finished(&view, &SimulateView::runFinished);
+    QTest::mouseClick(view.runButton(), Qt::LeftButton);
+    QVERIFY(waitFor([&] { return finished.count() == 1; }));
+    const auto r = view.result();
+    QVERIFY(r && r->completed);
+    const QString note = "lqr on the controllable part (4 of 6 states): the Plant/In inputs cannot move lambda = 0 (ball.wz)";
+    QVERIFY2(view.statusText().contains("; note: " + note), qPrintable(view.statusText()));
+    bool said = false;
+    for (const auto& m : messages) said = said || m.at(0).toString().startsWith("note: " + note);
+    QVERIFY(said);
+    const int N = r->samples();
+    QVERIFY(std::hypot(r->y(N - 1, 0), r->y(N - 1, 1)) < 1e-4);
+  }
+
   void cancelKeepsThePartialResult() {
     Document doc;
     QVERIFY(doc.load(kBricard));
