@@ -6,7 +6,9 @@
 # tests/data/fuzz_regressions/*, uses the dictionary tests/fuzz/model.dict,
 # and keeps what it finds (crash-*, leak-*, timeout-*, oom-*) in
 # tests/data/fuzz_findings/. Exit status: 0 when nothing was found.
-# CODYNA_JOBS (default 2) sets the build parallelism. See docs/reliability.md.
+# CODYNA_JOBS (default 2) sets the build parallelism; CODYNA_FUZZ_BUILD=DIR
+# reuses an existing CODYNA_FUZZ build (.ci/run: build-asan of scripts/sanitize.sh).
+# See docs/reliability.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${1:-60}"
@@ -16,14 +18,21 @@ case "$seconds" in ''|*[!0-9]*) echo "usage: $0 [SECONDS]" >&2; exit 2;; esac
 command -v clang++ > /dev/null || { echo "fuzz: clang++ not found (Debian: clang libclang-rt-14-dev)" >&2; exit 1; }
 
 src="$(pwd)"
-build="$src/build-fuzz"
-# -O1 with line tables, as fuzzing builds usually are, and without NDEBUG: the
-# assert()s and Eigen's bounds checks stay on and count as findings.
-CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCODYNA_FUZZ=ON \
-  -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" \
-  -DCODYNA_BUILD_GUI=OFF -DCODYNA_BUILD_TESTS=OFF -DCODYNA_BUILD_BENCH=OFF > "$build.log.tmp" 2>&1 \
-  || { cat "$build.log.tmp"; rm -f "$build.log.tmp"; exit 1; }
-rm -f "$build.log.tmp"
+if [ -n "${CODYNA_FUZZ_BUILD:-}" ]; then
+  # an existing CODYNA_FUZZ build (scripts/sanitize.sh's build-asan, as .ci/run uses)
+  build="$(cd "$CODYNA_FUZZ_BUILD" && pwd)"
+  grep -q '^CODYNA_FUZZ:BOOL=ON' "$build/CMakeCache.txt" \
+    || { echo "fuzz: $build is not a CODYNA_FUZZ build (configure it with scripts/sanitize.sh)" >&2; exit 1; }
+else
+  build="$src/build-fuzz"
+  # -O1 with line tables, as fuzzing builds usually are, and without NDEBUG: the
+  # assert()s and Eigen's bounds checks stay on and count as findings.
+  CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCODYNA_FUZZ=ON \
+    -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" \
+    -DCODYNA_BUILD_GUI=OFF -DCODYNA_BUILD_TESTS=OFF -DCODYNA_BUILD_BENCH=OFF > "$build.log.tmp" 2>&1 \
+    || { cat "$build.log.tmp"; rm -f "$build.log.tmp"; exit 1; }
+  rm -f "$build.log.tmp"
+fi
 cmake --build "$build" -j "${CODYNA_JOBS:-2}" --target model_loader_fuzz
 
 # Corpus: the examples and the known regression inputs as seeds (copied, so

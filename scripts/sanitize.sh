@@ -1,29 +1,38 @@
 #!/usr/bin/env bash
-# Builds the core library, the CLI and the core tests with AddressSanitizer +
-# UndefinedBehaviorSanitizer into build-asan/ (-O1, assertions on) and runs the
+# Builds the core library, the CLI, the core tests and the loader's fuzz target
+# with clang, AddressSanitizer + UndefinedBehaviorSanitizer (+ libFuzzer's
+# coverage, CODYNA_FUZZ) into build-asan/ (-O1, assertions on), and runs the
 # core GoogleTest suite and the CLI shell tests there (ctest -L "core|cli").
 # Any ASan error, leak or undefined behaviour fails the test that hit it.
-# Extra arguments go to ctest (e.g. -R ModelFile, -E cli.octave).
+# The same build then serves scripts/fuzz.sh (CODYNA_FUZZ_BUILD=build-asan),
+# as .ci/run does. Extra arguments go to ctest (e.g. -R ModelFile).
 # CODYNA_JOBS (default 2) sets the build and test parallelism.
 # See docs/reliability.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/deps.sh
+command -v clang++ > /dev/null || { echo "sanitize: clang++ not found (Debian: clang libclang-rt-14-dev)" >&2; exit 1; }
 jobs="${CODYNA_JOBS:-2}"
+build=build-asan
+# A directory configured by another compiler or set of options (an older
+# gcc-based build-asan) cannot be reused: start it afresh.
+if [ -f "$build/CMakeCache.txt" ] && ! grep -q '^CODYNA_FUZZ:BOOL=ON' "$build/CMakeCache.txt"; then
+  rm -rf "$build"
+fi
 # -O1 -g0 and no -DNDEBUG: faster to build, and Eigen's size assertions stay
-# on (they found an autodiff bug that the NDEBUG build could not see)
-cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCODYNA_SANITIZE=ON \
+# on (they found an autodiff bug that an NDEBUG build could not see)
+CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCODYNA_FUZZ=ON \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g0" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g0" \
-  -DCODYNA_BUILD_GUI=OFF -DCODYNA_BUILD_BENCH=OFF > build-asan.log.tmp 2>&1 \
-  || { cat build-asan.log.tmp; rm -f build-asan.log.tmp; exit 1; }
-rm -f build-asan.log.tmp
-# Only what the selected tests run: the CLI and the core test executable (the
-# Octave MEX is left out: an instrumented MEX cannot load into Octave).
-cmake --build build-asan -j "$jobs" --target codyna codyna_core_tests
+  -DCODYNA_BUILD_GUI=OFF -DCODYNA_BUILD_BENCH=OFF > "$build.log.tmp" 2>&1 \
+  || { cat "$build.log.tmp"; rm -f "$build.log.tmp"; exit 1; }
+rm -f "$build.log.tmp"
+# Only what the selected tests run, and the fuzz target (the Octave MEX is
+# left out: an instrumented MEX cannot load into Octave).
+cmake --build "$build" -j "$jobs" --target codyna codyna_core_tests model_loader_fuzz
 
 # LeakSanitizer is on; UBSan stops at the first finding with a stack trace.
 # Settings already in the environment are kept and take precedence.
 export ASAN_OPTIONS="detect_leaks=1${ASAN_OPTIONS:+:$ASAN_OPTIONS}"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1${UBSAN_OPTIONS:+:$UBSAN_OPTIONS}"
-cd build-asan
+cd "$build"
 ctest --output-on-failure -j "$jobs" -L "core|cli" "$@"
