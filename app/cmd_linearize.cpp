@@ -29,7 +29,7 @@ struct LinearizeArgs {
   double discrete = 0.0, trajectory = 0.0, trajectory_step = 0.0;
   bool closed_loop = false, lqr = false, lqr_controllable_part = false;
   std::vector<double> q_weights, r_weights;
-  std::vector<std::string> independent, set;
+  std::vector<std::string> independent, set, trim_free, free_inputs, targets;
   const CLI::App* cmd = nullptr;  // to tell given flags (they override the file's analysis section)
 };
 
@@ -168,6 +168,9 @@ ModelSpec study_of(const LinearizeArgs& a) {
     s.lqr_controllable_part = true;
   }
   apply_set(s, a.set);
+  if (given(a.cmd, "--trim-free")) s.trim_free = a.trim_free;
+  if (given(a.cmd, "--free-input")) s.free_inputs = a.free_inputs;
+  apply_targets(s, a.targets);
   return spec;
 }
 
@@ -253,7 +256,10 @@ void add_linearize(CLI::App& app) {
   cmd->add_option("--discrete", a->discrete, "sample time Ts > 0: exact zero-order-hold discrete model");
   cmd->add_option("--mat-version", a->mat_version, "5 | 7.3")->capture_default_str();
   cmd->add_option("--independent", a->independent, "closed loops: independent coordinate names")->delimiter(',');
-  cmd->add_option("--set", a->set, "NAME=VALUE: set a joint coordinate of the initial state (repeatable)");
+  cmd->add_option("--set", a->set, "NAME=VALUE: set a joint coordinate of the initial state (repeatable); held exactly by the equilibrium and trim searches");
+  cmd->add_option("--trim-free", a->trim_free, "trim: coordinates the trim solves instead of holding (comma-separated)")->delimiter(',');
+  cmd->add_option("--free-input", a->free_inputs, "equilibrium/trim: Plant/In inputs solved for (comma-separated; trim default: all)")->delimiter(',');
+  cmd->add_option("--target", a->targets, "NAME=VALUE: a Plant/Out value the equilibrium/trim must reach (repeatable)");
   cmd->add_option("--trajectory", a->trajectory, "T: linearize along a simulation from 0 to T (the model's controller in the loop, if any) instead of at one point");
   cmd->add_option("--trajectory-step", a->trajectory_step, "DT: spacing of the points along the trajectory (default: the model's output_step)");
   cmd->add_option("--name", a->name, "plant name (default: the model name as a MATLAB identifier)");

@@ -26,7 +26,7 @@ struct SimulateArgs {
   std::vector<double> q_weights, r_weights;
   double t_end = 0, rtol = 0, atol = 0, max_step = -1, output_step = 0;
   double max_samples = 1e7, divergence_bound = 1e8;
-  std::vector<std::string> independent, set;
+  std::vector<std::string> independent, set, trim_free, free_inputs, targets;
   const CLI::App* cmd = nullptr;  // to tell given flags (they override the file's analysis and solver sections)
 };
 
@@ -113,6 +113,9 @@ ModelSpec study_of(const SimulateArgs& a) {
   if (given(a.cmd, "--independent")) s.independent = a.independent;
   if (a.compare_linear) s.compare_linear = true;
   apply_set(s, a.set);
+  if (given(a.cmd, "--trim-free")) s.trim_free = a.trim_free;
+  if (given(a.cmd, "--free-input")) s.free_inputs = a.free_inputs;
+  apply_targets(s, a.targets);
   SolverSpec& sp = spec.solver;
   // each number given is checked where it enters, with its flag named
   const auto check = [&](const char* flag, double x, bool ok, const char* expected) {
@@ -222,7 +225,10 @@ void add_simulate(CLI::App& app) {
   cmd->add_option("--max-step", a->max_step, "largest step [s] (rk4: its fixed step)");
   cmd->add_option("--output-step", a->output_step, "output interval [s]");
   cmd->add_option("--independent", a->independent, "closed loops: independent coordinate names")->delimiter(',');
-  cmd->add_option("--set", a->set, "NAME=VALUE: set a joint coordinate of the initial state (repeatable)");
+  cmd->add_option("--set", a->set, "NAME=VALUE: set a joint coordinate of the initial state (repeatable); held exactly by the equilibrium and trim searches");
+  cmd->add_option("--trim-free", a->trim_free, "trim: coordinates the trim solves instead of holding (comma-separated)")->delimiter(',');
+  cmd->add_option("--free-input", a->free_inputs, "equilibrium/trim: Plant/In inputs solved for (comma-separated; trim default: all)")->delimiter(',');
+  cmd->add_option("--target", a->targets, "NAME=VALUE: a Plant/Out value the equilibrium/trim must reach (repeatable)");
   cmd->add_flag("--quiet", a->quiet, "no progress bar");
   cmd->add_option("--max-samples", a->max_samples, "refuse runs that would record more output samples")->capture_default_str();
   cmd->add_option("--divergence-bound", a->divergence_bound, "end the run when a state entry grows past this")->capture_default_str();

@@ -1,3 +1,4 @@
+#include <cmath>
 #include "common.hpp"
 
 #include <iostream>
@@ -15,10 +16,12 @@ ModelSpec load_spec(const std::string& path) {
   return spec;
 }
 
-void apply_set(StudySpec& study, const std::vector<std::string>& set) {
-  for (const std::string& s : set) {
+namespace {
+void apply_pairs(std::vector<std::pair<std::string, double>>& into, const std::vector<std::string>& given_pairs,
+                 const std::string& flag) {
+  for (const std::string& s : given_pairs) {
     const auto eq = s.find('=');
-    if (eq == std::string::npos) throw std::invalid_argument("--set " + s + ": expected NAME=VALUE");
+    if (eq == std::string::npos || eq == 0) throw std::invalid_argument(flag + " " + s + ": expected NAME=VALUE");
     const std::string name = s.substr(0, eq);
     double value;
     try {
@@ -26,12 +29,20 @@ void apply_set(StudySpec& study, const std::vector<std::string>& set) {
       value = std::stod(s.substr(eq + 1), &used);
       if (used != s.size() - eq - 1) throw std::invalid_argument("trailing text");
     } catch (const std::exception&) {
-      throw std::invalid_argument("--set " + s + ": expected a number after '='");
+      throw std::invalid_argument(flag + " " + s + ": expected a number after '='");
     }
-    auto it = std::find_if(study.set.begin(), study.set.end(), [&](const auto& p) { return p.first == name; });
-    if (it != study.set.end()) it->second = value;
-    else study.set.emplace_back(name, value);
+    if (!std::isfinite(value)) throw std::invalid_argument(flag + " " + s + ": expected a finite number");
+    auto it = std::find_if(into.begin(), into.end(), [&](const auto& p) { return p.first == name; });
+    if (it != into.end()) it->second = value;
+    else into.emplace_back(name, value);
   }
+}
+}  // namespace
+
+void apply_set(StudySpec& study, const std::vector<std::string>& set) { apply_pairs(study.set, set, "--set"); }
+
+void apply_targets(StudySpec& study, const std::vector<std::string>& targets) {
+  apply_pairs(study.output_targets, targets, "--target");
 }
 
 bool given(const CLI::App* cmd, const std::string& option) { return cmd->count(option) > 0; }

@@ -22,6 +22,8 @@ ModelSpec load_spec(const std::string& path);
 
 // --set NAME=VALUE ... added to the study's coordinates (a name given again replaces its value)
 void apply_set(StudySpec& study, const std::vector<std::string>& set);
+// the same for --target NAME=VALUE (StudySpec::output_targets)
+void apply_targets(StudySpec& study, const std::vector<std::string>& targets);
 
 // true when the option was given on the command line (so it overrides the file)
 bool given(const CLI::App* cmd, const std::string& option);

@@ -1,6 +1,8 @@
 #include "analysis/operating_point.hpp"
 
 #include <Eigen/QR>
+#include <algorithm>
+#include <cmath>
 #include <sstream>
 #include <stdexcept>
 
@@ -48,6 +50,144 @@ Eigen::VectorXd plant_u(const Model& m, const Eigen::VectorXd& u_all) {
   return u;
 }
 }  // namespace
+
+
+namespace {
+int index_of(const std::vector<std::string>& names, const std::string& name) {
+  const auto it = std::find(names.begin(), names.end(), name);
+  return it == names.end() ? -1 : static_cast<int>(it - names.begin());
+}
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string s;
+  for (const std::string& n : names) s += (s.empty() ? "" : ", ") + n;
+  return s.empty() ? "(none)" : s;
+}
+}  // namespace
+
+OperatingPoint steady_state(const Model& model, const OperatingPoint& start, const SteadyStateSpec& spec,
+                            const std::vector<std::string>& independent, const std::string& kind) {
+  OperatingPoint op = start;
+  op.kind = kind;
+  op.v = Eigen::VectorXd::Zero(model.nv);
+  // names -> indices
+  std::vector<std::string> in_names, out_names;
+  for (int k : model.plant_inputs) in_names.push_back(model.actuators[k].name);
+  for (int k : model.plant_outputs) out_names.push_back(model.sensors[k].name);
+  std::vector<int> free_u;  // positions in Plant/In
+  for (const std::string& name : spec.free_inputs) {
+    const int k = index_of(in_names, name);
+    if (k < 0) throw std::invalid_argument("steady state: free input \"" + name + "\" is not in Plant/In (" + joined(in_names) + ")");
+    if (std::find(free_u.begin(), free_u.end(), k) == free_u.end()) free_u.push_back(k);
+  }
+  std::vector<int> target_y;
+  Eigen::VectorXd target(static_cast<Eigen::Index>(spec.outputs.size()));
+  for (std::size_t i = 0; i < spec.outputs.size(); ++i) {
+    const int k = index_of(out_names, spec.outputs[i].first);
+    if (k < 0)
+      throw std::invalid_argument("steady state: output \"" + spec.outputs[i].first + "\" is not in Plant/Out (" +
+                                  joined(out_names) + ")");
+    if (!std::isfinite(spec.outputs[i].second))
+      throw std::invalid_argument("steady state: the value of output \"" + spec.outputs[i].first + "\" is not finite");
+    target_y.push_back(k);
+    target[static_cast<Eigen::Index>(i)] = spec.outputs[i].second;
+  }
+  Eigen::VectorXd u = plant_u(model, op.u);
+  std::vector<std::string> clamped;  // "name = limit (min|max)"
+  const auto residual = [&](const PlantFunction& f, const Eigen::VectorXd& z, const Eigen::VectorXd& uu) {
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(f.nx()), xd, y;
+    x.head(f.nz()) = z;
+    f.eval<double>(x, uu, xd, y);
+    Eigen::VectorXd r(f.nz() + static_cast<Eigen::Index>(target_y.size()));
+    r.head(f.nz()) = xd.tail(f.nz());
+    for (std::size_t i = 0; i < target_y.size(); ++i)
+      r[f.nz() + static_cast<Eigen::Index>(i)] = y[target_y[i]] - target[static_cast<Eigen::Index>(i)];
+    return r;
+  };
+  double accel_left = 0.0, output_left = 0.0;
+  const int rounds = static_cast<int>(free_u.size()) + 1;  // each clamps at least one input, or ends
+  for (int round = 0; round < rounds; ++round) {
+    for (op.iterations = 0; op.iterations < 60; ++op.iterations) {
+      const CoordinatePartition part = partition_holding(model, op.q, spec.held, independent);
+      for (std::size_t k = 0; k < model.plant_inputs.size(); ++k) op.u[model.plant_inputs[k]] = u[static_cast<Eigen::Index>(k)];
+      const PlantFunction f(model, op.q, op.u, part);
+      const int n = f.nz();
+      std::vector<int> free_z;  // unknown positions in z
+      for (int k = 0; k < n; ++k)
+        if (index_of(spec.held, model.v_names[static_cast<std::size_t>(part.independent[static_cast<std::size_t>(k)])]) < 0)
+          free_z.push_back(k);
+      const Eigen::VectorXd z0 = Eigen::VectorXd::Zero(n);
+      const Eigen::VectorXd r = residual(f, z0, u);
+      accel_left = n ? r.head(n).lpNorm<Eigen::Infinity>() : 0.0;
+      output_left = target_y.empty() ? 0.0 : r.tail(static_cast<Eigen::Index>(target_y.size())).lpNorm<Eigen::Infinity>();
+      if (accel_left < 1e-11 && output_left < 1e-11 * (1.0 + (target.size() ? target.lpNorm<Eigen::Infinity>() : 0.0)))
+        break;
+      const Eigen::MatrixXd J = plant_jacobian(f, Eigen::VectorXd::Zero(f.nx()), u, JacobianMethod::Exact);
+      const Eigen::Index m = r.size(), nf = static_cast<Eigen::Index>(free_z.size() + free_u.size());
+      if (nf == 0) break;
+      Eigen::MatrixXd G(m, nf);
+      for (Eigen::Index i = 0; i < m; ++i) {
+        const Eigen::Index row = i < n ? n + i : f.nx() + target_y[static_cast<std::size_t>(i - n)];
+        Eigen::Index c = 0;
+        for (int k : free_z) G(i, c++) = J(row, k);
+        for (int k : free_u) G(i, c++) = J(row, f.nx() + k);
+      }
+      const Eigen::VectorXd step = -Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(G).solve(r);
+      bool moved = false;
+      double t = 1.0;
+      for (int k = 0; k < 30 && !moved; ++k, t *= 0.5) {
+        Eigen::VectorXd dz = Eigen::VectorXd::Zero(n), un = u;
+        Eigen::Index c = 0;
+        for (int j : free_z) dz[j] = t * step[c++];
+        for (int j : free_u) un[j] += t * step[c++];
+        if (residual(f, dz, un).norm() < r.norm()) {
+          Eigen::VectorXd x = Eigen::VectorXd::Zero(f.nx()), v;
+          x.head(n) = dz;
+          f.state_to_qv(x, op.q, v);
+          u = un;
+          moved = true;
+        }
+      }
+      if (!moved) break;
+    }
+    // a free input beyond its limits: hold it at the limit, solve the rest again
+    bool clamped_now = false;
+    for (auto it = free_u.begin(); it != free_u.end();) {
+      const ActuatorModel& a = model.actuators[model.plant_inputs[static_cast<std::size_t>(*it)]];
+      const double value = u[*it];
+      if (value > a.max || value < a.min) {
+        const bool above = value > a.max;
+        u[*it] = above ? a.max : a.min;
+        std::ostringstream os;
+        os << a.name << " at its " << (above ? "max " : "min ") << u[*it] << " (it would need " << value << ")";
+        clamped.push_back(os.str());
+        it = free_u.erase(it);
+        clamped_now = true;
+      } else {
+        ++it;
+      }
+    }
+    if (!clamped_now) break;
+  }
+  for (std::size_t k = 0; k < model.plant_inputs.size(); ++k) op.u[model.plant_inputs[k]] = u[static_cast<Eigen::Index>(k)];
+  op.residual = accel_left;
+  const double out_tol = 1e-8 * (1.0 + (target.size() ? target.lpNorm<Eigen::Infinity>() : 0.0));
+  if (!(accel_left < 1e-8) || !(output_left < out_tol)) {
+    std::ostringstream os;
+    os << "steady state: not found: accelerations " << accel_left << " left";
+    if (!target_y.empty()) os << ", outputs off by " << output_left;
+    os << " (held: " << joined(spec.held) << "; free inputs: " << joined(spec.free_inputs) << ")";
+    if (!clamped.empty()) {
+      os << "; the actuator limits bind: ";
+      for (std::size_t k = 0; k < clamped.size(); ++k) os << (k ? "; " : "") << clamped[k];
+      os << " (raise the limits, free other inputs, or ask for another state)";
+    } else {
+      os << " (free more inputs or coordinates, or hold fewer)";
+    }
+    throw std::invalid_argument(os.str());
+  }
+  return op;
+}
 
 OperatingPoint static_equilibrium(const Model& model, const OperatingPoint& start,
                                   const std::vector<std::string>& independent) {

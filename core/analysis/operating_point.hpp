@@ -35,6 +35,26 @@ OperatingPoint static_equilibrium(const Model& model, const OperatingPoint& star
 
 OperatingPoint trim(const Model& model, const OperatingPoint& start, const std::vector<std::string>& independent = {});
 
+// A steady state with known and unknown parts (Simulink Control Design's
+// operspec, Adams' locked initial conditions): at rest (v = 0), the
+// accelerations vanish; the coordinates `held` keep their start values
+// exactly, the other independent coordinates are solved; the Plant/In inputs
+// `free_inputs` are solved within their actuators' limits, the others keep
+// their start values; each Plant/Out output named in `outputs` reaches its
+// value. Gauss-Newton with minimum-norm steps on the unknowns. A free input
+// that would leave its limits is held at the limit and the rest solved again;
+// when that fails, the error names the limit that binds. Throws
+// std::invalid_argument for an unknown name and when no steady state is found
+// (saying what is left).
+struct SteadyStateSpec {
+  std::vector<std::string> held;         // coordinates (Model::v_names) held at their start values
+  std::vector<std::string> free_inputs;  // Plant/In actuator names solved for
+  std::vector<std::pair<std::string, double>> outputs;  // Plant/Out name -> value to reach
+};
+
+OperatingPoint steady_state(const Model& model, const OperatingPoint& start, const SteadyStateSpec& spec,
+                            const std::vector<std::string>& independent = {}, const std::string& kind = "trim");
+
 OperatingPoint snapshot_point(const Model& model, double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
                               const Eigen::VectorXd& u);
 

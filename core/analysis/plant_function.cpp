@@ -95,6 +95,47 @@ CoordinatePartition partition_coordinates(const Model& m, const Eigen::VectorXd&
   return p;
 }
 
+CoordinatePartition partition_holding(const Model& m, const Eigen::VectorXd& q, const std::vector<std::string>& held,
+                                      const std::vector<std::string>& preferred) {
+  std::vector<int> held_v;
+  for (const std::string& name : held) {
+    const auto it = std::find(m.v_names.begin(), m.v_names.end(), name);
+    if (it == m.v_names.end())
+      throw std::invalid_argument("held coordinates: unknown coordinate \"" + name + "\"");
+    held_v.push_back(static_cast<int>(it - m.v_names.begin()));
+  }
+  if (held_v.empty() || !preferred.empty()) {
+    CoordinatePartition p = partition_coordinates(m, q, preferred);
+    for (std::size_t k = 0; k < held_v.size(); ++k)
+      if (std::find(p.independent.begin(), p.independent.end(), held_v[k]) == p.independent.end())
+        throw std::invalid_argument("held coordinates: \"" + held[k] +
+                                    "\" is not among the independent coordinates chosen; add it to them");
+    return p;
+  }
+  const std::vector<int> rows = independent_rows(m, q);
+  if (rows.empty()) return partition_coordinates(m, q);
+  // dependent coordinates among the others: the held columns are left out of the pivoting
+  Eigen::MatrixXd J = active_jacobian(m, q, rows);
+  for (int i : held_v) J.col(i).setZero();
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(J);
+  const auto& perm = qr.colsPermutation().indices();
+  std::set<int> dep;
+  for (Eigen::Index k = 0; k < J.rows(); ++k) dep.insert(perm[k]);
+  for (int i : held_v)
+    if (dep.count(i))
+      throw std::invalid_argument("held coordinates: the loops leave no freedom to hold \"" +
+                                  m.v_names[static_cast<std::size_t>(i)] + "\" with the others held too");
+  std::vector<std::string> names;
+  for (int i = 0; i < m.nv; ++i)
+    if (!dep.count(i)) names.push_back(m.v_names[static_cast<std::size_t>(i)]);
+  try {
+    return partition_coordinates(m, q, names);
+  } catch (const std::invalid_argument&) {
+    throw std::invalid_argument("held coordinates: the loops cannot close with these coordinates held (the remaining "
+                                "coordinates cannot be solved from the constraints here)");
+  }
+}
+
 PlantFunction::PlantFunction(const Model& model, const Eigen::VectorXd& q_ref, const Eigen::VectorXd& u_all,
                              CoordinatePartition partition)
     : model_(model), q_ref_(q_ref), u_all_(u_all), part_(std::move(partition)), rows_(independent_rows(model, q_ref)) {

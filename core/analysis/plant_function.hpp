@@ -35,6 +35,14 @@ struct CoordinatePartition {
 CoordinatePartition partition_coordinates(const Model& model, const Eigen::VectorXd& q,
                                           const std::vector<std::string>& preferred = {});
 
+// The same, with the coordinates `held` (Model::v_names) kept independent, so
+// that a search over the independent coordinates can hold them exactly. With
+// `preferred` given, every held coordinate must be among them; otherwise the
+// dependent coordinates are chosen among the others (column-pivoted QR).
+// Throws std::invalid_argument naming the coordinate when that is impossible.
+CoordinatePartition partition_holding(const Model& model, const Eigen::VectorXd& q, const std::vector<std::string>& held,
+                                      const std::vector<std::string>& preferred = {});
+
 class PlantFunction {
  public:
   // u_all: every actuator's value at the reference (plant inputs are replaced by eval's u)

@@ -1100,6 +1100,9 @@ const Schema<StudySpec>& schema<StudySpec>() {
       field("operating_point", &T::operating_point, read_study_operating_point),
       field("set", &T::set, read_set, encode_set),
       field("independent", &T::independent, read_names),
+      field("trim_free", &T::trim_free, read_names),
+      field("free_inputs", &T::free_inputs, read_names),
+      field("output_targets", &T::output_targets, read_set, encode_set),
       field("method", &T::method, [](const Node& n) { return read_word(n, study_methods(), "method"); }),
       field("discrete", &T::discrete,
             [](const Node& n) {

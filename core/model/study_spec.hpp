@@ -69,6 +69,16 @@ struct StudySpec {
   std::vector<std::pair<std::string, double>> set;
   // closed loops: the independent coordinates (empty = automatic choice)
   std::vector<std::string> independent;
+  // the steady-state search (operating points equilibrium and trim), as
+  // Simulink Control Design's operspec: coordinates set above are held
+  // exactly; a trim holds every independent coordinate except `trim_free`
+  // (solved), an equilibrium solves every coordinate not set; `free_inputs`
+  // are the Plant/In inputs solved for (a trim's default: all of Plant/In; an
+  // equilibrium's: none), within their limits; `output_targets` are Plant/Out
+  // values the steady state must reach
+  std::vector<std::string> trim_free;
+  std::vector<std::string> free_inputs;
+  std::vector<std::pair<std::string, double>> output_targets;
 
   // linearization and export
   std::string method = "exact";  // "exact", "fd-forward", "fd-central"

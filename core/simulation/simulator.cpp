@@ -159,7 +159,8 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
   if (controller && controller->sample_time() > 0 && (o.t_end - o.t0) / controller->sample_time() > o.max_samples * 100.0) {
     std::ostringstream os;
     os << "simulate: the controller's sample time " << controller->sample_time() << " s gives "
-       << (o.t_end - o.t0) / controller->sample_time() << " samples over the run, more than 100 times the sample limit";
+       << (o.t_end - o.t0) / controller->sample_time() << " samples over the run, more than 100 times the sample limit of "
+       << o.max_samples << " (raise the sample time, or the limit: --max-samples)";
     throw std::invalid_argument(os.str());
   }
   if (model.dof() == 0)

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/discretize.hpp"
+#include "analysis/plant_function.hpp"
 #include "control/controllability.hpp"
 #include "control/lqr.hpp"
 #include "control/lqr_controllable.hpp"
@@ -333,6 +334,39 @@ OperatingPoint study_operating_point(const Model& m, const std::string& which_in
   const std::string which = which_in.empty() ? s.operating_point : which_in;
   const OperatingPoint start = initial_point(m);
   if (which == "initial") return start;
+  // the positions set by the user (scalar coordinates: their q and v names agree) are held
+  std::vector<std::string> set_positions;
+  for (const auto& [name, value] : s.set)
+    if (std::count(m.v_names.begin(), m.v_names.end(), name) && std::count(m.q_names.begin(), m.q_names.end(), name))
+      set_positions.push_back(name);
+  const bool spec_given = !s.trim_free.empty() || !s.free_inputs.empty() || !s.output_targets.empty();
+  if ((which == "equilibrium" && (spec_given || !set_positions.empty())) || (which == "trim" && spec_given)) {
+    SteadyStateSpec spec;
+    spec.held = set_positions;
+    spec.outputs = s.output_targets;
+    spec.free_inputs = s.free_inputs;
+    if (which == "trim") {
+      // every independent coordinate is held except those the user frees
+      const CoordinatePartition p = partition_holding(m, start.q, set_positions, s.independent);
+      spec.held.clear();
+      for (int i : p.independent) {
+        const std::string& name = m.v_names[static_cast<std::size_t>(i)];
+        if (!std::count(s.trim_free.begin(), s.trim_free.end(), name)) spec.held.push_back(name);
+      }
+      for (const std::string& name : s.trim_free)
+        if (!std::count(m.v_names.begin(), m.v_names.end(), name))
+          fail(m, "trim_free", "unknown coordinate \"" + name + "\" (coordinates: " + listed(m.v_names) + ")");
+      if (spec.free_inputs.empty())
+        for (int k : m.plant_inputs) spec.free_inputs.push_back(m.actuators[static_cast<std::size_t>(k)].name);
+    } else if (!s.trim_free.empty()) {
+      fail(m, "trim_free", "coordinates are freed for operating point trim only (an equilibrium solves every coordinate not set)");
+    }
+    try {
+      return steady_state(m, start, spec, s.independent, which);
+    } catch (const std::invalid_argument& e) {
+      fail(m, "operating_point", std::string(which) + ": " + e.what());
+    }
+  }
   if (which == "equilibrium") {
     const OperatingPoint op = static_equilibrium(m, start, s.independent);
     if (!(op.residual < 1e-8)) {

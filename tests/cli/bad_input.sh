@@ -82,6 +82,19 @@ expect 2 "diverged" -- "$codyna" simulate unstable.json --out u.h5 --quiet --t-e
 [ $(( $(date +%s) - start )) -lt 20 ] || fail "the diverging run took more than 20 s"
 [ -s u.h5 ] || fail "no partial result after divergence"
 
+# a sampled (LTI) controller with a tiny sample time is refused before the run, not spun through
+python3 - "$src/examples/pendulum.json" > tinyts.json <<'PY'
+import json, sys
+m = json.load(open(sys.argv[1]))
+m["controller"] = {"type": "lti", "Ac": [[0]], "Bc": [[1]], "Cc": [[1]], "Dc": [[-1]], "Ts": 1e-12, "operating_point": "equilibrium"}
+json.dump(m, sys.stdout)
+PY
+start=$(date +%s)
+expect 1 "sample time" -- "$codyna" simulate tinyts.json --out ts.h5 --quiet
+expect 1 "max-samples" -- "$codyna" simulate tinyts.json --out ts.h5 --quiet
+[ $(( $(date +%s) - start )) -lt 20 ] || fail "refusing a tiny sample time took more than 20 s"
+[ ! -e ts.h5 ] || fail "a refused run wrote ts.h5"
+
 # a model controller declared about an equilibrium that does not exist is refused, as linearize refuses it
 python3 - "$src/examples/pendulum.json" > noeq.json <<'PY'
 import json, sys

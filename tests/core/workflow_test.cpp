@@ -150,9 +150,14 @@ TEST(Workflow, SetCoordinatesAndOperatingPoints) {
   const Model m = study_model(spec);
   EXPECT_EQ(m.q0[0], 1.0);
   EXPECT_EQ(study_operating_point(m).q[0], 1.0);
-  // equilibrium of the hanging/upright pendulum: theta = +-90 deg
-  const OperatingPoint eq = study_operating_point(m, "equilibrium");
-  EXPECT_NEAR(std::abs(std::remainder(eq.q[0], M_PI)), M_PI / 2, 1e-9);
+  // a set coordinate is held by the equilibrium search: at 1 rad gravity turns the rod, so there
+  // is no equilibrium with pivot held (nothing is free to hold it), and the error says so
+  expect_model_error_at([&] { study_operating_point(m, "equilibrium"); }, "/analysis/operating_point", "held: pivot");
+  // held upright (the com straight above the pivot) it is one, to the bit
+  spec.analysis.set = {{"pivot", M_PI / 2}};
+  const OperatingPoint eq = study_operating_point(study_model(spec), "equilibrium");
+  EXPECT_EQ(eq.q[0], M_PI / 2);
+  EXPECT_LT(eq.residual, 1e-12);
   spec.analysis.set = {{"no_such_joint", 1.0}};
   expect_model_error_at([&] { study_model(spec); }, "/analysis/set/no_such_joint", "positions: pivot");
   spec.analysis.set.clear();
