@@ -8,6 +8,11 @@ namespace codyna {
 template <class S>
 const MatXT<S>& crba(const Model& model, DataT<S>& d, const VecXT<S>& q) {
   forward_kinematics<S>(model, d, q);
+  return crba_after_kinematics<S>(model, d);
+}
+
+template <class S>
+const MatXT<S>& crba_after_kinematics(const Model& model, DataT<S>& d) {
   for (int i = 0; i < model.nbodies; ++i) d.Ic[i] = model.inertia[i].cast<S>();
   for (int i = model.nbodies - 1; i > 0; --i) {
     const int p = model.parent[i];
@@ -34,6 +39,8 @@ const MatXT<S>& crba(const Model& model, DataT<S>& d, const VecXT<S>& q) {
   return d.M;
 }
 
+template const MatXT<double>& crba_after_kinematics<double>(const Model&, DataT<double>&);
+template const MatXT<ADScalar>& crba_after_kinematics<ADScalar>(const Model&, DataT<ADScalar>&);
 template const MatXT<double>& crba<double>(const Model&, DataT<double>&, const VecXT<double>&);
 template const MatXT<ADScalar>& crba<ADScalar>(const Model&, DataT<ADScalar>&, const VecXT<ADScalar>&);
 

@@ -10,4 +10,9 @@ namespace codyna {
 template <class S>
 const MatXT<S>& crba(const Model& model, DataT<S>& data, const VecXT<S>& q);
 
+// the same, reusing the positions (liMi, oMi, Sb) that forward_kinematics(q)
+// already wrote into data
+template <class S>
+const MatXT<S>& crba_after_kinematics(const Model& model, DataT<S>& data);
+
 }  // namespace codyna
