@@ -27,6 +27,19 @@ Eigen::VectorXd stacked(const PlantFunction& f, const Eigen::VectorXd& xu) {
 }
 }  // namespace
 
+Eigen::MatrixXd plant_jacobian_autodiff(const PlantFunction& f, const Eigen::VectorXd& x, const Eigen::VectorXd& u) {
+  const int nx = f.nx(), nu = f.nu(), ny = f.ny(), n = nx + nu;
+  Eigen::MatrixXd J(nx + ny, n);
+  const ADVec xa = ad_seed(x, n, 0), ua = ad_seed(u, n, nx);
+  ADVec xd, y;
+  f.eval<ADScalar>(xa, ua, xd, y);
+  for (int r = 0; r < nx + ny; ++r) {
+    const ADScalar& s = r < nx ? xd[r] : y[r - nx];
+    J.row(r) = s.derivatives().size() ? Eigen::RowVectorXd(s.derivatives().transpose()) : Eigen::RowVectorXd::Zero(n);
+  }
+  return J;
+}
+
 Eigen::MatrixXd plant_jacobian(const PlantFunction& f, const Eigen::VectorXd& x, const Eigen::VectorXd& u,
                                JacobianMethod method) {
   const int nx = f.nx(), nu = f.nu(), ny = f.ny(), n = nx + nu;
@@ -34,14 +47,8 @@ Eigen::MatrixXd plant_jacobian(const PlantFunction& f, const Eigen::VectorXd& x,
   xu << x, u;
   Eigen::MatrixXd J(nx + ny, n);
   if (method == JacobianMethod::Exact) {
-    const ADVec xa = ad_seed(x, n, 0), ua = ad_seed(u, n, nx);
-    ADVec xd, y;
-    f.eval<ADScalar>(xa, ua, xd, y);
-    for (int r = 0; r < nx + ny; ++r) {
-      const ADScalar& s = r < nx ? xd[r] : y[r - nx];
-      J.row(r) = s.derivatives().size() ? Eigen::RowVectorXd(s.derivatives().transpose()) : Eigen::RowVectorXd::Zero(n);
-    }
-    return J;
+    if (f.analytic_jacobian(x, u, J)) return J;
+    return plant_jacobian_autodiff(f, x, u);
   }
   const double eps = std::numeric_limits<double>::epsilon();
   const bool central = method == JacobianMethod::CentralDifference;

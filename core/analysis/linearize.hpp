@@ -2,8 +2,11 @@
 // in minimal coordinates (see plant_function.hpp for the state):
 //   dx = A x + B u,  y = C x + D u   about (x0, u0, y0), with xdot0 = f(x0, u0).
 // Jacobians two ways behind one interface:
-//   Exact            forward-mode automatic differentiation of the same
-//                    Scalar-templated dynamics (default)
+//   Exact            analytic derivatives of the recursive algorithms for
+//                    trees at the operating point (dynamics/derivatives.hpp);
+//                    elsewhere (closed loops, off-point states) forward-mode
+//                    automatic differentiation of the same Scalar-templated
+//                    dynamics (default)
 //   ForwardDifference (f(x + h e) - f(x)) / h,      h = sqrt(eps) max(1, |x_i|)
 //   CentralDifference (f(x + h e) - f(x - h e)) / 2h, h = cbrt(eps) max(1, |x_i|)
 // The finite-difference results carry an accuracy estimate: their largest
@@ -38,5 +41,9 @@ Linearization linearize(const Model& model, const OperatingPoint& op, const Line
 // The full Jacobian [A B; C D] of the plant function at x, u (for checks and trim).
 Eigen::MatrixXd plant_jacobian(const PlantFunction& f, const Eigen::VectorXd& x, const Eigen::VectorXd& u,
                                JacobianMethod method);
+
+// The same by forward-mode automatic differentiation of PlantFunction::eval,
+// always (the independent check of the analytic path).
+Eigen::MatrixXd plant_jacobian_autodiff(const PlantFunction& f, const Eigen::VectorXd& x, const Eigen::VectorXd& u);
 
 }  // namespace codyna

@@ -4,10 +4,12 @@
 #include <Eigen/QR>
 #include <algorithm>
 #include <set>
+#include <type_traits>
 #include <stdexcept>
 
 #include "dynamics/assembly.hpp"
 #include "dynamics/constraints.hpp"
+#include "dynamics/derivatives.hpp"
 #include "dynamics/forward_dynamics.hpp"
 #include "dynamics/joint.hpp"
 #include "dynamics/kinematics.hpp"
@@ -123,8 +125,35 @@ Eigen::VectorXd PlantFunction::solve_dependent(const Eigen::VectorXd& z) const {
   return r;
 }
 
+void PlantFunction::eval_tree(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd& xdot,
+                              Eigen::VectorXd& y) const {
+  const Model& m = model_;
+  const int n = nz();
+  if (!ws_.data) ws_.data = std::make_unique<Data>(m);
+  Data& d = *ws_.data;
+  ws_.dq = x.head(n);  // a tree: every coordinate is independent, in order
+  ws_.w = x.tail(n);
+  integrate_into<double>(m, q_ref_, ws_.dq, ws_.q);
+  ws_.u_all = u_all_;
+  for (int k = 0; k < nu(); ++k) ws_.u_all[m.plant_inputs[k]] = u[k];
+  const Eigen::VectorXd& qdd = forward_dynamics<double>(m, d, ws_.q, ws_.w, ws_.u_all);
+  tangent_rate_into<double>(m, ws_.dq, ws_.w, ws_.rate);
+  if (xdot.size() != 2 * n) xdot.resize(2 * n);
+  xdot.head(n) = ws_.rate;
+  xdot.tail(n) = qdd;
+  // forward_dynamics left the kinematics of (q, v) in d
+  if (y.size() != ny()) y.resize(ny());
+  for (int k = 0; k < ny(); ++k) y[k] = sensor_value<double>(m, d, m.sensors[m.plant_outputs[k]], ws_.q, ws_.w);
+}
+
 template <class S>
 void PlantFunction::eval(const VecXT<S>& x, const VecXT<S>& u, VecXT<S>& xdot, VecXT<S>& y) const {
+  if constexpr (std::is_same_v<S, double>) {
+    if (part_.dependent.empty() && model_.nc == 0) {
+      eval_tree(x, u, xdot, y);
+      return;
+    }
+  }
   const Model& m = model_;
   const int n = nz(), nd = static_cast<int>(part_.dependent.size());
   const auto& ind = part_.independent;
@@ -176,6 +205,50 @@ void PlantFunction::eval(const VecXT<S>& x, const VecXT<S>& u, VecXT<S>& xdot, V
   }
   forward_kinematics<S>(m, d, q, v);
   y = sensor_outputs<S>(m, d, m.plant_outputs, q, v);
+}
+
+PlantFunction::Workspace::Workspace() = default;
+PlantFunction::Workspace::Workspace(const Workspace&) {}
+PlantFunction::Workspace& PlantFunction::Workspace::operator=(const Workspace&) {
+  td.reset();
+  return *this;
+}
+PlantFunction::Workspace::~Workspace() = default;
+
+bool PlantFunction::analytic_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::MatrixXd& J) const {
+  const Model& m = model_;
+  if (m.nc != 0 || !part_.dependent.empty()) return false;
+  const int n = nz(), nu_p = nu(), ny_p = ny();
+  for (int k = 0; k < n; ++k)
+    if (x[k] != 0.0 || part_.independent[k] != k) return false;
+  if (!ws_.td) {
+    ws_.td = std::make_unique<TreeDerivatives>(m);
+    ws_.v.resize(m.nv);
+    ws_.u_all.resize(m.nu());
+  }
+  TreeDerivatives& td = *ws_.td;
+  ws_.v = x.tail(n);
+  ws_.u_all = u_all_;
+  for (int k = 0; k < nu_p; ++k) ws_.u_all[m.plant_inputs[k]] = u[k];
+  td.compute(q_ref_, ws_.v, ws_.u_all, m.plant_outputs);
+  if (J.rows() != 2 * n + ny_p || J.cols() != 2 * n + nu_p) J.resize(2 * n + ny_p, 2 * n + nu_p);
+  J.setZero();
+  // d/dt of the position deviation: the velocity, turned by the tangent map of rotations
+  J.block(0, n, n, n).setIdentity();
+  for (int b = 1; b < m.nbodies; ++b) {
+    const JointModel& j = m.joints[b];
+    if (j.type != JointType::Spherical && j.type != JointType::Free) continue;
+    const Eigen::Vector3d w = ws_.v.segment<3>(j.idx_v);
+    J.block<3, 3>(j.idx_v, j.idx_v) = -0.5 * skew<double>(w);
+    if (j.type == JointType::Free)
+      J.block<3, 3>(j.idx_v + 3, j.idx_v) = -skew<double>(Eigen::Vector3d(ws_.v.segment<3>(j.idx_v + 3)));
+  }
+  J.block(n, 0, n, n) = td.dqdd_dq;
+  J.block(n, n, n, n) = td.dqdd_dv;
+  for (int k = 0; k < nu_p; ++k) J.block(n, 2 * n + k, n, 1) = td.dqdd_du.col(m.plant_inputs[k]);
+  J.block(2 * n, 0, ny_p, n) = td.dy_dq;
+  J.block(2 * n, n, ny_p, n) = td.dy_dv;
+  return true;
 }
 
 void PlantFunction::state_to_qv(const Eigen::VectorXd& x, Eigen::VectorXd& q, Eigen::VectorXd& v) const {

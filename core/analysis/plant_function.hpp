@@ -12,12 +12,15 @@
 // through the same code; double and ADScalar are instantiated.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "model/data.hpp"
 
 namespace codyna {
+
+class TreeDerivatives;
 
 struct CoordinatePartition {
   std::vector<int> independent;  // v indices, size DOF
@@ -56,6 +59,13 @@ class PlantFunction {
   std::vector<std::string> state_units() const;
   Eigen::VectorXd state_offset(const Eigen::VectorXd& v_ref) const;
 
+  // The exact Jacobian [A B; C D] at (x, u) by analytic derivatives of the
+  // recursive algorithms (dynamics/derivatives.hpp), into J (resized only when
+  // its size differs). Applies to tree models at x with zero position
+  // deviation (the operating point itself); returns false otherwise (callers
+  // then differentiate eval<ADScalar>). No heap allocation after the first call.
+  bool analytic_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::MatrixXd& J) const;
+
   const CoordinatePartition& partition() const { return part_; }
   const Eigen::VectorXd& u_all() const { return u_all_; }
 
@@ -66,6 +76,21 @@ class PlantFunction {
   Eigen::VectorXd q_ref_, u_all_;
   CoordinatePartition part_;
   std::vector<int> rows_;  // constraint rows independent at q_ref
+
+  // workspace of analytic_jacobian, made on first use; a copy starts without one
+  // eval<double> on a tree, into the workspace (no heap after the first call)
+  void eval_tree(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd& xdot, Eigen::VectorXd& y) const;
+
+  struct Workspace {
+    std::unique_ptr<TreeDerivatives> td;
+    std::unique_ptr<Data> data;
+    Eigen::VectorXd v, u_all, dq, q, w, rate;
+    Workspace();
+    Workspace(const Workspace&);
+    Workspace& operator=(const Workspace&);  // the copy makes its own
+    ~Workspace();
+  };
+  mutable Workspace ws_;
 };
 
 }  // namespace codyna

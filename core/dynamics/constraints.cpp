@@ -8,21 +8,45 @@ namespace codyna {
 namespace {
 
 // a body-fixed vector in world axes with its first two time derivatives (qdd = 0)
+// a . b for autodiff scalars whose derivative vectors may be empty (constants):
+// every product is evaluated into a plain scalar before it is summed, so that
+// Eigen's AutoDiffScalar can make the derivative sizes coherent (it cannot
+// inside an unevaluated expression, where a constant's empty derivative would
+// silently drop or misread the other's)
+template <class S>
+S dot3(const Vec3T<S>& a, const Vec3T<S>& b, Eigen::Index nd) {
+  S r = ad_coherent(S(a[0] * b[0]), nd);
+  for (int k = 1; k < 3; ++k) {
+    const S p = ad_coherent(S(a[k] * b[k]), nd);
+    r = r + p;
+  }
+  return r;
+}
+
 template <class S>
 struct Attached {
   Vec3T<S> x, xd, xdd;
 };
 
 template <class S>
-Attached<S> attached(const DataT<S>& d, int body, const Eigen::Vector3d& local) {
+Attached<S> attached(const DataT<S>& d, int body, const Eigen::Vector3d& local, Eigen::Index nd) {
+  auto coh = [nd](auto& m) { ad_make_coherent(m, nd); };
   const Vec3T<S> x = d.oMi[body].R * local.cast<S>();
   const Vec3T<S> w = angular_velocity<S>(d, body), al = angular_acceleration<S>(d, body);
-  const Vec3T<S> xd = w.cross(x);
-  return {x, xd, Vec3T<S>(al.cross(x) + w.cross(xd))};
+  Vec3T<S> xc = x, wc = w, alc = al;
+  coh(xc);
+  coh(wc);
+  coh(alc);
+  Vec3T<S> xd = wc.cross(xc);
+  coh(xd);
+  Vec3T<S> xdd = alc.cross(xc) + wc.cross(xd);
+  coh(xdd);
+  return {xc, xd, xdd};
 }
 
 template <class S>
-void fill_rows(const Model& model, DataT<S>& d, bool with_velocity) {
+void fill_rows(const Model& model, DataT<S>& d, bool with_velocity, Eigen::Index nd) {
+  auto coh = [nd](auto& m) { ad_make_coherent(m, nd); };
   for (const ConstraintModel& c : model.constraints) {
     const Vec3T<S> pa = point_position<S>(d, c.body_a, c.point_a), pb = point_position<S>(d, c.body_b, c.point_b);
     const Vec3T<S> dp = pa - pb;
@@ -35,11 +59,21 @@ void fill_rows(const Model& model, DataT<S>& d, bool with_velocity) {
       Jwa = body_jacobian_world<S>(model, d, c.body_a).topRows(3);
       Jwb = body_jacobian_world<S>(model, d, c.body_b).topRows(3);
     }
+    // constants (ground, fixed axes) beside variables: one derivative size for all
+    Vec3T<S> dpc = dp;
+    coh(dpc);
+    if (with_velocity) {
+      coh(dpd);
+      coh(dpdd);
+      coh(Jp);
+      coh(Jwa);
+      coh(Jwb);
+    }
     int r = c.row;
     switch (c.type) {
       case ConstraintType::Ball:
       case ConstraintType::Revolute:
-        d.phi.template segment<3>(r) = dp;
+        d.phi.template segment<3>(r) = dpc;
         if (with_velocity) {
           d.Jc.middleRows(r, 3) = Jp;
           d.gamma.template segment<3>(r) = dpdd;
@@ -48,22 +82,32 @@ void fill_rows(const Model& model, DataT<S>& d, bool with_velocity) {
         r += 3;
         for (const Eigen::Vector3d* perp : {&c.perp_b1, &c.perp_b2}) {
           // a . b with a on body_a, b on body_b
-          const Attached<S> a = attached<S>(d, c.body_a, c.axis_a), b = attached<S>(d, c.body_b, *perp);
-          d.phi[r] = a.x.dot(b.x);
+          const Attached<S> a = attached<S>(d, c.body_a, c.axis_a, nd), b = attached<S>(d, c.body_b, *perp, nd);
+          d.phi[r] = dot3<S>(a.x, b.x, nd);
           if (with_velocity) {
-            d.Jc.row(r) = a.x.cross(b.x).transpose() * (Jwa - Jwb);
-            d.gamma[r] = a.xdd.dot(b.x) + S(2) * a.xd.dot(b.xd) + a.x.dot(b.xdd);
+            Vec3T<S> axb = a.x.cross(b.x);
+            coh(axb);
+            d.Jc.row(r) = axb.transpose() * (Jwa - Jwb);
+            const S g1 = dot3<S>(a.xdd, b.x, nd), g2 = dot3<S>(a.xd, b.xd, nd), g3 = dot3<S>(a.x, b.xdd, nd);
+            const S g2x2 = ad_coherent(S(S(2) * g2), nd);
+            const S g12 = g1 + g2x2;
+            d.gamma[r] = g12 + g3;
           }
           ++r;
         }
         break;
       case ConstraintType::PlanarRevolute:
         for (const Eigen::Vector3d* perp : {&c.perp_a1, &c.perp_a2}) {
-          const Attached<S> e = attached<S>(d, c.body_a, *perp);
-          d.phi[r] = e.x.dot(dp);
+          const Attached<S> e = attached<S>(d, c.body_a, *perp, nd);
+          d.phi[r] = dot3<S>(e.x, dpc, nd);
           if (with_velocity) {
-            d.Jc.row(r) = e.x.cross(dp).transpose() * Jwa + e.x.transpose() * Jp;
-            d.gamma[r] = e.xdd.dot(dp) + S(2) * e.xd.dot(dpd) + e.x.dot(dpdd);
+            Vec3T<S> exd = e.x.cross(dpc);
+            coh(exd);
+            d.Jc.row(r) = exd.transpose() * Jwa + e.x.transpose() * Jp;
+            const S g1 = dot3<S>(e.xdd, dpc, nd), g2 = dot3<S>(e.xd, dpd, nd), g3 = dot3<S>(e.x, dpdd, nd);
+            const S g2x2 = ad_coherent(S(S(2) * g2), nd);
+            const S g12 = g1 + g2x2;
+            d.gamma[r] = g12 + g3;
           }
           ++r;
         }
@@ -77,7 +121,7 @@ void fill_rows(const Model& model, DataT<S>& d, bool with_velocity) {
 template <class S>
 const VecXT<S>& constraint_residual(const Model& model, DataT<S>& d, const VecXT<S>& q) {
   forward_kinematics<S>(model, d, q);
-  fill_rows<S>(model, d, false);
+  fill_rows<S>(model, d, false, ad_size(q));
   return d.phi;
 }
 
@@ -85,7 +129,7 @@ template <class S>
 void constraint_terms(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>& v) {
   const VecXT<S> zero = VecXT<S>::Zero(model.nv);
   forward_kinematics<S>(model, d, q, v, zero);
-  fill_rows<S>(model, d, true);
+  fill_rows<S>(model, d, true, std::max(ad_size(q), ad_size(v)));
 }
 
 #define CODYNA_INSTANTIATE(S)                                                                           \

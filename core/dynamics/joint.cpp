@@ -117,8 +117,8 @@ Vec6T<S> joint_bias(const JointModel& j, const VecXT<S>& q, const VecXT<S>& v) {
 }
 
 template <class S>
-VecXT<S> integrate(const Model& model, const VecXT<S>& q, const VecXT<S>& dv) {
-  VecXT<S> r = q;
+void integrate_into(const Model& model, const VecXT<S>& q, const VecXT<S>& dv, VecXT<S>& r) {
+  r = q;
   for (int b = 1; b < model.nbodies; ++b) {
     const JointModel& j = model.joints[b];
     const int iq = j.idx_q, iv = j.idx_v;
@@ -137,6 +137,12 @@ VecXT<S> integrate(const Model& model, const VecXT<S>& q, const VecXT<S>& dv) {
         for (int k = 0; k < j.nv; ++k) r[iq + k] += dv[iv + k];
     }
   }
+}
+
+template <class S>
+VecXT<S> integrate(const Model& model, const VecXT<S>& q, const VecXT<S>& dv) {
+  VecXT<S> r;
+  integrate_into<S>(model, q, dv, r);
   return r;
 }
 
@@ -251,8 +257,8 @@ Mat3T<S> so3_jr_inv(const Vec3T<S>& t) {
 }  // namespace
 
 template <class S>
-VecXT<S> tangent_rate(const Model& model, const VecXT<S>& dq, const VecXT<S>& v) {
-  VecXT<S> r = v;
+void tangent_rate_into(const Model& model, const VecXT<S>& dq, const VecXT<S>& v, VecXT<S>& r) {
+  r = v;
   for (int b = 1; b < model.nbodies; ++b) {
     const JointModel& j = model.joints[b];
     const int iv = j.idx_v;
@@ -261,6 +267,12 @@ VecXT<S> tangent_rate(const Model& model, const VecXT<S>& dq, const VecXT<S>& v)
     r.template segment<3>(iv) = so3_jr_inv<S>(t) * Vec3T<S>(v.template segment<3>(iv));
     if (j.type == JointType::Free) r.template segment<3>(iv + 3) = so3_exp<S>(t) * Vec3T<S>(v.template segment<3>(iv + 3));
   }
+}
+
+template <class S>
+VecXT<S> tangent_rate(const Model& model, const VecXT<S>& dq, const VecXT<S>& v) {
+  VecXT<S> r;
+  tangent_rate_into<S>(model, dq, v, r);
   return r;
 }
 
@@ -288,6 +300,8 @@ Eigen::VectorXd neutral(const Model& model) {
   template void joint_transform<S>(const JointModel&, const VecXT<S>&, SE3T<S>&, Mat6xT<S>&); \
   template Vec6T<S> joint_bias<S>(const JointModel&, const VecXT<S>&, const VecXT<S>&);       \
   template VecXT<S> integrate<S>(const Model&, const VecXT<S>&, const VecXT<S>&);             \
+  template void integrate_into<S>(const Model&, const VecXT<S>&, const VecXT<S>&, VecXT<S>&);  \
+  template void tangent_rate_into<S>(const Model&, const VecXT<S>&, const VecXT<S>&, VecXT<S>&); \
   template VecXT<S> qdot<S>(const Model&, const VecXT<S>&, const VecXT<S>&);                  \
   template VecXT<S> tangent_rate<S>(const Model&, const VecXT<S>&, const VecXT<S>&);
 CODYNA_INSTANTIATE(double)

@@ -28,6 +28,10 @@ Vec6T<S> joint_bias(const JointModel& j, const VecXT<S>& q, const VecXT<S>& v);
 template <class S>
 VecXT<S> integrate(const Model& model, const VecXT<S>& q, const VecXT<S>& dv);
 
+// the same into r (no allocation when r already has size nq)
+template <class S>
+void integrate_into(const Model& model, const VecXT<S>& q, const VecXT<S>& dv, VecXT<S>& r);
+
 // dv such that integrate(q0, dv) == q1 (double only)
 Eigen::VectorXd difference(const Model& model, const Eigen::VectorXd& q0, const Eigen::VectorXd& q1);
 
@@ -40,6 +44,9 @@ VecXT<S> qdot(const Model& model, const VecXT<S>& q, const VecXT<S>& v);
 // Exp(dq_w) v_lin for the translation of a free joint. Size nv.
 template <class S>
 VecXT<S> tangent_rate(const Model& model, const VecXT<S>& dq, const VecXT<S>& v);
+
+template <class S>
+void tangent_rate_into(const Model& model, const VecXT<S>& dq, const VecXT<S>& v, VecXT<S>& r);
 
 // unit quaternions, in place
 void normalize(const Model& model, Eigen::VectorXd& q);

@@ -1,0 +1,552 @@
+#include "dynamics/derivatives.hpp"
+
+#include <unsupported/Eigen/AutoDiff>
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "dynamics/kinematics.hpp"
+
+namespace codyna {
+
+namespace {
+
+using Vec6 = Vec6T<double>;
+using Mat6 = Mat6T<double>;
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
+
+// Forward differentiation over the local variables of at most two bodies:
+// [0, 6) pose twist of body a, [6, 12) velocity change of body a, [12, 24) the same for body b.
+using Der24 = Eigen::Matrix<double, 24, 1>;
+using AD = Eigen::AutoDiffScalar<Der24>;
+using Vec3A = Eigen::Matrix<AD, 3, 1>;
+using Mat3A = Eigen::Matrix<AD, 3, 3>;
+
+Vec6 crm(const Vec6& m, const Vec6& x) { return cross_motion<double>(m, x); }
+Vec6 crf(const Vec6& m, const Vec6& f) { return cross_force<double>(m, f); }
+
+// V x* I - I V x, the "Coriolis inertia" of a world inertia I moving with V
+Mat6 coriolis_inertia(const Vec6& V, const Mat6& I) {
+  Mat6 X = Mat6::Zero();  // crm(V)
+  const Mat3 w = skew<double>(Vec3(V.head<3>())), v = skew<double>(Vec3(V.tail<3>()));
+  X.topLeftCorner<3, 3>() = w;
+  X.bottomRightCorner<3, 3>() = w;
+  X.bottomLeftCorner<3, 3>() = v;
+  return -X.transpose() * I - I * X;  // crf(V) = -crm(V)^T
+}
+
+// H(h) u = u x* h
+void add_momentum_operator(const Vec6& h, Mat6& B) {
+  const Mat3 n = skew<double>(Vec3(h.head<3>())), f = skew<double>(Vec3(h.tail<3>()));
+  B.topLeftCorner<3, 3>() -= n;
+  B.topRightCorner<3, 3>() -= f;
+  B.bottomLeftCorner<3, 3>() -= f;
+}
+
+struct BodyAD {
+  Mat3A R;
+  Vec3A p;
+  Vec3A w, vO;  // world angular velocity, velocity of the point at the world origin
+  Vec3A point(const Vec3& x) const { return R * x.cast<AD>() + p; }
+  Vec3A point_velocity(const Vec3A& x) const { return vO + w.cross(x); }
+};
+
+// the pose and velocity of a body as functions of its local variables (offset 0 or 12);
+// ground (body 0) and inactive slots are constants
+BodyAD body_ad(const SE3& g, const Vec6& V, int offset, bool active) {
+  BodyAD b;
+  Vec3A dw, dv, Dw, Dv;
+  for (int k = 0; k < 3; ++k) {
+    dw[k] = AD(0.0);
+    dv[k] = AD(0.0);
+    Dw[k] = AD(V[k]);
+    Dv[k] = AD(V[3 + k]);
+    if (active) {
+      dw[k].derivatives()[offset + k] = 1.0;
+      dv[k].derivatives()[offset + 3 + k] = 1.0;
+      Dw[k].derivatives()[offset + 6 + k] = 1.0;
+      Dv[k].derivatives()[offset + 9 + k] = 1.0;
+    }
+  }
+  const Mat3A R0 = g.R.cast<AD>();
+  const Vec3A p0 = g.p.cast<AD>();
+  b.R = R0 + skew<AD>(dw) * R0;
+  b.p = p0 + dw.cross(p0) + dv;
+  b.w = Dw;
+  b.vO = Dv;
+  return b;
+}
+
+void wrench_value(const Vec3A& x, const Vec3A& F, const Vec3A& T, Vec6& w, Eigen::Matrix<double, 6, 24>& dw) {
+  const Vec3A n = x.cross(F) + T;
+  for (int k = 0; k < 3; ++k) {
+    w[k] = n[k].value();
+    w[3 + k] = F[k].value();
+    dw.row(k) = n[k].derivatives().transpose();
+    dw.row(3 + k) = F[k].derivatives().transpose();
+  }
+}
+
+}  // namespace
+
+bool TreeDerivatives::supports(const Model& model) { return model.nc == 0; }
+
+TreeDerivatives::TreeDerivatives(const Model& model) : m_(model), d_(model), llt_(model.nv) {
+  if (model.nc != 0) throw std::invalid_argument("TreeDerivatives: the model has loop closures");
+  const int nb = model.nbodies, nv = model.nv;
+  unit_begin_.assign(nb, 0);
+  unit_end_.assign(nb, 0);
+  col_unit_.assign(nv, 0);
+  for (int i = 1; i < nb; ++i) {
+    const JointModel& j = model.joints[i];
+    unit_begin_[i] = static_cast<int>(units_.size());
+    const bool chain = j.type == JointType::Universal || j.type == JointType::Planar;
+    if (chain) {
+      for (int c = 0; c < j.nv; ++c) units_.push_back({i, j.idx_v + c, 1});
+    } else if (j.nv > 0) {
+      units_.push_back({i, j.idx_v, j.nv});
+    }
+    unit_end_[i] = static_cast<int>(units_.size());
+    for (int u = unit_begin_[i]; u < unit_end_[i]; ++u)
+      for (int c = 0; c < units_[u].n; ++c) col_unit_[units_[u].iv + c] = u;
+  }
+  path_.assign(nb, {});
+  for (int i = 1; i < nb; ++i) {
+    path_[i] = path_[model.parent[i]];
+    for (int u = unit_begin_[i]; u < unit_end_[i]; ++u) path_[i].push_back(u);
+  }
+  const int nu = static_cast<int>(units_.size());
+  S_.assign(nb, Mat6xT<double>());
+  V_.assign(nb, Vec6::Zero());
+  A_.assign(nb, Vec6::Zero());
+  Vpar_.assign(nu, Vec6::Zero());
+  Apar_.assign(nu, Vec6::Zero());
+  Vu_.assign(nu, Vec6::Zero());
+  I_.assign(nb, Mat6::Zero());
+  Ic_.assign(nb, Mat6::Zero());
+  Bc_.assign(nb, Mat6::Zero());
+  hc_.assign(nb, Vec6::Zero());
+  F_.assign(nb, Vec6::Zero());
+  P_.assign(nu, Mat6::Zero());
+  R_.assign(nu, Mat6::Zero());
+  below_.assign(nb, 0);
+  Icom_.assign(nb, Mat3::Zero());
+  for (int i = 1; i < nb; ++i) {
+    const Mat3 cx = skew<double>(model.com[i]);
+    Icom_[i] = model.inertia[i].topLeftCorner<3, 3>() - model.mass[i] * cx * cx.transpose();
+  }
+  qdd.setZero(nv);
+  qdd_zero_.setZero(nv);
+  tau.setZero(nv);
+  dtau_dq.setZero(nv, nv);
+  dtau_dv.setZero(nv, nv);
+  Q.setZero(nv);
+  dQ_dq.setZero(nv, nv);
+  dQ_dv.setZero(nv, nv);
+  dQ_du.setZero(nv, model.nu());
+  dqdd_dq.setZero(nv, nv);
+  dqdd_dv.setZero(nv, nv);
+  dqdd_du.setZero(nv, model.nu());
+  M.setZero(nv, nv);
+  rhs_.setZero(nv, 2 * nv + model.nu());
+  scratch_.setZero(nv);
+}
+
+// positions and velocities: world motion subspaces, inertias and unit velocities
+void TreeDerivatives::world_kinematics(const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
+  forward_kinematics<double>(m_, d_, q, v);
+  for (int i = 1; i < m_.nbodies; ++i) {
+    const JointModel& j = m_.joints[i];
+    const SE3& g = d_.oMi[i];
+    S_[i].resize(6, j.nv);
+    for (int c = 0; c < j.nv; ++c) S_[i].col(c) = g.act_motion(Vec6(d_.Sb[i].col(c)));
+    // world spatial inertia about the world origin, from mass, com and rotational inertia
+    const double mass = m_.mass[i];
+    const Vec3 cw = g.act_point(m_.com[i]);
+    const Mat3 cx = skew<double>(cw);
+    Mat6& I = I_[i];
+    I.topLeftCorner<3, 3>().noalias() = g.R * Icom_[i] * g.R.transpose();
+    I.topLeftCorner<3, 3>().noalias() += mass * cx * cx.transpose();
+    I.topRightCorner<3, 3>() = mass * cx;
+    I.bottomLeftCorner<3, 3>() = mass * cx.transpose();
+    I.bottomRightCorner<3, 3>() = mass * Mat3::Identity();
+    const int p = j.parent;
+    Vec6 Vp = p > 0 ? V_[p] : Vec6::Zero();
+    for (int u = unit_begin_[i]; u < unit_end_[i]; ++u) {
+      const Unit& un = units_[u];
+      Vpar_[u] = Vp;
+      Vp.noalias() += S_[i].middleCols(un.iv - j.idx_v, un.n) * v.segment(un.iv, un.n);
+      Vu_[u] = Vp;
+    }
+    V_[i] = Vp;
+  }
+}
+
+// accelerations for joint accelerations a (gravity enters as A_0 = -g)
+void TreeDerivatives::accelerations(const Eigen::VectorXd& v, const Eigen::VectorXd& a) {
+  Vec6 A0 = Vec6::Zero();
+  if (m_.has_gravity) A0.tail<3>() = -m_.gravity;
+  for (int i = 1; i < m_.nbodies; ++i) {
+    const JointModel& j = m_.joints[i];
+    const int p = j.parent;
+    Vec6 Ap = p > 0 ? A_[p] : A0;
+    for (int u = unit_begin_[i]; u < unit_end_[i]; ++u) {
+      const Unit& un = units_[u];
+      const auto Su = S_[i].middleCols(un.iv - j.idx_v, un.n);
+      Apar_[u] = Ap;
+      const Vec6 vJ = Su * v.segment(un.iv, un.n);
+      Ap.noalias() += Su * a.segment(un.iv, un.n);
+      Ap += crm(Vu_[u], vJ);
+    }
+    A_[i] = Ap;
+  }
+}
+
+// subtree composites of inertia, momentum and Coriolis inertia; the unit rows P, R
+void TreeDerivatives::composites() {
+  for (int i = 1; i < m_.nbodies; ++i) {
+    Ic_[i] = I_[i];
+    hc_[i].noalias() = I_[i] * V_[i];
+    Bc_[i] = coriolis_inertia(V_[i], I_[i]);
+  }
+  for (int i = m_.nbodies - 1; i > 0; --i) {
+    const int p = m_.parent[i];
+    if (p > 0) {
+      Ic_[p] += Ic_[i];
+      hc_[p] += hc_[i];
+      Bc_[p] += Bc_[i];
+    }
+  }
+  for (int i = 1; i < m_.nbodies; ++i) {
+    if (unit_begin_[i] == unit_end_[i]) continue;
+    Mat6 BH = Bc_[i];
+    add_momentum_operator(hc_[i], BH);
+    const JointModel& j = m_.joints[i];
+    for (int u = unit_begin_[i]; u < unit_end_[i]; ++u) {
+      const Unit& un = units_[u];
+      const auto Su = S_[i].middleCols(un.iv - j.idx_v, un.n);
+      P_[u].topRows(un.n).noalias() = Su.transpose() * Ic_[i];
+      R_[u].topRows(un.n).noalias() = Su.transpose() * BH;
+    }
+  }
+}
+
+// body forces of the RNEA and their subtree sums; tau = S^T F
+void TreeDerivatives::forces() {
+  for (int i = 1; i < m_.nbodies; ++i) {
+    const Vec6 h = I_[i] * V_[i];
+    F_[i].noalias() = I_[i] * A_[i];
+    F_[i] += crf(V_[i], h);
+  }
+  for (int i = m_.nbodies - 1; i > 0; --i) {
+    const JointModel& j = m_.joints[i];
+    if (j.nv > 0) tau.segment(j.idx_v, j.nv).noalias() = S_[i].transpose() * F_[i];
+    const int p = j.parent;
+    if (p > 0) F_[p] += F_[i];
+  }
+}
+
+// M(i, j) = S_i^T Ic_i S_j for unit j at or above unit i
+void TreeDerivatives::mass_matrix() {
+  for (int i = 1; i < m_.nbodies; ++i) {
+    for (int ui = unit_begin_[i]; ui < unit_end_[i]; ++ui) {
+      const Unit& a = units_[ui];
+      for (int uj : path_[i]) {
+        const Unit& b = units_[uj];
+        const auto Sj = S_[b.body].middleCols(b.iv - m_.joints[b.body].idx_v, b.n);
+        M.block(a.iv, b.iv, a.n, b.n).noalias() = P_[ui].topRows(a.n) * Sj;
+        if (uj != ui) M.block(b.iv, a.iv, b.n, a.n) = M.block(a.iv, b.iv, a.n, b.n).transpose();
+        if (uj == ui) break;
+      }
+    }
+  }
+}
+
+void TreeDerivatives::differentiate_rnea() {
+  const int nb = m_.nbodies;
+  dtau_dq.setZero();  // units in other branches do not depend on each other
+  dtau_dv.setZero();
+  for (int i = 1; i < nb; ++i) {
+    if (unit_begin_[i] == unit_end_[i]) continue;
+    const JointModel& ji = m_.joints[i];
+    for (int b = 0; b < nb; ++b) below_[b] = 0;
+    below_[i] = 1;
+    for (int b = i + 1; b < nb; ++b) below_[b] = below_[m_.parent[b]];
+    Mat6 BH = Bc_[i];
+    add_momentum_operator(hc_[i], BH);
+    for (int k = unit_begin_[i]; k < unit_end_[i]; ++k) {
+      const Unit& uk = units_[k];
+      const Vec6& Vp = Vpar_[k];
+      const Vec6& Ap = Apar_[k];
+      const Vec6 Vsum = Vp + Vu_[k];
+      for (int c = 0; c < uk.n; ++c) {
+        const int col = uk.iv + c;
+        const Vec6 s = S_[i].col(uk.iv - ji.idx_v + c);
+        const Vec6 u = crm(s, Vp);
+        const Vec6 dw = crm(u, Vp) - crm(s, Ap);
+        const Vec6 cv = -crm(s, Vsum);
+        // units at or below k
+        for (int b = i; b < nb; ++b) {
+          if (!below_[b]) continue;
+          for (int j = (b == i ? k : unit_begin_[b]); j < unit_end_[b]; ++j) {
+            const Unit& uj = units_[j];
+            dtau_dq.block(uj.iv, col, uj.n, 1).noalias() = P_[j].topRows(uj.n) * dw - R_[j].topRows(uj.n) * u;
+            dtau_dv.block(uj.iv, col, uj.n, 1).noalias() = R_[j].topRows(uj.n) * s + P_[j].topRows(uj.n) * cv;
+          }
+        }
+        // units above k: the whole subtree's force change
+        const Vec6 G = crf(s, F_[i]) + Ic_[i] * dw - BH * u;
+        const Vec6 Gv = BH * s + Ic_[i] * cv;
+        auto above = [&](int j) {
+          const Unit& uj = units_[j];
+          const auto Sj = S_[uj.body].middleCols(uj.iv - m_.joints[uj.body].idx_v, uj.n);
+          dtau_dq.block(uj.iv, col, uj.n, 1).noalias() = Sj.transpose() * G;
+          dtau_dv.block(uj.iv, col, uj.n, 1).noalias() = Sj.transpose() * Gv;
+        };
+        for (int j = unit_begin_[i]; j < k; ++j) above(j);
+        for (int j : path_[m_.parent[i]]) above(j);
+      }
+    }
+  }
+}
+
+void TreeDerivatives::rnea_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& a) {
+  world_kinematics(q, v);
+  accelerations(v, a);
+  composites();
+  forces();
+  differentiate_rnea();
+}
+
+// chain rule for one world wrench w on `body` whose local derivatives dw are
+// taken with respect to the poses/velocities of body_a (columns 0..11) and body_b (12..23)
+void TreeDerivatives::add_body_wrench(int body, const Vec6& w, const Eigen::Matrix<double, 6, 24>& dw, int body_a,
+                                      int body_b) {
+  if (body == 0) return;  // the ground reacts; it does not move
+  const std::vector<int>& path = path_[body];
+  auto S_of = [&](int u) {
+    const Unit& un = units_[u];
+    return S_[un.body].middleCols(un.iv - m_.joints[un.body].idx_v, un.n);
+  };
+  for (int pj : path) {
+    const Unit& uj = units_[pj];
+    Q.segment(uj.iv, uj.n).noalias() += S_of(pj).transpose() * w;
+  }
+  // the wrench's own joint columns turn with the coordinates above them
+  for (std::size_t pi = 0; pi < path.size(); ++pi) {
+    const Unit& up = units_[path[pi]];
+    const auto Sp = S_of(path[pi]);
+    for (int c = 0; c < up.n; ++c) {
+      const Vec6 g = -crf(Vec6(Sp.col(c)), w);
+      for (std::size_t pj = pi; pj < path.size(); ++pj) {
+        const Unit& uj = units_[path[pj]];
+        dQ_dq.block(uj.iv, up.iv + c, uj.n, 1).noalias() += S_of(path[pj]).transpose() * g;
+      }
+    }
+  }
+  // the wrench's dependence on the poses and velocities of the bodies it reads
+  for (int slot = 0; slot < 2; ++slot) {
+    const int beta = slot == 0 ? body_a : body_b;
+    if (beta <= 0) continue;
+    const auto Dpose = dw.middleCols<6>(12 * slot);
+    const auto Dvel = dw.middleCols<6>(12 * slot + 6);
+    if (Dpose.isZero(0) && Dvel.isZero(0)) continue;
+    for (int pu : path_[beta]) {
+      const Unit& up = units_[pu];
+      const auto Sp = S_of(pu);
+      const Vec6 rel = V_[beta] - Vpar_[pu];
+      for (int c = 0; c < up.n; ++c) {
+        const Vec6 s = Sp.col(c);
+        const Vec6 gq = Dpose * s + Dvel * crm(s, rel);
+        const Vec6 gv = Dvel * s;
+        for (int pj : path) {
+          const Unit& uj = units_[pj];
+          const auto Sj = S_of(pj);
+          dQ_dq.block(uj.iv, up.iv + c, uj.n, 1).noalias() += Sj.transpose() * gq;
+          dQ_dv.block(uj.iv, up.iv + c, uj.n, 1).noalias() += Sj.transpose() * gv;
+        }
+      }
+    }
+  }
+}
+
+void TreeDerivatives::applied_force_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+                                                const Eigen::VectorXd& u) {
+  // the same forces as applied_forces(), with their derivatives
+  Q.setZero();
+  dQ_dq.setZero();
+  dQ_dv.setZero();
+  dQ_du.setZero();
+  for (const JointSpringModel& s : m_.joint_springs) {
+    Q[s.iv] -= s.stiffness * (q[s.iq] - s.rest_position) + s.damping * v[s.iv];
+    dQ_dq(s.iv, s.iv) -= s.stiffness;
+    dQ_dv(s.iv, s.iv) -= s.damping;
+  }
+  for (const JointSpringModel& s : m_.joint_frictions) {
+    Q[s.iv] -= s.damping * v[s.iv];
+    dQ_dv(s.iv, s.iv) -= s.damping;
+  }
+
+  Vec6 w;
+  Eigen::Matrix<double, 6, 24> dw;
+  const Vec3A zero3 = Vec3A::Constant(AD(0.0));
+  for (const SpringDamperModel& s : m_.springs) {
+    const BodyAD a = body_ad(d_.oMi[s.body_a], V_[s.body_a], 0, s.body_a > 0);
+    const BodyAD b = body_ad(d_.oMi[s.body_b], V_[s.body_b], 12, s.body_b > 0);
+    const Vec3A xa = a.point(s.point_a), xb = b.point(s.point_b);
+    const Vec3A dp = xb - xa;
+    const AD L = sqrt(dp.squaredNorm());
+    if (!(L.value() > 1e-12)) continue;  // as applied_forces: no direction, no force
+    const Vec3A n = dp / L;
+    const AD Ld = n.dot(b.point_velocity(xb) - a.point_velocity(xa));
+    const AD tension = AD(s.stiffness) * (L - AD(s.rest_length)) + AD(s.damping) * Ld;
+    wrench_value(xa, Vec3A(tension * n), zero3, w, dw);
+    add_body_wrench(s.body_a, w, dw, s.body_a, s.body_b);
+    wrench_value(xb, Vec3A(-tension * n), zero3, w, dw);
+    add_body_wrench(s.body_b, w, dw, s.body_a, s.body_b);
+  }
+  for (const BodyForceModel& f : m_.body_forces) {
+    const BodyAD a = body_ad(d_.oMi[f.body], V_[f.body], 0, f.body > 0);
+    Vec3A F = f.force.cast<AD>(), T = f.torque.cast<AD>();
+    if (!f.in_world) {
+      F = a.R * f.force.cast<AD>();
+      T = a.R * f.torque.cast<AD>();
+    }
+    wrench_value(a.point(f.point), F, T, w, dw);
+    add_body_wrench(f.body, w, dw, f.body, 0);
+  }
+  for (int k = 0; k < m_.nu(); ++k) {
+    const ActuatorModel& act = m_.actuators[k];
+    if (act.type == ActuatorType::JointForce) {
+      Q[act.iv] += act.gain * u[k];
+      dQ_du(act.iv, k) += act.gain;
+      continue;
+    }
+    if (act.body == 0) continue;
+    const BodyAD a = body_ad(d_.oMi[act.body], V_[act.body], 0, true);
+    Vec3A F = act.direction.cast<AD>() * AD(act.gain);
+    if (!act.in_world) F = a.R * F;
+    const Vec3A x = a.point(act.point);
+    // per unit input (linear in u)
+    wrench_value(x, F, zero3, w, dw);
+    for (int pu : path_[act.body]) {
+      const Unit& up = units_[pu];
+      dQ_du.block(up.iv, k, up.n, 1).noalias() +=
+          S_[up.body].middleCols(up.iv - m_.joints[up.body].idx_v, up.n).transpose() * w;
+    }
+    if (u[k] == 0.0) continue;
+    const AD uk(u[k]);
+    wrench_value(x, Vec3A(F * uk), zero3, w, dw);
+    add_body_wrench(act.body, w, dw, act.body, 0);
+  }
+}
+
+void TreeDerivatives::sensor_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+                                         const std::vector<int>& outputs) {
+  const int ny = static_cast<int>(outputs.size());
+  y.resize(ny);
+  dy_dq.setZero(ny, m_.nv);
+  dy_dv.setZero(ny, m_.nv);
+  for (int r = 0; r < ny; ++r) {
+    const SensorModel& s = m_.sensors[outputs[r]];
+    if (s.type == SensorType::JointPosition) {
+      y[r] = q[s.iq];
+      dy_dq(r, s.iv) = 1.0;
+      continue;
+    }
+    if (s.type == SensorType::JointVelocity) {
+      y[r] = v[s.iv];
+      dy_dv(r, s.iv) = 1.0;
+      continue;
+    }
+    int ba = 0, bb = 0;
+    AD value;
+    switch (s.type) {
+      case SensorType::PointPosition:
+      case SensorType::PointVelocity: {
+        ba = s.body;
+        bb = s.frame;
+        const BodyAD a = body_ad(d_.oMi[ba], V_[ba], 0, ba > 0);
+        const BodyAD f = body_ad(d_.oMi[bb], V_[bb], 12, bb > 0);
+        const Vec3A x = a.point(s.point);
+        const Vec3A loc = s.type == SensorType::PointPosition ? Vec3A(f.R.transpose() * (x - f.p))
+                                                               : Vec3A(f.R.transpose() * a.point_velocity(x));
+        value = loc[s.component];
+        break;
+      }
+      case SensorType::BodyAngle: {
+        ba = s.body;
+        const BodyAD a = body_ad(d_.oMi[ba], V_[ba], 0, ba > 0);
+        const Mat3A Rrel = a.R * s.R0.transpose().cast<AD>();
+        const Vec3A e1 = Rrel * s.perp1.cast<AD>();
+        value = atan2(e1.dot(s.perp2.cast<AD>()), e1.dot(s.perp1.cast<AD>()));
+        break;
+      }
+      case SensorType::Distance: {
+        ba = s.body_a;
+        bb = s.body_b;
+        const BodyAD a = body_ad(d_.oMi[ba], V_[ba], 0, ba > 0);
+        const BodyAD b = body_ad(d_.oMi[bb], V_[bb], 12, bb > 0);
+        value = sqrt((b.point(s.point_b) - a.point(s.point_a)).squaredNorm());
+        break;
+      }
+      default:
+        throw std::logic_error("TreeDerivatives: unknown sensor type");
+    }
+    y[r] = value.value();
+    const Der24& g = value.derivatives();
+    for (int slot = 0; slot < 2; ++slot) {
+      const int beta = slot == 0 ? ba : bb;
+      if (beta <= 0) continue;
+      const Eigen::Matrix<double, 6, 1> Dpose = g.segment<6>(12 * slot), Dvel = g.segment<6>(12 * slot + 6);
+      for (int pu : path_[beta]) {
+        const Unit& up = units_[pu];
+        const auto Sp = S_[up.body].middleCols(up.iv - m_.joints[up.body].idx_v, up.n);
+        const Vec6 rel = V_[beta] - Vpar_[pu];
+        for (int c = 0; c < up.n; ++c) {
+          const Vec6 sc = Sp.col(c);
+          dy_dq(r, up.iv + c) += Dpose.dot(sc) + Dvel.dot(crm(sc, rel));
+          dy_dv(r, up.iv + c) += Dvel.dot(sc);
+        }
+      }
+    }
+  }
+}
+
+void TreeDerivatives::compute(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& u_all,
+                              const std::vector<int>& outputs) {
+  const int nv = m_.nv, nu = m_.nu();
+  // bias forces at qdd = 0, applied forces, mass matrix
+  world_kinematics(q, v);
+  accelerations(v, qdd_zero_);
+  composites();
+  forces();
+  scratch_ = tau;
+  applied_force_derivatives(q, v, u_all);
+  mass_matrix();
+  llt_.compute(M);
+  if (llt_.info() != Eigen::Success)
+    throw std::runtime_error("the mass matrix is not positive definite at this configuration");
+  qdd = Q - scratch_;
+  llt_.solveInPlace(qdd);
+  // inverse dynamics at the true accelerations, and its derivatives
+  accelerations(v, qdd);
+  forces();
+  differentiate_rnea();
+  rhs_.leftCols(nv) = dQ_dq - dtau_dq;
+  rhs_.middleCols(nv, nv) = dQ_dv - dtau_dv;
+  rhs_.rightCols(nu) = dQ_du;
+  // in panels of columns: Eigen's blocked triangular solves then keep their
+  // packing buffers on the stack (a heap allocation above 128 KiB)
+  for (Eigen::Index c0 = 0; c0 < rhs_.cols(); c0 += 48) {
+    auto panel = rhs_.middleCols(c0, std::min<Eigen::Index>(48, rhs_.cols() - c0));
+    llt_.solveInPlace(panel);
+  }
+  dqdd_dq = rhs_.leftCols(nv);
+  dqdd_dv = rhs_.middleCols(nv, nv);
+  dqdd_du = rhs_.rightCols(nu);
+  sensor_derivatives(q, v, outputs);
+}
+
+}  // namespace codyna

@@ -1,0 +1,111 @@
+// Exact first derivatives of tree dynamics, by analytic differentiation of the
+// recursive algorithms (no automatic differentiation, no finite differences).
+//
+// Everything is expressed in world coordinates: body i has the world spatial
+// velocity V_i = [w; v_O] and acceleration A_i (gravity entered as A_0 = -g),
+// the world inertia I_i, and each joint column the world motion subspace S_c.
+// A position derivative is taken along a joint's tangent coordinate, the same
+// one the plant state uses (right-trivialized for spherical and free joints):
+// perturbing coordinate c moves the subtree below it rigidly by the twist S_c.
+//
+// Joints are handled as "units" whose columns move together with the child
+// body: revolute, prismatic, cylindrical, spherical and free joints are one
+// unit; universal and planar joints are chains of one-column units through
+// massless intermediate frames (their first columns do not turn with the
+// later ones). With u = s x V_par, w1 = s x A_par, w2 = u x V_par for a column s
+// of unit k (V_par, A_par: velocity and acceleration of the frame unit k moves
+// from), the composite inertia Ic, momentum hc, force F and "Coriolis inertia"
+// Bc = sum(V x* I - I V x) of a subtree give, for a unit j at or below k,
+//   d tau_j / d q_s  = S_j^T [ Ic (w2 - w1) - (Bc + H(hc)) u ]
+//   d tau_j / d qd_s = S_j^T [ (Bc + H(hc)) s + Ic c ],   c = -s x (V_par + V_k)
+// and for a unit j above k the same subtree terms of k plus s x* F_k (for q).
+// H(h) is the matrix with H(h) u = u x* h. Applied forces from body elements
+// (spring-dampers, body forces, body-force actuators) and body sensors are
+// differentiated through their world wrench / value as functions of the poses
+// and velocities of at most two bodies (fixed-size forward differentiation of
+// a few lines, no heap), chained with the analytic Jacobians above.
+//
+// Used by linearize() for tree models at the reference configuration; checked
+// against automatic differentiation of the same dynamics in the tests.
+#pragma once
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <vector>
+
+#include "model/data.hpp"
+#include "model/model.hpp"
+
+namespace codyna {
+
+class TreeDerivatives {
+ public:
+  // model must outlive this object; model.nc must be 0
+  explicit TreeDerivatives(const Model& model);
+
+  // true when compute() can differentiate this model with these plant outputs
+  // (a tree; every sensor type is supported)
+  static bool supports(const Model& model);
+
+  // Everything at (q, v, u_all) (u_all: one value per actuator). `outputs` are
+  // sensor indices whose values and derivatives are wanted. After the first
+  // call with the same sizes, no heap allocation.
+  void compute(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& u_all,
+               const std::vector<int>& outputs);
+
+  // Only the rigid-body inverse dynamics tau = RNEA(q, v, a) (no applied
+  // forces) and its derivatives; forward kinematics included.
+  void rnea_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& a);
+
+  // results of compute()
+  Eigen::VectorXd qdd;                      // [nv]
+  Eigen::MatrixXd dqdd_dq, dqdd_dv;         // [nv x nv]
+  Eigen::MatrixXd dqdd_du;                  // [nv x nu_all]
+  Eigen::VectorXd y;                        // [outputs]
+  Eigen::MatrixXd dy_dq, dy_dv;             // [outputs x nv]
+  // parts (also set by compute())
+  Eigen::VectorXd tau;                      // RNEA at (q, v, qdd) without applied forces
+  Eigen::MatrixXd dtau_dq, dtau_dv;         // [nv x nv]
+  Eigen::VectorXd Q;                        // applied generalized forces
+  Eigen::MatrixXd dQ_dq, dQ_dv, dQ_du;      // [nv x nv], [nv x nv], [nv x nu_all]
+  Eigen::MatrixXd M;                        // mass matrix at q
+
+ private:
+  struct Unit {
+    int body = 0;  // child body of the joint
+    int iv = 0;    // first velocity index
+    int n = 0;     // columns
+  };
+  void world_kinematics(const Eigen::VectorXd& q, const Eigen::VectorXd& v);  // S, I, V
+  void accelerations(const Eigen::VectorXd& v, const Eigen::VectorXd& a);     // A
+  void composites();                                                           // Ic, hc, Bc, P, R
+  void forces();                                                               // F, tau
+  void mass_matrix();                                                          // M from P and S
+  void differentiate_rnea();
+  void applied_force_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& u);
+  void add_body_wrench(int body, const Vec6T<double>& w, const Eigen::Matrix<double, 6, 24>& dw, int body_a,
+                       int body_b);
+  void sensor_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const std::vector<int>& outputs);
+
+  const Model& m_;
+  Data d_;
+  std::vector<Unit> units_;
+  std::vector<int> unit_begin_, unit_end_;       // [nbodies] units of a body's joint
+  std::vector<std::vector<int>> path_;           // [nbodies] units from the root down to the body
+  std::vector<int> col_unit_;                    // [nv] unit of a velocity column
+
+  // world-frame workspace
+  std::vector<Mat6xT<double>> S_;                // [nbodies] world motion subspace of the joint
+  std::vector<Vec6T<double>> V_, A_;             // [nbodies]
+  std::vector<Vec6T<double>> Vpar_, Apar_, Vu_;  // [units] velocity/acceleration the unit moves from; after it
+  std::vector<Mat6T<double>> I_, Ic_, Bc_;       // [nbodies]
+  std::vector<Eigen::Matrix3d> Icom_;            // [nbodies] rotational inertia about the com, body axes
+  std::vector<Vec6T<double>> hc_, F_;            // [nbodies]
+  std::vector<Mat6T<double>> P_, R_;             // [units] rows S^T Ic and S^T (Bc + H(hc)), padded to 6
+  std::vector<char> below_;                      // [nbodies] scratch: in the subtree of a body
+  Eigen::VectorXd qdd_zero_, scratch_;
+  Eigen::MatrixXd rhs_;
+  Eigen::LLT<Eigen::MatrixXd> llt_;
+};
+
+}  // namespace codyna

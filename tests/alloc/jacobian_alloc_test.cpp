@@ -1,0 +1,159 @@
+// No heap allocation in one exact plant Jacobian after the first call: a
+// counting global operator new/delete (this executable only) around the
+// second call of PlantFunction::analytic_jacobian and TreeDerivatives::compute.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <filesystem>
+#include <new>
+
+#include "analysis/linearize.hpp"
+#include "analysis/operating_point.hpp"
+#include "dynamics/derivatives.hpp"
+#include "io/model_file.hpp"
+#include "model/compile.hpp"
+
+namespace {
+std::atomic<bool> g_counting{false};
+std::atomic<long> g_allocations{0};
+}  // namespace
+
+void* operator new(std::size_t n) {
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t n) { return operator new(n); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+// Eigen allocates with std::malloc directly (its storage is aligned by the
+// platform's malloc), not with operator new: this executable is linked with
+// --wrap=malloc,calloc,realloc so that calls from codyna's code and the Eigen
+// code instantiated in it are counted too.
+extern "C" {
+void* __real_malloc(std::size_t);
+void* __real_calloc(std::size_t, std::size_t);
+void* __real_realloc(void*, std::size_t);
+void* __wrap_malloc(std::size_t n) {
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
+  return __real_malloc(n);
+}
+void* __wrap_calloc(std::size_t n, std::size_t s) {
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
+  return __real_calloc(n, s);
+}
+void* __wrap_realloc(void* p, std::size_t n) {
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
+  return __real_realloc(p, n);
+}
+}
+
+namespace codyna {
+namespace {
+
+struct Count {
+  Count() {
+    g_allocations = 0;
+    g_counting = true;
+  }
+  ~Count() { g_counting = false; }
+  long n() const { return g_allocations.load(); }
+};
+
+Model load(const std::string& name) {
+  const std::string path = std::string(CODYNA_EXAMPLES_DIR) + "/" + name;
+  return compile(load_model_spec(path), path);
+}
+
+void expect_no_allocation(const Model& m, const std::string& label) {
+  const OperatingPoint op = initial_point(m);
+  const PlantFunction f(m, op.q, op.u, partition_coordinates(m, op.q));
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(f.nx());
+  for (int k = 0; k < f.nz(); ++k) x[f.nz() + k] = 0.3 + 0.1 * k;
+  Eigen::VectorXd u = Eigen::VectorXd::Constant(f.nu(), 0.7);
+  Eigen::MatrixXd J;
+  ASSERT_TRUE(f.analytic_jacobian(x, u, J)) << label;  // warm-up: the workspace is made here
+  long n = 0;
+  {
+    Count c;
+    f.analytic_jacobian(x, u, J);
+    n = c.n();
+  }
+  EXPECT_EQ(n, 0) << label << ": heap allocations in one exact Jacobian after warm-up";
+}
+
+TEST(NoAllocation, ExactJacobianCartPendulum) { expect_no_allocation(load("cart_pendulum.json"), "cart_pendulum"); }
+
+TEST(NoAllocation, ExactJacobianEveryTreeExample) {
+  int trees = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(CODYNA_EXAMPLES_DIR)) {
+    if (entry.path().extension() != ".json") continue;
+    const Model m = load(entry.path().filename().string());
+    if (m.nc != 0) continue;
+    ++trees;
+    expect_no_allocation(m, entry.path().filename().string());
+  }
+  EXPECT_GE(trees, 3);
+}
+
+// a long chain: blocked factorizations and solves stay on the stack too
+TEST(NoAllocation, ExactJacobianNinetyLinkChain) {
+  ModelSpec s;
+  s.name = "chain90";
+  for (int i = 0; i < 90; ++i) {
+    BodySpec b;
+    b.name = "b" + std::to_string(i);
+    b.mass = 1.0 + 0.01 * i;
+    b.com = Eigen::Vector3d(0.2, 0.01, 0.0);
+    b.inertia = Eigen::Vector3d(0.01, 0.02, 0.025).asDiagonal();
+    s.bodies.push_back(b);
+    JointSpec j;
+    j.name = "j" + std::to_string(i);
+    j.type = JointType::Revolute;
+    j.parent = i ? "b" + std::to_string(i - 1) : std::string(kGroundName);
+    j.child = b.name;
+    j.axis = i % 2 ? Eigen::Vector3d::UnitY() : Eigen::Vector3d::UnitZ();
+    j.parent_frame.position = Eigen::Vector3d(i ? 0.4 : 0.0, 0.0, 0.0);
+    s.joints.push_back(j);
+    ActuatorSpec a;
+    a.name = "m" + std::to_string(i);
+    a.joint = j.name;
+    s.actuators.push_back(a);
+    s.plant.inputs.push_back(a.name);
+  }
+  EffectSpec g;
+  g.name = "gravity";
+  g.type = EffectType::Gravity;
+  s.effects.push_back(g);
+  SensorSpec y;
+  y.name = "tip_x";
+  y.type = SensorType::PointPosition;
+  y.body = "b89";
+  s.sensors.push_back(y);
+  s.plant.outputs.push_back("tip_x");
+  expect_no_allocation(compile(s), "chain90");
+}
+
+// the counter itself sees both kinds of allocation
+TEST(NoAllocation, CounterSeesAnAllocation) {
+  long n_new = 0, n_eigen = 0;
+  {
+    Count c;
+    std::vector<double>* v = new std::vector<double>(100);
+    delete v;
+    n_new = c.n();
+  }
+  {
+    Count c;
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(1000);
+    n_eigen = c.n() + (x[0] == 1.0);
+  }
+  EXPECT_GE(n_new, 2);
+  EXPECT_GE(n_eigen, 1);
+}
+
+}  // namespace
+}  // namespace codyna
