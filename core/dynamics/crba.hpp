@@ -1,6 +1,7 @@
 // Composite-rigid-body algorithm: the joint-space mass matrix M(q)
 // (= B^T M B of the velocity transformation method), symmetric, full.
-// Writes liMi, oMi, Sb, Ic, M; returns data.M. O(n d) for tree depth d.
+// Writes liMi, oMi, Sb, Ic, Sw, M; returns data.M. O(n d) for tree depth d.
+// M is allocated by the first call on a Data; later calls do not allocate.
 #pragma once
 
 #include "model/data.hpp"

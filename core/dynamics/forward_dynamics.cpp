@@ -16,7 +16,7 @@ template <class S>
 const VecXT<S>& forward_dynamics(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>& v,
                                  const VecXT<S>& u, const Baumgarte& stab) {
   forward_kinematics<S>(model, d, q, v);
-  const VecXT<S> Q = applied_forces<S>(model, d, q, v, u);
+  const VecXT<S>& Q = applied_forces<S>(model, d, q, v, u);  // data.Q: nothing below writes it
   if (model.nc == 0) {
     d.lambda.setZero(model.nc);
     return aba_after_kinematics<S>(model, d, v, Q);

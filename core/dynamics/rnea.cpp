@@ -31,14 +31,21 @@ const VecXT<S>& nonlinear_effects(const Model& model, DataT<S>& d, const VecXT<S
 }
 
 template <class S>
-VecXT<S> body_forces_to_generalized(const Model& model, DataT<S>& d) {
-  VecXT<S> Q = VecXT<S>::Zero(model.nv);
-  std::vector<Vec6T<S>> f = d.fext;
+void add_body_forces_to_generalized(const Model& model, DataT<S>& d, VecXT<S>& Q) {
+  std::vector<Vec6T<S>>& f = d.fsum;
+  for (int i = 1; i < model.nbodies; ++i) f[i] = d.fext[i];
   for (int i = model.nbodies - 1; i > 0; --i) {
     const JointModel& j = model.joints[i];
-    if (j.nv > 0) Q.segment(j.idx_v, j.nv) = d.Sb[i].transpose() * f[i];
+    if (j.nv == 1) Q[j.idx_v] += d.Sb[i].col(0).dot(f[i]);
+    else if (j.nv > 0) Q.segment(j.idx_v, j.nv).noalias() += d.Sb[i].transpose() * f[i];
     if (j.parent > 0) f[j.parent] += d.liMi[i].act_force(f[i]);
   }
+}
+
+template <class S>
+VecXT<S> body_forces_to_generalized(const Model& model, DataT<S>& d) {
+  VecXT<S> Q = VecXT<S>::Zero(model.nv);
+  add_body_forces_to_generalized<S>(model, d, Q);
   return Q;
 }
 
@@ -46,7 +53,8 @@ VecXT<S> body_forces_to_generalized(const Model& model, DataT<S>& d) {
   template const VecXT<S>& rnea<S>(const Model&, DataT<S>&, const VecXT<S>&, const VecXT<S>&,          \
                                    const VecXT<S>&);                                                   \
   template const VecXT<S>& nonlinear_effects<S>(const Model&, DataT<S>&, const VecXT<S>&, const VecXT<S>&); \
-  template VecXT<S> body_forces_to_generalized<S>(const Model&, DataT<S>&);
+  template VecXT<S> body_forces_to_generalized<S>(const Model&, DataT<S>&);                           \
+  template void add_body_forces_to_generalized<S>(const Model&, DataT<S>&, VecXT<S>&);
 CODYNA_INSTANTIATE(double)
 CODYNA_INSTANTIATE(ADScalar)
 #undef CODYNA_INSTANTIATE

@@ -11,9 +11,32 @@
 
 namespace codyna {
 
+// Constants the algorithms derive once from the Model (DataT's constructor),
+// in double whatever the scalar; not part of any algorithm's output.
+struct ModelConstants {
+  struct Joint {
+    SE3 X_PF, X_MC;                     // X_MC = X_CM^-1
+    bool constant_S = false;            // Sb does not depend on q (all but universal and planar)
+    Mat6xT<double> Sb{6, 0};            // X_CM S_M when constant_S
+    // revolute: liMi = (Rot(axis_P, q) R0, Rot(axis_P, q) p0 + X_PF.p)
+    Eigen::Vector3d axis_P = Eigen::Vector3d::UnitZ(), p0 = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d R0 = Eigen::Matrix3d::Identity();
+  };
+  std::vector<Joint> joints;                     // [nbodies]
+  std::vector<RigidInertiaT<double>> inertia;    // [nbodies] body inertia, body coordinates (= Model::inertia)
+  std::vector<int> root;                         // [nbodies] the body of its tree attached to ground (0 for ground)
+  std::vector<int> dof_body;                     // [nv] body whose joint a velocity index belongs to
+  std::vector<int> dof_parent;                   // [nv] next velocity index towards the root (-1: none)
+  bool dense_mass_matrix = false;                // every pair of velocity indices is related (a chain): M has no structural zero
+  bool body_force_sources = false;               // springs, body forces or body-force actuators write fext
+  explicit ModelConstants(const Model& model);
+};
+
 template <class S>
 struct DataT {
   explicit DataT(const Model& model);
+
+  ModelConstants constants;      // derived from the model once (see above)
 
   // position stage (forward_kinematics)
   std::vector<SE3T<S>> liMi;     // [nbodies] pose of body i in its parent
@@ -44,8 +67,11 @@ struct DataT {
   std::vector<Eigen::Matrix<S, Eigen::Dynamic, 1, 0, 6, 1>> u;
   std::vector<Vec6T<S>> c;       // velocity-product accelerations
 
-  // crba workspace
-  std::vector<Mat6T<S>> Ic;      // composite inertia
+  // crba workspace: world axes, moments about the origin of the body's tree
+  // root (ModelConstants::root), so that no transform is needed between bodies
+  std::vector<RigidInertiaT<S>> Ic;  // [nbodies] composite inertia of the subtree of body i
+  std::vector<Vec6T<S>> Sw;          // [nv] motion axis of each velocity index
+  std::vector<Vec6T<S>> fsum;        // [nbodies] scratch: body forces summed towards the root
 
   // loop closures
   VecXT<S> phi;                  // [nc] position residual
