@@ -22,10 +22,14 @@
 //          forces, ABA), vs mj_forward (every stage MuJoCo runs: kinematics,
 //          com, mass matrix and its factorization, velocities, bias forces,
 //          actuation, qacc)
-//   crba   the mass-matrix part alone: codyna crba_after_kinematics (after an
-//          untimed forward_kinematics(q)), vs mj_crb (after an untimed
-//          mj_kinematics + mj_comPos, which among other things give mj_crb
-//          its inputs: the inertias and motion axes in world axes)
+//   crba   the mass-matrix part alone: codyna crba_composite (after an
+//          untimed forward_kinematics(q) + crba_world_terms, which give it
+//          the body inertias and motion axes in world axes), vs mj_crb (after
+//          an untimed mj_kinematics + mj_comPos, which among other things give
+//          mj_crb the same inputs: cinert and cdof)
+//   crba_k from the poses to M: codyna crba_after_kinematics (both stages,
+//          after an untimed forward_kinematics(q)), vs mj_comPos + mj_crb
+//          (after an untimed mj_kinematics)
 //   crba_q the whole way from q to M: codyna crba<double>(q) (its own
 //          position kinematics included), vs mj_kinematics + mj_comPos + mj_crb
 //   jac    the linearization's Jacobians: codyna exact A, B
@@ -291,12 +295,25 @@ void fd_mujoco(benchmark::State& st, Case* c) {
 }
 void crba_codyna(benchmark::State& st, Case* c) {
   forward_kinematics<double>(*c->model, *c->data, c->q);
-  for (auto _ : st) benchmark::DoNotOptimize(crba_after_kinematics<double>(*c->model, *c->data).data());
+  crba_world_terms<double>(*c->model, *c->data);
+  for (auto _ : st) benchmark::DoNotOptimize(crba_composite<double>(*c->model, *c->data).data());
 }
 void crba_mujoco(benchmark::State& st, Case* c) {
   mj_kinematics(c->mm.get(), c->md.get());
   mj_comPos(c->mm.get(), c->md.get());
   for (auto _ : st) {
+    mj_crb(c->mm.get(), c->md.get());
+    benchmark::DoNotOptimize(c->md->qM);
+  }
+}
+void crba_k_codyna(benchmark::State& st, Case* c) {
+  forward_kinematics<double>(*c->model, *c->data, c->q);
+  for (auto _ : st) benchmark::DoNotOptimize(crba_after_kinematics<double>(*c->model, *c->data).data());
+}
+void crba_k_mujoco(benchmark::State& st, Case* c) {
+  mj_kinematics(c->mm.get(), c->md.get());
+  for (auto _ : st) {
+    mj_comPos(c->mm.get(), c->md.get());
     mj_crb(c->mm.get(), c->md.get());
     benchmark::DoNotOptimize(c->md->qM);
   }
@@ -325,7 +342,7 @@ void jac_mujoco(benchmark::State& st, Case* c) {
   }
 }
 
-const char* const kOps[] = {"fd", "crba", "crba_q", "jac"};
+const char* const kOps[] = {"fd", "crba", "crba_k", "crba_q", "jac"};
 
 // collects the median CPU time (ns) of every benchmark while the console reporter prints
 class Collector : public benchmark::ConsoleReporter {
@@ -387,8 +404,8 @@ std::string table(const Collector& col) {
   t << "Ratios codyna / MuJoCo " << mj_versionString()
     << " (median CPU time of interleaved repetitions; below 1: codyna is faster)\n\n"
     << "| model | nv | fd: forward_dynamics / mj_forward | crba: mass-matrix part / mj_crb "
-       "| crba_q: q -> M | jac: exact A,B / mjd_transitionFD |\n"
-    << "|---|---:|---|---|---|---|\n";
+       "| crba_k: poses -> M / mj_comPos + mj_crb | crba_q: q -> M | jac: exact A,B / mjd_transitionFD |\n"
+    << "|---|---:|---|---|---|---|---|\n";
   for (const auto& c : g_cases) {
     t << "| " << c->name << " | " << c->model->nv;
     for (const char* op : kOps) {
@@ -456,6 +473,8 @@ int main(int argc, char** argv) {
     benchmark::RegisterBenchmark(("fd/" + p->name + "/mujoco").c_str(), fd_mujoco, p)->Unit(benchmark::kMicrosecond);
     benchmark::RegisterBenchmark(("crba/" + p->name + "/codyna").c_str(), crba_codyna, p)->Unit(benchmark::kMicrosecond);
     benchmark::RegisterBenchmark(("crba/" + p->name + "/mujoco").c_str(), crba_mujoco, p)->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("crba_k/" + p->name + "/codyna").c_str(), crba_k_codyna, p)->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("crba_k/" + p->name + "/mujoco").c_str(), crba_k_mujoco, p)->Unit(benchmark::kMicrosecond);
     benchmark::RegisterBenchmark(("crba_q/" + p->name + "/codyna").c_str(), crba_q_codyna, p)->Unit(benchmark::kMicrosecond);
     benchmark::RegisterBenchmark(("crba_q/" + p->name + "/mujoco").c_str(), crba_q_mujoco, p)->Unit(benchmark::kMicrosecond);
     benchmark::RegisterBenchmark(("jac/" + p->name + "/codyna").c_str(), jac_codyna, p)->Unit(benchmark::kMillisecond);

@@ -8,11 +8,11 @@ namespace codyna {
 ModelConstants::ModelConstants(const Model& model) {
   const auto nb = static_cast<std::size_t>(model.nbodies);
   joints.resize(nb);
-  inertia.resize(nb);
+  com_inertia.resize(nb);
   root.assign(nb, 0);
   dof_body.assign(static_cast<std::size_t>(model.nv), 0);
   dof_parent.assign(static_cast<std::size_t>(model.nv), -1);
-  for (int i = 0; i < model.nbodies; ++i) inertia[i] = RigidInertiaT<double>::from_matrix(model.inertia[i]);
+  for (int i = 0; i < model.nbodies; ++i) com_inertia[i] = ComInertia::from_matrix(model.inertia[i]);
   std::vector<int> last_dof(nb, -1);  // the last velocity index at or above body i
   const Eigen::VectorXd q_neutral = neutral(model);
   for (int i = 1; i < model.nbodies; ++i) {
@@ -66,6 +66,7 @@ DataT<S>::DataT(const Model& model) : constants(model) {
   Dinv.resize(nb);
   u.resize(nb);
   c.assign(nb, Vec6T<S>::Zero());
+  Iw.assign(nb, RigidInertiaT<S>());
   Ic.assign(nb, RigidInertiaT<S>());
   Sw.assign(static_cast<std::size_t>(model.nv), Vec6T<S>::Zero());
   fsum.assign(nb, Vec6T<S>::Zero());

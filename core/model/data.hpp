@@ -23,7 +23,7 @@ struct ModelConstants {
     Eigen::Matrix3d R0 = Eigen::Matrix3d::Identity();
   };
   std::vector<Joint> joints;                     // [nbodies]
-  std::vector<RigidInertiaT<double>> inertia;    // [nbodies] body inertia, body coordinates (= Model::inertia)
+  std::vector<ComInertia> com_inertia;           // [nbodies] body inertia about its com, body axes (= Model::inertia)
   std::vector<int> root;                         // [nbodies] the body of its tree attached to ground (0 for ground)
   std::vector<int> dof_body;                     // [nv] body whose joint a velocity index belongs to
   std::vector<int> dof_parent;                   // [nv] next velocity index towards the root (-1: none)
@@ -69,6 +69,7 @@ struct DataT {
 
   // crba workspace: world axes, moments about the origin of the body's tree
   // root (ModelConstants::root), so that no transform is needed between bodies
+  std::vector<RigidInertiaT<S>> Iw;  // [nbodies] inertia of body i
   std::vector<RigidInertiaT<S>> Ic;  // [nbodies] composite inertia of the subtree of body i
   std::vector<Vec6T<S>> Sw;          // [nv] motion axis of each velocity index
   std::vector<Vec6T<S>> fsum;        // [nbodies] scratch: body forces summed towards the root

@@ -168,23 +168,6 @@ struct RigidInertiaT {
     I += o.I;
     return *this;
   }
-  // the same body in coordinates whose axes are turned by R (x_new = R x_old)
-  // and whose origin is at -d from the old origin (x_new = R x_old + d):
-  //   h' = R h + m d,  I' = R I R^T + (2 (R h).d + m |d|^2) 1 - (d (R h)^T + (R h) d^T + m d d^T)
-  template <class T>
-  RigidInertiaT<T> transformed(const Mat3T<T>& R, const Vec3T<T>& d) const {
-    RigidInertiaT<T> r;
-    const T mm = T(m);
-    const Vec3T<T> hr = R * h.template cast<T>();
-    r.m = mm;
-    r.h = hr + mm * d;
-    const Mat3T<T> Ir = R * (I.template cast<T>() * R.transpose()).eval();
-    const T s = T(2) * hr.dot(d) + mm * d.squaredNorm();
-    const Vec3T<T> g = hr + T(0.5) * mm * d;  // d (R h)^T + (R h) d^T + m d d^T = d g^T + g d^T
-    r.I = Ir - d * g.transpose() - g * d.transpose();
-    r.I.diagonal().array() += s;
-    return r;
-  }
   Mat6T<S> matrix() const {
     Mat6T<S> X;
     const Mat3T<S> H = skew<S>(h);
@@ -201,6 +184,43 @@ struct RigidInertiaT {
     r.h = Vec3T<S>(X(2, 4), X(0, 5), X(1, 3));
     r.I = X.template topLeftCorner<3, 3>();
     return r;
+  }
+};
+
+// A rigid body's inertia about its centre of mass (body axes): mass m, centre
+// of mass c and rotational inertia Ic about c, for the cheapest move to another
+// frame (to_frame).
+struct ComInertia {
+  double m = 0.0;
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d Ic = Eigen::Matrix3d::Zero();
+
+  static ComInertia from_matrix(const Mat6T<double>& X) {
+    ComInertia r;
+    const RigidInertiaT<double> o = RigidInertiaT<double>::from_matrix(X);
+    r.m = o.m;
+    r.c = o.m > 0.0 ? Eigen::Vector3d(o.h / o.m) : Eigen::Vector3d::Zero();
+    r.Ic = o.I - r.m * (r.c.squaredNorm() * Eigen::Matrix3d::Identity() - r.c * r.c.transpose());
+    return r;
+  }
+  // the body in a frame where its axes are R (body -> frame) and its origin at r:
+  //   p = R c + r,  h = m p,  I = R Ic R^T + m (|p|^2 1 - p p^T)
+  // (the symmetric R Ic R^T from its upper triangle)
+  template <class S>
+  void to_frame(const Mat3T<S>& R, const Vec3T<S>& r, RigidInertiaT<S>& out) const {
+    const Vec3T<S> p = R * c.template cast<S>() + r;
+    const S ms = S(m);
+    out.m = ms;
+    out.h = ms * p;
+    const Mat3T<S> T = R * Ic.template cast<S>();
+    const S pp = p.squaredNorm();
+    for (int i = 0; i < 3; ++i)
+      for (int j = i; j < 3; ++j) {
+        S v = T.row(i).dot(R.row(j)) - ms * p[i] * p[j];
+        if (i == j) v += ms * pp;
+        out.I(i, j) = v;
+        out.I(j, i) = v;
+      }
   }
 };
 
