@@ -102,7 +102,8 @@ const VecXT<S>& aba_after_kinematics(const Model& model, DataT<S>& d, const VecX
       d.U[i].noalias() = d.IA[i] * d.Sb[i];
       const SmallMatT<S> D = d.Sb[i].transpose() * d.U[i];
       small_inverse<S>(D, d.Dinv[i]);
-      d.u[i] = tau.segment(j.idx_v, j.nv) - d.Sb[i].transpose() * d.pA[i];
+      d.u[i] = tau.segment(j.idx_v, j.nv);  // in two steps: tau.segment - product would evaluate into a heap temporary
+      d.u[i].noalias() -= d.Sb[i].transpose() * d.pA[i];
       if (p == 0) continue;
       const Mat6xT<S> UD = d.U[i] * d.Dinv[i];
       Ia = d.IA[i];
@@ -123,7 +124,10 @@ const VecXT<S>& aba_after_kinematics(const Model& model, DataT<S>& d, const VecX
       d.qdd[j.idx_v] = qdd_i;
       d.a[i] = ap + s * qdd_i;
     } else if (j.nv > 0) {
-      const Eigen::Matrix<S, Eigen::Dynamic, 1, 0, 6, 1> qdd_i = d.Dinv[i] * (d.u[i] - d.U[i].transpose() * ap);
+      Eigen::Matrix<S, Eigen::Dynamic, 1, 0, 6, 1> r = d.u[i];
+      r.noalias() -= d.U[i].transpose() * ap;
+      Eigen::Matrix<S, Eigen::Dynamic, 1, 0, 6, 1> qdd_i(j.nv);
+      qdd_i.noalias() = d.Dinv[i] * r;
       d.qdd.segment(j.idx_v, j.nv) = qdd_i;
       d.a[i] = ap + d.Sb[i] * qdd_i;
     } else {
