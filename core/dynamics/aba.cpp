@@ -61,27 +61,71 @@ const VecXT<S>& aba(const Model& model, DataT<S>& d, const VecXT<S>& q, const Ve
   return aba_after_kinematics<S>(model, d, v, tau);
 }
 
+namespace {
+// velocity-product terms: bias accelerations c and the bodies' bias forces
+// (the start of pA), from the velocities
+template <class S>
+void aba_velocity_terms(const Model& model, DataT<S>& d, const VecXT<S>& v) {
+  for (int i = 1; i < model.nbodies; ++i) {
+    const JointModel& j = model.joints[i];
+    const Vec6T<S>& vi = d.v[i];
+    d.pA[i] = cross_force<S>(vi, Vec6T<S>(model.inertia[i].template cast<S>() * vi));
+    Vec6T<S> vJ;
+    if (j.nv == 1) vJ = d.Sb[i].col(0) * v[j.idx_v];
+    else if (j.nv > 0) vJ.noalias() = d.Sb[i] * v.segment(j.idx_v, j.nv);
+    else vJ.setZero();
+    d.c[i] = d.cJ[i] + cross_motion<S>(vi, vJ);
+  }
+}
+
+// the outward pass: accelerations from the ground's (-g) to the leaves
+template <class S>
+const VecXT<S>& aba_forward_pass(const Model& model, DataT<S>& d) {
+  d.a[0].setZero();
+  if (model.has_gravity) d.a[0].template tail<3>() = -model.gravity.cast<S>();
+  for (int i = 1; i < model.nbodies; ++i) {
+    const JointModel& j = model.joints[i];
+    const Vec6T<S> ap = d.liMi[i].inv_act_motion(d.a[j.parent]) + d.c[i];
+    if (j.nv == 1) {
+      const Vec6T<S> s = d.Sb[i].col(0);
+      const S qdd_i = d.Dinv[i](0, 0) * (d.u[i](0) - d.U[i].col(0).dot(ap));
+      d.qdd[j.idx_v] = qdd_i;
+      d.a[i] = ap + s * qdd_i;
+    } else if (j.nv > 0) {
+      Eigen::Matrix<S, Eigen::Dynamic, 1, 0, 6, 1> r = d.u[i];
+      r.noalias() -= d.U[i].transpose() * ap;
+      Eigen::Matrix<S, Eigen::Dynamic, 1, 0, 6, 1> qdd_i(j.nv);
+      qdd_i.noalias() = d.Dinv[i] * r;
+      d.qdd.segment(j.idx_v, j.nv) = qdd_i;
+      d.a[i] = ap + d.Sb[i] * qdd_i;
+    } else {
+      d.a[i] = ap;
+    }
+  }
+  // data.a holds accelerations including the gravity offset here; keep the
+  // documented meaning (no gravity) for callers that read it. The offset is a
+  // pure linear acceleration a0 = -g of the ground: in body i it is R_i^T a0.
+  if (model.has_gravity) {
+    const Vec3T<S> a0 = d.a[0].template tail<3>();
+    for (int i = 1; i < model.nbodies; ++i) d.a[i].template tail<3>().noalias() -= d.oMi[i].R.transpose() * a0;
+    d.a[0].setZero();
+  }
+  return d.qdd;
+}
+}  // namespace
+
 // Body-coordinate ABA. One-coordinate joints (the common case) take a path
 // with fixed-size vectors; the transform of an articulated inertia to the
 // parent is the structured add_transformed_inertia (spatial.hpp).
 template <class S>
 const VecXT<S>& aba_after_kinematics(const Model& model, DataT<S>& d, const VecXT<S>& v, const VecXT<S>& tau) {
-  std::vector<Vec6T<S>>& c = d.c;
-  for (int i = 1; i < model.nbodies; ++i) {
-    const JointModel& j = model.joints[i];
-    d.IA[i] = model.inertia[i].template cast<S>();
-    const Vec6T<S>& vi = d.v[i];
-    d.pA[i] = cross_force<S>(vi, Vec6T<S>(d.IA[i] * vi));
-    Vec6T<S> vJ;
-    if (j.nv == 1) vJ = d.Sb[i].col(0) * v[j.idx_v];
-    else if (j.nv > 0) vJ.noalias() = d.Sb[i] * v.segment(j.idx_v, j.nv);
-    else vJ.setZero();
-    c[i] = d.cJ[i] + cross_motion<S>(vi, vJ);
-  }
-  Mat6T<S> Ia;
+  for (int i = 1; i < model.nbodies; ++i) d.IA[i] = model.inertia[i].template cast<S>();
+  aba_velocity_terms<S>(model, d, v);
+  const std::vector<Vec6T<S>>& c = d.c;
   for (int i = model.nbodies - 1; i > 0; --i) {
     const JointModel& j = model.joints[i];
     const int p = j.parent;
+    Mat6T<S>& Ia = d.Ia[i];
     Vec6T<S> pa;
     if (j.nv == 1) {
       const Vec6T<S> s = d.Sb[i].col(0);
@@ -113,38 +157,40 @@ const VecXT<S>& aba_after_kinematics(const Model& model, DataT<S>& d, const VecX
     add_transformed_inertia<S>(d.liMi[i], Ia, d.IA[p]);
     d.pA[p] += d.liMi[i].act_force(pa);
   }
-  d.a[0].setZero();
-  if (model.has_gravity) d.a[0].template tail<3>() = -model.gravity.cast<S>();
-  for (int i = 1; i < model.nbodies; ++i) {
-    const JointModel& j = model.joints[i];
-    const Vec6T<S> ap = d.liMi[i].inv_act_motion(d.a[j.parent]) + c[i];
-    if (j.nv == 1) {
-      const Vec6T<S> s = d.Sb[i].col(0);
-      const S qdd_i = d.Dinv[i](0, 0) * (d.u[i](0) - d.U[i].col(0).dot(ap));
-      d.qdd[j.idx_v] = qdd_i;
-      d.a[i] = ap + s * qdd_i;
-    } else if (j.nv > 0) {
-      Eigen::Matrix<S, Eigen::Dynamic, 1, 0, 6, 1> r = d.u[i];
-      r.noalias() -= d.U[i].transpose() * ap;
-      Eigen::Matrix<S, Eigen::Dynamic, 1, 0, 6, 1> qdd_i(j.nv);
-      qdd_i.noalias() = d.Dinv[i] * r;
-      d.qdd.segment(j.idx_v, j.nv) = qdd_i;
-      d.a[i] = ap + d.Sb[i] * qdd_i;
-    } else {
-      d.a[i] = ap;
-    }
-  }
-  // data.a holds accelerations including the gravity offset here; keep the
-  // documented meaning (no gravity) for callers that read it. The offset is a
-  // pure linear acceleration a0 = -g of the ground: in body i it is R_i^T a0.
-  if (model.has_gravity) {
-    const Vec3T<S> a0 = d.a[0].template tail<3>();
-    for (int i = 1; i < model.nbodies; ++i) d.a[i].template tail<3>().noalias() -= d.oMi[i].R.transpose() * a0;
-    d.a[0].setZero();
-  }
-  return d.qdd;
+  return aba_forward_pass<S>(model, d);
 }
 
+// The inward pass without its inertia part: IA, Ia, U and Dinv depend on the
+// positions only and are those of the last full pass.
+template <class S>
+const VecXT<S>& aba_same_positions(const Model& model, DataT<S>& d, const VecXT<S>& v, const VecXT<S>& tau) {
+  aba_velocity_terms<S>(model, d, v);
+  const std::vector<Vec6T<S>>& c = d.c;
+  for (int i = model.nbodies - 1; i > 0; --i) {
+    const JointModel& j = model.joints[i];
+    const int p = j.parent;
+    Vec6T<S> pa;
+    if (j.nv == 1) {
+      const Vec6T<S> s = d.Sb[i].col(0);
+      const S ui = tau[j.idx_v] - s.dot(d.pA[i]);
+      d.u[i](0) = ui;
+      if (p == 0) continue;
+      const Vec6T<S> UD = d.U[i].col(0) * d.Dinv[i](0, 0);
+      pa = d.pA[i] + d.Ia[i] * c[i] + UD * ui;
+    } else {
+      d.u[i] = tau.segment(j.idx_v, j.nv);
+      d.u[i].noalias() -= d.Sb[i].transpose() * d.pA[i];
+      if (p == 0) continue;
+      const Mat6xT<S> UD = d.U[i] * d.Dinv[i];
+      pa = d.pA[i] + d.Ia[i] * c[i] + UD * d.u[i];
+    }
+    d.pA[p] += d.liMi[i].act_force(pa);
+  }
+  return aba_forward_pass<S>(model, d);
+}
+
+template const VecXT<double>& aba_same_positions<double>(const Model&, DataT<double>&, const VecXT<double>&,
+                                                        const VecXT<double>&);
 template const VecXT<double>& aba_after_kinematics<double>(const Model&, DataT<double>&, const VecXT<double>&,
                                                           const VecXT<double>&);
 template const VecXT<ADScalar>& aba_after_kinematics<ADScalar>(const Model&, DataT<ADScalar>&, const VecXT<ADScalar>&,

@@ -6,6 +6,22 @@
 namespace codyna {
 
 namespace {
+// v[i] and cJ[i] of body i from its parent's velocity (liMi, Sb of body i
+// already written); returns the joint velocity S qd
+template <class S>
+Vec6T<S> body_velocity(const JointModel& j, DataT<S>& d, int i, const VecXT<S>& q, const VecXT<S>& v) {
+  Vec6T<S> vJ;
+  if (j.nv == 1) vJ = d.Sb[i].col(0) * v[j.idx_v];
+  else if (j.nv > 0) vJ.noalias() = d.Sb[i] * v.segment(j.idx_v, j.nv);
+  else vJ.setZero();
+  if (j.type == JointType::Universal || j.type == JointType::Planar)
+    d.cJ[i] = j.X_CM.cast<S>().act_motion(joint_bias<S>(j, q, v));
+  else
+    d.cJ[i].setZero();
+  d.v[i] = d.liMi[i].inv_act_motion(d.v[j.parent]) + vJ;
+  return vJ;
+}
+
 template <class S>
 void fk(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>* v, const VecXT<S>* qdd) {
   using std::cos;
@@ -39,15 +55,7 @@ void fk(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>* v, c
       d.oMi[i].p += oMp.p;
     }
     if (!v) continue;
-    Vec6T<S> vJ;
-    if (j.nv == 1) vJ = d.Sb[i].col(0) * (*v)[j.idx_v];
-    else if (j.nv > 0) vJ.noalias() = d.Sb[i] * v->segment(j.idx_v, j.nv);
-    else vJ.setZero();
-    if (j.type == JointType::Universal || j.type == JointType::Planar)
-      d.cJ[i] = j.X_CM.cast<S>().act_motion(joint_bias<S>(j, q, *v));
-    else
-      d.cJ[i].setZero();
-    d.v[i] = liMi.inv_act_motion(d.v[p]) + vJ;
+    const Vec6T<S> vJ = body_velocity<S>(j, d, i, q, *v);
     if (!qdd) continue;
     Vec6T<S> aJ;
     if (j.nv == 1) aJ = d.Sb[i].col(0) * (*qdd)[j.idx_v];
@@ -69,6 +77,11 @@ void forward_kinematics(const Model& model, DataT<S>& data, const VecXT<S>& q, c
 template <class S>
 void forward_kinematics(const Model& model, DataT<S>& data, const VecXT<S>& q, const VecXT<S>& v, const VecXT<S>& qdd) {
   fk<S>(model, data, q, &v, &qdd);
+}
+
+template <class S>
+void velocity_kinematics(const Model& model, DataT<S>& data, const VecXT<S>& q, const VecXT<S>& v) {
+  for (int i = 1; i < model.nbodies; ++i) body_velocity<S>(model.joints[i], data, i, q, v);
 }
 
 template <class S>
@@ -126,6 +139,7 @@ MatXT<S> point_jacobian(const Model& model, const DataT<S>& data, int body, cons
   template void forward_kinematics<S>(const Model&, DataT<S>&, const VecXT<S>&, const VecXT<S>&);         \
   template void forward_kinematics<S>(const Model&, DataT<S>&, const VecXT<S>&, const VecXT<S>&,          \
                                       const VecXT<S>&);                                                   \
+  template void velocity_kinematics<S>(const Model&, DataT<S>&, const VecXT<S>&, const VecXT<S>&);        \
   template Vec3T<S> point_position<S>(const DataT<S>&, int, const Eigen::Vector3d&);                      \
   template Vec3T<S> point_velocity<S>(const DataT<S>&, int, const Eigen::Vector3d&);                      \
   template Vec3T<S> point_acceleration<S>(const DataT<S>&, int, const Eigen::Vector3d&);                  \

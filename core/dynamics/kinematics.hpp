@@ -18,6 +18,10 @@ template <class S>
 void forward_kinematics(const Model& model, DataT<S>& data, const VecXT<S>& q, const VecXT<S>& v);
 template <class S>
 void forward_kinematics(const Model& model, DataT<S>& data, const VecXT<S>& q, const VecXT<S>& v, const VecXT<S>& qdd);
+// the velocity stage alone (v, cJ) on the positions (liMi, Sb) that
+// forward_kinematics(q) already wrote: a velocity change at the same q
+template <class S>
+void velocity_kinematics(const Model& model, DataT<S>& data, const VecXT<S>& q, const VecXT<S>& v);
 
 // world position, velocity and (classical) acceleration of point p (body coordinates) of a body
 template <class S>

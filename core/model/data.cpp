@@ -61,6 +61,7 @@ DataT<S>::DataT(const Model& model) : constants(model) {
   f.assign(nb, Vec6T<S>::Zero());
   fext.assign(nb, Vec6T<S>::Zero());
   IA.assign(nb, Mat6T<S>::Zero());
+  Ia.assign(nb, Mat6T<S>::Zero());
   pA.assign(nb, Vec6T<S>::Zero());
   U.assign(nb, Mat6xT<S>(6, 0));
   Dinv.resize(nb);

@@ -60,7 +60,8 @@ struct DataT {
   VecXT<S> lambda;               // [nc] constraint multipliers (M qdd = Q - nle - J^T lambda); 0 on redundant rows
 
   // articulated-body workspace (aba)
-  std::vector<Mat6T<S>> IA;
+  std::vector<Mat6T<S>> IA;      // [nbodies] articulated inertia, body coordinates
+  std::vector<Mat6T<S>> Ia;      // [nbodies] IA less the part the joint takes (U Dinv U^T): what the parent receives
   std::vector<Vec6T<S>> pA;
   std::vector<Mat6xT<S>> U;
   std::vector<Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>> Dinv;
