@@ -1,7 +1,8 @@
 // No heap allocation in forward dynamics and in one plant evaluation after the
 // first call on a Data / PlantFunction: the counting allocator of
 // counting_allocator.hpp around the second call of forward_dynamics<double>,
-// crba<double> and PlantFunction::eval<double>, on the MuJoCo benchmark's
+// crba<double>, PlantFunction::eval<double> and PlantFunction::fd_jacobian
+// (finite differences), on the MuJoCo benchmark's
 // chains (2 to 90 links) and ball-joint tree, and on every example.
 #include <gtest/gtest.h>
 
@@ -77,12 +78,29 @@ long plant_eval_allocations(const Model& m) {
   return c.n();
 }
 
+// PlantFunction::fd_jacobian into a J of the right size, central and forward
+long fd_jacobian_allocations(const Model& m) {
+  const OperatingPoint op = initial_point(m);
+  const PlantFunction f(m, op.q, op.u, partition_coordinates(m, op.q));
+  Eigen::VectorXd x(f.nx());
+  for (int k = 0; k < f.nx(); ++k) x[k] = 0.05 + 0.02 * k;
+  const Eigen::VectorXd u = Eigen::VectorXd::Constant(f.nu(), 0.7);
+  Eigen::MatrixXd J;
+  f.fd_jacobian(x, u, true, J);
+  f.fd_jacobian(x, u, false, J);
+  Count c;
+  f.fd_jacobian(x, u, true, J);
+  f.fd_jacobian(x, u, false, J);
+  return c.n();
+}
+
 TEST(NoAllocation, ForwardDynamicsAndPlantOnChains) {
   for (int n : {1, 2, 7, 30, 90}) {
     const Model m = compile(speed_models::chain(n));
     EXPECT_EQ(forward_dynamics_allocations(m), 0) << "chain_" << n << ": forward_dynamics";
     EXPECT_EQ(crba_allocations(m), 0) << "chain_" << n << ": crba";
     EXPECT_EQ(plant_eval_allocations(m), 0) << "chain_" << n << ": PlantFunction::eval<double>";
+    if (n <= 30) EXPECT_EQ(fd_jacobian_allocations(m), 0) << "chain_" << n << ": PlantFunction::fd_jacobian";
   }
 }
 
@@ -91,6 +109,7 @@ TEST(NoAllocation, ForwardDynamicsAndPlantOnBallJointTree) {
   EXPECT_EQ(forward_dynamics_allocations(m), 0) << "tree28: forward_dynamics";
   EXPECT_EQ(crba_allocations(m), 0) << "tree28: crba";
   EXPECT_EQ(plant_eval_allocations(m), 0) << "tree28: PlantFunction::eval<double>";
+  EXPECT_EQ(fd_jacobian_allocations(m), 0) << "tree28: PlantFunction::fd_jacobian";
 }
 
 TEST(NoAllocation, ForwardDynamicsAndPlantOnEveryTreeExample) {
@@ -103,6 +122,7 @@ TEST(NoAllocation, ForwardDynamicsAndPlantOnEveryTreeExample) {
     ++trees;
     EXPECT_EQ(forward_dynamics_allocations(m), 0) << name << ": forward_dynamics";
     EXPECT_EQ(plant_eval_allocations(m), 0) << name << ": PlantFunction::eval<double>";
+    EXPECT_EQ(fd_jacobian_allocations(m), 0) << name << ": PlantFunction::fd_jacobian";
   }
   EXPECT_GE(trees, 3);
 }
