@@ -117,6 +117,22 @@ Vec3T<S> angular_acceleration(const DataT<S>& data, int body) {
 }
 
 template <class S>
+void body_jacobian_world_into(const Model& model, const DataT<S>& data, int body, MatXT<S>& J) {
+  if (J.rows() != 6 || J.cols() != model.nv) J.resize(6, model.nv);
+  J.setZero();
+  for (int i = body; i > 0; i = model.parent[i]) {
+    const JointModel& j = model.joints[i];
+    const SE3T<S>& X = data.oMi[i];
+    for (int c = 0; c < j.nv; ++c) {
+      // world motion of the joint axis: [R w; R v + p x R w]
+      const Vec3T<S> w = X.R * data.Sb[i].col(c).template head<3>();
+      J.col(j.idx_v + c).template head<3>() = w;
+      J.col(j.idx_v + c).template tail<3>() = X.R * data.Sb[i].col(c).template tail<3>() + X.p.cross(w);
+    }
+  }
+}
+
+template <class S>
 MatXT<S> body_jacobian_world(const Model& model, const DataT<S>& data, int body) {
   MatXT<S> J = MatXT<S>::Zero(6, model.nv);
   for (int i = body; i > 0; i = model.parent[i]) {
@@ -140,6 +156,7 @@ MatXT<S> point_jacobian(const Model& model, const DataT<S>& data, int body, cons
   template void forward_kinematics<S>(const Model&, DataT<S>&, const VecXT<S>&, const VecXT<S>&,          \
                                       const VecXT<S>&);                                                   \
   template void velocity_kinematics<S>(const Model&, DataT<S>&, const VecXT<S>&, const VecXT<S>&);        \
+  template void body_jacobian_world_into<S>(const Model&, const DataT<S>&, int, MatXT<S>&);                \
   template Vec3T<S> point_position<S>(const DataT<S>&, int, const Eigen::Vector3d&);                      \
   template Vec3T<S> point_velocity<S>(const DataT<S>&, int, const Eigen::Vector3d&);                      \
   template Vec3T<S> point_acceleration<S>(const DataT<S>&, int, const Eigen::Vector3d&);                  \

@@ -40,6 +40,9 @@ Vec3T<S> angular_acceleration(const DataT<S>& data, int body);
 // world velocity of the body-fixed point that is at the world origin.
 template <class S>
 MatXT<S> body_jacobian_world(const Model& model, const DataT<S>& data, int body);
+// the same into J (resized only when its size differs; no heap after that)
+template <class S>
+void body_jacobian_world_into(const Model& model, const DataT<S>& data, int body, MatXT<S>& J);
 // 3 x nv Jacobian of the world velocity of point p (body coordinates)
 template <class S>
 MatXT<S> point_jacobian(const Model& model, const DataT<S>& data, int body, const Eigen::Vector3d& p);

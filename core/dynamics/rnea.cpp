@@ -25,8 +25,8 @@ const VecXT<S>& rnea(const Model& model, DataT<S>& d, const VecXT<S>& q, const V
 
 template <class S>
 const VecXT<S>& nonlinear_effects(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>& v) {
-  const VecXT<S> zero = VecXT<S>::Zero(model.nv);
-  d.nle = rnea<S>(model, d, q, v, zero);
+  if (d.zero_v.size() != model.nv) d.zero_v = VecXT<S>::Zero(model.nv);
+  d.nle = rnea<S>(model, d, q, v, d.zero_v);
   return d.nle;
 }
 

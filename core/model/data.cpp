@@ -80,6 +80,7 @@ DataT<S>::DataT(const Model& model) : constants(model) {
   phi = VecXT<S>::Zero(model.nc);
   Jc = MatXT<S>::Zero(model.nc, model.nv);
   gamma = VecXT<S>::Zero(model.nc);
+  zero_v = VecXT<S>::Zero(model.nv);
 }
 
 template struct DataT<double>;

@@ -6,6 +6,8 @@
 
 #include <vector>
 
+#include <Eigen/QR>
+
 #include "model/model.hpp"
 #include "spatial/spatial.hpp"
 
@@ -79,6 +81,18 @@ struct DataT {
   VecXT<S> phi;                  // [nc] position residual
   MatXT<S> Jc;                   // [nc x nv] d phi / dq (tangent), so d/dt phi = Jc v
   VecXT<S> gamma;                // [nc] dJc/dt v, so d2/dt2 phi = Jc qdd + gamma
+
+  // loop-closure workspace (constraint_terms, forward_dynamics<double>): sized
+  // by the first call, so that later calls do not allocate
+  VecXT<S> zero_v;               // [nv] zeros, never written
+  MatXT<S> J6a, J6b;             // [6 x nv] body Jacobians of a constraint's two bodies
+  MatXT<S> Jp, Jwa, Jwb, Jwd;    // [3 x nv] point, angular (a, b) and relative angular Jacobians
+  struct LoopSolve {
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr;  // independent rows of Jc
+    std::vector<int> rows;                           // [na] independent rows at this q
+    Eigen::MatrixXd J, B, L, X, A, LA;               // [na x nv], [nv x 1+na], [nv x nv], [nv x 1+na], [na x na] x 2
+    Eigen::VectorXd rhs, Jvel, lam;                  // [na]
+  } loop;                        // used with S = double only
 };
 
 extern template struct DataT<double>;

@@ -3,7 +3,8 @@
 // counting_allocator.hpp around the second call of forward_dynamics<double>,
 // crba<double>, PlantFunction::eval<double> and PlantFunction::fd_jacobian
 // (finite differences), on the MuJoCo benchmark's
-// chains (2 to 90 links) and ball-joint tree, and on every example.
+// chains (2 to 90 links) and ball-joint tree, and on every example
+// (forward_dynamics also on the closed loops).
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -125,6 +126,32 @@ TEST(NoAllocation, ForwardDynamicsAndPlantOnEveryTreeExample) {
     EXPECT_EQ(fd_jacobian_allocations(m), 0) << name << ": PlantFunction::fd_jacobian";
   }
   EXPECT_GE(trees, 3);
+}
+
+// closed loops: CRBA, the constraint terms and the Schur complement on the
+// independent rows, in Data's loop workspace (at the assembled initial state)
+TEST(NoAllocation, ForwardDynamicsOnEveryClosedLoopExample) {
+  int loops = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(CODYNA_EXAMPLES_DIR)) {
+    if (entry.path().extension() != ".json") continue;
+    const std::string name = entry.path().filename().string();
+    const Model m = load(name);
+    if (m.nc == 0) continue;
+    ++loops;
+    Data d(m);
+    const Eigen::VectorXd u = m.u_nominal();
+    forward_dynamics<double>(m, d, m.q0, m.v0, u);  // warm-up, without and with stabilization
+    forward_dynamics<double>(m, d, m.q0, m.v0, u, Baumgarte{2.0, 3.0});
+    long n = 0;
+    {
+      Count c;
+      forward_dynamics<double>(m, d, m.q0, m.v0, u);
+      forward_dynamics<double>(m, d, m.q0, m.v0, u, Baumgarte{2.0, 3.0});
+      n = c.n();
+    }
+    EXPECT_EQ(n, 0) << name << ": forward_dynamics";
+  }
+  EXPECT_GE(loops, 3);
 }
 
 }  // namespace
