@@ -130,7 +130,7 @@ Eigen::VectorXd PlantFunction::solve_dependent(const Eigen::VectorXd& z) const {
 }
 
 void PlantFunction::eval_tree(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd& xdot,
-                              Eigen::VectorXd& y, bool same_position) const {
+                              Eigen::VectorXd& y, Reuse reuse) const {
   const Model& m = model_;
   const int n = nz();
   if (!ws_.data) ws_.data = std::make_unique<Data>(m);
@@ -139,11 +139,15 @@ void PlantFunction::eval_tree(const Eigen::VectorXd& x, const Eigen::VectorXd& u
   ws_.u_all = u_all_;
   for (int k = 0; k < nu(); ++k) ws_.u_all[m.plant_inputs[k]] = u[k];
   const Eigen::VectorXd* qdd = nullptr;
-  if (same_position) {
+  if (reuse == Reuse::Positions) {
     // ws_.dq, ws_.q and the position stage in d are those of x already
     velocity_kinematics<double>(m, d, ws_.q, ws_.w);
     const Eigen::VectorXd& Q = applied_forces<double>(m, d, ws_.q, ws_.w, ws_.u_all);
     qdd = &aba_same_positions<double>(m, d, ws_.w, Q);
+  } else if (reuse == Reuse::Motion) {
+    // and the velocity stage too
+    const Eigen::VectorXd& Q = applied_forces<double>(m, d, ws_.q, ws_.w, ws_.u_all);
+    qdd = &aba_same_motion<double>(m, d, Q);
   } else {
     ws_.dq = x.head(n);  // a tree: every coordinate is independent, in order
     integrate_into<double>(m, q_ref_, ws_.dq, ws_.q);
@@ -175,8 +179,8 @@ bool PlantFunction::fd_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd&
   us = u;
   for (Eigen::VectorXd* r : {&fp, &fm, &f0})
     if (r->size() != rows) r->resize(rows);
-  auto eval_into = [&](Eigen::VectorXd& out, bool same_position) {
-    eval_tree(xs, us, xd, y, same_position);
+  auto eval_into = [&](Eigen::VectorXd& out, Reuse reuse) {
+    eval_tree(xs, us, xd, y, reuse);
     out.head(nx_p) = xd;
     out.tail(ny_p) = y;
   };
@@ -184,30 +188,33 @@ bool PlantFunction::fd_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd&
   for (int k = 0; k < n; ++k) {
     const double h = fd_step(central, x[k]);
     xs[k] = x[k] + h;
-    eval_into(fp, false);
+    eval_into(fp, Reuse::Nothing);
     if (central) {
       xs[k] = x[k] - h;
-      eval_into(fm, false);
+      eval_into(fm, Reuse::Nothing);
       J.col(k) = (fp - fm) / (2 * h);
     } else {
       J.col(k) = fp;
     }
     xs[k] = x[k];
   }
-  // at x: the position stage that the other columns share
-  eval_into(f0, false);
+  // at x: the position and velocity stages that the other columns share
+  eval_into(f0, Reuse::Nothing);
   if (!central)
     for (int k = 0; k < n; ++k) J.col(k) = (J.col(k) - f0) / fd_step(false, x[k]);
-  // velocity and input columns on the position stage of x
-  for (int k = n; k < nx_p + nu_p; ++k) {
-    double& e = k < nx_p ? xs[k] : us[k - nx_p];
+  // input columns on the motion of x, then velocity columns on its positions
+  for (int c = 0; c < n + nu_p; ++c) {
+    const bool input = c < nu_p;
+    const int k = input ? nx_p + c : n + (c - nu_p);
+    const Reuse reuse = input ? Reuse::Motion : Reuse::Positions;
+    double& e = input ? us[c] : xs[k];
     const double e0 = e;
     const double h = fd_step(central, e0);
     e = e0 + h;
-    eval_into(fp, true);
+    eval_into(fp, reuse);
     if (central) {
       e = e0 - h;
-      eval_into(fm, true);
+      eval_into(fm, reuse);
       J.col(k) = (fp - fm) / (2 * h);
     } else {
       J.col(k) = (fp - f0) / h;

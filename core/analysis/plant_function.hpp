@@ -75,9 +75,10 @@ class PlantFunction {
   // h = fd_step(false, x_k)) or central ((f(x + h e) - f(x - h e)) / 2h,
   // h = fd_step(true, x_k)) differences of eval<double>. The velocity and input
   // columns reuse the position stage of x (kinematics of q and the articulated
-  // inertias): one full evaluation per position column (two if central), one
-  // more at x, the rest velocity-stage only; the same numbers as differencing
-  // eval column by column. Returns false for closed loops.
+  // inertias), the input columns its velocity terms too: one full evaluation
+  // per position column (two if central), one more at x, the rest without the
+  // position stage; the same numbers as differencing eval column by column.
+  // Returns false for closed loops.
   bool fd_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& u, bool central, Eigen::MatrixXd& J) const;
 
   const CoordinatePartition& partition() const { return part_; }
@@ -93,10 +94,12 @@ class PlantFunction {
 
   // workspace of analytic_jacobian, made on first use; a copy starts without one
   // eval<double> on a tree, into the workspace (no heap after the first call)
-  // same_position: x has the position part of the last eval_tree call (its
-  // kinematics of q and articulated inertias are still in the workspace)
+  // what eval_tree may reuse from its last call: Positions, x has the same
+  // position part (kinematics of q and articulated inertias are still in the
+  // workspace); Motion, x is the same (velocity terms too): only u changed
+  enum class Reuse { Nothing, Positions, Motion };
   void eval_tree(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd& xdot, Eigen::VectorXd& y,
-                 bool same_position = false) const;
+                 Reuse reuse = Reuse::Nothing) const;
 
   struct Workspace {
     std::unique_ptr<TreeDerivatives> td;

@@ -69,7 +69,8 @@ void aba_velocity_terms(const Model& model, DataT<S>& d, const VecXT<S>& v) {
   for (int i = 1; i < model.nbodies; ++i) {
     const JointModel& j = model.joints[i];
     const Vec6T<S>& vi = d.v[i];
-    d.pA[i] = cross_force<S>(vi, Vec6T<S>(model.inertia[i].template cast<S>() * vi));
+    d.pB[i] = cross_force<S>(vi, Vec6T<S>(model.inertia[i].template cast<S>() * vi));
+    d.pA[i] = d.pB[i];
     Vec6T<S> vJ;
     if (j.nv == 1) vJ = d.Sb[i].col(0) * v[j.idx_v];
     else if (j.nv > 0) vJ.noalias() = d.Sb[i] * v.segment(j.idx_v, j.nv);
@@ -160,11 +161,22 @@ const VecXT<S>& aba_after_kinematics(const Model& model, DataT<S>& d, const VecX
   return aba_forward_pass<S>(model, d);
 }
 
+template <class S>
+const VecXT<S>& aba_same_motion(const Model& model, DataT<S>& d, const VecXT<S>& tau, bool reset_bias);
+
 // The inward pass without its inertia part: IA, Ia, U and Dinv depend on the
 // positions only and are those of the last full pass.
 template <class S>
 const VecXT<S>& aba_same_positions(const Model& model, DataT<S>& d, const VecXT<S>& v, const VecXT<S>& tau) {
   aba_velocity_terms<S>(model, d, v);
+  return aba_same_motion<S>(model, d, tau, false);
+}
+
+// the inward pass on the velocity terms (c, pB) already in data
+template <class S>
+const VecXT<S>& aba_same_motion(const Model& model, DataT<S>& d, const VecXT<S>& tau, bool reset_bias) {
+  if (reset_bias)
+    for (int i = 1; i < model.nbodies; ++i) d.pA[i] = d.pB[i];
   const std::vector<Vec6T<S>>& c = d.c;
   for (int i = model.nbodies - 1; i > 0; --i) {
     const JointModel& j = model.joints[i];
@@ -191,6 +203,7 @@ const VecXT<S>& aba_same_positions(const Model& model, DataT<S>& d, const VecXT<
 
 template const VecXT<double>& aba_same_positions<double>(const Model&, DataT<double>&, const VecXT<double>&,
                                                         const VecXT<double>&);
+template const VecXT<double>& aba_same_motion<double>(const Model&, DataT<double>&, const VecXT<double>&, bool);
 template const VecXT<double>& aba_after_kinematics<double>(const Model&, DataT<double>&, const VecXT<double>&,
                                                           const VecXT<double>&);
 template const VecXT<ADScalar>& aba_after_kinematics<ADScalar>(const Model&, DataT<ADScalar>&, const VecXT<ADScalar>&,

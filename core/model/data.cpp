@@ -63,6 +63,7 @@ DataT<S>::DataT(const Model& model) : constants(model) {
   IA.assign(nb, Mat6T<S>::Zero());
   Ia.assign(nb, Mat6T<S>::Zero());
   pA.assign(nb, Vec6T<S>::Zero());
+  pB.assign(nb, Vec6T<S>::Zero());
   U.assign(nb, Mat6xT<S>(6, 0));
   Dinv.resize(nb);
   u.resize(nb);

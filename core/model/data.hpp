@@ -64,7 +64,8 @@ struct DataT {
   // articulated-body workspace (aba)
   std::vector<Mat6T<S>> IA;      // [nbodies] articulated inertia, body coordinates
   std::vector<Mat6T<S>> Ia;      // [nbodies] IA less the part the joint takes (U Dinv U^T): what the parent receives
-  std::vector<Vec6T<S>> pA;
+  std::vector<Vec6T<S>> pB;      // [nbodies] bias force of body i alone, v x* I v
+  std::vector<Vec6T<S>> pA;      // [nbodies] articulated bias force
   std::vector<Mat6xT<S>> U;
   std::vector<Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>> Dinv;
   std::vector<Eigen::Matrix<S, Eigen::Dynamic, 1, 0, 6, 1>> u;
