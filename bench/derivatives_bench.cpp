@@ -1,7 +1,9 @@
 // Cost of the exact plant Jacobian [A B; C D] three ways on the same models,
 // in one run: the analytic derivatives (linearize's exact path on trees), the
 // forward-mode autodiff of the plant function (the independent check), and
-// central finite differences; plus one forward-dynamics evaluation for scale.
+// finite differences (central and forward, with the position stage reused by
+// the velocity and input columns, and with a full evaluation per column as
+// before: the same numbers); plus one forward-dynamics evaluation for scale.
 // Models: 3-D hinge chains of n links (varied axes, full inertias, a motor per
 // joint, gravity) and a 28-DOF tree of ball joints. MuJoCo side by side: see
 // bench/mujoco_speed_bench.cpp.
@@ -108,10 +110,29 @@ void ExactAutodiff(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(plant_jacobian_autodiff(fx.f, fx.x, fx.u).data());
   state.counters["nv"] = fx.m.nv;
 }
+// finite differences as linearize does them (PlantFunction::fd_jacobian: the
+// velocity and input columns on the position stage of x) ...
 void CentralDifferences(benchmark::State& state) {
   Fixture fx(static_cast<int>(state.range(0)));
   for (auto _ : state)
     benchmark::DoNotOptimize(plant_jacobian(fx.f, fx.x, fx.u, JacobianMethod::CentralDifference).data());
+  state.counters["nv"] = fx.m.nv;
+}
+void ForwardDifferences(benchmark::State& state) {
+  Fixture fx(static_cast<int>(state.range(0)));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(plant_jacobian(fx.f, fx.x, fx.u, JacobianMethod::ForwardDifference).data());
+  state.counters["nv"] = fx.m.nv;
+}
+// ... and as before it: a full evaluation per perturbed column (the same numbers)
+void CentralDifferencesFull(benchmark::State& state) {
+  Fixture fx(static_cast<int>(state.range(0)));
+  for (auto _ : state) benchmark::DoNotOptimize(plant_jacobian_fd_full(fx.f, fx.x, fx.u, true).data());
+  state.counters["nv"] = fx.m.nv;
+}
+void ForwardDifferencesFull(benchmark::State& state) {
+  Fixture fx(static_cast<int>(state.range(0)));
+  for (auto _ : state) benchmark::DoNotOptimize(plant_jacobian_fd_full(fx.f, fx.x, fx.u, false).data());
   state.counters["nv"] = fx.m.nv;
 }
 void ForwardDynamics(benchmark::State& state) {
@@ -127,6 +148,9 @@ void ForwardDynamics(benchmark::State& state) {
 BENCHMARK(ExactAnalytic) SIZES;
 BENCHMARK(ExactAutodiff) SIZES;
 BENCHMARK(CentralDifferences) SIZES;
+BENCHMARK(CentralDifferencesFull) SIZES;
+BENCHMARK(ForwardDifferences) SIZES;
+BENCHMARK(ForwardDifferencesFull) SIZES;
 BENCHMARK(ForwardDynamics) SIZES;
 
 }  // namespace

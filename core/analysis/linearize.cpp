@@ -42,19 +42,25 @@ Eigen::MatrixXd plant_jacobian_autodiff(const PlantFunction& f, const Eigen::Vec
 
 Eigen::MatrixXd plant_jacobian(const PlantFunction& f, const Eigen::VectorXd& x, const Eigen::VectorXd& u,
                                JacobianMethod method) {
-  const int nx = f.nx(), nu = f.nu(), ny = f.ny(), n = nx + nu;
-  Eigen::VectorXd xu(n);
-  xu << x, u;
-  Eigen::MatrixXd J(nx + ny, n);
+  Eigen::MatrixXd J(f.nx() + f.ny(), f.nx() + f.nu());
   if (method == JacobianMethod::Exact) {
     if (f.analytic_jacobian(x, u, J)) return J;
     return plant_jacobian_autodiff(f, x, u);
   }
-  const double eps = std::numeric_limits<double>::epsilon();
   const bool central = method == JacobianMethod::CentralDifference;
+  if (f.fd_jacobian(x, u, central, J)) return J;
+  return plant_jacobian_fd_full(f, x, u, central);
+}
+
+Eigen::MatrixXd plant_jacobian_fd_full(const PlantFunction& f, const Eigen::VectorXd& x, const Eigen::VectorXd& u,
+                                       bool central) {
+  const int nx = f.nx(), nu = f.nu(), ny = f.ny(), n = nx + nu;
+  Eigen::VectorXd xu(n);
+  xu << x, u;
+  Eigen::MatrixXd J(nx + ny, n);
   const Eigen::VectorXd f0 = central ? Eigen::VectorXd() : stacked(f, xu);
   for (int k = 0; k < n; ++k) {
-    const double h = (central ? std::cbrt(eps) : std::sqrt(eps)) * std::max(1.0, std::abs(xu[k]));
+    const double h = fd_step(central, xu[k]);
     Eigen::VectorXd xp = xu;
     xp[k] += h;
     if (central) {

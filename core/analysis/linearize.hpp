@@ -9,6 +9,8 @@
 //                    dynamics (default)
 //   ForwardDifference (f(x + h e) - f(x)) / h,      h = sqrt(eps) max(1, |x_i|)
 //   CentralDifference (f(x + h e) - f(x - h e)) / 2h, h = cbrt(eps) max(1, |x_i|)
+//                    (on trees the velocity and input columns reuse the
+//                    position stage: PlantFunction::fd_jacobian)
 // The finite-difference results carry an accuracy estimate: their largest
 // difference from the exact Jacobian, relative to its largest entry.
 #pragma once
@@ -41,6 +43,12 @@ Linearization linearize(const Model& model, const OperatingPoint& op, const Line
 // The full Jacobian [A B; C D] of the plant function at x, u (for checks and trim).
 Eigen::MatrixXd plant_jacobian(const PlantFunction& f, const Eigen::VectorXd& x, const Eigen::VectorXd& u,
                                JacobianMethod method);
+
+// Finite differences by a full evaluation of f per perturbed column (what
+// plant_jacobian did before PlantFunction::fd_jacobian; still its path for
+// closed loops): the reference that fd_jacobian is checked against.
+Eigen::MatrixXd plant_jacobian_fd_full(const PlantFunction& f, const Eigen::VectorXd& x, const Eigen::VectorXd& u,
+                                       bool central);
 
 // The same by forward-mode automatic differentiation of PlantFunction::eval,
 // always (the independent check of the analytic path).

@@ -3,13 +3,17 @@
 #include <Eigen/LU>
 #include <Eigen/QR>
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <set>
 #include <type_traits>
 #include <stdexcept>
 
+#include "dynamics/aba.hpp"
 #include "dynamics/assembly.hpp"
 #include "dynamics/constraints.hpp"
 #include "dynamics/derivatives.hpp"
+#include "dynamics/effects.hpp"
 #include "dynamics/forward_dynamics.hpp"
 #include "dynamics/joint.hpp"
 #include "dynamics/kinematics.hpp"
@@ -167,24 +171,98 @@ Eigen::VectorXd PlantFunction::solve_dependent(const Eigen::VectorXd& z) const {
 }
 
 void PlantFunction::eval_tree(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd& xdot,
-                              Eigen::VectorXd& y) const {
+                              Eigen::VectorXd& y, Reuse reuse) const {
   const Model& m = model_;
   const int n = nz();
   if (!ws_.data) ws_.data = std::make_unique<Data>(m);
   Data& d = *ws_.data;
-  ws_.dq = x.head(n);  // a tree: every coordinate is independent, in order
   ws_.w = x.tail(n);
-  integrate_into<double>(m, q_ref_, ws_.dq, ws_.q);
   ws_.u_all = u_all_;
   for (int k = 0; k < nu(); ++k) ws_.u_all[m.plant_inputs[k]] = u[k];
-  const Eigen::VectorXd& qdd = forward_dynamics<double>(m, d, ws_.q, ws_.w, ws_.u_all);
+  const Eigen::VectorXd* qdd = nullptr;
+  if (reuse == Reuse::Positions) {
+    // ws_.dq, ws_.q and the position stage in d are those of x already
+    velocity_kinematics<double>(m, d, ws_.q, ws_.w);
+    const Eigen::VectorXd& Q = applied_forces<double>(m, d, ws_.q, ws_.w, ws_.u_all);
+    qdd = &aba_same_positions<double>(m, d, ws_.w, Q);
+  } else if (reuse == Reuse::Motion) {
+    // and the velocity stage too
+    const Eigen::VectorXd& Q = applied_forces<double>(m, d, ws_.q, ws_.w, ws_.u_all);
+    qdd = &aba_same_motion<double>(m, d, Q);
+  } else {
+    ws_.dq = x.head(n);  // a tree: every coordinate is independent, in order
+    integrate_into<double>(m, q_ref_, ws_.dq, ws_.q);
+    qdd = &forward_dynamics<double>(m, d, ws_.q, ws_.w, ws_.u_all);
+  }
   tangent_rate_into<double>(m, ws_.dq, ws_.w, ws_.rate);
   if (xdot.size() != 2 * n) xdot.resize(2 * n);
   xdot.head(n) = ws_.rate;
-  xdot.tail(n) = qdd;
+  xdot.tail(n) = *qdd;
   // forward_dynamics left the kinematics of (q, v) in d
   if (y.size() != ny()) y.resize(ny());
   for (int k = 0; k < ny(); ++k) y[k] = sensor_value<double>(m, d, m.sensors[m.plant_outputs[k]], ws_.q, ws_.w);
+}
+
+double fd_step(bool central, double xk) {
+  const double eps = std::numeric_limits<double>::epsilon();
+  return (central ? std::cbrt(eps) : std::sqrt(eps)) * std::max(1.0, std::abs(xk));
+}
+
+bool PlantFunction::fd_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& u, bool central,
+                                Eigen::MatrixXd& J) const {
+  const Model& m = model_;
+  if (m.nc != 0 || !part_.dependent.empty()) return false;
+  const int n = nz(), nx_p = 2 * n, nu_p = nu(), ny_p = ny(), rows = nx_p + ny_p;
+  if (J.rows() != rows || J.cols() != nx_p + nu_p) J.resize(rows, nx_p + nu_p);
+  Eigen::VectorXd &xs = ws_.fd_x, &us = ws_.fd_u, &xd = ws_.fd_xd, &y = ws_.fd_y;
+  Eigen::VectorXd &fp = ws_.fd_p, &fm = ws_.fd_m, &f0 = ws_.fd_0;
+  xs = x;
+  us = u;
+  for (Eigen::VectorXd* r : {&fp, &fm, &f0})
+    if (r->size() != rows) r->resize(rows);
+  auto eval_into = [&](Eigen::VectorXd& out, Reuse reuse) {
+    eval_tree(xs, us, xd, y, reuse);
+    out.head(nx_p) = xd;
+    out.tail(ny_p) = y;
+  };
+  // position columns: every stage anew; forward differences keep f(x + h e) in J until f(x) is known
+  for (int k = 0; k < n; ++k) {
+    const double h = fd_step(central, x[k]);
+    xs[k] = x[k] + h;
+    eval_into(fp, Reuse::Nothing);
+    if (central) {
+      xs[k] = x[k] - h;
+      eval_into(fm, Reuse::Nothing);
+      J.col(k) = (fp - fm) / (2 * h);
+    } else {
+      J.col(k) = fp;
+    }
+    xs[k] = x[k];
+  }
+  // at x: the position and velocity stages that the other columns share
+  eval_into(f0, Reuse::Nothing);
+  if (!central)
+    for (int k = 0; k < n; ++k) J.col(k) = (J.col(k) - f0) / fd_step(false, x[k]);
+  // input columns on the motion of x, then velocity columns on its positions
+  for (int c = 0; c < n + nu_p; ++c) {
+    const bool input = c < nu_p;
+    const int k = input ? nx_p + c : n + (c - nu_p);
+    const Reuse reuse = input ? Reuse::Motion : Reuse::Positions;
+    double& e = input ? us[c] : xs[k];
+    const double e0 = e;
+    const double h = fd_step(central, e0);
+    e = e0 + h;
+    eval_into(fp, reuse);
+    if (central) {
+      e = e0 - h;
+      eval_into(fm, reuse);
+      J.col(k) = (fp - fm) / (2 * h);
+    } else {
+      J.col(k) = (fp - f0) / h;
+    }
+    e = e0;
+  }
+  return true;
 }
 
 template <class S>
@@ -252,6 +330,7 @@ PlantFunction::Workspace::Workspace() = default;
 PlantFunction::Workspace::Workspace(const Workspace&) {}
 PlantFunction::Workspace& PlantFunction::Workspace::operator=(const Workspace&) {
   td.reset();
+  data.reset();
   return *this;
 }
 PlantFunction::Workspace::~Workspace() = default;

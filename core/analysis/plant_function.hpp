@@ -43,6 +43,10 @@ CoordinatePartition partition_coordinates(const Model& model, const Eigen::Vecto
 CoordinatePartition partition_holding(const Model& model, const Eigen::VectorXd& q, const std::vector<std::string>& held,
                                       const std::vector<std::string>& preferred = {});
 
+// the finite-difference step of coordinate value xk: sqrt(eps) max(1, |xk|)
+// for forward differences, cbrt(eps) max(1, |xk|) for central ones
+double fd_step(bool central, double xk);
+
 class PlantFunction {
  public:
   // u_all: every actuator's value at the reference (plant inputs are replaced by eval's u)
@@ -74,6 +78,17 @@ class PlantFunction {
   // then differentiate eval<ADScalar>). No heap allocation after the first call.
   bool analytic_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::MatrixXd& J) const;
 
+  // The finite-difference Jacobian [A B; C D] at (x, u) on tree models, into J
+  // (resized only when its size differs): forward ((f(x + h e) - f(x)) / h,
+  // h = fd_step(false, x_k)) or central ((f(x + h e) - f(x - h e)) / 2h,
+  // h = fd_step(true, x_k)) differences of eval<double>. The velocity and input
+  // columns reuse the position stage of x (kinematics of q and the articulated
+  // inertias), the input columns its velocity terms too: one full evaluation
+  // per position column (two if central), one more at x, the rest without the
+  // position stage; the same numbers as differencing eval column by column.
+  // Returns false for closed loops.
+  bool fd_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& u, bool central, Eigen::MatrixXd& J) const;
+
   const CoordinatePartition& partition() const { return part_; }
   const Eigen::VectorXd& u_all() const { return u_all_; }
 
@@ -87,12 +102,18 @@ class PlantFunction {
 
   // workspace of analytic_jacobian, made on first use; a copy starts without one
   // eval<double> on a tree, into the workspace (no heap after the first call)
-  void eval_tree(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd& xdot, Eigen::VectorXd& y) const;
+  // what eval_tree may reuse from its last call: Positions, x has the same
+  // position part (kinematics of q and articulated inertias are still in the
+  // workspace); Motion, x is the same (velocity terms too): only u changed
+  enum class Reuse { Nothing, Positions, Motion };
+  void eval_tree(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd& xdot, Eigen::VectorXd& y,
+                 Reuse reuse = Reuse::Nothing) const;
 
   struct Workspace {
     std::unique_ptr<TreeDerivatives> td;
     std::unique_ptr<Data> data;
     Eigen::VectorXd v, u_all, dq, q, w, rate;
+    Eigen::VectorXd fd_x, fd_u, fd_xd, fd_y, fd_p, fd_m, fd_0;  // fd_jacobian
     Workspace();
     Workspace(const Workspace&);
     Workspace& operator=(const Workspace&);  // the copy makes its own

@@ -1,5 +1,7 @@
 #include "dynamics/constraints.hpp"
 
+#include <type_traits>
+
 #include "dynamics/kinematics.hpp"
 #include "spatial/autodiff.hpp"
 
@@ -51,13 +53,24 @@ void fill_rows(const Model& model, DataT<S>& d, bool with_velocity, Eigen::Index
     const Vec3T<S> pa = point_position<S>(d, c.body_a, c.point_a), pb = point_position<S>(d, c.body_b, c.point_b);
     const Vec3T<S> dp = pa - pb;
     Vec3T<S> dpd, dpdd;
-    MatXT<S> Jp, Jwa, Jwb;
+    MatXT<S>&Jp = d.Jp, &Jwa = d.Jwa, &Jwb = d.Jwb;  // Data's workspace: no heap after the first call
     if (with_velocity) {
       dpd = point_velocity<S>(d, c.body_a, c.point_a) - point_velocity<S>(d, c.body_b, c.point_b);
       dpdd = point_acceleration<S>(d, c.body_a, c.point_a) - point_acceleration<S>(d, c.body_b, c.point_b);
-      Jp = point_jacobian<S>(model, d, c.body_a, c.point_a) - point_jacobian<S>(model, d, c.body_b, c.point_b);
-      Jwa = body_jacobian_world<S>(model, d, c.body_a).topRows(3);
-      Jwb = body_jacobian_world<S>(model, d, c.body_b).topRows(3);
+      if constexpr (std::is_same_v<S, double>) {
+        body_jacobian_world_into<S>(model, d, c.body_a, d.J6a);
+        body_jacobian_world_into<S>(model, d, c.body_b, d.J6b);
+        Jwa = d.J6a.topRows(3);
+        Jwb = d.J6b.topRows(3);
+        // point Jacobians: linear rows less (point x angular rows)
+        Jp = d.J6a.bottomRows(3) - d.J6b.bottomRows(3);
+        Jp.noalias() -= skew<S>(pa) * Jwa;
+        Jp.noalias() += skew<S>(pb) * Jwb;
+      } else {
+        Jp = point_jacobian<S>(model, d, c.body_a, c.point_a) - point_jacobian<S>(model, d, c.body_b, c.point_b);
+        Jwa = body_jacobian_world<S>(model, d, c.body_a).topRows(3);
+        Jwb = body_jacobian_world<S>(model, d, c.body_b).topRows(3);
+      }
     }
     // constants (ground, fixed axes) beside variables: one derivative size for all
     Vec3T<S> dpc = dp;
@@ -68,6 +81,7 @@ void fill_rows(const Model& model, DataT<S>& d, bool with_velocity, Eigen::Index
       coh(Jp);
       coh(Jwa);
       coh(Jwb);
+      d.Jwd = Jwa - Jwb;
     }
     int r = c.row;
     switch (c.type) {
@@ -87,7 +101,7 @@ void fill_rows(const Model& model, DataT<S>& d, bool with_velocity, Eigen::Index
           if (with_velocity) {
             Vec3T<S> axb = a.x.cross(b.x);
             coh(axb);
-            d.Jc.row(r) = axb.transpose() * (Jwa - Jwb);
+            d.Jc.row(r).noalias() = axb.transpose() * d.Jwd;
             const S g1 = dot3<S>(a.xdd, b.x, nd), g2 = dot3<S>(a.xd, b.xd, nd), g3 = dot3<S>(a.x, b.xdd, nd);
             const S g2x2 = ad_coherent(S(S(2) * g2), nd);
             const S g12 = g1 + g2x2;
@@ -103,7 +117,8 @@ void fill_rows(const Model& model, DataT<S>& d, bool with_velocity, Eigen::Index
           if (with_velocity) {
             Vec3T<S> exd = e.x.cross(dpc);
             coh(exd);
-            d.Jc.row(r) = exd.transpose() * Jwa + e.x.transpose() * Jp;
+            d.Jc.row(r).noalias() = exd.transpose() * Jwa;
+            d.Jc.row(r).noalias() += e.x.transpose() * Jp;
             const S g1 = dot3<S>(e.xdd, dpc, nd), g2 = dot3<S>(e.xd, dpd, nd), g3 = dot3<S>(e.x, dpdd, nd);
             const S g2x2 = ad_coherent(S(S(2) * g2), nd);
             const S g12 = g1 + g2x2;
@@ -127,8 +142,8 @@ const VecXT<S>& constraint_residual(const Model& model, DataT<S>& d, const VecXT
 
 template <class S>
 void constraint_terms(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>& v) {
-  const VecXT<S> zero = VecXT<S>::Zero(model.nv);
-  forward_kinematics<S>(model, d, q, v, zero);
+  if (d.zero_v.size() != model.nv) d.zero_v = VecXT<S>::Zero(model.nv);
+  forward_kinematics<S>(model, d, q, v, d.zero_v);
   fill_rows<S>(model, d, true, std::max(ad_size(q), ad_size(v)));
 }
 

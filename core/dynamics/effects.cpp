@@ -78,7 +78,7 @@ const VecXT<S>& applied_forces(const Model& model, DataT<S>& d, const VecXT<S>& 
       any_body_force = true;
     }
   }
-  if (any_body_force) d.Q += body_forces_to_generalized<S>(model, d);
+  if (any_body_force) add_body_forces_to_generalized<S>(model, d, d.Q);
   return d.Q;
 }
 

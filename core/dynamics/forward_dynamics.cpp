@@ -1,5 +1,10 @@
 #include "dynamics/forward_dynamics.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <type_traits>
+
 #include "dynamics/aba.hpp"
 #include "dynamics/assembly.hpp"
 #include "dynamics/constraints.hpp"
@@ -12,15 +17,108 @@
 
 namespace codyna {
 
+namespace {
+// L L^T = A into L (lower triangle; the upper one is left as it was), as
+// cholesky_solve (spatial/linalg.hpp) computes it; no heap once L has A's size
+void cholesky_factor_into(const Eigen::MatrixXd& A, Eigen::MatrixXd& L) {
+  const Eigen::Index n = A.rows();
+  if (L.rows() != n || L.cols() != n) L.resize(n, n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    double d = A(j, j);
+    for (Eigen::Index k = 0; k < j; ++k) d -= L(j, k) * L(j, k);
+    if (!(d > 0.0)) throw std::runtime_error("matrix is not positive definite");
+    L(j, j) = std::sqrt(d);
+    for (Eigen::Index i = j + 1; i < n; ++i) {
+      double s = A(i, j);
+      for (Eigen::Index k = 0; k < j; ++k) s -= L(i, k) * L(j, k);
+      L(i, j) = s / L(j, j);
+    }
+  }
+}
+// X <- A^-1 X for A = L L^T
+template <class M>
+void cholesky_solve_in_place(const Eigen::MatrixXd& L, M& X) {
+  const Eigen::Index n = L.rows();
+  for (Eigen::Index c = 0; c < X.cols(); ++c) {
+    for (Eigen::Index i = 0; i < n; ++i) {  // L y = b
+      double s = X(i, c);
+      for (Eigen::Index k = 0; k < i; ++k) s -= L(i, k) * X(k, c);
+      X(i, c) = s / L(i, i);
+    }
+    for (Eigen::Index i = n - 1; i >= 0; --i) {  // L^T x = y
+      double s = X(i, c);
+      for (Eigen::Index k = i + 1; k < n; ++k) s -= L(k, i) * X(k, c);
+      X(i, c) = s / L(i, i);
+    }
+  }
+}
+template <class M>
+void resize_if(M& m, Eigen::Index r, Eigen::Index c) {
+  if (m.rows() != r || m.cols() != c) m.resize(r, c);
+}
+
+// the closed-loop branch of forward_dynamics in double, in data's workspace
+// (the same steps and the same arithmetic as the generic branch below, no heap
+// after the first call); forward_kinematics(q, v) and applied_forces have run
+const Eigen::VectorXd& closed_loop_dynamics(const Model& model, Data& d, const Eigen::VectorXd& q,
+                                            const Eigen::VectorXd& v, const Eigen::VectorXd& Q,
+                                            const Baumgarte& stab) {
+  crba_after_kinematics<double>(model, d);
+  nonlinear_effects<double>(model, d, q, v);
+  constraint_terms<double>(model, d, q, v);
+  Data::LoopSolve& w = d.loop;
+  const int nv = model.nv;
+  // independent rows at this configuration (partition_rows with the rank fixed at assembly)
+  w.qr.compute(d.Jc.transpose());
+  const int rank = static_cast<int>(model.active_rows.size());
+  const auto& perm = w.qr.colsPermutation().indices();
+  w.rows.clear();
+  for (int k = 0; k < rank; ++k) w.rows.push_back(perm[k]);
+  std::sort(w.rows.begin(), w.rows.end());
+  const int na = rank;
+  resize_if(w.J, na, nv);
+  resize_if(w.rhs, na, 1);
+  for (int k = 0; k < na; ++k) {
+    w.J.row(k) = d.Jc.row(w.rows[k]);
+    w.rhs[k] = d.gamma[w.rows[k]];
+  }
+  if (stab.alpha != 0.0 || stab.beta != 0.0) {
+    resize_if(w.Jvel, na, 1);
+    w.Jvel.noalias() = w.J * v;
+    for (int k = 0; k < na; ++k)
+      w.rhs[k] += 2.0 * stab.alpha * w.Jvel[k] + stab.beta * stab.beta * d.phi[w.rows[k]];
+  }
+  // [qdd_free, M^-1 J^T] in one factorization
+  resize_if(w.X, nv, 1 + na);
+  w.X.col(0) = Q - d.nle;
+  w.X.rightCols(na) = w.J.transpose();
+  cholesky_factor_into(d.M, w.L);
+  cholesky_solve_in_place(w.L, w.X);
+  resize_if(w.A, na, na);
+  w.A.noalias() = w.J * w.X.rightCols(na);
+  resize_if(w.lam, na, 1);
+  w.lam.noalias() = w.J * w.X.col(0);
+  w.lam += w.rhs;
+  cholesky_factor_into(w.A, w.LA);
+  cholesky_solve_in_place(w.LA, w.lam);
+  d.qdd = w.X.col(0);
+  d.qdd.noalias() -= w.X.rightCols(na) * w.lam;
+  d.lambda.setZero(model.nc);
+  for (int k = 0; k < na; ++k) d.lambda[w.rows[k]] = w.lam[k];
+  return d.qdd;
+}
+}  // namespace
+
 template <class S>
 const VecXT<S>& forward_dynamics(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>& v,
                                  const VecXT<S>& u, const Baumgarte& stab) {
   forward_kinematics<S>(model, d, q, v);
-  const VecXT<S> Q = applied_forces<S>(model, d, q, v, u);
+  const VecXT<S>& Q = applied_forces<S>(model, d, q, v, u);  // data.Q: nothing below writes it
   if (model.nc == 0) {
     d.lambda.setZero(model.nc);
     return aba_after_kinematics<S>(model, d, v, Q);
   }
+  if constexpr (std::is_same_v<S, double>) return closed_loop_dynamics(model, d, q, v, Q, stab);
   crba<S>(model, d, q);
   nonlinear_effects<S>(model, d, q, v);
   constraint_terms<S>(model, d, q, v);

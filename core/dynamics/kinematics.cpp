@@ -6,26 +6,62 @@
 namespace codyna {
 
 namespace {
+// v[i] and cJ[i] of body i from its parent's velocity (liMi, Sb of body i
+// already written); returns the joint velocity S qd
+template <class S>
+Vec6T<S> body_velocity(const JointModel& j, DataT<S>& d, int i, const VecXT<S>& q, const VecXT<S>& v) {
+  Vec6T<S> vJ;
+  if (j.nv == 1) vJ = d.Sb[i].col(0) * v[j.idx_v];
+  else if (j.nv > 0) vJ.noalias() = d.Sb[i] * v.segment(j.idx_v, j.nv);
+  else vJ.setZero();
+  if (j.type == JointType::Universal || j.type == JointType::Planar)
+    d.cJ[i] = j.X_CM.cast<S>().act_motion(joint_bias<S>(j, q, v));
+  else
+    d.cJ[i].setZero();
+  d.v[i] = d.liMi[i].inv_act_motion(d.v[j.parent]) + vJ;
+  return vJ;
+}
+
 template <class S>
 void fk(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>* v, const VecXT<S>* qdd) {
+  using std::cos;
+  using std::sin;
   SE3T<S> X_FM;
   Mat6xT<S> S_M;
   for (int i = 1; i < model.nbodies; ++i) {
     const JointModel& j = model.joints[i];
+    const ModelConstants::Joint& k = d.constants.joints[i];
     const int p = j.parent;
-    joint_transform<S>(j, q, X_FM, S_M);
-    const SE3T<S> X_CM = j.X_CM.cast<S>();
-    d.liMi[i] = j.X_PF.cast<S>() * X_FM * X_CM.inverse();
-    d.oMi[i] = d.oMi[p] * d.liMi[i];
-    d.Sb[i] = X_CM.motion_matrix() * S_M;
+    SE3T<S>& liMi = d.liMi[i];
+    if (j.type == JointType::Revolute) {
+      // X_PF Rot(axis, q) X_CM^-1 = (Rot(R_PF axis, q) R0, Rot(R_PF axis, q) p0 + p_PF)
+      const S qi = q[j.idx_q];
+      const Mat3T<S> Rq = axis_rotation<S>(k.axis_P, cos(qi), sin(qi));
+      liMi.R.noalias() = Rq * k.R0.template cast<S>();
+      liMi.p.noalias() = Rq * k.p0.template cast<S>();
+      liMi.p += k.X_PF.p.template cast<S>();
+    } else {
+      joint_transform<S>(j, q, X_FM, S_M);
+      liMi = k.X_PF.template cast<S>() * X_FM * k.X_MC.template cast<S>();
+      if (!k.constant_S) d.Sb[i] = j.X_CM.cast<S>().motion_matrix() * S_M;
+    }
+    if (k.constant_S) d.Sb[i] = k.Sb.template cast<S>();
+    if (p == 0) {
+      d.oMi[i] = liMi;
+    } else {
+      const SE3T<S>& oMp = d.oMi[p];
+      d.oMi[i].R.noalias() = oMp.R * liMi.R;
+      d.oMi[i].p.noalias() = oMp.R * liMi.p;
+      d.oMi[i].p += oMp.p;
+    }
     if (!v) continue;
-    const auto qd = v->segment(j.idx_v, j.nv);
-    const Vec6T<S> vJ = d.Sb[i] * qd;
-    d.cJ[i] = X_CM.act_motion(joint_bias<S>(j, q, *v));
-    d.v[i] = d.liMi[i].inv_act_motion(d.v[p]) + vJ;
+    const Vec6T<S> vJ = body_velocity<S>(j, d, i, q, *v);
     if (!qdd) continue;
-    d.a[i] = d.liMi[i].inv_act_motion(d.a[p]) + d.Sb[i] * qdd->segment(j.idx_v, j.nv) + d.cJ[i] +
-             cross_motion<S>(d.v[i], vJ);
+    Vec6T<S> aJ;
+    if (j.nv == 1) aJ = d.Sb[i].col(0) * (*qdd)[j.idx_v];
+    else if (j.nv > 0) aJ.noalias() = d.Sb[i] * qdd->segment(j.idx_v, j.nv);
+    else aJ.setZero();
+    d.a[i] = liMi.inv_act_motion(d.a[p]) + aJ + d.cJ[i] + cross_motion<S>(d.v[i], vJ);
   }
 }
 }  // namespace
@@ -41,6 +77,11 @@ void forward_kinematics(const Model& model, DataT<S>& data, const VecXT<S>& q, c
 template <class S>
 void forward_kinematics(const Model& model, DataT<S>& data, const VecXT<S>& q, const VecXT<S>& v, const VecXT<S>& qdd) {
   fk<S>(model, data, q, &v, &qdd);
+}
+
+template <class S>
+void velocity_kinematics(const Model& model, DataT<S>& data, const VecXT<S>& q, const VecXT<S>& v) {
+  for (int i = 1; i < model.nbodies; ++i) body_velocity<S>(model.joints[i], data, i, q, v);
 }
 
 template <class S>
@@ -76,6 +117,22 @@ Vec3T<S> angular_acceleration(const DataT<S>& data, int body) {
 }
 
 template <class S>
+void body_jacobian_world_into(const Model& model, const DataT<S>& data, int body, MatXT<S>& J) {
+  if (J.rows() != 6 || J.cols() != model.nv) J.resize(6, model.nv);
+  J.setZero();
+  for (int i = body; i > 0; i = model.parent[i]) {
+    const JointModel& j = model.joints[i];
+    const SE3T<S>& X = data.oMi[i];
+    for (int c = 0; c < j.nv; ++c) {
+      // world motion of the joint axis: [R w; R v + p x R w]
+      const Vec3T<S> w = X.R * data.Sb[i].col(c).template head<3>();
+      J.col(j.idx_v + c).template head<3>() = w;
+      J.col(j.idx_v + c).template tail<3>() = X.R * data.Sb[i].col(c).template tail<3>() + X.p.cross(w);
+    }
+  }
+}
+
+template <class S>
 MatXT<S> body_jacobian_world(const Model& model, const DataT<S>& data, int body) {
   MatXT<S> J = MatXT<S>::Zero(6, model.nv);
   for (int i = body; i > 0; i = model.parent[i]) {
@@ -98,6 +155,8 @@ MatXT<S> point_jacobian(const Model& model, const DataT<S>& data, int body, cons
   template void forward_kinematics<S>(const Model&, DataT<S>&, const VecXT<S>&, const VecXT<S>&);         \
   template void forward_kinematics<S>(const Model&, DataT<S>&, const VecXT<S>&, const VecXT<S>&,          \
                                       const VecXT<S>&);                                                   \
+  template void velocity_kinematics<S>(const Model&, DataT<S>&, const VecXT<S>&, const VecXT<S>&);        \
+  template void body_jacobian_world_into<S>(const Model&, const DataT<S>&, int, MatXT<S>&);                \
   template Vec3T<S> point_position<S>(const DataT<S>&, int, const Eigen::Vector3d&);                      \
   template Vec3T<S> point_velocity<S>(const DataT<S>&, int, const Eigen::Vector3d&);                      \
   template Vec3T<S> point_acceleration<S>(const DataT<S>&, int, const Eigen::Vector3d&);                  \

@@ -18,6 +18,10 @@ template <class S>
 void forward_kinematics(const Model& model, DataT<S>& data, const VecXT<S>& q, const VecXT<S>& v);
 template <class S>
 void forward_kinematics(const Model& model, DataT<S>& data, const VecXT<S>& q, const VecXT<S>& v, const VecXT<S>& qdd);
+// the velocity stage alone (v, cJ) on the positions (liMi, Sb) that
+// forward_kinematics(q) already wrote: a velocity change at the same q
+template <class S>
+void velocity_kinematics(const Model& model, DataT<S>& data, const VecXT<S>& q, const VecXT<S>& v);
 
 // world position, velocity and (classical) acceleration of point p (body coordinates) of a body
 template <class S>
@@ -36,6 +40,9 @@ Vec3T<S> angular_acceleration(const DataT<S>& data, int body);
 // world velocity of the body-fixed point that is at the world origin.
 template <class S>
 MatXT<S> body_jacobian_world(const Model& model, const DataT<S>& data, int body);
+// the same into J (resized only when its size differs; no heap after that)
+template <class S>
+void body_jacobian_world_into(const Model& model, const DataT<S>& data, int body, MatXT<S>& J);
 // 3 x nv Jacobian of the world velocity of point p (body coordinates)
 template <class S>
 MatXT<S> point_jacobian(const Model& model, const DataT<S>& data, int body, const Eigen::Vector3d& p);

@@ -25,20 +25,27 @@ const VecXT<S>& rnea(const Model& model, DataT<S>& d, const VecXT<S>& q, const V
 
 template <class S>
 const VecXT<S>& nonlinear_effects(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>& v) {
-  const VecXT<S> zero = VecXT<S>::Zero(model.nv);
-  d.nle = rnea<S>(model, d, q, v, zero);
+  if (d.zero_v.size() != model.nv) d.zero_v = VecXT<S>::Zero(model.nv);
+  d.nle = rnea<S>(model, d, q, v, d.zero_v);
   return d.nle;
+}
+
+template <class S>
+void add_body_forces_to_generalized(const Model& model, DataT<S>& d, VecXT<S>& Q) {
+  std::vector<Vec6T<S>>& f = d.fsum;
+  for (int i = 1; i < model.nbodies; ++i) f[i] = d.fext[i];
+  for (int i = model.nbodies - 1; i > 0; --i) {
+    const JointModel& j = model.joints[i];
+    if (j.nv == 1) Q[j.idx_v] += d.Sb[i].col(0).dot(f[i]);
+    else if (j.nv > 0) Q.segment(j.idx_v, j.nv).noalias() += d.Sb[i].transpose() * f[i];
+    if (j.parent > 0) f[j.parent] += d.liMi[i].act_force(f[i]);
+  }
 }
 
 template <class S>
 VecXT<S> body_forces_to_generalized(const Model& model, DataT<S>& d) {
   VecXT<S> Q = VecXT<S>::Zero(model.nv);
-  std::vector<Vec6T<S>> f = d.fext;
-  for (int i = model.nbodies - 1; i > 0; --i) {
-    const JointModel& j = model.joints[i];
-    if (j.nv > 0) Q.segment(j.idx_v, j.nv) = d.Sb[i].transpose() * f[i];
-    if (j.parent > 0) f[j.parent] += d.liMi[i].act_force(f[i]);
-  }
+  add_body_forces_to_generalized<S>(model, d, Q);
   return Q;
 }
 
@@ -46,7 +53,8 @@ VecXT<S> body_forces_to_generalized(const Model& model, DataT<S>& d) {
   template const VecXT<S>& rnea<S>(const Model&, DataT<S>&, const VecXT<S>&, const VecXT<S>&,          \
                                    const VecXT<S>&);                                                   \
   template const VecXT<S>& nonlinear_effects<S>(const Model&, DataT<S>&, const VecXT<S>&, const VecXT<S>&); \
-  template VecXT<S> body_forces_to_generalized<S>(const Model&, DataT<S>&);
+  template VecXT<S> body_forces_to_generalized<S>(const Model&, DataT<S>&);                           \
+  template void add_body_forces_to_generalized<S>(const Model&, DataT<S>&, VecXT<S>&);
 CODYNA_INSTANTIATE(double)
 CODYNA_INSTANTIATE(ADScalar)
 #undef CODYNA_INSTANTIATE

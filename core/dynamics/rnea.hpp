@@ -20,5 +20,8 @@ const VecXT<S>& nonlinear_effects(const Model& model, DataT<S>& data, const VecX
 // forces: returns J^T fext summed over bodies. Needs liMi and Sb.
 template <class S>
 VecXT<S> body_forces_to_generalized(const Model& model, DataT<S>& data);
+// the same, added to Q (size nv) without allocating; uses data.fsum as scratch
+template <class S>
+void add_body_forces_to_generalized(const Model& model, DataT<S>& data, VecXT<S>& Q);
 
 }  // namespace codyna

@@ -1,11 +1,56 @@
 #include "model/data.hpp"
 
+#include "dynamics/joint.hpp"
 #include "spatial/autodiff.hpp"
 
 namespace codyna {
 
+ModelConstants::ModelConstants(const Model& model) {
+  const auto nb = static_cast<std::size_t>(model.nbodies);
+  joints.resize(nb);
+  com_inertia.resize(nb);
+  root.assign(nb, 0);
+  dof_body.assign(static_cast<std::size_t>(model.nv), 0);
+  dof_parent.assign(static_cast<std::size_t>(model.nv), -1);
+  for (int i = 0; i < model.nbodies; ++i) com_inertia[i] = ComInertia::from_matrix(model.inertia[i]);
+  std::vector<int> last_dof(nb, -1);  // the last velocity index at or above body i
+  const Eigen::VectorXd q_neutral = neutral(model);
+  for (int i = 1; i < model.nbodies; ++i) {
+    const JointModel& j = model.joints[i];
+    Joint& c = joints[i];
+    c.X_PF = j.X_PF;
+    c.X_MC = j.X_CM.inverse();
+    c.constant_S = j.type != JointType::Universal && j.type != JointType::Planar;
+    if (c.constant_S) {
+      SE3 X;
+      Mat6xT<double> S_M;
+      joint_transform<double>(j, q_neutral, X, S_M);
+      c.Sb = j.X_CM.motion_matrix() * S_M;
+    }
+    c.axis_P = j.X_PF.R * j.axis;
+    c.R0 = j.X_PF.R * c.X_MC.R;
+    c.p0 = j.X_PF.R * c.X_MC.p;
+    const int p = j.parent;
+    root[i] = p == 0 ? i : root[p];
+    int up = last_dof[p];
+    for (int k = 0; k < j.nv; ++k) {
+      dof_body[j.idx_v + k] = i;
+      dof_parent[j.idx_v + k] = up;
+      up = j.idx_v + k;
+    }
+    last_dof[i] = up;
+  }
+  long pairs = 0;
+  for (int a = 0; a < model.nv; ++a)
+    for (int b = a; b >= 0; b = dof_parent[b]) ++pairs;
+  dense_mass_matrix = pairs == static_cast<long>(model.nv) * (model.nv + 1) / 2;
+  body_force_sources = !model.springs.empty() || !model.body_forces.empty();
+  for (const ActuatorModel& a : model.actuators)
+    if (a.type != ActuatorType::JointForce) body_force_sources = true;
+}
+
 template <class S>
-DataT<S>::DataT(const Model& model) {
+DataT<S>::DataT(const Model& model) : constants(model) {
   const auto nb = static_cast<std::size_t>(model.nbodies);
   liMi.resize(nb);
   oMi.resize(nb);
@@ -16,12 +61,17 @@ DataT<S>::DataT(const Model& model) {
   f.assign(nb, Vec6T<S>::Zero());
   fext.assign(nb, Vec6T<S>::Zero());
   IA.assign(nb, Mat6T<S>::Zero());
+  Ia.assign(nb, Mat6T<S>::Zero());
   pA.assign(nb, Vec6T<S>::Zero());
+  pB.assign(nb, Vec6T<S>::Zero());
   U.assign(nb, Mat6xT<S>(6, 0));
   Dinv.resize(nb);
   u.resize(nb);
   c.assign(nb, Vec6T<S>::Zero());
-  Ic.assign(nb, Mat6T<S>::Zero());
+  Iw.assign(nb, RigidInertiaT<S>());
+  Ic.assign(nb, RigidInertiaT<S>());
+  Sw.assign(static_cast<std::size_t>(model.nv), Vec6T<S>::Zero());
+  fsum.assign(nb, Vec6T<S>::Zero());
   tau = VecXT<S>::Zero(model.nv);
   // M [nv x nv] is sized by crba() when a mass matrix is asked for: ABA and kinematics never need it
   nle = VecXT<S>::Zero(model.nv);
@@ -31,6 +81,7 @@ DataT<S>::DataT(const Model& model) {
   phi = VecXT<S>::Zero(model.nc);
   Jc = MatXT<S>::Zero(model.nc, model.nv);
   gamma = VecXT<S>::Zero(model.nc);
+  zero_v = VecXT<S>::Zero(model.nv);
 }
 
 template struct DataT<double>;

@@ -6,14 +6,39 @@
 
 #include <vector>
 
+#include <Eigen/QR>
+
 #include "model/model.hpp"
 #include "spatial/spatial.hpp"
 
 namespace codyna {
 
+// Constants the algorithms derive once from the Model (DataT's constructor),
+// in double whatever the scalar; not part of any algorithm's output.
+struct ModelConstants {
+  struct Joint {
+    SE3 X_PF, X_MC;                     // X_MC = X_CM^-1
+    bool constant_S = false;            // Sb does not depend on q (all but universal and planar)
+    Mat6xT<double> Sb{6, 0};            // X_CM S_M when constant_S
+    // revolute: liMi = (Rot(axis_P, q) R0, Rot(axis_P, q) p0 + X_PF.p)
+    Eigen::Vector3d axis_P = Eigen::Vector3d::UnitZ(), p0 = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d R0 = Eigen::Matrix3d::Identity();
+  };
+  std::vector<Joint> joints;                     // [nbodies]
+  std::vector<ComInertia> com_inertia;           // [nbodies] body inertia about its com, body axes (= Model::inertia)
+  std::vector<int> root;                         // [nbodies] the body of its tree attached to ground (0 for ground)
+  std::vector<int> dof_body;                     // [nv] body whose joint a velocity index belongs to
+  std::vector<int> dof_parent;                   // [nv] next velocity index towards the root (-1: none)
+  bool dense_mass_matrix = false;                // every pair of velocity indices is related (a chain): M has no structural zero
+  bool body_force_sources = false;               // springs, body forces or body-force actuators write fext
+  explicit ModelConstants(const Model& model);
+};
+
 template <class S>
 struct DataT {
   explicit DataT(const Model& model);
+
+  ModelConstants constants;      // derived from the model once (see above)
 
   // position stage (forward_kinematics)
   std::vector<SE3T<S>> liMi;     // [nbodies] pose of body i in its parent
@@ -37,20 +62,38 @@ struct DataT {
   VecXT<S> lambda;               // [nc] constraint multipliers (M qdd = Q - nle - J^T lambda); 0 on redundant rows
 
   // articulated-body workspace (aba)
-  std::vector<Mat6T<S>> IA;
-  std::vector<Vec6T<S>> pA;
+  std::vector<Mat6T<S>> IA;      // [nbodies] articulated inertia, body coordinates
+  std::vector<Mat6T<S>> Ia;      // [nbodies] IA less the part the joint takes (U Dinv U^T): what the parent receives
+  std::vector<Vec6T<S>> pB;      // [nbodies] bias force of body i alone, v x* I v
+  std::vector<Vec6T<S>> pA;      // [nbodies] articulated bias force
   std::vector<Mat6xT<S>> U;
   std::vector<Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>> Dinv;
   std::vector<Eigen::Matrix<S, Eigen::Dynamic, 1, 0, 6, 1>> u;
   std::vector<Vec6T<S>> c;       // velocity-product accelerations
 
-  // crba workspace
-  std::vector<Mat6T<S>> Ic;      // composite inertia
+  // crba workspace: world axes, moments about the origin of the body's tree
+  // root (ModelConstants::root), so that no transform is needed between bodies
+  std::vector<RigidInertiaT<S>> Iw;  // [nbodies] inertia of body i
+  std::vector<RigidInertiaT<S>> Ic;  // [nbodies] composite inertia of the subtree of body i
+  std::vector<Vec6T<S>> Sw;          // [nv] motion axis of each velocity index
+  std::vector<Vec6T<S>> fsum;        // [nbodies] scratch: body forces summed towards the root
 
   // loop closures
   VecXT<S> phi;                  // [nc] position residual
   MatXT<S> Jc;                   // [nc x nv] d phi / dq (tangent), so d/dt phi = Jc v
   VecXT<S> gamma;                // [nc] dJc/dt v, so d2/dt2 phi = Jc qdd + gamma
+
+  // loop-closure workspace (constraint_terms, forward_dynamics<double>): sized
+  // by the first call, so that later calls do not allocate
+  VecXT<S> zero_v;               // [nv] zeros, never written
+  MatXT<S> J6a, J6b;             // [6 x nv] body Jacobians of a constraint's two bodies
+  MatXT<S> Jp, Jwa, Jwb, Jwd;    // [3 x nv] point, angular (a, b) and relative angular Jacobians
+  struct LoopSolve {
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr;  // independent rows of Jc
+    std::vector<int> rows;                           // [na] independent rows at this q
+    Eigen::MatrixXd J, B, L, X, A, LA;               // [na x nv], [nv x 1+na], [nv x nv], [nv x 1+na], [na x na] x 2
+    Eigen::VectorXd rhs, Jvel, lam;                  // [na]
+  } loop;                        // used with S = double only
 };
 
 extern template struct DataT<double>;

@@ -114,6 +114,129 @@ inline Mat6T<double> spatial_inertia(double m, const Eigen::Vector3d& c, const E
   return I;
 }
 
+// --- structured operations on spatial inertias ------------------------------
+// A symmetric 6x6 spatial inertia (rigid or articulated) acting on a motion
+// [w; v] in the coordinates of some frame: I = [A B; B^T C], n = A w + B v,
+// f = B^T w + C v.
+
+// out += X* I X*^T with X = X_AB: the inertia I given in B coordinates,
+// expressed in A coordinates and added to out. X* = [R, [p]R; 0, R] is the
+// force transform B -> A, so this is Xm^T I Xm with Xm the 6x6 motion transform
+// A -> B (what ABA and CRBA add to a parent). Written on the 3x3 blocks: rotate
+// A, B, C by R, then shift the moment reference by p:
+//   C' = R C R^T,  B' = R B R^T + [p] C',  A' = R A R^T + [p] (R B R^T)^T + B' [p]^T
+// I is assumed symmetric (only its A, B and C blocks are read).
+template <class S>
+void add_transformed_inertia(const SE3T<S>& X, const Mat6T<S>& I, Mat6T<S>& out) {
+  const Mat3T<S>& R = X.R;
+  const Vec3T<S>& p = X.p;
+  const Mat3T<S> Rt = R.transpose();
+  const Mat3T<S> A = R * (I.template topLeftCorner<3, 3>() * Rt).eval();
+  const Mat3T<S> B = R * (I.template topRightCorner<3, 3>() * Rt).eval();
+  const Mat3T<S> C = R * (I.template bottomRightCorner<3, 3>() * Rt).eval();
+  Mat3T<S> Bp, Ap;
+  for (int k = 0; k < 3; ++k) Bp.col(k) = B.col(k) + p.cross(Vec3T<S>(C.col(k)));  // B + [p] C
+  for (int k = 0; k < 3; ++k) Ap.col(k) = A.col(k) + p.cross(Vec3T<S>(B.row(k).transpose()));  // A + [p] B^T
+  for (int k = 0; k < 3; ++k) Ap.row(k) += p.cross(Vec3T<S>(Bp.row(k).transpose())).transpose();  // + B' [p]^T
+  out.template topLeftCorner<3, 3>() += Ap;
+  out.template topRightCorner<3, 3>() += Bp;
+  out.template bottomLeftCorner<3, 3>() += Bp.transpose();
+  out.template bottomRightCorner<3, 3>() += C;
+}
+
+// A rigid-body inertia as ten numbers: mass m, first moment h = m c (c: centre
+// of mass) and the rotational inertia I about the frame origin (symmetric),
+// all in the coordinates of one frame. As a 6x6 spatial inertia it is
+// [I, [h]; [h]^T, m 1] (spatial_inertia below gives the same matrix).
+template <class S>
+struct RigidInertiaT {
+  S m = S(0);
+  Vec3T<S> h = Vec3T<S>::Zero();
+  Mat3T<S> I = Mat3T<S>::Zero();
+
+  // the force [I w + h x v; m v - h x w] of a motion [w; v]
+  Vec6T<S> apply(const Vec6T<S>& mo) const {
+    const Vec3T<S> w = mo.template head<3>(), v = mo.template tail<3>();
+    Vec6T<S> r;
+    r.template head<3>() = I * w + h.cross(v);
+    r.template tail<3>() = m * v - h.cross(w);
+    return r;
+  }
+  RigidInertiaT& operator+=(const RigidInertiaT& o) {
+    m += o.m;
+    h += o.h;
+    I += o.I;
+    return *this;
+  }
+  Mat6T<S> matrix() const {
+    Mat6T<S> X;
+    const Mat3T<S> H = skew<S>(h);
+    X.template topLeftCorner<3, 3>() = I;
+    X.template topRightCorner<3, 3>() = H;
+    X.template bottomLeftCorner<3, 3>() = H.transpose();
+    X.template bottomRightCorner<3, 3>() = m * Mat3T<S>::Identity();
+    return X;
+  }
+  // from a 6x6 rigid-body spatial inertia (as spatial_inertia makes it)
+  static RigidInertiaT from_matrix(const Mat6T<S>& X) {
+    RigidInertiaT r;
+    r.m = X(5, 5);
+    r.h = Vec3T<S>(X(2, 4), X(0, 5), X(1, 3));
+    r.I = X.template topLeftCorner<3, 3>();
+    return r;
+  }
+};
+
+// A rigid body's inertia about its centre of mass (body axes): mass m, centre
+// of mass c and rotational inertia Ic about c, for the cheapest move to another
+// frame (to_frame).
+struct ComInertia {
+  double m = 0.0;
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d Ic = Eigen::Matrix3d::Zero();
+
+  static ComInertia from_matrix(const Mat6T<double>& X) {
+    ComInertia r;
+    const RigidInertiaT<double> o = RigidInertiaT<double>::from_matrix(X);
+    r.m = o.m;
+    r.c = o.m > 0.0 ? Eigen::Vector3d(o.h / o.m) : Eigen::Vector3d::Zero();
+    r.Ic = o.I - r.m * (r.c.squaredNorm() * Eigen::Matrix3d::Identity() - r.c * r.c.transpose());
+    return r;
+  }
+  // the body in a frame where its axes are R (body -> frame) and its origin at r:
+  //   p = R c + r,  h = m p,  I = R Ic R^T + m (|p|^2 1 - p p^T)
+  // (the symmetric R Ic R^T from its upper triangle)
+  template <class S>
+  void to_frame(const Mat3T<S>& R, const Vec3T<S>& r, RigidInertiaT<S>& out) const {
+    const Vec3T<S> p = R * c.template cast<S>() + r;
+    const S ms = S(m);
+    out.m = ms;
+    out.h = ms * p;
+    const Mat3T<S> T = R * Ic.template cast<S>();
+    const S pp = p.squaredNorm();
+    for (int i = 0; i < 3; ++i)
+      for (int j = i; j < 3; ++j) {
+        S v = T.row(i).dot(R.row(j)) - ms * p[i] * p[j];
+        if (i == j) v += ms * pp;
+        out.I(i, j) = v;
+        out.I(j, i) = v;
+      }
+  }
+};
+
+// Rotation by angle about a unit axis given its cosine and sine:
+//   c 1 + s [a] + (1 - c) a a^T
+template <class S>
+Mat3T<S> axis_rotation(const Eigen::Vector3d& a, const S& c, const S& s) {
+  const S t = S(1) - c;
+  const S x = S(a.x()), y = S(a.y()), z = S(a.z());
+  Mat3T<S> R;
+  R << c + t * x * x, t * x * y - s * z, t * x * z + s * y,
+       t * x * y + s * z, c + t * y * y, t * y * z - s * x,
+       t * x * z - s * y, t * y * z + s * x, c + t * z * z;
+  return R;
+}
+
 // Rotation by angle about a unit axis, for any scalar.
 template <class S>
 Mat3T<S> axis_angle(const Eigen::Vector3d& axis, const S& angle) {

@@ -113,7 +113,9 @@ TEST(Iftomm, A01PendulumFollowsTheExactSolution) {
 TEST(Iftomm, A01PendulumPeriod) {
   // sample at multiples of the exact period: the pendulum is back at rest at x = +1 each time.
   // Near the turning point the angular rate is v(T + dt) = -(g/L) dt, so |v| / g bounds the
-  // period error dt.
+  // period error dt. At rtol 1e-10 the integrator's own phase error after 4 periods scatters
+  // between about -3e-8 and 3e-8 s as the rounding of f or rtol (0.8e-10 .. 1.25e-10) changes
+  // (measured), so the bound is 5e-8 s: 5e-9 of the 9.5 s simulated.
   const Model m = test::load_example("iftomm_a01_pendulum.json");
   const double T = 2.36784194757624;
   const SimulationResult r = simulate(m, nullptr, nullptr, options("cvode-bdf", 4 * T, 1e-10, 1e-12, T / 100));
@@ -123,7 +125,7 @@ TEST(Iftomm, A01PendulumPeriod) {
     const int i = 100 * n;
     ASSERT_NEAR(r.t[i], n * T, 1e-12);
     const double dt = r.v(i, 0) / g;  // time from the turning point to the sample
-    EXPECT_LT(std::abs(dt), 1e-8) << "period " << n;
+    EXPECT_LT(std::abs(dt), 5e-8) << "period " << n;
     EXPECT_NEAR(r.y(i, 0), 1.0, 1e-10) << "period " << n;
     EXPECT_NEAR(r.y(i, 1), 0.0, 1e-7) << "period " << n;
     if (n == 4) std::cout << "A01 after 4 periods: time off the turning point " << dt << " s\n";

@@ -170,6 +170,44 @@ TEST(Linearize, ExactMatchesCentralDifferencesOnRandom3DTree) {
   }
 }
 
+// PlantFunction::fd_jacobian (velocity and input columns on the position stage
+// of x) against differencing a full evaluation per column: the same numbers
+TEST(Linearize, ReusingFiniteDifferencesEqualFullEvaluations) {
+  auto check = [](const Model& m, const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& u_all,
+                  const Eigen::VectorXd& dz, const std::string& label) {
+    const PlantFunction f(m, q, u_all, partition_coordinates(m, q));
+    Eigen::VectorXd x(f.nx());
+    x << dz, v;
+    Eigen::VectorXd u(f.nu());
+    for (int k = 0; k < f.nu(); ++k) u[k] = u_all[m.plant_inputs[k]];
+    for (bool central : {false, true}) {
+      const Eigen::MatrixXd full = plant_jacobian_fd_full(f, x, u, central);
+      Eigen::MatrixXd reuse;
+      ASSERT_TRUE(f.fd_jacobian(x, u, central, reuse)) << label;
+      const double scale = std::max(1.0, full.cwiseAbs().maxCoeff());
+      EXPECT_LE((reuse - full).cwiseAbs().maxCoeff(), 1e-12 * scale) << label << (central ? " central" : " forward");
+      const JacobianMethod method = central ? JacobianMethod::CentralDifference : JacobianMethod::ForwardDifference;
+      EXPECT_EQ(plant_jacobian(f, x, u, method), reuse) << label;
+    }
+  };
+  for (unsigned seed : {91u, 92u, 93u}) {
+    const Model m = compile(random_plant(seed));
+    std::mt19937 rng(seed);
+    Eigen::VectorXd u_all(2);
+    u_all << 0.7, -1.3;
+    check(m, test::random_q(m, rng), test::random_v(m, rng, 1.0), u_all, test::random_v(m, rng, 0.3),
+          "random tree " + std::to_string(seed));
+  }
+  for (const char* name : {"pendulum.json", "double_pendulum.json", "cart_pendulum.json", "heavy_top.json",
+                           "iftomm_a05_flyball.json"}) {
+    const Model m = test::load_example(name);
+    const OperatingPoint op = initial_point(m);
+    Eigen::VectorXd v = op.v;
+    for (int k = 0; k < m.nv; ++k) v[k] += 0.2 + 0.1 * k;
+    check(m, op.q, v, op.u, Eigen::VectorXd::Constant(m.nv, 0.05), name);
+  }
+}
+
 TEST(Linearize, ExactMatchesCentralDifferencesOnFourBar) {
   const Model m = test::load_example("four_bar.json");
   const PlantFunction f(m, m.q0, m.u_nominal(), partition_coordinates(m, m.q0));

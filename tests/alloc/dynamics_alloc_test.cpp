@@ -1,0 +1,158 @@
+// No heap allocation in forward dynamics and in one plant evaluation after the
+// first call on a Data / PlantFunction: the counting allocator of
+// counting_allocator.hpp around the second call of forward_dynamics<double>,
+// crba<double>, PlantFunction::eval<double> and PlantFunction::fd_jacobian
+// (finite differences), on the MuJoCo benchmark's
+// chains (2 to 90 links) and ball-joint tree, and on every example
+// (forward_dynamics also on the closed loops).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <random>
+
+#include "analysis/linearize.hpp"
+#include "analysis/operating_point.hpp"
+#include "counting_allocator.hpp"
+#include "dynamics/crba.hpp"
+#include "dynamics/forward_dynamics.hpp"
+#include "dynamics/joint.hpp"
+#include "io/model_file.hpp"
+#include "model/compile.hpp"
+#include "models/speed_models.hpp"
+
+namespace codyna {
+namespace {
+
+using alloc_test::Count;
+
+Model load(const std::string& name) {
+  const std::string path = std::string(CODYNA_EXAMPLES_DIR) + "/" + name;
+  return compile(load_model_spec(path), path);
+}
+
+// a state away from the reference: every coordinate moved, every velocity and input non-zero
+struct State {
+  Eigen::VectorXd q, v, u;
+  explicit State(const Model& m, const Eigen::VectorXd& q_ref) {
+    std::mt19937 rng(11 + m.nv);
+    std::uniform_real_distribution<double> u1(-1.0, 1.0);
+    Eigen::VectorXd dq(m.nv);
+    for (int i = 0; i < m.nv; ++i) dq[i] = 0.5 * u1(rng);
+    q = integrate<double>(m, q_ref, dq);
+    v.resize(m.nv);
+    for (int i = 0; i < m.nv; ++i) v[i] = u1(rng);
+    u.resize(m.nu());
+    for (int i = 0; i < m.nu(); ++i) u[i] = u1(rng);
+  }
+};
+
+long forward_dynamics_allocations(const Model& m) {
+  const State s(m, m.q0);
+  Data d(m);
+  forward_dynamics<double>(m, d, s.q, s.v, s.u);  // warm-up
+  Count c;
+  forward_dynamics<double>(m, d, s.q, s.v, s.u);
+  return c.n();
+}
+
+long crba_allocations(const Model& m) {
+  const State s(m, m.q0);
+  Data d(m);
+  crba<double>(m, d, s.q);
+  Count c;
+  crba<double>(m, d, s.q);
+  return c.n();
+}
+
+// PlantFunction::eval<double> at a state off the reference (position deviation and velocity)
+long plant_eval_allocations(const Model& m) {
+  const OperatingPoint op = initial_point(m);
+  const PlantFunction f(m, op.q, op.u, partition_coordinates(m, op.q));
+  Eigen::VectorXd x(f.nx());
+  for (int k = 0; k < f.nx(); ++k) x[k] = 0.05 + 0.02 * k;
+  const Eigen::VectorXd u = Eigen::VectorXd::Constant(f.nu(), 0.7);
+  Eigen::VectorXd xd, y;
+  f.eval<double>(x, u, xd, y);  // warm-up: the workspace is made here
+  x[0] += 0.01;
+  Count c;
+  f.eval<double>(x, u, xd, y);
+  return c.n();
+}
+
+// PlantFunction::fd_jacobian into a J of the right size, central and forward
+long fd_jacobian_allocations(const Model& m) {
+  const OperatingPoint op = initial_point(m);
+  const PlantFunction f(m, op.q, op.u, partition_coordinates(m, op.q));
+  Eigen::VectorXd x(f.nx());
+  for (int k = 0; k < f.nx(); ++k) x[k] = 0.05 + 0.02 * k;
+  const Eigen::VectorXd u = Eigen::VectorXd::Constant(f.nu(), 0.7);
+  Eigen::MatrixXd J;
+  f.fd_jacobian(x, u, true, J);
+  f.fd_jacobian(x, u, false, J);
+  Count c;
+  f.fd_jacobian(x, u, true, J);
+  f.fd_jacobian(x, u, false, J);
+  return c.n();
+}
+
+TEST(NoAllocation, ForwardDynamicsAndPlantOnChains) {
+  for (int n : {1, 2, 7, 30, 90}) {
+    const Model m = compile(speed_models::chain(n));
+    EXPECT_EQ(forward_dynamics_allocations(m), 0) << "chain_" << n << ": forward_dynamics";
+    EXPECT_EQ(crba_allocations(m), 0) << "chain_" << n << ": crba";
+    EXPECT_EQ(plant_eval_allocations(m), 0) << "chain_" << n << ": PlantFunction::eval<double>";
+    if (n <= 30) EXPECT_EQ(fd_jacobian_allocations(m), 0) << "chain_" << n << ": PlantFunction::fd_jacobian";
+  }
+}
+
+TEST(NoAllocation, ForwardDynamicsAndPlantOnBallJointTree) {
+  const Model m = compile(speed_models::tree28());
+  EXPECT_EQ(forward_dynamics_allocations(m), 0) << "tree28: forward_dynamics";
+  EXPECT_EQ(crba_allocations(m), 0) << "tree28: crba";
+  EXPECT_EQ(plant_eval_allocations(m), 0) << "tree28: PlantFunction::eval<double>";
+  EXPECT_EQ(fd_jacobian_allocations(m), 0) << "tree28: PlantFunction::fd_jacobian";
+}
+
+TEST(NoAllocation, ForwardDynamicsAndPlantOnEveryTreeExample) {
+  int trees = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(CODYNA_EXAMPLES_DIR)) {
+    if (entry.path().extension() != ".json") continue;
+    const std::string name = entry.path().filename().string();
+    const Model m = load(name);
+    if (m.nc != 0) continue;
+    ++trees;
+    EXPECT_EQ(forward_dynamics_allocations(m), 0) << name << ": forward_dynamics";
+    EXPECT_EQ(plant_eval_allocations(m), 0) << name << ": PlantFunction::eval<double>";
+    EXPECT_EQ(fd_jacobian_allocations(m), 0) << name << ": PlantFunction::fd_jacobian";
+  }
+  EXPECT_GE(trees, 3);
+}
+
+// closed loops: CRBA, the constraint terms and the Schur complement on the
+// independent rows, in Data's loop workspace (at the assembled initial state)
+TEST(NoAllocation, ForwardDynamicsOnEveryClosedLoopExample) {
+  int loops = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(CODYNA_EXAMPLES_DIR)) {
+    if (entry.path().extension() != ".json") continue;
+    const std::string name = entry.path().filename().string();
+    const Model m = load(name);
+    if (m.nc == 0) continue;
+    ++loops;
+    Data d(m);
+    const Eigen::VectorXd u = m.u_nominal();
+    forward_dynamics<double>(m, d, m.q0, m.v0, u);  // warm-up, without and with stabilization
+    forward_dynamics<double>(m, d, m.q0, m.v0, u, Baumgarte{2.0, 3.0});
+    long n = 0;
+    {
+      Count c;
+      forward_dynamics<double>(m, d, m.q0, m.v0, u);
+      forward_dynamics<double>(m, d, m.q0, m.v0, u, Baumgarte{2.0, 3.0});
+      n = c.n();
+    }
+    EXPECT_EQ(n, 0) << name << ": forward_dynamics";
+  }
+  EXPECT_GE(loops, 3);
+}
+
+}  // namespace
+}  // namespace codyna
