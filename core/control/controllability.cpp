@@ -73,17 +73,21 @@ std::vector<HiddenMode> unobservable_modes(const Eigen::MatrixXd& A, const Eigen
 }
 
 std::string describe(const std::vector<HiddenMode>& modes) {
-  std::ostringstream os;
-  os.precision(6);
-  for (std::size_t i = 0; i < modes.size(); ++i) {
-    const auto& m = modes[i];
-    os << (i ? "; " : "") << "lambda = " << m.eigenvalue.real();
+  // a repeated mode (a double pole at 0 may come out of the decomposition once or twice) is said once
+  std::vector<std::string> said;
+  for (const auto& m : modes) {
+    std::ostringstream os;
+    os.precision(6);
+    os << "lambda = " << m.eigenvalue.real();
     if (m.eigenvalue.imag() != 0) os << " +/- " << std::abs(m.eigenvalue.imag()) << "i";
     os << " (";
     for (std::size_t k = 0; k < m.states.size(); ++k) os << (k ? ", " : "") << m.states[k];
     os << ")";
+    if (std::find(said.begin(), said.end(), os.str()) == said.end()) said.push_back(os.str());
   }
-  return os.str();
+  std::string out;
+  for (const std::string& t : said) out += (out.empty() ? "" : "; ") + t;
+  return out;
 }
 
 }  // namespace codyna

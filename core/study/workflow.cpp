@@ -86,6 +86,14 @@ std::string plant_study_json(const StudySpec& s, const std::string& operating_po
   j["set"] = set;
   j["independent"] = s.independent;
   j["disabled_effects"] = s.disabled_effects;
+  // the steady-state search's knowns and unknowns (left out when unused, as older exports have them)
+  if (!s.trim_free.empty()) j["trim_free"] = s.trim_free;
+  if (!s.free_inputs.empty()) j["free_inputs"] = s.free_inputs;
+  if (!s.output_targets.empty()) {
+    nlohmann::ordered_json t = nlohmann::ordered_json::object();
+    for (const auto& [name, value] : s.output_targets) t[name] = value;
+    j["output_targets"] = t;
+  }
   return j.dump();
 }
 
@@ -247,6 +255,11 @@ bool adopt_controller_study(ModelSpec& spec, const std::string& file) {
     for (const auto& [name, value] : j.at("set").items()) s.set.emplace_back(name, value.get<double>());
     s.independent = j.at("independent").get<std::vector<std::string>>();
     s.disabled_effects = j.at("disabled_effects").get<std::vector<std::string>>();
+    s.trim_free = j.value("trim_free", std::vector<std::string>{});
+    s.free_inputs = j.value("free_inputs", std::vector<std::string>{});
+    s.output_targets.clear();
+    if (j.contains("output_targets"))
+      for (const auto& [name, value] : j.at("output_targets").items()) s.output_targets.emplace_back(name, value.get<double>());
     spec.notes.push_back(path + ": the controller was designed about the " + s.operating_point +
                          " point of its export (coordinates set, independent coordinates and effects as there)" +
                          (before != s.operating_point ? "; using that point instead of " + before : std::string()));
