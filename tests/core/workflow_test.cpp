@@ -121,8 +121,10 @@ TEST(Workflow, BadStudyFieldsNameTheirPath) {
       {R"({"references": [{"output": "y", "type": "file", "file": ""}]})", "/analysis/references/0/file",
        "a file name (CSV or .mat)"},
   };
-  for (const auto& [analysis, path, phrase] : bad)
-    expect_model_error_at([&] { parse_model_spec_text(with(analysis), "m.json"); }, path, phrase);
+  for (const auto& [analysis, path, phrase] : bad) {
+    const std::string text = with(analysis);  // a structured binding cannot be captured before C++20
+    expect_model_error_at([&text] { parse_model_spec_text(text, "m.json"); }, path, phrase);
+  }
 }
 
 TEST(Workflow, DisabledEffectsAreLeftOutOfTheModel) {
