@@ -36,7 +36,16 @@ void print_info(const Model& m) {
   std::cout << "effects      " << (m.has_gravity ? "gravity" : "no gravity");
   if (!m.springs.empty()) std::cout << ", " << m.springs.size() << " spring-damper(s)";
   if (!m.joint_springs.empty()) std::cout << ", " << m.joint_springs.size() << " joint spring(s)";
-  if (!m.joint_frictions.empty()) std::cout << ", " << m.joint_frictions.size() << " joint friction(s)";
+  {
+    // a joint_damper acts on every coordinate of its joint: count the elements, not the coordinates
+    long frictions = 0, dampers = 0;
+    for (const EffectSpec& e : m.spec.effects) {
+      if (e.type == EffectType::JointFriction) ++frictions;
+      if (e.type == EffectType::JointDamper) ++dampers;
+    }
+    if (frictions) std::cout << ", " << frictions << " joint friction(s)";
+    if (dampers) std::cout << ", " << dampers << " joint damper(s)";
+  }
   if (!m.body_forces.empty()) std::cout << ", " << m.body_forces.size() << " body force(s)";
   std::cout << "\ninputs       (candidate plant inputs; * = Plant/In)\n";
   for (int k = 0; k < m.nu(); ++k) {

@@ -74,7 +74,7 @@ QVariant PlantListModel::data(const QModelIndex& index, int role) const {
     switch (index.column()) {
       case 0: return on ? QStringLiteral("u%1  %2").arg(index.row() + 1).arg(name) : name;
       case 1: return QStringLiteral("%1 on %2").arg(to_string(a.type), qs(a.type == ActuatorType::JointForce ? a.joint : a.body));
-      case 2: return qs(a.unit.empty() ? (a.type == ActuatorType::JointForce ? "N | N m" : "N") : a.unit);
+      case 2: return qs(a.unit.empty() ? (a.type == ActuatorType::JointForce ? "N | N m" : a.type == ActuatorType::BodyTorque ? "N m" : "N") : a.unit);
       case 3: return a.u0;
       case 4: return limit_text(a.min);
       case 5: return limit_text(a.max);

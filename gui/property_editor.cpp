@@ -26,8 +26,8 @@ QStringList type_names(ElementKind k) {
   switch (k) {
     case ElementKind::Joint: return {"revolute", "prismatic", "fixed", "spherical", "universal", "cylindrical", "planar", "free"};
     case ElementKind::Constraint: return {"ball", "revolute", "planar_revolute"};
-    case ElementKind::Effect: return {"gravity", "spring_damper", "joint_spring_damper", "joint_friction", "body_force"};
-    case ElementKind::Actuator: return {"joint_force", "body_force"};
+    case ElementKind::Effect: return {"gravity", "spring_damper", "joint_spring_damper", "joint_friction", "joint_damper", "body_force"};
+    case ElementKind::Actuator: return {"joint_force", "body_force", "body_torque"};
     case ElementKind::Sensor: return {"joint_position", "joint_velocity", "point_position", "point_velocity", "body_angle", "distance"};
     default: return {};
   }

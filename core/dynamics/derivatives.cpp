@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "dynamics/kinematics.hpp"
+#include "dynamics/sensors.hpp"
 
 namespace codyna {
 
@@ -425,11 +426,12 @@ void TreeDerivatives::applied_force_derivatives(const Eigen::VectorXd& q, const 
     }
     if (act.body == 0) continue;
     const BodyAD a = body_ad(d_.oMi[act.body], V_[act.body], 0, true);
+    const bool torque = act.type == ActuatorType::BodyTorque;
     Vec3A F = act.direction.cast<AD>() * AD(act.gain);
     if (!act.in_world) F = a.R * F;
     const Vec3A x = a.point(act.point);
-    // per unit input (linear in u)
-    wrench_value(x, F, zero3, w, dw);
+    // per unit input (linear in u); a body_torque actuator applies a couple
+    wrench_value(x, torque ? zero3 : F, torque ? F : zero3, w, dw);
     for (int pu : path_[act.body]) {
       const Unit& up = units_[pu];
       dQ_du.block(up.iv, k, up.n, 1).noalias() +=
@@ -437,7 +439,7 @@ void TreeDerivatives::applied_force_derivatives(const Eigen::VectorXd& q, const 
     }
     if (u[k] == 0.0) continue;
     const AD uk(u[k]);
-    wrench_value(x, Vec3A(F * uk), zero3, w, dw);
+    wrench_value(x, torque ? zero3 : Vec3A(F * uk), torque ? Vec3A(F * uk) : zero3, w, dw);
     add_body_wrench(act.body, w, dw, act.body, 0);
   }
 }
@@ -479,8 +481,7 @@ void TreeDerivatives::sensor_derivatives(const Eigen::VectorXd& q, const Eigen::
         ba = s.body;
         const BodyAD a = body_ad(d_.oMi[ba], V_[ba], 0, ba > 0);
         const Mat3A Rrel = a.R * s.R0.transpose().cast<AD>();
-        const Vec3A e1 = Rrel * s.perp1.cast<AD>();
-        value = atan2(e1.dot(s.perp2.cast<AD>()), e1.dot(s.perp1.cast<AD>()));
+        value = rotation_about_axis<AD>(Rrel, s.axis);
         break;
       }
       case SensorType::Distance: {

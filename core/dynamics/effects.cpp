@@ -71,6 +71,11 @@ const VecXT<S>& applied_forces(const Model& model, DataT<S>& d, const VecXT<S>& 
     const S value = S(a.gain) * u[k];
     if (a.type == ActuatorType::JointForce) {
       d.Q[a.iv] += value;
+    } else if (a.type == ActuatorType::BodyTorque) {
+      Vec3T<S> T = a.direction.cast<S>() * value;
+      if (!a.in_world) T = d.oMi[a.body].R * T;
+      add_world_force<S>(d, a.body, Eigen::Vector3d::Zero(), zero3, T);
+      any_body_force = true;
     } else {
       Vec3T<S> F = a.direction.cast<S>() * value;
       if (!a.in_world) F = d.oMi[a.body].R * F;

@@ -27,9 +27,9 @@ S sensor_value(const Model& model, const DataT<S>& d, const SensorModel& s, cons
     }
     case SensorType::BodyAngle: {
       // rotation of the body relative to its zero-configuration orientation, about the world axis
+      // (the axis component of the rotation vector of R R0^T)
       const Mat3T<S> Rrel = d.oMi[s.body].R * s.R0.transpose().cast<S>();
-      const Vec3T<S> e1 = Rrel * s.perp1.cast<S>();
-      return atan2(e1.dot(s.perp2.cast<S>()), e1.dot(s.perp1.cast<S>()));
+      return rotation_about_axis<S>(Rrel, s.axis);
     }
     case SensorType::Distance: {
       const Vec3T<S> dp = point_position<S>(d, s.body_b, s.point_b) - point_position<S>(d, s.body_a, s.point_a);

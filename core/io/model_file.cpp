@@ -759,6 +759,7 @@ const Schema<EffectSpec>& schema<EffectSpec>() {
           case EffectType::JointSpringDamper:
             return element_keys({"joint", "dof", "stiffness", "damping", "rest_position"});
           case EffectType::JointFriction: return element_keys({"joint", "dof", "damping"});
+          case EffectType::JointDamper: return element_keys({"joint", "damping"});
           case EffectType::BodyForce: return element_keys({"body", "point", "force", "torque", "frame"});
         }
         return element_keys({});
@@ -786,6 +787,7 @@ const Schema<ActuatorSpec>& schema<ActuatorSpec>() {
         switch (a.type) {
           case ActuatorType::JointForce: return element_keys({"joint", "dof"}, tail);
           case ActuatorType::BodyForce: return element_keys({"body", "point", "direction", "frame"}, tail);
+          case ActuatorType::BodyTorque: return element_keys({"body", "direction", "frame"}, tail);
         }
         return element_keys({}, tail);
       }};

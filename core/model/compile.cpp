@@ -130,10 +130,12 @@ class Compiler {
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(I);
       const Eigen::Vector3d ev = es.eigenvalues();  // ascending
       const double scale = std::max(ev.cwiseAbs().maxCoeff(), 1e-300);
-      if (b.mass > 0 && !(ev[0] > 1e-12 * scale))
-        fail(p + "/inertia", "expected a positive definite inertia matrix for a body with mass, got principal moments " +
-                                 fmt(ev[0]) + ", " + fmt(ev[1]) + ", " + fmt(ev[2]));
-      if (b.mass == 0 && ev[0] < -1e-12 * scale) fail(p + "/inertia", "expected a positive semi-definite inertia matrix");
+      // positive semi-definite is accepted (a slender rod has no moment about its own
+      // axis); whether the mass matrix stays positive definite is checked on the
+      // assembled tree (check_mass_matrix), which names the coordinate that moves nothing
+      if (ev[0] < -1e-12 * scale)
+        fail(p + "/inertia", "expected a positive semi-definite inertia matrix, got principal moments " + fmt(ev[0]) + ", " +
+                                 fmt(ev[1]) + ", " + fmt(ev[2]));
       if (ev[0] + ev[1] < ev[2] * (1 - 1e-9))
         fail(p + "/inertia", "principal moments " + fmt(ev[0]) + ", " + fmt(ev[1]) + ", " + fmt(ev[2]) +
                                  " violate the triangle inequality (I1 + I2 >= I3): no rigid body has them");
@@ -410,6 +412,23 @@ class Compiler {
           m_.body_forces.push_back(b);
           break;
         }
+        case EffectType::JointDamper: {
+          // one damping value on every velocity coordinate of the joint: -damping * v
+          // (for a spherical joint an isotropic viscous torque -damping * omega)
+          const int jb = joint(e.joint, p + "/joint");
+          const JointModel& j = m_.joints[jb];
+          if (j.nv == 0) fail(p + "/joint", "joint " + quoted(j.name) + " is fixed: it has no coordinate to damp");
+          non_negative(e.damping, p + "/damping", "damping");
+          for (int k = 0; k < j.nv; ++k) {
+            JointSpringModel s;
+            s.name = e.name;
+            s.iv = j.idx_v + k;
+            s.iq = j.idx_q;  // not read: a damper acts on velocities only
+            s.damping = e.damping;
+            m_.joint_frictions.push_back(s);
+          }
+          break;
+        }
       }
     }
   }
@@ -428,10 +447,10 @@ class Compiler {
         a.unit = is_angular(m_.joints[jb].type, s.dof) ? "N m" : "N";
       } else {
         a.body = body(s.body, p + "/body", false);
-        a.point = s.point;
+        a.point = s.type == ActuatorType::BodyTorque ? Eigen::Vector3d::Zero() : s.point;
         a.direction = unit(s.direction, p + "/direction", *this);
         a.in_world = s.in_world;
-        a.unit = "N";
+        a.unit = s.type == ActuatorType::BodyTorque ? "N m" : "N";
       }
       if (!std::isfinite(s.gain)) fail(p + "/gain", "expected a finite number");
       if (!std::isfinite(s.u0)) fail(p + "/u0", "expected a finite number");
@@ -596,7 +615,8 @@ class Compiler {
           Eigen::Index k;
           es.eigenvectors().col(0).cwiseAbs().maxCoeff(&k);
           fail("/bodies", "the mass matrix is singular at the initial state: coordinate " +
-                              quoted(m_.v_names[j.idx_v + k]) + " moves no mass or inertia (give the bodies it moves mass and inertia)");
+                              quoted(m_.v_names[j.idx_v + k]) + " moves no mass or inertia (give the bodies it moves mass and inertia)" +
+                              semi_definite_note(i));
         }
         Ia -= U * D.inverse() * U.transpose();
       }
@@ -604,6 +624,23 @@ class Compiler {
       IA[p] += Xi.transpose() * Ia * Xi;
       Ic[p] += Xi.transpose() * Ic[i] * Xi;
     }
+  }
+
+  // Names a body moved by joint i whose inertia is only positive semi-definite
+  // (a slender rod turned about its own axis), the usual cause of a singular
+  // mass matrix in a model that passed the per-body checks.
+  std::string semi_definite_note(int i) const {
+    for (int k = i; k < m_.nbodies; ++k) {
+      int a = k;
+      while (a > i) a = m_.parent[a];
+      if (a != i || m_.body_spec_index[k] < 0) continue;
+      const BodySpec& b = spec_.bodies[m_.body_spec_index[k]];
+      const Eigen::Vector3d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(b.inertia).eigenvalues();
+      if (b.mass > 0 && !(ev[0] > 1e-12 * std::max(ev[2], 1e-300)))
+        return "; body " + quoted(b.name) + " has no inertia about one of its axes (principal moments " + fmt(ev[0]) + ", " +
+               fmt(ev[1]) + ", " + fmt(ev[2]) + "): a joint that turns it about that axis alone moves nothing";
+    }
+    return "";
   }
 
   const ModelSpec& spec_;

@@ -34,16 +34,18 @@ constexpr std::array<std::pair<ConstraintType, const char*>, 3> kConstraints{{
     {ConstraintType::Revolute, "revolute"},
     {ConstraintType::PlanarRevolute, "planar_revolute"},
 }};
-constexpr std::array<std::pair<EffectType, const char*>, 5> kEffects{{
+constexpr std::array<std::pair<EffectType, const char*>, 6> kEffects{{
     {EffectType::Gravity, "gravity"},
     {EffectType::SpringDamper, "spring_damper"},
     {EffectType::JointSpringDamper, "joint_spring_damper"},
     {EffectType::JointFriction, "joint_friction"},
+    {EffectType::JointDamper, "joint_damper"},
     {EffectType::BodyForce, "body_force"},
 }};
-constexpr std::array<std::pair<ActuatorType, const char*>, 2> kActuators{{
+constexpr std::array<std::pair<ActuatorType, const char*>, 3> kActuators{{
     {ActuatorType::JointForce, "joint_force"},
     {ActuatorType::BodyForce, "body_force"},
+    {ActuatorType::BodyTorque, "body_torque"},
 }};
 constexpr std::array<std::pair<SensorType, const char*>, 6> kSensors{{
     {SensorType::JointPosition, "joint_position"},

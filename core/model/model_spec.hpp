@@ -95,6 +95,7 @@ enum class EffectType {
   SpringDamper,      // point-to-point: body_a/point_a to body_b/point_b; stiffness, damping, rest_length
   JointSpringDamper, // on one joint coordinate: stiffness, damping, rest_position
   JointFriction,     // viscous, on one joint coordinate: damping
+  JointDamper,       // viscous, on every coordinate of a joint with one value: damping
   BodyForce,         // constant force at a body point and constant torque; in world or body axes
 };
 
@@ -120,6 +121,7 @@ struct EffectSpec {
 enum class ActuatorType {
   JointForce,  // generalized force/torque on one coordinate of a joint: tau = gain * u
   BodyForce,   // force gain * u * direction at point of body; direction in world or body axes
+  BodyTorque,  // torque gain * u * direction on body (a couple: no point); direction in world or body axes
 };
 
 struct ActuatorSpec {

@@ -58,7 +58,7 @@ void for_each_body_ref(ModelSpec& s, F&& f) {  // f(std::string& ref, const std:
     }
   }
   for (auto& a : s.actuators)
-    if (a.type == ActuatorType::BodyForce) f(a.body, "actuator " + a.name + ": body");
+    if (a.type == ActuatorType::BodyForce || a.type == ActuatorType::BodyTorque) f(a.body, "actuator " + a.name + ": body");
   for (auto& x : s.sensors) {
     switch (x.type) {
       case SensorType::PointPosition:
@@ -79,7 +79,9 @@ void for_each_body_ref(ModelSpec& s, F&& f) {  // f(std::string& ref, const std:
 template <class F>
 void for_each_joint_ref(ModelSpec& s, F&& f) {
   for (auto& e : s.effects)
-    if (e.type == EffectType::JointSpringDamper || e.type == EffectType::JointFriction) f(e.joint, "effect " + e.name + ": joint");
+    if (e.type == EffectType::JointSpringDamper || e.type == EffectType::JointFriction ||
+        e.type == EffectType::JointDamper)
+      f(e.joint, "effect " + e.name + ": joint");
   for (auto& a : s.actuators)
     if (a.type == ActuatorType::JointForce) f(a.joint, "actuator " + a.name + ": joint");
   for (auto& x : s.sensors)

@@ -16,6 +16,9 @@ grep -q "controller from the model file: PD" "$work/p.txt" || { cat "$work/p.txt
 grep -q "within 1 % throughout" "$work/c.txt" || { cat "$work/c.txt"; fail "linear comparison missing"; }
 "$codyna" simulate "$src/examples/pendulum.json" --open-loop --quiet --t-end 2 --out "$work/open.h5" > /dev/null
 head -1 "$work/pendulum.csv" | grep -q '^t,pivot,pivot_dot,torque,theta' || fail "CSV header: $(head -1 "$work/pendulum.csv")"
+# the header docs/simulation.md shows is the one written (with --compare-linear)
+"$codyna" simulate "$src/examples/pendulum.json" --quiet --compare-linear --out "$work/pl.h5" --csv "$work/pl.csv" > /dev/null
+grep -qxF "    $(head -1 "$work/pl.csv")" "$src/docs/simulation.md" || fail "docs/simulation.md does not show the CSV header $(head -1 "$work/pl.csv")"
 
 "$PY" - "$work" <<'PY'
 import sys, math

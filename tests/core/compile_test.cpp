@@ -68,10 +68,10 @@ TEST(CompileErrors, NegativeMass) {
   expect_error(s, "/bodies/1/mass", "non-negative mass");
 }
 
-TEST(CompileErrors, InertiaNotPositiveDefinite) {
+TEST(CompileErrors, InertiaNotPositiveSemiDefinite) {
   ModelSpec s = two_links();
   s.bodies[0].inertia = Eigen::Vector3d(0.1, -0.1, 0.1).asDiagonal();
-  expect_error(s, "/bodies/0/inertia", "positive definite");
+  expect_error(s, "/bodies/0/inertia", "positive semi-definite");
 }
 
 TEST(CompileErrors, InertiaViolatesTriangleInequality) {

@@ -51,6 +51,12 @@ ModelSpec rich_tree(unsigned seed, int n = 10) {
   e = effect("jfric", EffectType::JointFriction);
   e.joint = "j2", e.dof = 1, e.damping = 0.4;
   s.effects.push_back(e);
+  e = effect("ball_damper", EffectType::JointDamper);  // j2 is spherical: one value, three coordinates
+  e.joint = "j2", e.damping = 0.25;
+  s.effects.push_back(e);
+  e = effect("free_damper", EffectType::JointDamper);  // j0 is free: six coordinates
+  e.joint = "j0", e.damping = 0.05;
+  s.effects.push_back(e);
   e = effect("spring36", EffectType::SpringDamper);
   e.body_a = "b3", e.body_b = "b6", e.point_a = test::random_vec(rng, 0.2), e.point_b = test::random_vec(rng, 0.2);
   e.stiffness = 30.0, e.damping = 1.5, e.rest_length = 0.3;
@@ -88,6 +94,12 @@ ModelSpec rich_tree(unsigned seed, int n = 10) {
   a.body = "b9", a.point = test::random_vec(rng, 0.3), a.direction = test::random_vec(rng).normalized(), a.gain = 1.5;
   a.in_world = false;
   s.actuators.push_back(a);
+  a = actuator("t3", ActuatorType::BodyTorque);
+  a.body = "b3", a.direction = test::random_vec(rng).normalized(), a.gain = 0.8, a.in_world = true;
+  s.actuators.push_back(a);
+  a = actuator("t7", ActuatorType::BodyTorque);
+  a.body = "b7", a.direction = test::random_vec(rng).normalized(), a.gain = 1.2, a.in_world = false;
+  s.actuators.push_back(a);
 
   auto sensor = [&](const std::string& name, SensorType t) {
     SensorSpec x;
@@ -112,6 +124,9 @@ ModelSpec rich_tree(unsigned seed, int n = 10) {
   s.sensors.push_back(y);
   y = sensor("angle5", SensorType::BodyAngle);
   y.body = "b5", y.axis = Eigen::Vector3d(0.0, 1.0, 1.0).normalized();
+  s.sensors.push_back(y);
+  y = sensor("angle9", SensorType::BodyAngle);  // j9 is spherical
+  y.body = "b9", y.axis = Eigen::Vector3d(1.0, 0.0, 0.0);
   s.sensors.push_back(y);
   y = sensor("dist28", SensorType::Distance);
   y.body_a = "b2", y.body_b = "b8", y.point_a = test::random_vec(rng, 0.3), y.point_b = test::random_vec(rng, 0.3);

@@ -101,6 +101,12 @@ ModelSpec random_plant(unsigned seed) {
   a.direction = Eigen::Vector3d(1, 2, 3);
   a.in_world = false;
   s.actuators.push_back(a);
+  a.name = "twist";
+  a.type = ActuatorType::BodyTorque;
+  a.body = "b6";
+  a.direction = Eigen::Vector3d(0.3, -1, 0.5);
+  a.in_world = false;
+  s.actuators.push_back(a);
   SensorSpec y;
   y.name = "p5";
   y.type = SensorType::PointPosition;
@@ -130,7 +136,7 @@ ModelSpec random_plant(unsigned seed) {
   y.type = SensorType::JointVelocity;
   y.joint = "j1";
   s.sensors.push_back(y);
-  s.plant.inputs = {"tau1", "push"};
+  s.plant.inputs = {"tau1", "push", "twist"};
   s.plant.outputs = {"p5", "v6", "ang2", "dist", "w1"};
   EffectSpec e;
   e.name = "spring";
@@ -147,6 +153,11 @@ ModelSpec random_plant(unsigned seed) {
   e.dof = 1;
   e.damping = 0.3;
   s.effects.push_back(e);
+  e.name = "ball_damper";
+  e.type = EffectType::JointDamper;
+  e.joint = "j2";  // spherical
+  e.damping = 0.2;
+  s.effects.push_back(e);
   return s;
 }
 
@@ -157,13 +168,13 @@ TEST(Linearize, ExactMatchesCentralDifferencesOnRandom3DTree) {
     OperatingPoint op = initial_point(m);
     op.q = test::random_q(m, rng);
     op.v = test::random_v(m, rng, 1.0);
-    op.u << 0.7, -1.3;
+    op.u << 0.7, -1.3, 0.4;
     const PlantFunction f(m, op.q, op.u, partition_coordinates(m, op.q));
     // at a point with non-zero tangent deviation too, where the rotation maps are not identity
     Eigen::VectorXd x(f.nx());
     for (int k = 0; k < f.nz(); ++k) x[f.nz() + k] = op.v[k];
     x.head(f.nz()) = test::random_v(m, rng, 0.3);
-    const Eigen::VectorXd u = Eigen::Vector2d(0.7, -1.3);
+    const Eigen::VectorXd u = Eigen::Vector3d(0.7, -1.3, 0.4);
     const Eigen::MatrixXd Je = plant_jacobian(f, x, u, JacobianMethod::Exact);
     const Eigen::MatrixXd Jc = plant_jacobian(f, x, u, JacobianMethod::CentralDifference);
     EXPECT_TRUE(MatrixNear(Jc, Je, 1e-7)) << "seed " << seed;
@@ -193,8 +204,8 @@ TEST(Linearize, ReusingFiniteDifferencesEqualFullEvaluations) {
   for (unsigned seed : {91u, 92u, 93u}) {
     const Model m = compile(random_plant(seed));
     std::mt19937 rng(seed);
-    Eigen::VectorXd u_all(2);
-    u_all << 0.7, -1.3;
+    Eigen::VectorXd u_all(3);
+    u_all << 0.7, -1.3, 0.4;
     check(m, test::random_q(m, rng), test::random_v(m, rng, 1.0), u_all, test::random_v(m, rng, 0.3),
           "random tree " + std::to_string(seed));
   }
