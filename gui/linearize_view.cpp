@@ -15,6 +15,7 @@
 #include <QListWidget>
 #include <QPushButton>
 #include <QScrollArea>
+#include <QStyle>
 #include <QSignalBlocker>
 #include <QSplitter>
 #include <QTabWidget>
@@ -224,7 +225,9 @@ void LinearizeView::buildUi() {
   left_scroll->setWidgetResizable(true);
   left_scroll->setFrameShape(QFrame::NoFrame);
   left_scroll->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
-  left_scroll->setFixedWidth(370);
+  // a narrow column (long combo entries are elided), the scroll bar beside it
+  left_widget->setMaximumWidth(390);
+  left_scroll->setFixedWidth(390 + left_scroll->style()->pixelMetric(QStyle::PM_ScrollBarExtent) + 4);
   auto* layout = new QHBoxLayout(this);
   layout->addWidget(left_scroll, 0);
   layout->addWidget(vsplit, 1);

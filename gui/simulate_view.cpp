@@ -19,6 +19,7 @@
 #include <QSignalBlocker>
 #include <QSplitter>
 #include <QStackedWidget>
+#include <QTabWidget>
 #include <QTableWidget>
 #include <QVBoxLayout>
 #include <algorithm>
@@ -234,18 +235,25 @@ void SimulateView::buildUi() {
   form->addRow(closed_loop_);
 
   // ---- references and disturbances (under the plots: the table needs the width)
-  auto* signals_box = new QGroupBox(tr("References r(t) and disturbances d(t)"), this);
-  auto* signals_layout = new QHBoxLayout(signals_box);
-  auto* ref_col = new QVBoxLayout;
-  ref_col->addWidget(new QLabel(tr("References on Plant/Out (r = y0 before the time; every controller follows them)"), signals_box));
-  references_ = new SignalTable(tr("Plant/Out"), signals_box);
+  auto* signals_box = new QTabWidget(this);
+  auto* ref_page = new QWidget(signals_box);
+  auto* ref_col = new QVBoxLayout(ref_page);
+  auto* ref_note = new QLabel(tr("r(t) on Plant/Out, one per output (r = y0 before the time); every controller "
+                                   "follows it: PID on r - y, state feedback through Nbar, LTI on y - r"), ref_page);
+  ref_note->setWordWrap(true);
+  ref_col->addWidget(ref_note);
+  references_ = new SignalTable(tr("Plant/Out"), ref_page);
   ref_col->addWidget(references_);
-  auto* dist_col = new QVBoxLayout;
-  dist_col->addWidget(new QLabel(tr("Disturbances added to actuators that are not Plant/In (d = 0 before the time)"), signals_box));
-  disturbances_ = new SignalTable(tr("Actuator"), signals_box);
+  signals_box->addTab(ref_page, tr("References r(t)"));
+  auto* dist_page = new QWidget(signals_box);
+  auto* dist_col = new QVBoxLayout(dist_page);
+  auto* dist_note = new QLabel(tr("d(t) added to an actuator that is not Plant/In (d = 0 before the time), then "
+                                    "limited like the actuator"), dist_page);
+  dist_note->setWordWrap(true);
+  dist_col->addWidget(dist_note);
+  disturbances_ = new SignalTable(tr("Actuator"), dist_page);
   dist_col->addWidget(disturbances_);
-  signals_layout->addLayout(ref_col, 1);
-  signals_layout->addLayout(dist_col, 1);
+  signals_box->addTab(dist_page, tr("Disturbances d(t)"));
 
   // ---- run
   run_button_ = new QPushButton(tr("Run"), this);

@@ -146,7 +146,7 @@ SignalTable::SignalTable(const QString& targetHeader, QWidget* parent) : QWidget
   layout->setContentsMargins(0, 0, 0, 0);
   table_ = new QTableWidget(0, ColumnCount, this);
   table_->setHorizontalHeaderLabels(
-      {targetHeader, tr("Type"), tr("Time [s]"), tr("Value / slope / amplitude"), tr("Frequency [Hz]"), tr("Phase [rad]"),
+      {targetHeader, tr("Type"), tr("Time [s]"), tr("Value"), tr("Frequency [Hz]"), tr("Phase [rad]"),
        tr("Points \"t r; t r\" or file")});
   table_->horizontalHeaderItem(Value)->setToolTip(
       tr("step: the value after the time (absolute for a reference, added for a disturbance); ramp: the slope per s; "
@@ -155,11 +155,14 @@ SignalTable::SignalTable(const QString& targetHeader, QWidget* parent) : QWidget
       tr("table: the points t r separated by ';' (times increasing); file: a CSV (t,value) or .mat (t, value), "
          "relative to the model file"));
   table_->verticalHeader()->setVisible(false);
-  table_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
+  // cell widgets do not size their columns: widths that show a combo's word and a number
+  const int widths[ColumnCount] = {120, 80, 95, 150, 110, 100, 160};
+  for (int c = 0; c < ColumnCount; ++c) table_->setColumnWidth(c, widths[c]);
   table_->horizontalHeader()->setStretchLastSection(true);
+  table_->verticalHeader()->setDefaultSectionSize(28);
   table_->setSelectionBehavior(QAbstractItemView::SelectRows);
   table_->setSelectionMode(QAbstractItemView::SingleSelection);
-  table_->setMaximumHeight(120);
+  table_->setMaximumHeight(130);
   layout->addWidget(table_);
   layout->addLayout(buttonRow(this, &add_, &remove_));
   connect(add_, &QPushButton::clicked, this, [this] {
@@ -255,7 +258,8 @@ void SignalTable::updateRow(int row) {
   const bool tabular = t == QLatin1String("table") || t == QLatin1String("file");
   spin(row, Time)->setEnabled(!tabular);
   spin(row, Value)->setEnabled(!tabular);
-  spin(row, Value)->setPrefix(t == QLatin1String("ramp") ? tr("slope ") : t == QLatin1String("sine") ? tr("amp. ") : QString());
+  spin(row, Value)->setPrefix(t == QLatin1String("ramp") ? tr("slope ") : t == QLatin1String("sine") ? tr("ampl. ") : QString());
+  spin(row, Value)->setSuffix(t == QLatin1String("ramp") ? tr(" /s") : QString());
   spin(row, Frequency)->setEnabled(t == QLatin1String("sine"));
   spin(row, Phase)->setEnabled(t == QLatin1String("sine"));
   dataEdit(row)->setEnabled(tabular);
