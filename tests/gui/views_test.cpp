@@ -507,6 +507,14 @@ class ViewsTest : public QObject {
     QVERIFY(view2.lqrControllablePartCheck()->isChecked());
     QVERIFY(view2.closedLoopCheck()->isChecked());
 
+    // a reload refreshes the view: the example without references, then the saved file again
+    QVERIFY(doc2.load(kCart));
+    QCOMPARE(view2.referencesTable()->table()->rowCount(), 0);
+    QCOMPARE(view2.antiWindupCombo()->currentData().toString(), QString("none"));
+    QVERIFY(doc2.load(path));
+    QCOMPARE(view2.referencesTable()->table()->rowCount(), 1);
+    QVERIFY(view2.closedLoopCheck()->isChecked());
+
     // undo to the start: the widgets follow; redo brings it all back
     while (undo->index() > base) undo->undo();
     QVERIFY(doc.spec().analysis.references.empty());
@@ -519,6 +527,40 @@ class ViewsTest : public QObject {
     QCOMPARE(refs->table()->rowCount(), 1);
     QCOMPARE(refs->spin(0, SignalTable::Value)->value(), 0.2);
     QVERIFY(view.closedLoopCheck()->isChecked());
+  }
+
+  // A disturbance on an actuator that is not Plant/In (the cart's force, once unticked):
+  // offered, written, and what the core's run setup adds to that actuator.
+  void disturbanceOnAnActuatorOutsidePlantIn() {
+    Document doc;
+    QVERIFY(doc.load(kCart));
+    SimulateView view(&doc);
+    SignalTable* dist = view.disturbancesTable();
+    QTest::mouseClick(dist->addButton(), Qt::LeftButton);
+    QCOMPARE(dist->table()->rowCount(), 0);  // force is Plant/In: nothing offered
+    QVERIFY(doc.setPlantInputs({}));
+    view.controllerCombo()->setCurrentIndex(view.controllerCombo()->findData("none"));
+    QTest::mouseClick(dist->addButton(), Qt::LeftButton);
+    QCOMPARE(dist->table()->rowCount(), 1);
+    QCOMPARE(dist->targetCombo(0)->currentText(), QString("force"));
+    dist->typeCombo(0)->setCurrentIndex(dist->typeCombo(0)->findText("sine"));
+    dist->spin(0, SignalTable::Time)->setValue(0.5);
+    dist->spin(0, SignalTable::Value)->setValue(5.0);
+    dist->spin(0, SignalTable::Frequency)->setValue(2.0);
+    QCOMPARE(doc.spec().analysis.disturbances.size(), std::size_t(1));
+    const DisturbanceSpec& d = doc.spec().analysis.disturbances[0];
+    QCOMPARE(d.actuator, std::string("force"));
+    QVERIFY(d.output.empty());
+    QCOMPARE(d.type, std::string("sine"));
+    QCOMPARE(d.amplitude, 5.0);
+    QCOMPARE(d.frequency, 2.0);
+    QVERIFY(doc.model());
+    const StudySimulation setup = study_simulation(*doc.model());
+    QVERIFY(setup.options.disturbance);
+    const int k = doc.model()->find_actuator("force");
+    const double t = 0.5 + 0.125;  // a quarter period after the start: the sine's peak
+    QVERIFY(std::abs(setup.options.disturbance(t)[k] - 5.0) < 1e-12);
+    QCOMPARE(setup.options.disturbance(0.4)[k], 0.0);
   }
 
   // ---------------------------------------------------------------- Simulate
