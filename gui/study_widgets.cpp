@@ -238,9 +238,14 @@ void SignalTable::addRow(const SignalSpec& s) {
     if (!syncing_) emit edited();
   };
   connect(target, &QComboBox::currentIndexChanged, this, changed);
-  connect(type, &QComboBox::currentIndexChanged, this, [this, type, changed] {
+  connect(type, &QComboBox::currentIndexChanged, this, [this, type, data, changed] {
     for (int r = 0; r < table_->rowCount(); ++r)
       if (typeCombo(r) == type) updateRow(r);
+    // a file signal needs its file (the core refuses an empty name): written once it is entered
+    if (type->currentText() == QLatin1String("file") && data->text().trimmed().isEmpty()) {
+      data->setFocus();
+      return;
+    }
     changed();
   });
   for (QDoubleSpinBox* sp : {time, val, freq, phase}) connect(sp, &QDoubleSpinBox::valueChanged, this, changed);

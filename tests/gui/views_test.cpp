@@ -476,6 +476,30 @@ class ViewsTest : public QObject {
     emit refs->dataEdit(0)->editingFinished();
     QCOMPARE(messages.count(), 1);
     QVERIFY(doc.spec().analysis.references.at(0).points.empty());
+    // times that do not increase: the core's reader refuses, its message (and field) is shown
+    refs->dataEdit(0)->setText("0 0; 2 0.1; 1 0.2");
+    refs->dataEdit(0)->setModified(true);
+    emit refs->dataEdit(0)->editingFinished();
+    QCOMPARE(messages.count(), 2);
+    QVERIFY2(messages.at(1).at(0).toString().contains("/analysis/references/0/points/2"), qPrintable(messages.at(1).at(0).toString()));
+    QVERIFY2(messages.at(1).at(0).toString().contains("increase"), qPrintable(messages.at(1).at(0).toString()));
+    QVERIFY(doc.spec().analysis.references.at(0).points.empty());
+    refs->dataEdit(0)->setText("0 0; 1 0.2");
+    refs->dataEdit(0)->setModified(true);
+    emit refs->dataEdit(0)->editingFinished();
+    QCOMPARE(doc.spec().analysis.references.at(0).points, (std::vector<std::pair<double, double>>{{0, 0}, {1, 0.2}}));
+    undo->undo();  // the points
+    // a file signal is written once its file is named (the core refuses an empty one)
+    const int before_file = undo->index();
+    refs->typeCombo(0)->setCurrentIndex(refs->typeCombo(0)->findText("file"));
+    QCOMPARE(undo->index(), before_file);
+    QCOMPARE(messages.count(), 2);
+    refs->dataEdit(0)->setText("ref.csv");
+    refs->dataEdit(0)->setModified(true);
+    emit refs->dataEdit(0)->editingFinished();
+    QCOMPARE(doc.spec().analysis.references.at(0).type, std::string("file"));
+    QCOMPARE(doc.spec().analysis.references.at(0).file, std::string("ref.csv"));
+    undo->undo();  // the file
     undo->undo();  // back to the step
     QCOMPARE(doc.spec().analysis.references, std::vector<SignalSpec>{step});
     QCOMPARE(refs->typeCombo(0)->currentText(), QString("step"));
