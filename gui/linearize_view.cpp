@@ -38,6 +38,8 @@ namespace {
 // merge keys of the spin boxes (consecutive steps of one spin box are one undo step)
 constexpr int kMergeOpTime = 0x4c5a01;
 constexpr int kMergeTs = 0x4c5a02;
+constexpr int kMergeSet = 0x4c5a03;      // values stepped in the coordinates-set table
+constexpr int kMergeTargets = 0x4c5a04;  // and in the output targets
 
 QStringList qlist(const std::vector<std::string>& v) {
   QStringList l;
@@ -260,24 +262,24 @@ void LinearizeView::buildUi() {
   connect(independent_, &QListWidget::itemChanged, this, &LinearizeView::independentChanged);
   // the steady-state search goes through setStudyChecked: the core refuses what it cannot
   // use (an unknown name, a value the loops cannot hold), the widgets then show the study again
-  auto writeChecked = [this](const std::function<void(StudySpec&)>& change, const QString& text) {
+  auto writeChecked = [this](const std::function<void(StudySpec&)>& change, const QString& text, int key = -1) {
     if (syncing_) return;
     StudySpec s = doc_->spec().analysis;
     change(s);
     if (s == doc_->spec().analysis) return;
     QString error;
-    if (!doc_->setStudyChecked(s, text, &error)) {
+    if (!doc_->setStudyChecked(s, text, &error, key)) {
       emit message(tr("Refused: %1").arg(error));
       refreshSteadyState();
     }
   };
-  connect(set_table_, &NameValueTable::edited, this, [this, writeChecked] {
+  connect(set_table_, &NameValueTable::edited, this, [this, writeChecked](bool number) {
     const auto v = set_table_->pairs();
-    writeChecked([&](StudySpec& s) { s.set = v; }, tr("Change the coordinates set"));
+    writeChecked([&](StudySpec& s) { s.set = v; }, tr("Change the coordinates set"), number ? kMergeSet : -1);
   });
-  connect(targets_, &NameValueTable::edited, this, [this, writeChecked] {
+  connect(targets_, &NameValueTable::edited, this, [this, writeChecked](bool number) {
     const auto v = targets_->pairs();
-    writeChecked([&](StudySpec& s) { s.output_targets = v; }, tr("Change the output targets"));
+    writeChecked([&](StudySpec& s) { s.output_targets = v; }, tr("Change the output targets"), number ? kMergeTargets : -1);
   });
   connect(free_inputs_, &QListWidget::itemChanged, this, [this, writeChecked] {
     const auto v = checkedNames(free_inputs_);

@@ -38,6 +38,8 @@ namespace {
 constexpr int kMergeTEnd = 0x53490001;
 constexpr int kMergeOutputStep = 0x53490002;
 constexpr int kMergeTracking = 0x53490003;
+constexpr int kMergeReferences = 0x53490004;    // numbers stepped in the references table
+constexpr int kMergeDisturbances = 0x53490005;  // and in the disturbances table
 // points per plotted series while a run is live (ResultPlots decimates beyond it):
 // a Qt Charts redraw costs ~10 us per point on the GUI thread, so the live view
 // stays light; the finished result is shown at the plots' own limit
@@ -354,8 +356,8 @@ void SimulateView::buildUi() {
   connect(tracking_time_, &QDoubleSpinBox::valueChanged, this, [this](double v) {
     writeStudyChecked([&](StudySpec& s) { s.tracking_time = v; }, tr("Change the tracking time"), kMergeTracking);
   });
-  connect(references_, &SignalTable::edited, this, [this] { signalsEdited(true); });
-  connect(disturbances_, &SignalTable::edited, this, [this] { signalsEdited(false); });
+  connect(references_, &SignalTable::edited, this, [this](bool number) { signalsEdited(true, number); });
+  connect(disturbances_, &SignalTable::edited, this, [this](bool number) { signalsEdited(false, number); });
 
   connect(run_button_, &QPushButton::clicked, this, &SimulateView::run);
   connect(cancel_button_, &QPushButton::clicked, this, &SimulateView::cancel);
@@ -386,7 +388,7 @@ void SimulateView::writeStudyChecked(const std::function<void(StudySpec&)>& chan
   }
 }
 
-void SimulateView::signalsEdited(bool references) {
+void SimulateView::signalsEdited(bool references, bool number) {
   SignalTable* t = references ? references_ : disturbances_;
   std::vector<SignalSpec> v;
   QString error;
@@ -410,7 +412,8 @@ void SimulateView::signalsEdited(bool references) {
           s.disturbances.push_back(std::move(d));
         }
       },
-      references ? tr("Change the references") : tr("Change the disturbances"));
+      references ? tr("Change the references") : tr("Change the disturbances"),
+      number ? (references ? kMergeReferences : kMergeDisturbances) : -1);
 }
 
 void SimulateView::refreshSignals() {

@@ -117,7 +117,7 @@ class SimulateView : public QWidget {
   void refreshFromDocument();
   void refreshController();
   void refreshSignals();  // targets offered and the study's references and disturbances
-  void signalsEdited(bool references);
+  void signalsEdited(bool references, bool number);  // number: a spin box stepped (merged undo steps)
   // setStudyChecked: the core's refusal goes to message() and the widgets show the study again
   void writeStudyChecked(const std::function<void(codyna::StudySpec&)>& change, const QString& text, int mergeKey = -1);
   void writeStudy(const std::function<void(codyna::StudySpec&)>& change, const QString& text, int mergeKey = -1);

@@ -85,14 +85,14 @@ NameValueTable::NameValueTable(const QString& nameHeader, const QString& valueHe
     }
     if (name.isEmpty()) return;  // every name has its row
     addRow(name, 0.0);
-    emit edited();
+    emit edited(false);
   });
   connect(remove_, &QPushButton::clicked, this, [this] {
     int row = table_->currentRow();
     if (row < 0) row = table_->rowCount() - 1;
     if (row < 0) return;
     table_->removeRow(row);
-    emit edited();
+    emit edited(false);
   });
 }
 
@@ -118,10 +118,10 @@ void NameValueTable::addRow(const QString& name, double value) {
   table_->setCellWidget(row, 0, combo);
   table_->setCellWidget(row, 1, spin);
   connect(combo, &QComboBox::currentIndexChanged, this, [this] {
-    if (!syncing_) emit edited();
+    if (!syncing_) emit edited(false);
   });
   connect(spin, &QDoubleSpinBox::valueChanged, this, [this] {
-    if (!syncing_) emit edited();
+    if (!syncing_) emit edited(true);
   });
 }
 
@@ -179,14 +179,14 @@ SignalTable::SignalTable(const QString& targetHeader, QWidget* parent) : QWidget
     SignalSpec s;
     s.output = ss(name);
     addRow(s);
-    emit edited();
+    emit edited(false);
   });
   connect(remove_, &QPushButton::clicked, this, [this] {
     int row = table_->currentRow();
     if (row < 0) row = table_->rowCount() - 1;
     if (row < 0) return;
     table_->removeRow(row);
-    emit edited();
+    emit edited(false);
   });
 }
 
@@ -235,7 +235,10 @@ void SignalTable::addRow(const SignalSpec& s) {
   table_->setCellWidget(row, Phase, phase);
   table_->setCellWidget(row, Data, data);
   auto changed = [this] {
-    if (!syncing_) emit edited();
+    if (!syncing_) emit edited(false);
+  };
+  auto stepped = [this] {
+    if (!syncing_) emit edited(true);
   };
   connect(target, &QComboBox::currentIndexChanged, this, changed);
   connect(type, &QComboBox::currentIndexChanged, this, [this, type, data, changed] {
@@ -248,7 +251,7 @@ void SignalTable::addRow(const SignalSpec& s) {
     }
     changed();
   });
-  for (QDoubleSpinBox* sp : {time, val, freq, phase}) connect(sp, &QDoubleSpinBox::valueChanged, this, changed);
+  for (QDoubleSpinBox* sp : {time, val, freq, phase}) connect(sp, &QDoubleSpinBox::valueChanged, this, stepped);
   connect(data, &QLineEdit::editingFinished, this, [this, data, changed] {
     if (data->isModified()) {
       data->setModified(false);

@@ -1,7 +1,9 @@
 // Small editors of the study's lists (StudySpec), shared by the Linearize and
 // Simulate views. They hold no state of their own beyond what is shown: the
 // views fill them from the Document (set*, no signal) and write the Document
-// when edited() fires, reading the edited value back (pairs(), signals()).
+// when edited() fires, reading the edited value back (pairs(), readSignals()).
+// edited(true) is a number stepped in a spin box: the views merge those into
+// one undo step, as the other spin boxes of the views do.
 //
 //   NameValueTable  NAME = VALUE rows (coordinates set, output targets): a name
 //                   combo offering the model's names, a value spin box
@@ -47,7 +49,7 @@ class NameValueTable : public QWidget {
   QDoubleSpinBox* valueSpin(int row) const;
 
  signals:
-  void edited();
+  void edited(bool number);
 
  private:
   void addRow(const QString& name, double value);
@@ -78,7 +80,7 @@ class SignalTable : public QWidget {
   QLineEdit* dataEdit(int row) const;              // table points "t r; t r" or the file
 
  signals:
-  void edited();
+  void edited(bool number);
 
  private:
   void addRow(const codyna::SignalSpec& s);
