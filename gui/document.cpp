@@ -108,6 +108,26 @@ bool Document::setStudy(const StudySpec& study, const QString& text, int mergeKe
   return edit(text, [&](ModelSpec& s) { s.analysis = study; }, nullptr, mergeKey);
 }
 
+bool Document::setStudyChecked(const StudySpec& study, const QString& text, QString* error, int mergeKey) {
+  const bool compiled = model_ != nullptr;
+  return edit(
+      text,
+      [&](ModelSpec& s) {
+        s.analysis = study;
+        // only the study's own errors refuse the edit: a model being fixed elsewhere stays editable
+        const auto check = [](const std::function<void()>& f) {
+          try {
+            f();
+          } catch (const ModelError& e) {
+            if (e.path().rfind("/analysis", 0) == 0) throw;
+          }
+        };
+        check([&] { (void)parse_model_spec(to_json(s), ss(displayName())); });  // the reader's checks
+        if (compiled) check([&] { (void)study_model(s, ss(path_)); });          // names, coordinates held
+      },
+      error, mergeKey);
+}
+
 bool Document::setSolver(const SolverSpec& solver, const QString& text, int mergeKey) {
   return edit(text, [&](ModelSpec& s) { s.solver = solver; }, nullptr, mergeKey);
 }

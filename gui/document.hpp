@@ -56,6 +56,11 @@ class Document : public QObject {
   bool setPlantInputs(const QStringList& names);
   bool setPlantOutputs(const QStringList& names);
   bool setStudy(const StudySpec& study, const QString& text = "Change analysis settings", int mergeKey = -1);
+  // setStudy checked by the core first: the model file reader's checks (the spec written
+  // and read back, as a save and a load would) and study_model's (coordinates set,
+  // independent coordinates; only when the model compiled before). A refusal changes
+  // nothing and gives the core's message (file, field path, what was expected).
+  bool setStudyChecked(const StudySpec& study, const QString& text, QString* error, int mergeKey = -1);
   bool setSolver(const SolverSpec& solver, const QString& text = "Change solver settings", int mergeKey = -1);
 
   // replaces the spec without an undo step (used by the undo commands)

@@ -14,18 +14,22 @@
 #include <QLineEdit>
 #include <QListWidget>
 #include <QPushButton>
+#include <QScrollArea>
+#include <QStyle>
 #include <QSignalBlocker>
 #include <QSplitter>
 #include <QTabWidget>
 #include <QTableView>
 #include <QTableWidget>
 #include <QVBoxLayout>
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
 #include "gui/document.hpp"
 #include "gui/matrix_models.hpp"
 #include "gui/pole_map.hpp"
+#include "gui/study_widgets.hpp"
 
 namespace codyna::gui {
 
@@ -34,6 +38,8 @@ namespace {
 // merge keys of the spin boxes (consecutive steps of one spin box are one undo step)
 constexpr int kMergeOpTime = 0x4c5a01;
 constexpr int kMergeTs = 0x4c5a02;
+constexpr int kMergeSet = 0x4c5a03;      // values stepped in the coordinates-set table
+constexpr int kMergeTargets = 0x4c5a04;  // and in the output targets
 
 QStringList qlist(const std::vector<std::string>& v) {
   QStringList l;
@@ -53,6 +59,7 @@ LinearizeView::LinearizeView(Document* doc, QWidget* parent) : QWidget(parent), 
   connect(doc_, &Document::specChanged, this, &LinearizeView::refreshFromDocument);
   connect(doc_, &Document::modelChanged, this, [this] {
     refreshIndependent();
+    refreshSteadyState();
     updateStaleness();
   });
   refreshFromDocument();
@@ -126,6 +133,27 @@ void LinearizeView::buildUi() {
   independent_->setMaximumHeight(120);
   ind_layout->addWidget(independent_);
 
+  // the steady-state search (operspec): what an equilibrium or a trim holds, solves and reaches
+  steady_box_ = new QGroupBox(tr("Steady-state search (equilibrium, trim)"), this);
+  auto* steady = new QFormLayout(steady_box_);
+  steady->setRowWrapPolicy(QFormLayout::WrapAllRows);
+  set_table_ = new NameValueTable(tr("Coordinate"), tr("Value (m, rad, /s)"), steady_box_);
+  set_table_->setToolTip(tr("Coordinates set in the initial state and held exactly by the equilibrium or trim "
+                            "(positions by name, rates as NAME_dot); the loops are closed around them"));
+  steady->addRow(tr("Coordinates set (held)"), set_table_);
+  free_inputs_ = new QListWidget(steady_box_);
+  free_inputs_->setMaximumHeight(70);
+  free_inputs_->setToolTip(tr("Plant/In inputs the steady state solves for, within their limits "
+                              "(none checked: a trim solves all of Plant/In, an equilibrium none)"));
+  steady->addRow(tr("Inputs solved for (Plant/In)"), free_inputs_);
+  targets_ = new NameValueTable(tr("Plant/Out"), tr("Target"), steady_box_);
+  targets_->setToolTip(tr("Values the Plant/Out outputs must reach at the steady state"));
+  steady->addRow(tr("Output targets"), targets_);
+  trim_free_ = new QListWidget(steady_box_);
+  trim_free_->setMaximumHeight(70);
+  trim_free_->setToolTip(tr("Trim only: coordinates the trim solves instead of holding them at the initial state"));
+  steady->addRow(tr("Coordinates a trim solves"), trim_free_);
+
   linearize_button_ = new QPushButton(tr("Linearize"), this);
   linearize_button_->setDefault(true);
   export_button_ = new QPushButton(tr("Export…"), this);
@@ -187,15 +215,23 @@ void LinearizeView::buildUi() {
 
   // the settings keep a narrow column: the matrices, modes and pole map need the room
   auto* left_widget = new QWidget(this);
-  left_widget->setMaximumWidth(330);
   auto* left = new QVBoxLayout(left_widget);
   left->setContentsMargins(0, 0, 0, 0);
   left->addWidget(settings);
   left->addWidget(independent_box_);
+  left->addWidget(steady_box_);
   left->addLayout(buttons);
   left->addStretch(1);
+  auto* left_scroll = new QScrollArea(this);
+  left_scroll->setWidget(left_widget);
+  left_scroll->setWidgetResizable(true);
+  left_scroll->setFrameShape(QFrame::NoFrame);
+  left_scroll->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
+  // a narrow column (long combo entries are elided), the scroll bar beside it
+  left_widget->setMaximumWidth(390);
+  left_scroll->setFixedWidth(390 + left_scroll->style()->pixelMetric(QStyle::PM_ScrollBarExtent) + 4);
   auto* layout = new QHBoxLayout(this);
-  layout->addWidget(left_widget, 0);
+  layout->addWidget(left_scroll, 0);
   layout->addWidget(vsplit, 1);
 
   // ---- widgets -> study (each change one undo step)
@@ -224,6 +260,35 @@ void LinearizeView::buildUi() {
   });
   connect(export_browse_, &QPushButton::clicked, this, &LinearizeView::browseExport);
   connect(independent_, &QListWidget::itemChanged, this, &LinearizeView::independentChanged);
+  // the steady-state search goes through setStudyChecked: the core refuses what it cannot
+  // use (an unknown name, a value the loops cannot hold), the widgets then show the study again
+  auto writeChecked = [this](const std::function<void(StudySpec&)>& change, const QString& text, int key = -1) {
+    if (syncing_) return;
+    StudySpec s = doc_->spec().analysis;
+    change(s);
+    if (s == doc_->spec().analysis) return;
+    QString error;
+    if (!doc_->setStudyChecked(s, text, &error, key)) {
+      emit message(tr("Refused: %1").arg(error));
+      refreshSteadyState();
+    }
+  };
+  connect(set_table_, &NameValueTable::edited, this, [this, writeChecked](bool number) {
+    const auto v = set_table_->pairs();
+    writeChecked([&](StudySpec& s) { s.set = v; }, tr("Change the coordinates set"), number ? kMergeSet : -1);
+  });
+  connect(targets_, &NameValueTable::edited, this, [this, writeChecked](bool number) {
+    const auto v = targets_->pairs();
+    writeChecked([&](StudySpec& s) { s.output_targets = v; }, tr("Change the output targets"), number ? kMergeTargets : -1);
+  });
+  connect(free_inputs_, &QListWidget::itemChanged, this, [this, writeChecked] {
+    const auto v = checkedNames(free_inputs_);
+    writeChecked([&](StudySpec& s) { s.free_inputs = v; }, tr("Change the inputs solved for"));
+  });
+  connect(trim_free_, &QListWidget::itemChanged, this, [this, writeChecked] {
+    const auto v = checkedNames(trim_free_);
+    writeChecked([&](StudySpec& s) { s.trim_free = v; }, tr("Change the coordinates a trim solves"));
+  });
 
   connect(linearize_button_, &QPushButton::clicked, this, [this] { linearize(); });
   connect(export_button_, &QPushButton::clicked, this, [this] {
@@ -301,6 +366,30 @@ void LinearizeView::refreshFromDocument() {
   }
   syncing_ = false;
   refreshIndependent();
+  refreshSteadyState();
+}
+
+void LinearizeView::refreshSteadyState() {
+  const ModelSpec& spec = doc_->spec();
+  const StudySpec& s = spec.analysis;
+  syncing_ = true;
+  // the names offered come from the compiled model (kept while it does not compile)
+  if (const std::shared_ptr<const Model> m = doc_->model()) {
+    QStringList coords = qlist(m->q_names);
+    for (const auto& v : m->v_names)
+      coords << (std::count(m->q_names.begin(), m->q_names.end(), v) ? qs(v + "_dot") : qs(v));
+    set_table_->setChoices(coords);
+    setCheckList(trim_free_, qlist(m->v_names), s.trim_free);
+  } else {
+    setCheckList(trim_free_, {}, s.trim_free);
+  }
+  set_table_->setPairs(s.set);
+  setCheckList(free_inputs_, qlist(spec.plant.inputs), s.free_inputs);
+  targets_->setChoices(qlist(spec.plant.outputs));
+  targets_->setPairs(s.output_targets);
+  const QString op = qs(s.operating_point);
+  trim_free_->setEnabled(op == QLatin1String("trim") || !s.trim_free.empty());
+  syncing_ = false;
 }
 
 void LinearizeView::refreshIndependent() {

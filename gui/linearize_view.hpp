@@ -4,8 +4,13 @@
 // file's "analysis" section, StudySpec): operating point (initial,
 // equilibrium, trim, time=T), Jacobian method, sample time Ts (0 =
 // continuous), MAT version, export folder and name, and for closed loops the
-// independent coordinates. Every change is written through
-// Document::setStudy (one undo step; spin boxes merge while they are
+// independent coordinates, and the steady-state search of an equilibrium or
+// a trim (as Simulink's operspec): the coordinates set and held (a name combo
+// of the model's positions and rates, a value), the Plant/In inputs solved
+// for, the Plant/Out targets, the coordinates a trim solves instead of
+// holding. Every change is written through
+// Document::setStudy or, for the steady-state search, setStudyChecked (which
+// refuses what the core refuses, with its message; one undo step; spin boxes merge while they are
 // stepped), and the widgets follow the Document (undo, redo, load).
 //
 // "Linearize" calls study_linearize() on the document's model, as
@@ -51,6 +56,7 @@ namespace codyna::gui {
 class Document;
 class MatrixTableModel;
 class ModeTableModel;
+class NameValueTable;
 class PoleMap;
 
 class LinearizeView : public QWidget {
@@ -85,6 +91,12 @@ class LinearizeView : public QWidget {
   QLineEdit* exportDirEdit() const { return export_dir_; }
   QLineEdit* exportNameEdit() const { return export_name_; }
   QListWidget* independentList() const { return independent_; }
+  // the steady-state search (equilibrium, trim): coordinates held, inputs solved, output targets,
+  // coordinates a trim frees
+  NameValueTable* setTable() const { return set_table_; }
+  QListWidget* freeInputsList() const { return free_inputs_; }
+  NameValueTable* targetsTable() const { return targets_; }
+  QListWidget* trimFreeList() const { return trim_free_; }
   QPushButton* linearizeButton() const { return linearize_button_; }
   QPushButton* exportButton() const { return export_button_; }
   // A, B, C, D (k = 0..3)
@@ -106,6 +118,7 @@ class LinearizeView : public QWidget {
   void buildUi();
   void refreshFromDocument();  // study -> widgets
   void refreshIndependent();   // coordinates of the model (closed loops only)
+  void refreshSteadyState();   // the names offered and the study's choices of the steady-state search
   void writeStudy(const std::function<void(codyna::StudySpec&)>& change, const QString& text, int mergeKey = -1);
   void opChanged();
   void independentChanged(QListWidgetItem* item);
@@ -133,6 +146,11 @@ class LinearizeView : public QWidget {
   QPushButton* export_browse_ = nullptr;
   QGroupBox* independent_box_ = nullptr;
   QListWidget* independent_ = nullptr;
+  QGroupBox* steady_box_ = nullptr;
+  NameValueTable* set_table_ = nullptr;
+  QListWidget* free_inputs_ = nullptr;
+  NameValueTable* targets_ = nullptr;
+  QListWidget* trim_free_ = nullptr;
   QPushButton* linearize_button_ = nullptr;
   QPushButton* export_button_ = nullptr;
   QLabel* op_label_ = nullptr;

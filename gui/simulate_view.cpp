@@ -15,9 +15,11 @@
 #include <QProgressBar>
 #include <QPushButton>
 #include <QRegularExpression>
+#include <QScrollArea>
 #include <QSignalBlocker>
 #include <QSplitter>
 #include <QStackedWidget>
+#include <QTabWidget>
 #include <QTableWidget>
 #include <QVBoxLayout>
 #include <algorithm>
@@ -25,6 +27,7 @@
 
 #include "gui/document.hpp"
 #include "gui/result_plots.hpp"
+#include "gui/study_widgets.hpp"
 #include "io/results_file.hpp"
 #include "model/model_spec.hpp"
 
@@ -34,6 +37,9 @@ namespace {
 
 constexpr int kMergeTEnd = 0x53490001;
 constexpr int kMergeOutputStep = 0x53490002;
+constexpr int kMergeTracking = 0x53490003;
+constexpr int kMergeReferences = 0x53490004;    // numbers stepped in the references table
+constexpr int kMergeDisturbances = 0x53490005;  // and in the disturbances table
 // points per plotted series while a run is live (ResultPlots decimates beyond it):
 // a Qt Charts redraw costs ~10 us per point on the GUI thread, so the live view
 // stays light; the finished result is shown at the plots' own limit
@@ -135,6 +141,25 @@ void SimulateView::buildUi() {
   ctrl_layout->addWidget(controller_combo_);
   controller_pages_ = new QStackedWidget(ctrl_box);
   ctrl_layout->addWidget(controller_pages_);
+  auto* aw_form = new QFormLayout;
+  anti_windup_ = new QComboBox(ctrl_box);
+  anti_windup_->addItem(tr("none (the integral runs on)"), QStringLiteral("none"));
+  anti_windup_->addItem(tr("back-calculation"), QStringLiteral("back_calculation"));
+  anti_windup_->addItem(tr("conditional integration"), QStringLiteral("conditional"));
+  anti_windup_->setToolTip(tr("PID with integral action, when an actuator sits at its min/max: back-calculation "
+                              "bleeds the integral with the tracking time; conditional holds an integral that would "
+                              "push a saturated input further"));
+  tracking_time_ = new QDoubleSpinBox(ctrl_box);
+  tracking_time_->setRange(0.0, 1e6);
+  tracking_time_->setDecimals(4);
+  tracking_time_->setSingleStep(0.01);
+  tracking_time_->setSuffix(QStringLiteral(" s"));
+  tracking_time_->setSpecialValueText(tr("not set"));
+  tracking_time_->setKeyboardTracking(false);
+  tracking_time_->setToolTip(tr("Back-calculation's time constant (> 0), e.g. the integral time Kp/Ki"));
+  aw_form->addRow(tr("PID anti-windup"), anti_windup_);
+  aw_form->addRow(tr("Tracking time"), tracking_time_);
+  ctrl_layout->addLayout(aw_form);
 
   auto* none_page = new QLabel(tr("Actuators at their nominal values u0."), controller_pages_);
   none_page->setWordWrap(true);
@@ -174,6 +199,10 @@ void SimulateView::buildUi() {
   lqr_hint_->setWordWrap(true);
   lqr_form->addRow(tr("Q diagonal"), q_weights_);
   lqr_form->addRow(tr("R diagonal"), r_weights_);
+  lqr_controllable_ = new QCheckBox(tr("Design on the controllable part only"), lqr_page);
+  lqr_controllable_->setToolTip(tr("A plant that is not stabilizable: the modes no input moves are named and left as "
+                                   "they are (without this, such a plant is refused)"));
+  lqr_form->addRow(lqr_controllable_);
   lqr_form->addRow(lqr_hint_);
   controller_pages_->addWidget(lqr_page);
 
@@ -202,6 +231,31 @@ void SimulateView::buildUi() {
   form->addRow(tr("Absolute tolerance"), atol_);
   compare_linear_ = new QCheckBox(tr("Compare with the linear closed loop"), solver_box);
   form->addRow(compare_linear_);
+  closed_loop_ = new QCheckBox(tr("Export the linear closed loop with the plant"), solver_box);
+  closed_loop_->setToolTip(tr("codyna linearize also writes NAME_cl.m/.mat (Acl, Bcl, Ccl, Dcl) and the step and "
+                              "frequency responses"));
+  form->addRow(closed_loop_);
+
+  // ---- references and disturbances (under the plots: the table needs the width)
+  auto* signals_box = new QTabWidget(this);
+  auto* ref_page = new QWidget(signals_box);
+  auto* ref_col = new QVBoxLayout(ref_page);
+  auto* ref_note = new QLabel(tr("r(t) on Plant/Out, one per output (r = y0 before the time); every controller "
+                                   "follows it: PID on r - y, state feedback through Nbar, LTI on y - r"), ref_page);
+  ref_note->setWordWrap(true);
+  ref_col->addWidget(ref_note);
+  references_ = new SignalTable(tr("Plant/Out"), ref_page);
+  ref_col->addWidget(references_);
+  signals_box->addTab(ref_page, tr("References r(t)"));
+  auto* dist_page = new QWidget(signals_box);
+  auto* dist_col = new QVBoxLayout(dist_page);
+  auto* dist_note = new QLabel(tr("d(t) added to an actuator that is not Plant/In (d = 0 before the time), then "
+                                    "limited like the actuator"), dist_page);
+  dist_note->setWordWrap(true);
+  dist_col->addWidget(dist_note);
+  disturbances_ = new SignalTable(tr("Actuator"), dist_page);
+  dist_col->addWidget(disturbances_);
+  signals_box->addTab(dist_page, tr("Disturbances d(t)"));
 
   // ---- run
   run_button_ = new QPushButton(tr("Run"), this);
@@ -233,9 +287,20 @@ void SimulateView::buildUi() {
   left_layout->addStretch(1);
 
   plots_ = new ResultPlots(this);
+  auto* right = new QSplitter(Qt::Vertical, this);
+  right->addWidget(plots_);
+  right->addWidget(signals_box);
+  right->setStretchFactor(0, 1);
+  right->setStretchFactor(1, 0);
+  auto* left_scroll = new QScrollArea(this);
+  left_scroll->setWidget(left);
+  left_scroll->setWidgetResizable(true);
+  left_scroll->setFrameShape(QFrame::NoFrame);
+  left_scroll->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
+  left_scroll->setMinimumWidth(left->sizeHint().width() + 20);
   auto* split = new QSplitter(Qt::Horizontal, this);
-  split->addWidget(left);
-  split->addWidget(plots_);
+  split->addWidget(left_scroll);
+  split->addWidget(right);
   split->setStretchFactor(0, 0);
   split->setStretchFactor(1, 1);
   auto* layout = new QHBoxLayout(this);
@@ -274,6 +339,26 @@ void SimulateView::buildUi() {
     writeStudy([&](StudySpec& s) { s.compare_linear = on; }, on ? tr("Compare with the linear loop") : tr("Do not compare with the linear loop"));
   });
 
+  connect(closed_loop_, &QCheckBox::toggled, this, [this](bool on) {
+    writeStudyChecked([&](StudySpec& s) { s.closed_loop.enabled = on; },
+                      on ? tr("Export the linear closed loop") : tr("Do not export the linear closed loop"));
+  });
+  connect(lqr_controllable_, &QCheckBox::toggled, this, [this](bool on) {
+    writeStudyChecked([&](StudySpec& s) { s.lqr_controllable_part = on; },
+                      on ? tr("LQR on the controllable part") : tr("LQR on the whole plant"));
+  });
+  connect(anti_windup_, &QComboBox::currentIndexChanged, this, [this](int i) {
+    if (i < 0) return;
+    const std::string a = ss(anti_windup_->itemData(i).toString());
+    tracking_time_->setEnabled(a == "back_calculation");
+    writeStudyChecked([&](StudySpec& s) { s.anti_windup = a; }, tr("Change the anti-windup"));
+  });
+  connect(tracking_time_, &QDoubleSpinBox::valueChanged, this, [this](double v) {
+    writeStudyChecked([&](StudySpec& s) { s.tracking_time = v; }, tr("Change the tracking time"), kMergeTracking);
+  });
+  connect(references_, &SignalTable::edited, this, [this](bool number) { signalsEdited(true, number); });
+  connect(disturbances_, &SignalTable::edited, this, [this](bool number) { signalsEdited(false, number); });
+
   connect(run_button_, &QPushButton::clicked, this, &SimulateView::run);
   connect(cancel_button_, &QPushButton::clicked, this, &SimulateView::cancel);
   connect(save_results_, &QPushButton::clicked, this, &SimulateView::saveResultsDialog);
@@ -289,6 +374,67 @@ void SimulateView::writeStudy(const std::function<void(StudySpec&)>& change, con
   change(s);
   if (s == doc_->spec().analysis) return;
   doc_->setStudy(s, text, mergeKey);
+}
+
+void SimulateView::writeStudyChecked(const std::function<void(StudySpec&)>& change, const QString& text, int mergeKey) {
+  if (syncing_) return;
+  StudySpec s = doc_->spec().analysis;
+  change(s);
+  if (s == doc_->spec().analysis) return;
+  QString error;
+  if (!doc_->setStudyChecked(s, text, &error, mergeKey)) {
+    emit message(tr("Refused: %1").arg(error));
+    refreshFromDocument();
+  }
+}
+
+void SimulateView::signalsEdited(bool references, bool number) {
+  SignalTable* t = references ? references_ : disturbances_;
+  std::vector<SignalSpec> v;
+  QString error;
+  if (!t->readSignals(&v, &error)) {
+    emit message(tr("%1: %2").arg(references ? tr("References") : tr("Disturbances"), error));
+    refreshSignals();
+    return;
+  }
+  writeStudyChecked(
+      [&](StudySpec& s) {
+        if (references) {
+          s.references = v;
+          return;
+        }
+        s.disturbances.clear();
+        for (const SignalSpec& x : v) {
+          DisturbanceSpec d;
+          static_cast<SignalSpec&>(d) = x;
+          d.actuator = x.output;
+          d.output.clear();
+          s.disturbances.push_back(std::move(d));
+        }
+      },
+      references ? tr("Change the references") : tr("Change the disturbances"),
+      number ? (references ? kMergeReferences : kMergeDisturbances) : -1);
+}
+
+void SimulateView::refreshSignals() {
+  const ModelSpec& spec = doc_->spec();
+  references_->setChoices([&] {
+    QStringList l;
+    for (const auto& n : spec.plant.outputs) l << qs(n);
+    return l;
+  }());
+  references_->setSignals(spec.analysis.references);
+  QStringList actuators;
+  for (const auto& a : spec.actuators)
+    if (!std::count(spec.plant.inputs.begin(), spec.plant.inputs.end(), a.name)) actuators << qs(a.name);
+  disturbances_->setChoices(actuators);
+  std::vector<SignalSpec> d;
+  for (const DisturbanceSpec& x : spec.analysis.disturbances) {
+    SignalSpec s = x;
+    s.output = x.actuator;
+    d.push_back(std::move(s));
+  }
+  disturbances_->setSignals(d);
 }
 
 void SimulateView::writeSolver(const std::function<void(SolverSpec&)>& change, const QString& text, int mergeKey) {
@@ -336,6 +482,14 @@ void SimulateView::refreshFromDocument() {
     atol_->setText(num(so.atol));
     compare_linear_->setChecked(st.compare_linear);
   }
+  {
+    const QSignalBlocker b1(closed_loop_), b2(lqr_controllable_), b3(anti_windup_), b4(tracking_time_);
+    closed_loop_->setChecked(st.closed_loop.enabled);
+    lqr_controllable_->setChecked(st.lqr_controllable_part);
+    anti_windup_->setCurrentIndex(anti_windup_->findData(qs(st.anti_windup)));
+    tracking_time_->setValue(st.tracking_time);
+    tracking_time_->setEnabled(st.anti_windup == "back_calculation");
+  }
   const int dof2 = doc_->model() ? 2 * doc_->model()->dof() : -1;
   const int nu = static_cast<int>(spec.plant.inputs.size());
   lqr_hint_->setText(dof2 >= 0 ? tr("Q: %1 weights in state order (positions, then velocities); R: %2 weights, one per "
@@ -344,6 +498,7 @@ void SimulateView::refreshFromDocument() {
                                      .arg(nu)
                                : tr("Q: one weight per state; R: one per Plant/In. Empty = identity."));
   syncing_ = false;
+  refreshSignals();
   refreshController();
 }
 

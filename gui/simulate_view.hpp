@@ -8,6 +8,15 @@
 //               LQR with the diagonals of Q and R        -> StudySpec::controller...
 //   solver      end time, output step, integrator, rtol, atol -> SolverSpec
 //   compare with the linear closed loop                  -> StudySpec::compare_linear
+//   export the linear closed loop with the plant          -> StudySpec::closed_loop.enabled
+//   LQR on the controllable part only                     -> StudySpec::lqr_controllable_part
+//   PID anti-windup (none, back_calculation, conditional)
+//               and its tracking time                     -> StudySpec::anti_windup, tracking_time
+//   references r(t) on Plant/Out, disturbances d(t) on the other actuators
+//               (step, ramp, sine, table, file; SignalTable, under the plots)
+//                                                         -> StudySpec::references, disturbances
+// The last five go through Document::setStudyChecked: what the core's reader or
+// study_model refuses is refused here with the core's message.
 //
 // Run starts a SimWorker (study_simulation + study_simulate on a worker
 // thread, the code of `codyna simulate`) on the document's current model; the
@@ -44,6 +53,7 @@ namespace codyna::gui {
 
 class Document;
 class ResultPlots;
+class SignalTable;
 
 class SimulateView : public QWidget {
   Q_OBJECT
@@ -86,6 +96,12 @@ class SimulateView : public QWidget {
   QLineEdit* rtolEdit() const { return rtol_; }
   QLineEdit* atolEdit() const { return atol_; }
   QCheckBox* compareLinearCheck() const { return compare_linear_; }
+  SignalTable* referencesTable() const { return references_; }      // one row per Plant/Out followed
+  SignalTable* disturbancesTable() const { return disturbances_; }  // actuators that are not Plant/In
+  QComboBox* antiWindupCombo() const { return anti_windup_; }
+  QDoubleSpinBox* trackingTimeSpin() const { return tracking_time_; }
+  QCheckBox* lqrControllablePartCheck() const { return lqr_controllable_; }
+  QCheckBox* closedLoopCheck() const { return closed_loop_; }
   QPushButton* runButton() const { return run_button_; }
   QPushButton* cancelButton() const { return cancel_button_; }
   QProgressBar* progressBar() const { return progress_; }
@@ -100,6 +116,10 @@ class SimulateView : public QWidget {
   void buildUi();
   void refreshFromDocument();
   void refreshController();
+  void refreshSignals();  // targets offered and the study's references and disturbances
+  void signalsEdited(bool references, bool number);  // number: a spin box stepped (merged undo steps)
+  // setStudyChecked: the core's refusal goes to message() and the widgets show the study again
+  void writeStudyChecked(const std::function<void(codyna::StudySpec&)>& change, const QString& text, int mergeKey = -1);
   void writeStudy(const std::function<void(codyna::StudySpec&)>& change, const QString& text, int mergeKey = -1);
   void writeSolver(const std::function<void(codyna::SolverSpec&)>& change, const QString& text, int mergeKey = -1);
   void pidEdited(int row, int column);
@@ -141,6 +161,12 @@ class SimulateView : public QWidget {
   QLineEdit* rtol_ = nullptr;
   QLineEdit* atol_ = nullptr;
   QCheckBox* compare_linear_ = nullptr;
+  QCheckBox* closed_loop_ = nullptr;
+  QCheckBox* lqr_controllable_ = nullptr;
+  QComboBox* anti_windup_ = nullptr;
+  QDoubleSpinBox* tracking_time_ = nullptr;
+  SignalTable* references_ = nullptr;
+  SignalTable* disturbances_ = nullptr;
   QPushButton* run_button_ = nullptr;
   QPushButton* cancel_button_ = nullptr;
   QPushButton* save_results_ = nullptr;

@@ -1,13 +1,19 @@
 // codyna-gui rendered for real (xvfb-run, Mesa's software OpenGL): the main window
 // of every example with the mechanism in the 3-D view, the panels, the linearize
 // view with its pole map, a simulation plot and a playback frame, written as PNGs
-// under build/screenshots. A blank 3-D view fails (pixel statistics, not file existence).
+// under build/screenshots; the study's steady-state search and references filled in
+// through their widgets (linearize_steady_state.png, simulate_references.png). A blank 3-D view fails (pixel statistics, not file existence).
 #include <QDir>
 #include <QCheckBox>
 #include <QComboBox>
 #include <QElapsedTimer>
 #include <QDockWidget>
+#include <QDoubleSpinBox>
+#include <QListWidget>
+#include <QPushButton>
 #include <QScreen>
+#include <QSplitter>
+#include <QTableWidget>
 #include <QSet>
 #include <QSignalSpy>
 #include <QTabWidget>
@@ -20,6 +26,7 @@
 #include "gui/pole_map.hpp"
 #include "gui/result_plots.hpp"
 #include "gui/simulate_view.hpp"
+#include "gui/study_widgets.hpp"
 #include "gui/view3d.hpp"
 #include "simulation/result.hpp"
 
@@ -122,6 +129,55 @@ class MainWindowXvfb : public QObject {
     QVERIFY2(s.foreground > 0.01, qPrintable(QString("%1: only %2 of the 3-D view differs from the background").arg(file).arg(s.foreground)));
     QVERIFY2(s.colours > 50, qPrintable(QString("%1: %2 colours").arg(file).arg(s.colours)));
     save(screenOf(&w), "main_" + QFileInfo(file).baseName() + ".png");
+    w.document()->undoStack()->setClean();
+  }
+
+  // The control workflow's widgets as a user sees them, the analysis area dragged taller:
+  // the four-bar's crank held at 1.3 rad with its torque solved, then the cart-pendulum's
+  // LQR following a step of the cart position.
+  void controlWorkflowWidgets() {
+    MainWindow w;
+    w.resize(1600, 1000);
+    w.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&w));
+    QVERIFY(w.openFile(QStringLiteral(CODYNA_EXAMPLES_DIR "/four_bar.json")));
+    auto* centre = qobject_cast<QSplitter*>(w.analysisTabs()->parentWidget());
+    QVERIFY(centre);
+    centre->setSizes({250, 10000});
+    LinearizeView* lv = w.linearizeView();
+    w.analysisTabs()->setCurrentWidget(lv);
+    NameValueTable* set = lv->setTable();
+    QTest::mouseClick(set->addButton(), Qt::LeftButton);
+    set->nameCombo(0)->setCurrentIndex(set->nameCombo(0)->findText("pivot_A"));
+    set->valueSpin(0)->setValue(1.3);
+    lv->freeInputsList()->item(0)->setCheckState(Qt::Checked);
+    QVERIFY(lv->linearize());
+    auto* results = lv->findChild<QTabWidget*>();  // A, B, C, D, offsets: show the torque solved (u0)
+    QVERIFY(results);
+    results->setCurrentIndex(results->count() - 1);
+    QTest::qWait(300);
+    const QImage lin = screenOfChild(&w, w.analysisTabs());
+    QVERIFY2(stats(lin).foreground > 0.02, "the linearize view shows its widgets");
+    save(lin, "linearize_steady_state.png");
+    w.document()->undoStack()->setClean();
+
+    QVERIFY(w.openFile(QStringLiteral(CODYNA_EXAMPLES_DIR "/cart_pendulum.json")));
+    SimulateView* sv = w.simulateView();
+    w.analysisTabs()->setCurrentWidget(sv);
+    SignalTable* refs = sv->referencesTable();
+    QTest::mouseClick(refs->addButton(), Qt::LeftButton);
+    refs->spin(0, SignalTable::Time)->setValue(1.0);
+    refs->spin(0, SignalTable::Value)->setValue(0.2);
+    QCOMPARE(w.document()->spec().analysis.references.size(), std::size_t(1));
+    QSignalSpy done(sv, &SimulateView::runFinished);
+    sv->run();
+    QVERIFY(waitFor([&] { return done.count() == 1; }));
+    QVERIFY(sv->result() && sv->result()->completed);
+    // the cart follows the step: h ends near 0.2
+    const auto& r = *sv->result();
+    QVERIFY2(std::abs(r.y(r.y.rows() - 1, 0) - 0.2) < 0.02, qPrintable(QString::number(r.y(r.y.rows() - 1, 0))));
+    QTest::qWait(300);
+    save(screenOfChild(&w, w.analysisTabs()), "simulate_references.png");
     w.document()->undoStack()->setClean();
   }
 

@@ -7,7 +7,11 @@
 //    equal matrices in NAME.mat);
 //  - a run plots exactly the simulated samples, the integrator runs on the worker
 //    thread, batches arrive at a bounded rate and lose nothing; cancel keeps the
-//    partial result; a failing setup is reported, not a crash; results save.
+//    partial result; a failing setup is reported, not a crash; results save;
+//  - the steady-state search set in the Linearize view (a coordinate held, an input
+//    solved) gives what the core gives for the same study; the core's refusals are
+//    shown, not taken; a reference set in the Simulate view is saved, reloaded,
+//    undone and redone.
 #include <QCheckBox>
 #include <QComboBox>
 #include <QDoubleSpinBox>
@@ -37,6 +41,9 @@
 #include "gui/result_plots.hpp"
 #include "gui/sim_worker.hpp"
 #include "gui/simulate_view.hpp"
+#include "gui/study_widgets.hpp"
+#include "io/model_file.hpp"
+#include "study/workflow.hpp"
 #include "io/mat_export.hpp"
 #include "io/results_file.hpp"
 
@@ -333,6 +340,254 @@ class ViewsTest : public QObject {
     doc.undoStack()->undo();  // independent
     QVERIFY(doc.spec().analysis.independent.empty());
     QCOMPARE(list->item(list->count() - 1)->checkState(), Qt::Unchecked);
+  }
+
+
+  // The four-bar's crank held at 1.3 rad, its torque solved: the widgets write the study,
+  // and Linearize gives what the core computes headless for the same study.
+  void steadyStateSearchEqualsTheCore() {
+    Document doc;
+    QVERIFY(doc.load(kFourBar));
+    LinearizeView view(&doc);
+    view.show();
+    QSignalSpy messages(&view, &LinearizeView::message);
+    QCOMPARE(view.operatingPointCombo()->currentData().toString(), QString("equilibrium"));
+    const int base = doc.undoStack()->index();
+
+    NameValueTable* set = view.setTable();
+    QTest::mouseClick(set->addButton(), Qt::LeftButton);
+    QCOMPARE(set->table()->rowCount(), 1);
+    QComboBox* name = set->nameCombo(0);
+    QVERIFY(name->findText("pivot_A") >= 0);
+    QVERIFY(name->findText("pivot_A_dot") >= 0);  // rates are offered too
+    name->setCurrentIndex(name->findText("pivot_A"));
+    const int stepsBefore = doc.undoStack()->index();
+    set->valueSpin(0)->setValue(1.2);
+    set->valueSpin(0)->setValue(1.3);  // stepping the value: one undo step
+    QCOMPARE(doc.undoStack()->index(), stepsBefore + 1);
+    QListWidget* inputs = view.freeInputsList();
+    QCOMPARE(inputs->count(), 1);
+    QCOMPARE(inputs->item(0)->text(), QString("crank_torque"));
+    inputs->item(0)->setCheckState(Qt::Checked);
+
+    const StudySpec& st = doc.spec().analysis;
+    QCOMPARE(st.set, (std::vector<std::pair<std::string, double>>{{"pivot_A", 1.3}}));
+    QCOMPARE(st.free_inputs, std::vector<std::string>{"crank_torque"});
+    QCOMPARE(messages.count(), 0);
+
+    // the core, headless, on the same study
+    ModelSpec spec = load_model_spec(kFourBar.toStdString());
+    spec.analysis.set = {{"pivot_A", 1.3}};
+    spec.analysis.free_inputs = {"crank_torque"};
+    const Model m = study_model(spec, kFourBar.toStdString());
+    const StudyLinearization core = study_linearize(m);
+    const int k = m.find_actuator("crank_torque");
+    QVERIFY(k >= 0);
+    const double torque = core.op.u[k];
+    QVERIFY2(std::abs(torque) > 1.0, "holding the crank mid-stroke takes a torque");
+
+    QVERIFY(view.linearize());
+    const StudyLinearization& gui = *view.result();
+    QCOMPARE(gui.op.kind, std::string("equilibrium"));
+    QVERIFY2(relClose(gui.op.u[k], torque, 1e-9), qPrintable(QString("%1 vs %2").arg(gui.op.u[k], 0, 'g', 17).arg(torque, 0, 'g', 17)));
+    const int iq = static_cast<int>(std::find(m.q_names.begin(), m.q_names.end(), "pivot_A") - m.q_names.begin());
+    QCOMPARE(gui.op.q[iq], 1.3);  // held exactly
+    QCOMPARE(gui.system.A.rows(), core.system.A.rows());
+    QVERIFY((gui.system.A - core.system.A).cwiseAbs().maxCoeff() <= 1e-9 * (1 + core.system.A.cwiseAbs().maxCoeff()));
+    QVERIFY((gui.system.B - core.system.B).cwiseAbs().maxCoeff() <= 1e-9 * (1 + core.system.B.cwiseAbs().maxCoeff()));
+    // the offsets tab shows the torque solved
+    QCOMPARE(gui.system.u0[0], gui.op.u[k]);
+
+    // a second coordinate the loop cannot hold with the first: the core refuses, with its message
+    const StudySpec before = doc.spec().analysis;
+    const int steps = doc.undoStack()->index();
+    QTest::mouseClick(set->addButton(), Qt::LeftButton);
+    QCOMPARE(doc.spec().analysis, before);
+    QCOMPARE(doc.undoStack()->index(), steps);
+    QCOMPARE(set->table()->rowCount(), 1);
+    QCOMPARE(messages.count(), 1);
+    QVERIFY2(messages.at(0).at(0).toString().contains("/analysis/set"), qPrintable(messages.at(0).at(0).toString()));
+
+    // output target and trim_free write the study too; undo takes everything back, the widgets follow
+    QTest::mouseClick(view.targetsTable()->addButton(), Qt::LeftButton);
+    QCOMPARE(doc.spec().analysis.output_targets.size(), std::size_t(1));
+    QCOMPARE(doc.spec().analysis.output_targets[0].first, std::string("rocker_angle"));
+    view.operatingPointCombo()->setCurrentIndex(view.operatingPointCombo()->findData("trim"));
+    QVERIFY(view.trimFreeList()->isEnabled());
+    view.trimFreeList()->item(0)->setCheckState(Qt::Checked);
+    QCOMPARE(doc.spec().analysis.trim_free, std::vector<std::string>{view.trimFreeList()->item(0)->text().toStdString()});
+    while (doc.undoStack()->index() > base) doc.undoStack()->undo();
+    QCOMPARE(doc.spec().analysis, StudySpec{});
+    QCOMPARE(set->table()->rowCount(), 0);
+    QCOMPARE(view.targetsTable()->table()->rowCount(), 0);
+    QCOMPARE(inputs->item(0)->checkState(), Qt::Unchecked);
+    QCOMPARE(view.trimFreeList()->item(0)->checkState(), Qt::Unchecked);
+    while (doc.undoStack()->canRedo()) doc.undoStack()->redo();
+    QCOMPARE(set->table()->rowCount(), 1);
+    QCOMPARE(set->nameCombo(0)->currentText(), QString("pivot_A"));
+    QCOMPARE(set->valueSpin(0)->value(), 1.3);
+    QCOMPARE(inputs->item(0)->checkState(), Qt::Checked);
+  }
+
+  // A step reference on the cart's position h: in the study, in the saved file, undone and redone;
+  // the other controller settings land in the study too.
+  void referencesAndControllerSettingsAreSavedAndUndone() {
+    const QString path = tmp.filePath("cart_ref.json");
+    QFile::remove(path);
+    QVERIFY(QFile::copy(kCart, path));
+    Document doc;
+    QVERIFY(doc.load(path));
+    SimulateView view(&doc);
+    view.show();
+    QSignalSpy messages(&view, &SimulateView::message);
+    QUndoStack* undo = doc.undoStack();
+    const int base = undo->index();
+
+    SignalTable* refs = view.referencesTable();
+    QTest::mouseClick(refs->addButton(), Qt::LeftButton);
+    QCOMPARE(refs->table()->rowCount(), 1);
+    QCOMPARE(refs->targetCombo(0)->currentText(), QString("h"));
+    QCOMPARE(refs->typeCombo(0)->currentText(), QString("step"));
+    QVERIFY(!refs->spin(0, SignalTable::Frequency)->isEnabled());
+    refs->spin(0, SignalTable::Time)->setValue(1.0);
+    refs->spin(0, SignalTable::Value)->setValue(0.2);
+    SignalSpec step;
+    step.output = "h";
+    step.type = "step";
+    step.time = 1.0;
+    step.value = 0.2;
+    QCOMPARE(doc.spec().analysis.references, std::vector<SignalSpec>{step});
+    QCOMPARE(undo->index(), base + 2);  // the row added; the numbers typed merge into one step
+    QCOMPARE(messages.count(), 0);
+    // the core takes it: the run's setup follows h's reference
+    QVERIFY(doc.model());
+    const StudySimulation setup = study_simulation(*doc.model());
+    QVERIFY(setup.controller);
+    QVERIFY(setup.options.reference);
+    QCOMPARE(setup.options.reference(2.0)[0], 0.2);  // h is the first Plant/Out: 0.2 after t = 1 s
+    QCOMPARE(setup.options.reference(2.0)[1], setup.options.reference(0.5)[1]);  // theta stays at y0
+
+    // the cart has no actuator outside Plant/In: nothing to disturb
+    QTest::mouseClick(view.disturbancesTable()->addButton(), Qt::LeftButton);
+    QCOMPARE(view.disturbancesTable()->table()->rowCount(), 0);
+    // a table whose points do not parse is refused
+    refs->typeCombo(0)->setCurrentIndex(refs->typeCombo(0)->findText("table"));
+    QVERIFY(refs->dataEdit(0)->isEnabled());
+    QCOMPARE(doc.spec().analysis.references.at(0).type, std::string("table"));
+    refs->dataEdit(0)->setText("0 0; 1 x");
+    refs->dataEdit(0)->setModified(true);
+    emit refs->dataEdit(0)->editingFinished();
+    QCOMPARE(messages.count(), 1);
+    QVERIFY(doc.spec().analysis.references.at(0).points.empty());
+    // times that do not increase: the core's reader refuses, its message (and field) is shown
+    refs->dataEdit(0)->setText("0 0; 2 0.1; 1 0.2");
+    refs->dataEdit(0)->setModified(true);
+    emit refs->dataEdit(0)->editingFinished();
+    QCOMPARE(messages.count(), 2);
+    QVERIFY2(messages.at(1).at(0).toString().contains("/analysis/references/0/points/2"), qPrintable(messages.at(1).at(0).toString()));
+    QVERIFY2(messages.at(1).at(0).toString().contains("increase"), qPrintable(messages.at(1).at(0).toString()));
+    QVERIFY(doc.spec().analysis.references.at(0).points.empty());
+    refs->dataEdit(0)->setText("0 0; 1 0.2");
+    refs->dataEdit(0)->setModified(true);
+    emit refs->dataEdit(0)->editingFinished();
+    QCOMPARE(doc.spec().analysis.references.at(0).points, (std::vector<std::pair<double, double>>{{0, 0}, {1, 0.2}}));
+    undo->undo();  // the points
+    // a file signal is written once its file is named (the core refuses an empty one)
+    const int before_file = undo->index();
+    refs->typeCombo(0)->setCurrentIndex(refs->typeCombo(0)->findText("file"));
+    QCOMPARE(undo->index(), before_file);
+    QCOMPARE(messages.count(), 2);
+    refs->dataEdit(0)->setText("ref.csv");
+    refs->dataEdit(0)->setModified(true);
+    emit refs->dataEdit(0)->editingFinished();
+    QCOMPARE(doc.spec().analysis.references.at(0).type, std::string("file"));
+    QCOMPARE(doc.spec().analysis.references.at(0).file, std::string("ref.csv"));
+    undo->undo();  // the file
+    undo->undo();  // back to the step
+    QCOMPARE(doc.spec().analysis.references, std::vector<SignalSpec>{step});
+    QCOMPARE(refs->typeCombo(0)->currentText(), QString("step"));
+
+    view.antiWindupCombo()->setCurrentIndex(view.antiWindupCombo()->findData("back_calculation"));
+    QVERIFY(view.trackingTimeSpin()->isEnabled());
+    view.trackingTimeSpin()->setValue(0.5);
+    view.lqrControllablePartCheck()->setChecked(true);
+    view.closedLoopCheck()->setChecked(true);
+    const StudySpec& st = doc.spec().analysis;
+    QCOMPARE(st.anti_windup, std::string("back_calculation"));
+    QCOMPARE(st.tracking_time, 0.5);
+    QVERIFY(st.lqr_controllable_part);
+    QVERIFY(st.closed_loop.enabled);
+
+    // saved and read back (by the core's reader and by a second view)
+    QString error;
+    QVERIFY2(doc.save(&error), qPrintable(error));
+    const ModelSpec reread = load_model_spec(path.toStdString());
+    QCOMPARE(reread.analysis, doc.spec().analysis);
+    Document doc2;
+    QVERIFY(doc2.load(path));
+    SimulateView view2(&doc2);
+    QCOMPARE(view2.referencesTable()->table()->rowCount(), 1);
+    QCOMPARE(view2.referencesTable()->spin(0, SignalTable::Value)->value(), 0.2);
+    QCOMPARE(view2.referencesTable()->spin(0, SignalTable::Time)->value(), 1.0);
+    QCOMPARE(view2.antiWindupCombo()->currentData().toString(), QString("back_calculation"));
+    QCOMPARE(view2.trackingTimeSpin()->value(), 0.5);
+    QVERIFY(view2.lqrControllablePartCheck()->isChecked());
+    QVERIFY(view2.closedLoopCheck()->isChecked());
+
+    // a reload refreshes the view: the example without references, then the saved file again
+    QVERIFY(doc2.load(kCart));
+    QCOMPARE(view2.referencesTable()->table()->rowCount(), 0);
+    QCOMPARE(view2.antiWindupCombo()->currentData().toString(), QString("none"));
+    QVERIFY(doc2.load(path));
+    QCOMPARE(view2.referencesTable()->table()->rowCount(), 1);
+    QVERIFY(view2.closedLoopCheck()->isChecked());
+
+    // undo to the start: the widgets follow; redo brings it all back
+    while (undo->index() > base) undo->undo();
+    QVERIFY(doc.spec().analysis.references.empty());
+    QCOMPARE(refs->table()->rowCount(), 0);
+    QCOMPARE(view.antiWindupCombo()->currentData().toString(), QString("none"));
+    QVERIFY(!view.trackingTimeSpin()->isEnabled());
+    QVERIFY(!view.closedLoopCheck()->isChecked());
+    while (undo->canRedo()) undo->redo();
+    QCOMPARE(doc.spec().analysis, reread.analysis);
+    QCOMPARE(refs->table()->rowCount(), 1);
+    QCOMPARE(refs->spin(0, SignalTable::Value)->value(), 0.2);
+    QVERIFY(view.closedLoopCheck()->isChecked());
+  }
+
+  // A disturbance on an actuator that is not Plant/In (the cart's force, once unticked):
+  // offered, written, and what the core's run setup adds to that actuator.
+  void disturbanceOnAnActuatorOutsidePlantIn() {
+    Document doc;
+    QVERIFY(doc.load(kCart));
+    SimulateView view(&doc);
+    SignalTable* dist = view.disturbancesTable();
+    QTest::mouseClick(dist->addButton(), Qt::LeftButton);
+    QCOMPARE(dist->table()->rowCount(), 0);  // force is Plant/In: nothing offered
+    QVERIFY(doc.setPlantInputs({}));
+    view.controllerCombo()->setCurrentIndex(view.controllerCombo()->findData("none"));
+    QTest::mouseClick(dist->addButton(), Qt::LeftButton);
+    QCOMPARE(dist->table()->rowCount(), 1);
+    QCOMPARE(dist->targetCombo(0)->currentText(), QString("force"));
+    dist->typeCombo(0)->setCurrentIndex(dist->typeCombo(0)->findText("sine"));
+    dist->spin(0, SignalTable::Time)->setValue(0.5);
+    dist->spin(0, SignalTable::Value)->setValue(5.0);
+    dist->spin(0, SignalTable::Frequency)->setValue(2.0);
+    QCOMPARE(doc.spec().analysis.disturbances.size(), std::size_t(1));
+    const DisturbanceSpec& d = doc.spec().analysis.disturbances[0];
+    QCOMPARE(d.actuator, std::string("force"));
+    QVERIFY(d.output.empty());
+    QCOMPARE(d.type, std::string("sine"));
+    QCOMPARE(d.amplitude, 5.0);
+    QCOMPARE(d.frequency, 2.0);
+    QVERIFY(doc.model());
+    const StudySimulation setup = study_simulation(*doc.model());
+    QVERIFY(setup.options.disturbance);
+    const int k = doc.model()->find_actuator("force");
+    const double t = 0.5 + 0.125;  // a quarter period after the start: the sine's peak
+    QVERIFY(std::abs(setup.options.disturbance(t)[k] - 5.0) < 1e-12);
+    QCOMPARE(setup.options.disturbance(0.4)[k], 0.0);
   }
 
   // ---------------------------------------------------------------- Simulate
