@@ -12,6 +12,7 @@
 #include <QVBoxLayout>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 
 #include "gui/document.hpp"
@@ -55,6 +56,16 @@ QString pointsText(const std::vector<std::pair<double, double>>& p) {
   return l.join(QStringLiteral("; "));
 }
 
+// the first of `choices` that no row uses yet ("" when each has its row)
+QString firstUnused(const QStringList& choices, int rows, const std::function<QString(int)>& nameAt) {
+  for (const QString& c : choices) {
+    bool used = false;
+    for (int r = 0; r < rows && !used; ++r) used = nameAt(r) == c;
+    if (!used) return c;
+  }
+  return {};
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------
@@ -73,16 +84,7 @@ NameValueTable::NameValueTable(const QString& nameHeader, const QString& valueHe
   layout->addWidget(table_);
   layout->addLayout(buttonRow(this, &add_, &remove_));
   connect(add_, &QPushButton::clicked, this, [this] {
-    // the first name not used yet
-    QString name;
-    for (const QString& c : choices_) {
-      bool used = false;
-      for (int r = 0; r < table_->rowCount() && !used; ++r) used = nameCombo(r)->currentText() == c;
-      if (!used) {
-        name = c;
-        break;
-      }
-    }
+    const QString name = firstUnused(choices_, table_->rowCount(), [this](int r) { return nameCombo(r)->currentText(); });
     if (name.isEmpty()) return;  // every name has its row
     addRow(name, 0.0);
     emit edited(false);
@@ -166,15 +168,8 @@ SignalTable::SignalTable(const QString& targetHeader, QWidget* parent) : QWidget
   layout->addWidget(table_);
   layout->addLayout(buttonRow(this, &add_, &remove_));
   connect(add_, &QPushButton::clicked, this, [this] {
-    QString name;
-    for (const QString& c : choices_) {
-      bool used = false;
-      for (int r = 0; r < table_->rowCount() && !used; ++r) used = targetCombo(r)->currentText() == c;
-      if (!used) {
-        name = c;
-        break;
-      }
-    }
+    const QString name =
+        firstUnused(choices_, table_->rowCount(), [this](int r) { return targetCombo(r)->currentText(); });
     if (name.isEmpty()) return;  // one signal per target (the core refuses a second)
     SignalSpec s;
     s.output = ss(name);
