@@ -22,6 +22,9 @@ namespace {
 
 Eigen::Map<Eigen::VectorXd> view(N_Vector v) { return {N_VGetArrayPointer(v), N_VGetLength(v)}; }
 
+// CVODE BDF runs at this fraction of the tolerances asked for (measured, docs/work-precision.md)
+constexpr double kBdfToleranceFactor = 0.1;
+
 // owns a SUNContext, the state vector(s) and the solver memory
 class SundialsBase : public Integrator {
  protected:
@@ -117,7 +120,11 @@ class Cvode final : public SundialsBase {
       mem_ = CVodeCreate(bdf_ ? CV_BDF : CV_ADAMS, ctx_);
       check(CVodeInit(mem_, &SundialsBase::ode_rhs, t, y_), "CVodeInit");
       check(CVodeSetUserData(mem_, static_cast<SundialsBase*>(this)), "CVodeSetUserData");
-      check(CVodeSStolerances(mem_, set_.rtol, set_.atol), "CVodeSStolerances");
+      // BDF: CVODE's local error test at the tolerances asked for leaves a global error
+      // about 5x larger on Andrews' squeezer (SCD 7.4 at 1e-10); a tenth of them gives
+      // SCD 8.3 for 15% more steps (docs/work-precision.md). Adams keeps them as asked.
+      const double f = bdf_ ? kBdfToleranceFactor : 1.0;
+      check(CVodeSStolerances(mem_, f * set_.rtol, f * set_.atol), "CVodeSStolerances");
       check(CVodeSetErrHandlerFn(mem_, &SundialsBase::on_error, static_cast<SundialsBase*>(this)), "CVodeSetErrHandlerFn");
       check(CVodeSetMaxNumSteps(mem_, 1000000), "CVodeSetMaxNumSteps");
       if (set_.max_step > 0) check(CVodeSetMaxStep(mem_, set_.max_step), "CVodeSetMaxStep");
