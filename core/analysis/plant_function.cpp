@@ -337,7 +337,8 @@ PlantFunction::Workspace::~Workspace() = default;
 
 bool PlantFunction::analytic_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::MatrixXd& J) const {
   const Model& m = model_;
-  if (m.nc != 0 || !part_.dependent.empty()) return false;
+  if (m.nc != 0) return closed_loop_jacobian(x, u, J);
+  if (!part_.dependent.empty()) return false;
   const int n = nz(), nu_p = nu(), ny_p = ny();
   for (int k = 0; k < n; ++k)
     if (x[k] != 0.0 || part_.independent[k] != k) return false;
@@ -368,6 +369,88 @@ bool PlantFunction::analytic_jacobian(const Eigen::VectorXd& x, const Eigen::Vec
   for (int k = 0; k < nu_p; ++k) J.block(n, 2 * n + k, n, 1) = td.dqdd_du.col(m.plant_inputs[k]);
   J.block(2 * n, 0, ny_p, n) = td.dy_dq;
   J.block(2 * n, n, ny_p, n) = td.dy_dv;
+  return true;
+}
+
+bool PlantFunction::closed_loop_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& u,
+                                         Eigen::MatrixXd& J) const {
+  const Model& m = model_;
+  const int n = nz(), nu_p = nu(), ny_p = ny(), nv = m.nv, nd = static_cast<int>(part_.dependent.size());
+  for (int k = 0; k < n; ++k)
+    if (x[k] != 0.0) return false;
+  const auto& ind = part_.independent;
+  const auto& dep = part_.dependent;
+  Workspace& W = ws_;
+  if (!W.td) {
+    W.td = std::make_unique<TreeDerivatives>(m);
+    W.data = std::make_unique<Data>(m);
+    W.v.resize(nv);
+    W.u_all.resize(m.nu());
+    W.dq.setZero(nv);
+    W.Ja.resize(nd, nv);
+    W.Jd.resize(nd, nd);
+    W.Jz.resize(nd, n);
+    W.G.resize(nv, n);
+    W.H.resize(nv, n);
+    W.P.resize(nd, n);
+    W.DQ.resize(nv, n);
+  }
+  Data& d = *W.data;
+  TreeDerivatives& td = *W.td;
+  // the velocity map G at q_ref: v_ind = w, Jd v_dep = -Jz w
+  W.dq.setZero();
+  constraint_terms<double>(m, d, q_ref_, W.dq);
+  for (int k = 0; k < nd; ++k) W.Ja.row(k) = d.Jc.row(rows_[k]);
+  for (int c = 0; c < nd; ++c) W.Jd.col(c) = W.Ja.col(dep[c]);
+  for (int c = 0; c < n; ++c) W.Jz.col(c) = W.Ja.col(ind[c]);
+  W.lu.compute(W.Jd);
+  W.G.setZero();
+  for (int k = 0; k < n; ++k) W.G(ind[k], k) = 1.0;
+  W.P.noalias() = W.lu.solve(W.Jz);
+  for (int k = 0; k < nd; ++k) W.G.row(dep[k]) = -W.P.row(k);
+  W.v.noalias() = W.G * x.tail(n);
+  W.u_all = u_all_;
+  for (int k = 0; k < nu_p; ++k) W.u_all[m.plant_inputs[k]] = u[k];
+  // the constrained accelerations and multipliers, then their derivatives
+  forward_dynamics<double>(m, d, q_ref_, W.v, W.u_all);
+  td.compute_constrained(q_ref_, W.v, W.u_all, d.qdd, d.lambda, d.loop.rows, m.plant_outputs);
+  // H = dv/dz: Jd dv_dep/dz = -(d(Jc v)/dq) G on the plant's rows
+  for (int k = 0; k < nd; ++k) W.Ja.row(k) = td.dphid_dq.row(rows_[k]);
+  W.P.noalias() = W.Ja * W.G;
+  W.P = W.lu.solve(W.P);
+  W.H.setZero();
+  for (int k = 0; k < nd; ++k) W.H.row(dep[k]) = -W.P.row(k);
+  if (J.rows() != 2 * n + ny_p || J.cols() != 2 * n + nu_p) J.resize(2 * n + ny_p, 2 * n + nu_p);
+  J.setZero();
+  // position rows: d(rate)/d(dq) G + H (d(rate)/dv = I at dq = 0), and d/dw = G = I on the independent rows
+  W.DQ = W.H;
+  for (int b = 1; b < m.nbodies; ++b) {
+    const JointModel& j = m.joints[b];
+    if (j.type != JointType::Spherical && j.type != JointType::Free) continue;
+    const Eigen::Matrix3d wx = skew<double>(Eigen::Vector3d(W.v.segment<3>(j.idx_v)));
+    W.DQ.middleRows<3>(j.idx_v).noalias() -= 0.5 * wx * W.G.middleRows<3>(j.idx_v);
+    if (j.type == JointType::Free)
+      W.DQ.middleRows<3>(j.idx_v + 3).noalias() -=
+          skew<double>(Eigen::Vector3d(W.v.segment<3>(j.idx_v + 3))) * W.G.middleRows<3>(j.idx_v);
+  }
+  for (int k = 0; k < n; ++k) {
+    J.row(k).head(n) = W.DQ.row(ind[k]);
+    J(k, n + k) = 1.0;
+  }
+  // accelerations: dqdd/dz = dqdd_dq G + dqdd_dv H, dqdd/dw = dqdd_dv G
+  W.DQ.noalias() = td.dqdd_dq * W.G;
+  W.DQ.noalias() += td.dqdd_dv * W.H;
+  for (int k = 0; k < n; ++k) J.row(n + k).head(n) = W.DQ.row(ind[k]);
+  W.DQ.noalias() = td.dqdd_dv * W.G;
+  for (int k = 0; k < n; ++k) J.row(n + k).segment(n, n) = W.DQ.row(ind[k]);
+  for (int k = 0; k < nu_p; ++k)
+    for (int r = 0; r < n; ++r) J(n + r, 2 * n + k) = td.dqdd_du(ind[r], m.plant_inputs[k]);
+  // sensors
+  if (ny_p > 0) {
+    J.block(2 * n, 0, ny_p, n).noalias() = td.dy_dq * W.G;
+    J.block(2 * n, 0, ny_p, n).noalias() += td.dy_dv * W.H;
+    J.block(2 * n, n, ny_p, n).noalias() = td.dy_dv * W.G;
+  }
   return true;
 }
 

@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/LU>
+
 #include "model/data.hpp"
 
 namespace codyna {
@@ -73,9 +75,13 @@ class PlantFunction {
 
   // The exact Jacobian [A B; C D] at (x, u) by analytic derivatives of the
   // recursive algorithms (dynamics/derivatives.hpp), into J (resized only when
-  // its size differs). Applies to tree models at x with zero position
-  // deviation (the operating point itself); returns false otherwise (callers
-  // then differentiate eval<ADScalar>). No heap allocation after the first call.
+  // its size differs). Applies at x with zero position deviation (the
+  // operating point itself), on trees and closed loops; returns false
+  // otherwise (callers then differentiate eval<ADScalar>). No heap allocation
+  // after the first call. For closed loops, with G = d(v)/d(w) (the
+  // independent velocities' map, from Jc v = 0) and H = d(v)/d(z) (from the
+  // derivative of Jc v along the loops), the chain rule through q(z), v(z, w)
+  // gives A and C from the constrained accelerations' and sensors' derivatives.
   bool analytic_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::MatrixXd& J) const;
 
   // The finite-difference Jacobian [A B; C D] at (x, u) on tree models, into J
@@ -109,10 +115,14 @@ class PlantFunction {
   void eval_tree(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd& xdot, Eigen::VectorXd& y,
                  Reuse reuse = Reuse::Nothing) const;
 
+  bool closed_loop_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::MatrixXd& J) const;
+
   struct Workspace {
     std::unique_ptr<TreeDerivatives> td;
     std::unique_ptr<Data> data;
     Eigen::VectorXd v, u_all, dq, q, w, rate;
+    Eigen::MatrixXd Ja, Jd, Jz, G, H, P, DQ;  // closed loops: active rows, their columns, v maps, products
+    Eigen::PartialPivLU<Eigen::MatrixXd> lu;  // of Jd
     Eigen::VectorXd fd_x, fd_u, fd_xd, fd_y, fd_p, fd_m, fd_0;  // fd_jacobian
     Workspace();
     Workspace(const Workspace&);

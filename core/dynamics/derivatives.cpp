@@ -89,12 +89,66 @@ void wrench_value(const Vec3A& x, const Vec3A& F, const Vec3A& T, Vec6& w, Eigen
   }
 }
 
+// Forward differentiation over the motion of two bodies, for the loop closures:
+// [0, 6) pose twist, [6, 12) velocity change, [12, 18) acceleration change of
+// body a; [18, 36) the same for body b.
+using Der36 = Eigen::Matrix<double, 36, 1>;
+using AD36 = Eigen::AutoDiffScalar<Der36>;
+using Vec3B = Eigen::Matrix<AD36, 3, 1>;
+using Mat3B = Eigen::Matrix<AD36, 3, 3>;
+
+struct MotionAD {
+  Mat3B R;
+  Vec3B p, w, vO, al, aO;  // pose; world angular velocity and origin velocity; their accelerations
+};
+
+// A: the body's true spatial acceleration (gravity not included)
+MotionAD motion_ad(const SE3& g, const Vec6& V, const Vec6& A, int offset, bool active) {
+  MotionAD b;
+  Vec3B dw, dv;
+  for (int k = 0; k < 3; ++k) {
+    dw[k] = AD36(0.0);
+    dv[k] = AD36(0.0);
+    b.w[k] = AD36(V[k]);
+    b.vO[k] = AD36(V[3 + k]);
+    b.al[k] = AD36(A[k]);
+    b.aO[k] = AD36(A[3 + k]);
+    if (active) {
+      dw[k].derivatives()[offset + k] = 1.0;
+      dv[k].derivatives()[offset + 3 + k] = 1.0;
+      b.w[k].derivatives()[offset + 6 + k] = 1.0;
+      b.vO[k].derivatives()[offset + 9 + k] = 1.0;
+      b.al[k].derivatives()[offset + 12 + k] = 1.0;
+      b.aO[k].derivatives()[offset + 15 + k] = 1.0;
+    }
+  }
+  const Mat3B R0 = g.R.cast<AD36>();
+  const Vec3B p0 = g.p.cast<AD36>();
+  b.R = R0 + skew<AD36>(dw) * R0;
+  b.p = p0 + dw.cross(p0) + dv;
+  return b;
+}
+
+// a body point (or a body-fixed vector, with `vector`) and its first two time derivatives
+struct Moving {
+  Vec3B x, xd, xdd;
+};
+Moving moving(const MotionAD& b, const Vec3& local, bool vector) {
+  Moving m;
+  m.x = b.R * local.cast<AD36>();
+  if (!vector) m.x += b.p;
+  m.xd = b.w.cross(m.x);
+  if (!vector) m.xd += b.vO;
+  m.xdd = b.al.cross(m.x) + b.w.cross(m.xd);
+  if (!vector) m.xdd += b.aO;
+  return m;
+}
+
 }  // namespace
 
 bool TreeDerivatives::supports(const Model& model) { return model.nc == 0; }
 
 TreeDerivatives::TreeDerivatives(const Model& model) : m_(model), d_(model), llt_(model.nv) {
-  if (model.nc != 0) throw std::invalid_argument("TreeDerivatives: the model has loop closures");
   const int nb = model.nbodies, nv = model.nv;
   unit_begin_.assign(nb, 0);
   unit_end_.assign(nb, 0);
@@ -152,6 +206,11 @@ TreeDerivatives::TreeDerivatives(const Model& model) : m_(model), d_(model), llt
   M.setZero(nv, nv);
   rhs_.setZero(nv, 2 * nv + model.nu());
   scratch_.setZero(nv);
+  Jc.setZero(model.nc, nv);
+  dc_dq.setZero(model.nc, nv);
+  dc_dv.setZero(model.nc, nv);
+  dphid_dq.setZero(model.nc, nv);
+  c.setZero(model.nc);
 }
 
 // positions and velocities: world motion subspaces, inertias and unit velocities
@@ -544,6 +603,156 @@ void TreeDerivatives::compute(const Eigen::VectorXd& q, const Eigen::VectorXd& v
     auto panel = rhs_.middleCols(c0, std::min<Eigen::Index>(48, rhs_.cols() - c0));
     llt_.solveInPlace(panel);
   }
+  dqdd_dq = rhs_.leftCols(nv);
+  dqdd_dv = rhs_.middleCols(nv, nv);
+  dqdd_du = rhs_.rightCols(nu);
+  sensor_derivatives(q, v, outputs);
+}
+
+void TreeDerivatives::chain_constraint_row(int row, const Der36& gc, const Der36& gp, int body_a, int body_b) {
+  for (int slot = 0; slot < 2; ++slot) {
+    const int beta = slot == 0 ? body_a : body_b;
+    if (beta <= 0) continue;
+    const auto Cpose = gc.segment<6>(18 * slot), CV = gc.segment<6>(18 * slot + 6), CA = gc.segment<6>(18 * slot + 12);
+    const auto Ppose = gp.segment<6>(18 * slot), PV = gp.segment<6>(18 * slot + 6);
+    for (int pu : path_[beta]) {
+      const Unit& up = units_[pu];
+      const auto Sp = S_[up.body].middleCols(up.iv - m_.joints[up.body].idx_v, up.n);
+      const Vec6& Vp = Vpar_[pu];
+      const Vec6 rel = V_[beta] - Vp;
+      const Vec6 acc_rel = A_[beta] - Apar_[pu] - crm(Vp, rel);
+      const Vec6 vel_after = V_[beta] - Vu_[pu] - Vp;
+      for (int k = 0; k < up.n; ++k) {
+        const Vec6 s = Sp.col(k);
+        const Vec6 dV = crm(s, rel);                          // dV_beta / dq_s
+        const Vec6 dA = crm(Vp, dV) + crm(s, acc_rel);        // dA_beta / dq_s
+        const Vec6 dAv = crm(s, vel_after);                   // dA_beta / dv_s
+        const int col = up.iv + k;
+        dc_dq(row, col) += Cpose.dot(s) + CV.dot(dV) + CA.dot(dA);
+        dc_dv(row, col) += CV.dot(s) + CA.dot(dAv);
+        Jc(row, col) += CA.dot(s);
+        dphid_dq(row, col) += Ppose.dot(s) + PV.dot(dV);
+      }
+    }
+  }
+}
+
+// the loop closures: reactions -Jc^T lambda into Q and dQ_dq, and the rows' derivatives
+void TreeDerivatives::constraint_derivatives(const Eigen::VectorXd& lambda) {
+  Jc.setZero();
+  dc_dq.setZero();
+  dc_dv.setZero();
+  dphid_dq.setZero();
+  Vec6 A0 = Vec6::Zero();  // the true accelerations: A_ carries gravity as A_0 = -g
+  if (m_.has_gravity) A0.tail<3>() = -m_.gravity;
+  auto motion = [&](int body, int offset) {
+    return body > 0 ? motion_ad(d_.oMi[body], V_[body], Vec6(A_[body] - A0), offset, true)
+                    : motion_ad(d_.oMi[0], Vec6::Zero(), Vec6::Zero(), offset, false);
+  };
+  auto row_out = [&](int r, const AD36& phid, const AD36& cc, int ba, int bb) {
+    c[r] = cc.value();
+    chain_constraint_row(r, cc.derivatives(), phid.derivatives(), ba, bb);
+  };
+  Vec6 w;
+  Eigen::Matrix<double, 6, 24> dw;
+  const Vec3A zero3 = Vec3A::Constant(AD(0.0));
+  for (const ConstraintModel& cm : m_.constraints) {
+    const int ba = cm.body_a, bb = cm.body_b;
+    const MotionAD A = motion(ba, 0), B = motion(bb, 18);
+    const Moving pa = moving(A, cm.point_a, false), pb = moving(B, cm.point_b, false);
+    const Vec3B dp = pa.x - pb.x, dpd = pa.xd - pb.xd, dpdd = pa.xdd - pb.xdd;
+    // the reactions as world wrenches of the poses (body_ad: [pose a, vel a, pose b, vel b])
+    const BodyAD ga = body_ad(d_.oMi[ba], V_[ba], 0, ba > 0), gb = body_ad(d_.oMi[bb], V_[bb], 12, bb > 0);
+    const Vec3A xa = ga.point(cm.point_a), xb = gb.point(cm.point_b);
+    int r = cm.row;
+    switch (cm.type) {
+      case ConstraintType::Ball:
+      case ConstraintType::Revolute: {
+        for (int k = 0; k < 3; ++k) row_out(r + k, dpd[k], dpdd[k], ba, bb);
+        const Vec3A lam = (-lambda.segment<3>(r)).cast<AD>();
+        wrench_value(xa, lam, zero3, w, dw);
+        add_body_wrench(ba, w, dw, ba, bb);
+        wrench_value(xb, Vec3A(-lam), zero3, w, dw);
+        add_body_wrench(bb, w, dw, ba, bb);
+        if (cm.type == ConstraintType::Ball) break;
+        r += 3;
+        for (const Eigen::Vector3d* perp : {&cm.perp_b1, &cm.perp_b2}) {
+          const Moving ax = moving(A, cm.axis_a, true), bx = moving(B, *perp, true);
+          const AD36 phid = ax.xd.dot(bx.x) + ax.x.dot(bx.xd);
+          const AD36 cc = ax.xdd.dot(bx.x) + AD36(2.0) * ax.xd.dot(bx.xd) + ax.x.dot(bx.xdd);
+          row_out(r, phid, cc, ba, bb);
+          // a couple lambda (a x b) on body_a, its opposite on body_b
+          const Vec3A T = (ga.R * cm.axis_a.cast<AD>()).cross(gb.R * perp->cast<AD>()) * AD(-lambda[r]);
+          wrench_value(xa, zero3, T, w, dw);
+          add_body_wrench(ba, w, dw, ba, bb);
+          wrench_value(xb, zero3, Vec3A(-T), w, dw);
+          add_body_wrench(bb, w, dw, ba, bb);
+          ++r;
+        }
+        break;
+      }
+      case ConstraintType::PlanarRevolute:
+        for (const Eigen::Vector3d* perp : {&cm.perp_a1, &cm.perp_a2}) {
+          const Moving e = moving(A, *perp, true);
+          const AD36 phid = e.xd.dot(dp) + e.x.dot(dpd);
+          const AD36 cc = e.xdd.dot(dp) + AD36(2.0) * e.xd.dot(dpd) + e.x.dot(dpdd);
+          row_out(r, phid, cc, ba, bb);
+          // phidot = w_a . (e x dp) + e . (velocity of x_a - velocity of x_b)
+          const Vec3A ew = ga.R * perp->cast<AD>();
+          const AD lr(-lambda[r]);
+          wrench_value(xa, Vec3A(ew * lr), Vec3A(ew.cross(Vec3A(xa - xb)) * lr), w, dw);
+          add_body_wrench(ba, w, dw, ba, bb);
+          wrench_value(xb, Vec3A(-ew * lr), zero3, w, dw);
+          add_body_wrench(bb, w, dw, ba, bb);
+          ++r;
+        }
+        break;
+    }
+  }
+}
+
+void TreeDerivatives::compute_constrained(const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+                                          const Eigen::VectorXd& u_all, const Eigen::VectorXd& a,
+                                          const Eigen::VectorXd& lambda, const std::vector<int>& rows,
+                                          const std::vector<int>& outputs) {
+  const int nv = m_.nv, nu = m_.nu(), na = static_cast<int>(rows.size());
+  world_kinematics(q, v);
+  accelerations(v, a);
+  composites();
+  forces();
+  differentiate_rnea();
+  applied_force_derivatives(q, v, u_all);
+  constraint_derivatives(lambda);
+  mass_matrix();
+  llt_.compute(M);
+  if (llt_.info() != Eigen::Success)
+    throw std::runtime_error("the mass matrix is not positive definite at this configuration");
+  qdd = a;
+  // M da + Jr^T dlambda = dQ - dtau,  Jr da = -dc
+  rhs_.leftCols(nv) = dQ_dq - dtau_dq;
+  rhs_.middleCols(nv, nv) = dQ_dv - dtau_dv;
+  rhs_.rightCols(nu) = dQ_du;
+  for (Eigen::Index c0 = 0; c0 < rhs_.cols(); c0 += 48) {
+    auto panel = rhs_.middleCols(c0, std::min<Eigen::Index>(48, rhs_.cols() - c0));
+    llt_.solveInPlace(panel);
+  }
+  if (Jr_.rows() != na || Jr_.cols() != nv) Jr_.resize(na, nv);
+  for (int k = 0; k < na; ++k) Jr_.row(k) = Jc.row(rows[k]);
+  Y_ = Jr_.transpose();
+  llt_.solveInPlace(Y_);
+  if (Sc_.rows() != na) Sc_.resize(na, na);
+  Sc_.noalias() = Jr_ * Y_;
+  llt_schur_.compute(Sc_);
+  if (llt_schur_.info() != Eigen::Success)
+    throw std::runtime_error("the loop closures' Schur complement is singular at this configuration");
+  if (T_.rows() != na || T_.cols() != rhs_.cols()) T_.resize(na, rhs_.cols());
+  T_.noalias() = Jr_ * rhs_;
+  for (int k = 0; k < na; ++k) {
+    T_.row(k).head(nv) += dc_dq.row(rows[k]);
+    T_.row(k).segment(nv, nv) += dc_dv.row(rows[k]);
+  }
+  llt_schur_.solveInPlace(T_);
+  rhs_.noalias() -= Y_ * T_;
   dqdd_dq = rhs_.leftCols(nv);
   dqdd_dv = rhs_.middleCols(nv, nv);
   dqdd_du = rhs_.rightCols(nu);

@@ -25,8 +25,25 @@
 // and velocities of at most two bodies (fixed-size forward differentiation of
 // a few lines, no heap), chained with the analytic Jacobians above.
 //
-// Used by linearize() for tree models at the reference configuration; checked
-// against automatic differentiation of the same dynamics in the tests.
+// Closed loops (compute_constrained): the same tree derivatives at the
+// constrained accelerations a, plus the loop closures. The reactions -Jc^T lambda
+// are body wrenches (a force at each ball point, a couple for each orientation
+// row) differentiated like the applied ones. The closure rows
+// c = Jc a + gamma = d2 phi/dt2 and phidot = Jc v are functions of the poses,
+// velocities and accelerations of two bodies (differentiated by fixed-size
+// forward differentiation over those 36 local variables), chained with the
+// world-frame derivatives of the bodies' motion: perturbing column s (unit k,
+// parent frame motion V_p, A_p) of an ancestor of body i at fixed joint
+// velocities and accelerations gives
+//   dV_i/dq_s = s x (V_i - V_p)
+//   dA_i/dq_s = V_p x (s x (V_i - V_p)) + s x (A_i - A_p - V_p x (V_i - V_p))
+//   dA_i/dv_s = s x (V_i - V_k - V_p)          (V_k: velocity after unit k)
+// Differentiating M a + Jc^T lambda = Q - nle and Jc_r a + gamma_r = 0 (the
+// rows r independent at q) gives the derivatives of a by one solve with the
+// same Schur complement as the forward dynamics.
+//
+// Used by linearize() at the reference configuration (trees and closed loops);
+// checked against automatic differentiation of the same dynamics in the tests.
 #pragma once
 
 #include <Eigen/Cholesky>
@@ -40,12 +57,24 @@ namespace codyna {
 
 class TreeDerivatives {
  public:
-  // model must outlive this object; model.nc must be 0
+  // model must outlive this object; with loop closures (model.nc > 0) only
+  // compute_constrained() and rnea_derivatives() apply
   explicit TreeDerivatives(const Model& model);
 
   // true when compute() can differentiate this model with these plant outputs
   // (a tree; every sensor type is supported)
   static bool supports(const Model& model);
+
+  // Closed loops: everything at (q, v, u_all) for joint accelerations a and
+  // multipliers lambda [nc] that satisfy M a + nle = Q - Jc^T lambda and
+  // Jc a + gamma = 0 on `rows` (independent constraint rows at q, as
+  // forward_dynamics chose them; lambda is zero on the others). Fills
+  // dqdd_dq, dqdd_dv, dqdd_du (the constrained accelerations' derivatives),
+  // Jc, dc_dq, dc_dv, dphid_dq, tau/dtau (at a), Q/dQ (including -Jc^T lambda)
+  // and the sensors. No heap after the first call with the same sizes.
+  void compute_constrained(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& u_all,
+                           const Eigen::VectorXd& a, const Eigen::VectorXd& lambda, const std::vector<int>& rows,
+                           const std::vector<int>& outputs);
 
   // Everything at (q, v, u_all) (u_all: one value per actuator). `outputs` are
   // sensor indices whose values and derivatives are wanted. After the first
@@ -69,6 +98,11 @@ class TreeDerivatives {
   Eigen::VectorXd Q;                        // applied generalized forces
   Eigen::MatrixXd dQ_dq, dQ_dv, dQ_du;      // [nv x nv], [nv x nv], [nv x nu_all]
   Eigen::MatrixXd M;                        // mass matrix at q
+  // results of compute_constrained(), one row per constraint row [nc x nv]
+  Eigen::MatrixXd Jc;                       // d phi / dq (tangent), as constraint_terms gives it
+  Eigen::MatrixXd dc_dq, dc_dv;             // derivatives of c = Jc a + gamma at the given a
+  Eigen::MatrixXd dphid_dq;                 // derivatives of phidot = Jc v
+  Eigen::VectorXd c;                        // c itself (zero on the kept rows, up to round-off)
 
  private:
   struct Unit {
@@ -86,6 +120,10 @@ class TreeDerivatives {
   void add_body_wrench(int body, const Vec6T<double>& w, const Eigen::Matrix<double, 6, 24>& dw, int body_a,
                        int body_b);
   void sensor_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const std::vector<int>& outputs);
+  void constraint_derivatives(const Eigen::VectorXd& lambda);
+  // one constraint row's local derivatives (36 = [pose, V, A] of body_a then body_b), chained
+  void chain_constraint_row(int row, const Eigen::Matrix<double, 36, 1>& gc, const Eigen::Matrix<double, 36, 1>& gp,
+                            int body_a, int body_b);
 
   const Model& m_;
   Data d_;
@@ -106,6 +144,9 @@ class TreeDerivatives {
   Eigen::VectorXd qdd_zero_, scratch_;
   Eigen::MatrixXd rhs_;
   Eigen::LLT<Eigen::MatrixXd> llt_;
+  // closed loops: kept rows of Jc, M^-1 Jr^T, the Schur complement and its right-hand sides
+  Eigen::MatrixXd Jr_, Y_, Sc_, T_;
+  Eigen::LLT<Eigen::MatrixXd> llt_schur_;
 };
 
 }  // namespace codyna
