@@ -268,10 +268,9 @@ bool PlantFunction::fd_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd&
 template <class S>
 void PlantFunction::eval(const VecXT<S>& x, const VecXT<S>& u, VecXT<S>& xdot, VecXT<S>& y) const {
   if constexpr (std::is_same_v<S, double>) {
-    if (part_.dependent.empty() && model_.nc == 0) {
-      eval_tree(x, u, xdot, y);
-      return;
-    }
+    if (part_.dependent.empty() && model_.nc == 0) eval_tree(x, u, xdot, y);
+    else eval_closed(x, u, xdot, y);
+    return;
   }
   const Model& m = model_;
   const int n = nz(), nd = static_cast<int>(part_.dependent.size());
@@ -372,6 +371,84 @@ bool PlantFunction::analytic_jacobian(const Eigen::VectorXd& x, const Eigen::Vec
   return true;
 }
 
+void PlantFunction::loop_workspace() const {
+  Workspace& W = ws_;
+  if (W.data && W.G.rows() == model_.nv) return;
+  const int n = nz(), nv = model_.nv, nd = static_cast<int>(part_.dependent.size());
+  if (!W.data) W.data = std::make_unique<Data>(model_);
+  W.v.resize(nv);
+  W.u_all.resize(model_.nu());
+  W.dq.setZero(nv);
+  W.q.resize(model_.nq);
+  W.rate.resize(nv);
+  W.zero.setZero(nv);
+  W.phi.resize(nd);
+  W.step.resize(nd);
+  W.vd.resize(nd);
+  W.Ja.resize(nd, nv);
+  W.Jd.resize(nd, nd);
+  W.Jz.resize(nd, n);
+  W.G.resize(nv, n);
+  W.H.resize(nv, n);
+  W.P.resize(nd, n);
+  W.DQ.resize(nv, n);
+}
+
+void PlantFunction::eval_closed(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd& xdot,
+                                Eigen::VectorXd& y) const {
+  const Model& m = model_;
+  const int n = nz(), nd = static_cast<int>(part_.dependent.size());
+  const auto& ind = part_.independent;
+  const auto& dep = part_.dependent;
+  loop_workspace();
+  Workspace& W = ws_;
+  Data& d = *W.data;
+  W.dq.setZero();
+  for (int k = 0; k < n; ++k) W.dq[ind[k]] = x[k];
+  // dependent positions: Newton on the plant's rows, from the reference
+  auto jd = [&]() {
+    for (int c = 0; c < nd; ++c)
+      for (int k = 0; k < nd; ++k) W.Jd(k, c) = d.Jc(rows_[k], dep[c]);
+    W.lu.compute(W.Jd);
+  };
+  for (int it = 0; it < 50 && nd > 0; ++it) {
+    integrate_into<double>(m, q_ref_, W.dq, W.q);
+    constraint_terms<double>(m, d, W.q, W.zero);
+    for (int k = 0; k < nd; ++k) W.phi[k] = d.phi[rows_[k]];
+    if (W.phi.lpNorm<Eigen::Infinity>() < 1e-14) break;
+    jd();
+    W.step.noalias() = W.lu.solve(W.phi);
+    for (int k = 0; k < nd; ++k) W.dq[dep[k]] -= W.step[k];
+  }
+  integrate_into<double>(m, q_ref_, W.dq, W.q);
+  W.v.setZero();
+  for (int k = 0; k < n; ++k) W.v[ind[k]] = x[n + k];
+  if (nd > 0) {
+    // dependent velocities from Jc v = 0 on the plant's rows
+    constraint_terms<double>(m, d, W.q, W.zero);
+    jd();
+    for (int k = 0; k < nd; ++k) {
+      double s = 0.0;
+      for (int c = 0; c < n; ++c) s += d.Jc(rows_[k], ind[c]) * x[n + c];
+      W.phi[k] = -s;
+    }
+    W.vd.noalias() = W.lu.solve(W.phi);
+    for (int k = 0; k < nd; ++k) W.v[dep[k]] = W.vd[k];
+  }
+  W.u_all = u_all_;
+  for (int k = 0; k < nu(); ++k) W.u_all[m.plant_inputs[k]] = u[k];
+  const Eigen::VectorXd& qdd = forward_dynamics<double>(m, d, W.q, W.v, W.u_all);
+  tangent_rate_into<double>(m, W.dq, W.v, W.rate);
+  if (xdot.size() != 2 * n) xdot.resize(2 * n);
+  for (int k = 0; k < n; ++k) {
+    xdot[k] = W.rate[ind[k]];
+    xdot[n + k] = qdd[ind[k]];
+  }
+  // forward_dynamics left the kinematics of (q, v) in d
+  if (y.size() != ny()) y.resize(ny());
+  for (int k = 0; k < ny(); ++k) y[k] = sensor_value<double>(m, d, m.sensors[m.plant_outputs[k]], W.q, W.v);
+}
+
 bool PlantFunction::closed_loop_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& u,
                                          Eigen::MatrixXd& J) const {
   const Model& m = model_;
@@ -381,20 +458,8 @@ bool PlantFunction::closed_loop_jacobian(const Eigen::VectorXd& x, const Eigen::
   const auto& ind = part_.independent;
   const auto& dep = part_.dependent;
   Workspace& W = ws_;
-  if (!W.td) {
-    W.td = std::make_unique<TreeDerivatives>(m);
-    W.data = std::make_unique<Data>(m);
-    W.v.resize(nv);
-    W.u_all.resize(m.nu());
-    W.dq.setZero(nv);
-    W.Ja.resize(nd, nv);
-    W.Jd.resize(nd, nd);
-    W.Jz.resize(nd, n);
-    W.G.resize(nv, n);
-    W.H.resize(nv, n);
-    W.P.resize(nd, n);
-    W.DQ.resize(nv, n);
-  }
+  loop_workspace();
+  if (!W.td) W.td = std::make_unique<TreeDerivatives>(m);
   Data& d = *W.data;
   TreeDerivatives& td = *W.td;
   // the velocity map G at q_ref: v_ind = w, Jd v_dep = -Jz w
@@ -416,8 +481,8 @@ bool PlantFunction::closed_loop_jacobian(const Eigen::VectorXd& x, const Eigen::
   td.compute_constrained(q_ref_, W.v, W.u_all, d.qdd, d.lambda, d.loop.rows, m.plant_outputs);
   // H = dv/dz: Jd dv_dep/dz = -(d(Jc v)/dq) G on the plant's rows
   for (int k = 0; k < nd; ++k) W.Ja.row(k) = td.dphid_dq.row(rows_[k]);
-  W.P.noalias() = W.Ja * W.G;
-  W.P = W.lu.solve(W.P);
+  W.Jz.noalias() = W.Ja * W.G;
+  W.P.noalias() = W.lu.solve(W.Jz);
   W.H.setZero();
   for (int k = 0; k < nd; ++k) W.H.row(dep[k]) = -W.P.row(k);
   if (J.rows() != 2 * n + ny_p || J.cols() != 2 * n + nu_p) J.resize(2 * n + ny_p, 2 * n + nu_p);

@@ -116,12 +116,18 @@ class PlantFunction {
                  Reuse reuse = Reuse::Nothing) const;
 
   bool closed_loop_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::MatrixXd& J) const;
+  // eval<double> on a closed loop, into the workspace (no heap after the first call):
+  // Newton on the plant's rows for the dependent positions, Jc v = 0 for the velocities
+  void eval_closed(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd& xdot,
+                   Eigen::VectorXd& y) const;
+  void loop_workspace() const;  // sizes the closed-loop part of the workspace once
 
   struct Workspace {
     std::unique_ptr<TreeDerivatives> td;
     std::unique_ptr<Data> data;
     Eigen::VectorXd v, u_all, dq, q, w, rate;
     Eigen::MatrixXd Ja, Jd, Jz, G, H, P, DQ;  // closed loops: active rows, their columns, v maps, products
+    Eigen::VectorXd zero, phi, step, vd;      // closed loops: [nv], [nd] x 3
     Eigen::PartialPivLU<Eigen::MatrixXd> lu;  // of Jd
     Eigen::VectorXd fd_x, fd_u, fd_xd, fd_y, fd_p, fd_m, fd_0;  // fd_jacobian
     Workspace();

@@ -129,8 +129,9 @@ TEST(NoAllocation, ForwardDynamicsAndPlantOnEveryTreeExample) {
 }
 
 // closed loops: CRBA, the constraint terms and the Schur complement on the
-// independent rows, in Data's loop workspace (at the assembled initial state)
-TEST(NoAllocation, ForwardDynamicsOnEveryClosedLoopExample) {
+// independent rows, in Data's loop workspace (at the assembled initial state);
+// the plant evaluation in the PlantFunction's workspace
+TEST(NoAllocation, ForwardDynamicsAndPlantOnEveryClosedLoopExample) {
   int loops = 0;
   for (const auto& entry : std::filesystem::directory_iterator(CODYNA_EXAMPLES_DIR)) {
     if (entry.path().extension() != ".json") continue;
@@ -150,6 +151,8 @@ TEST(NoAllocation, ForwardDynamicsOnEveryClosedLoopExample) {
       n = c.n();
     }
     EXPECT_EQ(n, 0) << name << ": forward_dynamics";
+    // one plant evaluation: Newton for the dependent positions, Jc v = 0, the dynamics, the sensors
+    EXPECT_EQ(plant_eval_allocations(m), 0) << name << ": PlantFunction::eval<double>";
   }
   EXPECT_GE(loops, 3);
 }
