@@ -142,7 +142,7 @@ class TreeDerivatives {
   std::vector<Mat6T<double>> P_, R_;             // [units] rows S^T Ic and S^T (Bc + H(hc)), padded to 6
   std::vector<char> below_;                      // [nbodies] scratch: in the subtree of a body
   Eigen::VectorXd qdd_zero_, scratch_;
-  Eigen::MatrixXd rhs_;
+  Eigen::MatrixXd rhs_, Minv_;
   Eigen::LLT<Eigen::MatrixXd> llt_;
   // closed loops: kept rows of Jc, M^-1 Jr^T, the Schur complement and its right-hand sides
   Eigen::MatrixXd Jr_, Y_, Sc_, T_;
