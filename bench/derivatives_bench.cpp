@@ -5,8 +5,10 @@
 // the velocity and input columns, and with a full evaluation per column as
 // before: the same numbers); plus one forward-dynamics evaluation for scale.
 // Models: 3-D hinge chains of n links (varied axes, full inertias, a motor per
-// joint, gravity) and a 28-DOF tree of ball joints. MuJoCo side by side: see
-// bench/mujoco_speed_bench.cpp.
+// joint, gravity) and a 28-DOF tree of ball joints; and the closed-loop
+// examples (loop/<example>: analytic, autodiff, central differences with a
+// full evaluation per column, one plant evaluation), at their initial state.
+// MuJoCo side by side: see bench/mujoco_speed_bench.cpp.
 //   build/bin/codyna_bench_derivatives
 #include <benchmark/benchmark.h>
 
@@ -16,6 +18,7 @@
 #include "analysis/linearize.hpp"
 #include "analysis/operating_point.hpp"
 #include "dynamics/forward_dynamics.hpp"
+#include "io/model_file.hpp"
 #include "model/compile.hpp"
 
 namespace {
@@ -152,6 +155,61 @@ BENCHMARK(CentralDifferencesFull) SIZES;
 BENCHMARK(ForwardDifferences) SIZES;
 BENCHMARK(ForwardDifferencesFull) SIZES;
 BENCHMARK(ForwardDynamics) SIZES;
+
+// closed loops: the examples, at their initial state, with a moving independent velocity
+struct LoopFixture {
+  Model m;
+  OperatingPoint op;
+  PlantFunction f;
+  Eigen::VectorXd x, u;
+  explicit LoopFixture(const std::string& name)
+      : m(load(name)), op(initial_point(m)), f(m, op.q, op.u, partition_coordinates(m, op.q)) {
+    x = Eigen::VectorXd::Zero(f.nx());
+    for (int k = 0; k < f.nz(); ++k) x[f.nz() + k] = 0.5;
+    u = Eigen::VectorXd::Constant(f.nu(), 0.3);
+  }
+  static Model load(const std::string& name) {
+    const std::string path = std::string(CODYNA_SOURCE_DIR) + "/examples/" + name + ".json";
+    return compile(load_model_spec(path), path);
+  }
+};
+
+const char* const kLoops[] = {"four_bar", "andrews_squeezer", "bricard", "iftomm_a02_four_bars"};
+
+int register_loops() {
+  for (const char* name : kLoops) {
+    const std::string n = name;
+    benchmark::RegisterBenchmark(("LoopExactAnalytic/" + n).c_str(), [n](benchmark::State& st) {
+      LoopFixture fx(n);
+      Eigen::MatrixXd J;
+      for (auto _ : st) {
+        fx.f.analytic_jacobian(fx.x, fx.u, J);
+        benchmark::DoNotOptimize(J.data());
+      }
+      st.counters["nv"] = fx.m.nv;
+      st.counters["dof"] = fx.f.nz();
+    })->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("LoopExactAutodiff/" + n).c_str(), [n](benchmark::State& st) {
+      LoopFixture fx(n);
+      for (auto _ : st) benchmark::DoNotOptimize(plant_jacobian_autodiff(fx.f, fx.x, fx.u).data());
+    })->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("LoopCentralDifferences/" + n).c_str(), [n](benchmark::State& st) {
+      LoopFixture fx(n);
+      for (auto _ : st)
+        benchmark::DoNotOptimize(plant_jacobian(fx.f, fx.x, fx.u, JacobianMethod::CentralDifference).data());
+    })->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("LoopPlantEval/" + n).c_str(), [n](benchmark::State& st) {
+      LoopFixture fx(n);
+      Eigen::VectorXd xd, y;
+      for (auto _ : st) {
+        fx.f.eval<double>(fx.x, fx.u, xd, y);
+        benchmark::DoNotOptimize(xd.data());
+      }
+    })->Unit(benchmark::kMicrosecond);
+  }
+  return 0;
+}
+const int registered = register_loops();
 
 }  // namespace
 

@@ -89,59 +89,51 @@ void wrench_value(const Vec3A& x, const Vec3A& F, const Vec3A& T, Vec6& w, Eigen
   }
 }
 
-// Forward differentiation over the motion of two bodies, for the loop closures:
-// [0, 6) pose twist, [6, 12) velocity change, [12, 18) acceleration change of
-// body a; [18, 36) the same for body b.
-using Der36 = Eigen::Matrix<double, 36, 1>;
-using AD36 = Eigen::AutoDiffScalar<Der36>;
-using Vec3B = Eigen::Matrix<AD36, 3, 1>;
-using Mat3B = Eigen::Matrix<AD36, 3, 3>;
-
-struct MotionAD {
-  Mat3B R;
-  Vec3B p, w, vO, al, aO;  // pose; world angular velocity and origin velocity; their accelerations
+// A body point (or a body-fixed vector) in world axes with its first two time
+// derivatives, and their derivatives with respect to the body's 18 local
+// variables [pose twist, velocity V, acceleration A] (world axes, about the
+// origin; the pose twist moves x by dtheta x x + dp). With P = dx/dpose,
+// W = [w]x and Al = [alpha]x:
+//   dx   = [P, 0, 0]
+//   dxd  = [W P, P, 0]
+//   dxdd = [(Al + W W) P, [-[xd]x, 0] + W P, P]
+struct LocalKin {
+  Vec3 x, xd, xdd;
+  Eigen::Matrix<double, 3, 18> Dx, Dxd, Dxdd;
 };
-
-// A: the body's true spatial acceleration (gravity not included)
-MotionAD motion_ad(const SE3& g, const Vec6& V, const Vec6& A, int offset, bool active) {
-  MotionAD b;
-  Vec3B dw, dv;
-  for (int k = 0; k < 3; ++k) {
-    dw[k] = AD36(0.0);
-    dv[k] = AD36(0.0);
-    b.w[k] = AD36(V[k]);
-    b.vO[k] = AD36(V[3 + k]);
-    b.al[k] = AD36(A[k]);
-    b.aO[k] = AD36(A[3 + k]);
-    if (active) {
-      dw[k].derivatives()[offset + k] = 1.0;
-      dv[k].derivatives()[offset + 3 + k] = 1.0;
-      b.w[k].derivatives()[offset + 6 + k] = 1.0;
-      b.vO[k].derivatives()[offset + 9 + k] = 1.0;
-      b.al[k].derivatives()[offset + 12 + k] = 1.0;
-      b.aO[k].derivatives()[offset + 15 + k] = 1.0;
-    }
-  }
-  const Mat3B R0 = g.R.cast<AD36>();
-  const Vec3B p0 = g.p.cast<AD36>();
-  b.R = R0 + skew<AD36>(dw) * R0;
-  b.p = p0 + dw.cross(p0) + dv;
-  return b;
+LocalKin local_kin(const SE3& g, const Vec6& V, const Vec6& A, const Vec3& l, bool vector, bool active) {
+  LocalKin k;
+  const Vec3 w = V.head<3>(), al = A.head<3>();
+  k.x = g.R * l;
+  if (!vector) k.x += g.p;
+  k.xd = w.cross(k.x);
+  if (!vector) k.xd += V.tail<3>();
+  k.xdd = al.cross(k.x) + w.cross(k.xd);
+  if (!vector) k.xdd += A.tail<3>();
+  k.Dx.setZero();
+  k.Dxd.setZero();
+  k.Dxdd.setZero();
+  if (!active) return k;
+  Eigen::Matrix<double, 3, 6> P;
+  P.leftCols<3>() = -skew<double>(k.x);
+  if (vector) P.rightCols<3>().setZero();
+  else P.rightCols<3>().setIdentity();
+  const Mat3 W = skew<double>(w);
+  const Eigen::Matrix<double, 3, 6> WP = W * P;
+  k.Dx.leftCols<6>() = P;
+  k.Dxd.leftCols<6>() = WP;
+  k.Dxd.middleCols<6>(6) = P;
+  k.Dxdd.leftCols<6>().noalias() = skew<double>(al) * P + W * WP;
+  k.Dxdd.middleCols<6>(6) = WP;
+  k.Dxdd.middleCols<3>(6) -= skew<double>(k.xd);
+  k.Dxdd.middleCols<6>(12) = P;
+  return k;
 }
 
-// a body point (or a body-fixed vector, with `vector`) and its first two time derivatives
-struct Moving {
-  Vec3B x, xd, xdd;
-};
-Moving moving(const MotionAD& b, const Vec3& local, bool vector) {
-  Moving m;
-  m.x = b.R * local.cast<AD36>();
-  if (!vector) m.x += b.p;
-  m.xd = b.w.cross(m.x);
-  if (!vector) m.xd += b.vO;
-  m.xdd = b.al.cross(m.x) + b.w.cross(m.xd);
-  if (!vector) m.xdd += b.aO;
-  return m;
+using Grad36 = Eigen::Matrix<double, 36, 1>;
+// g += D^T f on the 18 variables of `slot`
+void add_grad(Grad36& g, int slot, const Vec3& f, const Eigen::Matrix<double, 3, 18>& D) {
+  g.segment<18>(18 * slot).noalias() += D.transpose() * f;
 }
 
 }  // namespace
@@ -633,7 +625,7 @@ void TreeDerivatives::compute(const Eigen::VectorXd& q, const Eigen::VectorXd& v
   sensor_derivatives(q, v, outputs);
 }
 
-void TreeDerivatives::chain_constraint_row(int row, const Der36& gc, const Der36& gp, int body_a, int body_b) {
+void TreeDerivatives::chain_constraint_row(int row, const Grad36& gc, const Grad36& gp, int body_a, int body_b) {
   for (int slot = 0; slot < 2; ++slot) {
     const int beta = slot == 0 ? body_a : body_b;
     if (beta <= 0) continue;
@@ -669,68 +661,125 @@ void TreeDerivatives::constraint_derivatives(const Eigen::VectorXd& lambda) {
   dphid_dq.setZero();
   Vec6 A0 = Vec6::Zero();  // the true accelerations: A_ carries gravity as A_0 = -g
   if (m_.has_gravity) A0.tail<3>() = -m_.gravity;
-  auto motion = [&](int body, int offset) {
-    return body > 0 ? motion_ad(d_.oMi[body], V_[body], Vec6(A_[body] - A0), offset, true)
-                    : motion_ad(d_.oMi[0], Vec6::Zero(), Vec6::Zero(), offset, false);
+  auto kin = [&](int body, const Vec3& l, bool vector) {
+    return body > 0 ? local_kin(d_.oMi[body], V_[body], Vec6(A_[body] - A0), l, vector, true)
+                    : local_kin(d_.oMi[0], Vec6::Zero(), Vec6::Zero(), l, vector, false);
   };
-  auto row_out = [&](int r, const AD36& phid, const AD36& cc, int ba, int bb) {
-    c[r] = cc.value();
-    chain_constraint_row(r, cc.derivatives(), phid.derivatives(), ba, bb);
+  Grad36 gc, gp;
+  auto row_out = [&](int r, double value, int ba, int bb) {
+    c[r] = value;
+    chain_constraint_row(r, gc, gp, ba, bb);
   };
+  // a reaction wrench w on `body` with dw/d(pose) of body_a (columns 0..5) and body_b (12..17)
   Vec6 w;
   Eigen::Matrix<double, 6, 24> dw;
-  const Vec3A zero3 = Vec3A::Constant(AD(0.0));
   for (const ConstraintModel& cm : m_.constraints) {
     const int ba = cm.body_a, bb = cm.body_b;
-    const MotionAD A = motion(ba, 0), B = motion(bb, 18);
-    const Moving pa = moving(A, cm.point_a, false), pb = moving(B, cm.point_b, false);
-    const Vec3B dp = pa.x - pb.x, dpd = pa.xd - pb.xd, dpdd = pa.xdd - pb.xdd;
-    // the reactions as world wrenches of the poses (body_ad: [pose a, vel a, pose b, vel b])
-    const BodyAD ga = body_ad(d_.oMi[ba], V_[ba], 0, ba > 0), gb = body_ad(d_.oMi[bb], V_[bb], 12, bb > 0);
-    const Vec3A xa = ga.point(cm.point_a), xb = gb.point(cm.point_b);
+    const LocalKin xa = kin(ba, cm.point_a, false), xb = kin(bb, cm.point_b, false);
     int r = cm.row;
     switch (cm.type) {
       case ConstraintType::Ball:
       case ConstraintType::Revolute: {
-        for (int k = 0; k < 3; ++k) row_out(r + k, dpd[k], dpdd[k], ba, bb);
-        const Vec3A lam = (-lambda.segment<3>(r)).cast<AD>();
-        wrench_value(xa, lam, zero3, w, dw);
+        for (int k = 0; k < 3; ++k) {
+          gc.setZero();
+          gp.setZero();
+          gc.segment<18>(0) = xa.Dxdd.row(k).transpose();
+          gc.segment<18>(18) = -xb.Dxdd.row(k).transpose();
+          gp.segment<18>(0) = xa.Dxd.row(k).transpose();
+          gp.segment<18>(18) = -xb.Dxd.row(k).transpose();
+          row_out(r + k, xa.xdd[k] - xb.xdd[k], ba, bb);
+        }
+        // a force f = -lambda at x_a, -f at x_b: w = [x x f; f], d(x x f) = -[f]x dx
+        const Vec3 f = -lambda.segment<3>(r);
+        const Mat3 fx = skew<double>(f);
+        dw.setZero();
+        w << xa.x.cross(f), f;
+        dw.block<3, 6>(0, 0).noalias() = -fx * xa.Dx.leftCols<6>();
         add_body_wrench(ba, w, dw, ba, bb);
-        wrench_value(xb, Vec3A(-lam), zero3, w, dw);
+        dw.setZero();
+        w << -xb.x.cross(f), -f;
+        dw.block<3, 6>(0, 12).noalias() = fx * xb.Dx.leftCols<6>();
         add_body_wrench(bb, w, dw, ba, bb);
         if (cm.type == ConstraintType::Ball) break;
         r += 3;
+        const LocalKin u = kin(ba, cm.axis_a, true);
         for (const Eigen::Vector3d* perp : {&cm.perp_b1, &cm.perp_b2}) {
-          const Moving ax = moving(A, cm.axis_a, true), bx = moving(B, *perp, true);
-          const AD36 phid = ax.xd.dot(bx.x) + ax.x.dot(bx.xd);
-          const AD36 cc = ax.xdd.dot(bx.x) + AD36(2.0) * ax.xd.dot(bx.xd) + ax.x.dot(bx.xdd);
-          row_out(r, phid, cc, ba, bb);
-          // a couple lambda (a x b) on body_a, its opposite on body_b
-          const Vec3A T = (ga.R * cm.axis_a.cast<AD>()).cross(gb.R * perp->cast<AD>()) * AD(-lambda[r]);
-          wrench_value(xa, zero3, T, w, dw);
+          const LocalKin b = kin(bb, *perp, true);
+          // phidot = ud . b + u . bd;  c = udd . b + 2 ud . bd + u . bdd
+          gp.setZero();
+          add_grad(gp, 0, b.x, u.Dxd);
+          add_grad(gp, 0, b.xd, u.Dx);
+          add_grad(gp, 1, u.xd, b.Dx);
+          add_grad(gp, 1, u.x, b.Dxd);
+          gc.setZero();
+          add_grad(gc, 0, b.x, u.Dxdd);
+          add_grad(gc, 0, 2.0 * b.xd, u.Dxd);
+          add_grad(gc, 0, b.xdd, u.Dx);
+          add_grad(gc, 1, u.xdd, b.Dx);
+          add_grad(gc, 1, 2.0 * u.xd, b.Dxd);
+          add_grad(gc, 1, u.x, b.Dxdd);
+          row_out(r, u.xdd.dot(b.x) + 2.0 * u.xd.dot(b.xd) + u.x.dot(b.xdd), ba, bb);
+          // a couple T = -lambda (u x b) on body_a, -T on body_b:
+          // dT = -lambda (-[b]x du + [u]x db)
+          const double l = -lambda[r];
+          const Vec3 T = l * u.x.cross(b.x);
+          const Eigen::Matrix<double, 3, 6> dTa = -l * skew<double>(b.x) * u.Dx.leftCols<6>();
+          const Eigen::Matrix<double, 3, 6> dTb = l * skew<double>(u.x) * b.Dx.leftCols<6>();
+          dw.setZero();
+          w << T, Vec3::Zero();
+          dw.block<3, 6>(0, 0) = dTa;
+          dw.block<3, 6>(0, 12) = dTb;
           add_body_wrench(ba, w, dw, ba, bb);
-          wrench_value(xb, zero3, Vec3A(-T), w, dw);
+          w << -T, Vec3::Zero();
+          dw.block<3, 6>(0, 0) = -dTa;
+          dw.block<3, 6>(0, 12) = -dTb;
           add_body_wrench(bb, w, dw, ba, bb);
           ++r;
         }
         break;
       }
-      case ConstraintType::PlanarRevolute:
+      case ConstraintType::PlanarRevolute: {
+        const Vec3 dp = xa.x - xb.x, dpd = xa.xd - xb.xd, dpdd = xa.xdd - xb.xdd;
         for (const Eigen::Vector3d* perp : {&cm.perp_a1, &cm.perp_a2}) {
-          const Moving e = moving(A, *perp, true);
-          const AD36 phid = e.xd.dot(dp) + e.x.dot(dpd);
-          const AD36 cc = e.xdd.dot(dp) + AD36(2.0) * e.xd.dot(dpd) + e.x.dot(dpdd);
-          row_out(r, phid, cc, ba, bb);
-          // phidot = w_a . (e x dp) + e . (velocity of x_a - velocity of x_b)
-          const Vec3A ew = ga.R * perp->cast<AD>();
-          const AD lr(-lambda[r]);
-          wrench_value(xa, Vec3A(ew * lr), Vec3A(ew.cross(Vec3A(xa - xb)) * lr), w, dw);
+          const LocalKin e = kin(ba, *perp, true);
+          // phidot = ed . dp + e . dpd;  c = edd . dp + 2 ed . dpd + e . dpdd
+          gp.setZero();
+          add_grad(gp, 0, dp, e.Dxd);
+          add_grad(gp, 0, dpd, e.Dx);
+          add_grad(gp, 0, e.xd, xa.Dx);
+          add_grad(gp, 0, e.x, xa.Dxd);
+          add_grad(gp, 1, -e.xd, xb.Dx);
+          add_grad(gp, 1, -e.x, xb.Dxd);
+          gc.setZero();
+          add_grad(gc, 0, dp, e.Dxdd);
+          add_grad(gc, 0, 2.0 * dpd, e.Dxd);
+          add_grad(gc, 0, dpdd, e.Dx);
+          add_grad(gc, 0, e.xdd, xa.Dx);
+          add_grad(gc, 0, 2.0 * e.xd, xa.Dxd);
+          add_grad(gc, 0, e.x, xa.Dxdd);
+          add_grad(gc, 1, -e.xdd, xb.Dx);
+          add_grad(gc, 1, -2.0 * e.xd, xb.Dxd);
+          add_grad(gc, 1, -e.x, xb.Dxdd);
+          row_out(r, e.xdd.dot(dp) + 2.0 * e.xd.dot(dpd) + e.x.dot(dpdd), ba, bb);
+          // phidot = w_a . (e x dp) + e . (velocity of x_a - velocity of x_b): with l = -lambda,
+          // body_a: [l (x_b x e); l e],  body_b: [-l (x_b x e); -l e]
+          const double l = -lambda[r];
+          const Eigen::Matrix<double, 3, 6> de = e.Dx.leftCols<6>();  // d e / d pose_a
+          const Eigen::Matrix<double, 3, 6> dxb = xb.Dx.leftCols<6>();
+          const Mat3 ex = skew<double>(e.x), xbx = skew<double>(xb.x);
+          dw.setZero();
+          w << l * xb.x.cross(e.x), l * e.x;
+          dw.block<3, 6>(0, 0).noalias() = l * xbx * de;
+          dw.block<3, 6>(0, 12).noalias() = -l * ex * dxb;
+          dw.block<3, 6>(3, 0) = l * de;
           add_body_wrench(ba, w, dw, ba, bb);
-          wrench_value(xb, Vec3A(-ew * lr), zero3, w, dw);
+          w = -w;
+          dw = -dw;
           add_body_wrench(bb, w, dw, ba, bb);
           ++r;
         }
         break;
+      }
     }
   }
 }
