@@ -313,6 +313,13 @@ void TreeDerivatives::mass_matrix() {
           if (uj == ui) break;
           continue;
         }
+        if (a.n == 3 && b.n == 3) {
+          const Eigen::Matrix<double, 6, 3> sj = Sj;
+          M.block<3, 3>(a.iv, b.iv).noalias() = P_[ui].topRows<3>() * sj;
+          if (uj == ui) break;
+          M.block<3, 3>(b.iv, a.iv) = M.block<3, 3>(a.iv, b.iv).transpose();
+          continue;
+        }
         M.block(a.iv, b.iv, a.n, b.n).noalias() = P_[ui].topRows(a.n) * Sj;
         if (uj != ui) M.block(b.iv, a.iv, b.n, a.n) = M.block(a.iv, b.iv, a.n, b.n).transpose();
         if (uj == ui) break;
@@ -354,6 +361,11 @@ void TreeDerivatives::differentiate_rnea() {
               dtau_dv(uj.iv, col) = R_[j].row(0).dot(s) + P_[j].row(0).dot(cv);
               continue;
             }
+            if (uj.n == 3) {  // a ball joint: fixed-size 3 x 6 products
+              dtau_dq.block<3, 1>(uj.iv, col).noalias() = P_[j].topRows<3>() * dw - R_[j].topRows<3>() * u;
+              dtau_dv.block<3, 1>(uj.iv, col).noalias() = R_[j].topRows<3>() * s + P_[j].topRows<3>() * cv;
+              continue;
+            }
             dtau_dq.block(uj.iv, col, uj.n, 1).noalias() = P_[j].topRows(uj.n) * dw - R_[j].topRows(uj.n) * u;
             dtau_dv.block(uj.iv, col, uj.n, 1).noalias() = R_[j].topRows(uj.n) * s + P_[j].topRows(uj.n) * cv;
           }
@@ -368,6 +380,12 @@ void TreeDerivatives::differentiate_rnea() {
             const Vec6 sj = Sj.col(0);
             dtau_dq(uj.iv, col) = sj.dot(G);
             dtau_dv(uj.iv, col) = sj.dot(Gv);
+            return;
+          }
+          if (uj.n == 3) {
+            const Eigen::Matrix<double, 6, 3> sj = Sj;
+            dtau_dq.block<3, 1>(uj.iv, col).noalias() = sj.transpose() * G;
+            dtau_dv.block<3, 1>(uj.iv, col).noalias() = sj.transpose() * Gv;
             return;
           }
           dtau_dq.block(uj.iv, col, uj.n, 1).noalias() = Sj.transpose() * G;

@@ -10,6 +10,7 @@
 #include "analysis/linearize.hpp"
 #include "analysis/operating_point.hpp"
 #include "core/test_util.hpp"
+#include "models/speed_models.hpp"
 #include "dynamics/constraints.hpp"
 #include "dynamics/derivatives.hpp"
 #include "dynamics/forward_dynamics.hpp"
@@ -225,6 +226,29 @@ TEST(TreeDerivatives, PlantJacobianMatchesAutodiffOnRandomTrees) {
     op.u = test::random_v(m, rng, 1.0).head(m.nu());
     expect_plant_agrees(m, op, "rich tree " + std::to_string(seed));
   }
+}
+
+// Branched trees: a star of every joint type on two bodies with every effect,
+// actuator and sensor, and the 28-DOF humanoid of the speed benchmarks.
+TEST(TreeDerivatives, PlantJacobianMatchesAutodiffOnBranchedTrees) {
+  for (unsigned seed : {24u, 25u}) {
+    ModelSpec s = rich_tree(seed);
+    for (std::size_t i = 2; i < s.joints.size(); ++i) s.joints[i].parent = i % 2 ? "b0" : "b1";
+    const Model m = compile(s);
+    std::mt19937 rng(seed);
+    OperatingPoint op = initial_point(m);
+    op.q = test::random_q(m, rng);
+    op.v = test::random_v(m, rng, 1.5);
+    op.u = test::random_v(m, rng, 1.0).head(m.nu());
+    expect_plant_agrees(m, op, "branched rich tree " + std::to_string(seed));
+  }
+  const Model h = compile(speed_models::tree28());
+  std::mt19937 rng(5);
+  OperatingPoint op = initial_point(h);
+  op.q = test::random_q(h, rng);
+  op.v = test::random_v(h, rng, 1.5);
+  op.u = test::random_v(h, rng, 1.0).head(h.nu());
+  expect_plant_agrees(h, op, "tree28");
 }
 
 TEST(TreeDerivatives, PlantJacobianMatchesAutodiffOnEveryExample) {
