@@ -478,19 +478,38 @@ void TreeDerivatives::applied_force_derivatives(const Eigen::VectorXd& q, const 
   Vec6 w;
   Eigen::Matrix<double, 6, 24> dw;
   const Vec3A zero3 = Vec3A::Constant(AD(0.0));
+  // spring-dampers in closed form: with dp = x_b - x_a, L = |dp|, n = dp / L,
+  // Ld = n . (xd_b - xd_a), tension T = k (L - L0) + c Ld, F = T n on x_a and -F on x_b:
+  //   dn = (I - n n^T) / L d(dp),  dT = k n . d(dp) + c (vrel . dn + n . d(vrel)),  dF = n dT + T dn
+  using Mat3x24 = Eigen::Matrix<double, 3, 24>;
   for (const SpringDamperModel& s : m_.springs) {
-    const BodyAD a = body_ad(d_.oMi[s.body_a], V_[s.body_a], 0, s.body_a > 0);
-    const BodyAD b = body_ad(d_.oMi[s.body_b], V_[s.body_b], 12, s.body_b > 0);
-    const Vec3A xa = a.point(s.point_a), xb = b.point(s.point_b);
-    const Vec3A dp = xb - xa;
-    const AD L = sqrt(dp.squaredNorm());
-    if (!(L.value() > 1e-12)) continue;  // as applied_forces: no direction, no force
-    const Vec3A n = dp / L;
-    const AD Ld = n.dot(b.point_velocity(xb) - a.point_velocity(xa));
-    const AD tension = AD(s.stiffness) * (L - AD(s.rest_length)) + AD(s.damping) * Ld;
-    wrench_value(xa, Vec3A(tension * n), zero3, w, dw);
+    const LocalKin a = local_kin(d_.oMi[s.body_a], V_[s.body_a], Vec6::Zero(), s.point_a, false, s.body_a > 0);
+    const LocalKin b = local_kin(d_.oMi[s.body_b], V_[s.body_b], Vec6::Zero(), s.point_b, false, s.body_b > 0);
+    const Vec3 dp = b.x - a.x, vrel = b.xd - a.xd;
+    const double L = dp.norm();
+    if (!(L > 1e-12)) continue;  // as applied_forces: no direction, no force
+    const Vec3 n = dp / L;
+    Mat3x24 Dxa = Mat3x24::Zero(), Dxb = Mat3x24::Zero(), Dvrel;
+    Dxa.leftCols<12>() = a.Dx.leftCols<12>();
+    Dxb.rightCols<12>() = b.Dx.leftCols<12>();
+    Dvrel.leftCols<12>() = -a.Dxd.leftCols<12>();
+    Dvrel.rightCols<12>() = b.Dxd.leftCols<12>();
+    const Mat3x24 Ddp = Dxb - Dxa;
+    const Mat3x24 Dn = (Mat3::Identity() - n * n.transpose()) / L * Ddp;
+    const double Ld = n.dot(vrel);
+    const double T = s.stiffness * (L - s.rest_length) + s.damping * Ld;
+    const Eigen::Matrix<double, 1, 24> DT =
+        s.stiffness * n.transpose() * Ddp + s.damping * (vrel.transpose() * Dn + n.transpose() * Dvrel);
+    const Vec3 F = T * n;
+    const Mat3x24 DF = n * DT + T * Dn;
+    const Mat3 Fx = skew<double>(F);
+    w << a.x.cross(F), F;
+    dw.topRows<3>().noalias() = skew<double>(a.x) * DF - Fx * Dxa;
+    dw.bottomRows<3>() = DF;
     add_body_wrench(s.body_a, w, dw, s.body_a, s.body_b);
-    wrench_value(xb, Vec3A(-tension * n), zero3, w, dw);
+    w << -b.x.cross(F), -F;
+    dw.topRows<3>().noalias() = Fx * Dxb - skew<double>(b.x) * DF;
+    dw.bottomRows<3>() = -DF;
     add_body_wrench(s.body_b, w, dw, s.body_a, s.body_b);
   }
   for (const BodyForceModel& f : m_.body_forces) {
