@@ -135,10 +135,11 @@ A02Run run_a02(const Model& m, int N, const char* method, double t_end, SolverSt
   return a;
 }
 
-// N = 40, the benchmark's size, over its 10 s (10 passages through the flat configuration):
-// cvode-bdf (projection inside CVODE after every step). ida, arkode and cvode-adams at N = 40:
-// docs/work-precision.md (too slow for the default run, or not on the branch).
-TEST(HardSingular, A02FortyFourBarsCvodeBdfStaysOnTheRigidBranch) {
+// N = 40, the benchmark's size, over its 10 s (10 passages through the flat configuration),
+// with cvode-bdf (projection inside CVODE after every step), arkode (projection after every
+// step) and cvode-adams (projection at output stops). ida at N = 40 (a dense 242 x 242
+// difference-quotient Jacobian) takes minutes: docs/work-precision.md.
+TEST(HardSingular, A02FortyFourBarsStayOnTheRigidBranch) {
   const int N = 40;
   const Model m = test::load_example("iftomm_a02_forty_bars.json");
   ASSERT_EQ(m.nbodies, 2 * N + 2);
@@ -150,21 +151,25 @@ TEST(HardSingular, A02FortyFourBarsCvodeBdfStaysOnTheRigidBranch) {
     EXPECT_LT((built.q0 - m.q0).cwiseAbs().maxCoeff(), 1e-15);
     EXPECT_LT((built.v0 - m.v0).cwiseAbs().maxCoeff(), 1e-15);
   }
-  const A02Run a = run_a02(m, N, "cvode-bdf", 10.0);
-  EXPECT_EQ(a.passages, 10);
-  EXPECT_LT(a.rigid, 1e-6);
-  EXPECT_LT(a.dE, 1e-5);
-  EXPECT_LT(a.dphi, 1e-3);
-  EXPECT_LT(a.drift, 3e-12);
+  for (const A02Case& c : {A02Case{"cvode-bdf", 1.7e-9, 1.8e-6, 2e-4}, A02Case{"cvode-adams", 6e-9, 2.4e-6, 1.8e-4},
+                           A02Case{"arkode", 1e-8, 7e-4, 0.034}}) {
+    const A02Run a = run_a02(m, N, c.method, 10.0);
+    EXPECT_EQ(a.passages, 10) << c.method;
+    EXPECT_LT(a.rigid, c.rigid) << c.method;
+    EXPECT_LT(a.dE, c.dE) << c.method;
+    EXPECT_LT(a.dphi, c.dphi) << c.method;
+  }
 }
 
-// N = 4, 20 s, 20 passages: the integrators that project after every step (cvode-bdf, arkode)
-// or that integrate the DAE (ida, projected at output stops when the drift passes atol / 10).
+// N = 4, 20 s, 20 passages, every SUNDIALS integrator. arkode pays for the passages in energy
+// (2e-5 here, 2e-4 at N = 40): inside the band where the loops' Schur complement is dropped
+// (core/simulation/closed_loop.cpp) it moves by inertia and its per-step projection then
+// takes the difference out of the velocities.
 TEST(HardSingular, A02FourBarsStayOnTheRigidBranch) {
   const int N = 4;
   const Model m = compile(a02_spec(N));
-  for (const A02Case& c : {A02Case{"ida", 3e-10, 3.5e-6, 1e-3}, A02Case{"cvode-bdf", 2.2e-10, 1.6e-6, 2.1e-4},
-                           A02Case{"arkode", 1.3e-13, 1e-8, 1.4e-6}}) {
+  for (const A02Case& c : {A02Case{"ida", 4e-10, 3.3e-6, 6e-4}, A02Case{"cvode-bdf", 5e-10, 8e-7, 1.2e-4},
+                           A02Case{"cvode-adams", 1e-9, 3e-6, 6e-4}, A02Case{"arkode", 2.5e-10, 6.5e-5, 1.2e-2}}) {
     const A02Run a = run_a02(m, N, c.method, 20.0);
     EXPECT_EQ(a.passages, 20) << c.method;
     EXPECT_LT(a.rigid, c.rigid) << c.method;
