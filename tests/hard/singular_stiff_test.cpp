@@ -1,6 +1,7 @@
 // Hard cases (issue 11, label `hard`):
 //   IFToMM A02 with N = 40 four-bars (built here from examples/iftomm_a02_four_bars.json's
-//   pattern): 81 links, 80 loop rows, 1 DOF, flat (singular: the constraint Jacobian loses 40
+//   pattern; not an example file: the GUI tests pick every body of every example, and the
+//   41 m chain is too long for their view): 81 links, 80 loop rows, 1 DOF, flat (singular: the constraint Jacobian loses 40
 //   of its rank) each time the cranks pass the horizontal. The exact motion is a rigid
 //   rotation of all cranks; every integrator at its default tolerances must keep to it.
 //   The stiff flyball governor (A05): the implicit methods are far cheaper than the explicit
@@ -141,16 +142,10 @@ A02Run run_a02(const Model& m, int N, const char* method, double t_end, SolverSt
 // difference-quotient Jacobian) takes minutes: docs/work-precision.md.
 TEST(HardSingular, A02FortyFourBarsStayOnTheRigidBranch) {
   const int N = 40;
-  const Model m = test::load_example("iftomm_a02_forty_bars.json");
+  const Model m = compile(a02_spec(N));
   ASSERT_EQ(m.nbodies, 2 * N + 2);
   ASSERT_EQ(m.dof(), 1);
   ASSERT_EQ(m.nc, 2 * N);
-  {  // the example file is the pattern built here
-    const Model built = compile(a02_spec(N));
-    ASSERT_EQ(built.nq, m.nq);
-    EXPECT_LT((built.q0 - m.q0).cwiseAbs().maxCoeff(), 1e-15);
-    EXPECT_LT((built.v0 - m.v0).cwiseAbs().maxCoeff(), 1e-15);
-  }
   for (const A02Case& c : {A02Case{"cvode-bdf", 1.7e-9, 1.8e-6, 2e-4}, A02Case{"cvode-adams", 6e-9, 2.4e-6, 1.8e-4},
                            A02Case{"arkode", 1e-8, 7e-4, 0.034}}) {
     const A02Run a = run_a02(m, N, c.method, 10.0);
