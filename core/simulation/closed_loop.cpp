@@ -1,5 +1,7 @@
 #include "simulation/closed_loop.hpp"
 
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 #include <Eigen/SVD>
 #include <algorithm>
@@ -15,6 +17,56 @@
 #include "spatial/autodiff.hpp"
 
 namespace codyna {
+
+namespace {
+// Closed loops for the ODE integrators: M qdd + nle = Q - Jc^T lambda, Jc qdd + gamma = -stab
+// on all rows, through the Schur complement A = Jc M^-1 Jc^T. Where A is well conditioned
+// (no redundant rows, no singular configuration) a pivoted LDLT solves it, as forward_dynamics
+// does on its chosen rows. Otherwise (redundant rows, or a configuration near a singular one,
+// where A loses rank: the flat position of IFToMM A02) its eigen-decomposition keeps the
+// model's rank of largest directions and drops those below kSingularA of the largest: in a
+// direction the constraints no longer see the mechanism moves by inertia, instead of by
+// multipliers that grow like 1/sigma^2 and carry the round-off and the drift of the loops
+// (docs/work-precision.md, "Hard cases").
+Eigen::VectorXd loop_accelerations(const Model& model_, Data& data_, const Baumgarte& stab_, const Eigen::VectorXd& q,
+                                   const Eigen::VectorXd& v, const Eigen::VectorXd& u) {
+  constexpr double kSingularA = 1e-8, kWellConditioned = 1e-6;
+  Data& d = data_;
+  const int nv = model_.nv, nc = model_.nc;
+  forward_kinematics<double>(model_, d, q, v);
+  const Eigen::VectorXd Q = applied_forces<double>(model_, d, q, v, u);
+  const Eigen::MatrixXd M = crba_after_kinematics<double>(model_, d);
+  const Eigen::VectorXd h = nonlinear_effects<double>(model_, d, q, v);
+  constraint_terms<double>(model_, d, q, v);
+  Eigen::MatrixXd X(nv, 1 + nc);
+  X.col(0) = Q - h;
+  X.rightCols(nc) = d.Jc.transpose();
+  Eigen::LLT<Eigen::MatrixXd> llt(M);
+  if (llt.info() != Eigen::Success) throw std::runtime_error("the mass matrix is not positive definite");
+  llt.solveInPlace(X);
+  const Eigen::MatrixXd A = d.Jc * X.rightCols(nc);
+  Eigen::VectorXd b = d.Jc * X.col(0) + d.gamma;
+  if (stab_.alpha != 0.0 || stab_.beta != 0.0) b += 2.0 * stab_.alpha * (d.Jc * v) + stab_.beta * stab_.beta * d.phi;
+  const int rank = static_cast<int>(model_.active_rows.size());
+  Eigen::VectorXd lambda;
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(A);
+  const Eigen::VectorXd D = ldlt.vectorD().cwiseAbs();
+  if (rank == nc && ldlt.info() == Eigen::Success && D.minCoeff() > kWellConditioned * D.maxCoeff()) {
+    lambda = ldlt.solve(b);
+  } else {
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(A);  // ascending eigenvalues
+    const Eigen::VectorXd& mu = es.eigenvalues();
+    const double largest = mu[nc - 1];
+    lambda = Eigen::VectorXd::Zero(nc);
+    for (int k = nc - 1; k >= nc - rank && k >= 0; --k) {
+      if (!(mu[k] > kSingularA * largest)) break;
+      lambda += es.eigenvectors().col(k) * (es.eigenvectors().col(k).dot(b) / mu[k]);
+    }
+  }
+  d.lambda = lambda;
+  return X.col(0) - X.rightCols(nc) * lambda;
+}
+}  // namespace
 
 ClosedLoopSystem::ClosedLoopSystem(const Model& model, const Controller* controller, const PlantFunction* plant,
                                    const Eigen::VectorXd& x_ref, const Eigen::VectorXd& u_nominal, Baumgarte stab)
@@ -84,9 +136,12 @@ void ClosedLoopSystem::rhs(double t, const Eigen::VectorXd& y, Eigen::VectorXd& 
   const Eigen::VectorXd u = inputs(t, q, v, xc);
   ydot.resize(ode_size());
   ydot.head(nq) = qdot<double>(model_, q, v);
-  ydot.segment(nq, nv) = forward_dynamics<double>(model_, data_, q, v, u, stab_);
+  if (model_.nc == 0) ydot.segment(nq, nv) = forward_dynamics<double>(model_, data_, q, v, u, stab_);
+  else ydot.segment(nq, nv) = loop_accelerations(model_, data_, stab_, q, v, u);
   if (nx) ydot.tail(nx) = controller_rates(t, q, v, xc, u);
 }
+
+
 
 Eigen::VectorXd ClosedLoopSystem::controller_rates(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
                                                    const Eigen::VectorXd& xc, const Eigen::VectorXd& u) const {
@@ -133,7 +188,9 @@ void ClosedLoopSystem::consistent(double t, const Eigen::VectorXd& y, Eigen::Vec
   if (na()) {
     constraint_terms<double>(model_, data_, y.head(model_.nq), y.segment(model_.nq, model_.nv));
     rows_ = partition_rows(data_.Jc, 1e-9, na()).independent;
-    rhs(t, y, yd);  // multipliers for these rows
+    // multipliers for these rows (forward_dynamics gives them on its independent rows)
+    forward_dynamics<double>(model_, data_, y.head(model_.nq), y.segment(model_.nq, model_.nv),
+                             inputs(t, y.head(model_.nq), y.segment(model_.nq, model_.nv), y.tail(nxc())), stab_);
   }
   for (int k = 0; k < na(); ++k) Y[ode_size() + k] = data_.lambda[rows_[k]];
 }

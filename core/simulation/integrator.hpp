@@ -4,7 +4,8 @@
 //   cvode-bdf    SUNDIALS CVODE, BDF with Newton iterations (stiff problems); for closed
 //                loops it projects onto the constraints after every step (CVodeSetProjFn)
 //   cvode-adams  SUNDIALS CVODE, Adams-Moulton with fixed-point iterations (non-stiff)
-//   arkode       SUNDIALS ARKODE ERKStep, adaptive explicit Runge-Kutta (order 4 default)
+//   arkode       SUNDIALS ARKODE ERKStep, adaptive explicit Runge-Kutta (order 4 default); with
+//                loops it projects onto the constraints after every step (postprocess hook)
 //   rk4          fixed-step classical Runge-Kutta (step = max_step, or 1 ms), the reference
 // All advance to an exact output/event time (stop time set, no overshoot) and
 // can be reset after a discontinuity (controller sample, projection).

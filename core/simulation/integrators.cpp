@@ -200,6 +200,7 @@ class Erk final : public SundialsBase {
       check(ERKStepSetErrHandlerFn(mem_, &SundialsBase::on_error, static_cast<SundialsBase*>(this)), "ARKODE", "ERKStepSetErrHandlerFn");
       check(ERKStepSetMaxNumSteps(mem_, 10000000), "ARKODE", "ERKStepSetMaxNumSteps");
       if (set_.max_step > 0) check(ERKStepSetMaxStep(mem_, set_.max_step), "ARKODE", "ERKStepSetMaxStep");
+      if (projects()) check(ERKStepSetPostprocessStepFn(mem_, &Erk::project), "ARKODE", "ERKStepSetPostprocessStepFn");
     } else {
       view(y_) = y;
       counters(done_);
@@ -212,6 +213,7 @@ class Erk final : public SundialsBase {
     if (flag < 0) fail("ARKODE", flag, t_);
   }
   Eigen::VectorXd state() const override { return view(y_); }
+  bool projects() const override { return sys_.model().nc > 0; }
   void counters(SolverStats& s) const override {
     long v = 0;
     ERKStepGetNumSteps(mem_, &v), s.steps += v;
@@ -220,6 +222,15 @@ class Erk final : public SundialsBase {
   }
 
  private:
+  // after every accepted step, back onto phi = 0, Jc v = 0 (a one-step method starts the next
+  // step from the projected state, so this costs no accuracy)
+  static int project(double, N_Vector y, void* self) {
+    auto* me = static_cast<Erk*>(static_cast<SundialsBase*>(self));
+    return me->guarded([&] {
+      Eigen::VectorXd x = view(y);
+      if (me->sys_.project(x, 0.0)) ++me->projections_, view(y) = x;
+    });
+  }
 };
 
 class Ida final : public SundialsBase {

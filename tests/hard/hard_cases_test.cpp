@@ -95,7 +95,7 @@ TEST(Hard, HeavyTop100s) {
 // its default tolerances keeps to the rigid branch through all 20 singular passages now that
 // the projection threshold follows atol (measured defect 9e-11 rad; iftomm_test.cpp's note
 // says ida left the branch before, not re-measured here).
-// cvode-adams (mxstep at t = 4.6 s) and arkode (folds) do not yet: see docs/work-precision.md.
+// Every integrator, and N = 40: tests/hard/singular_stiff_test.cpp.
 TEST(Hard, A02FourBarsIdaStaysOnTheRigidBranch) {
   const Model m = test::load_example("iftomm_a02_four_bars.json");
   const int N = 4;
