@@ -468,11 +468,13 @@ bool PlantFunction::closed_loop_jacobian(const Eigen::VectorXd& x, const Eigen::
   for (int k = 0; k < nd; ++k) W.Ja.row(k) = d.Jc.row(rows_[k]);
   for (int c = 0; c < nd; ++c) W.Jd.col(c) = W.Ja.col(dep[c]);
   for (int c = 0; c < n; ++c) W.Jz.col(c) = W.Ja.col(ind[c]);
-  W.lu.compute(W.Jd);
   W.G.setZero();
   for (int k = 0; k < n; ++k) W.G(ind[k], k) = 1.0;
-  W.P.noalias() = W.lu.solve(W.Jz);
-  for (int k = 0; k < nd; ++k) W.G.row(dep[k]) = -W.P.row(k);
+  if (nd > 0) {  // (Eigen's LU must not see an empty matrix)
+    W.lu.compute(W.Jd);
+    W.P.noalias() = W.lu.solve(W.Jz);
+    for (int k = 0; k < nd; ++k) W.G.row(dep[k]) = -W.P.row(k);
+  }
   W.v.noalias() = W.G * x.tail(n);
   W.u_all = u_all_;
   for (int k = 0; k < nu_p; ++k) W.u_all[m.plant_inputs[k]] = u[k];
@@ -480,11 +482,13 @@ bool PlantFunction::closed_loop_jacobian(const Eigen::VectorXd& x, const Eigen::
   forward_dynamics<double>(m, d, q_ref_, W.v, W.u_all);
   td.compute_constrained(q_ref_, W.v, W.u_all, d.qdd, d.lambda, d.loop.rows, m.plant_outputs);
   // H = dv/dz: Jd dv_dep/dz = -(d(Jc v)/dq) G on the plant's rows
-  for (int k = 0; k < nd; ++k) W.Ja.row(k) = td.dphid_dq.row(rows_[k]);
-  W.Jz.noalias() = W.Ja * W.G;
-  W.P.noalias() = W.lu.solve(W.Jz);
   W.H.setZero();
-  for (int k = 0; k < nd; ++k) W.H.row(dep[k]) = -W.P.row(k);
+  if (nd > 0) {
+    for (int k = 0; k < nd; ++k) W.Ja.row(k) = td.dphid_dq.row(rows_[k]);
+    W.Jz.noalias() = W.Ja * W.G;
+    W.P.noalias() = W.lu.solve(W.Jz);
+    for (int k = 0; k < nd; ++k) W.H.row(dep[k]) = -W.P.row(k);
+  }
   if (J.rows() != 2 * n + ny_p || J.cols() != 2 * n + nu_p) J.resize(2 * n + ny_p, 2 * n + nu_p);
   J.setZero();
   // position rows: d(rate)/d(dq) G + H (d(rate)/dv = I at dq = 0), and d/dw = G = I on the independent rows

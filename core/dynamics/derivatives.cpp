@@ -846,23 +846,25 @@ void TreeDerivatives::compute_constrained(const Eigen::VectorXd& q, const Eigen:
     auto panel = rhs_.middleCols(c0, std::min<Eigen::Index>(48, rhs_.cols() - c0));
     llt_.solveInPlace(panel);
   }
-  if (Jr_.rows() != na || Jr_.cols() != nv) Jr_.resize(na, nv);
-  for (int k = 0; k < na; ++k) Jr_.row(k) = Jc.row(rows[k]);
-  Y_ = Jr_.transpose();
-  llt_.solveInPlace(Y_);
-  if (Sc_.rows() != na) Sc_.resize(na, na);
-  Sc_.noalias() = Jr_ * Y_;
-  llt_schur_.compute(Sc_);
-  if (llt_schur_.info() != Eigen::Success)
-    throw std::runtime_error("the loop closures' Schur complement is singular at this configuration");
-  if (T_.rows() != na || T_.cols() != rhs_.cols()) T_.resize(na, rhs_.cols());
-  T_.noalias() = Jr_ * rhs_;
-  for (int k = 0; k < na; ++k) {
-    T_.row(k).head(nv) += dc_dq.row(rows[k]);
-    T_.row(k).segment(nv, nv) += dc_dv.row(rows[k]);
+  if (na > 0) {  // (no kept rows: the tree's derivatives; Eigen's solves must not see empty matrices)
+    if (Jr_.rows() != na || Jr_.cols() != nv) Jr_.resize(na, nv);
+    for (int k = 0; k < na; ++k) Jr_.row(k) = Jc.row(rows[k]);
+    Y_ = Jr_.transpose();
+    llt_.solveInPlace(Y_);
+    if (Sc_.rows() != na) Sc_.resize(na, na);
+    Sc_.noalias() = Jr_ * Y_;
+    llt_schur_.compute(Sc_);
+    if (llt_schur_.info() != Eigen::Success)
+      throw std::runtime_error("the loop closures' Schur complement is singular at this configuration");
+    if (T_.rows() != na || T_.cols() != rhs_.cols()) T_.resize(na, rhs_.cols());
+    T_.noalias() = Jr_ * rhs_;
+    for (int k = 0; k < na; ++k) {
+      T_.row(k).head(nv) += dc_dq.row(rows[k]);
+      T_.row(k).segment(nv, nv) += dc_dv.row(rows[k]);
+    }
+    llt_schur_.solveInPlace(T_);
+    rhs_.noalias() -= Y_ * T_;
   }
-  llt_schur_.solveInPlace(T_);
-  rhs_.noalias() -= Y_ * T_;
   dqdd_dq = rhs_.leftCols(nv);
   dqdd_dv = rhs_.middleCols(nv, nv);
   dqdd_du = rhs_.rightCols(nu);
