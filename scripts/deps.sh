@@ -8,9 +8,11 @@ PKGS=(
   build-essential cmake pkg-config
   libeigen3-dev libsundials-dev libhdf5-dev libmatio-dev
   nlohmann-json3-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
+  libsimbody-dev  # the Simbody peer of the work-precision study (bench/work_precision); the build skips it without
   libmujoco-dev  # the MuJoCo peer test (tests/peers_mujoco); the build skips it without
   clang libclang-rt-14-dev  # the libFuzzer target (scripts/fuzz.sh): clang 14 with its fuzzer/sanitizer runtimes
   octave octave-control liboctave-dev python3 python3-scipy python3-h5py python3-numpy
+  python3-matplotlib  # scripts/plot_work_precision.py (work-precision plots, Agg backend)
   # the GUI (codyna-gui) and its tests: Qt 6 widgets, OpenGL, Charts, SVG export,
   # and a virtual X server with Mesa's software OpenGL for the rendering tests
   qt6-base-dev qt6-base-dev-tools libqt6opengl6-dev qt6-charts-dev qt6-svg-dev

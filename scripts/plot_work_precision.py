@@ -1,0 +1,57 @@
+#!/usr/bin/env python3
+"""Work-precision plots from the CSV of build/bin/codyna_work_precision.
+
+    /usr/bin/python3 scripts/plot_work_precision.py docs/work_precision/work_precision.csv docs/work_precision
+
+One PNG per problem: error against CPU time (log-log), one line per integrator,
+codyna solid, Simbody (integrator names starting "simbody-") dashed, and the IFToMM
+high-precision bound as a horizontal line where one exists.
+"""
+import csv
+import math
+import sys
+from collections import defaultdict
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+TITLES = {
+    "andrews": "Andrews' squeezer, t = 0.03 s: max relative error of the 7 angles",
+    "a01": "IFToMM A01 pendulum, 10 s: max position error of the mass [m]",
+}
+BOUNDS = {"a01": (1e-3, "IFToMM high precision (1e-3)")}  # problem -> (value, label)
+
+
+def main(path, outdir):
+    runs = defaultdict(lambda: defaultdict(list))
+    with open(path) as f:
+        for row in csv.DictReader(f):
+            err, cpu = float(row["error"]), float(row["cpu_s"])
+            if row["completed"] != "1" or not math.isfinite(err) or err <= 0:
+                continue
+            runs[row["problem"]][row["integrator"]].append((cpu, max(err, 1e-16), float(row["tol"])))
+    for problem, by_int in runs.items():
+        fig, ax = plt.subplots(figsize=(7, 5))
+        for name, pts in sorted(by_int.items()):
+            pts.sort(key=lambda p: -p[2])
+            ax.loglog([p[0] for p in pts], [p[1] for p in pts], "--" if name.startswith("simbody-") else "-",
+                      marker="o", ms=3, label=name)
+        if problem in BOUNDS:
+            v, lab = BOUNDS[problem]
+            ax.axhline(v, color="grey", lw=1, ls=":", label=lab)
+        ax.set_xlabel("CPU time [s] (best of repeats)")
+        ax.set_ylabel("error")
+        ax.set_title(TITLES.get(problem, problem), fontsize=10)
+        ax.grid(True, which="major", alpha=0.4)
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        out = f"{outdir}/{problem}.png"
+        fig.savefig(out, dpi=100)
+        plt.close(fig)
+        print("wrote", out)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1], sys.argv[2] if len(sys.argv) > 2 else "docs/work_precision")
