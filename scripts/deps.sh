@@ -8,7 +8,6 @@ PKGS=(
   build-essential cmake pkg-config
   libeigen3-dev libsundials-dev libhdf5-dev libmatio-dev
   nlohmann-json3-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
-  libsimbody-dev  # the Simbody peer of the work-precision study (bench/work_precision); the build skips it without
   libmujoco-dev  # the MuJoCo peer test (tests/peers_mujoco); the build skips it without
   clang libclang-rt-14-dev  # the libFuzzer target (scripts/fuzz.sh): clang 14 with its fuzzer/sanitizer runtimes
   octave octave-control liboctave-dev python3 python3-scipy python3-h5py python3-numpy
