@@ -92,7 +92,7 @@ void LinearizeView::buildUi() {
   form->addRow(tr("Operating point"), op_row);
 
   method_combo_ = new QComboBox(settings);
-  method_combo_->addItem(tr("exact (automatic differentiation)"), QStringLiteral("exact"));
+  method_combo_->addItem(tr("exact (analytic derivatives)"), QStringLiteral("exact"));
   method_combo_->addItem(tr("fd-forward (forward differences)"), QStringLiteral("fd-forward"));
   method_combo_->addItem(tr("fd-central (central differences)"), QStringLiteral("fd-central"));
   form->addRow(tr("Jacobians"), method_combo_);

@@ -2,9 +2,9 @@
 // in minimal coordinates (see plant_function.hpp for the state):
 //   dx = A x + B u,  y = C x + D u   about (x0, u0, y0), with xdot0 = f(x0, u0).
 // Jacobians two ways behind one interface:
-//   Exact            analytic derivatives of the recursive algorithms for
-//                    trees at the operating point (dynamics/derivatives.hpp);
-//                    elsewhere (closed loops, off-point states) forward-mode
+//   Exact            analytic derivatives of the recursive algorithms at the
+//                    operating point, trees and closed loops
+//                    (dynamics/derivatives.hpp); at off-point states forward-mode
 //                    automatic differentiation of the same Scalar-templated
 //                    dynamics (default)
 //   ForwardDifference (f(x + h e) - f(x)) / h,      h = sqrt(eps) max(1, |x_i|)
