@@ -148,25 +148,9 @@ PlantFunction::PlantFunction(const Model& model, const Eigen::VectorXd& q_ref, c
 }
 
 Eigen::VectorXd PlantFunction::solve_dependent(const Eigen::VectorXd& z) const {
-  const int nd = static_cast<int>(part_.dependent.size());
-  Eigen::VectorXd dq = Eigen::VectorXd::Zero(model_.nv);
-  for (int k = 0; k < nz(); ++k) dq[part_.independent[k]] = z[k];
-  Data d(model_);
-  for (int it = 0; it < 50; ++it) {
-    const Eigen::VectorXd q = integrate<double>(model_, q_ref_, dq);
-    constraint_terms<double>(model_, d, q, Eigen::VectorXd::Zero(model_.nv));
-    Eigen::VectorXd phi(nd);
-    Eigen::MatrixXd J(nd, model_.nv);
-    for (int k = 0; k < nd; ++k) {
-      phi[k] = d.phi[rows_[k]];
-      J.row(k) = d.Jc.row(rows_[k]);
-    }
-    if (phi.lpNorm<Eigen::Infinity>() < 1e-14) break;
-    const Eigen::VectorXd step = columns(J, part_.dependent).partialPivLu().solve(phi);
-    for (int k = 0; k < nd; ++k) dq[part_.dependent[k]] -= step[k];
-  }
-  Eigen::VectorXd r(nd);
-  for (int k = 0; k < nd; ++k) r[k] = dq[part_.dependent[k]];
+  newton_dependent(z);
+  Eigen::VectorXd r(part_.dependent.size());
+  for (std::size_t k = 0; k < part_.dependent.size(); ++k) r[k] = ws_.dq[part_.dependent[k]];
   return r;
 }
 
@@ -394,39 +378,50 @@ void PlantFunction::loop_workspace() const {
   W.DQ.resize(nv, n);
 }
 
+// Jd (the plant's rows, the dependent columns) of the constraint terms in the workspace's Data, factored
+void PlantFunction::factor_dependent() const {
+  const int nd = static_cast<int>(part_.dependent.size());
+  const Data& d = *ws_.data;
+  for (int c = 0; c < nd; ++c)
+    for (int k = 0; k < nd; ++k) ws_.Jd(k, c) = d.Jc(rows_[k], part_.dependent[c]);
+  ws_.lu.compute(ws_.Jd);
+}
+
+void PlantFunction::newton_dependent(const Eigen::Ref<const Eigen::VectorXd>& z) const {
+  const Model& m = model_;
+  const int nd = static_cast<int>(part_.dependent.size());
+  loop_workspace();
+  Workspace& W = ws_;
+  Data& d = *W.data;
+  W.dq.setZero();
+  for (int k = 0; k < nz(); ++k) W.dq[part_.independent[k]] = z[k];
+  integrate_into<double>(m, q_ref_, W.dq, W.q);
+  if (nd == 0) return;
+  for (int it = 0;; ++it) {
+    constraint_terms<double>(m, d, W.q, W.zero);
+    for (int k = 0; k < nd; ++k) W.phi[k] = d.phi[rows_[k]];
+    if (W.phi.lpNorm<Eigen::Infinity>() < 1e-14 || it == 50) break;
+    factor_dependent();
+    W.step.noalias() = W.lu.solve(W.phi);
+    for (int k = 0; k < nd; ++k) W.dq[part_.dependent[k]] -= W.step[k];
+    integrate_into<double>(m, q_ref_, W.dq, W.q);
+  }
+}
+
 void PlantFunction::eval_closed(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd& xdot,
                                 Eigen::VectorXd& y) const {
   const Model& m = model_;
   const int n = nz(), nd = static_cast<int>(part_.dependent.size());
   const auto& ind = part_.independent;
   const auto& dep = part_.dependent;
-  loop_workspace();
   Workspace& W = ws_;
+  newton_dependent(x.head(n));  // W.dq, W.q, and the constraint terms at W.q in d
   Data& d = *W.data;
-  W.dq.setZero();
-  for (int k = 0; k < n; ++k) W.dq[ind[k]] = x[k];
-  // dependent positions: Newton on the plant's rows, from the reference
-  auto jd = [&]() {
-    for (int c = 0; c < nd; ++c)
-      for (int k = 0; k < nd; ++k) W.Jd(k, c) = d.Jc(rows_[k], dep[c]);
-    W.lu.compute(W.Jd);
-  };
-  for (int it = 0; it < 50 && nd > 0; ++it) {
-    integrate_into<double>(m, q_ref_, W.dq, W.q);
-    constraint_terms<double>(m, d, W.q, W.zero);
-    for (int k = 0; k < nd; ++k) W.phi[k] = d.phi[rows_[k]];
-    if (W.phi.lpNorm<Eigen::Infinity>() < 1e-14) break;
-    jd();
-    W.step.noalias() = W.lu.solve(W.phi);
-    for (int k = 0; k < nd; ++k) W.dq[dep[k]] -= W.step[k];
-  }
-  integrate_into<double>(m, q_ref_, W.dq, W.q);
   W.v.setZero();
   for (int k = 0; k < n; ++k) W.v[ind[k]] = x[n + k];
   if (nd > 0) {
     // dependent velocities from Jc v = 0 on the plant's rows
-    constraint_terms<double>(m, d, W.q, W.zero);
-    jd();
+    factor_dependent();
     for (int k = 0; k < nd; ++k) {
       double s = 0.0;
       for (int c = 0; c < n; ++c) s += d.Jc(rows_[k], ind[c]) * x[n + c];
@@ -452,7 +447,7 @@ void PlantFunction::eval_closed(const Eigen::VectorXd& x, const Eigen::VectorXd&
 bool PlantFunction::closed_loop_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& u,
                                          Eigen::MatrixXd& J) const {
   const Model& m = model_;
-  const int n = nz(), nu_p = nu(), ny_p = ny(), nv = m.nv, nd = static_cast<int>(part_.dependent.size());
+  const int n = nz(), nu_p = nu(), ny_p = ny(), nd = static_cast<int>(part_.dependent.size());
   for (int k = 0; k < n; ++k)
     if (x[k] != 0.0) return false;
   const auto& ind = part_.independent;
@@ -463,15 +458,13 @@ bool PlantFunction::closed_loop_jacobian(const Eigen::VectorXd& x, const Eigen::
   Data& d = *W.data;
   TreeDerivatives& td = *W.td;
   // the velocity map G at q_ref: v_ind = w, Jd v_dep = -Jz w
-  W.dq.setZero();
-  constraint_terms<double>(m, d, q_ref_, W.dq);
-  for (int k = 0; k < nd; ++k) W.Ja.row(k) = d.Jc.row(rows_[k]);
-  for (int c = 0; c < nd; ++c) W.Jd.col(c) = W.Ja.col(dep[c]);
-  for (int c = 0; c < n; ++c) W.Jz.col(c) = W.Ja.col(ind[c]);
+  constraint_terms<double>(m, d, q_ref_, W.zero);
+  for (int k = 0; k < nd; ++k)
+    for (int c = 0; c < n; ++c) W.Jz(k, c) = d.Jc(rows_[k], ind[c]);
   W.G.setZero();
   for (int k = 0; k < n; ++k) W.G(ind[k], k) = 1.0;
   if (nd > 0) {  // (Eigen's LU must not see an empty matrix)
-    W.lu.compute(W.Jd);
+    factor_dependent();
     W.P.noalias() = W.lu.solve(W.Jz);
     for (int k = 0; k < nd; ++k) W.G.row(dep[k]) = -W.P.row(k);
   }

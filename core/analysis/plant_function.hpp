@@ -8,8 +8,9 @@
 // Jacobian (or the user's choice); the dependent ones follow from phi(q) = 0
 // (Newton) and Jc v = 0. Rotations of spherical/free joints are tangent
 // vectors (right-trivialized: R = R_ref Exp(z)), never quaternion components.
-// eval is templated so that exact Jacobians come from automatic differentiation
-// through the same code; double and ADScalar are instantiated.
+// eval is templated so that automatic differentiation runs through the same
+// code (the independent check of the analytic Jacobian, and the exact Jacobian
+// away from the operating point); double and ADScalar are instantiated.
 #pragma once
 
 #include <memory>
@@ -99,7 +100,7 @@ class PlantFunction {
   const Eigen::VectorXd& u_all() const { return u_all_; }
 
  private:
-  Eigen::VectorXd solve_dependent(const Eigen::VectorXd& z) const;  // tangent deviation of dependent coords
+  Eigen::VectorXd solve_dependent(const Eigen::VectorXd& z) const;  // tangent deviation of dependent coords (newton_dependent)
 
   const Model& model_;
   Eigen::VectorXd q_ref_, u_all_;
@@ -121,6 +122,10 @@ class PlantFunction {
   void eval_closed(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd& xdot,
                    Eigen::VectorXd& y) const;
   void loop_workspace() const;  // sizes the closed-loop part of the workspace once
+  // Newton on phi(q) = 0 (the plant's rows) for the dependent coordinates at independent
+  // deviations z, from the reference: leaves dq, q and the constraint terms at q in the workspace
+  void newton_dependent(const Eigen::Ref<const Eigen::VectorXd>& z) const;
+  void factor_dependent() const;  // Jd from the workspace's constraint terms, into its LU
 
   struct Workspace {
     std::unique_ptr<TreeDerivatives> td;
