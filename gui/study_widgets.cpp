@@ -66,6 +66,15 @@ QString firstUnused(const QStringList& choices, int rows, const std::function<QS
   return {};
 }
 
+// removes the selected row, or the last one when none is selected; false when the table is empty
+bool removeSelectedRow(QTableWidget* table) {
+  int row = table->currentRow();
+  if (row < 0) row = table->rowCount() - 1;
+  if (row < 0) return false;
+  table->removeRow(row);
+  return true;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------
@@ -90,11 +99,7 @@ NameValueTable::NameValueTable(const QString& nameHeader, const QString& valueHe
     emit edited(false);
   });
   connect(remove_, &QPushButton::clicked, this, [this] {
-    int row = table_->currentRow();
-    if (row < 0) row = table_->rowCount() - 1;
-    if (row < 0) return;
-    table_->removeRow(row);
-    emit edited(false);
+    if (removeSelectedRow(table_)) emit edited(false);
   });
 }
 
@@ -177,11 +182,7 @@ SignalTable::SignalTable(const QString& targetHeader, QWidget* parent) : QWidget
     emit edited(false);
   });
   connect(remove_, &QPushButton::clicked, this, [this] {
-    int row = table_->currentRow();
-    if (row < 0) row = table_->rowCount() - 1;
-    if (row < 0) return;
-    table_->removeRow(row);
-    emit edited(false);
+    if (removeSelectedRow(table_)) emit edited(false);
   });
 }
 
