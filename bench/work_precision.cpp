@@ -21,6 +21,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "io/atomic_file.hpp"
 #include "io/model_file.hpp"
 #include "model/compile.hpp"
 #include "simulation/simulator.hpp"
@@ -79,7 +80,8 @@ int main(int argc, char** argv) {
   std::string csv;
   std::vector<std::string> integrators{"ida", "cvode-bdf", "cvode-adams", "arkode"};
   std::vector<std::string> problems{"andrews", "a01"};
-  for (int i = 1; i + 1 < argc; i += 2) {
+  for (int i = 1; i < argc; i += 2) {
+    if (i + 1 == argc) argv[i] = const_cast<char*>("");  // an option without its value: usage
     if (!std::strcmp(argv[i], "--kmax")) kmax = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--repeats")) repeats = std::max(1, std::atoi(argv[i + 1]));
     else if (!std::strcmp(argv[i], "--csv")) csv = argv[i + 1];
@@ -159,10 +161,10 @@ int main(int argc, char** argv) {
     }
   }
   if (!csv.empty()) {
-    std::ofstream f(csv);
-    f << out.str();
-    if (!f) {
-      std::cerr << csv << ": cannot write\n";
+    try {
+      write_file_atomically(csv, out.str());  // the whole file or the old one, never half
+    } catch (const std::exception& e) {
+      std::cerr << csv << ": cannot write: " << e.what() << "\n";
       return 2;
     }
     std::cout << "wrote " << csv << "\n";
