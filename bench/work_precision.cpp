@@ -1,36 +1,64 @@
-// Work-precision study (docs/work-precision.md): for each problem, integrator and
-// rtol = atol = 10^-(2 + k/2), k = 0..kmax, one run, its error against an exact or
-// reference solution and its CPU time (best of `repeats` runs).
-//   andrews: Andrews' squeezing mechanism (protocol of the Test Set for IVP Solvers),
-//            t = 0.03 s, error = max_i |y_i - y_ref,i| / |y_ref,i| over the seven
-//            angles (SCD = -log10 error);
-//   a01:     IFToMM A01 pendulum, 10 s, error = max over the output samples (every
-//            0.1 s) of the distance [m] between the mass and the exact elliptic-function
-//            solution (computed here by the AGM).
+// Work-precision study (docs/work-precision.md, docs/performance.md): for each problem,
+// each codyna integrator (and each Simbody integrator when the Simbody peer is built) and
+// rtol = atol = 10^-(2 + k/2), k = 0..kmax, one run, its error against an exact solution,
+// a published reference, an exact invariant or a tight reference run, and its CPU time.
 //
-//   build/bin/codyna_work_precision [--kmax 20] [--repeats 3] [--csv FILE] [--integrators ida,cvode-bdf,...]
-//                                   [--problems andrews,a01]
+//   andrews          Andrews' squeezer (Test Set for IVP Solvers), t = 0.03 s: max over the 7
+//                    angles of |y - y_ref| / |y_ref| at t = 0.03 (SCD = -log10 of it)
+//   a01              IFToMM A01 pendulum, 10 s: max over the samples (every 0.1 s) of the
+//                    distance [m] between the mass and the exact elliptic solution (AGM)
+//   a02              IFToMM A02, N = 40 four-bars, 10 s through 10 singular positions: max over
+//                    the samples (every 0.05 s) and the 41 cranks of |crank - phi_exact| [rad]
+//                    (the exact 1-DOF reduction, tests/models/iftomm_a02.hpp)
+//   bricard          IFToMM A04 Bricard (redundant constraints), 10 s: max over the samples
+//                    (every 0.05 s) of the distance [m] of point C from a reference run
+//   a05              IFToMM A05 stiff flyball governor, 10 s: max over the samples (every
+//                    0.05 s) of |slider height - reference run| [m]
+//   heavy_top        heavy top at 150 rad/s, 10 s: max over the samples (every 0.01 s) of the
+//                    relative change of the energy and of the vertical angular momentum
+//   double_pendulum  double pendulum, 1000 s: max over the samples (every 1 s) of
+//                    |E - E0| / |E0| (E0: the energy at the start, potential datum y = 0)
+// The reference runs (bricard, a05) are codyna at 1e-12 with two integrators; their
+// difference is printed as the reference's own uncertainty.
 //
-// Prints a table and writes CSV columns:
-//   problem,integrator,k,tol,error,scd,cpu_s,steps,evaluations,jacobians,projections,completed
-#include <chrono>
+//   build/bin/codyna_work_precision [--kmax K] [--repeats N] [--max-cpu S] [--csv FILE]
+//       [--table FILE] [--integrators ida,cvode-bdf,...] [--problems andrews,a01,...]
+//
+// CPU time: process CPU time of one simulate() call (setting up the solver, integrating,
+// recording the samples), the best of up to `repeats` runs (repeats stop once 1 s is spent).
+// An integrator's sweep on a problem stops at the first run over --max-cpu seconds.
+// CSV columns:
+//   problem,code,integrator,k,tol,error,cpu_s,steps,evaluations,jacobians,projections,completed
+#include <time.h>
+
+#include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
-#include <fstream>
+#include <functional>
 #include <iomanip>
 #include <iostream>
+#include <map>
+#include <set>
 #include <sstream>
 
+#include "dynamics/kinematics.hpp"
 #include "io/atomic_file.hpp"
 #include "io/model_file.hpp"
 #include "model/compile.hpp"
+#include "models/iftomm_a02.hpp"
 #include "simulation/simulator.hpp"
+#ifdef CODYNA_HAVE_SIMBODY
+#include "simbody_peer.hpp"
+#endif
 
 namespace {
 
 using namespace codyna;
 
-const std::pair<const char*, double> kReference[] = {
+constexpr int kA02N = 40;
+
+const std::pair<const char*, double> kAndrewsReference[] = {
     {"beta", 15.81077119629904},  {"Theta", -15.75637105984298},  {"gamma", 0.04082224013073101},
     {"Phi", -0.5347301163226948}, {"delta", 0.5244099658805304},  {"Omega", 0.5347301163226948},
     {"epsilon", 1.048080741042263}};
@@ -73,25 +101,283 @@ std::vector<std::string> split(const std::string& s) {
   return r;
 }
 
+double cpu_now() {
+  timespec ts;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+// a run's output: the problem's quantities at each output time (the same for every code)
+struct Series {
+  std::vector<double> t;
+  std::vector<std::vector<double>> y;
+};
+
+struct Problem {
+  std::string name;
+  double t_end, output_step;
+  int kmax;  // the tightest tolerance of the default sweep
+  Model model;
+  // codyna's result -> the quantities
+  std::function<Series(const Model&, const SimulationResult&)> quantities;
+  // the error of a run's quantities (ref: the reference run's, empty where not needed)
+  std::function<double(const Series&, const Series& ref)> error;
+  bool needs_reference = false;
+};
+
+Model load_example(const std::string& file) {
+  const std::string path = std::string(CODYNA_SOURCE_DIR) + "/examples/" + file;
+  return compile(load_model_spec(path), path);
+}
+
+int joint_q(const Model& m, const std::string& name) { return m.joints[m.find_joint(name)].idx_q; }
+
+Series by_joint(const SimulationResult& r, const std::vector<int>& idx) {
+  Series s;
+  s.t = r.t;
+  for (int i = 0; i < r.samples(); ++i) {
+    std::vector<double> y;
+    for (int j : idx) y.push_back(r.q(i, j));
+    s.y.push_back(y);
+  }
+  return s;
+}
+
+double max_over_samples(const Series& s, const std::function<double(int)>& f) {
+  double e = 0;
+  for (int i = 0; i < static_cast<int>(s.t.size()); ++i) e = std::max(e, f(i));
+  return e;
+}
+
+// the two series have the same output times (else the comparison is meaningless: NaN)
+bool aligned(const Series& a, const Series& b) {
+  if (a.t.size() != b.t.size()) return false;
+  for (size_t i = 0; i < a.t.size(); ++i)
+    if (std::abs(a.t[i] - b.t[i]) > 1e-9 * std::max(1.0, std::abs(b.t[i]))) return false;
+  return true;
+}
+
+std::vector<Problem> make_problems(const std::vector<std::string>& names) {
+  std::vector<Problem> ps;
+  for (const std::string& n : names) {
+    Problem p;
+    p.name = n;
+    if (n == "andrews") {
+      p.t_end = p.output_step = 0.03, p.kmax = 20;
+      p.model = load_example("andrews_squeezer.json");
+      p.quantities = [](const Model& m, const SimulationResult& r) {
+        std::vector<int> idx;
+        for (const auto& [name, ref] : kAndrewsReference) idx.push_back(joint_q(m, name));
+        return by_joint(r, idx);
+      };
+      p.error = [](const Series& s, const Series&) {
+        double e = 0;
+        for (int i = 0; i < 7; ++i)
+          e = std::max(e, std::abs(s.y.back()[i] - kAndrewsReference[i].second) / std::abs(kAndrewsReference[i].second));
+        return e;
+      };
+    } else if (n == "a01") {
+      p.t_end = 10, p.output_step = 0.1, p.kmax = 20;
+      p.model = load_example("iftomm_a01_pendulum.json");
+      p.quantities = [](const Model& m, const SimulationResult& r) {  // q from the horizontal
+        Series s = by_joint(r, {joint_q(m, "pin")});
+        for (auto& y : s.y) y = {std::cos(y[0]), std::sin(y[0])};
+        return s;
+      };
+      p.error = [](const Series& s, const Series&) {
+        return max_over_samples(s, [&](int i) {
+          double x, y;
+          a01_exact(s.t[i], &x, &y);
+          return std::hypot(s.y[i][0] - x, s.y[i][1] - y);
+        });
+      };
+    } else if (n == "a02") {
+      p.t_end = 10, p.output_step = 0.05, p.kmax = 16;
+      p.model = compile(iftomm::a02_spec(kA02N), "iftomm_a02_40");
+      p.quantities = [](const Model& m, const SimulationResult& r) {
+        std::vector<int> idx;
+        for (int i = 0; i <= kA02N; ++i) idx.push_back(joint_q(m, "pivot" + std::to_string(i)));
+        return by_joint(r, idx);
+      };
+      p.error = [](const Series& s, const Series&) {
+        const Eigen::VectorXd phi = iftomm::a02_exact(kA02N, s.t);
+        return max_over_samples(s, [&](int i) {
+          double e = 0;
+          for (double c : s.y[i]) e = std::max(e, std::abs(c - phi[i]));
+          return e;
+        });
+      };
+    } else if (n == "bricard") {
+      p.t_end = 10, p.output_step = 0.05, p.kmax = 20, p.needs_reference = true;
+      p.model = load_example("bricard.json");
+      p.quantities = [](const Model& m, const SimulationResult& r) {  // E, C (the origin of rod3)
+        Series s;
+        s.t = r.t;
+        Data d(m);
+        const int rod3 = m.find_body("rod3");
+        for (int i = 0; i < r.samples(); ++i) {
+          const Eigen::VectorXd q = r.q.row(i).transpose();
+          forward_kinematics<double>(m, d, q);
+          const Eigen::Vector3d C = point_position<double>(d, rod3, Eigen::Vector3d::Zero());
+          s.y.push_back({r.kinetic_energy[i] + r.potential_energy[i], C.x(), C.y(), C.z()});
+        }
+        return s;
+      };
+      p.error = [](const Series& s, const Series& ref) {
+        if (!aligned(s, ref)) return std::nan("");
+        return max_over_samples(s, [&](int i) {
+          return std::hypot(s.y[i][1] - ref.y[i][1], s.y[i][2] - ref.y[i][2], s.y[i][3] - ref.y[i][3]);
+        });
+      };
+    } else if (n == "a05") {
+      p.t_end = 10, p.output_step = 0.05, p.kmax = 18, p.needs_reference = true;
+      p.model = load_example("iftomm_a05_flyball.json");
+      p.quantities = [](const Model& m, const SimulationResult& r) {
+        Series s = by_joint(r, {joint_q(m, "slide")});
+        for (auto& y : s.y) y[0] += 0.5;  // the slider's height
+        return s;
+      };
+      p.error = [](const Series& s, const Series& ref) {
+        if (!aligned(s, ref)) return std::nan("");
+        return max_over_samples(s, [&](int i) { return std::abs(s.y[i][0] - ref.y[i][0]); });
+      };
+    } else if (n == "heavy_top") {
+      p.t_end = 10, p.output_step = 0.01, p.kmax = 20;
+      p.model = load_example("heavy_top.json");
+      p.quantities = [](const Model& m, const SimulationResult& r) {  // E, Lz about the fixed point
+        Series s;
+        s.t = r.t;
+        Data d(m);
+        const int b = m.find_body("top");
+        const BodySpec& spec = *std::find_if(m.spec.bodies.begin(), m.spec.bodies.end(),
+                                             [](const BodySpec& x) { return x.name == "top"; });
+        for (int i = 0; i < r.samples(); ++i) {
+          const Eigen::VectorXd q = r.q.row(i).transpose(), v = r.v.row(i).transpose();
+          forward_kinematics<double>(m, d, q, v);
+          const Eigen::Matrix3d& R = d.oMi[b].R;
+          const Eigen::Vector3d L = R * spec.inertia * R.transpose() * angular_velocity<double>(d, b) +
+                                    spec.mass * point_position<double>(d, b, spec.com)
+                                                    .cross(point_velocity<double>(d, b, spec.com));
+          s.y.push_back({r.kinetic_energy[i] + r.potential_energy[i], L.z()});
+        }
+        return s;
+      };
+      p.error = [](const Series& s, const Series&) {
+        return max_over_samples(s, [&](int i) {
+          return std::max(std::abs(s.y[i][0] - s.y[0][0]) / std::abs(s.y[0][0]),
+                          std::abs(s.y[i][1] - s.y[0][1]) / std::abs(s.y[0][1]));
+        });
+      };
+    } else if (n == "double_pendulum") {
+      p.t_end = 1000, p.output_step = 1, p.kmax = 20;
+      p.model = load_example("double_pendulum.json");
+      p.quantities = [](const Model&, const SimulationResult& r) {
+        Series s;
+        s.t = r.t;
+        for (int i = 0; i < r.samples(); ++i) s.y.push_back({r.kinetic_energy[i] + r.potential_energy[i]});
+        return s;
+      };
+      p.error = [](const Series& s, const Series&) {
+        return max_over_samples(s, [&](int i) { return std::abs(s.y[i][0] - s.y[0][0]) / std::abs(s.y[0][0]); });
+      };
+    } else {
+      throw std::invalid_argument("unknown problem \"" + n +
+                                  "\" (expected andrews, a01, a02, bricard, a05, heavy_top, double_pendulum)");
+    }
+    ps.push_back(std::move(p));
+  }
+  return ps;
+}
+
+struct Run {
+  std::string problem, code, integrator;
+  int k = 0;
+  double tol = 0, error = NAN, cpu = 0;
+  long steps = 0, evals = 0, jacs = 0, projections = 0;
+  bool completed = false;
+  std::string failure;
+};
+
+struct CodynaRun {
+  SimulationResult result;
+  double cpu = 0;
+};
+
+CodynaRun run_codyna(const Problem& p, const std::string& method, double tol, int repeats, double max_cpu = 1e300) {
+  SimulationOptions o;
+  o.integrator.method = method;
+  o.integrator.rtol = o.integrator.atol = tol;
+  o.t_end = p.t_end;
+  o.output_step = p.output_step;
+  o.projection_tolerance = 0.1 * tol;  // projections must not spoil the accuracy asked for
+  CodynaRun best;
+  best.cpu = 1e300;
+  double spent = 0;
+  for (int rep = 0; rep < repeats && (rep == 0 || spent < 1.0); ++rep) {
+    const double t0 = cpu_now();
+    std::atomic<bool> cancel{false};
+    SimulationCallbacks cb;  // a run over max_cpu is stopped at its next output time
+    cb.progress = [&](double, double) {
+      if (cpu_now() - t0 > max_cpu) cancel = true;
+    };
+    cb.cancel = &cancel;
+    SimulationResult r = simulate(p.model, nullptr, nullptr, o, cb);
+    const double dt = cpu_now() - t0;
+    if (r.cancelled) r.failure = "stopped: over the CPU time limit (--max-cpu)";
+    spent += dt;
+    if (dt < best.cpu) best.cpu = dt;
+    best.result = std::move(r);
+  }
+  return best;
+}
+
+void print_run(const Run& r) {
+  std::cout << std::left << std::setw(16) << r.integrator << std::right << std::setw(4) << r.k << std::setw(10)
+            << std::setprecision(2) << r.tol << std::setw(12) << std::setprecision(3) << r.error << std::setw(12)
+            << std::fixed << std::setprecision(4) << r.cpu << std::defaultfloat << std::setw(10) << r.steps
+            << std::setw(12) << r.evals << (r.completed ? "" : "  FAILED: " + r.failure) << std::endl;
+}
+
+std::string cell_ms(double cpu) {
+  if (!(cpu < 1e300)) return "—";
+  std::ostringstream os;
+  os << std::setprecision(cpu < 0.01 ? 2 : 3) << cpu * 1e3;
+  return os.str();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  int kmax = 20, repeats = 3;  // tolerances 1e-2 .. 1e-12
-  std::string csv;
+  int kmax = 20, repeats = 3;
+  double max_cpu = 30;
+  std::string csv, table_file;
   std::vector<std::string> integrators{"ida", "cvode-bdf", "cvode-adams", "arkode"};
-  std::vector<std::string> problems{"andrews", "a01"};
+  std::vector<std::string> problem_names{"andrews", "a01", "a02", "bricard", "a05", "heavy_top", "double_pendulum"};
+#ifdef CODYNA_HAVE_SIMBODY
+  for (const std::string& s : peer::simbody_integrators()) integrators.push_back(s);
+#endif
   for (int i = 1; i < argc; i += 2) {
     if (i + 1 == argc) argv[i] = const_cast<char*>("");  // an option without its value: usage
     if (!std::strcmp(argv[i], "--kmax")) kmax = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--repeats")) repeats = std::max(1, std::atoi(argv[i + 1]));
+    else if (!std::strcmp(argv[i], "--max-cpu")) max_cpu = std::atof(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--csv")) csv = argv[i + 1];
+    else if (!std::strcmp(argv[i], "--table")) table_file = argv[i + 1];
     else if (!std::strcmp(argv[i], "--integrators")) integrators = split(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--problems")) problems = split(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--problems")) problem_names = split(argv[i + 1]);
     else {
-      std::cerr << "usage: codyna_work_precision [--kmax K] [--repeats N] [--csv FILE] [--integrators a,b] "
-                   "[--problems andrews,a01]\n";
+      std::cerr << "usage: codyna_work_precision [--kmax K] [--repeats N] [--max-cpu S] [--csv FILE] [--table FILE]\n"
+                   "                             [--integrators a,b] [--problems andrews,a01,a02,bricard,a05,heavy_top,"
+                   "double_pendulum]\n";
       return 1;
     }
+  }
+  std::vector<Problem> problems;
+  try {
+    problems = make_problems(problem_names);
+  } catch (const std::exception& e) {
+    std::cerr << e.what() << "\n";
+    return 1;
   }
   {  // the exact solution against the published point (docs of examples/iftomm_a01_pendulum.json)
     double x, y;
@@ -100,74 +386,119 @@ int main(int argc, char** argv) {
               << "), published (-0.9862917511319, -0.1650108531255)\n"
               << std::defaultfloat;
   }
-  std::ostringstream out;
-  out << "problem,integrator,k,tol,error,scd,cpu_s,steps,evaluations,jacobians,projections,completed\n";
-  for (const std::string& problem : problems) {
-    std::string file;
-    double t_end, output_step;
-    if (problem == "andrews") file = "andrews_squeezer.json", t_end = 0.03, output_step = 0.03;
-    else if (problem == "a01") file = "iftomm_a01_pendulum.json", t_end = 10.0, output_step = 0.1;
-    else {
-      std::cerr << "unknown problem " << problem << "\n";
-      return 1;
+  std::vector<Run> runs;
+  for (const Problem& p : problems) {
+    std::cout << "\n" << p.name << " (" << p.t_end << " s, samples every " << p.output_step << " s)" << std::endl;
+    Series ref;
+    if (p.needs_reference) {  // two codyna integrators at 1e-12; their difference is the reference's uncertainty
+      const char* methods[2] = {"cvode-bdf", "arkode"};
+      Series s[2];
+      for (int i = 0; i < 2; ++i) {
+        const CodynaRun c = run_codyna(p, methods[i], 1e-12, 1);
+        if (!c.result.completed) {
+          std::cerr << p.name << ": the reference run (" << methods[i] << " at 1e-12) failed: " << c.result.failure << "\n";
+          return 2;
+        }
+        s[i] = p.quantities(p.model, c.result);
+      }
+      ref = s[0];
+      std::cout << "reference: cvode-bdf at 1e-12; its error measured against arkode at 1e-12: "
+                << p.error(s[1], s[0]) << std::endl;
     }
-    const std::string model_path = std::string(CODYNA_SOURCE_DIR) + "/examples/" + file;
-    const Model m = compile(load_model_spec(model_path), model_path);
-    std::cout << "\n" << problem << "\n"
-              << std::left << std::setw(12) << "integrator" << std::right << std::setw(4) << "k" << std::setw(10)
+    std::cout << std::left << std::setw(16) << "integrator" << std::right << std::setw(4) << "k" << std::setw(10)
               << "tol" << std::setw(12) << "error" << std::setw(12) << "CPU [s]" << std::setw(10) << "steps"
-              << std::setw(12) << "evals" << "\n";
+              << std::setw(12) << "evals" << std::endl;
     for (const std::string& method : integrators) {
-      for (int k = 0; k <= kmax; ++k) {
-        const double tol = std::pow(10.0, -(2.0 + k / 2.0));
-        SimulationOptions o;
-        o.integrator.method = method;
-        o.integrator.rtol = o.integrator.atol = tol;
-        o.t_end = t_end;
-        o.output_step = output_step;
-        o.projection_tolerance = 0.1 * tol;  // projections must not spoil the accuracy asked for
-        SimulationResult r;
-        double best = 1e300;
-        for (int rep = 0; rep < repeats; ++rep) {
-          const auto t0 = std::chrono::steady_clock::now();
-          r = simulate(m, nullptr, nullptr, o);
-          best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-        }
-        double err = 0;
-        if (problem == "andrews") {
-          for (const auto& [name, ref] : kReference)
-            err = std::max(err, std::abs(r.q(r.samples() - 1, m.joints[m.find_joint(name)].idx_q) - ref) /
-                                    std::abs(ref));
-        } else {  // a01: q from the horizontal, mass at (cos q, sin q)
-          const int iq = m.joints[m.find_joint("pin")].idx_q;
-          for (int s = 0; s < r.samples(); ++s) {
-            double x, y;
-            a01_exact(r.t[s], &x, &y);
-            const double q = r.q(s, iq);
-            err = std::max(err, std::hypot(std::cos(q) - x, std::sin(q) - y));
+      const bool simbody = method.rfind("simbody-", 0) == 0;
+#ifdef CODYNA_HAVE_SIMBODY
+      if (simbody && !peer::simbody_supports(p.name)) {
+        std::cout << method << ": the Simbody peer does not model " << p.name << std::endl;
+        continue;
+      }
+#endif
+      for (int k = 0; k <= std::min(kmax, p.kmax); ++k) {
+        Run r;
+        r.problem = p.name, r.code = simbody ? "simbody" : "codyna", r.integrator = method, r.k = k;
+        r.tol = std::pow(10.0, -(2.0 + k / 2.0));
+        Series s;
+        if (!simbody) {
+          CodynaRun c;
+          try {
+            c = run_codyna(p, method, r.tol, repeats, max_cpu);
+          } catch (const std::exception& e) {
+            std::cerr << method << ": " << e.what() << "\n";
+            return 1;
           }
+          r.cpu = c.cpu, r.completed = c.result.completed, r.failure = c.result.failure;
+          r.steps = c.result.stats.steps, r.evals = c.result.stats.rhs_evals;
+          r.jacs = c.result.stats.jac_evals, r.projections = c.result.stats.projections;
+          s = p.quantities(p.model, c.result);
+        } else {
+#ifdef CODYNA_HAVE_SIMBODY
+          const peer::PeerRun pr = peer::run_simbody(p.name, method, r.tol, p.t_end, p.output_step, repeats, kA02N);
+          r.cpu = pr.cpu_s, r.completed = pr.completed, r.failure = pr.failure;
+          r.steps = pr.steps, r.evals = pr.evaluations;
+          s.t = pr.t, s.y = pr.y;
+#else
+          std::cerr << method << ": this build has no Simbody peer (libsimbody-dev)\n";
+          return 1;
+#endif
         }
-        if (!r.completed) err = std::nan("");
-        const double scd = -std::log10(err);
-        std::cout << std::left << std::setw(12) << method << std::right << std::setw(4) << k << std::setw(10)
-                  << std::setprecision(2) << tol << std::setw(12) << std::setprecision(3) << err << std::setw(12)
-                  << std::fixed << std::setprecision(4) << best << std::defaultfloat << std::setw(10)
-                  << r.stats.steps << std::setw(12) << r.stats.rhs_evals
-                  << (r.completed ? "" : "  FAILED: " + r.failure) << "\n";
-        out << problem << "," << method << "," << k << "," << tol << "," << err << "," << scd << "," << best << ","
-            << r.stats.steps << "," << r.stats.rhs_evals << "," << r.stats.jac_evals << "," << r.stats.projections
-            << "," << r.completed << "\n";
+        r.error = r.completed ? p.error(s, ref) : std::nan("");
+        print_run(r);
+        runs.push_back(r);
+        if (r.cpu > max_cpu || r.failure.rfind("stopped:", 0) == 0) {
+          std::cout << method << ": over " << max_cpu << " s CPU, tighter tolerances skipped" << std::endl;
+          break;
+        }
       }
     }
   }
-  if (!csv.empty()) {
+
+  // CPU time at equal accuracy: the cheapest run of each integrator whose error is at most the target
+  std::ostringstream table;
+  std::vector<std::string> cols;
+  for (const std::string& i : integrators) cols.push_back(i);
+  table << "| problem | error <= |";
+  for (const std::string& c : cols) table << " " << c << " |";
+  table << " codyna best / Simbody best |\n|---|---|";
+  for (size_t i = 0; i <= cols.size(); ++i) table << "---|";
+  table << "\n";
+  for (const Problem& p : problems) {
+    for (double target : {1e-3, 1e-6, 1e-9}) {
+      std::map<std::string, double> best;
+      double best_codyna = 1e300, best_simbody = 1e300;
+      for (const Run& r : runs) {
+        if (r.problem != p.name || !(r.error <= target)) continue;
+        double& b = best.try_emplace(r.integrator, 1e300).first->second;
+        b = std::min(b, r.cpu);
+        (r.code == "simbody" ? best_simbody : best_codyna) = std::min(r.code == "simbody" ? best_simbody : best_codyna, r.cpu);
+      }
+      table << "| " << p.name << " | " << std::setprecision(1) << target << " |";
+      for (const std::string& c : cols) table << " " << cell_ms(best.count(c) ? best[c] : 1e300) << " |";
+      if (best_codyna < 1e300 && best_simbody < 1e300)
+        table << " " << std::setprecision(2) << best_codyna / best_simbody << " |\n";
+      else
+        table << " — |\n";
+    }
+  }
+  std::cout << "\nCPU time [ms] of the cheapest run whose error is at most the target:\n" << table.str();
+
+  std::ostringstream out;
+  out << "problem,code,integrator,k,tol,error,cpu_s,steps,evaluations,jacobians,projections,completed\n";
+  for (const Run& r : runs)
+    out << r.problem << "," << r.code << "," << r.integrator << "," << r.k << "," << std::setprecision(17) << r.tol << ","
+        << r.error << "," << r.cpu << "," << r.steps << "," << r.evals << "," << r.jacs << "," << r.projections << ","
+        << r.completed << "\n";
+  for (const auto& [file, text] : {std::pair{csv, out.str()}, std::pair{table_file, table.str()}}) {
+    if (file.empty()) continue;
     try {
-      write_file_atomically(csv, out.str());  // the whole file or the old one, never half
+      write_file_atomically(file, text);  // the whole file or the old one, never half
     } catch (const std::exception& e) {
-      std::cerr << csv << ": cannot write: " << e.what() << "\n";
+      std::cerr << file << ": cannot write: " << e.what() << "\n";
       return 2;
     }
-    std::cout << "wrote " << csv << "\n";
+    std::cout << "wrote " << file << "\n";
   }
   return 0;
 }
