@@ -47,6 +47,7 @@ void summary(const SimulationResult& r, const Model& m, const LinearPlant* plant
             << "): " << r.stats.steps << " steps, " << r.stats.rhs_evals << " evaluations, " << r.stats.jac_evals
             << " Jacobians, " << r.stats.projections << " projections, " << std::setprecision(3) << r.stats.wall_time
             << " s\n" << std::setprecision(6);
+  if (!r.stats.integrator_choice.empty()) std::cout << "                 " << r.stats.integrator_choice << "\n";
   if (N == 0) return;
   for (int k = 0; k < r.y.cols(); ++k) {
     const double y0 = plant ? plant->lin.system.y0[k] : r.y(0, k);
@@ -219,7 +220,7 @@ void add_simulate(CLI::App& app) {
   cmd->add_option("--operating-point", a->op, "where the controller's plant is linearized: initial | equilibrium | trim | time=T")->capture_default_str();
   cmd->add_flag("--compare-linear", a->compare_linear, "also simulate the linear closed loop and report where it parts from the nonlinear one");
   cmd->add_option("--t-end", a->t_end, "end time [s] (default: the model's solver settings)");
-  cmd->add_option("--integrator", a->integrator, "ida | cvode-bdf | cvode-adams | arkode | rk4");
+  cmd->add_option("--integrator", a->integrator, "auto | ida | cvode-bdf | cvode-adams | arkode | rk4 (default: the model file's solver, auto when it names none)");
   cmd->add_option("--rtol", a->rtol, "relative tolerance");
   cmd->add_option("--atol", a->atol, "absolute tolerance");
   cmd->add_option("--max-step", a->max_step, "largest step [s] (rk4: its fixed step)");

@@ -45,7 +45,7 @@ constexpr int kMergeDisturbances = 0x53490005;  // and in the disturbances table
 // stays light; the finished result is shown at the plots' own limit
 constexpr int kLivePlotPoints = 2000;
 
-const char* const kIntegrators[] = {"ida", "cvode-bdf", "cvode-adams", "arkode", "rk4"};
+const char* const kIntegrators[] = {"auto", "ida", "cvode-bdf", "cvode-adams", "arkode", "rk4"};
 
 QString num(double x, int digits = 6) { return QString::number(x, 'g', digits); }
 
@@ -715,7 +715,7 @@ void SimulateView::onFinished(std::shared_ptr<const SimulationResult> r) {
                 .arg(head)
                 .arg(N)
                 .arg(r->stats.steps)
-                .arg(qs(r->stats.integrator))
+                .arg(qs(r->stats.integrator_choice.empty() ? r->stats.integrator : r->stats.integrator_choice))
                 .arg(num(worker_->wallTime(), 3))
                 .arg(qs(r->controller.empty() ? worker_->controllerSource().toStdString() : r->controller));
   for (const QString& n : worker_->notes()) status_ += tr("; note: %1").arg(n);

@@ -204,7 +204,7 @@ struct ControllerSpec {
 };
 
 struct SolverSpec {
-  std::string integrator = "ida";
+  std::string integrator = "auto";  // chosen per model at the start of a run (simulation/integrator_choice.hpp)
   double rtol = 1e-8;
   double atol = 1e-10;
   double t_end = 5.0;

@@ -22,7 +22,7 @@
 namespace codyna {
 
 struct IntegratorSettings {
-  std::string method = "ida";
+  std::string method = "auto";  // auto: chosen per model (simulation/integrator_choice.hpp)
   double rtol = 1e-8, atol = 1e-10;
   double max_step = 0;  // 0 = no limit (rk4: its fixed step, default 1e-3)
 };
@@ -46,7 +46,8 @@ class Integrator {
   virtual void add_stats(SolverStats& s) const = 0;
 };
 
-// throws std::invalid_argument for an unknown method or bad tolerances
+// throws std::invalid_argument for an unknown method or bad tolerances, and for "auto", which
+// the caller resolves first (choose_integrator)
 std::unique_ptr<Integrator> make_integrator(ClosedLoopSystem& system, const IntegratorSettings& settings);
 
 }  // namespace codyna

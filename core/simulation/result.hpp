@@ -10,7 +10,7 @@
 namespace codyna {
 
 struct SolverStats {
-  std::string integrator;          // "ida", "cvode-bdf", "cvode-adams", "arkode", "rk4"
+  std::string integrator;          // "ida", "cvode-bdf", "cvode-adams", "arkode", "rk4" (never "auto": the one chosen)
   double rtol = 0, atol = 0, max_step = 0;
   long steps = 0;                  // internal steps
   long rhs_evals = 0;              // right-hand side / residual evaluations
@@ -21,6 +21,7 @@ struct SolverStats {
   long projections = 0;            // constraint projections (closed loops)
   long restarts = 0;               // re-initializations at controller samples / projections
   double wall_time = 0;            // seconds
+  std::string integrator_choice;   // when "auto" was asked: what was chosen and why (simulation/integrator_choice.hpp)
 };
 
 struct SimulationResult {

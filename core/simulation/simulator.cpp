@@ -9,6 +9,7 @@
 #include "dynamics/energy.hpp"
 #include "dynamics/kinematics.hpp"
 #include "dynamics/sensors.hpp"
+#include "simulation/integrator_choice.hpp"
 
 namespace codyna {
 
@@ -207,11 +208,17 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
   if (discrete) controller_sample(o.t0);
 
   SimulationResult r;
-  r.stats.integrator = o.integrator.method;
+  IntegratorSettings settings = o.integrator;
+  if (settings.method == "auto") {  // the default: chosen from the closed loop at the initial state
+    const IntegratorChoice choice = choose_integrator(sys, o.t0, y, o.t_end - o.t0);
+    settings.method = choice.method;
+    r.stats.integrator_choice = choice.reason;
+  }
+  r.stats.integrator = settings.method;
   r.stats.rtol = o.integrator.rtol;
   r.stats.atol = o.integrator.atol;
   r.stats.max_step = o.integrator.max_step;
-  auto integrator = make_integrator(sys, o.integrator);
+  auto integrator = make_integrator(sys, settings);
   integrator->reset(o.t0, y);
 
   Recorder rec;

@@ -4,14 +4,31 @@
 #include <sstream>
 
 #include "dynamics/assembly.hpp"
+#include "simulation/integrator_choice.hpp"
 
 namespace codyna {
 
 Stepper::Stepper(const Model& model, const IntegratorSettings& settings, double projection_tolerance)
     : model_(model), projection_tolerance_(projection_tolerance),
-      sys_(model, nullptr, nullptr, Eigen::VectorXd(), model.u_nominal()),
-      integrator_(make_integrator(sys_, settings)) {
-  extra_.integrator = settings.method;
+      sys_(model, nullptr, nullptr, Eigen::VectorXd(), model.u_nominal()) {
+  IntegratorSettings s = settings;
+  if (s.method == "auto") {  // chosen at the model's initial state; a stepped run has no length: 1 s
+    Eigen::VectorXd q = model.q0, v = model.v0;
+    if (model.nc) {
+      const AssemblyResult a = assemble(model, q, v);
+      if (a.converged) q = a.q, v = a.v;
+    }
+    Eigen::VectorXd y(sys_.ode_size());
+    y << q, v;
+    Eigen::VectorXd u(nu());
+    for (int k = 0; k < nu(); ++k) u[k] = model.actuators[model.plant_inputs[k]].u0;
+    sys_.set_held(u);
+    const IntegratorChoice choice = choose_integrator(sys_, 0.0, y, 1.0);
+    s.method = choice.method;
+    extra_.integrator_choice = choice.reason;
+  }
+  integrator_ = make_integrator(sys_, s);
+  extra_.integrator = s.method;
   extra_.rtol = settings.rtol;
   extra_.atol = settings.atol;
   extra_.max_step = settings.max_step;

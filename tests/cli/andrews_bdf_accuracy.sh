@@ -3,7 +3,7 @@
 # t = 0.03 s at rtol = atol = 1e-10 through `codyna simulate`, scored by the
 # Test Set's significant correct digits SCD = -log10(max_i |y_i - y_ref,i| / |y_ref,i|)
 # over the seven angles against the Test Set's PSIDE reference (itself good to
-# about SCD 10). IDA, CVODE BDF and the default integrator must each reach SCD 8.
+# about SCD 10). IDA, CVODE BDF, auto and the default integrator (the model file's, auto) must each reach SCD 8.
 # usage: andrews_bdf_accuracy.sh CODYNA SOURCE_DIR WORK_DIR
 set -euo pipefail
 codyna=$1 src=$2 work=$3
@@ -25,7 +25,7 @@ print("%.3f" % -math.log10(err))
 PYEOF
 }
 
-for integ in ida cvode-bdf default; do
+for integ in ida cvode-bdf auto default; do
   flag=(); [ "$integ" = default ] || flag=(--integrator "$integ")
   "$codyna" simulate "$src/examples/andrews_squeezer.json" --open-loop "${flag[@]}" --t-end 0.03 \
     --rtol 1e-10 --atol 1e-10 --quiet --out "$work/$integ.h5" --csv "$work/$integ.csv" > "$work/$integ.txt" \

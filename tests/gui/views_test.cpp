@@ -825,7 +825,7 @@ class ViewsTest : public QObject {
     while (undo->index() > base) undo->undo();
     QCOMPARE(doc.spec().analysis, original.analysis);
     QCOMPARE(view.controllerCombo()->currentData().toString(), QString("model"));
-    QCOMPARE(view.integratorCombo()->currentData().toString(), QString("ida"));
+    QCOMPARE(view.integratorCombo()->currentData().toString(), QString("auto"));
     QCOMPARE(view.qWeightsEdit()->text(), QString());
 
     // the model file's controller is described (an LQR here)

@@ -1,0 +1,34 @@
+// The default integrator, "auto": chosen per model and initial state from the
+// eigenvalues of the closed loop's Jacobian d ydot / d y there (ODE form, central
+// differences), by the rule that was fastest at equal accuracy on the reference
+// problems of the work-precision study (docs/work-precision.md, "The default integrator"):
+//   stiff (a decay rate at least 100 times every other rate of the motion and 1 / span)
+//                                      -> cvode-bdf
+//   not stiff, a tree                  -> cvode-adams
+//   not stiff, closed loops            -> arkode (explicit Runge-Kutta, projected every step)
+// Models with more than kMaxAnalysed states are not analysed (their eigenvalues would cost
+// more than a short run) and are taken as not stiff; the reason says so.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+
+#include "simulation/closed_loop.hpp"
+#include "simulation/integrator.hpp"
+
+namespace codyna {
+
+struct IntegratorChoice {
+  std::string method;             // one of ida, cvode-bdf, cvode-adams, arkode
+  std::string reason;             // one line, for the run's log and results
+  double fastest_decay = 0;       // max -Re(lambda) [1/s]
+  double slow_rate = 0;           // max |lambda| of the other modes, or 1 / span [1/s]
+  bool stiff = false, analysed = false;
+};
+
+constexpr int kMaxAnalysed = 600;
+
+// y: the ODE-layout state [q; v; xc] at time t (on the constraints); span: the run's length
+IntegratorChoice choose_integrator(ClosedLoopSystem& sys, double t, const Eigen::VectorXd& y, double span);
+
+}  // namespace codyna
