@@ -26,10 +26,16 @@
 //
 // CPU time: process CPU time of one simulate() call (setting up the solver, integrating,
 // recording the samples), the best of up to `repeats` runs (repeats stop once 1 s is spent).
-// An integrator's sweep on a problem stops at the first run over --max-cpu seconds.
+// Each run happens in a child process limited to --max-cpu seconds of CPU (default 30): a
+// run over it is killed and reported as stopped, and the integrator's sweep on that problem
+// stops there (tighter tolerances cost more).
 // CSV columns:
 //   problem,code,integrator,k,tol,error,cpu_s,steps,evaluations,jacobians,projections,completed
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <time.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -303,7 +309,7 @@ struct CodynaRun {
   double cpu = 0;
 };
 
-CodynaRun run_codyna(const Problem& p, const std::string& method, double tol, int repeats, double max_cpu = 1e300) {
+CodynaRun run_codyna(const Problem& p, const std::string& method, double tol, int repeats) {
   SimulationOptions o;
   o.integrator.method = method;
   o.integrator.rtol = o.integrator.atol = tol;
@@ -315,20 +321,97 @@ CodynaRun run_codyna(const Problem& p, const std::string& method, double tol, in
   double spent = 0;
   for (int rep = 0; rep < repeats && (rep == 0 || spent < 1.0); ++rep) {
     const double t0 = cpu_now();
-    std::atomic<bool> cancel{false};
-    SimulationCallbacks cb;  // a run over max_cpu is stopped at its next output time
-    cb.progress = [&](double, double) {
-      if (cpu_now() - t0 > max_cpu) cancel = true;
-    };
-    cb.cancel = &cancel;
-    SimulationResult r = simulate(p.model, nullptr, nullptr, o, cb);
+    SimulationResult r = simulate(p.model, nullptr, nullptr, o);
     const double dt = cpu_now() - t0;
-    if (r.cancelled) r.failure = "stopped: over the CPU time limit (--max-cpu)";
     spent += dt;
     if (dt < best.cpu) best.cpu = dt;
     best.result = std::move(r);
   }
   return best;
+}
+
+// One run in a child process (fork) whose CPU time is limited (RLIMIT_CPU): a run that gets
+// stuck inside one output interval (tiny steps at a singular position) is killed, the sweep
+// goes on. The child sends back the run's numbers and quantities through a pipe.
+struct Outcome {
+  bool completed = false;
+  std::string failure;
+  double cpu = 0;
+  long steps = 0, evals = 0, jacs = 0, projections = 0;
+  Series s;
+};
+
+void put(std::string& b, double x) { b.append(reinterpret_cast<const char*>(&x), sizeof x); }
+double get(const std::string& b, size_t& at) {
+  double x = NAN;
+  if (at + sizeof x <= b.size()) std::memcpy(&x, b.data() + at, sizeof x);
+  at += sizeof x;
+  return x;
+}
+
+Outcome in_child(double max_cpu, const std::function<Outcome()>& work) {
+  Outcome o;
+  int fd[2];
+  if (pipe(fd) != 0) throw std::runtime_error("pipe failed");
+  std::cout.flush();
+  const pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error("fork failed");
+  if (pid == 0) {  // the child: run, write, exit without running the parent's destructors
+    close(fd[0]);
+    const rlim_t limit = static_cast<rlim_t>(std::ceil(cpu_now() + max_cpu + 1));
+    rlimit rl{limit, limit + 1};
+    setrlimit(RLIMIT_CPU, &rl);
+    std::string b;
+    try {
+      const Outcome r = work();
+      put(b, r.completed), put(b, r.cpu), put(b, r.steps), put(b, r.evals), put(b, r.jacs), put(b, r.projections);
+      put(b, r.s.t.size()), put(b, r.s.y.empty() ? 0 : r.s.y[0].size());
+      for (size_t i = 0; i < r.s.t.size(); ++i) {
+        put(b, r.s.t[i]);
+        for (double y : r.s.y[i]) put(b, y);
+      }
+      b += r.failure;
+    } catch (const std::exception& e) {
+      b.clear();
+      put(b, -1.0);
+      b += e.what();
+    }
+    for (size_t at = 0; at < b.size();) {
+      const ssize_t n = write(fd[1], b.data() + at, b.size() - at);
+      if (n <= 0) break;
+      at += n;
+    }
+    close(fd[1]);
+    _exit(0);
+  }
+  close(fd[1]);
+  std::string b;
+  char buf[65536];
+  for (ssize_t n; (n = read(fd[0], buf, sizeof buf)) > 0;) b.append(buf, n);
+  close(fd[0]);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  if (!WIFEXITED(status) || b.size() < sizeof(double)) {
+    o.failure = WIFSIGNALED(status) && (WTERMSIG(status) == SIGXCPU || WTERMSIG(status) == SIGKILL)
+                    ? "stopped: over the CPU time limit (--max-cpu)"
+                    : "the run's process ended abnormally";
+    o.cpu = max_cpu;
+    return o;
+  }
+  size_t at = 0;
+  const double first = get(b, at);
+  if (first < 0) throw std::runtime_error(b.substr(at));
+  o.completed = first > 0;
+  o.cpu = get(b, at), o.steps = get(b, at), o.evals = get(b, at), o.jacs = get(b, at), o.projections = get(b, at);
+  const size_t n = get(b, at), m = get(b, at);
+  for (size_t i = 0; i < n; ++i) {
+    o.s.t.push_back(get(b, at));
+    std::vector<double> y(m);
+    for (double& x : y) x = get(b, at);
+    o.s.y.push_back(y);
+  }
+  if (at < b.size()) o.failure = b.substr(at);
+  return o;
 }
 
 void print_run(const Run& r) {
@@ -420,31 +503,39 @@ int main(int argc, char** argv) {
         Run r;
         r.problem = p.name, r.code = simbody ? "simbody" : "codyna", r.integrator = method, r.k = k;
         r.tol = std::pow(10.0, -(2.0 + k / 2.0));
-        Series s;
-        if (!simbody) {
-          CodynaRun c;
-          try {
-            c = run_codyna(p, method, r.tol, repeats, max_cpu);
-          } catch (const std::exception& e) {
-            std::cerr << method << ": " << e.what() << "\n";
-            return 1;
-          }
-          r.cpu = c.cpu, r.completed = c.result.completed, r.failure = c.result.failure;
-          r.steps = c.result.stats.steps, r.evals = c.result.stats.rhs_evals;
-          r.jacs = c.result.stats.jac_evals, r.projections = c.result.stats.projections;
-          s = p.quantities(p.model, c.result);
-        } else {
-#ifdef CODYNA_HAVE_SIMBODY
-          const peer::PeerRun pr = peer::run_simbody(p.name, method, r.tol, p.t_end, p.output_step, repeats, kA02N);
-          r.cpu = pr.cpu_s, r.completed = pr.completed, r.failure = pr.failure;
-          r.steps = pr.steps, r.evals = pr.evaluations;
-          s.t = pr.t, s.y = pr.y;
-#else
+#ifndef CODYNA_HAVE_SIMBODY
+        if (simbody) {
           std::cerr << method << ": this build has no Simbody peer (libsimbody-dev)\n";
           return 1;
-#endif
         }
-        r.error = r.completed ? p.error(s, ref) : std::nan("");
+#endif
+        Outcome o;
+        try {
+          o = in_child(max_cpu, [&] {
+            Outcome x;
+            if (!simbody) {
+              const CodynaRun c = run_codyna(p, method, r.tol, repeats);
+              x.cpu = c.cpu, x.completed = c.result.completed, x.failure = c.result.failure;
+              x.steps = c.result.stats.steps, x.evals = c.result.stats.rhs_evals;
+              x.jacs = c.result.stats.jac_evals, x.projections = c.result.stats.projections;
+              x.s = p.quantities(p.model, c.result);
+            } else {
+#ifdef CODYNA_HAVE_SIMBODY
+              const peer::PeerRun pr = peer::run_simbody(p.name, method, r.tol, p.t_end, p.output_step, repeats, kA02N);
+              x.cpu = pr.cpu_s, x.completed = pr.completed, x.failure = pr.failure;
+              x.steps = pr.steps, x.evals = pr.evaluations;
+              x.s.t = pr.t, x.s.y = pr.y;
+#endif
+            }
+            return x;
+          });
+        } catch (const std::exception& e) {
+          std::cerr << method << ": " << e.what() << "\n";
+          return 1;
+        }
+        r.cpu = o.cpu, r.completed = o.completed, r.failure = o.failure;
+        r.steps = o.steps, r.evals = o.evals, r.jacs = o.jacs, r.projections = o.projections;
+        r.error = r.completed ? p.error(o.s, ref) : std::nan("");
         print_run(r);
         runs.push_back(r);
         if (r.cpu > max_cpu || r.failure.rfind("stopped:", 0) == 0) {
