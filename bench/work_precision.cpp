@@ -7,7 +7,7 @@
 //                    angles of |y - y_ref| / |y_ref| at t = 0.03 (SCD = -log10 of it)
 //   a01              IFToMM A01 pendulum, 10 s: max over the samples (every 0.1 s) of the
 //                    distance [m] between the mass and the exact elliptic solution (AGM)
-//   a02              IFToMM A02, N = 40 four-bars, 10 s through 10 singular positions: max over
+//   a02              IFToMM A02, N = 40 four-bars, 20 s through 20 singular positions: max over
 //                    the samples (every 0.05 s) and the 41 cranks of |crank - phi_exact| [rad]
 //                    (the exact 1-DOF reduction, tests/models/iftomm_a02.hpp)
 //   bricard          IFToMM A04 Bricard (redundant constraints), 10 s: max over the samples
@@ -198,7 +198,7 @@ std::vector<Problem> make_problems(const std::vector<std::string>& names) {
         });
       };
     } else if (n == "a02") {
-      p.t_end = 10, p.output_step = 0.05, p.kmax = 16;
+      p.t_end = 20, p.output_step = 0.05, p.kmax = 16;
       p.model = compile(iftomm::a02_spec(kA02N), "iftomm_a02_40");
       p.quantities = [](const Model& m, const SimulationResult& r) {
         std::vector<int> idx;

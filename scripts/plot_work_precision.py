@@ -20,8 +20,14 @@ import matplotlib.pyplot as plt  # noqa: E402
 TITLES = {
     "andrews": "Andrews' squeezer, t = 0.03 s: max relative error of the 7 angles",
     "a01": "IFToMM A01 pendulum, 10 s: max position error of the mass [m]",
+    "a02": "IFToMM A02, N = 40 four-bars, 20 s: max crank angle error [rad] (exact reduction)",
+    "bricard": "IFToMM A04 Bricard, 10 s: max error of point C [m] (reference run)",
+    "a05": "IFToMM A05 stiff flyball, 10 s: max slider height error [m] (reference run)",
+    "heavy_top": "Heavy top, 10 s: max relative change of energy and vertical momentum",
+    "double_pendulum": "Double pendulum, 1000 s: max relative energy change",
 }
-BOUNDS = {"a01": (1e-3, "IFToMM high precision (1e-3)")}  # problem -> (value, label)
+_HIGH = (1e-3, "IFToMM high precision (1e-3)")
+BOUNDS = {"a01": _HIGH, "a02": _HIGH, "bricard": _HIGH, "a05": _HIGH}  # problem -> (value, label)
 
 
 def main(path, outdir):
