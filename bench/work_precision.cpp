@@ -433,7 +433,8 @@ std::string cell_ms(double cpu) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int kmax = 20, repeats = 3;
+  int kmin = 0, kmax = 20, repeats = 3;
+  double expect_below = 0;  // > 0: exit 3 unless every integrator's tightest run on every problem is within it
   double max_cpu = 30;
   std::string csv, table_file;
   std::vector<std::string> integrators{"ida", "cvode-bdf", "cvode-adams", "arkode"};
@@ -444,6 +445,8 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; i += 2) {
     if (i + 1 == argc) argv[i] = const_cast<char*>("");  // an option without its value: usage
     if (!std::strcmp(argv[i], "--kmax")) kmax = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--kmin")) kmin = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--expect-error-below")) expect_below = std::atof(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--repeats")) repeats = std::max(1, std::atoi(argv[i + 1]));
     else if (!std::strcmp(argv[i], "--max-cpu")) max_cpu = std::atof(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--csv")) csv = argv[i + 1];
@@ -451,7 +454,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--integrators")) integrators = split(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--problems")) problem_names = split(argv[i + 1]);
     else {
-      std::cerr << "usage: codyna_work_precision [--kmax K] [--repeats N] [--max-cpu S] [--csv FILE] [--table FILE]\n"
+      std::cerr << "usage: codyna_work_precision [--kmin K] [--kmax K] [--expect-error-below E] [--repeats N] [--max-cpu S] [--csv FILE] [--table FILE]\n"
                    "                             [--integrators a,b] [--problems andrews,a01,a02,bricard,a05,heavy_top,"
                    "double_pendulum]\n";
       return 1;
@@ -472,6 +475,7 @@ int main(int argc, char** argv) {
               << std::defaultfloat;
   }
   std::vector<Run> runs;
+  bool check_failed = false;
   for (const Problem& p : problems) {
     std::cout << "\n" << p.name << " (" << p.t_end << " s, samples every " << p.output_step << " s)" << std::endl;
     Series ref;
@@ -501,7 +505,7 @@ int main(int argc, char** argv) {
         continue;
       }
 #endif
-      for (int k = 0; k <= std::min(kmax, p.kmax); ++k) {
+      for (int k = kmin; k <= std::min(kmax, p.kmax); ++k) {
         Run r;
         r.problem = p.name, r.code = simbody ? "simbody" : "codyna", r.integrator = method, r.k = k;
         r.tol = std::pow(10.0, -(2.0 + k / 2.0));
@@ -540,6 +544,11 @@ int main(int argc, char** argv) {
         r.error = r.completed ? p.error(o.s, ref) : std::nan("");
         print_run(r);
         runs.push_back(r);
+        if (expect_below > 0 && k == std::min(kmax, p.kmax) && !(r.error <= expect_below)) {
+          std::cout << "CHECK FAILED: " << p.name << " " << method << " at tol " << r.tol << ": error " << r.error
+                    << " is not below " << expect_below << std::endl;
+          check_failed = true;
+        }
         if (r.cpu > max_cpu || r.failure.rfind("stopped:", 0) == 0) {
           std::cout << method << ": over " << max_cpu << " s CPU, tighter tolerances skipped" << std::endl;
           break;
@@ -593,5 +602,5 @@ int main(int argc, char** argv) {
     }
     std::cout << "wrote " << file << "\n";
   }
-  return 0;
+  return check_failed ? 3 : 0;
 }
