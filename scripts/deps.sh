@@ -9,6 +9,7 @@ PKGS=(
   libeigen3-dev libsundials-dev libhdf5-dev libmatio-dev
   nlohmann-json3-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
   libmujoco-dev  # the MuJoCo peer test (tests/peers_mujoco); the build skips it without
+  libsimbody-dev  # the Simbody peer of the work-precision study (bench/simbody_*.cpp, peer.simbody_agrees)
   clang libclang-rt-14-dev  # the libFuzzer target (scripts/fuzz.sh): clang 14 with its fuzzer/sanitizer runtimes
   octave octave-control liboctave-dev python3 python3-scipy python3-h5py python3-numpy
   python3-matplotlib  # scripts/plot_work_precision.py (work-precision plots, Agg backend)
