@@ -236,3 +236,148 @@ bool ClosedLoopSystem::project(Eigen::VectorXd& y, double tol) {
 }
 
 }  // namespace codyna
+
+namespace codyna {
+
+namespace {
+// quaternion products as matrices: a (x) b = Lq(a) b = Rq(b) a, components [w, x, y, z]
+Eigen::Matrix4d Lq(const Eigen::Vector4d& a) {
+  Eigen::Matrix4d L;
+  L << a[0], -a[1], -a[2], -a[3], a[1], a[0], -a[3], a[2], a[2], a[3], a[0], -a[1], a[3], -a[2], a[1], a[0];
+  return L;
+}
+Eigen::Matrix4d Rq(const Eigen::Vector4d& b) {
+  Eigen::Matrix4d R;
+  R << b[0], -b[1], -b[2], -b[3], b[1], b[0], b[3], -b[2], b[2], -b[3], b[0], b[1], b[3], b[2], -b[1], b[0];
+  return R;
+}
+Eigen::Matrix3d hat(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d H;
+  H << 0, -v[2], v[1], v[2], 0, -v[0], -v[1], v[0], 0;
+  return H;
+}
+// d(rotation tangent)/dp for the (not necessarily unit) quaternion p of a joint: the rotation is
+// that of p/|p| and a tangent step d moves it to p/|p| (x) exp(d), so d = 2 vec(conj(p^) (x) dp)/|p|
+Eigen::Matrix<double, 3, 4> rotation_tangent(const Eigen::Vector4d& p) {
+  const double n = p.norm();
+  const Eigen::Vector4d u = p / n;
+  const Eigen::Vector3d e = u.tail<3>();
+  Eigen::Matrix<double, 3, 4> G;
+  G.col(0) = -e;
+  G.rightCols<3>() = u[0] * Eigen::Matrix3d::Identity() - hat(e);
+  return (2.0 / n) * G;
+}
+}  // namespace
+
+bool ClosedLoopSystem::exact_dae_jacobian() const {
+  return nxc() == 0 && (!controller_ || controller_->sample_time() > 0);
+}
+
+bool ClosedLoopSystem::exact_ode_jacobian() const {
+  return exact_dae_jacobian() && (model_.nc == 0 || (stab_.alpha == 0.0 && stab_.beta == 0.0));
+}
+
+void ClosedLoopSystem::kinematic_jacobians(const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
+  const int nq = model_.nq, nv = model_.nv;
+  if (tangent_map_.rows() != nv || tangent_map_.cols() != nq) tangent_map_.resize(nv, nq);
+  if (qdot_dq_.rows() != nq || qdot_dq_.cols() != nq) qdot_dq_.resize(nq, nq);
+  if (qdot_dv_.rows() != nq || qdot_dv_.cols() != nv) qdot_dv_.resize(nq, nv);
+  tangent_map_.setZero();
+  qdot_dq_.setZero();
+  qdot_dv_.setZero();
+  // quaternion at qi, angular velocity (body axes) at wi: qdot = p (x) (0, w) / 2
+  auto quaternion = [&](int qi, int wi) {
+    const Eigen::Vector4d p = q.segment<4>(qi);
+    const Eigen::Vector4d w(0.0, v[wi], v[wi + 1], v[wi + 2]);
+    qdot_dq_.block<4, 4>(qi, qi) = 0.5 * Rq(w);
+    qdot_dv_.block<4, 3>(qi, wi) = 0.5 * Lq(p).rightCols<3>();
+    tangent_map_.block<3, 4>(wi, qi) = rotation_tangent(p);
+  };
+  for (int b = 1; b < model_.nbodies; ++b) {
+    const JointModel& j = model_.joints[b];
+    const int iq = j.idx_q, iv = j.idx_v;
+    switch (j.type) {
+      case JointType::Spherical:
+        quaternion(iq, iv);
+        break;
+      case JointType::Free: {
+        quaternion(iq + 3, iv);
+        // position rate R(p) v_lin; a rotation step d turns it by R (d x v_lin)
+        const Eigen::Vector4d p = q.segment<4>(iq + 3);
+        const Eigen::Matrix3d R = quat_to_matrix<double>(p[0], p[1], p[2], p[3]);
+        const Eigen::Vector3d vl = v.segment<3>(iv + 3);
+        qdot_dv_.block<3, 3>(iq, iv + 3) = R;
+        qdot_dq_.block<3, 4>(iq, iq + 3) = -R * hat(vl) * rotation_tangent(p);
+        tangent_map_.block<3, 3>(iv + 3, iq) = R.transpose();  // q_pos = p0 + R dv_lin
+        break;
+      }
+      default:
+        for (int k = 0; k < j.nv; ++k) {
+          tangent_map_(iv + k, iq + k) = 1.0;
+          qdot_dv_(iq + k, iv + k) = 1.0;
+        }
+    }
+  }
+}
+
+bool ClosedLoopSystem::ode_jacobian(double t, const Eigen::VectorXd& y, Eigen::MatrixXd& J) {
+  if (!exact_ode_jacobian()) return false;
+  const int nq = model_.nq, nv = model_.nv, n = ode_size();
+  const Eigen::VectorXd q = y.head(nq), v = y.segment(nq, nv);
+  const Eigen::VectorXd u = inputs(t, q, v, y.tail(nxc()));
+  if (!deriv_) deriv_ = std::make_unique<TreeDerivatives>(model_);
+  if (model_.nc == 0) {
+    deriv_->compute(q, v, u, {});
+  } else {
+    forward_dynamics<double>(model_, data_, q, v, u, stab_);
+    deriv_->compute_constrained(q, v, u, data_.qdd, data_.lambda, data_.loop.rows, {});
+  }
+  kinematic_jacobians(q, v);
+  if (J.rows() != n || J.cols() != n) J.resize(n, n);
+  J.setZero();
+  J.topLeftCorner(nq, nq) = qdot_dq_;
+  J.block(0, nq, nq, nv) = qdot_dv_;
+  J.block(nq, 0, nv, nq).noalias() = deriv_->dqdd_dq * tangent_map_;
+  J.block(nq, nq, nv, nv) = deriv_->dqdd_dv;
+  return true;
+}
+
+bool ClosedLoopSystem::dae_jacobian(double t, const Eigen::VectorXd& Y, const Eigen::VectorXd& Yp, double cj,
+                                    Eigen::MatrixXd& J) {
+  if (!exact_dae_jacobian()) return false;
+  const int nq = model_.nq, nv = model_.nv, nc = model_.nc, n = dae_size(), m = ode_size(), na_ = na();
+  if (static_cast<int>(rows_.size()) != na_) return false;  // consistent() not called yet
+  const Eigen::VectorXd q = Y.head(nq), v = Y.segment(nq, nv), vp = Yp.segment(nq, nv);
+  const Eigen::VectorXd u = inputs(t, q, v, Y.segment(nq + nv, nxc()));
+  if (!deriv_) deriv_ = std::make_unique<TreeDerivatives>(model_);
+  if (lambda_full_.size() != nc) lambda_full_.resize(nc);
+  lambda_full_.setZero();
+  for (int k = 0; k < na_; ++k) lambda_full_[rows_[k]] = Y[m + k];
+  // tau(q, v, v') and Q - Jc^T lambda with their derivatives (the accelerations' derivatives,
+  // which this also solves for, are not used)
+  deriv_->compute_constrained(q, v, u, vp, lambda_full_, rows_, {});
+  const TreeDerivatives& D = *deriv_;
+  kinematic_jacobians(q, v);
+  if (J.rows() != n || J.cols() != n) J.resize(n, n);
+  J.setZero();
+  // q' - qdot(q, v)
+  J.topLeftCorner(nq, nq) = cj * Eigen::MatrixXd::Identity(nq, nq) - qdot_dq_;
+  J.block(0, nq, nq, nv) = -qdot_dv_;
+  // M v' + nle - Q + Jc^T lambda = tau - (Q - Jc^T lambda)
+  J.block(nq, 0, nv, nq).noalias() = (D.dtau_dq - D.dQ_dq) * tangent_map_;
+  J.block(nq, nq, nv, nv) = D.dtau_dv - D.dQ_dv + cj * D.M;
+  for (int k = 0; k < na_; ++k) {
+    const int r = rows_[k];
+    J.block(nq, m + k, nv, 1) = D.Jc.row(r).transpose();
+    // Ja v' + gamma + 2 alpha Ja v + beta^2 phi
+    Eigen::RowVectorXd dq = D.dc_dq.row(r);
+    Eigen::RowVectorXd dv = D.dc_dv.row(r) + cj * D.Jc.row(r);
+    if (stab_.alpha != 0.0) dq += 2.0 * stab_.alpha * D.dphid_dq.row(r), dv += 2.0 * stab_.alpha * D.Jc.row(r);
+    if (stab_.beta != 0.0) dq += stab_.beta * stab_.beta * D.Jc.row(r);
+    J.block(m + k, 0, 1, nq).noalias() = dq * tangent_map_;
+    J.block(m + k, nq, 1, nv) = dv;
+  }
+  return true;
+}
+
+}  // namespace codyna

@@ -17,6 +17,7 @@
 #include <optional>
 
 #include "analysis/plant_function.hpp"
+#include "dynamics/derivatives.hpp"
 #include "dynamics/forward_dynamics.hpp"
 #include "model/data.hpp"
 #include "spatial/autodiff.hpp"
@@ -69,6 +70,20 @@ class ClosedLoopSystem {
 
   long evaluations() const { return evaluations_; }
 
+  // Exact Jacobians from the analytic derivatives (dynamics/derivatives.hpp), for the implicit
+  // integrators' Newton matrices. Available when u does not depend on the state inside a step
+  // (no controller, or a discrete one whose output is held) and, for the ODE form of closed
+  // loops, without Baumgarte stabilization; otherwise false and SUNDIALS difference-quotients.
+  bool exact_ode_jacobian() const;
+  bool exact_dae_jacobian() const;
+  // d ydot / d y of rhs() [ode_size x ode_size]. Closed loops: the derivative of the
+  // accelerations on the independent rows at q; rhs() drops near-singular directions of the
+  // Schur complement on all rows, so near a singular configuration this is an approximation
+  // (good enough for a Newton matrix). Returns false when not available.
+  bool ode_jacobian(double t, const Eigen::VectorXd& y, Eigen::MatrixXd& J);
+  // dF/dY + cj dF/dY' of residual() [dae_size x dae_size] (rows chosen by consistent())
+  bool dae_jacobian(double t, const Eigen::VectorXd& Y, const Eigen::VectorXd& Yp, double cj, Eigen::MatrixXd& J);
+
  private:
   Eigen::VectorXd saturate(Eigen::VectorXd u_all) const;
 
@@ -87,6 +102,12 @@ class ClosedLoopSystem {
   mutable Data data_;
   mutable std::unique_ptr<DataT<ADScalar>> ad_data_;  // output rates (PD), made on first use
   long evaluations_ = 0;
+  // exact Jacobians: made on first use
+  std::unique_ptr<TreeDerivatives> deriv_;
+  Eigen::MatrixXd tangent_map_;  // [nv x nq] d(tangent)/dq at the last q
+  Eigen::MatrixXd qdot_dq_, qdot_dv_;  // [nq x nq], [nq x nv]
+  Eigen::VectorXd lambda_full_;
+  void kinematic_jacobians(const Eigen::VectorXd& q, const Eigen::VectorXd& v);
 };
 
 }  // namespace codyna

@@ -25,6 +25,9 @@ struct IntegratorSettings {
   std::string method = "auto";  // auto: chosen per model (simulation/integrator_choice.hpp)
   double rtol = 1e-8, atol = 1e-10;
   double max_step = 0;  // 0 = no limit (rk4: its fixed step, default 1e-3)
+  // cvode-bdf / ida: the Newton matrix from the analytic derivatives where the system has them
+  // (ClosedLoopSystem::exact_ode_jacobian / exact_dae_jacobian); false: SUNDIALS' difference quotients
+  bool exact_jacobian = true;
 };
 
 class IntegratorFailure : public std::runtime_error {

@@ -132,6 +132,8 @@ class Cvode final : public SundialsBase {
         A_ = SUNDenseMatrix(sys_.ode_size(), sys_.ode_size(), ctx_);
         LS_ = SUNLinSol_Dense(y_, A_, ctx_);
         check(CVodeSetLinearSolver(mem_, LS_, A_), "CVodeSetLinearSolver");
+        // exact Jacobian from the analytic derivatives where the system has one (issue 11)
+        if (set_.exact_jacobian && sys_.exact_ode_jacobian()) check(CVodeSetJacFn(mem_, &Cvode::jacobian), "CVodeSetJacFn");
         // loops: CVODE projects after every step itself, so the simulator need not restart it
         if (sys_.model().nc > 0) check(CVodeSetProjFn(mem_, &Cvode::project), "CVodeSetProjFn");
       } else {
@@ -155,6 +157,7 @@ class Cvode final : public SundialsBase {
     long v = 0;
     CVodeGetNumSteps(mem_, &v), s.steps += v;
     CVodeGetNumRhsEvals(mem_, &v), s.rhs_evals += v;
+    if (bdf_) CVodeGetNumLinRhsEvals(mem_, &v), s.rhs_evals += v;  // difference-quotient Jacobians
     CVodeGetNumErrTestFails(mem_, &v), s.error_test_failures += v;
     CVodeGetNumNonlinSolvIters(mem_, &v), s.nonlinear_iterations += v;
     CVodeGetNumNonlinSolvConvFails(mem_, &v), s.nonlinear_failures += v;
@@ -163,6 +166,15 @@ class Cvode final : public SundialsBase {
 
  private:
   static void check(int flag, const char* what) { SundialsBase::check(flag, "CVODE", what); }
+  static int jacobian(double t, N_Vector y, N_Vector, SUNMatrix Jac, void* self, N_Vector, N_Vector, N_Vector) {
+    auto* me = static_cast<Cvode*>(static_cast<SundialsBase*>(self));
+    return me->guarded([&] {
+      if (!me->sys_.ode_jacobian(t, view(y), me->jac_)) throw std::runtime_error("no exact Jacobian");
+      const auto n = static_cast<Eigen::Index>(SUNDenseMatrix_Rows(Jac));
+      Eigen::Map<Eigen::MatrixXd>(SUNDenseMatrix_Data(Jac), n, n) = me->jac_;
+    });
+  }
+  Eigen::MatrixXd jac_;  // workspace of the exact Jacobian
   // CVProjFn: the correction that brings ycur back onto phi = 0, Jc v = 0, and the error
   // estimate projected onto the constraints' tangent space (CVODE's default expects both)
   static int project(double, N_Vector ycur, N_Vector corr, double, N_Vector err, void* self) {
@@ -265,6 +277,7 @@ class Ida final : public SundialsBase {
       A_ = SUNDenseMatrix(n, n, ctx_);
       LS_ = SUNLinSol_Dense(y_, A_, ctx_);
       check(IDASetLinearSolver(mem_, LS_, A_), "IDASetLinearSolver");
+      if (set_.exact_jacobian && sys_.exact_dae_jacobian()) check(IDASetJacFn(mem_, &Ida::jacobian), "IDASetJacFn");
     } else {
       view(y_) = Y;
       view(yp_) = Yp;
@@ -282,6 +295,7 @@ class Ida final : public SundialsBase {
     long v = 0;
     IDAGetNumSteps(mem_, &v), s.steps += v;
     IDAGetNumResEvals(mem_, &v), s.rhs_evals += v;
+    IDAGetNumLinResEvals(mem_, &v), s.rhs_evals += v;  // difference-quotient Jacobians
     IDAGetNumErrTestFails(mem_, &v), s.error_test_failures += v;
     IDAGetNumNonlinSolvIters(mem_, &v), s.nonlinear_iterations += v;
     IDAGetNumNonlinSolvConvFails(mem_, &v), s.nonlinear_failures += v;
@@ -298,6 +312,16 @@ class Ida final : public SundialsBase {
     });
   }
   static void check(int flag, const char* what) { SundialsBase::check(flag, "IDA", what); }
+  static int jacobian(double t, double cj, N_Vector Y, N_Vector Yp, N_Vector, SUNMatrix Jac, void* self, N_Vector,
+                      N_Vector, N_Vector) {
+    auto* me = static_cast<Ida*>(self);
+    return me->guarded([&] {
+      if (!me->sys_.dae_jacobian(t, view(Y), view(Yp), cj, me->jac_)) throw std::runtime_error("no exact Jacobian");
+      const auto n = static_cast<Eigen::Index>(SUNDenseMatrix_Rows(Jac));
+      Eigen::Map<Eigen::MatrixXd>(SUNDenseMatrix_Data(Jac), n, n) = me->jac_;
+    });
+  }
+  Eigen::MatrixXd jac_;  // workspace of the exact Jacobian
 };
 
 class Rk4 final : public Integrator {

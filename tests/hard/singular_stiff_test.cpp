@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <iostream>
 #include <map>
 
@@ -210,6 +211,49 @@ TEST(HardStiff, A05FlyballImplicitFarCheaperThanExplicit) {
       EXPECT_GT(cost[exp].steps, 4 * cost[imp].steps) << exp << " vs " << imp;
       EXPECT_GT(cost[exp].evals, 3 * cost[imp].evals) << exp << " vs " << imp;
     }
+}
+
+}  // namespace
+}  // namespace codyna
+
+namespace codyna {
+namespace {
+
+// Exact Jacobians for the implicit integrators (issue 11): the table of docs/work-precision.md,
+// "Exact Jacobians for the implicit integrators". Disabled (minutes): run with
+//   build-jac/bin/codyna_hard_tests --gtest_also_run_disabled_tests --gtest_filter='HardJacobian.*'
+// CODYNA_A02_IDA_DQ=1 adds ida with difference quotients at N = 40 (many minutes).
+void jacobian_row(const char* what, const Model& m, const char* method, bool exact, double t_end, double tol,
+                  int a02_n = 0) {
+  SimulationOptions o;
+  o.integrator.method = method;
+  o.integrator.exact_jacobian = exact;
+  o.t_end = t_end;
+  o.output_step = a02_n ? 0.01 : t_end / 100;
+  if (tol > 0) o.integrator.rtol = o.integrator.atol = tol;
+  const SimulationResult r = simulate(m, nullptr, nullptr, o);
+  EXPECT_TRUE(r.completed) << what << " " << method << ": " << r.failure;
+  std::cout << "| " << what << " | " << method << " | " << (exact ? "exact" : "difference quotients") << " | "
+            << r.stats.steps << " | " << r.stats.rhs_evals << " | " << r.stats.jac_evals << " | " << r.stats.wall_time
+            << " s | q_end[0] " << r.q(r.q.rows() - 1, 0);
+  if (a02_n) {
+    const A02Run a = measure_a02(m, a02_n, r);
+    std::cout << ", passages " << a.passages << ", |dE|/E0 " << a.dE;
+  }
+  std::cout << " |\n";
+}
+
+TEST(HardJacobian, DISABLED_ExactAgainstDifferenceQuotients) {
+  const Model andrews = test::load_example("andrews_squeezer.json");
+  const Model flyball = test::load_example("iftomm_a05_flyball.json");
+  const Model a02 = compile(a02_spec(40));
+  for (const char* method : {"cvode-bdf", "ida"})
+    for (bool exact : {false, true}) jacobian_row("Andrews 0.03 s, 1e-10", andrews, method, exact, 0.03, 1e-10);
+  for (const char* method : {"cvode-bdf", "ida"})
+    for (bool exact : {false, true}) jacobian_row("A05 flyball 2 s", flyball, method, exact, 2.0, 0);
+  for (bool exact : {false, true}) jacobian_row("A02 N = 40, 10 s", a02, "cvode-bdf", exact, 10.0, 0, 40);
+  if (std::getenv("CODYNA_A02_IDA_DQ")) jacobian_row("A02 N = 40, 10 s", a02, "ida", false, 10.0, 0, 40);
+  jacobian_row("A02 N = 40, 10 s", a02, "ida", true, 10.0, 0, 40);
 }
 
 }  // namespace
