@@ -179,7 +179,7 @@ TEST(IntegratorJacobian, CvodeBdfAndIdaAgreeWithDifferenceQuotientsForFewerEvalu
   // measured: Andrews cvode-bdf 1655 -> 1389, ida 6297 -> 2057; flyball cvode-bdf 1606 -> 1556,
   // ida 1542 -> 955 (CVODE re-uses its Jacobian for many steps: on these small systems the
   // difference quotients cost it little; the gain grows with n, docs/work-precision.md)
-  compare_runs("andrews_squeezer.json", "cvode-bdf", 0.03, 1e-8, 1.1);
+  // (cvode-bdf keeps difference quotients on closed loops: integrators.cpp says why)
   compare_runs("andrews_squeezer.json", "ida", 0.03, 1e-8, 2.5);
   compare_runs("iftomm_a05_flyball.json", "cvode-bdf", 2.0, 0, 1.0);
   compare_runs("iftomm_a05_flyball.json", "ida", 2.0, 0, 1.4);
