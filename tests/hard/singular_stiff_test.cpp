@@ -16,6 +16,7 @@
 #include <map>
 
 #include "core/test_util.hpp"
+#include "models/iftomm_a02.hpp"
 #include "simulation/simulator.hpp"
 
 namespace codyna {
@@ -23,60 +24,7 @@ namespace {
 
 constexpr double g = 9.81;
 
-// N four-bars as examples/iftomm_a02_four_bars.json (N = 4 there): cranks crank0..crankN
-// pinned to ground at x = 0..N, couplers coupler1..couplerN pinned to the top of the previous
-// crank and closed on the top of the next one; B0 at 1 m/s in +x, cranks vertical.
-ModelSpec a02_spec(int N) {
-  ModelSpec s;
-  s.name = "iftomm_a02_" + std::to_string(N);
-  auto rod = [](const std::string& name, const Eigen::Vector3d& com, int axial) {
-    BodySpec b;
-    b.name = name;
-    b.mass = 1.0;
-    b.com = com;
-    Eigen::Vector3d I = Eigen::Vector3d::Constant(1.0 / 12);
-    I[axial] = 5e-5;
-    b.inertia = I.asDiagonal();
-    return b;
-  };
-  for (int i = 0; i <= N; ++i) s.bodies.push_back(rod("crank" + std::to_string(i), Eigen::Vector3d(0, 0.5, 0), 1));
-  for (int i = 1; i <= N; ++i) s.bodies.push_back(rod("coupler" + std::to_string(i), Eigen::Vector3d(0.5, 0, 0), 0));
-  for (int i = 0; i <= N; ++i) {
-    JointSpec j;
-    j.name = "pivot" + std::to_string(i);
-    j.parent = "ground";
-    j.child = "crank" + std::to_string(i);
-    j.parent_frame.position = Eigen::Vector3d(i, 0, 0);
-    j.q0 = Eigen::VectorXd::Constant(1, 0.0);
-    j.v0 = Eigen::VectorXd::Constant(1, -1.0);
-    s.joints.push_back(j);
-  }
-  for (int i = 1; i <= N; ++i) {
-    JointSpec j;
-    j.name = "pin" + std::to_string(i);
-    j.parent = "crank" + std::to_string(i - 1);
-    j.child = "coupler" + std::to_string(i);
-    j.parent_frame.position = Eigen::Vector3d(0, 1, 0);
-    j.q0 = Eigen::VectorXd::Constant(1, 0.0);
-    j.v0 = Eigen::VectorXd::Constant(1, 1.0);
-    s.joints.push_back(j);
-    ConstraintSpec c;
-    c.name = "close" + std::to_string(i);
-    c.type = ConstraintType::PlanarRevolute;
-    c.body_a = "coupler" + std::to_string(i);
-    c.point_a = Eigen::Vector3d(1, 0, 0);
-    c.body_b = "crank" + std::to_string(i);
-    c.point_b = Eigen::Vector3d(0, 1, 0);
-    c.axis_a = Eigen::Vector3d::UnitZ();
-    s.constraints.push_back(c);
-  }
-  EffectSpec e;
-  e.name = "gravity";
-  e.type = EffectType::Gravity;
-  e.g = Eigen::Vector3d(0, -g, 0);
-  s.effects.push_back(e);
-  return s;
-}
+using iftomm::a02_spec;  // tests/models/iftomm_a02.hpp
 
 struct A02Run {
   int passages = 0;
