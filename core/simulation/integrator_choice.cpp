@@ -14,18 +14,24 @@ IntegratorChoice choose_integrator(ClosedLoopSystem& sys, double t, const Eigen:
   const int n = sys.ode_size();
   const double slowest = 1.0 / std::max(span, 1e-12);
   c.slow_rate = slowest;
+  std::string failed;  // the right-hand side threw at a perturbed state
   if (n <= kMaxAnalysed) {
     // J = d ydot / d y by central differences (2 n evaluations)
     Eigen::MatrixXd J(n, n);
     Eigen::VectorXd yp = y, ym = y, fp, fm;
-    for (int j = 0; j < n; ++j) {
-      const double h = 1e-6 * std::max(1.0, std::abs(y[j]));
-      yp[j] = y[j] + h;
-      ym[j] = y[j] - h;
-      sys.rhs(t, yp, fp);
-      sys.rhs(t, ym, fm);
-      J.col(j) = (fp - fm) / (2 * h);
-      yp[j] = ym[j] = y[j];
+    try {
+      for (int j = 0; j < n; ++j) {
+        const double h = 1e-6 * std::max(1.0, std::abs(y[j]));
+        yp[j] = y[j] + h;
+        ym[j] = y[j] - h;
+        sys.rhs(t, yp, fp);
+        sys.rhs(t, ym, fm);
+        J.col(j) = (fp - fm) / (2 * h);
+        yp[j] = ym[j] = y[j];
+      }
+    } catch (const std::exception& e) {  // no analysis, not a failed run: the integrator will say
+      failed = e.what();
+      J.setConstant(NAN);
     }
     if (J.allFinite()) {
       const Eigen::VectorXcd lambda = Eigen::EigenSolver<Eigen::MatrixXd>(J, false).eigenvalues();
@@ -42,7 +48,9 @@ IntegratorChoice choose_integrator(ClosedLoopSystem& sys, double t, const Eigen:
   std::ostringstream why;
   why << std::setprecision(3);
   if (!c.analysed)
-    why << (n > kMaxAnalysed ? "not analysed (" + std::to_string(n) + " states)" : std::string("not analysed (the Jacobian is not finite)"))
+    why << (n > kMaxAnalysed    ? "not analysed (" + std::to_string(n) + " states)"
+            : !failed.empty() ? "not analysed (" + failed + ")"
+                              : std::string("not analysed (the Jacobian is not finite)"))
         << ", taken as not stiff";
   else if (c.stiff)
     why << "stiff: a mode decays at " << c.fastest_decay << " 1/s, " << c.fastest_decay / c.slow_rate
