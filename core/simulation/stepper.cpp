@@ -11,19 +11,10 @@ namespace codyna {
 Stepper::Stepper(const Model& model, const IntegratorSettings& settings, double projection_tolerance)
     : model_(model), projection_tolerance_(projection_tolerance),
       sys_(model, nullptr, nullptr, Eigen::VectorXd(), model.u_nominal()) {
+  set_state(0.0, {}, {});
   IntegratorSettings s = settings;
   if (s.method == "auto") {  // chosen at the model's initial state; a stepped run has no length: 1 s
-    Eigen::VectorXd q = model.q0, v = model.v0;
-    if (model.nc) {
-      const AssemblyResult a = assemble(model, q, v);
-      if (a.converged) q = a.q, v = a.v;
-    }
-    Eigen::VectorXd y(sys_.ode_size());
-    y << q, v;
-    Eigen::VectorXd u(nu());
-    for (int k = 0; k < nu(); ++k) u[k] = model.actuators[model.plant_inputs[k]].u0;
-    sys_.set_held(u);
-    const IntegratorChoice choice = choose_integrator(sys_, 0.0, y, 1.0);
+    const IntegratorChoice choice = choose_integrator(sys_, t_, y_, 1.0);
     s.method = choice.method;
     extra_.integrator_choice = choice.reason;
   }
@@ -32,10 +23,11 @@ Stepper::Stepper(const Model& model, const IntegratorSettings& settings, double 
   extra_.rtol = settings.rtol;
   extra_.atol = settings.atol;
   extra_.max_step = settings.max_step;
-  reset();
+  integrator_->reset(t_, y_);
+  measure();
 }
 
-void Stepper::reset(double t0, const Eigen::VectorXd& q_in, const Eigen::VectorXd& v_in) {
+void Stepper::set_state(double t0, const Eigen::VectorXd& q_in, const Eigen::VectorXd& v_in) {
   Eigen::VectorXd q = q_in.size() ? q_in : model_.q0, v = v_in.size() ? v_in : model_.v0;
   if (q.size() != model_.nq || v.size() != model_.nv)
     throw std::invalid_argument("stepper: the state has the wrong size (nq = " + std::to_string(model_.nq) +
@@ -52,6 +44,10 @@ void Stepper::reset(double t0, const Eigen::VectorXd& q_in, const Eigen::VectorX
   Eigen::VectorXd u(nu());
   for (int k = 0; k < nu(); ++k) u[k] = model_.actuators[model_.plant_inputs[k]].u0;
   sys_.set_held(u);
+}
+
+void Stepper::reset(double t0, const Eigen::VectorXd& q_in, const Eigen::VectorXd& v_in) {
+  set_state(t0, q_in, v_in);
   integrator_->reset(t_, y_);
   measure();
 }

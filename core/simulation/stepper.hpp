@@ -33,6 +33,8 @@ class Stepper {
 
  private:
   void measure();
+  // t_, y_ (assembled onto the loops) and the held nominal inputs; no integrator reset
+  void set_state(double t0, const Eigen::VectorXd& q, const Eigen::VectorXd& v);
 
   const Model& model_;
   double projection_tolerance_;
