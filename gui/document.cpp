@@ -145,6 +145,7 @@ bool Document::load(const QString& path, QString* error) {
   restore(spec);
   undo_.setClean();
   emit fileChanged();
+  emit replaced();
   return true;
 }
 
@@ -180,6 +181,7 @@ void Document::clear() {
   restore(empty);
   undo_.setClean();
   emit fileChanged();
+  emit replaced();
 }
 
 }  // namespace codyna::gui

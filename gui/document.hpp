@@ -71,6 +71,8 @@ class Document : public QObject {
   void modelChanged();                // after the compiled model was refreshed (model() may be null)
   void fileChanged();                 // path or modified state changed (window title)
   void errorChanged(const QString& text, const QString& path);
+  // another model took the document's place (load, clear): every result of the old one must go
+  void replaced();
 
  private:
   void recompile();

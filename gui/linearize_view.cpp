@@ -57,6 +57,7 @@ LinearizeView::LinearizeView(Document* doc, QWidget* parent) : QWidget(parent), 
   qRegisterMetaType<std::complex<double>>("std::complex<double>");
   buildUi();
   connect(doc_, &Document::specChanged, this, &LinearizeView::refreshFromDocument);
+  connect(doc_, &Document::replaced, this, &LinearizeView::clearResult);
   connect(doc_, &Document::modelChanged, this, [this] {
     refreshIndependent();
     refreshSteadyState();
@@ -167,7 +168,10 @@ void LinearizeView::buildUi() {
   op_label_ = new QLabel(tr("Not linearized yet."), this);
   op_label_->setWordWrap(true);
   op_label_->setTextInteractionFlags(Qt::TextSelectableByMouse);
-  stale_label_ = new QLabel(tr("<i>The model or the study changed since: linearize again.</i>"), this);
+  stale_label_ = new QLabel(tr("<b>Out of date:</b> the model or the study changed since these results: linearize again."), this);
+  stale_label_->setObjectName("linearizeStale");
+  stale_label_->setStyleSheet("QLabel { background: #fff0c0; color: #6a4a00; padding: 3px; }");
+  stale_label_->setWordWrap(true);
   stale_label_->setVisible(false);
 
   tabs_ = new QTabWidget(this);
@@ -474,13 +478,50 @@ bool LinearizeView::linearize() {
   }
   showResult();
   updateStaleness();
+  {
+    const LinearSystem& sys = result_->system;
+    QString note = tr("Linearized about %1: %2 states, %3 inputs, %4 outputs (%5)")
+                       .arg(qs(result_->op.kind))
+                       .arg(sys.nx())
+                       .arg(sys.nu())
+                       .arg(sys.ny())
+                       .arg(qs(sys.method));
+    emit message(note);
+  }
   emit linearized();
   return true;
 }
 
 bool LinearizeView::isStale() const { return !result_ || result_model_ != doc_->model(); }
 
-void LinearizeView::updateStaleness() { stale_label_->setVisible(result_ && isStale()); }
+void LinearizeView::updateStaleness() {
+  const bool stale = result_ && isStale();
+  stale_label_->setVisible(stale);
+  // the matrices and modes stay readable, greyed, beside the note
+  for (QTableView* v : matrix_views_) v->setEnabled(!stale);
+  mode_view_->setEnabled(!stale);
+}
+
+void LinearizeView::clearResult() {
+  const bool had = result_.has_value();
+  result_.reset();
+  result_model_.reset();
+  modal_ = ModalAnalysis{};
+  selected_mode_ = -1;
+  syncing_ = true;
+  const char* names[4] = {"A", "B", "C", "D"};
+  for (int k = 0; k < 4; ++k) {
+    matrix_models_[k]->clear();
+    tabs_->setTabText(k, QLatin1String(names[k]));
+  }
+  offsets_->setRowCount(0);
+  mode_model_->setModes(modal_);
+  pole_map_->setModes(modal_);
+  syncing_ = false;
+  op_label_->setText(tr("Not linearized yet."));
+  updateStaleness();
+  if (had) emit modeSelected(-1, Eigen::VectorXcd(), std::complex<double>());
+}
 
 void LinearizeView::showResult() {
   const StudyLinearization& r = *result_;

@@ -76,6 +76,8 @@ class LinearizeView : public QWidget {
   const codyna::StudyLinearization* result() const { return result_ ? &*result_ : nullptr; }
   const codyna::ModalAnalysis& modes() const { return modal_; }
   bool isStale() const;
+  // Forgets the result (the document now holds another model): empty matrices, modes and pole map.
+  void clearResult();
 
   // Selects mode `index` in the table and the pole map and emits modeSelected
   // (-1 clears the selection, without a signal).

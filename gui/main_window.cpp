@@ -5,6 +5,10 @@
 #include <QCloseEvent>
 #include <QComboBox>
 #include <QDateTime>
+#include <QDesktopServices>
+#include <QIcon>
+#include <QUrl>
+#include <Eigen/Core>
 #include <QDockWidget>
 #include <QFileDialog>
 #include <QFileInfo>
@@ -32,7 +36,11 @@
 #include "gui/result_plots.hpp"
 #include "gui/simulate_view.hpp"
 #include "gui/view3d.hpp"
+#include "gui/wheel_guard.hpp"
 #include "simulation/result.hpp"
+
+// the icon lives in codyna_gui, a static library: its resources must be registered by name
+static void init_codyna_resources() { Q_INIT_RESOURCE(codyna); }
 
 namespace codyna::gui {
 
@@ -43,6 +51,9 @@ const char* kFilter = "codyna models (*.json);;All files (*)";
 }  // namespace
 
 MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document(this)) {
+  WheelGuard::install();  // before any field is polished
+  init_codyna_resources();
+  setWindowIcon(QIcon(QStringLiteral(":/codyna/codyna.svg")));
   setObjectName("codynaMainWindow");
   resize(1600, 1000);
 
@@ -130,8 +141,20 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
 
   connect(doc_, &Document::fileChanged, this, &MainWindow::updateTitle);
   connect(doc_, &Document::modelChanged, this, &MainWindow::onModelChanged);
+  connect(doc_, &Document::replaced, this, [this] {
+    // the results on screen belonged to the model that left
+    setPlaying(false);
+    onResult(nullptr);
+    play_t_ = 0;
+    time_label_->setText(tr("no result"));
+    sim_view_->plots()->setTimeCursor(std::nan(""));
+  });
   connect(doc_, &Document::errorChanged, this, [this](const QString& text, const QString& path) {
-    if (text.isEmpty()) return;
+    if (text.isEmpty()) {
+      // fixed: the old error leaves the status bar
+      if (statusBar()->currentMessage().startsWith(tr("Error:"))) statusBar()->clearMessage();
+      return;
+    }
     message(text, true);
     if (const auto ref = element_at_path(ss(path))) {
       selectElement(ElementId{ref->kind, ref->index});
@@ -201,6 +224,8 @@ void MainWindow::buildMenus() {
     const QString p = chooseFile(tr("Save model as"), doc_->filePath(), kFilter, true);
     if (!p.isEmpty()) saveFileAs(p);
   });
+  a_open->setToolTip(tr("Open a model file (JSON)"));
+  a_save->setToolTip(tr("Save the model to its file"));
   a_save_as->setShortcut(QKeySequence::SaveAs);
   file->addSeparator();
   QAction* a_export = file->addAction(tr("&Export plant (NAME.m + NAME.mat)..."), this, [this] {
@@ -236,13 +261,83 @@ void MainWindow::buildMenus() {
   frames->setChecked(true);
   connect(frames, &QAction::toggled, view_, &View3D::setShowFrames);
 
+  view->addSeparator();
+  for (QDockWidget* d : findChildren<QDockWidget*>()) view->addAction(d->toggleViewAction());
+
+  // the analysis steps, where users look for them (the views' buttons do the same)
+  QMenu* analysis = menuBar()->addMenu(tr("&Analysis"));
+  a_linearize_ = analysis->addAction(tr("&Linearize"), this, [this] {
+    tabs_->setCurrentWidget(lin_view_);
+    lin_view_->linearize();
+  });
+  a_linearize_->setObjectName("actionLinearize");
+  a_linearize_->setShortcut(QKeySequence(Qt::CTRL | Qt::Key_L));
+  a_linearize_->setToolTip(tr("Linearize the model about its operating point (Ctrl+L)"));
+  analysis->addAction(a_export);
+  a_export->setToolTip(tr("Write the linear plant as NAME.m + NAME.mat for MATLAB and GNU Octave (Ctrl+E)"));
+  analysis->addSeparator();
+  a_run_ = analysis->addAction(tr("&Run simulation"), this, [this] {
+    tabs_->setCurrentWidget(sim_view_);
+    sim_view_->run();
+  });
+  a_run_->setObjectName("actionRun");
+  a_run_->setShortcut(QKeySequence(Qt::Key_F5));
+  a_run_->setToolTip(tr("Simulate the controller on the nonlinear model (F5)"));
+  a_cancel_ = analysis->addAction(tr("&Cancel simulation"), this, [this] { sim_view_->cancel(); });
+  a_cancel_->setObjectName("actionCancel");
+  a_cancel_->setShortcut(QKeySequence(Qt::SHIFT | Qt::Key_F5));
+  a_cancel_->setToolTip(tr("Stop the running simulation; its partial result is kept (Shift+F5)"));
+  a_cancel_->setEnabled(false);
+  connect(sim_view_, &SimulateView::runningChanged, this, [this](bool running) {
+    a_run_->setEnabled(!running);
+    a_cancel_->setEnabled(running);
+  });
+
+  QMenu* help = menuBar()->addMenu(tr("&Help"));
+  QAction* a_docs = help->addAction(tr("codyna &documentation"), this, [this] {
+    QDesktopServices::openUrl(documentationUrl());
+  });
+  a_docs->setShortcut(QKeySequence::HelpContents);
+  help->addAction(tr("&About codyna"), this, [this] {
+    QMessageBox::about(this, tr("About codyna"), aboutText());
+  });
+  help->addAction(tr("About &Qt"), qApp, &QApplication::aboutQt);
+
   QToolBar* tb = addToolBar(tr("Main"));
   tb->setObjectName("mainToolbar");
   tb->addAction(a_open);
   tb->addAction(a_save);
   tb->addAction(undo);
   tb->addAction(redo);
+  tb->addSeparator();
+  tb->addAction(a_linearize_);
   tb->addAction(a_export);
+  tb->addAction(a_run_);
+  tb->addAction(a_cancel_);
+}
+
+QString MainWindow::aboutText() const {
+  return tr("<h3>codyna %1</h3>"
+            "<p>Multibody dynamics pre/post-processor with a control module: "
+            "linearization into A, B, C, D, export to MATLAB and GNU Octave, "
+            "closed-loop simulation on the nonlinear mechanism.</p>"
+            "<p>Qt %2 (built with %3), Eigen %4.%5.%6</p>"
+            "<p>Documentation: <a href=\"%7\">%7</a></p>")
+      .arg(QCoreApplication::applicationVersion().isEmpty() ? tr("(development)") : QCoreApplication::applicationVersion(),
+           QString::fromLatin1(qVersion()), QStringLiteral(QT_VERSION_STR))
+      .arg(EIGEN_WORLD_VERSION)
+      .arg(EIGEN_MAJOR_VERSION)
+      .arg(EIGEN_MINOR_VERSION)
+      .arg(documentationUrl().toString());
+}
+
+QUrl MainWindow::documentationUrl() {
+  // the installed docs when there are any, else the source tree's (a build run in place)
+  for (const QString& d : {QCoreApplication::applicationDirPath() + "/../share/doc/codyna/gui.md",
+                           QStringLiteral(CODYNA_SOURCE_DOCS "/gui.md")}) {
+    if (QFileInfo::exists(d)) return QUrl::fromLocalFile(QFileInfo(d).absoluteFilePath());
+  }
+  return QUrl::fromLocalFile(QStringLiteral(CODYNA_SOURCE_DOCS "/gui.md"));
 }
 
 int MainWindow::ask(const QString& title, const QString& text, int buttons) {
@@ -313,7 +408,10 @@ bool MainWindow::saveFile() {
   return true;
 }
 
-bool MainWindow::saveFileAs(const QString& path) {
+bool MainWindow::saveFileAs(const QString& chosen) {
+  // a name typed without its suffix gets ".json" (else Open's filter would hide the file)
+  QString path = chosen;
+  if (QFileInfo(path).suffix().isEmpty()) path += QStringLiteral(".json");
   QString error;
   if (!doc_->saveAs(path, &error)) {
     message(tr("Not saved: %1").arg(error), true);

@@ -7,6 +7,7 @@
 
 #include <QMainWindow>
 #include <QTimer>
+#include <QUrl>
 #include <complex>
 #include <functional>
 #include <memory>
@@ -14,6 +15,7 @@
 #include "gui/document.hpp"
 #include "gui/model_tree.hpp"
 
+class QAction;
 class QTreeView;
 class QPlainTextEdit;
 class QSlider;
@@ -88,6 +90,10 @@ class MainWindow : public QMainWindow {
   bool isAnimatingMode() const;
 
   QStringList recentFiles() const;
+  static QUrl documentationUrl();  // docs/gui.md (installed, or the source tree's)
+  QAction* linearizeAction() const { return a_linearize_; }
+  QAction* runAction() const { return a_run_; }
+  QAction* cancelAction() const { return a_cancel_; }
   void message(const QString& text, bool error = false);
 
  protected:
@@ -95,6 +101,7 @@ class MainWindow : public QMainWindow {
 
  private:
   void buildMenus();
+  QString aboutText() const;
   void updateTitle();
   void addRecent(const QString& path);
   void rebuildRecentMenu();
@@ -122,6 +129,9 @@ class MainWindow : public QMainWindow {
   QTimer anim_;
   std::shared_ptr<const SimulationResult> result_;
   double play_t_ = 0;
+  QAction* a_linearize_ = nullptr;
+  QAction* a_run_ = nullptr;
+  QAction* a_cancel_ = nullptr;
   int mode_ = -1;
   Eigen::VectorXcd mode_shape_;
   double mode_phase_ = 0;

@@ -153,7 +153,8 @@ QVariant ModeTableModel::data(const QModelIndex& index, int role) const {
       case Eigenvalue: return complexText(m.eigenvalue);
       case NaturalFrequency: return QString::number(m.natural_frequency, 'g', 6);
       case FrequencyHz: return QString::number(hz, 'g', 6);
-      case DampingRatio: return QString::number(m.damping_ratio, 'g', 4);
+      // a zero eigenvalue (a rigid-body or integrator mode) has no damping ratio: "-", not -1
+      case DampingRatio: return m.natural_frequency > 0.0 ? QString::number(m.damping_ratio, 'g', 4) : QStringLiteral("-");
       case TimeConstant:
         if (std::isinf(tau)) return QStringLiteral("\u221e");
         return QStringLiteral("%1 = %2").arg(period ? QStringLiteral("T") : QStringLiteral("\u03c4"),

@@ -9,6 +9,7 @@
 #include <QRegularExpression>
 #include <QScrollArea>
 #include <QVBoxLayout>
+#include <cmath>
 #include <nlohmann/json.hpp>
 
 #include "io/model_file.hpp"
@@ -65,7 +66,8 @@ json parse_text(const QString& text, const json& old) {
   auto number = [](const QString& s) -> json {
     bool ok = false;
     const double x = QLocale::c().toDouble(s.trimmed(), &ok);
-    if (!ok) throw std::invalid_argument("\"" + s.trimmed().toStdString() + "\" is not a number");
+    // inf, nan and numbers beyond double's range (1e400) are no values a model can hold
+    if (!ok || !std::isfinite(x)) throw std::invalid_argument("\"" + s.trimmed().toStdString() + "\" is not a finite number");
     return x;
   };
   auto numbers = [&](const QString& s) {
@@ -108,6 +110,13 @@ PropertyEditor::PropertyEditor(Document* doc, QWidget* parent) : QWidget(parent)
   title_ = new QLabel(tr("Select an element in the model tree"), this);
   title_->setWordWrap(true);
   outer->addWidget(title_);
+  error_ = new QLabel(this);
+  error_->setObjectName("propertyError");
+  error_->setWordWrap(true);
+  error_->setStyleSheet("QLabel { color: #a00000; background: #ffe8e8; padding: 3px; }");
+  error_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  error_->hide();
+  outer->addWidget(error_);
   auto* scroll = new QScrollArea(this);
   scroll->setWidgetResizable(true);
   body_ = new QWidget;
@@ -190,12 +199,17 @@ bool PropertyEditor::applyText(const QString& field, const QString& text, QStrin
 
 void PropertyEditor::markField(const QString& field, const QString& message) {
   marked_ = field;
+  // the reason, in words, at the top of the fields (and as the field's tooltip)
+  error_->setText(field.isEmpty() || message.isEmpty() ? QString() : QStringLiteral("%1: %2").arg(QString(field).replace('/', '.'), message));
+  error_->setVisible(!error_->text().isEmpty());
   for (auto& [key, w] : editors_) {
     const bool bad = key == field || field.startsWith(key + "/");
     w->setStyleSheet(bad ? "background: #ffd0d0;" : "");
     w->setToolTip(bad ? message : QString());
   }
 }
+
+QString PropertyEditor::errorText() const { return error_->text(); }
 
 void PropertyEditor::refreshMarks() {
   if (!id_) return;
@@ -204,9 +218,39 @@ void PropertyEditor::refreshMarks() {
   else if (!marked_.isEmpty()) markField(QString(), QString());
 }
 
-void PropertyEditor::rebuild() {
-  while (form_->rowCount() > 0) form_->removeRow(0);
+// Rebuilds run inside the signals of the very editors they replace (a combo
+// box's activated -> applyText -> Document::edit -> specChanged -> rebuild), and
+// Qt goes on using the sender after the slot returns (QComboBox emits
+// textActivated after activated). So an editor is never deleted here: it is
+// cut off from this editor first (so that hiding it, which moves the focus and
+// finishes its line edit, edits nothing), hidden, and deleted once control is
+// back in the event loop.
+void PropertyEditor::retireEditors() {
+  while (form_->rowCount() > 0) {
+    const QFormLayout::TakeRowResult row = form_->takeRow(0);
+    for (QLayoutItem* item : {row.labelItem, row.fieldItem}) {
+      if (!item) continue;
+      if (QWidget* w = item->widget()) {
+        QObject::disconnect(w, nullptr, this, nullptr);
+        for (QObject* child : w->findChildren<QObject*>()) QObject::disconnect(child, nullptr, this, nullptr);
+        w->hide();
+        w->deleteLater();
+      }
+      delete item;  // the layout item only, not its widget
+    }
+  }
   editors_.clear();
+}
+
+bool PropertyEditor::isCurrent(const QString& key, const QWidget* editor) const {
+  const auto it = editors_.find(key);
+  return it != editors_.end() && it->second == editor;
+}
+
+void PropertyEditor::rebuild() {
+  retireEditors();
+  error_->clear();
+  error_->hide();
   const ModelSpec& spec = doc_->spec();
   if (!id_ || id_->index >= element_count(spec, id_->kind)) {
     title_->setText(tr("Select an element in the model tree"));
@@ -227,29 +271,36 @@ void PropertyEditor::rebuild() {
       auto* c = new QComboBox;
       c->addItems(type_names(id_->kind));
       c->setCurrentText(qs(v.get<std::string>()));
-      connect(c, &QComboBox::activated, this, [this, c] { applyText("type", c->currentText()); });
+      connect(c, &QComboBox::activated, this, [this, c] {
+        if (isCurrent("type", c)) applyText("type", c->currentText());
+      });
       editor = c;
     } else if (v.is_string() && (kBodyRefs.contains(last) || last == "joint")) {
       auto* c = new QComboBox;
       c->setEditable(true);
       c->addItems(last == "joint" ? joints : bodies);
       c->setCurrentText(qs(v.get<std::string>()));
-      connect(c, &QComboBox::activated, this, [this, c, key] { applyText(key, c->currentText()); });
-      connect(c->lineEdit(), &QLineEdit::editingFinished, this, [this, c, key] {
-        if (c->currentText() != editorFor(key)->property("value").toString()) applyText(key, c->currentText());
-      });
+      // a pick from the list (activated) and typed text confirmed (editingFinished) both
+      // apply; the second of the two sees the value already applied and does nothing
+      auto apply = [this, c, key] {
+        if (isCurrent(key, c) && c->currentText() != c->property("value").toString()) applyText(key, c->currentText());
+      };
+      connect(c, &QComboBox::activated, this, apply);
+      connect(c->lineEdit(), &QLineEdit::editingFinished, this, apply);
       c->setProperty("value", qs(v.get<std::string>()));
       editor = c;
     } else if (v.is_boolean()) {
       auto* c = new QCheckBox;
       c->setChecked(v.get<bool>());
-      connect(c, &QCheckBox::toggled, this, [this, key](bool on) { applyText(key, on ? "true" : "false"); });
+      connect(c, &QCheckBox::toggled, this, [this, c, key](bool on) {
+        if (isCurrent(key, c)) applyText(key, on ? "true" : "false");
+      });
       editor = c;
     } else {
       auto* e = new QLineEdit(value_text(v));
       e->setProperty("value", e->text());
       connect(e, &QLineEdit::editingFinished, this, [this, e, key] {
-        if (e->text() != e->property("value").toString()) applyText(key, e->text());
+        if (isCurrent(key, e) && e->text() != e->property("value").toString()) applyText(key, e->text());
       });
       editor = e;
     }

@@ -27,6 +27,7 @@ class PropertyEditor : public QWidget {
   // marks a field (its key path below the element, e.g. "parent" or "parent_frame/position") as wrong
   void markField(const QString& field, const QString& message);
   QString markedField() const { return marked_; }
+  QString errorText() const;  // the reason shown at the fields ("" when none is marked)
   QWidget* editorFor(const QString& field) const;  // for tests: the editor of a field
 
   // applies `text` as the new value of `field` (what typing + Enter does); false with *error when rejected
@@ -39,9 +40,12 @@ class PropertyEditor : public QWidget {
 
  private:
   void rebuild();
+  void retireEditors();                                             // takes the rows out, deletes them later
+  bool isCurrent(const QString& key, const QWidget* editor) const;  // false for a retired editor
   void refreshMarks();
   QFormLayout* form_ = nullptr;
   QLabel* title_ = nullptr;
+  QLabel* error_ = nullptr;  // the marked field's reason
   QWidget* body_ = nullptr;
   Document* doc_;
   std::optional<ElementId> id_;

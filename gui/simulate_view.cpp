@@ -119,8 +119,31 @@ SimulateView::SimulateView(Document* doc, QWidget* parent) : QWidget(parent), do
     for (const QString& n : worker_->notes()) emit message(tr("note: %1").arg(n));
   });
   connect(doc_, &Document::specChanged, this, &SimulateView::refreshFromDocument);
+  connect(doc_, &Document::replaced, this, &SimulateView::clearResult);
+  connect(doc_, &Document::modelChanged, this, &SimulateView::updateStaleness);
   refreshFromDocument();
   setRunning(false);
+}
+
+bool SimulateView::isStale() const { return result_ && result_model_ != doc_->model(); }
+
+void SimulateView::updateStaleness() { stale_label_->setVisible(isStale() && !isRunning()); }
+
+void SimulateView::clearResult() {
+  if (isRunning()) {
+    discard_run_ = true;  // what it still delivers belongs to the old model
+    cancel();
+  }
+  result_.reset();
+  result_model_.reset();
+  plant_inputs_.clear();
+  restorePlotLimit();
+  plots_->reset({}, {}, {}, {}, 1.0);
+  progress_->setValue(0);
+  status_ = tr("Not run yet.");
+  status_label_->setText(status_);
+  setRunning(isRunning());
+  updateStaleness();
 }
 
 SimulateView::~SimulateView() {
@@ -267,6 +290,11 @@ void SimulateView::buildUi() {
   status_label_ = new QLabel(tr("Not run yet."), this);
   status_label_->setWordWrap(true);
   status_label_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  stale_label_ = new QLabel(tr("<b>Out of date:</b> the model changed since this run: run again."), this);
+  stale_label_->setObjectName("simulateStale");
+  stale_label_->setStyleSheet("QLabel { background: #fff0c0; color: #6a4a00; padding: 3px; }");
+  stale_label_->setWordWrap(true);
+  stale_label_->setVisible(false);
   save_results_ = new QPushButton(tr("Save results…"), this);
   save_plot_ = new QPushButton(tr("Save plot…"), this);
   auto* run_row = new QHBoxLayout;
@@ -283,6 +311,7 @@ void SimulateView::buildUi() {
   left_layout->addLayout(run_row);
   left_layout->addWidget(progress_);
   left_layout->addWidget(status_label_);
+  left_layout->addWidget(stale_label_);
   left_layout->addLayout(save_row);
   left_layout->addStretch(1);
 
@@ -625,6 +654,8 @@ void SimulateView::setRunning(bool running) {
   cancel_button_->setEnabled(running);
   save_results_->setEnabled(!running && result_ != nullptr);
   save_plot_->setEnabled(!running);
+  if (stale_label_) updateStaleness();
+  emit runningChanged(running);
 }
 
 void SimulateView::run() {
@@ -670,6 +701,7 @@ void SimulateView::cancel() {
 }
 
 void SimulateView::onSamples(const SampleBatch& batch) {
+  if (discard_run_) return;
   const Eigen::Index nin = static_cast<Eigen::Index>(plant_inputs_.size());
   Eigen::VectorXd u(nin);
   for (const Snapshot& s : batch) {
@@ -682,6 +714,7 @@ void SimulateView::onSamples(const SampleBatch& batch) {
 }
 
 void SimulateView::onProgress(double t, double tEnd) {
+  if (discard_run_) return;
   if (tEnd > 0) progress_->setValue(static_cast<int>(std::clamp(1000.0 * t / tEnd, 0.0, 1000.0)));
   if (!worker_->cancelRequested()) {
     status_ = tr("running: t = %1 s of %2 s").arg(num(t, 4), num(tEnd));
@@ -697,6 +730,14 @@ void SimulateView::restorePlotLimit() {
 }
 
 void SimulateView::onFinished(std::shared_ptr<const SimulationResult> r) {
+  if (discard_run_) {
+    discard_run_ = false;
+    restorePlotLimit();
+    plots_->reset({}, {}, {}, {}, 1.0);
+    setRunning(false);
+    emit message(tr("Simulation of the previous model cancelled"));
+    return;
+  }
   result_ = r;
   restorePlotLimit();
   plots_->setResult(*r, plant_inputs_);
@@ -727,6 +768,12 @@ void SimulateView::onFinished(std::shared_ptr<const SimulationResult> r) {
 
 void SimulateView::onFailed(const QString& why) {
   result_.reset();
+  if (discard_run_) {
+    discard_run_ = false;
+    restorePlotLimit();
+    setRunning(false);
+    return;
+  }
   restorePlotLimit();
   status_ = tr("failed: %1").arg(why);
   status_label_->setText(status_);

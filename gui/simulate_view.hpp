@@ -74,6 +74,11 @@ class SimulateView : public QWidget {
   // The model the last run simulated (for playback: result()->q belongs to it).
   std::shared_ptr<const codyna::Model> resultModel() const { return result_model_; }
   ResultPlots* plots() const { return plots_; }
+  // isStale(): the document's model changed since the run (the results stay, marked).
+  bool isStale() const;
+  // Forgets the result (the document now holds another model); a running simulation is cancelled.
+  void clearResult();
+  QPushButton* saveResultsButton() const { return save_results_; }
   SimWorker* worker() const { return worker_; }
 
   // HDF5 (.h5, .hdf5) or CSV (.csv) by suffix, through core's writers.
@@ -108,6 +113,7 @@ class SimulateView : public QWidget {
 
  signals:
   void runStarted();
+  void runningChanged(bool running);  // Run/Cancel availability (the window's actions follow it)
   // result null: the setup failed (message() says why)
   void runFinished(std::shared_ptr<const codyna::SimulationResult> result);
   void message(const QString& text);
@@ -133,6 +139,7 @@ class SimulateView : public QWidget {
   void setRunning(bool running);
   void restorePlotLimit();
   void saveResultsDialog();
+  void updateStaleness();
   void savePlotDialog();
 
   Document* doc_;
@@ -170,6 +177,8 @@ class SimulateView : public QWidget {
   QPushButton* run_button_ = nullptr;
   QPushButton* cancel_button_ = nullptr;
   QPushButton* save_results_ = nullptr;
+  QLabel* stale_label_ = nullptr;
+  bool discard_run_ = false;  // the running simulation's model was replaced: drop what it delivers
   QPushButton* save_plot_ = nullptr;
   QProgressBar* progress_ = nullptr;
   QLabel* status_label_ = nullptr;

@@ -170,6 +170,13 @@ double read_positive_length(const Node& n) {
   return x;
 }
 
+// a body's mass: 0 (a massless link between joints) or more
+double read_mass(const Node& n) {
+  const double x = read_number(n);
+  if (!(x >= 0)) n.expected("a non-negative mass (kg)");
+  return x;
+}
+
 Eigen::Matrix3d read_matrix3(const Node& n) {
   if (!n.value().is_array() || n.value().size() != 3) n.expected("a 3x3 array (3 rows of 3 numbers)");
   Eigen::Matrix3d m;
@@ -643,7 +650,7 @@ template <>
 const Schema<BodySpec>& schema<BodySpec>() {
   static const Schema<BodySpec> s{{
       name_field<BodySpec>(),
-      field("mass", &BodySpec::mass, read_number, Need::Required),
+      field("mass", &BodySpec::mass, read_mass, Need::Required),
       field("com", &BodySpec::com, read_vec3),
       field("inertia", &BodySpec::inertia, read_inertia, encode_inertia, Need::Required),
       list_field("shapes", &BodySpec::shapes),

@@ -1,0 +1,482 @@
+// Editing a model through the real widgets, the way a person does it: drop-downs
+// picked from their open list with the mouse or the keys, or typed and confirmed
+// with Enter; mouse wheels over fields. Regression tests for the crash of issue 18
+// (an edit from a drop-down rebuilt the property editor, deleting the drop-down
+// inside its own signal: SIGSEGV in QComboBox::textActivated) and for the wheel
+// that changed settings while a user scrolled a panel.
+#include <QAbstractItemView>
+#include <QApplication>
+#include <QComboBox>
+#include <QDoubleSpinBox>
+#include <QLineEdit>
+#include <QMessageBox>
+#include <QPlainTextEdit>
+#include <QPointer>
+#include <QScrollArea>
+#include <QScrollBar>
+#include <QTest>
+#include <QTreeView>
+#include <QUndoStack>
+#include <QWheelEvent>
+
+#include <QElapsedTimer>
+#include <QLabel>
+#include <QPushButton>
+#include <QSignalSpy>
+#include <QSlider>
+#include <QTableView>
+#include <QTemporaryDir>
+
+#include <QAction>
+#include <QMenuBar>
+#include <QProgressBar>
+#include <QStatusBar>
+#include <QToolBar>
+
+#include "analysis/modal.hpp"
+#include "gui/linearize_view.hpp"
+#include "gui/main_window.hpp"
+#include "gui/matrix_models.hpp"
+#include "gui/property_editor.hpp"
+#include "gui/result_plots.hpp"
+#include "gui/simulate_view.hpp"
+
+using namespace codyna;
+using namespace codyna::gui;
+
+namespace {
+
+// opens `c`'s list with a click on its arrow, as a person does
+QAbstractItemView* openPopup(QComboBox* c) {
+  QTest::mouseClick(c, Qt::LeftButton, {}, QPoint(c->width() - 6, c->height() / 2));
+  QAbstractItemView* v = c->view();
+  if (!QTest::qWaitFor([v] { return v->isVisible(); }, 2000)) return nullptr;
+  // a release right after the opening press is ignored by the popup: wait as a person would
+  QTest::qWait(QApplication::doubleClickInterval() + 50);
+  return v;
+}
+
+// picks `text` from `c`'s open list with the mouse: move onto the item, click it
+bool pickWithMouse(QComboBox* c, const QString& text) {
+  QAbstractItemView* v = openPopup(c);
+  if (!v) return false;
+  const int row = c->findText(text);
+  if (row < 0) return false;
+  const QPoint at = v->visualRect(v->model()->index(row, c->modelColumn())).center();
+  QTest::mouseMove(v->viewport(), at);
+  QTest::mouseClick(v->viewport(), Qt::LeftButton, {}, at);
+  return QTest::qWaitFor([v] { return !v->isVisible(); }, 2000);
+}
+
+// picks `text` from `c`'s open list with the arrow keys and Enter
+bool pickWithKeys(QComboBox* c, const QString& text) {
+  QAbstractItemView* v = openPopup(c);
+  if (!v) return false;
+  const int row = c->findText(text);
+  if (row < 0) return false;
+  for (int guard = 0; v->currentIndex().row() != row && guard < 50; ++guard)
+    QTest::keyClick(v, v->currentIndex().row() < row ? Qt::Key_Down : Qt::Key_Up);
+  QTest::keyClick(v, Qt::Key_Return);
+  return QTest::qWaitFor([v] { return !v->isVisible(); }, 2000);
+}
+
+// a wheel notch over the middle of `w` (delivered as Qt delivers one: to the widget under the mouse)
+void wheelOver(QWidget* w, int notches) {
+  const QPointF at(w->width() / 2.0, w->height() / 2.0);
+  QWheelEvent e(at, w->mapToGlobal(at), QPoint(), QPoint(0, 120 * notches), Qt::NoButton, Qt::NoModifier,
+                Qt::NoScrollPhase, false);
+  QApplication::sendEvent(w, &e);
+}
+
+const QString kCart = QStringLiteral(CODYNA_EXAMPLES_DIR "/cart_pendulum.json");
+const QString kPendulum = QStringLiteral(CODYNA_EXAMPLES_DIR "/pendulum.json");
+
+}  // namespace
+
+class EditingTest : public QObject {
+  Q_OBJECT
+ private:
+  std::unique_ptr<MainWindow> w;
+
+  PropertyEditor* props() { return w->propertyEditor(); }
+  QComboBox* combo(const QString& field) { return qobject_cast<QComboBox*>(props()->editorFor(field)); }
+  const JointSpec& joint(int k) { return w->document()->spec().joints.at(k); }
+
+  // File > New; body, joint, body, joint (both joints on the ground, as added); selects the second joint
+  void buildChainOfTwo() {
+    QVERIFY(w->newModel());
+    QVERIFY(w->addElement(ElementKind::Body));
+    QVERIFY(w->addElement(ElementKind::Joint));
+    QVERIFY(w->addElement(ElementKind::Body));
+    QVERIFY(w->addElement(ElementKind::Joint));
+    QCOMPARE(w->document()->spec().joints.size(), std::size_t(2));
+    QCOMPARE(QString::fromStdString(joint(1).parent), QString("ground"));
+    QCOMPARE(QString::fromStdString(joint(1).child), QString("body_2"));
+    QCOMPARE(props()->element()->kind, ElementKind::Joint);
+    QCOMPARE(props()->element()->index, 1);
+    QVERIFY(combo("parent"));
+  }
+
+ private slots:
+  void init() {
+    QCoreApplication::setOrganizationName("codyna-test");
+    QCoreApplication::setApplicationName("editing_test");
+    w = std::make_unique<MainWindow>();
+    w->setQuestionHook([](const QString&, const QString&, int) { return int(QMessageBox::Discard); });
+    w->setFileHook([](const QString&, const QString&, const QString&, bool) { return QString(); });
+    w->show();
+    QVERIFY(QTest::qWaitForWindowExposed(w.get()));
+  }
+  void cleanup() {
+    w->document()->undoStack()->setClean();
+    w.reset();
+  }
+
+  // the issue's reproduction: a joint's parent set from the drop-down's list with the mouse
+  void parentPickedWithTheMouseChainsTheJoint() {
+    buildChainOfTwo();
+    QPointer<QComboBox> c = combo("parent");
+    QVERIFY(pickWithMouse(c, "body"));
+    QCOMPARE(QString::fromStdString(joint(1).parent), QString("body"));
+    QVERIFY(w->document()->model());  // a double pendulum now: it compiles
+    QCOMPARE(w->document()->model()->nq, 2);
+    // the editor was rebuilt with a new drop-down; the old one goes once the event loop runs
+    QVERIFY(combo("parent") != c.data());
+    QCOMPARE(combo("parent")->currentText(), QString("body"));
+    QTRY_VERIFY(c.isNull());
+    // the rebuilt editor works as well: back to the ground, with the keys this time
+    QVERIFY(pickWithKeys(combo("parent"), "ground"));
+    QCOMPARE(QString::fromStdString(joint(1).parent), QString("ground"));
+  }
+
+  void parentPickedWithTheArrowKeys() {
+    buildChainOfTwo();
+    QVERIFY(pickWithKeys(combo("parent"), "body"));
+    QCOMPARE(QString::fromStdString(joint(1).parent), QString("body"));
+    QCOMPARE(w->document()->undoStack()->undoText(), QString("Edit joint_2.parent"));
+  }
+
+  // the drop-down closed, focused: Down moves to the next body at once (activated, then textActivated)
+  void parentStepsWithDownOnTheClosedDropDown() {
+    buildChainOfTwo();
+    QComboBox* c = combo("parent");
+    c->setFocus();
+    QTRY_VERIFY(c->hasFocus());
+    QCOMPARE(c->currentText(), QString("ground"));
+    QTest::keyClick(c, Qt::Key_Down);
+    QCOMPARE(QString::fromStdString(joint(1).parent), QString("body"));
+    QTest::keyClick(combo("parent"), Qt::Key_Down);  // the new drop-down has the focus path too
+    QCOMPARE(QString::fromStdString(joint(1).parent), QString("body_2"));  // its own child: refused by compile
+    QVERIFY(!w->document()->model());
+    QVERIFY(!w->document()->errorText().isEmpty());
+  }
+
+  void parentTypedAndConfirmedWithEnter() {
+    buildChainOfTwo();
+    QComboBox* c = combo("parent");
+    QVERIFY(c->isEditable());
+    c->lineEdit()->setFocus();
+    c->lineEdit()->selectAll();
+    QTest::keyClicks(c->lineEdit(), "body");
+    QTest::keyClick(c->lineEdit(), Qt::Key_Return);
+    QCOMPARE(QString::fromStdString(joint(1).parent), QString("body"));
+    // one edit, not two (Enter both activates and finishes the line edit)
+    QCOMPARE(w->document()->undoStack()->count(), 5);
+    QCOMPARE(combo("parent")->currentText(), QString("body"));
+  }
+
+  // a broken reference (red) fixed from the list
+  void brokenReferenceFixedFromTheList() {
+    buildChainOfTwo();
+    QComboBox* c = combo("parent");
+    c->lineEdit()->setFocus();
+    c->lineEdit()->selectAll();
+    QTest::keyClicks(c->lineEdit(), "nowhere");
+    QTest::keyClick(c->lineEdit(), Qt::Key_Return);
+    QCOMPARE(QString::fromStdString(joint(1).parent), QString("nowhere"));
+    QVERIFY(!w->document()->model());
+    QCOMPARE(props()->markedField(), QString("parent"));
+    QVERIFY(pickWithMouse(combo("parent"), "body"));
+    QCOMPARE(QString::fromStdString(joint(1).parent), QString("body"));
+    QVERIFY(w->document()->model());
+  }
+
+  void jointTypeChangedFromTheList() {
+    buildChainOfTwo();
+    QVERIFY(pickWithMouse(combo("type"), "prismatic"));
+    QCOMPARE(joint(1).type, JointType::Prismatic);
+    QVERIFY(pickWithKeys(combo("type"), "spherical"));
+    QCOMPARE(joint(1).type, JointType::Spherical);
+    QVERIFY(w->document()->model());
+    QCOMPARE(w->document()->model()->nv, 1 + 3);
+    QVERIFY(pickWithMouse(combo("type"), "revolute"));
+    QCOMPARE(joint(1).type, JointType::Revolute);
+  }
+
+  // every drop-down of every element kind, each of its entries picked in turn: no crash
+  void everyDropDownOfEveryKind() {
+    buildChainOfTwo();
+    for (ElementKind k : {ElementKind::Effect, ElementKind::Actuator, ElementKind::Sensor, ElementKind::Constraint})
+      QVERIFY(w->addElement(k));
+    for (ElementKind k : kElementKinds) {
+      for (int i = 0; i < element_count(w->document()->spec(), k); ++i) {
+        w->selectElement(ElementId{k, i});
+        QCOMPARE(props()->element()->index, i);
+        QStringList fields;
+        for (const QString& f : {"type", "parent", "child", "body", "body_a", "body_b", "joint", "frame"})
+          if (combo(f)) fields << f;
+        for (const QString& f : fields) {
+          const int n = combo(f)->count();
+          for (int item = 0; item < n && combo(f); ++item) {
+            QComboBox* c = combo(f);
+            const QString text = c->itemText(item);
+            if (item % 2 == 0) QVERIFY(pickWithKeys(c, text));
+            else QVERIFY(pickWithMouse(c, text));
+          }
+        }
+        w->selectElement(ElementId{k, i});
+      }
+    }
+    // and back through the undo stack, every step
+    while (w->document()->undoStack()->canUndo()) w->document()->undoStack()->undo();
+    QCOMPARE(w->document()->spec().bodies.size(), std::size_t(0));
+  }
+
+  // linearizes and runs the open model (0.3 s); both results on screen
+  void linearizeAndRun() {
+    LinearizeView* lv = w->linearizeView();
+    QVERIFY(lv->linearize());
+    QVERIFY(lv->result());
+    QVERIFY(lv->matrixModel(0)->rowCount() > 0);
+    QVERIFY(lv->modeModel()->rowCount() > 0);
+    QVERIFY(!lv->isStale());
+    SimulateView* sv = w->simulateView();
+    w->analysisTabs()->setCurrentWidget(sv);
+    sv->endTimeSpin()->setValue(0.3);
+    QSignalSpy finished(sv, &SimulateView::runFinished);
+    QTest::mouseClick(sv->runButton(), Qt::LeftButton);
+    QVERIFY(QTest::qWaitFor([&] { return finished.count() == 1; }, 60000));
+    QVERIFY(sv->result() && sv->result()->completed);
+    QVERIFY(sv->saveResultsButton()->isEnabled());
+    QVERIFY(w->playbackSlider()->isEnabled());
+    QVERIFY(!sv->isStale());
+    QVERIFY(!sv->findChild<QLabel*>("simulateStale")->isVisibleTo(sv));
+  }
+
+  // nothing of the old model's results is left on screen
+  void verifyNoResult() {
+    LinearizeView* lv = w->linearizeView();
+    QVERIFY(!lv->result());
+    for (int k = 0; k < 4; ++k) QCOMPARE(lv->matrixModel(k)->rowCount(), 0);
+    QCOMPARE(lv->modeModel()->rowCount(), 0);
+    QCOMPARE(lv->operatingPointLabel()->text(), QString("Not linearized yet."));
+    QVERIFY(!lv->findChild<QLabel*>("linearizeStale")->isVisibleTo(lv));
+    SimulateView* sv = w->simulateView();
+    QVERIFY(!sv->result());
+    QVERIFY(!sv->saveResultsButton()->isEnabled());
+    QString error;
+    QTemporaryDir dir;
+    QVERIFY(!sv->saveResults(dir.filePath("r.h5"), &error));  // and the call refuses too
+    QVERIFY(!QFileInfo::exists(dir.filePath("r.h5")));
+    QCOMPARE(sv->statusText(), QString("Not run yet."));
+    QCOMPARE(sv->plots()->inputSeriesCount() + sv->plots()->outputSeriesCount(), 0);
+    QVERIFY(!w->playbackSlider()->isEnabled());
+    QVERIFY(!w->isAnimatingMode());
+  }
+
+  void newAndOpenLeaveNoResultOfTheOldModel() {
+    QVERIFY(w->openFile(kCart));
+    linearizeAndRun();
+    w->linearizeView()->selectMode(0);  // a mode animated in the 3-D view
+    QVERIFY(w->isAnimatingMode());
+    QVERIFY(w->newModel());
+    verifyNoResult();
+    // Open
+    QVERIFY(w->openFile(kCart));
+    linearizeAndRun();
+    QVERIFY(w->openFile(kPendulum));
+    verifyNoResult();
+    // a simulation still running when another model is opened: what it delivers later is dropped
+    SimulateView* sv = w->simulateView();
+    sv->endTimeSpin()->setValue(5000);
+    QSignalSpy finished(sv, &SimulateView::runFinished);
+    QTest::mouseClick(sv->runButton(), Qt::LeftButton);
+    QVERIFY(QTest::qWaitFor([&] { return sv->progressBar()->value() > 0; }, 30000));
+    w->document()->undoStack()->setClean();
+    QVERIFY(w->openFile(kCart));
+    QVERIFY(QTest::qWaitFor([&] { return !sv->isRunning(); }, 30000));
+    QTest::qWait(100);
+    QCOMPARE(finished.count(), 0);
+    verifyNoResult();
+    QVERIFY(sv->runButton()->isEnabled());
+  }
+
+  void anEditMarksTheResultsOutOfDate() {
+    QVERIFY(w->openFile(kCart));
+    linearizeAndRun();
+    w->selectElement(ElementId{ElementKind::Body, 1});
+    QLineEdit* mass = qobject_cast<QLineEdit*>(props()->editorFor("mass"));
+    QVERIFY(mass);
+    mass->setFocus();
+    mass->selectAll();
+    QTest::keyClicks(mass, "12");
+    QTest::keyClick(mass, Qt::Key_Return);
+    QCOMPARE(w->document()->spec().bodies[1].mass, 12.0);
+    LinearizeView* lv = w->linearizeView();
+    SimulateView* sv = w->simulateView();
+    QVERIFY(lv->isStale());
+    QVERIFY(lv->findChild<QLabel*>("linearizeStale")->isVisibleTo(lv));
+    QVERIFY(!lv->matrixView(0)->isEnabled());  // greyed, still readable
+    QVERIFY(sv->isStale());
+    QVERIFY(sv->findChild<QLabel*>("simulateStale")->isVisibleTo(sv));
+    QVERIFY(sv->saveResultsButton()->isEnabled());  // the run itself can still be saved
+    // linearizing again makes it current
+    QVERIFY(lv->linearize());
+    QVERIFY(!lv->findChild<QLabel*>("linearizeStale")->isVisibleTo(lv));
+    QVERIFY(lv->matrixView(0)->isEnabled());
+  }
+
+  // typed values the model cannot hold are refused at the field, with the reason, and never reach the model
+  void invalidValuesAreRefusedAtTheField() {
+    QVERIFY(w->openFile(kCart));
+    w->selectElement(ElementId{ElementKind::Body, 1});
+    const double mass = w->document()->spec().bodies[1].mass;
+    const int steps = w->document()->undoStack()->count();
+    auto type = [&](const QString& field, const QString& text) {
+      QLineEdit* e = qobject_cast<QLineEdit*>(props()->editorFor(field));
+      QVERIFY(e);
+      e->setFocus();
+      e->selectAll();
+      QTest::keyClicks(e, text);
+      QTest::keyClick(e, Qt::Key_Return);
+    };
+    const QStringList bad{"inf", "-inf", "nan", "1e400", "abc", "1, 2", "-3"};
+    for (const QString& text : bad) {
+      type("mass", text);
+      QCOMPARE(w->document()->spec().bodies[1].mass, mass);
+      QCOMPARE(w->document()->undoStack()->count(), steps);
+      QVERIFY2(w->document()->model(), qPrintable(text));  // the model still compiles: nothing reached it
+      QCOMPARE(props()->markedField(), QString("mass"));
+      QVERIFY2(props()->errorText().startsWith("mass: "), qPrintable(props()->errorText()));
+      QVERIFY(props()->findChild<QLabel*>("propertyError")->isVisibleTo(props()));
+      QVERIFY(props()->editorFor("mass")->styleSheet().contains("#ffd0d0"));
+      // the field keeps what was typed (to correct it), marked
+      QCOMPARE(qobject_cast<QLineEdit*>(props()->editorFor("mass"))->text(), text);
+    }
+    QVERIFY(props()->errorText().contains("non-negative mass"));  // "-3": the reader's reason
+    type("mass", "nan");
+    QVERIFY2(props()->errorText().contains("not a finite number"), qPrintable(props()->errorText()));
+    // a vector field given the wrong number of values
+    type("com", "1, 2");
+    QCOMPARE(props()->markedField(), QString("com"));
+    QCOMPARE(w->document()->undoStack()->count(), steps);
+    // a good value: taken, and every mark and error goes
+    type("mass", "12");
+    QCOMPARE(w->document()->spec().bodies[1].mass, 12.0);
+    QCOMPARE(props()->markedField(), QString());
+    QCOMPARE(props()->errorText(), QString());
+    QVERIFY(!w->statusBar()->currentMessage().startsWith("Error:"));
+  }
+
+  // Linearize, Export, Run and Cancel in a menu and the toolbar, with shortcuts; Help; the icon
+  void actionsWhereUsersLook() {
+    QVERIFY(w->openFile(kCart));
+    QAction* lin = w->linearizeAction();
+    QAction* run = w->runAction();
+    QAction* cancel = w->cancelAction();
+    QVERIFY(lin && run && cancel);
+    QCOMPARE(lin->shortcut(), QKeySequence(Qt::CTRL | Qt::Key_L));
+    QCOMPARE(run->shortcut(), QKeySequence(Qt::Key_F5));
+    QCOMPARE(cancel->shortcut(), QKeySequence(Qt::SHIFT | Qt::Key_F5));
+    QToolBar* tb = w->findChild<QToolBar*>("mainToolbar");
+    QVERIFY(tb->actions().contains(lin) && tb->actions().contains(run) && tb->actions().contains(cancel));
+    QStringList menus;
+    for (QAction* a : w->menuBar()->actions()) menus << a->text();
+    QVERIFY2(menus.contains("&Analysis") && menus.contains("&Help"), qPrintable(menus.join(",")));
+    // the shortcut does what it says (a person pressing Ctrl+L in the window)
+    QVERIFY(!w->linearizeView()->result());
+    w->activateWindow();
+    w->modelTree()->setFocus();
+    QTest::keyClick(w.get(), Qt::Key_L, Qt::ControlModifier);
+    QTRY_VERIFY(w->linearizeView()->result());
+    QVERIFY(w->messages()->toPlainText().contains("Linearized about"));
+    // F5 runs, Cancel follows the run
+    QVERIFY(!cancel->isEnabled());
+    w->simulateView()->endTimeSpin()->setValue(2000);
+    QSignalSpy finished(w->simulateView(), &SimulateView::runFinished);
+    QTest::keyClick(w.get(), Qt::Key_F5);
+    QTRY_VERIFY(w->simulateView()->isRunning() || finished.count() > 0);
+    QVERIFY(cancel->isEnabled() && !run->isEnabled());
+    cancel->trigger();
+    QTRY_VERIFY_WITH_TIMEOUT(finished.count() == 1, 30000);
+    QVERIFY(w->simulateView()->result() && w->simulateView()->result()->cancelled);
+    QVERIFY(!cancel->isEnabled() && run->isEnabled());
+    // the window icon comes from the library's resources
+    QVERIFY(QFile::exists(":/codyna/codyna.svg"));
+    QVERIFY(!w->windowIcon().isNull());
+    QVERIFY(QFileInfo(MainWindow::documentationUrl().toLocalFile()).exists());
+  }
+
+  // Save As without ".json" writes a file Open's filter shows
+  void saveAsAddsTheSuffix() {
+    QVERIFY(w->openFile(kCart));
+    QTemporaryDir dir;
+    QVERIFY(w->saveFileAs(dir.filePath("mine")));
+    QVERIFY(QFileInfo::exists(dir.filePath("mine.json")));
+    QVERIFY(!QFileInfo::exists(dir.filePath("mine")));
+    QCOMPARE(w->document()->filePath(), QFileInfo(dir.filePath("mine.json")).absoluteFilePath());
+  }
+
+  // a zero eigenvalue has no damping ratio: "-" in the mode table, not -1
+  void zeroEigenvalueHasNoDamping() {
+    LinearSystem s;
+    s.A = Eigen::Matrix2d{{0.0, 1.0}, {0.0, -2.0}};  // a free mass with viscous damping: s = 0 and s = -2
+    s.B = Eigen::Vector2d(0, 1);
+    s.C = Eigen::RowVector2d(1, 0);
+    s.D = Eigen::MatrixXd::Zero(1, 1);
+    s.state_names = {"x", "xdot"};
+    const ModalAnalysis modal = modal_analysis(s);
+    ModeTableModel m;
+    m.setModes(modal);
+    QCOMPARE(m.rowCount(), 2);
+    QStringList damping;
+    for (int r = 0; r < 2; ++r) damping << m.index(r, ModeTableModel::DampingRatio).data().toString();
+    damping.sort();
+    QCOMPARE(damping, QStringList({"-", "1"}));
+  }
+
+  // a wheel turned over a field that was not clicked into scrolls, and changes nothing
+  void wheelOverAnUnfocusedFieldChangesNothing() {
+    SimulateView* sim = w->simulateView();
+    w->analysisTabs()->setCurrentWidget(sim);
+    QComboBox* integrator = sim->integratorCombo();
+    QTRY_VERIFY(integrator->isVisible());
+    QCOMPARE(integrator->focusPolicy(), Qt::StrongFocus);  // a wheel gives it no focus
+    const int before = integrator->currentIndex();
+    const int edits = w->document()->undoStack()->count();
+    w->setFocus();
+    wheelOver(integrator, -3);
+    wheelOver(integrator, 2);
+    QCOMPARE(integrator->currentIndex(), before);
+    QCOMPARE(w->document()->undoStack()->count(), edits);
+    // spin boxes too
+    const QList<QDoubleSpinBox*> spins = sim->findChildren<QDoubleSpinBox*>();
+    QVERIFY(!spins.isEmpty());
+    for (QDoubleSpinBox* s : spins) {
+      if (!s->isVisible()) continue;
+      QCOMPARE(s->focusPolicy(), Qt::StrongFocus);
+      const double v = s->value();
+      wheelOver(s, 1);
+      QCOMPARE(s->value(), v);
+    }
+    QCOMPARE(w->document()->undoStack()->count(), edits);
+    // once clicked into, the wheel is the field's again (the test can see a change)
+    integrator->setFocus();
+    QTRY_VERIFY(integrator->hasFocus());
+    wheelOver(integrator, -1);
+    QVERIFY(integrator->currentIndex() != before);
+  }
+};
+
+QTEST_MAIN(EditingTest)
+#include "editing_test.moc"

@@ -1,0 +1,237 @@
+// A randomized "monkey" test of codyna-gui: fixed seeds, thousands of random
+// clicks, double clicks, right clicks, wheel turns, keys and typed values on
+// whatever widget is visible (the model tree and property editor of every
+// element type, the plant panels, the Linearize and Simulate views, their
+// drop-downs, spin boxes, line edits, tables and buttons), with popups and
+// dialogs closed as they open. What it asserts: the process survives, the
+// document stays consistent (its spec reads back through the model file
+// reader), and the monkey did reach edits, undo steps and every element kind.
+// Built and run under ASan + UBSan by scripts/sanitize.sh as well.
+//
+// It works on a copy of the cart-pendulum in a scratch folder with a scratch
+// HOME, and the window's file questions answer "no file", so nothing outside
+// that folder can be written or deleted.
+//
+// CODYNA_MONKEY_EVENTS (default 4000) sets the events per seed; the seeds are 1..5.
+#include <QAbstractItemView>
+#include <QAbstractSpinBox>
+#include <QApplication>
+#include <QCheckBox>
+#include <QComboBox>
+#include <QDialog>
+#include <QDir>
+#include <QFile>
+#include <QLineEdit>
+#include <QMenu>
+#include <QMessageBox>
+#include <QPointer>
+#include <QPushButton>
+#include <QRandomGenerator>
+#include <QSet>
+#include <QTemporaryDir>
+#include <QTest>
+#include <QTimer>
+#include <QTreeView>
+#include <QUndoStack>
+#include <QWheelEvent>
+#include <nlohmann/json.hpp>
+
+#include "gui/main_window.hpp"
+#include "gui/property_editor.hpp"
+#include "gui/simulate_view.hpp"
+#include "io/model_file.hpp"
+
+using namespace codyna;
+using namespace codyna::gui;
+
+namespace {
+
+const QString kCart = QStringLiteral(CODYNA_EXAMPLES_DIR "/cart_pendulum.json");
+
+const char* const kTexts[] = {"1",    "-2.5", "0",     "inf",    "nan",  "1e400", "abc",   "1, 2", "",
+                              "0.1 0 0", "body", "ground", "rod", "cart", "3; 4", "{}",   "[1]",  "-1e-9",
+                              "1e6",  "joint", "force", "x",   "0 0 1",  "true", "  7  ", "é", "1,2,3"};
+
+// closes every popup and dialog that opens while the monkey's own event is being handled
+class Closer : public QObject {
+ public:
+  Closer() {
+    timer_.setInterval(5);
+    connect(&timer_, &QTimer::timeout, this, [] {
+      if (QWidget* p = QApplication::activePopupWidget()) p->close();
+      if (QWidget* m = QApplication::activeModalWidget()) {
+        if (auto* d = qobject_cast<QDialog*>(m)) d->reject();
+        else m->close();
+      }
+    });
+    timer_.start();
+  }
+
+ private:
+  QTimer timer_;
+};
+
+}  // namespace
+
+class MonkeyTest : public QObject {
+  Q_OBJECT
+ private:
+  QTemporaryDir scratch_;
+
+  static QList<QWidget*> targets(QWidget* root) {
+    QList<QWidget*> out;
+    for (QWidget* c : root->findChildren<QWidget*>()) {
+      if (!c->isVisible() || !c->isEnabled() || c->width() < 2 || c->height() < 2) continue;
+      if (c->window() != root) continue;  // not popups (closed by the Closer)
+      out << c;
+    }
+    return out;
+  }
+
+  // one run of `events` random events with generator seed `seed`
+  void runSeed(quint32 seed, int events) {
+    QVERIFY(scratch_.isValid());
+    const QString dir = scratch_.filePath(QStringLiteral("seed%1").arg(seed));
+    QVERIFY(QDir().mkpath(dir));
+    const QString model = dir + "/cart_pendulum.json";
+    QFile::remove(model);
+    QVERIFY(QFile::copy(kCart, model));
+    QFile::setPermissions(model, QFile::ReadOwner | QFile::WriteOwner);
+    QDir::setCurrent(dir);
+
+    QRandomGenerator rng(seed);
+    auto w = std::make_unique<MainWindow>();
+    w->setQuestionHook([&rng](const QString&, const QString&, int buttons) {
+      // any of the offered answers
+      QList<int> offered;
+      for (int b : {int(QMessageBox::Yes), int(QMessageBox::No), int(QMessageBox::Save), int(QMessageBox::Discard),
+                    int(QMessageBox::Cancel), int(QMessageBox::Ok)})
+        if (buttons & b) offered << b;
+      return offered.isEmpty() ? int(QMessageBox::Cancel) : offered[int(rng.bounded(offered.size()))];
+    });
+    w->setFileHook([](const QString&, const QString&, const QString&, bool) { return QString(); });
+    w->resize(1400, 900);
+    w->show();
+    QVERIFY(QTest::qWaitForWindowExposed(w.get()));
+    QVERIFY(w->openFile(model));
+    Closer closer;
+
+    int spec_changes = 0;
+    connect(w->document(), &Document::specChanged, w.get(), [&] { ++spec_changes; });
+    QSet<QString> classes;
+    QSet<int> kinds_edited;
+    int max_undo = 0;
+
+    for (int e = 0; e < events; ++e) {
+      if (!w->isVisible()) w->show();  // Quit answered "discard" closes it: reopen and go on
+      if (e % 300 == 299) w->simulateView()->cancel();  // as a person would stop a run that goes on too long
+      if (e % 500 == 250) {
+        // a person opens the model again now and then (every kind of element comes back)
+        w->document()->undoStack()->setClean();
+        QVERIFY(w->openFile(model));
+      }
+      QList<QWidget*> all = targets(w.get());
+      if (all.isEmpty()) continue;
+      // a third of the events go to the model editing half: tree and property editor
+      QList<QWidget*> pool = all;
+      if (rng.bounded(3) == 0) {
+        QList<QWidget*> left;
+        for (QWidget* c : all)
+          if (w->propertyEditor()->isAncestorOf(c) || c == w->modelTree()->viewport()) left << c;
+        if (!left.isEmpty()) pool = left;
+      }
+      QPointer<QWidget> t = pool[int(rng.bounded(pool.size()))];
+      classes << QString::fromLatin1(t->metaObject()->className());
+      const QPoint at(int(rng.bounded(t->width())), int(rng.bounded(t->height())));
+      const int action = int(rng.bounded(100));
+      if (action < 38) {
+        QTest::mouseClick(t, Qt::LeftButton, {}, at);
+      } else if (action < 42) {
+        QTest::mouseDClick(t, Qt::LeftButton, {}, at);
+      } else if (action < 45) {
+        QTest::mouseClick(t, Qt::RightButton, {}, at);
+      } else if (action < 55) {
+        const QPointF p(at);
+        QWheelEvent wheel(p, t->mapToGlobal(p), QPoint(), QPoint(0, rng.bounded(2) ? 120 : -120), Qt::NoButton,
+                          Qt::NoModifier, Qt::NoScrollPhase, false);
+        QApplication::sendEvent(t, &wheel);
+      } else if (action < 80) {
+        static const Qt::Key keys[] = {Qt::Key_Up,     Qt::Key_Down,  Qt::Key_Left,  Qt::Key_Right, Qt::Key_Return,
+                                       Qt::Key_Escape, Qt::Key_Tab,   Qt::Key_Space, Qt::Key_Home,  Qt::Key_End,
+                                       Qt::Key_PageUp, Qt::Key_PageDown, Qt::Key_F2, Qt::Key_Delete, Qt::Key_Backspace};
+        QPointer<QWidget> f = QApplication::focusWidget() ? QApplication::focusWidget() : t.data();
+        if (!f) continue;
+        Qt::KeyboardModifiers mod = Qt::NoModifier;
+        Qt::Key key = keys[rng.bounded(int(std::size(keys)))];
+        const int m = int(rng.bounded(20));
+        if (m == 0) { mod = Qt::ControlModifier; key = Qt::Key_Z; }            // undo
+        else if (m == 1) { mod = Qt::ControlModifier | Qt::ShiftModifier; key = Qt::Key_Z; }  // redo
+        else if (m == 2) { mod = Qt::ControlModifier; key = Qt::Key_D; }       // duplicate
+        QTest::keyClick(f, key, mod);
+      } else {
+        // typed text, confirmed with Enter, into the focused field or the target
+        QPointer<QWidget> f = QApplication::focusWidget();
+        if (!f || !w->isAncestorOf(f)) {
+          QTest::mouseClick(t, Qt::LeftButton, {}, at);
+          f = QApplication::focusWidget();
+        }
+        if (f && w->isAncestorOf(f)) {
+          if (auto* le = qobject_cast<QLineEdit*>(f)) le->selectAll();
+          QTest::keyClicks(f, QString::fromUtf8(kTexts[rng.bounded(int(std::size(kTexts)))]));
+          if (f) QTest::keyClick(f, Qt::Key_Return);
+        }
+      }
+      if (const auto id = w->propertyEditor()->element()) kinds_edited << int(id->kind);
+      max_undo = std::max(max_undo, w->document()->undoStack()->count());
+      if (e % 4 == 0) QTest::qWait(0);  // deferred deletes, queued signals, worker results
+    }
+    // the document is still a model a file can hold: its spec writes and reads back
+    const nlohmann::json j = to_json(w->document()->spec());
+    try {
+      (void)parse_model_spec(j, "monkey.json");
+    } catch (const std::exception& ex) {
+      QFAIL(qPrintable(QString("the document's spec no longer reads back: %1").arg(ex.what())));
+    }
+    // the monkey did reach the editing paths
+    qInfo("seed %u: %d events, %d spec changes, undo stack up to %d, %lld widget classes, %lld element kinds selected",
+          seed, events, spec_changes, max_undo, qlonglong(classes.size()), qlonglong(kinds_edited.size()));
+    QVERIFY(spec_changes > events / 100);
+    QVERIFY(classes.contains("QComboBox"));
+    QVERIFY(classes.contains("QLineEdit"));
+    w->simulateView()->cancel();
+    QVERIFY(QTest::qWaitFor([&] { return !w->simulateView()->isRunning(); }, 60000));
+    w->document()->undoStack()->setClean();
+    w.reset();
+    QTest::qWait(0);
+  }
+
+ private slots:
+  void initTestCase() {
+    QCoreApplication::setOrganizationName("codyna-test");
+    QCoreApplication::setApplicationName("monkey_test");
+  }
+
+  void randomEvents_data() {
+    QTest::addColumn<quint32>("seed");
+    for (quint32 s = 1; s <= 5; ++s) QTest::newRow(qPrintable(QStringLiteral("seed %1").arg(s))) << s;
+  }
+  void randomEvents() {
+    QFETCH(quint32, seed);
+    bool ok = false;
+    int events = qEnvironmentVariableIntValue("CODYNA_MONKEY_EVENTS", &ok);
+    if (!ok || events <= 0) events = 4000;
+    runSeed(seed, events);
+  }
+};
+
+int main(int argc, char** argv) {
+  // a scratch HOME (settings, recent files, dialogs' start folders) before Qt reads it
+  QTemporaryDir home;
+  qputenv("HOME", home.path().toLocal8Bit());
+  qputenv("XDG_CONFIG_HOME", (home.path() + "/.config").toLocal8Bit());
+  QApplication app(argc, argv);
+  MonkeyTest t;
+  return QTest::qExec(&t, argc, argv);
+}
+
+#include "monkey_test.moc"
