@@ -30,6 +30,7 @@
 #include <cmath>
 
 #include "dynamics/assembly.hpp"
+#include "gui/control_view.hpp"
 #include "gui/linearize_view.hpp"
 #include "gui/plant_panel.hpp"
 #include "gui/property_editor.hpp"
@@ -88,6 +89,11 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
   tabs_ = new QTabWidget(this);
   tabs_->addTab(lin_view_, tr("Linearize"));
   tabs_->addTab(sim_view_, tr("Simulate"));
+  control_view_ = new ControlView(doc_, this);
+  tabs_->addTab(control_view_, tr("Control"));
+  tabs_->setTabToolTip(0, tr("Operating point, A, B, C, D, modes; export for MATLAB and GNU Octave"));
+  tabs_->setTabToolTip(1, tr("The controller on the nonlinear mechanism: run, plots, results"));
+  tabs_->setTabToolTip(2, tr("The linear plant and closed loop: gain K, closed-loop poles, Bode and step responses"));
   auto* centre = new QSplitter(Qt::Vertical, this);
   centre->addWidget(top);
   centre->addWidget(tabs_);
@@ -188,6 +194,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
   connect(lin_view_, &LinearizeView::modeSelected, this,
           [this](int index, const Eigen::VectorXcd& shape, std::complex<double>) { animateMode(index, shape); });
   connect(sim_view_, &SimulateView::message, this, [this](const QString& m) { message(m); });
+  connect(control_view_, &ControlView::message, this, [this](const QString& m) { message(m); });
   connect(sim_view_, &SimulateView::runFinished, this, &MainWindow::onResult);
   connect(sim_view_, &SimulateView::runStarted, this, [this] { animateMode(-1, {}); });
 

@@ -36,6 +36,7 @@ class PropertyEditor;
 class PlantPanel;
 class LinearizeView;
 class SimulateView;
+class ControlView;
 
 class MainWindow : public QMainWindow {
   Q_OBJECT
@@ -52,6 +53,7 @@ class MainWindow : public QMainWindow {
   PlantPanel* plantOutPanel() { return plant_out_; }
   LinearizeView* linearizeView() { return lin_view_; }
   SimulateView* simulateView() { return sim_view_; }
+  ControlView* controlView() { return control_view_; }
   QTabWidget* analysisTabs() { return tabs_; }
   QPlainTextEdit* messages() { return messages_; }
   QSlider* playbackSlider() { return slider_; }
@@ -119,6 +121,7 @@ class MainWindow : public QMainWindow {
   View3D* view_;
   LinearizeView* lin_view_;
   SimulateView* sim_view_;
+  ControlView* control_view_ = nullptr;
   QTabWidget* tabs_;
   QPlainTextEdit* messages_;
   QSlider* slider_;

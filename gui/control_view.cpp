@@ -1,0 +1,386 @@
+#include "gui/control_view.hpp"
+
+#include <QChart>
+#include <QChartView>
+#include <QComboBox>
+#include <QGroupBox>
+#include <QHBoxLayout>
+#include <QHeaderView>
+#include <QLabel>
+#include <QLineSeries>
+#include <QLogValueAxis>
+#include <QPushButton>
+#include <QSplitter>
+#include <QTabWidget>
+#include <QTableView>
+#include <QVBoxLayout>
+#include <QValueAxis>
+#include <algorithm>
+#include <cmath>
+
+#include "gui/document.hpp"
+#include "gui/matrix_models.hpp"
+
+namespace codyna::gui {
+
+namespace {
+
+QStringList qlist(const std::vector<std::string>& v) {
+  QStringList l;
+  for (const auto& s : v) l << qs(s);
+  return l;
+}
+
+QChart* makeChart(const QString& title) {
+  auto* c = new QChart;
+  c->setTitle(title);
+  c->legend()->setAlignment(Qt::AlignRight);
+  c->setMargins(QMargins(4, 4, 4, 4));
+  return c;
+}
+
+// axis range with a little room; a flat curve gets +-1 around its value
+void fitAxis(QValueAxis* a, double lo, double hi) {
+  if (!(lo <= hi) || !std::isfinite(lo) || !std::isfinite(hi)) {
+    a->setRange(-1, 1);
+    return;
+  }
+  if (hi - lo < 1e-12 * std::max(1.0, std::abs(hi))) {
+    lo -= 1;
+    hi += 1;
+  }
+  const double pad = 0.05 * (hi - lo);
+  a->setRange(lo - pad, hi + pad);
+  a->applyNiceNumbers();
+}
+
+}  // namespace
+
+ControlView::ControlView(Document* doc, QWidget* parent) : QWidget(parent), doc_(doc) {
+  buildUi();
+  connect(doc_, &Document::replaced, this, &ControlView::clearResult);
+  connect(doc_, &Document::modelChanged, this, &ControlView::updateStaleness);
+  clearResult();
+}
+
+ControlView::~ControlView() = default;
+
+void ControlView::buildUi() {
+  analyse_button_ = new QPushButton(tr("Analyse"), this);
+  analyse_button_->setObjectName("analyseButton");
+  analyse_button_->setToolTip(tr("Linearize the plant and close the loop with the study's controller (as the Simulate view sets it): "
+                                 "gain, closed-loop poles, Bode and step responses"));
+  status_ = new QLabel(this);
+  status_->setWordWrap(true);
+  status_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  stale_ = new QLabel(tr("<b>Out of date:</b> the model or the study changed since: analyse again."), this);
+  stale_->setObjectName("controlStale");
+  stale_->setStyleSheet("QLabel { background: #fff0c0; color: #6a4a00; padding: 3px; }");
+  stale_->setVisible(false);
+
+  system_combo_ = new QComboBox(this);
+  system_combo_->setObjectName("controlSystem");
+  system_combo_->addItem(tr("open-loop plant"));
+  system_combo_->addItem(tr("closed loop"));
+  system_combo_->setToolTip(tr("The plant as linearized (inputs: Plant/In; outputs: Plant/Out), or the loop closed by the controller "
+                               "(inputs: references r_ and disturbances d_; outputs: Plant/Out and the efforts u_)"));
+  input_combo_ = new QComboBox(this);
+  input_combo_->setObjectName("controlInput");
+  input_combo_->setToolTip(tr("The input of the Bode plot and of the step"));
+  output_combo_ = new QComboBox(this);
+  output_combo_->setObjectName("controlOutput");
+  output_combo_->setToolTip(tr("The output of the Bode plot"));
+
+  auto* top = new QHBoxLayout;
+  top->addWidget(analyse_button_);
+  top->addWidget(new QLabel(tr("system"), this));
+  top->addWidget(system_combo_);
+  top->addWidget(new QLabel(tr("input"), this));
+  top->addWidget(input_combo_, 1);
+  top->addWidget(new QLabel(tr("output"), this));
+  top->addWidget(output_combo_, 1);
+
+  // left: K and the closed-loop poles
+  gain_model_ = new MatrixTableModel(this);
+  gain_view_ = new QTableView(this);
+  gain_view_->setModel(gain_model_);
+  gain_view_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
+  gain_view_->setToolTip(tr("The state-feedback gain K codyna designed (u = u0 - K dx); empty for other controllers"));
+  pole_model_ = new ModeTableModel(this);
+  pole_view_ = new QTableView(this);
+  pole_view_->setModel(pole_model_);
+  pole_view_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
+  pole_view_->setColumnHidden(ModeTableModel::DominantStates, true);
+  auto* gain_box = new QGroupBox(tr("Gain K (LQR)"), this);
+  (new QVBoxLayout(gain_box))->addWidget(gain_view_);
+  auto* pole_box = new QGroupBox(tr("Closed-loop poles"), this);
+  (new QVBoxLayout(pole_box))->addWidget(pole_view_);
+  auto* left = new QSplitter(Qt::Vertical, this);
+  left->addWidget(gain_box);
+  left->addWidget(pole_box);
+
+  // right: Bode (magnitude over phase) and step
+  mag_chart_ = makeChart(tr("Magnitude"));
+  phase_chart_ = makeChart(tr("Phase"));
+  step_chart_ = makeChart(tr("Step response"));
+  mag_series_ = new QLineSeries;
+  phase_series_ = new QLineSeries;
+  mag_chart_->addSeries(mag_series_);
+  phase_chart_->addSeries(phase_series_);
+  mag_chart_->legend()->hide();
+  phase_chart_->legend()->hide();
+  for (auto [chart, series, unit] : {std::tuple{mag_chart_, mag_series_, tr("dB")}, std::tuple{phase_chart_, phase_series_, tr("deg")}}) {
+    auto* x = new QLogValueAxis;
+    x->setBase(10);
+    x->setLabelFormat("%g");
+    x->setTitleText(tr("frequency [rad/s]"));
+    x->setMinorTickCount(8);
+    auto* y = new QValueAxis;
+    y->setTitleText(unit);
+    y->setLabelFormat("%g");
+    chart->addAxis(x, Qt::AlignBottom);
+    chart->addAxis(y, Qt::AlignLeft);
+    series->attachAxis(x);
+    series->attachAxis(y);
+  }
+  auto* tx = new QValueAxis;
+  tx->setTitleText(tr("t [s]"));
+  tx->setLabelFormat("%g");
+  auto* ty = new QValueAxis;
+  ty->setLabelFormat("%g");
+  step_chart_->addAxis(tx, Qt::AlignBottom);
+  step_chart_->addAxis(ty, Qt::AlignLeft);
+  auto view = [this](QChart* c, const QString& name) {
+    auto* v = new QChartView(c, this);
+    v->setObjectName(name);
+    v->setRenderHint(QPainter::Antialiasing);
+    v->setMinimumSize(200, 120);
+    return v;
+  };
+  auto* bode = new QSplitter(Qt::Vertical, this);
+  bode->setObjectName("bodeView");
+  bode->addWidget(view(mag_chart_, "bodeMagnitude"));
+  bode->addWidget(view(phase_chart_, "bodePhase"));
+  auto* plots = new QTabWidget(this);
+  plots->addTab(bode, tr("Bode"));
+  plots->addTab(view(step_chart_, "stepView"), tr("Step"));
+
+  auto* body = new QSplitter(Qt::Horizontal, this);
+  body->addWidget(left);
+  body->addWidget(plots);
+  body->setStretchFactor(0, 1);
+  body->setStretchFactor(1, 3);
+
+  auto* layout = new QVBoxLayout(this);
+  layout->addLayout(top);
+  layout->addWidget(status_);
+  layout->addWidget(stale_);
+  layout->addWidget(body, 1);
+
+  connect(analyse_button_, &QPushButton::clicked, this, [this] { analyse(); });
+  connect(system_combo_, &QComboBox::currentIndexChanged, this, [this] {
+    fillPairs();
+    redraw();
+  });
+  connect(input_combo_, &QComboBox::currentIndexChanged, this, [this] { redraw(); });
+  connect(output_combo_, &QComboBox::currentIndexChanged, this, [this] { redraw(); });
+}
+
+const LinearSystem* ControlView::system(System s) const {
+  if (s == Plant) return plant_ ? &plant_->system : nullptr;
+  return closed_ ? &closed_->loop.system : nullptr;
+}
+const FrequencyResponse* ControlView::frequency(System s) const {
+  if (s == Plant) return plant_ ? &plant_frequency_ : nullptr;
+  return closed_ ? &closed_->frequency : nullptr;
+}
+const StepResponse* ControlView::step(System s) const {
+  if (s == Plant) return plant_ ? &plant_step_ : nullptr;
+  return closed_ ? &closed_->step : nullptr;
+}
+
+bool ControlView::analyse() {
+  const std::shared_ptr<const Model> m = doc_->model();
+  if (!m) {
+    emit message(tr("Analyse: the model does not compile: %1").arg(doc_->errorText()));
+    return false;
+  }
+  clearResult();
+  QStringList notes;
+  try {
+    StudyLinearization lin = study_linearize(*m);
+    // the plant's curves on the grids the closed loop uses (core's defaults from the poles)
+    const ModalAnalysis poles = modal_analysis(lin.system);
+    const auto [w_lo, w_hi] = default_frequency_range(poles, lin.system.Ts);
+    const double t_step = default_step_time(poles);
+    plant_frequency_ = frequency_response(lin.system, log_grid(w_lo, w_hi, 400));
+    plant_step_ = step_response(lin.system, t_step, 500);
+    plant_ = std::move(lin);
+  } catch (const std::exception& e) {
+    status_->setText(tr("The plant could not be linearized: %1").arg(qs(e.what())));
+    emit message(tr("Analyse: %1").arg(qs(e.what())));
+    return false;
+  }
+  model_ = m;
+  try {
+    closed_ = study_closed_loop(*m);
+    for (const auto& n : closed_->notes) notes << qs(n);
+  } catch (const std::exception& e) {
+    closed_.reset();
+    notes << tr("no closed loop: %1").arg(qs(e.what()));
+  }
+  QString text = tr("<b>Plant</b> about %1: %2 states, %3 inputs, %4 outputs.")
+                     .arg(qs(plant_->op.kind).toHtmlEscaped())
+                     .arg(plant_->system.nx())
+                     .arg(plant_->system.nu())
+                     .arg(plant_->system.ny());
+  if (closed_) {
+    int unstable = 0;
+    for (const Mode& md : closed_->poles.modes)
+      if (closed_->poles.Ts > 0 ? std::abs(md.eigenvalue) > 1.0 + 1e-9 : md.s.real() > 1e-9 * std::max(1.0, std::abs(md.s)))
+        ++unstable;
+    text += tr(" <b>Closed loop</b> with %1: %2 poles, %3.")
+                .arg(qs(closed_->loop.controller).toHtmlEscaped())
+                .arg(closed_->poles.modes.size())
+                .arg(unstable ? tr("<span style='color:#b00000'>%1 unstable</span>").arg(unstable) : tr("all stable"));
+    pole_model_->setModes(closed_->poles);
+    const Eigen::MatrixXd& K = closed_->setup.lqr_gain;
+    if (K.size() > 0) gain_model_->setMatrix(K, qlist(plant_->system.input_names), qlist(plant_->system.state_names));
+  }
+  if (!notes.isEmpty()) text += QStringLiteral("<br>") + notes.join(QStringLiteral("<br>")).toHtmlEscaped();
+  status_->setText(text);
+  system_combo_->setEnabled(true);
+  {
+    const QSignalBlocker b(system_combo_);
+    system_combo_->setCurrentIndex(closed_ ? ClosedLoop : Plant);
+  }
+  fillPairs();
+  redraw();
+  updateStaleness();
+  emit message(closed_ ? tr("Analysed the plant and the closed loop (%1)").arg(qs(closed_->loop.controller))
+                       : tr("Analysed the plant (no closed loop)"));
+  return true;
+}
+
+void ControlView::clearResult() {
+  model_.reset();
+  plant_.reset();
+  closed_.reset();
+  plant_frequency_ = {};
+  plant_step_ = {};
+  gain_model_->clear();
+  pole_model_->clear();
+  status_->setText(tr("Not analysed yet: Analyse linearizes the plant and closes the loop with the study's controller."));
+  fillPairs();
+  redraw();
+  updateStaleness();
+}
+
+bool ControlView::isStale() const { return model_ && model_ != doc_->model(); }
+
+void ControlView::updateStaleness() {
+  const bool stale = isStale();
+  stale_->setVisible(stale);
+  gain_view_->setEnabled(!stale);
+  pole_view_->setEnabled(!stale);
+}
+
+void ControlView::fillPairs() {
+  const QSignalBlocker bi(input_combo_), bo(output_combo_);
+  const QString in = input_combo_->currentText(), out = output_combo_->currentText();
+  input_combo_->clear();
+  output_combo_->clear();
+  if (const LinearSystem* s = system(System(system_combo_->currentIndex()))) {
+    input_combo_->addItems(qlist(s->input_names));
+    output_combo_->addItems(qlist(s->output_names));
+    if (input_combo_->findText(in) >= 0) input_combo_->setCurrentText(in);
+    if (output_combo_->findText(out) >= 0) output_combo_->setCurrentText(out);
+  }
+  system_combo_->setItemData(ClosedLoop, closed_ ? QVariant() : QVariant(0), Qt::UserRole - 1);  // disabled without a loop
+}
+
+void ControlView::redraw() {
+  mag_series_->clear();
+  phase_series_->clear();
+  for (QLineSeries* s : step_series_) {
+    step_chart_->removeSeries(s);
+    delete s;
+  }
+  step_series_.clear();
+  const System which = System(system_combo_->currentIndex());
+  const FrequencyResponse* f = frequency(which);
+  const StepResponse* st = step(which);
+  const LinearSystem* sys = system(which);
+  const int in = input_combo_->currentIndex(), out = output_combo_->currentIndex();
+  auto* mx = static_cast<QLogValueAxis*>(mag_chart_->axes(Qt::Horizontal).value(0));
+  auto* my = static_cast<QValueAxis*>(mag_chart_->axes(Qt::Vertical).value(0));
+  auto* px = static_cast<QLogValueAxis*>(phase_chart_->axes(Qt::Horizontal).value(0));
+  auto* py = static_cast<QValueAxis*>(phase_chart_->axes(Qt::Vertical).value(0));
+  auto* tx = static_cast<QValueAxis*>(step_chart_->axes(Qt::Horizontal).value(0));
+  auto* ty = static_cast<QValueAxis*>(step_chart_->axes(Qt::Vertical).value(0));
+  if (!f || !st || !sys || in < 0 || out < 0 || f->w.empty()) {
+    mx->setRange(0.01, 100);
+    px->setRange(0.01, 100);
+    fitAxis(my, 0, 0);
+    fitAxis(py, 0, 0);
+    tx->setRange(0, 1);
+    fitAxis(ty, 0, 0);
+    return;
+  }
+  QList<QPointF> mag, phase;
+  double mlo = INFINITY, mhi = -INFINITY, plo = INFINITY, phi = -INFINITY;
+  for (std::size_t k = 0; k < f->w.size(); ++k) {
+    const double m = f->magnitude[k](out, in);
+    const double db = 20.0 * std::log10(m);
+    const double ph = f->phase_deg[k](out, in);
+    if (!std::isfinite(db) || !std::isfinite(ph)) continue;  // an exact zero of the transfer function
+    mag << QPointF(f->w[k], db);
+    phase << QPointF(f->w[k], ph);
+    mlo = std::min(mlo, db);
+    mhi = std::max(mhi, db);
+    plo = std::min(plo, ph);
+    phi = std::max(phi, ph);
+  }
+  mag_series_->replace(mag);
+  phase_series_->replace(phase);
+  mx->setRange(f->w.front(), f->w.back());
+  px->setRange(f->w.front(), f->w.back());
+  fitAxis(my, mlo, mhi);
+  fitAxis(py, plo, phi);
+  mag_chart_->setTitle(tr("Magnitude, %1 to %2").arg(input_combo_->currentText(), output_combo_->currentText()));
+  phase_chart_->setTitle(tr("Phase, %1 to %2").arg(input_combo_->currentText(), output_combo_->currentText()));
+
+  // the step on the chosen input: every output
+  double ylo = INFINITY, yhi = -INFINITY;
+  if (in < static_cast<int>(st->y.size())) {
+    const Eigen::MatrixXd& Y = st->y[in];
+    for (Eigen::Index j = 0; j < Y.cols() && j < sys->ny(); ++j) {
+      auto* s = new QLineSeries;
+      s->setName(qs(j < static_cast<Eigen::Index>(sys->output_names.size()) ? sys->output_names[j] : std::to_string(j + 1)));
+      QList<QPointF> p;
+      for (Eigen::Index k = 0; k < Y.rows() && k < static_cast<Eigen::Index>(st->t.size()); ++k) {
+        if (!std::isfinite(Y(k, j))) continue;
+        p << QPointF(st->t[k], Y(k, j));
+        ylo = std::min(ylo, Y(k, j));
+        yhi = std::max(yhi, Y(k, j));
+      }
+      s->replace(p);
+      step_chart_->addSeries(s);
+      s->attachAxis(tx);
+      s->attachAxis(ty);
+      step_series_.push_back(s);
+    }
+  }
+  tx->setRange(0, st->t.empty() ? 1.0 : st->t.back());
+  fitAxis(ty, ylo, yhi);
+  step_chart_->setTitle(tr("Step on %1").arg(input_combo_->currentText()));
+}
+
+QList<QPointF> ControlView::magnitudePoints() const { return mag_series_->points(); }
+QList<QPointF> ControlView::phasePoints() const { return phase_series_->points(); }
+int ControlView::stepSeriesCount() const { return static_cast<int>(step_series_.size()); }
+QList<QPointF> ControlView::stepPoints(int output) const {
+  return output >= 0 && output < stepSeriesCount() ? step_series_[output]->points() : QList<QPointF>();
+}
+
+}  // namespace codyna::gui

@@ -1,0 +1,111 @@
+// ControlView: the "Control" page of codyna-gui, the linear views a control
+// engineer reads before running the nonlinear loop (Simulink Control Design's
+// Linear System Analyzer, Adams Controls' plant plots).
+//
+// "Analyse" calls core's study_linearize() (the open-loop plant, as `codyna
+// linearize` does) and study_closed_loop() (the plant closed by the study's
+// controller: the model file's PID, a K or LTI from a .mat, or the LQR the
+// Simulate view designs) on the document's model. It shows
+//  - the controller's gain K when codyna designed it (LQR), and the closed-loop
+//    poles (a table: eigenvalue, frequency, damping; unstable ones in red);
+//  - a Bode plot, magnitude in dB and phase in degrees over a logarithmic
+//    frequency axis, of one input-output pair of the open-loop plant or of
+//    the closed loop (chosen with three drop-downs);
+//  - the step response of every output of the chosen system to a unit step
+//    on the chosen input (exact at the samples: core's step_response).
+// Nothing is computed here: the curves are core's frequency_response() and
+// step_response() on the study's grids. An edit marks the results out of date;
+// New and Open clear them.
+#pragma once
+
+#include <QWidget>
+#include <memory>
+#include <optional>
+
+#include "study/workflow.hpp"
+
+QT_BEGIN_NAMESPACE
+class QChart;
+class QChartView;
+class QComboBox;
+class QLabel;
+class QLineSeries;
+class QPushButton;
+class QTableView;
+QT_END_NAMESPACE
+
+namespace codyna::gui {
+
+class Document;
+class MatrixTableModel;
+class ModeTableModel;
+
+class ControlView : public QWidget {
+  Q_OBJECT
+ public:
+  explicit ControlView(Document* doc, QWidget* parent = nullptr);
+  ~ControlView() override;
+
+  // Linearizes and closes the loop on the document's model. False (and message()) when the
+  // plant cannot be linearized; a loop that cannot be closed (no controller, a K that does not
+  // fit) leaves the plant's views and says why.
+  bool analyse();
+  void clearResult();
+  bool isStale() const;
+
+  // what is shown: 0 = the open-loop plant, 1 = the closed loop
+  enum System { Plant = 0, ClosedLoop = 1 };
+  bool hasClosedLoop() const { return closed_.has_value(); }
+  const codyna::LinearSystem* system(System s) const;
+  const codyna::FrequencyResponse* frequency(System s) const;
+  const codyna::StepResponse* step(System s) const;
+  const codyna::StudyClosedLoop* closedLoop() const { return closed_ ? &*closed_ : nullptr; }
+
+  // the widgets, for tests
+  QComboBox* systemCombo() const { return system_combo_; }
+  QComboBox* inputCombo() const { return input_combo_; }
+  QComboBox* outputCombo() const { return output_combo_; }
+  QPushButton* analyseButton() const { return analyse_button_; }
+  QList<QPointF> magnitudePoints() const;  // (w rad/s, |H| dB)
+  QList<QPointF> phasePoints() const;      // (w rad/s, phase deg)
+  QList<QPointF> stepPoints(int output) const;  // (t s, y) of each output of the chosen system
+  int stepSeriesCount() const;
+  MatrixTableModel* gainModel() const { return gain_model_; }
+  ModeTableModel* poleModel() const { return pole_model_; }
+  QLabel* statusLabel() const { return status_; }
+
+ signals:
+  void message(const QString& text);
+
+ private:
+  void buildUi();
+  void fillPairs();  // input and output names of the chosen system
+  void redraw();     // the chosen pair's Bode and step curves
+  void updateStaleness();
+
+  Document* doc_;
+  std::shared_ptr<const codyna::Model> model_;  // the model the results belong to
+  std::optional<codyna::StudyLinearization> plant_;
+  codyna::FrequencyResponse plant_frequency_;
+  codyna::StepResponse plant_step_;
+  std::optional<codyna::StudyClosedLoop> closed_;
+
+  QPushButton* analyse_button_ = nullptr;
+  QLabel* status_ = nullptr;
+  QLabel* stale_ = nullptr;
+  QComboBox* system_combo_ = nullptr;
+  QComboBox* input_combo_ = nullptr;
+  QComboBox* output_combo_ = nullptr;
+  QTableView* gain_view_ = nullptr;
+  MatrixTableModel* gain_model_ = nullptr;
+  QTableView* pole_view_ = nullptr;
+  ModeTableModel* pole_model_ = nullptr;
+  QChart* mag_chart_ = nullptr;
+  QChart* phase_chart_ = nullptr;
+  QChart* step_chart_ = nullptr;
+  QLineSeries* mag_series_ = nullptr;
+  QLineSeries* phase_series_ = nullptr;
+  std::vector<QLineSeries*> step_series_;
+};
+
+}  // namespace codyna::gui

@@ -1,0 +1,170 @@
+// The Control view (Bode, step, gain K, closed-loop poles), offscreen, checked
+// against computations of its own: the Bode points against C (jwI - A)^-1 B + D
+// of the matrices `codyna linearize` exports, the step curves against an RK4
+// integration of the closed loop's matrices at a step far below the plot's.
+#include <QComboBox>
+#include <QDir>
+#include <QLabel>
+#include <QMessageBox>
+#include <QProcess>
+#include <QPushButton>
+#include <QTabWidget>
+#include <QTemporaryDir>
+#include <QTest>
+#include <QUndoStack>
+#include <Eigen/LU>
+#include <cmath>
+#include <complex>
+#include <numbers>
+
+#include "gui/control_view.hpp"
+#include "gui/main_window.hpp"
+#include "gui/matrix_models.hpp"
+#include "io/mat_export.hpp"
+
+using namespace codyna;
+using namespace codyna::gui;
+
+namespace {
+const QString kCart = QStringLiteral(CODYNA_EXAMPLES_DIR "/cart_pendulum.json");
+
+std::complex<double> transfer(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& C,
+                              const Eigen::MatrixXd& D, int out, int in, double w) {
+  const Eigen::Index n = A.rows();
+  const Eigen::MatrixXcd M = std::complex<double>(0, w) * Eigen::MatrixXcd::Identity(n, n) - A.cast<std::complex<double>>();
+  const Eigen::VectorXcd x = M.partialPivLu().solve(B.col(in).cast<std::complex<double>>());
+  return (C.row(out).cast<std::complex<double>>() * x)(0) + D(out, in);
+}
+
+// the angle difference a - b in degrees, brought into (-180, 180]
+double angleDiff(double a, double b) {
+  double d = std::fmod(a - b, 360.0);
+  if (d > 180) d -= 360;
+  if (d <= -180) d += 360;
+  return d;
+}
+}  // namespace
+
+class ControlViewTest : public QObject {
+  Q_OBJECT
+ private:
+  std::unique_ptr<MainWindow> w;
+
+ private slots:
+  void init() {
+    QCoreApplication::setOrganizationName("codyna-test");
+    QCoreApplication::setApplicationName("control_view_test");
+    w = std::make_unique<MainWindow>();
+    w->setQuestionHook([](const QString&, const QString&, int) { return int(QMessageBox::Discard); });
+    w->setFileHook([](const QString&, const QString&, const QString&, bool) { return QString(); });
+    w->show();
+    QVERIFY(QTest::qWaitForWindowExposed(w.get()));
+    QVERIFY(w->openFile(kCart));
+  }
+  void cleanup() {
+    w->document()->undoStack()->setClean();
+    w.reset();
+  }
+
+  void bodeEqualsTheExportedMatrices() {
+    ControlView* cv = w->controlView();
+    w->analysisTabs()->setCurrentWidget(cv);
+    QTest::mouseClick(cv->analyseButton(), Qt::LeftButton);
+    QVERIFY(cv->system(ControlView::Plant));
+    cv->systemCombo()->setCurrentIndex(ControlView::Plant);
+    cv->inputCombo()->setCurrentText("force");
+    QCOMPARE(cv->inputCombo()->currentText(), QString("force"));
+
+    // the exported plant, by the command line
+    QTemporaryDir tmp;
+    QProcess cli;
+    cli.start(CODYNA_CLI, {"linearize", kCart, "--out", tmp.path()});
+    QVERIFY(cli.waitForFinished(60000));
+    QCOMPARE(cli.exitCode(), 0);
+    const MatVariables mat = read_mat_file((tmp.path() + "/cart_pendulum.mat").toStdString());
+    const Eigen::MatrixXd &A = mat.matrices.at("A"), &B = mat.matrices.at("B"), &C = mat.matrices.at("C"),
+                          &D = mat.matrices.at("D");
+    const std::vector<std::string>& outs = mat.strings.at("output_names");
+    const std::vector<std::string>& ins = mat.strings.at("input_names");
+    QCOMPARE(ins.at(0), std::string("force"));
+    QVERIFY(outs.size() >= 2);
+    for (int o = 0; o < static_cast<int>(outs.size()); ++o) {
+      cv->outputCombo()->setCurrentText(QString::fromStdString(outs[o]));
+      const QList<QPointF> mag = cv->magnitudePoints(), ph = cv->phasePoints();
+      QVERIFY(mag.size() > 100);
+      QCOMPARE(ph.size(), mag.size());
+      // three frequencies: low, middle, high
+      for (int k : {2, int(mag.size()) / 2, int(mag.size()) - 3}) {
+        const double wk = mag[k].x();
+        const std::complex<double> h = transfer(A, B, C, D, o, 0, wk);
+        const double db = 20 * std::log10(std::abs(h));
+        QVERIFY2(std::abs(mag[k].y() - db) <= 1e-9 * std::max(1.0, std::abs(db)),
+                 qPrintable(QString("%1 at w = %2: %3 dB, expected %4").arg(QString::fromStdString(outs[o])).arg(wk).arg(mag[k].y()).arg(db)));
+        const double deg = std::arg(h) * 180 / std::numbers::pi;
+        QVERIFY2(std::abs(angleDiff(ph[k].y(), deg)) <= 1e-7,
+                 qPrintable(QString("phase at w = %1: %2, expected %3 (mod 360)").arg(wk).arg(ph[k].y()).arg(deg)));
+        QCOMPARE(ph[k].x(), wk);
+      }
+    }
+  }
+
+  void closedLoopStepGainAndPoles() {
+    ControlView* cv = w->controlView();
+    QVERIFY(cv->analyse());
+    QVERIFY(cv->hasClosedLoop());
+    QCOMPARE(cv->systemCombo()->currentIndex(), int(ControlView::ClosedLoop));
+    const StudyClosedLoop* cl = cv->closedLoop();
+    // the example's LQR: K shown with the plant's input and state names, every closed-loop pole stable
+    QCOMPARE(cv->gainModel()->rowCount(), 1);
+    QCOMPARE(cv->gainModel()->columnCount(), 4);
+    QCOMPARE((cv->gainModel()->matrix() - cl->setup.lqr_gain).cwiseAbs().maxCoeff(), 0.0);
+    QCOMPARE(cv->poleModel()->rowCount(), 4);
+    for (const Mode& m : cl->poles.modes) QVERIFY(m.s.real() < 0);
+    QVERIFY(cv->statusLabel()->text().contains("all stable"));
+
+    // step on the first reference: every output against RK4 on the loop's matrices
+    const LinearSystem& s = *cv->system(ControlView::ClosedLoop);
+    cv->inputCombo()->setCurrentIndex(0);
+    QCOMPARE(cv->stepSeriesCount(), s.ny());
+    const QList<QPointF> first = cv->stepPoints(0);
+    QVERIFY(first.size() > 50);
+    const double t_end = first.back().x();
+    const int substeps = 40;
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(s.nx());
+    const Eigen::VectorXd b = s.B.col(0);
+    auto f = [&](const Eigen::VectorXd& z) -> Eigen::VectorXd { return s.A * z + b; };
+    double max_err = 0, scale = 1e-12;
+    for (int k = 0; k < first.size(); ++k) {
+      if (k > 0) {
+        const double h = (first[k].x() - first[k - 1].x()) / substeps;
+        for (int i = 0; i < substeps; ++i) {
+          const Eigen::VectorXd k1 = f(x), k2 = f(x + 0.5 * h * k1), k3 = f(x + 0.5 * h * k2), k4 = f(x + h * k3);
+          x += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+        }
+      }
+      const Eigen::VectorXd y = s.C * x + s.D.col(0);
+      for (int j = 0; j < s.ny(); ++j) {
+        const QList<QPointF> p = cv->stepPoints(j);
+        QCOMPARE(p[k].x(), first[k].x());
+        max_err = std::max(max_err, std::abs(p[k].y() - y[j]));
+        scale = std::max(scale, std::abs(y[j]));
+      }
+    }
+    QVERIFY2(max_err <= 1e-8 * scale, qPrintable(QString("step: max error %1 (scale %2, t_end %3)").arg(max_err).arg(scale).arg(t_end)));
+
+    // an edit marks it out of date; New clears it
+    w->selectElement(ElementId{ElementKind::Body, 1});
+    QVERIFY(w->document()->edit("mass", [](ModelSpec& m) { m.bodies[1].mass = 11; }));
+    QVERIFY(cv->isStale());
+    QVERIFY(cv->findChild<QLabel*>("controlStale")->isVisibleTo(cv));
+    QVERIFY(w->newModel());
+    QVERIFY(!cv->hasClosedLoop());
+    QVERIFY(!cv->system(ControlView::Plant));
+    QCOMPARE(cv->magnitudePoints().size(), 0);
+    QCOMPARE(cv->stepSeriesCount(), 0);
+    QCOMPARE(cv->poleModel()->rowCount(), 0);
+  }
+};
+
+QTEST_MAIN(ControlViewTest)
+#include "control_view_test.moc"
