@@ -4,12 +4,17 @@
 #include <QComboBox>
 #include <QFormLayout>
 #include <QLabel>
+#include <QHBoxLayout>
 #include <QLineEdit>
+#include <QPushButton>
 #include <QLocale>
 #include <QRegularExpression>
 #include <QScrollArea>
 #include <QVBoxLayout>
+#include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <nlohmann/json.hpp>
 
 #include "io/model_file.hpp"
@@ -89,7 +94,132 @@ json parse_text(const QString& text, const json& old) {
 // sets /a/b/c in j
 void set_at(json& j, const QString& path, json value) { j[json::json_pointer(path.toStdString())] = std::move(value); }
 
+// A rotation is shown and typed as roll, pitch, yaw in degrees (R = Rz(yaw) Ry(pitch) Rx(roll),
+// the reader's "rpy"), whatever form the file holds.
+bool is_rotation_key(const QString& key) { return key.section('/', -1) == QLatin1String("rotation"); }
+
+QString rotation_text(const json& v) {
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  if (v.is_object() && v.contains("matrix") && is_matrix(v["matrix"]) && v["matrix"].size() == 3) {
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3 && c < static_cast<int>(v["matrix"][r].size()); ++c) R(r, c) = v["matrix"][r][c].get<double>();
+  }
+  const double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
+  const double roll = std::atan2(R(2, 1), R(2, 2));
+  const double yaw = std::atan2(R(1, 0), R(0, 0));
+  QStringList l;
+  for (double a : {roll, pitch, yaw}) {
+    double deg = a * 180.0 / std::numbers::pi;
+    if (std::abs(deg) < 1e-12) deg = 0.0;
+    l << QString::number(deg, 'g', 15);
+  }
+  return l.join(", ");
+}
+
+json rotation_value(const QString& text) {
+  const QStringList parts = text.split(QRegularExpression("[,\\s]+"), Qt::SkipEmptyParts);
+  if (parts.size() != 3) throw std::invalid_argument("expected roll, pitch, yaw in degrees (three numbers)");
+  json rpy = json::array();
+  for (const QString& p : parts) {
+    bool ok = false;
+    const double d = QLocale::c().toDouble(p, &ok);
+    if (!ok || !std::isfinite(d)) throw std::invalid_argument("\"" + p.toStdString() + "\" is not a finite number");
+    rpy.push_back(d * std::numbers::pi / 180.0);
+  }
+  return json{{"rpy", rpy}};
+}
+
+// Fields that are empty by default (a number that may be left out: an actuator's limits)
+bool is_clearable(ElementKind k, const QString& key) {
+  return k == ElementKind::Actuator && (key == QLatin1String("min") || key == QLatin1String("max"));
+}
+
+// The element as the editor shows it: what the model file writes, and every optional
+// field the reader takes for its type that the file leaves out while it holds its
+// default (a joint's q0 and v0, units, an actuator's limits, a body's shape list).
+json shown_element(const ModelSpec& spec, ElementKind k, int index) {
+  json e = to_json(spec)[section_of(k)][index];
+  switch (k) {
+    case ElementKind::Joint: {
+      const JointSpec& jt = spec.joints[index];
+      if (!e.contains("q0")) {
+        json q = json::array();
+        const int nq = joint_nq(jt.type);
+        const int iq = jt.type == JointType::Spherical ? 0 : jt.type == JointType::Free ? 3 : -1;
+        for (int i = 0; i < nq; ++i) q.push_back(i == iq ? 1.0 : 0.0);
+        if (nq > 0) e["q0"] = q;
+      }
+      if (!e.contains("v0") && joint_nv(jt.type) > 0) e["v0"] = json(std::vector<double>(joint_nv(jt.type), 0.0));
+      break;
+    }
+    case ElementKind::Body:
+      if (!e.contains("com")) e["com"] = json{0.0, 0.0, 0.0};
+      if (!e.contains("shapes")) e["shapes"] = json::array();
+      break;
+    case ElementKind::Actuator:
+      for (const char* key : {"min", "max"})
+        if (!e.contains(key)) e[key] = nullptr;
+      if (!e.contains("unit")) e["unit"] = "";
+      break;
+    case ElementKind::Sensor:
+      if (!e.contains("unit")) e["unit"] = "";
+      break;
+    default: break;
+  }
+  return e;
+}
+
 }  // namespace
+
+QString PropertyEditor::fieldHelp(ElementKind kind, const QString& key, const QString& unit) {
+  static const std::map<QString, QString> meaning{
+      {"name", "The element's name; references to it follow a rename"},
+      {"type", "The element's type; fields the new type does not take are dropped"},
+      {"mass", "Mass of the body (>= 0)"},
+      {"com", "Centre of mass in the body frame (x, y, z)"},
+      {"inertia", "Inertia about the centre of mass, body axes: Ixx, Iyy, Izz[, Ixy, Ixz, Iyz]"},
+      {"parent", "The body the joint is fixed on (ground: the world)"},
+      {"child", "The body the joint moves"},
+      {"position", "Origin of the frame (x, y, z)"},
+      {"rotation", "Orientation of the frame: roll, pitch, yaw about x, y, z (R = Rz Ry Rx)"},
+      {"axis", "Axis in the joint frame (normalized when read)"},
+      {"axis2", "Second axis of a universal joint"},
+      {"q0", "Initial joint coordinates (rad for rotations, m for translations; quaternion w, x, y, z for ball joints)"},
+      {"v0", "Initial joint rates (rad/s, m/s)"},
+      {"g", "Gravity acceleration vector (x, y, z)"},
+      {"stiffness", "Spring stiffness"},
+      {"damping", "Damping coefficient"},
+      {"rest_length", "Length at which the spring exerts no force"},
+      {"rest_position", "Joint coordinate at which the spring exerts no torque or force"},
+      {"joint", "The joint it acts on or measures"},
+      {"dof", "Which coordinate of a joint with several (0 = the first)"},
+      {"body", "The body it acts on or measures"},
+      {"body_a", "First body"},
+      {"body_b", "Second body"},
+      {"point", "Point in the body frame"},
+      {"point_a", "Point on the first body, in its frame"},
+      {"point_b", "Point on the second body, in its frame"},
+      {"force", "Force vector"},
+      {"torque", "Torque vector"},
+      {"direction", "Direction of the force or torque"},
+      {"frame", "Frame the vectors are given in"},
+      {"gain", "Effort per unit of the plant input (effort = gain * u)"},
+      {"u0", "Nominal input (used when the actuator is not driven)"},
+      {"min", "Lower limit of the input (empty: none)"},
+      {"max", "Upper limit of the input (empty: none)"},
+      {"unit", "Unit shown with the input or output"},
+      {"component", "Which component is measured"},
+      {"size", "Box edge lengths x, y, z"},
+      {"radius", "Radius"},
+      {"length", "Length along the shape frame's z"},
+      {"color", "Colour: red, green, blue, alpha in 0..1"},
+  };
+  const auto it = meaning.find(key.section('/', -1));
+  QString text = it == meaning.end() ? QString(key).replace('/', '.') : it->second;
+  if (!unit.isEmpty()) text += QStringLiteral(" [%1]").arg(unit);
+  (void)kind;
+  return text;
+}
 
 QString PropertyEditor::unitOf(const QString& key) {
   static const std::map<QString, QString> units{
@@ -156,24 +286,42 @@ bool PropertyEditor::applyText(const QString& field, const QString& text, QStrin
   }
   json j = to_json(spec);
   const QString base = QStringLiteral("/%1/%2").arg(section_of(id_->kind)).arg(id_->index);
-  const json& old = j[json::json_pointer((base + "/" + field).toStdString())];
+  const json shown = shown_element(spec, id_->kind, id_->index);
+  const json::json_pointer at(("/" + field).toStdString());
+  const json old = shown.contains(at) ? shown[at] : json();
   json value;
+  bool clear = false;
   try {
-    value = parse_text(text, old);
+    if (is_rotation_key(field)) value = rotation_value(text);
+    else if (is_clearable(id_->kind, field) && text.trimmed().isEmpty()) clear = true;
+    else if (old.is_null() && is_clearable(id_->kind, field)) value = parse_text(text, json(0.0));
+    else value = parse_text(text, old);
   } catch (const std::exception& e) {
     return reject(tr("%1: %2").arg(field, qs(e.what())));
   }
-  set_at(j, base + "/" + field, value);
-  if (field == "type") {
-    // keep only what the new type accepts: drop fields the reader calls unknown
+  if (clear) {
+    json& parent = j[json::json_pointer((base + "/" + field).toStdString()).parent_pointer()];
+    if (parent.is_object()) parent.erase(ss(field.section('/', -1)));
+  } else {
+    set_at(j, base + "/" + field, value);
+  }
+  if (field.section('/', -1) == QLatin1String("type")) {
+    // keep only what the new type accepts: drop the fields the reader calls unknown, and
+    // initial values sized for the old type (a joint's q0, v0)
     for (int tries = 0; tries < 40; ++tries) {
       try {
         parse_model_spec(j, ss(doc_->filePath()));
         break;
       } catch (const ModelError& e) {
         const std::string p = e.path();
-        if (e.detail().find("unknown field") == std::string::npos || p.rfind(ss(base), 0) != 0) break;
-        j[json::json_pointer(ss(base))].erase(p.substr(p.rfind('/') + 1));
+        if (p.rfind(ss(base) + "/", 0) != 0) break;
+        const std::string last = p.substr(p.rfind('/') + 1);
+        const bool unknown = e.detail().find("unknown field") != std::string::npos;
+        const bool sized = last == "q0" || last == "v0";
+        if (!unknown && !sized) break;
+        json& parent = j[json::json_pointer(p).parent_pointer()];
+        if (!parent.is_object() || !parent.contains(last)) break;
+        parent.erase(last);
       }
     }
   }
@@ -205,7 +353,7 @@ void PropertyEditor::markField(const QString& field, const QString& message) {
   for (auto& [key, w] : editors_) {
     const bool bad = key == field || field.startsWith(key + "/");
     w->setStyleSheet(bad ? "background: #ffd0d0;" : "");
-    w->setToolTip(bad ? message : QString());
+    w->setToolTip(bad ? message : w->property("help").toString());
   }
 }
 
@@ -256,23 +404,26 @@ void PropertyEditor::rebuild() {
     title_->setText(tr("Select an element in the model tree"));
     return;
   }
-  const json j = to_json(spec)[section_of(id_->kind)][id_->index];
+  const json j = shown_element(spec, id_->kind, id_->index);
   title_->setText(QStringLiteral("<b>%1</b> (%2)").arg(qs(element_name(spec, id_->kind, id_->index)).toHtmlEscaped(), to_string(id_->kind)));
 
   QStringList bodies{QString::fromLatin1(kGroundName)};
   for (const auto& b : spec.bodies) bodies << qs(b.name);
   QStringList joints;
   for (const auto& jt : spec.joints) joints << qs(jt.name);
+  const ElementKind kind = id_->kind;
+  const int index = id_->index;
 
   auto add_row = [&](const QString& key, const json& v) {
     QWidget* editor = nullptr;
     const QString last = key.section('/', -1);
-    if (key == "type") {
+    const bool shape_type = key.startsWith("shapes/") && last == "type";
+    if (last == "type") {
       auto* c = new QComboBox;
-      c->addItems(type_names(id_->kind));
+      c->addItems(shape_type ? QStringList{"box", "cylinder", "sphere"} : type_names(kind));
       c->setCurrentText(qs(v.get<std::string>()));
-      connect(c, &QComboBox::activated, this, [this, c] {
-        if (isCurrent("type", c)) applyText("type", c->currentText());
+      connect(c, &QComboBox::activated, this, [this, c, key] {
+        if (isCurrent(key, c)) applyText(key, c->currentText());
       });
       editor = c;
     } else if (v.is_string() && (kBodyRefs.contains(last) || last == "joint")) {
@@ -297,7 +448,11 @@ void PropertyEditor::rebuild() {
       });
       editor = c;
     } else {
-      auto* e = new QLineEdit(value_text(v));
+      QString text;
+      if (is_rotation_key(key)) text = rotation_text(v);
+      else if (!v.is_null()) text = value_text(v);
+      auto* e = new QLineEdit(text);
+      if (v.is_null()) e->setPlaceholderText(tr("none"));
       e->setProperty("value", e->text());
       connect(e, &QLineEdit::editingFinished, this, [this, e, key] {
         if (isCurrent(key, e) && e->text() != e->property("value").toString()) applyText(key, e->text());
@@ -306,21 +461,59 @@ void PropertyEditor::rebuild() {
     }
     editor->setObjectName("field:" + key);
     editors_[key] = editor;
-    const QString unit = unitOf(key);
+    const QString unit = is_rotation_key(key) ? tr("deg: roll, pitch, yaw") : unitOf(key);
     QString label = key;
     label.replace('/', '.');
+    editor->setProperty("help", fieldHelp(kind, key, unit));
+    editor->setToolTip(editor->property("help").toString());
     form_->addRow(unit.isEmpty() ? label : QStringLiteral("%1 [%2]").arg(label, unit), editor);
   };
-  // name and type first, then the rest; frames (objects) one level down
+  // objects one level down (frames), rotations as one field, a body's shapes each with its fields
+  std::function<void(const QString&, const json&)> add = [&](const QString& key, const json& v) {
+    if (v.is_object() && !is_rotation_key(key)) {
+      if (v.contains("type")) add_row(key + "/type", v["type"]);
+      for (const auto& [sub, sv] : v.items())
+        if (sub != "type") add(key + "/" + qs(sub), sv);
+    } else if (key == QLatin1String("shapes") && kind == ElementKind::Body && v.is_array()) {
+      for (std::size_t i = 0; i < v.size(); ++i) {
+        auto* head = new QWidget;
+        auto* hl = new QHBoxLayout(head);
+        hl->setContentsMargins(0, 6, 0, 0);
+        hl->addWidget(new QLabel(tr("<b>shape %1</b>").arg(i + 1)));
+        hl->addStretch(1);
+        auto* remove = new QPushButton(tr("Remove shape"));
+        remove->setObjectName(QStringLiteral("removeShape:%1").arg(i));
+        remove->setToolTip(tr("Remove this display shape (the dynamics do not depend on it)"));
+        hl->addWidget(remove);
+        const int shape = static_cast<int>(i);
+        connect(remove, &QPushButton::clicked, this, [this, index, shape] {
+          doc_->edit(tr("Remove shape"), [&](ModelSpec& s) {
+            if (index < static_cast<int>(s.bodies.size()) && shape < static_cast<int>(s.bodies[index].shapes.size()))
+              s.bodies[index].shapes.erase(s.bodies[index].shapes.begin() + shape);
+          });
+        });
+        form_->addRow(head);
+        add(QStringLiteral("shapes/%1").arg(i), v[i]);
+      }
+      auto* plus = new QPushButton(tr("Add shape"));
+      plus->setObjectName("addShape");
+      plus->setToolTip(tr("Add a display shape (box, cylinder or sphere) to this body"));
+      connect(plus, &QPushButton::clicked, this, [this, index] {
+        doc_->edit(tr("Add shape"), [&](ModelSpec& s) {
+          if (index < static_cast<int>(s.bodies.size())) s.bodies[index].shapes.push_back(ShapeSpec{});
+        });
+      });
+      form_->addRow(plus);
+    } else {
+      add_row(key, v);
+    }
+  };
+  // name and type first, then the rest
   if (j.contains("name")) add_row("name", j["name"]);
   if (j.contains("type")) add_row("type", j["type"]);
   for (const auto& [key, v] : j.items()) {
     if (key == "name" || key == "type") continue;
-    if (v.is_object()) {
-      for (const auto& [sub, sv] : v.items()) add_row(qs(key) + "/" + qs(sub), sv);
-    } else {
-      add_row(qs(key), v);
-    }
+    add(qs(key), v);
   }
   refreshMarks();
 }

@@ -34,6 +34,8 @@ class PropertyEditor : public QWidget {
   bool applyText(const QString& field, const QString& text, QString* error = nullptr);
 
   static QString unitOf(const QString& key);
+  // the tooltip of a field: what it means, with its unit
+  static QString fieldHelp(ElementKind kind, const QString& key, const QString& unit);
 
  signals:
   void message(const QString& text);
