@@ -111,7 +111,7 @@ void ControlView::buildUi() {
   pole_view_->setModel(pole_model_);
   pole_view_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
   pole_view_->setColumnHidden(ModeTableModel::DominantStates, true);
-  auto* gain_box = new QGroupBox(tr("Gain K (LQR)"), this);
+  auto* gain_box = new QGroupBox(tr("Gain K (u = u0 - K dx)"), this);
   (new QVBoxLayout(gain_box))->addWidget(gain_view_);
   auto* pole_box = new QGroupBox(tr("Closed-loop poles"), this);
   (new QVBoxLayout(pole_box))->addWidget(pole_view_);
@@ -244,8 +244,14 @@ bool ControlView::analyse() {
                 .arg(closed_->poles.modes.size())
                 .arg(unstable ? tr("<span style='color:#b00000'>%1 unstable</span>").arg(unstable) : tr("all stable"));
     pole_model_->setModes(closed_->poles);
-    const Eigen::MatrixXd& K = closed_->setup.lqr_gain;
-    if (K.size() > 0) gain_model_->setMatrix(K, qlist(plant_->system.input_names), qlist(plant_->system.state_names));
+    // a controller without states acts as u = u0 - K dx: K is read off the closed loop's effort rows
+    const ClosedLoopLinear& L = closed_->loop;
+    if (L.nxc == 0 && L.nu > 0 && L.nx > 0) {
+      const Eigen::MatrixXd K = -L.system.C.block(L.ny, 0, L.nu, L.nx);
+      QStringList inputs;
+      for (int k = 0; k < L.nu; ++k) inputs << qs(L.system.output_names[L.ny + k]).mid(2);  // "u_force" -> "force"
+      gain_model_->setMatrix(K, inputs, qlist(plant_->system.state_names));
+    }
   }
   if (!notes.isEmpty()) text += QStringLiteral("<br>") + notes.join(QStringLiteral("<br>")).toHtmlEscaped();
   status_->setText(text);

@@ -6,7 +6,8 @@
 // linearize` does) and study_closed_loop() (the plant closed by the study's
 // controller: the model file's PID, a K or LTI from a .mat, or the LQR the
 // Simulate view designs) on the document's model. It shows
-//  - the controller's gain K when codyna designed it (LQR), and the closed-loop
+//  - the controller's gain K when it has no states of its own (state feedback, LQR,
+//    P and PD: u = u0 - K dx, read off the closed loop), and the closed-loop
 //    poles (a table: eigenvalue, frequency, damping; unstable ones in red);
 //  - a Bode plot, magnitude in dB and phase in degrees over a logarithmic
 //    frequency axis, of one input-output pair of the open-loop plant or of

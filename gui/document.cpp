@@ -129,7 +129,18 @@ bool Document::setStudyChecked(const StudySpec& study, const QString& text, QStr
 }
 
 bool Document::setSolver(const SolverSpec& solver, const QString& text, int mergeKey) {
-  return edit(text, [&](ModelSpec& s) { s.solver = solver; }, nullptr, mergeKey);
+  return edit(
+      text,
+      [&](ModelSpec& s) {
+        s.solver = solver;
+        // the reader's checks on the solver section (an end time of 0 would save a file that does not load)
+        try {
+          (void)parse_model_spec(to_json(s), ss(displayName()));
+        } catch (const ModelError& e) {
+          if (e.path().rfind("/solver", 0) == 0) throw;
+        }
+      },
+      nullptr, mergeKey);
 }
 
 bool Document::load(const QString& path, QString* error) {
@@ -159,6 +170,8 @@ bool Document::save(QString* error) {
 
 bool Document::saveAs(const QString& path, QString* error) {
   try {
+    // a file that would not load again is not written (the one on disk stays as it was)
+    (void)parse_model_spec(to_json(spec_), ss(path));
     save_model_spec(spec_, ss(path));
   } catch (const std::exception& e) {
     if (error) *error = qs(e.what());

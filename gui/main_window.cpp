@@ -168,6 +168,8 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
     }
   });
   connect(doc_, &Document::specChanged, this, [this] {
+    // an accepted change: an error shown for an earlier, refused one is over
+    if (doc_->errorText().isEmpty() && statusBar()->currentMessage().startsWith(tr("Error:"))) statusBar()->clearMessage();
     // the tree was reset: keep the property editor's element selected
     if (const auto id = props_->element()) tree_->setCurrentIndex(tree_model_->indexOf(*id));
   });
@@ -213,6 +215,11 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
 MainWindow::~MainWindow() {
   anim_.stop();
   sim_view_->cancel();
+  // The widgets go before the Document they edit: QObject deletes children in the order
+  // they were made, and the Document came first; a floating dock closed on the way
+  // moves the focus, and a field that loses it applies its text to the Document.
+  const QList<QWidget*> widgets = findChildren<QWidget*>(QString(), Qt::FindDirectChildrenOnly);
+  for (QWidget* w : widgets) delete w;
 }
 
 void MainWindow::buildMenus() {

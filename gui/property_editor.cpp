@@ -1,5 +1,6 @@
 #include "gui/property_editor.hpp"
 
+#include <QApplication>
 #include <QCheckBox>
 #include <QComboBox>
 #include <QFormLayout>
@@ -396,6 +397,12 @@ bool PropertyEditor::isCurrent(const QString& key, const QWidget* editor) const 
 }
 
 void PropertyEditor::rebuild() {
+  // the field being edited keeps the keyboard focus in its new editor
+  QString focused;
+  if (QWidget* f = QApplication::focusWidget()) {
+    for (const auto& [key, w] : editors_)
+      if (w == f || w->isAncestorOf(f)) focused = key;
+  }
   retireEditors();
   error_->clear();
   error_->hide();
@@ -430,7 +437,10 @@ void PropertyEditor::rebuild() {
       auto* c = new QComboBox;
       c->setEditable(true);
       c->addItems(last == "joint" ? joints : bodies);
-      c->setCurrentText(qs(v.get<std::string>()));
+      // the entry itself when it is one (so that arrow keys step from it), else the text as typed
+      const int at = c->findText(qs(v.get<std::string>()));
+      if (at >= 0) c->setCurrentIndex(at);
+      else c->setEditText(qs(v.get<std::string>()));
       // a pick from the list (activated) and typed text confirmed (editingFinished) both
       // apply; the second of the two sees the value already applied and does nothing
       auto apply = [this, c, key] {
@@ -514,6 +524,9 @@ void PropertyEditor::rebuild() {
   for (const auto& [key, v] : j.items()) {
     if (key == "name" || key == "type") continue;
     add(qs(key), v);
+  }
+  if (!focused.isEmpty()) {
+    if (QWidget* e = editorFor(focused)) e->setFocus(Qt::OtherFocusReason);
   }
   refreshMarks();
 }

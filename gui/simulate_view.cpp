@@ -233,7 +233,7 @@ void SimulateView::buildUi() {
   auto* solver_box = new QGroupBox(tr("Simulation"), this);
   auto* form = new QFormLayout(solver_box);
   t_end_ = new QDoubleSpinBox(solver_box);
-  t_end_->setRange(1e-6, 1e7);
+  t_end_->setRange(1e-4, 1e7);  // the smallest value the 4 decimals show (not 0: the reader refuses it)
   t_end_->setDecimals(4);
   t_end_->setSuffix(QStringLiteral(" s"));
   t_end_->setKeyboardTracking(false);
@@ -474,7 +474,7 @@ void SimulateView::writeSolver(const std::function<void(SolverSpec&)>& change, c
   if (s.integrator == o.integrator && s.rtol == o.rtol && s.atol == o.atol && s.t_end == o.t_end &&
       s.output_step == o.output_step && s.max_step == o.max_step)
     return;
-  doc_->setSolver(s, text, mergeKey);
+  if (!doc_->setSolver(s, text, mergeKey)) refreshFromDocument();  // refused: show the model's value again
 }
 
 void SimulateView::refreshFromDocument() {

@@ -20,6 +20,7 @@
 #include "gui/control_view.hpp"
 #include "gui/main_window.hpp"
 #include "gui/matrix_models.hpp"
+#include "control/lqr.hpp"
 #include "io/mat_export.hpp"
 
 using namespace codyna;
@@ -117,7 +118,13 @@ class ControlViewTest : public QObject {
     // the example's LQR: K shown with the plant's input and state names, every closed-loop pole stable
     QCOMPARE(cv->gainModel()->rowCount(), 1);
     QCOMPARE(cv->gainModel()->columnCount(), 4);
-    QCOMPARE((cv->gainModel()->matrix() - cl->setup.lqr_gain).cwiseAbs().maxCoeff(), 0.0);
+    // K equals the LQR designed from the plant with the example's weights Q = diag(10, 100, 1, 1), R = 0.01
+    const LinearSystem& plant = *cv->system(ControlView::Plant);
+    const Eigen::Vector4d q(10, 100, 1, 1);
+    const LqrResult design = lqr(plant.A, plant.B, Eigen::MatrixXd(q.asDiagonal()), Eigen::MatrixXd::Constant(1, 1, 0.01));
+    const double k_err = (cv->gainModel()->matrix() - design.K).cwiseAbs().maxCoeff();
+    QVERIFY2(k_err <= 1e-9 * design.K.cwiseAbs().maxCoeff(), qPrintable(QString("K differs by %1").arg(k_err)));
+    QCOMPARE(cv->gainModel()->headerData(0, Qt::Vertical).toString(), QString("force"));
     QCOMPARE(cv->poleModel()->rowCount(), 4);
     for (const Mode& m : cl->poles.modes) QVERIFY(m.s.real() < 0);
     QVERIFY(cv->statusLabel()->text().contains("all stable"));
