@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   codyna::gui::MainWindow w;
   app.setWindowIcon(QIcon(":/codyna/codyna.svg"));
   w.show();
-  if (!parser.positionalArguments().isEmpty()) w.openFile(parser.positionalArguments().first());
+  // unsaved work of a codyna that was killed comes first; else the model asked for
+  if (!w.offerRecovery() && !parser.positionalArguments().isEmpty()) w.openFile(parser.positionalArguments().first());
   return app.exec();
 }

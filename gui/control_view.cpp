@@ -34,9 +34,33 @@ QStringList qlist(const std::vector<std::string>& v) {
 QChart* makeChart(const QString& title) {
   auto* c = new QChart;
   c->setTitle(title);
+  QFont tf = c->titleFont();
+  tf.setBold(true);
+  tf.setPointSizeF(9);
+  c->setTitleFont(tf);
+  c->setBackgroundRoundness(0);
+  c->setMargins(QMargins(2, 0, 6, 0));
+  c->setAnimationOptions(QChart::NoAnimation);
   c->legend()->setAlignment(Qt::AlignRight);
-  c->setMargins(QMargins(4, 4, 4, 4));
+  QFont lf = c->legend()->font();
+  lf.setPointSizeF(8);
+  c->legend()->setFont(lf);
   return c;
+}
+
+// small fonts and few ticks, so that the labels fit a short chart (no "..." for a number)
+void styleAxis(QAbstractAxis* a, const QString& title) {
+  QFont f = a->labelsFont();
+  f.setPointSizeF(8);
+  a->setLabelsFont(f);
+  QFont tf = f;
+  tf.setPointSizeF(8.5);
+  a->setTitleFont(tf);
+  a->setTitleText(title);
+  if (auto* v = qobject_cast<QValueAxis*>(a)) {
+    v->setLabelFormat("%.4g");
+    v->setTickCount(4);
+  }
 }
 
 // axis range with a little room; a flat curve gets +-1 around its value
@@ -133,28 +157,27 @@ void ControlView::buildUi() {
     auto* x = new QLogValueAxis;
     x->setBase(10);
     x->setLabelFormat("%g");
-    x->setTitleText(tr("frequency [rad/s]"));
     x->setMinorTickCount(8);
+    styleAxis(x, chart == phase_chart_ ? tr("frequency [rad/s]") : QString());
     auto* y = new QValueAxis;
-    y->setTitleText(unit);
-    y->setLabelFormat("%g");
+    styleAxis(y, unit);
     chart->addAxis(x, Qt::AlignBottom);
     chart->addAxis(y, Qt::AlignLeft);
     series->attachAxis(x);
     series->attachAxis(y);
   }
   auto* tx = new QValueAxis;
-  tx->setTitleText(tr("t [s]"));
-  tx->setLabelFormat("%g");
+  styleAxis(tx, tr("t [s]"));
   auto* ty = new QValueAxis;
-  ty->setLabelFormat("%g");
+  styleAxis(ty, QString());
   step_chart_->addAxis(tx, Qt::AlignBottom);
   step_chart_->addAxis(ty, Qt::AlignLeft);
   auto view = [this](QChart* c, const QString& name) {
     auto* v = new QChartView(c, this);
     v->setObjectName(name);
     v->setRenderHint(QPainter::Antialiasing);
-    v->setMinimumSize(200, 120);
+    v->setMinimumSize(200, 90);
+    v->setFrameShape(QFrame::NoFrame);
     return v;
   };
   auto* bode = new QSplitter(Qt::Vertical, this);
@@ -173,6 +196,7 @@ void ControlView::buildUi() {
 
   auto* layout = new QVBoxLayout(this);
   layout->addLayout(top);
+  layout->setContentsMargins(4, 4, 4, 4);
   layout->addWidget(status_);
   layout->addWidget(stale_);
   layout->addWidget(body, 1);
@@ -353,16 +377,29 @@ void ControlView::redraw() {
   px->setRange(f->w.front(), f->w.back());
   fitAxis(my, mlo, mhi);
   fitAxis(py, plo, phi);
+  my->setTickCount(5);
+  py->setTickCount(5);
   mag_chart_->setTitle(tr("Magnitude, %1 to %2").arg(input_combo_->currentText(), output_combo_->currentText()));
   phase_chart_->setTitle(tr("Phase, %1 to %2").arg(input_combo_->currentText(), output_combo_->currentText()));
 
   // the step on the chosen input: every output
   double ylo = INFINITY, yhi = -INFINITY;
+  step_outputs_.clear();
   if (in < static_cast<int>(st->y.size())) {
     const Eigen::MatrixXd& Y = st->y[in];
-    for (Eigen::Index j = 0; j < Y.cols() && j < sys->ny(); ++j) {
+    // the outputs of the chosen output's group: the measured outputs, or (closed loop) the efforts,
+    // which are far larger and would flatten the outputs on one axis
+    int first = 0, last = sys->ny();
+    if (which == ClosedLoop && closed_) {
+      const int ny = closed_->loop.ny;
+      if (out < ny) last = ny;
+      else first = ny;
+    }
+    for (int j = first; j < last; ++j) step_outputs_.push_back(j);
+    for (const int j : step_outputs_) {
+      if (j >= Y.cols()) continue;
       auto* s = new QLineSeries;
-      s->setName(qs(j < static_cast<Eigen::Index>(sys->output_names.size()) ? sys->output_names[j] : std::to_string(j + 1)));
+      s->setName(qs(j < static_cast<int>(sys->output_names.size()) ? sys->output_names[j] : std::to_string(j + 1)));
       QList<QPointF> p;
       for (Eigen::Index k = 0; k < Y.rows() && k < static_cast<Eigen::Index>(st->t.size()); ++k) {
         if (!std::isfinite(Y(k, j))) continue;
@@ -377,7 +414,14 @@ void ControlView::redraw() {
       step_series_.push_back(s);
     }
   }
-  tx->setRange(0, st->t.empty() ? 1.0 : st->t.back());
+  const double t_end = st->t.empty() ? 1.0 : st->t.back();
+  tx->setRange(0, t_end);
+  // ticks at round times (1, 2 or 5 times a power of ten), from 0
+  const double raw = t_end / 4, p10 = std::pow(10.0, std::floor(std::log10(raw)));
+  const double step = raw / p10 < 1.5 ? p10 : raw / p10 < 3.5 ? 2 * p10 : raw / p10 < 7.5 ? 5 * p10 : 10 * p10;
+  tx->setTickType(QValueAxis::TicksDynamic);
+  tx->setTickAnchor(0);
+  tx->setTickInterval(step);
   fitAxis(ty, ylo, yhi);
   step_chart_->setTitle(tr("Step on %1").arg(input_combo_->currentText()));
 }
@@ -386,7 +430,8 @@ QList<QPointF> ControlView::magnitudePoints() const { return mag_series_->points
 QList<QPointF> ControlView::phasePoints() const { return phase_series_->points(); }
 int ControlView::stepSeriesCount() const { return static_cast<int>(step_series_.size()); }
 QList<QPointF> ControlView::stepPoints(int output) const {
-  return output >= 0 && output < stepSeriesCount() ? step_series_[output]->points() : QList<QPointF>();
+  const auto it = std::find(step_outputs_.begin(), step_outputs_.end(), output);
+  return it == step_outputs_.end() ? QList<QPointF>() : step_series_[it - step_outputs_.begin()]->points();
 }
 
 }  // namespace codyna::gui

@@ -12,8 +12,8 @@
 //  - a Bode plot, magnitude in dB and phase in degrees over a logarithmic
 //    frequency axis, of one input-output pair of the open-loop plant or of
 //    the closed loop (chosen with three drop-downs);
-//  - the step response of every output of the chosen system to a unit step
-//    on the chosen input (exact at the samples: core's step_response).
+//  - the step response to a unit step on the chosen input of the outputs of
+//    the chosen output's group (exact at the samples: core's step_response).
 // Nothing is computed here: the curves are core's frequency_response() and
 // step_response() on the study's grids. An edit marks the results out of date;
 // New and Open clear them.
@@ -69,7 +69,10 @@ class ControlView : public QWidget {
   QPushButton* analyseButton() const { return analyse_button_; }
   QList<QPointF> magnitudePoints() const;  // (w rad/s, |H| dB)
   QList<QPointF> phasePoints() const;      // (w rad/s, phase deg)
-  QList<QPointF> stepPoints(int output) const;  // (t s, y) of each output of the chosen system
+  // the step curves drawn: the outputs of the chosen output's group (all outputs of the plant;
+  // of the closed loop, its measured outputs or its efforts), as (t s, y)
+  const std::vector<int>& stepOutputs() const { return step_outputs_; }
+  QList<QPointF> stepPoints(int output) const;  // empty when `output` is not drawn
   int stepSeriesCount() const;
   MatrixTableModel* gainModel() const { return gain_model_; }
   ModeTableModel* poleModel() const { return pole_model_; }
@@ -107,6 +110,7 @@ class ControlView : public QWidget {
   QLineSeries* mag_series_ = nullptr;
   QLineSeries* phase_series_ = nullptr;
   std::vector<QLineSeries*> step_series_;
+  std::vector<int> step_outputs_;
 };
 
 }  // namespace codyna::gui

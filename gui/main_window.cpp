@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 #include <QDockWidget>
 #include <QFileDialog>
+#include <QFile>
 #include <QFileInfo>
 #include <QHBoxLayout>
 #include <QHeaderView>
@@ -28,8 +29,12 @@
 #include <QTreeView>
 #include <QVBoxLayout>
 #include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "io/model_file.hpp"
 
 #include "dynamics/assembly.hpp"
+#include "gui/autosave.hpp"
 #include "gui/control_view.hpp"
 #include "gui/linearize_view.hpp"
 #include "gui/plant_panel.hpp"
@@ -95,6 +100,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
   tabs_->setTabToolTip(1, tr("The controller on the nonlinear mechanism: run, plots, results"));
   tabs_->setTabToolTip(2, tr("The linear plant and closed loop: gain K, closed-loop poles, Bode and step responses"));
   auto* centre = new QSplitter(Qt::Vertical, this);
+  centre->setObjectName("centreSplitter");
   centre->addWidget(top);
   centre->addWidget(tabs_);
   centre->setStretchFactor(0, 1);
@@ -112,6 +118,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
   connect(tree_model_, &QAbstractItemModel::modelReset, tree_, &QTreeView::expandAll);
   props_ = new PropertyEditor(doc_, this);
   auto* left = new QSplitter(Qt::Vertical, this);
+  left->setObjectName("modelSplitter");
   left->addWidget(tree_);
   left->addWidget(props_);
   auto* left_dock = new QDockWidget(tr("Model"), this);
@@ -140,10 +147,12 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
   msg_dock->setObjectName("messageDock");
   msg_dock->setWidget(messages_);
   addDockWidget(Qt::BottomDockWidgetArea, msg_dock);
-  resizeDocks({left_dock, in_dock}, {270, 330}, Qt::Horizontal);
+  resizeDocks({left_dock, in_dock}, {320, 320}, Qt::Horizontal);
   resizeDocks({msg_dock}, {90}, Qt::Vertical);
 
   buildMenus();
+  autosave_ = new Autosave(doc_, this);
+  restoreLayout();
 
   connect(doc_, &Document::fileChanged, this, &MainWindow::updateTitle);
   connect(doc_, &Document::modelChanged, this, &MainWindow::onModelChanged);
@@ -474,7 +483,61 @@ void MainWindow::closeEvent(QCloseEvent* e) {
   if (!maybeSave()) return e->ignore();
   anim_.stop();
   sim_view_->cancel();
+  autosave_->remove();  // saved or discarded: nothing to recover
+  saveLayout();
   e->accept();
+}
+
+// The window's size, docks and splitters as the user left them (QSettings)
+void MainWindow::saveLayout() const {
+  QSettings s;
+  s.setValue("window/geometry", saveGeometry());
+  s.setValue("window/state", saveState());
+  for (const QSplitter* sp : findChildren<QSplitter*>())
+    if (!sp->objectName().isEmpty()) s.setValue("splitters/" + sp->objectName(), sp->saveState());
+}
+
+void MainWindow::restoreLayout() {
+  QSettings s;
+  if (s.contains("window/geometry")) restoreGeometry(s.value("window/geometry").toByteArray());
+  if (s.contains("window/state")) restoreState(s.value("window/state").toByteArray());
+  for (QSplitter* sp : findChildren<QSplitter*>())
+    if (!sp->objectName().isEmpty() && s.contains("splitters/" + sp->objectName()))
+      sp->restoreState(s.value("splitters/" + sp->objectName()).toByteArray());
+}
+
+bool MainWindow::offerRecovery() {
+  for (const Autosave::Recovered& r : Autosave::orphans()) {
+    const QString what = r.model_file.isEmpty() ? tr("an untitled model") : r.model_file;
+    const int b = ask(tr("Recover unsaved work"),
+                      tr("codyna stopped before the changes to %1 were saved (last autosave %2).\n"
+                         "Recover them? The model file is not changed until you save.")
+                          .arg(what, r.saved_at),
+                      QMessageBox::Yes | QMessageBox::No);
+    if (b != QMessageBox::Yes) {
+      QFile::remove(r.recovery_file);
+      message(tr("Discarded the unsaved changes to %1").arg(what));
+      continue;
+    }
+    ModelSpec spec;
+    try {
+      spec = parse_model_spec(nlohmann::json::parse(r.model_json.toStdString()), ss(r.model_file));
+    } catch (const std::exception& e) {
+      message(tr("Cannot recover %1 (%2): %3").arg(what, r.recovery_file, qs(e.what())), true);
+      continue;  // the recovery file stays for a look by hand
+    }
+    // the file as saved, then the recovered edits as one undoable, unsaved step
+    if (r.model_file.isEmpty() || !QFileInfo::exists(r.model_file) || !openFile(r.model_file)) {
+      sim_view_->cancel();
+      doc_->clear();
+    }
+    doc_->edit(tr("Recover unsaved changes"), [&](ModelSpec& s) { s = spec; });
+    QFile::remove(r.recovery_file);
+    autosave_->writeNow();
+    message(tr("Recovered the unsaved changes to %1 (autosaved %2)").arg(what, r.saved_at));
+    return true;  // one at a time: the others are offered at the next start
+  }
+  return false;
 }
 
 void MainWindow::selectElement(std::optional<ElementId> id) {

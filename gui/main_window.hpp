@@ -37,6 +37,7 @@ class PlantPanel;
 class LinearizeView;
 class SimulateView;
 class ControlView;
+class Autosave;
 
 class MainWindow : public QMainWindow {
   Q_OBJECT
@@ -68,6 +69,11 @@ class MainWindow : public QMainWindow {
 
   // Asks before unsaved changes are lost: true when it may go on (saved or discarded).
   bool maybeSave();
+  // Offers back the unsaved work of a codyna that crashed or was killed (Autosave): true when
+  // a model was recovered (the file opened, the recovered edits one unsaved undo step on top).
+  bool offerRecovery();
+  void saveLayout() const;  // window size, docks, splitters (QSettings; also on close)
+  Autosave* autosave() { return autosave_; }
 
   // Dialogs go through these hooks so that tests answer them without a modal loop.
   // question: returns QMessageBox::StandardButton; file: returns a path ("" = cancelled).
@@ -104,6 +110,7 @@ class MainWindow : public QMainWindow {
  private:
   void buildMenus();
   QString aboutText() const;
+  void restoreLayout();
   void updateTitle();
   void addRecent(const QString& path);
   void rebuildRecentMenu();
@@ -122,6 +129,7 @@ class MainWindow : public QMainWindow {
   LinearizeView* lin_view_;
   SimulateView* sim_view_;
   ControlView* control_view_ = nullptr;
+  Autosave* autosave_ = nullptr;
   QTabWidget* tabs_;
   QPlainTextEdit* messages_;
   QSlider* slider_;

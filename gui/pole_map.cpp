@@ -176,7 +176,7 @@ PoleMap::PoleMap(QWidget* parent) : QWidget(parent) {
   connect(chart_, &QChart::plotAreaChanged, this, [this](const QRectF&) {
     if (discrete_) updateRanges();
   });
-  setMinimumSize(240, 220);
+  setMinimumSize(160, 120);
   rebuild();
 }
 

@@ -250,9 +250,12 @@ PropertyEditor::PropertyEditor(Document* doc, QWidget* parent) : QWidget(parent)
   outer->addWidget(error_);
   auto* scroll = new QScrollArea(this);
   scroll->setWidgetResizable(true);
+  scroll->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
   body_ = new QWidget;
   form_ = new QFormLayout(body_);
   form_->setFieldGrowthPolicy(QFormLayout::AllNonFixedFieldsGrow);
+  // a long label puts its field on the next line: the dock is narrow, the fields must stay in view
+  form_->setRowWrapPolicy(QFormLayout::WrapLongRows);
   scroll->setWidget(body_);
   outer->addWidget(scroll, 1);
   connect(doc, &Document::specChanged, this, &PropertyEditor::rebuild);
@@ -471,7 +474,7 @@ void PropertyEditor::rebuild() {
     }
     editor->setObjectName("field:" + key);
     editors_[key] = editor;
-    const QString unit = is_rotation_key(key) ? tr("deg: roll, pitch, yaw") : unitOf(key);
+    const QString unit = is_rotation_key(key) ? tr("deg, roll pitch yaw") : unitOf(key);
     QString label = key;
     label.replace('/', '.');
     editor->setProperty("help", fieldHelp(kind, key, unit));

@@ -145,7 +145,7 @@ ResultPlots::ResultPlots(QWidget* parent)
   updateTimeAxis(1.0);
   updateYRange(in_, true);
   updateYRange(out_, true);
-  setMinimumSize(320, 300);
+  setMinimumSize(240, 160);  // the window fits 1024 x 700
 }
 
 ResultPlots::~ResultPlots() = default;
@@ -188,7 +188,7 @@ void ResultPlots::buildPanel(Panel& p, const QString& title) {
   p.view = new QChartView(p.chart);  // takes ownership of the chart
   p.view->setRenderHint(QPainter::Antialiasing, true);
   p.view->setRenderHint(QPainter::TextAntialiasing, true);
-  p.view->setMinimumHeight(140);
+  p.view->setMinimumHeight(70);
   p.view->setBackgroundBrush(Qt::white);
   p.view->setFrameShape(QFrame::NoFrame);
 

@@ -132,8 +132,20 @@ class ControlViewTest : public QObject {
     // step on the first reference: every output against RK4 on the loop's matrices
     const LinearSystem& s = *cv->system(ControlView::ClosedLoop);
     cv->inputCombo()->setCurrentIndex(0);
-    QCOMPARE(cv->stepSeriesCount(), s.ny());
-    const QList<QPointF> first = cv->stepPoints(0);
+    // the measured outputs (h, theta), then with an effort chosen, the efforts (force)
+    const int ny = cl->loop.ny;
+    cv->outputCombo()->setCurrentIndex(0);
+    QCOMPARE(cv->stepSeriesCount(), ny);
+    cv->outputCombo()->setCurrentIndex(ny);
+    QCOMPARE(cv->stepSeriesCount(), s.ny() - ny);
+    QCOMPARE(cv->stepOutputs().front(), ny);
+    // every output's curve, each group in turn, against RK4
+    std::vector<QList<QPointF>> curves;
+    for (int j = 0; j < s.ny(); ++j) {
+      cv->outputCombo()->setCurrentIndex(j);
+      curves.push_back(cv->stepPoints(j));
+    }
+    const QList<QPointF> first = curves[0];
     QVERIFY(first.size() > 50);
     const double t_end = first.back().x();
     const int substeps = 40;
@@ -151,7 +163,8 @@ class ControlViewTest : public QObject {
       }
       const Eigen::VectorXd y = s.C * x + s.D.col(0);
       for (int j = 0; j < s.ny(); ++j) {
-        const QList<QPointF> p = cv->stepPoints(j);
+        const QList<QPointF>& p = curves[j];
+        QCOMPARE(p.size(), first.size());
         QCOMPARE(p[k].x(), first[k].x());
         max_err = std::max(max_err, std::abs(p[k].y() - y[j]));
         scale = std::max(scale, std::abs(y[j]));

@@ -23,7 +23,9 @@
 #include <QLabel>
 #include <QPushButton>
 #include <QSignalSpy>
+#include <QSettings>
 #include <QSlider>
+#include <QSplitter>
 #include <QTableView>
 #include <QTemporaryDir>
 
@@ -448,6 +450,28 @@ class EditingTest : public QObject {
     for (int r = 0; r < 2; ++r) damping << m.index(r, ModeTableModel::DampingRatio).data().toString();
     damping.sort();
     QCOMPARE(damping, QStringList({"-", "1"}));
+  }
+
+  // the window fits a 1024 x 700 screen; docks and splitters come back as they were left
+  void fitsSmallScreensAndRemembersItsLayout() {
+    QVERIFY(w->openFile(kCart));
+    w->resize(1024, 700);
+    QTRY_COMPARE(w->size(), QSize(1024, 700));
+    QVERIFY2(w->minimumSizeHint().height() <= 700, qPrintable(QString::number(w->minimumSizeHint().height())));
+    QVERIFY2(w->minimumSizeHint().width() <= 1024, qPrintable(QString::number(w->minimumSizeHint().width())));
+    w->resize(1500, 950);
+    QTRY_COMPARE(w->size(), QSize(1500, 950));
+    auto* centre = w->findChild<QSplitter*>("centreSplitter");
+    QVERIFY(centre);
+    centre->setSizes({200, 600});
+    const QList<int> sizes = centre->sizes();
+    w->saveLayout();
+    auto second = std::make_unique<MainWindow>();
+    second->show();
+    QVERIFY(QTest::qWaitForWindowExposed(second.get()));
+    QCOMPARE(second->size(), QSize(1500, 950));
+    QCOMPARE(second->findChild<QSplitter*>("centreSplitter")->sizes(), sizes);
+    QSettings().clear();  // the next test starts from the defaults
   }
 
   // a wheel turned over a field that was not clicked into scrolls, and changes nothing

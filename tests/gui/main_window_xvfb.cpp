@@ -18,6 +18,8 @@
 #include <QSignalSpy>
 #include <QTabWidget>
 #include <QTableView>
+#include <QLineEdit>
+#include <QTabWidget>
 #include <QTest>
 #include <QWindow>
 
@@ -27,6 +29,8 @@
 #include "gui/result_plots.hpp"
 #include "gui/simulate_view.hpp"
 #include "gui/study_widgets.hpp"
+#include "gui/control_view.hpp"
+#include "gui/property_editor.hpp"
 #include "gui/view3d.hpp"
 #include "simulation/result.hpp"
 
@@ -237,6 +241,60 @@ class MainWindowXvfb : public QObject {
     w.setPlaybackTime(sv->result()->t.back());
     QTest::qWait(200);
     QVERIFY2(difference(early, screenOfChild(&w, w.view3d())) > 0.001, "playback moves the mechanism");
+    w.document()->undoStack()->setClean();
+  }
+
+  // the views of issue 18: the Control view (closed-loop poles, gain, Bode, step), a joint's
+  // typed fields in the property editor, a refused value, results out of date
+  void controlViewAndEditing() {
+    MainWindow w;
+    w.resize(1600, 1000);
+    w.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&w));
+    QVERIFY(w.openFile(QStringLiteral(CODYNA_EXAMPLES_DIR "/cart_pendulum.json")));
+    ControlView* cv = w.controlView();
+    w.analysisTabs()->setCurrentWidget(cv);
+    w.findChild<QSplitter*>("centreSplitter")->setSizes({330, 610});  // the plots taller, as a user drags it
+    QVERIFY(cv->analyse());
+    cv->systemCombo()->setCurrentIndex(ControlView::Plant);
+    cv->inputCombo()->setCurrentText("force");
+    cv->outputCombo()->setCurrentText("theta");
+    QTest::qWait(300);
+    auto* bode = w.findChild<QWidget*>("bodeView");
+    QVERIFY(bode && bode->isVisible());
+    const Stats bs = stats(screenOfChild(&w, bode));
+    QVERIFY2(bs.foreground > 0.005, "the Bode plot shows curves");
+    save(screenOf(&w), "bode.png");
+    cv->systemCombo()->setCurrentIndex(ControlView::ClosedLoop);
+    cv->inputCombo()->setCurrentIndex(0);
+    auto* tabs = bode->parentWidget();
+    while (tabs && !qobject_cast<QTabWidget*>(tabs)) tabs = tabs->parentWidget();
+    QVERIFY(tabs);
+    qobject_cast<QTabWidget*>(tabs)->setCurrentIndex(1);
+    QTest::qWait(300);
+    save(screenOf(&w), "step_response.png");
+
+    // the rod's joint, its fields typed; a refused mass, marked with the reason
+    w.selectElement(ElementId{ElementKind::Joint, 1});
+    QTest::qWait(200);
+    save(screenOfChild(&w, w.propertyEditor()), "property_editor_joint.png");
+    w.selectElement(ElementId{ElementKind::Body, 1});
+    auto* mass = qobject_cast<QLineEdit*>(w.propertyEditor()->editorFor("mass"));
+    QVERIFY(mass);
+    mass->setFocus();
+    mass->selectAll();
+    QTest::keyClicks(mass, "-3");
+    QTest::keyClick(mass, Qt::Key_Return);
+    QVERIFY(!w.propertyEditor()->errorText().isEmpty());
+    QTest::qWait(200);
+    save(screenOfChild(&w, w.propertyEditor()), "property_editor_refused.png");
+    // an accepted edit: the Control view's results are out of date
+    mass->selectAll();
+    QTest::keyClicks(mass, "11");
+    QTest::keyClick(mass, Qt::Key_Return);
+    QVERIFY(cv->isStale());
+    QTest::qWait(200);
+    save(screenOf(&w), "control_stale.png");
     w.document()->undoStack()->setClean();
   }
 };
