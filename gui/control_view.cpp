@@ -18,8 +18,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include "gui/chart_view.hpp"
 #include "gui/document.hpp"
 #include "gui/matrix_models.hpp"
+#include "gui/matrix_view.hpp"
 
 namespace codyna::gui {
 
@@ -126,10 +128,11 @@ void ControlView::buildUi() {
 
   // left: K and the closed-loop poles
   gain_model_ = new MatrixTableModel(this);
-  gain_view_ = new QTableView(this);
-  gain_view_->setModel(gain_model_);
-  gain_view_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
-  gain_view_->setToolTip(tr("The state-feedback gain K codyna designed (u = u0 - K dx); empty for other controllers"));
+  auto* gv = new MatrixView(QStringLiteral("K"), this);
+  gv->setMatrixModel(gain_model_);
+  gain_view_ = gv;
+  gain_view_->setToolTip(tr("The gain of a controller without states (u = u0 - K dx), read off the closed loop; "
+                            "Ctrl+C copies the selection, right click copies K as MATLAB or CSV"));
   pole_model_ = new ModeTableModel(this);
   pole_view_ = new QTableView(this);
   pole_view_->setModel(pole_model_);
@@ -173,9 +176,8 @@ void ControlView::buildUi() {
   step_chart_->addAxis(tx, Qt::AlignBottom);
   step_chart_->addAxis(ty, Qt::AlignLeft);
   auto view = [this](QChart* c, const QString& name) {
-    auto* v = new QChartView(c, this);
+    auto* v = new ChartView(c, this);
     v->setObjectName(name);
-    v->setRenderHint(QPainter::Antialiasing);
     v->setMinimumSize(200, 90);
     v->setFrameShape(QFrame::NoFrame);
     return v;

@@ -28,6 +28,7 @@
 
 #include "gui/document.hpp"
 #include "gui/matrix_models.hpp"
+#include "gui/matrix_view.hpp"
 #include "gui/pole_map.hpp"
 #include "gui/study_widgets.hpp"
 
@@ -178,8 +179,9 @@ void LinearizeView::buildUi() {
   const char* names[4] = {"A", "B", "C", "D"};
   for (int k = 0; k < 4; ++k) {
     matrix_models_[k] = new MatrixTableModel(this);
-    matrix_views_[k] = new QTableView(tabs_);
-    matrix_views_[k]->setModel(matrix_models_[k]);
+    auto* mv = new MatrixView(QLatin1String(names[k]), tabs_);
+    mv->setMatrixModel(matrix_models_[k]);
+    matrix_views_[k] = mv;
     matrix_views_[k]->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
     matrix_views_[k]->setObjectName(QStringLiteral("matrix_%1").arg(QLatin1String(names[k])));
     tabs_->addTab(matrix_views_[k], QLatin1String(names[k]));
@@ -233,7 +235,9 @@ void LinearizeView::buildUi() {
   left_scroll->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
   // a narrow column (long combo entries are elided), the scroll bar beside it
   left_widget->setMaximumWidth(390);
-  left_scroll->setFixedWidth(390 + left_scroll->style()->pixelMetric(QStyle::PM_ScrollBarExtent) + 4);
+  // at most that wide, and narrower on a small screen (1024 px): the fields shrink, the results keep room
+  left_scroll->setMaximumWidth(390 + left_scroll->style()->pixelMetric(QStyle::PM_ScrollBarExtent) + 4);
+  left_scroll->setMinimumWidth(300);
   auto* layout = new QHBoxLayout(this);
   layout->addWidget(left_scroll, 0);
   layout->addWidget(vsplit, 1);

@@ -202,6 +202,12 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
     message(text);
     statusBar()->showMessage(text, 15000);
   });
+  connect(lin_view_, &LinearizeView::linearized, this, [this] {
+    // the 3-D view shows the operating point it was linearized about
+    const auto* r = lin_view_->result();
+    const auto m = doc_->model();
+    if (r && m && r->op.q.size() == m->nq && !isPlaying()) animateMode(-1, {});  // shows r->op.q
+  });
   connect(lin_view_, &LinearizeView::modeSelected, this,
           [this](int index, const Eigen::VectorXcd& shape, std::complex<double>) { animateMode(index, shape); });
   connect(sim_view_, &SimulateView::message, this, [this](const QString& m) { message(m); });
@@ -646,7 +652,12 @@ void MainWindow::animateMode(int index, const Eigen::VectorXcd& shape) {
   } else {
     anim_.stop();
     play_->setText(tr("Play"));
-    if (const auto m = doc_->model()) view_->setConfiguration(m->q0);
+    // back to the operating point of a current linearization, else the initial state
+    if (const auto m = doc_->model()) {
+      const auto* r = lin_view_->result();
+      const bool at_op = r && !lin_view_->isStale() && r->op.q.size() == m->nq;
+      view_->setConfiguration(at_op ? r->op.q : m->q0);
+    }
   }
 }
 

@@ -1,5 +1,6 @@
 #include "gui/result_plots.hpp"
 
+#include "gui/chart_view.hpp"
 #include "gui/image_export.hpp"
 
 #include <QApplication>
@@ -185,7 +186,7 @@ void ResultPlots::buildPanel(Panel& p, const QString& title) {
   p.cursor->setVisible(false);
   hideLegendEntry(p.chart, p.cursor);
 
-  p.view = new QChartView(p.chart);  // takes ownership of the chart
+  p.view = new ChartView(p.chart);  // takes ownership of the chart; zoom, pan, readout, copy
   p.view->setRenderHint(QPainter::Antialiasing, true);
   p.view->setRenderHint(QPainter::TextAntialiasing, true);
   p.view->setMinimumHeight(70);

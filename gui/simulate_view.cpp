@@ -27,6 +27,7 @@
 
 #include "gui/document.hpp"
 #include "gui/result_plots.hpp"
+#include "gui/signal_plot.hpp"
 #include "gui/study_widgets.hpp"
 #include "io/results_file.hpp"
 #include "model/model_spec.hpp"
@@ -139,6 +140,8 @@ void SimulateView::clearResult() {
   plant_inputs_.clear();
   restorePlotLimit();
   plots_->reset({}, {}, {}, {}, 1.0);
+  signal_plot_->setResult(nullptr);
+  signal_plot_->clearKept();  // runs of another model are no comparison
   progress_->setValue(0);
   status_ = tr("Not run yet.");
   status_label_->setText(status_);
@@ -316,8 +319,14 @@ void SimulateView::buildUi() {
   left_layout->addStretch(1);
 
   plots_ = new ResultPlots(this);
+  signal_plot_ = new SignalPlot(this);
+  plot_tabs_ = new QTabWidget(this);
+  plot_tabs_->addTab(plots_, tr("Plant/In, Plant/Out"));
+  plot_tabs_->addTab(signal_plot_, tr("Any signal"));
+  plot_tabs_->setTabToolTip(1, tr("Every recorded quantity: coordinates, rates, efforts, outputs, controller states, "
+                                  "energy, constraint drift; runs kept for comparison"));
   auto* right = new QSplitter(Qt::Vertical, this);
-  right->addWidget(plots_);
+  right->addWidget(plot_tabs_);
   right->addWidget(signals_box);
   right->setStretchFactor(0, 1);
   right->setStretchFactor(1, 0);
@@ -326,7 +335,8 @@ void SimulateView::buildUi() {
   left_scroll->setWidgetResizable(true);
   left_scroll->setFrameShape(QFrame::NoFrame);
   left_scroll->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
-  left_scroll->setMinimumWidth(left->sizeHint().width() + 20);
+  // as wide as its fields want, but a small screen (1024 px) may squeeze it
+  left_scroll->setMinimumWidth(std::min(left->sizeHint().width() + 20, 300));
   auto* split = new QSplitter(Qt::Horizontal, this);
   split->addWidget(left_scroll);
   split->addWidget(right);
@@ -741,6 +751,7 @@ void SimulateView::onFinished(std::shared_ptr<const SimulationResult> r) {
   result_ = r;
   restorePlotLimit();
   plots_->setResult(*r, plant_inputs_);
+  signal_plot_->setResult(r);
   const int N = r->samples();
   const double tLast = N ? r->t.back() : 0.0;
   QString head;

@@ -45,6 +45,7 @@ class QLabel;
 class QLineEdit;
 class QProgressBar;
 class QPushButton;
+class QTabWidget;
 class QStackedWidget;
 class QTableWidget;
 QT_END_NAMESPACE
@@ -53,6 +54,7 @@ namespace codyna::gui {
 
 class Document;
 class ResultPlots;
+class SignalPlot;
 class SignalTable;
 
 class SimulateView : public QWidget {
@@ -74,6 +76,7 @@ class SimulateView : public QWidget {
   // The model the last run simulated (for playback: result()->q belongs to it).
   std::shared_ptr<const codyna::Model> resultModel() const { return result_model_; }
   ResultPlots* plots() const { return plots_; }
+  SignalPlot* signalPlot() const { return signal_plot_; }
   // isStale(): the document's model changed since the run (the results stay, marked).
   bool isStale() const;
   // Forgets the result (the document now holds another model); a running simulation is cancelled.
@@ -145,6 +148,8 @@ class SimulateView : public QWidget {
   Document* doc_;
   SimWorker* worker_ = nullptr;
   ResultPlots* plots_ = nullptr;
+  SignalPlot* signal_plot_ = nullptr;
+  QTabWidget* plot_tabs_ = nullptr;
   std::shared_ptr<const codyna::SimulationResult> result_;
   std::shared_ptr<const codyna::Model> result_model_;  // the model of the run (current or last)
   std::vector<int> plant_inputs_;                      // of result_model_

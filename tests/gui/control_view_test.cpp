@@ -17,6 +17,7 @@
 #include <complex>
 #include <numbers>
 
+#include "gui/chart_view.hpp"
 #include "gui/control_view.hpp"
 #include "gui/main_window.hpp"
 #include "gui/matrix_models.hpp"
@@ -107,6 +108,37 @@ class ControlViewTest : public QObject {
         QCOMPARE(ph[k].x(), wk);
       }
     }
+  }
+
+  // the charts zoom by a dragged rectangle and back by a double click, read the value under the pointer,
+  // and copy their curves as CSV
+  void chartsZoomReadAndCopy() {
+    ControlView* cv = w->controlView();
+    w->analysisTabs()->setCurrentWidget(cv);
+    QVERIFY(cv->analyse());
+    cv->systemCombo()->setCurrentIndex(ControlView::Plant);
+    auto* view = cv->findChild<ChartView*>("bodeMagnitude");
+    QVERIFY(view);
+    QTRY_VERIFY(view->isVisible() && view->chart()->plotArea().width() > 50);
+    const QRectF area = view->chart()->plotArea();
+    const QPoint a = view->mapFromScene(view->chart()->mapToScene(area.center() - QPointF(area.width() / 4, area.height() / 4)));
+    const QPoint b = view->mapFromScene(view->chart()->mapToScene(area.center() + QPointF(area.width() / 4, area.height() / 4)));
+    QVERIFY(!view->isZoomed());
+    QTest::mouseMove(view->viewport(), a);
+    QVERIFY2(view->readout().startsWith("x = "), qPrintable(view->readout()));
+    QTest::mousePress(view->viewport(), Qt::LeftButton, {}, a);
+    QTest::mouseMove(view->viewport(), b);
+    QTest::mouseRelease(view->viewport(), Qt::LeftButton, {}, b);
+    QVERIFY(view->isZoomed());
+    QTest::mouseDClick(view->viewport(), Qt::LeftButton, {}, a);
+    QVERIFY(!view->isZoomed());
+    const QStringList csv = view->dataCsv().trimmed().split('\n');
+    const QList<QPointF> mag = cv->magnitudePoints();
+    QCOMPARE(csv.size(), int(mag.size()) + 1);
+    const QStringList row = csv[5].split(',');
+    QCOMPARE(row.size(), 2);
+    QCOMPARE(row[0].toDouble(), mag[4].x());
+    QCOMPARE(row[1].toDouble(), mag[4].y());
   }
 
   void closedLoopStepGainAndPoles() {

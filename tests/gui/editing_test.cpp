@@ -19,6 +19,7 @@
 #include <QUndoStack>
 #include <QWheelEvent>
 
+#include <QDockWidget>
 #include <QElapsedTimer>
 #include <QLabel>
 #include <QPushButton>
@@ -30,17 +31,23 @@
 #include <QTemporaryDir>
 
 #include <QAction>
+#include <QClipboard>
+#include <QItemSelection>
 #include <QMenuBar>
 #include <QProgressBar>
 #include <QStatusBar>
 #include <QToolBar>
 
 #include "analysis/modal.hpp"
+#include "gui/control_view.hpp"
 #include "gui/linearize_view.hpp"
 #include "gui/main_window.hpp"
 #include "gui/matrix_models.hpp"
+#include "gui/matrix_view.hpp"
+#include "gui/view3d.hpp"
 #include "gui/property_editor.hpp"
 #include "gui/result_plots.hpp"
+#include "gui/signal_plot.hpp"
 #include "gui/simulate_view.hpp"
 
 using namespace codyna;
@@ -472,6 +479,83 @@ class EditingTest : public QObject {
     QCOMPARE(second->size(), QSize(1500, 950));
     QCOMPARE(second->findChild<QSplitter*>("centreSplitter")->sizes(), sizes);
     QSettings().clear();  // the next test starts from the defaults
+  }
+
+  // the 3-D view shows the operating point after Linearize; the matrices copy as text that reads back exactly
+  void operatingPointShownAndMatricesCopied() {
+    QVERIFY(w->openFile(kCart));
+    const Eigen::VectorXd q0 = w->document()->model()->q0;
+    QVERIFY(std::abs(q0[1]) > 0.05);  // the example starts 0.1 rad off upright
+    QVERIFY(w->linearizeView()->linearize());
+    const Eigen::VectorXd& op = w->linearizeView()->result()->op.q;
+    QVERIFY(std::abs(op[1]) < 1e-9);  // the upright equilibrium
+    QCOMPARE(w->view3d()->configuration(), op);
+
+    auto* view = qobject_cast<MatrixView*>(w->linearizeView()->matrixView(0));
+    QVERIFY(view);
+    const Eigen::MatrixXd& A = w->linearizeView()->result()->system.A;
+    view->setFocus();
+    view->selectAll();
+    QTest::keyClick(view, Qt::Key_C, Qt::ControlModifier);
+    const QStringList rows = QApplication::clipboard()->text().trimmed().split('\n');
+    QCOMPARE(rows.size(), int(A.rows()));
+    for (int r = 0; r < A.rows(); ++r) {
+      const QStringList cells = rows[r].split('\t');
+      QCOMPARE(cells.size(), int(A.cols()));
+      for (int c = 0; c < A.cols(); ++c) QCOMPARE(cells[c].toDouble(), A(r, c));  // exact: 17 digits
+    }
+    // a block of the selection only
+    view->clearSelection();
+    view->selectionModel()->select(QItemSelection(view->model()->index(1, 2), view->model()->index(2, 3)), QItemSelectionModel::Select);
+    QTest::keyClick(view, Qt::Key_C, Qt::ControlModifier);
+    QCOMPARE(QApplication::clipboard()->text(), QString("%1\t%2\n%3\t%4\n")
+                                                     .arg(A(1, 2), 0, 'g', 17).arg(A(1, 3), 0, 'g', 17)
+                                                     .arg(A(2, 2), 0, 'g', 17).arg(A(2, 3), 0, 'g', 17));
+    // MATLAB: A = [ ...; ... ]; with the names; CSV with a header of the state names
+    const QString m = view->text(MatrixView::Format::Matlab);
+    QVERIFY2(m.contains("A = [") && m.contains("];") && m.contains("cart_slider"), qPrintable(m));
+    QCOMPARE(m.count(QLatin1Char(0x3b)), int(A.rows()) + 1);  // rows - 1 separators, the closing one, one in the comment
+    const QStringList csv = view->text(MatrixView::Format::Csv).trimmed().split('\n');
+    QCOMPARE(csv.size(), int(A.rows()) + 1);
+    QVERIFY(csv[0].startsWith(",cart_slider,"));
+    QCOMPARE(csv[1].split(',').at(1).toDouble(), A(0, 0));
+  }
+
+  // any recorded quantity can be plotted, and runs kept for comparison
+  void anySignalPlottedAndRunsKept() {
+    QVERIFY(w->openFile(kCart));
+    SimulateView* sv = w->simulateView();
+    w->analysisTabs()->setCurrentWidget(sv);
+    sv->endTimeSpin()->setValue(0.4);
+    QSignalSpy finished(sv, &SimulateView::runFinished);
+    QTest::mouseClick(sv->runButton(), Qt::LeftButton);
+    QVERIFY(QTest::qWaitFor([&] { return finished.count() == 1; }, 60000));
+    const auto r = sv->result();
+    SignalPlot* sp = sv->signalPlot();
+    const QStringList names = SignalPlot::signalNames(*r);
+    for (const char* n : {"cart_slider", "rod_pivot_dot", "kinetic energy [J]", "total energy [J]", "y: theta [rad]"})
+      QVERIFY2(names.contains(n), qPrintable(names.join(" | ")));
+    // the outputs are ticked at first; add the total energy
+    QCOMPARE(sp->checked().size(), int(r->y.cols()));
+    sp->setChecked("total energy [J]", true);
+    QCOMPARE(sp->curveCount(), int(r->y.cols()) + 1);
+    const std::vector<double> e = SignalPlot::signal(*r, "total energy [J]");
+    QCOMPARE(int(e.size()), r->samples());
+    for (int i = 0; i < r->samples(); i += 7) QCOMPARE(e[i], r->kinetic_energy[i] + r->potential_energy[i]);
+    const std::vector<double> q = SignalPlot::signal(*r, "rod_pivot");
+    for (int i = 0; i < r->samples(); i += 7) QCOMPARE(q[i], r->q(i, 1));
+    // keep this run, run again: the kept run's curves are drawn too
+    QTest::mouseClick(sp->findChild<QPushButton*>("keepRun"), Qt::LeftButton);
+    QCOMPARE(sp->keptCount(), 1);
+    sv->endTimeSpin()->setValue(0.6);
+    QTest::mouseClick(sv->runButton(), Qt::LeftButton);
+    QVERIFY(QTest::qWaitFor([&] { return finished.count() == 2; }, 60000));
+    QCOMPARE(sp->checked().size(), int(r->y.cols()) + 1);  // the ticks stay
+    QCOMPARE(sp->curveCount(), 2 * (int(r->y.cols()) + 1));
+    // another model: nothing kept
+    QVERIFY(w->newModel());
+    QCOMPARE(sp->keptCount(), 0);
+    QCOMPARE(sp->curveCount(), 0);
   }
 
   // a wheel turned over a field that was not clicked into scrolls, and changes nothing

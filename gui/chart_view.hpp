@@ -1,0 +1,41 @@
+// ChartView: a QChartView a person can read and explore. Left drag zooms into
+// the rectangle, the wheel zooms about the pointer, the middle button (or
+// Shift + left) drags the view, a double click or the context menu resets it;
+// the value under the pointer is shown in the corner (x, y in the axes' units);
+// the context menu copies every curve as CSV (x, then one column per curve,
+// full precision) and resets the zoom.
+#pragma once
+
+#include <QChartView>
+
+class QLabel;
+
+namespace codyna::gui {
+
+class ChartView : public QChartView {
+  Q_OBJECT
+ public:
+  explicit ChartView(QChart* chart, QWidget* parent = nullptr);
+
+  QString dataCsv() const;  // the curves as plotted (visible series with a name or the only one)
+  QString readout() const;  // what the corner shows ("" outside the plot area)
+  bool isZoomed() const;
+  void resetZoom();
+
+ protected:
+  void mousePressEvent(QMouseEvent* e) override;
+  void mouseMoveEvent(QMouseEvent* e) override;
+  void mouseReleaseEvent(QMouseEvent* e) override;
+  void mouseDoubleClickEvent(QMouseEvent* e) override;
+  void wheelEvent(QWheelEvent* e) override;
+  void leaveEvent(QEvent* e) override;
+  void contextMenuEvent(QContextMenuEvent* e) override;
+
+ private:
+  void showReadout(const QPointF& widgetPos);
+  QLabel* readout_ = nullptr;
+  bool panning_ = false;
+  QPoint last_;
+};
+
+}  // namespace codyna::gui
