@@ -87,6 +87,9 @@ void SimWorker::runJob(std::shared_ptr<const codyna::Model> model) {
   } catch (...) {
     return fail(QStringLiteral("the simulation setup failed (unknown error)"));
   }
+  // a Cancel pressed while the setup ran (it cannot be interrupted: the operating-point search,
+  // a time=T pre-run) takes effect here, before the run starts
+  if (cancel_.load()) return fail(QStringLiteral("cancelled during the setup (operating point, controller design)"));
   const QString source = QString::fromStdString(setup.controller_source);
   QStringList notes;
   for (const std::string& n : setup.notes) notes << QString::fromStdString(n);

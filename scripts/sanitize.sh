@@ -3,9 +3,8 @@
 # with clang, AddressSanitizer + UndefinedBehaviorSanitizer (+ libFuzzer's
 # coverage, CODYNA_FUZZ) into build-asan/ (-O1, assertions on), and runs the
 # core GoogleTest suite and the CLI shell tests there (ctest -L "core|cli"),
-# then the GUI tests that drive the widgets as a person does (editing_test,
-# main_window_test, and the monkey test with 5 seeds x 4000 random events),
-# offscreen. Any ASan error, leak or undefined behaviour fails the test that hit it.
+# then every offscreen GUI test program (tests/gui/*_test.cpp: they drive the
+# widgets as a person does; the monkey test with 5 seeds x 4000 random events). Any ASan error, leak or undefined behaviour fails the test that hit it.
 # The same build then serves scripts/fuzz.sh (CODYNA_FUZZ_BUILD=build-asan),
 # as .ci/run does. Extra arguments go to ctest (e.g. -R ModelFile).
 # CODYNA_JOBS (default 2) sets the build and test parallelism.
@@ -31,7 +30,9 @@ rm -f "$build.log.tmp"
 # Only what the selected tests run, and the fuzz target (the Octave MEX is
 # left out: an instrumented MEX cannot load into Octave).
 cmake --build "$build" -j "$jobs" --target codyna codyna_core_tests model_loader_fuzz
-cmake --build "$build" -j "$jobs" --target editing_test main_window_test monkey_test
+gui_tests=$(cd tests/gui && ls *_test.cpp | sed 's/\.cpp$//')
+# shellcheck disable=SC2086
+cmake --build "$build" -j "$jobs" --target $gui_tests
 
 # LeakSanitizer is on; UBSan stops at the first finding with a stack trace.
 # Settings already in the environment are kept and take precedence.
@@ -45,5 +46,5 @@ ctest --output-on-failure -j "$jobs" -L "core|cli" "$@"
 # (only in the full run: extra arguments select among the core and CLI tests)
 if [ $# -eq 0 ]; then
   LSAN_OPTIONS="suppressions=$PWD/../tests/data/lsan_qt.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}" \
-    ctest --output-on-failure -j 1 -R '^gui\.(editing|main_window|monkey)_test$'
+    ctest --output-on-failure -j 1 -R '^gui\.[a-z0-9_]+_test$'
 fi
