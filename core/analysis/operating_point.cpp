@@ -73,6 +73,8 @@ std::string steady_state_advice(const std::vector<std::string>& plant_inputs, co
     a = "the plant has no Plant/In input to free: add an actuator to plant.inputs";
   else if (!fixed_inputs.empty())
     a = "free an input: free_inputs / --free-input " + joined(fixed_inputs);
+  else
+    a = "every Plant/In input is free already; add one that acts on the coordinates left unbalanced";
   if (!held.empty()) {
     a += a.empty() ? "" : "; or ";
     a += kind == "trim" ? "free a held coordinate: trim_free / --trim-free " + joined(held)
