@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "analysis/discretize.hpp"
@@ -29,7 +30,7 @@ struct LinearizeArgs {
   double discrete = 0.0, trajectory = 0.0, trajectory_step = 0.0;
   bool closed_loop = false, lqr = false, lqr_controllable_part = false;
   std::vector<double> q_weights, r_weights;
-  std::vector<std::string> independent, set, trim_free, free_inputs, targets;
+  std::vector<std::string> independent, set, initial, trim_free, free_inputs, targets;
   const CLI::App* cmd = nullptr;  // to tell given flags (they override the file's analysis section)
 };
 
@@ -75,6 +76,11 @@ void run_trajectory(const Model& m, const LinearizeArgs& a, const std::string& n
   o.output_step = a.trajectory_step > 0 ? a.trajectory_step : m.spec.solver.output_step;
   if (!std::isfinite(a.trajectory) || (given(a.cmd, "--trajectory-step") && !(a.trajectory_step > 0 && std::isfinite(a.trajectory_step))))
     throw std::invalid_argument("--trajectory, --trajectory-step: expected finite numbers of seconds > 0");
+  if (!m.spec.analysis.initial.empty()) {  // the run starts at the study's initial state
+    const StudyInitialState start = study_initial_state(m);
+    o.q0 = start.q;
+    o.v0 = start.v;
+  }
   const double points = a.trajectory / o.output_step + 1;
   if (points > 100000)
     throw std::invalid_argument("--trajectory " + std::to_string(a.trajectory) + " with a step of " +
@@ -115,8 +121,7 @@ void run_trajectory(const Model& m, const LinearizeArgs& a, const std::string& n
 }
 
 // the study's controller around the plant: NAME_cl.{mat,m} and the step and frequency curves
-void run_closed_loop(const Model& m, const LinearizeArgs& a) {
-  const StudyClosedLoop cl = study_closed_loop(m);
+void run_closed_loop(const Model& m, const LinearizeArgs& a, const StudyClosedLoop& cl) {
   for (const std::string& n : cl.setup.notes) std::cerr << "codyna: note: " << n << "\n";
   for (const std::string& n : cl.notes) std::cerr << "codyna: note: closed loop: " << n << "\n";
   const LinearSystem& s = cl.loop.system;
@@ -168,6 +173,7 @@ ModelSpec study_of(const LinearizeArgs& a) {
     s.lqr_controllable_part = true;
   }
   apply_set(s, a.set);
+  apply_initial(s, a.initial);
   if (given(a.cmd, "--trim-free")) s.trim_free = a.trim_free;
   if (given(a.cmd, "--free-input")) s.free_inputs = a.free_inputs;
   apply_targets(s, a.targets);
@@ -200,7 +206,14 @@ void run(const LinearizeArgs& a) {
       guard_output(base.string() + "_cl_freq.csv", OutputKind::CurvesCsv, {a.model});
     }
   }
+  if (!a.initial.empty())
+    throw std::invalid_argument("--initial: the initial state of a run; linearize uses it with --trajectory only (the "
+                                "operating point's coordinates are --hold NAME=VALUE)");
   const StudyLinearization sl = study_linearize(m);
+  // the closed loop's operating point (the model controller's own may differ) is found before
+  // anything is written, so that a search that fails leaves no export behind
+  std::optional<StudyClosedLoop> cl;
+  if (m.spec.analysis.closed_loop.enabled) cl = study_closed_loop(m);
   const OperatingPoint& op = sl.op;
   const Linearization& lin = sl.lin;
   const LinearSystem& sys = sl.system;
@@ -241,7 +254,7 @@ void run(const LinearizeArgs& a) {
 
   const ExportPaths p = study_export(m, sys, a.out);
   std::cout << "wrote " << p.mat_file << "\nwrote " << p.m_file << "\n";
-  if (m.spec.analysis.closed_loop.enabled) run_closed_loop(m, a);
+  if (cl) run_closed_loop(m, a, *cl);
 }
 
 }  // namespace
@@ -256,7 +269,8 @@ void add_linearize(CLI::App& app) {
   cmd->add_option("--discrete", a->discrete, "sample time Ts > 0: exact zero-order-hold discrete model");
   cmd->add_option("--mat-version", a->mat_version, "5 | 7.3")->capture_default_str();
   cmd->add_option("--independent", a->independent, "closed loops: independent coordinate names")->delimiter(',');
-  cmd->add_option("--set", a->set, "NAME=VALUE: set a joint coordinate of the initial state (repeatable); held exactly by the equilibrium and trim searches");
+  cmd->add_option("--hold,--set", a->set, "NAME=VALUE: hold a joint coordinate (or rate, NAME_dot) in the operating-point search: set in the model's state and kept exactly by the equilibrium and trim searches (repeatable; --set is the older name)");
+  cmd->add_option("--initial", a->initial, "NAME=VALUE: with --trajectory, the simulation's initial state (repeatable); the operating point does not depend on it");
   cmd->add_option("--trim-free", a->trim_free, "trim: coordinates the trim solves instead of holding (comma-separated)")->delimiter(',');
   cmd->add_option("--free-input", a->free_inputs, "equilibrium/trim: Plant/In inputs solved for (comma-separated; trim default: all)")->delimiter(',');
   cmd->add_option("--target", a->targets, "NAME=VALUE: a Plant/Out value the equilibrium/trim must reach (repeatable)");

@@ -26,7 +26,7 @@ struct SimulateArgs {
   std::vector<double> q_weights, r_weights;
   double t_end = 0, rtol = 0, atol = 0, max_step = -1, output_step = 0;
   double max_samples = 1e7, divergence_bound = 1e8;
-  std::vector<std::string> independent, set, trim_free, free_inputs, targets;
+  std::vector<std::string> independent, set, initial, trim_free, free_inputs, targets;
   const CLI::App* cmd = nullptr;  // to tell given flags (they override the file's analysis and solver sections)
 };
 
@@ -37,7 +37,17 @@ std::string row(const Eigen::MatrixXd& M, int r) {
   return os.str();
 }
 
-void summary(const SimulationResult& r, const Model& m, const LinearPlant* plant) {
+std::string poles_text(const Eigen::VectorXcd& p, int precision) {
+  std::ostringstream os;
+  os.precision(precision);
+  for (Eigen::Index k = 0; k < p.size(); ++k) {
+    os << (k ? ", " : "") << p[k].real();
+    if (p[k].imag() != 0) os << (p[k].imag() < 0 ? "-" : "+") << std::abs(p[k].imag()) << "i";
+  }
+  return os.str();
+}
+
+void summary(const SimulationResult& r, const Model& m, const LinearPlant* plant, const StudySimulation& setup) {
   const int N = r.samples();
   std::cout << "\nsimulation       " << (r.completed ? "completed" : r.cancelled ? "cancelled" : "FAILED") << ", t = "
             << r.t.front() << " .. " << r.t.back() << " s, " << N << " samples\n";
@@ -48,6 +58,19 @@ void summary(const SimulationResult& r, const Model& m, const LinearPlant* plant
             << " Jacobians, " << r.stats.projections << " projections, " << std::setprecision(3) << r.stats.wall_time
             << " s\n" << std::setprecision(6);
   if (!r.stats.integrator_choice.empty()) std::cout << "                 " << r.stats.integrator_choice << "\n";
+  if (setup.linear_unstable) {
+    std::vector<std::string> bad;
+    for (Eigen::Index k = 0; k < setup.linear_poles.size(); ++k)
+      if (setup.linear_discrete ? std::abs(setup.linear_poles[k]) > 1 + 1e-9 : setup.linear_poles[k].real() > 0) {
+        Eigen::VectorXcd one(1);
+        one << setup.linear_poles[k];
+        bad.push_back(poles_text(one, 6));
+      }
+    std::cout << "warning          unstable linear closed loop: " << bad.size() << " of " << setup.linear_poles.size()
+              << " poles " << (setup.linear_discrete ? "outside the unit circle" : "with positive real part") << " (";
+    for (std::size_t k = 0; k < bad.size(); ++k) std::cout << (k ? ", " : "") << bad[k];
+    std::cout << ")\n";
+  }
   if (N == 0) return;
   for (int k = 0; k < r.y.cols(); ++k) {
     const double y0 = plant ? plant->lin.system.y0[k] : r.y(0, k);
@@ -114,6 +137,7 @@ ModelSpec study_of(const SimulateArgs& a) {
   if (given(a.cmd, "--independent")) s.independent = a.independent;
   if (a.compare_linear) s.compare_linear = true;
   apply_set(s, a.set);
+  apply_initial(s, a.initial);
   if (given(a.cmd, "--trim-free")) s.trim_free = a.trim_free;
   if (given(a.cmd, "--free-input")) s.free_inputs = a.free_inputs;
   apply_targets(s, a.targets);
@@ -176,6 +200,29 @@ void run(const SimulateArgs& a) {
     }
   }
 
+  if (setup.linear_poles.size()) {
+    std::cout << "linear closed-loop poles (" << (setup.linear_discrete ? "discrete, z" : "continuous, s") << ", about the "
+              << plant->op.kind << " point): " << poles_text(setup.linear_poles, 12) << "\n";
+    if (setup.linear_unstable)
+      std::cerr << "codyna: warning: unstable linear closed loop: the controller does not stabilize the plant about the "
+                << plant->op.kind << " point (check the sign of the gain: u = u0 - K (x - x0))\n";
+  }
+  if (plant) {
+    // the point the linear parts (controller, comparison) are about, apart from where the run starts
+    std::cout << "operating point  " << plant->op.kind;
+    if (plant->op.kind == "equilibrium" || plant->op.kind == "trim") std::cout << " (residual " << plant->op.residual << ")";
+    std::cout << ":";
+    for (int k = 0; k < m.nq; ++k) std::cout << (k ? ", " : " ") << m.q_names[k] << " = " << std::setprecision(10) << plant->op.q[k];
+    for (int k : m.plant_inputs) std::cout << ", " << m.actuators[k].name << " = " << plant->op.u[k];
+    std::cout << std::setprecision(6) << "\n";
+  }
+  if (!m.spec.analysis.initial.empty()) {
+    const Eigen::VectorXd& q0 = o.q0;
+    std::cout << "initial state   ";
+    for (int k = 0; k < m.nq; ++k) std::cout << (k ? ", " : " ") << m.q_names[k] << " = " << std::setprecision(10) << q0[k];
+    std::cout << std::setprecision(6) << " (the study's initial state, apart from the operating point)\n";
+  }
+
   // check the output paths before spending time on the run
   for (const std::string& p : {a.out, a.csv}) {
     if (p.empty()) continue;
@@ -198,7 +245,7 @@ void run(const SimulateArgs& a) {
   const SimulationResult r = study_simulate(m, setup, cb);
   if (bar) std::fprintf(stderr, "\n");
   write_results(r, a.out, a.csv);
-  summary(r, m, plant);
+  summary(r, m, plant, setup);
   std::cout << "wrote " << a.out << (a.csv.empty() ? "" : "\nwrote " + a.csv) << "\n";
   if (!r.completed && !r.cancelled) throw std::runtime_error("the run failed at " + r.failure + "; the partial result is in " + a.out);
 }
@@ -226,7 +273,8 @@ void add_simulate(CLI::App& app) {
   cmd->add_option("--max-step", a->max_step, "largest step [s] (rk4: its fixed step)");
   cmd->add_option("--output-step", a->output_step, "output interval [s]");
   cmd->add_option("--independent", a->independent, "closed loops: independent coordinate names")->delimiter(',');
-  cmd->add_option("--set", a->set, "NAME=VALUE: set a joint coordinate of the initial state (repeatable); held exactly by the equilibrium and trim searches");
+  cmd->add_option("--hold,--set", a->set, "NAME=VALUE: hold a joint coordinate (or rate, NAME_dot) in the operating-point search: set in the model's state, kept exactly by the equilibrium and trim searches, and the run's start unless --initial says otherwise (repeatable; --set is the older name)");
+  cmd->add_option("--initial", a->initial, "NAME=VALUE: the run's initial state: a joint coordinate (or rate, NAME_dot), the loops closed with it held (repeatable); the operating point is searched apart from it, from the model's state");
   cmd->add_option("--trim-free", a->trim_free, "trim: coordinates the trim solves instead of holding (comma-separated)")->delimiter(',');
   cmd->add_option("--free-input", a->free_inputs, "equilibrium/trim: Plant/In inputs solved for (comma-separated; trim default: all)")->delimiter(',');
   cmd->add_option("--target", a->targets, "NAME=VALUE: a Plant/Out value the equilibrium/trim must reach (repeatable)");

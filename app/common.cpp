@@ -39,7 +39,11 @@ void apply_pairs(std::vector<std::pair<std::string, double>>& into, const std::v
 }
 }  // namespace
 
-void apply_set(StudySpec& study, const std::vector<std::string>& set) { apply_pairs(study.set, set, "--set"); }
+void apply_set(StudySpec& study, const std::vector<std::string>& set) { apply_pairs(study.set, set, "--hold"); }
+
+void apply_initial(StudySpec& study, const std::vector<std::string>& initial) {
+  apply_pairs(study.initial, initial, "--initial");
+}
 
 void apply_targets(StudySpec& study, const std::vector<std::string>& targets) {
   apply_pairs(study.output_targets, targets, "--target");

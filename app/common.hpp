@@ -20,8 +20,11 @@ Model load_model(const std::string& path);
 // reads the model file (errors name it)
 ModelSpec load_spec(const std::string& path);
 
-// --set NAME=VALUE ... added to the study's coordinates (a name given again replaces its value)
+// --hold (alias --set) NAME=VALUE ... added to the study's held coordinates (a name given again
+// replaces its value)
 void apply_set(StudySpec& study, const std::vector<std::string>& set);
+// --initial NAME=VALUE ... added to the study's initial state (StudySpec::initial)
+void apply_initial(StudySpec& study, const std::vector<std::string>& initial);
 // the same for --target NAME=VALUE (StudySpec::output_targets)
 void apply_targets(StudySpec& study, const std::vector<std::string>& targets);
 

@@ -8,6 +8,7 @@
 
 #include "analysis/linearize.hpp"
 #include "analysis/plant_function.hpp"
+#include "model/errors.hpp"
 
 namespace codyna {
 
@@ -65,6 +66,53 @@ std::string joined(const std::vector<std::string>& names) {
 }
 }  // namespace
 
+std::string steady_state_advice(const std::vector<std::string>& plant_inputs, const std::vector<std::string>& fixed_inputs,
+                                const std::vector<std::string>& held, const std::string& kind) {
+  std::string a;
+  if (plant_inputs.empty())
+    a = "the plant has no Plant/In input to free: add an actuator to plant.inputs";
+  else if (!fixed_inputs.empty())
+    a = "free an input: free_inputs / --free-input " + joined(fixed_inputs);
+  else
+    a = "every Plant/In input is free already; add one that acts on the coordinates left unbalanced";
+  if (!held.empty()) {
+    a += a.empty() ? "" : "; or ";
+    a += kind == "trim" ? "free a held coordinate: trim_free / --trim-free " + joined(held)
+                        : "hold fewer coordinates (analysis set / --hold; held now: " + joined(held) + ")";
+  }
+  if (a.empty()) a = "ask for another state: a reachable output target, or the operating point initial or time=T";
+  return a;
+}
+
+void require_steady_state(const Model& model, const OperatingPoint& op, const std::vector<std::string>& independent,
+                          double tolerance) {
+  if (op.residual < tolerance) return;
+  const PlantFunction f(model, op.q, op.u, partition_coordinates(model, op.q, independent));
+  const Eigen::VectorXd r = rest_accelerations(f, Eigen::VectorXd::Zero(f.nz()), plant_u(model, op.u));
+  std::vector<std::string> in_names, coords;
+  for (int k : model.plant_inputs) in_names.push_back(model.actuators[k].name);
+  const CoordinatePartition part = partition_coordinates(model, op.q, independent);
+  for (int i : part.independent) coords.push_back(model.v_names[static_cast<std::size_t>(i)]);
+  std::ostringstream os;
+  os << op.kind << ": not converged: the residual accelerations are " << op.residual << " after " << op.iterations
+     << " iterations (tolerance " << tolerance;
+  if (r.size()) {
+    Eigen::Index i = 0;
+    const double worst = r.cwiseAbs().maxCoeff(&i);
+    os << "; largest on " << coords[static_cast<std::size_t>(i)] << ": " << worst;
+  }
+  os << ")";
+  if (op.kind == "trim") {
+    // every independent coordinate held, every Plant/In input solved
+    os << "; unknowns: free inputs " << joined(in_names) << ", free coordinates (none); held: " << joined(coords) << " ("
+       << steady_state_advice(in_names, {}, coords, "trim") << ")";
+  } else {
+    os << "; unknowns: free inputs (none), free coordinates " << joined(coords) << " ("
+       << steady_state_advice(in_names, in_names, {}, "equilibrium") << ")";
+  }
+  throw ConvergenceError(os.str());
+}
+
 OperatingPoint steady_state(const Model& model, const OperatingPoint& start, const SteadyStateSpec& spec,
                             const std::vector<std::string>& independent, const std::string& kind) {
   OperatingPoint op = start;
@@ -105,6 +153,8 @@ OperatingPoint steady_state(const Model& model, const OperatingPoint& start, con
     return r;
   };
   double accel_left = 0.0, output_left = 0.0;
+  std::vector<std::string> free_coords;  // the unknown coordinates of the last iteration
+  std::string worst;                     // the coordinate whose acceleration is furthest from 0
   const int rounds = static_cast<int>(free_u.size()) + 1;  // each clamps at least one input, or ends
   for (int round = 0; round < rounds; ++round) {
     for (op.iterations = 0; op.iterations < 60; ++op.iterations) {
@@ -119,6 +169,13 @@ OperatingPoint steady_state(const Model& model, const OperatingPoint& start, con
       const Eigen::VectorXd z0 = Eigen::VectorXd::Zero(n);
       const Eigen::VectorXd r = residual(f, z0, u);
       accel_left = n ? r.head(n).lpNorm<Eigen::Infinity>() : 0.0;
+      free_coords.clear();
+      for (int k : free_z) free_coords.push_back(model.v_names[static_cast<std::size_t>(part.independent[static_cast<std::size_t>(k)])]);
+      if (n) {
+        Eigen::Index i = 0;
+        r.head(n).cwiseAbs().maxCoeff(&i);
+        worst = model.v_names[static_cast<std::size_t>(part.independent[static_cast<std::size_t>(i)])];
+      }
       output_left = target_y.empty() ? 0.0 : r.tail(static_cast<Eigen::Index>(target_y.size())).lpNorm<Eigen::Infinity>();
       if (accel_left < 1e-11 && output_left < 1e-11 * (1.0 + (target.size() ? target.lpNorm<Eigen::Infinity>() : 0.0)))
         break;
@@ -174,17 +231,23 @@ OperatingPoint steady_state(const Model& model, const OperatingPoint& start, con
   const double out_tol = 1e-8 * (1.0 + (target.size() ? target.lpNorm<Eigen::Infinity>() : 0.0));
   if (!(accel_left < 1e-8) || !(output_left < out_tol)) {
     std::ostringstream os;
-    os << "steady state: not found: accelerations " << accel_left << " left";
+    os << "steady state: not found: the residual accelerations are " << accel_left << " (tolerance 1e-08";
+    if (!worst.empty()) os << "; largest on " << worst;
+    os << ")";
     if (!target_y.empty()) os << ", outputs off by " << output_left;
-    os << " (held: " << joined(spec.held) << "; free inputs: " << joined(spec.free_inputs) << ")";
+    std::vector<std::string> fixed_inputs;  // Plant/In inputs the search did not solve for
+    for (const std::string& name : in_names)
+      if (std::find(spec.free_inputs.begin(), spec.free_inputs.end(), name) == spec.free_inputs.end()) fixed_inputs.push_back(name);
+    os << "; unknowns: free inputs " << joined(spec.free_inputs) << ", free coordinates " << joined(free_coords)
+       << "; held: " << joined(spec.held);
     if (!clamped.empty()) {
       os << "; the actuator limits bind: ";
       for (std::size_t k = 0; k < clamped.size(); ++k) os << (k ? "; " : "") << clamped[k];
       os << " (raise the limits, free other inputs, or ask for another state)";
     } else {
-      os << " (free more inputs or coordinates, or hold fewer)";
+      os << " (" << steady_state_advice(in_names, fixed_inputs, spec.held, kind) << ")";
     }
-    throw std::invalid_argument(os.str());
+    throw ConvergenceError(os.str());
   }
   return op;
 }
@@ -249,7 +312,7 @@ OperatingPoint trim(const Model& model, const OperatingPoint& start, const std::
     if (op.u[k] < a.min) bound << (bound.tellp() ? "; " : "") << a.name << " = " << op.u[k] << " is below its min " << a.min;
   }
   if (bound.tellp())
-    throw std::invalid_argument("trim: holding this configuration needs inputs beyond their limits: " + bound.str() +
+    throw ConvergenceError("trim: holding this configuration needs inputs beyond their limits: " + bound.str() +
                                 " (raise the limits, add inputs, or trim another configuration)");
   return op;
 }

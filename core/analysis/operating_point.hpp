@@ -44,8 +44,8 @@ OperatingPoint trim(const Model& model, const OperatingPoint& start, const std::
 // value. Gauss-Newton with minimum-norm steps on the unknowns. A free input
 // that would leave its limits is held at the limit and the rest solved again;
 // when that fails, the error names the limit that binds. Throws
-// std::invalid_argument for an unknown name and when no steady state is found
-// (saying what is left).
+// std::invalid_argument for an unknown name, and ConvergenceError when no
+// steady state is found (saying what is left, the unknowns and what to free).
 struct SteadyStateSpec {
   std::vector<std::string> held;         // coordinates (Model::v_names) held at their start values
   std::vector<std::string> free_inputs;  // Plant/In actuator names solved for
@@ -54,6 +54,18 @@ struct SteadyStateSpec {
 
 OperatingPoint steady_state(const Model& model, const OperatingPoint& start, const SteadyStateSpec& spec,
                             const std::vector<std::string>& independent = {}, const std::string& kind = "trim");
+
+// The verdict on an equilibrium or trim found by the two searches above (which return their
+// best effort): a residual at or above `tolerance` throws ConvergenceError (model/errors.hpp)
+// naming the residual, the coordinate it is largest on, the unknowns and what to free.
+// steady_state gives that verdict itself.
+void require_steady_state(const Model& model, const OperatingPoint& op, const std::vector<std::string>& independent = {},
+                          double tolerance = 1e-8);
+
+// What to free when a steady state is not found (for messages): the Plant/In inputs not free,
+// the coordinates held; `kind` "trim" frees held coordinates, an equilibrium holds fewer.
+std::string steady_state_advice(const std::vector<std::string>& plant_inputs, const std::vector<std::string>& fixed_inputs,
+                                const std::vector<std::string>& held, const std::string& kind);
 
 OperatingPoint snapshot_point(const Model& model, double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
                               const Eigen::VectorXd& u);

@@ -1108,6 +1108,7 @@ const Schema<StudySpec>& schema<StudySpec>() {
       field("disabled_effects", &T::disabled_effects, read_names),
       field("operating_point", &T::operating_point, read_study_operating_point),
       field("set", &T::set, read_set, encode_set),
+      field("initial", &T::initial, read_set, encode_set),
       field("independent", &T::independent, read_names),
       field("trim_free", &T::trim_free, read_names),
       field("free_inputs", &T::free_inputs, read_names),

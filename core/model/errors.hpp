@@ -31,4 +31,13 @@ class ModelError : public std::runtime_error {
   std::string file_, path_, detail_;
 };
 
+// A steady-state search (equilibrium, trim) that ended without converging: the residual it
+// left is above the tolerance. Not bad input (the request was well formed) but a failure of
+// the work: the front ends report it with exit code 2 and export or simulate nothing about
+// the point. The message names the residual, the unknowns and what to free.
+class ConvergenceError : public std::runtime_error {
+ public:
+  explicit ConvergenceError(const std::string& what) : std::runtime_error(what) {}
+};
+
 }  // namespace codyna

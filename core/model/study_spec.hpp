@@ -64,9 +64,16 @@ struct StudySpec {
 
   // operating point: "initial", "equilibrium", "trim" or "time=T" (T >= 0, seconds)
   std::string operating_point = "equilibrium";
-  // joint coordinates set in the initial state before anything runs (q names as
-  // `codyna info` prints them), then the loops are re-assembled
+  // the held coordinates of the operating-point search (`--hold`, alias `--set`): joint
+  // coordinates and rates (q names as `codyna info` prints them, rates as NAME_dot) set in
+  // the model's initial state before anything runs, the loops re-assembled with them held;
+  // the equilibrium and trim searches start there and keep them exactly
   std::vector<std::pair<std::string, double>> set;
+  // the simulation's initial state (`--initial`), apart from the operating point: the same
+  // names, set on top of the state above and assembled onto the loops with them held. The
+  // operating point is searched from the model's state, not from this one; only the runs
+  // (simulate, linearize --trajectory) start here.
+  std::vector<std::pair<std::string, double>> initial;
   // closed loops: the independent coordinates (empty = automatic choice)
   std::vector<std::string> independent;
   // the steady-state search (operating points equilibrium and trim), as

@@ -37,6 +37,7 @@ LinearPlant controller_plant(const Model& model) {
   if (c.operating_point == "equilibrium") p.op = static_equilibrium(model, start);
   else if (c.operating_point == "trim") p.op = trim(model, start);
   else p.op = start;
+  if (c.operating_point != "initial") require_steady_state(model, p.op);  // no controller about an unconverged point
   p.lin = linearize(model, p.op);
   return p;
 }

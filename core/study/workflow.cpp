@@ -1,7 +1,9 @@
 #include "study/workflow.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <filesystem>
 #include <sstream>
 #include <stdexcept>
@@ -47,6 +49,11 @@ std::string listed(const std::vector<std::string>& names) {
 
 [[noreturn]] void fail(const Model& m, const std::string& field, const std::string& what) {
   throw ModelError(m.source_file, "/analysis/" + field, what);
+}
+
+// a steady-state search that did not converge: a failure of the work (exit code 2), not bad input
+[[noreturn]] void not_converged(const Model& m, const std::string& what) {
+  throw ConvergenceError((m.source_file.empty() ? std::string() : m.source_file + ": ") + "/analysis/operating_point: " + what);
 }
 
 JacobianMethod method_of(const Model& m) {
@@ -180,6 +187,34 @@ void attach_disturbances(const Model& m, StudySimulation& out) {
   out.plant = plant;
 }
 
+// The linear closed loop's poles of a linear controller (state feedback, LTI) about the plant's point
+void attach_linear_poles(StudySimulation& out) {
+  if (!out.plant || !out.controller || out.controller->pid()) return;
+  const LinearSystem& sys = out.plant->lin.system;
+  const std::optional<LinearLaw> law = out.controller->linear_law(sys.nx(), sys.ny());
+  if (!law) return;
+  DisturbanceInputs w;
+  w.Bw = Eigen::MatrixXd::Zero(sys.nx(), 0);
+  w.Dw = Eigen::MatrixXd::Zero(sys.ny(), 0);
+  ClosedLoopLinear loop;
+  try {
+    loop = close_loop(sys, *law, w, out.controller->state_names(), out.controller->describe());
+  } catch (const std::invalid_argument& e) {
+    out.notes.push_back(std::string("no linear closed-loop poles: ") + e.what());
+    return;
+  }
+  const Eigen::MatrixXd& A = loop.system.A;
+  Eigen::VectorXcd p = A.size() ? Eigen::VectorXcd(A.eigenvalues()) : Eigen::VectorXcd();
+  std::sort(p.data(), p.data() + p.size(), [](const std::complex<double>& a, const std::complex<double>& b) {
+    return a.real() != b.real() ? a.real() < b.real() : a.imag() < b.imag();
+  });
+  out.linear_poles = p;
+  out.linear_discrete = loop.system.Ts > 0;
+  const double tol = 1e-9 * std::max(1.0, A.norm());
+  for (Eigen::Index k = 0; k < p.size(); ++k)
+    if (out.linear_discrete ? std::abs(p[k]) > 1 + 1e-9 : p[k].real() > tol) out.linear_unstable = true;
+}
+
 // PID anti-windup, from the study, on whichever PID the study runs
 void attach_anti_windup(const Model& m, StudySimulation& out) {
   const StudySpec& s = m.spec.analysis;
@@ -250,9 +285,28 @@ bool adopt_controller_study(ModelSpec& spec, const std::string& file) {
   try {
     j = nlohmann::json::parse(it->second.front());
     const std::string before = s.operating_point;
-    s.operating_point = j.at("operating_point").get<std::string>();
-    s.set.clear();
-    for (const auto& [name, value] : j.at("set").items()) s.set.emplace_back(name, value.get<double>());
+    const std::string carried_point = j.at("operating_point").get<std::string>();
+    std::vector<std::pair<std::string, double>> carried;
+    for (const auto& [name, value] : j.at("set").items()) carried.emplace_back(name, value.get<double>());
+    // a coordinate held by the study (analysis set, --hold / --set) must be one the controller's
+    // own point holds, at the same value: the controller is applied about that point only
+    for (const auto& [name, value] : s.set) {
+      const auto it = std::find_if(carried.begin(), carried.end(), [&](const auto& c) { return c.first == name; });
+      if (it != carried.end() && it->second == value) continue;
+      std::ostringstream os;
+      os.precision(17);
+      os << path << ": the controller carries the operating point it was designed about (codyna_study: " << carried_point
+         << ", held: ";
+      for (std::size_t k = 0; k < carried.size(); ++k) os << (k ? ", " : "") << carried[k].first << " = " << carried[k].second;
+      os << (carried.empty() ? "none" : "") << "), and the held coordinate " << name << " = " << value
+         << " (analysis set, --hold / --set) "
+         << (it == carried.end() ? "is not one of them" : "is held there at another value") << ": a carried controller is "
+         << "applied about its own point only. Leave the hold out; to start the run elsewhere use --initial " << name
+         << "=VALUE (analysis initial); to design about another point, export there and save the controller again";
+      throw std::invalid_argument(os.str());
+    }
+    s.operating_point = carried_point;
+    s.set = carried;
     s.independent = j.at("independent").get<std::vector<std::string>>();
     s.disabled_effects = j.at("disabled_effects").get<std::vector<std::string>>();
     s.trim_free = j.value("trim_free", std::vector<std::string>{});
@@ -268,6 +322,64 @@ bool adopt_controller_study(ModelSpec& spec, const std::string& file) {
   }
   return true;
 }
+
+namespace {
+// `pairs` set on (q, v) and the loops closed with them held; errors at /analysis/FIELD[/NAME]
+StudyInitialState set_coordinates(const Model& m, Eigen::VectorXd q, Eigen::VectorXd v,
+                                  const std::vector<std::pair<std::string, double>>& pairs, const std::string& field) {
+  // coordinates set by the user are held exactly while the loops are closed (Adams' locked
+  // initial conditions); positions by q name, rates by "NAME_dot" or a rate's own name
+  AssemblyOptions hold;
+  std::vector<std::pair<std::string, double>> positions;  // what was asked, to check it afterwards
+  const auto joint_of_q = [&](int iq) {
+    for (int i = 1; i < m.nbodies; ++i)
+      if (iq >= m.joints[i].idx_q && iq < m.joints[i].idx_q + m.joints[i].nq) return i;
+    return 0;
+  };
+  for (const auto& [name, value] : pairs) {
+    if (!std::isfinite(value) || std::abs(value) > 1e6)
+      fail(m, field + "/" + name, "expected a finite number of magnitude at most 1e6 (m, rad, m/s or rad/s)");
+    if (const auto it = std::find(m.q_names.begin(), m.q_names.end(), name); it != m.q_names.end()) {
+      const int iq = static_cast<int>(it - m.q_names.begin());
+      const JointModel& j = m.joints[joint_of_q(iq)];
+      q[iq] = value;
+      if (j.nq == j.nv) {
+        hold.locked_positions.push_back(j.idx_v + iq - j.idx_q);
+      } else {  // a quaternion or a free joint's position: hold the whole joint
+        for (int k = 0; k < j.nv; ++k) hold.locked_positions.push_back(j.idx_v + k);
+      }
+      positions.emplace_back(name, value);
+      continue;
+    }
+    std::string rate = name;
+    if (rate.size() > 4 && rate.compare(rate.size() - 4, 4, "_dot") == 0) rate.resize(rate.size() - 4);
+    const auto iv = std::find(m.v_names.begin(), m.v_names.end(), rate);
+    if (iv == m.v_names.end() || (rate == name && std::count(m.q_names.begin(), m.q_names.end(), name)))
+      fail(m, field + "/" + name, "unknown coordinate \"" + name + "\" (positions: " + listed(m.q_names) + "; rates: " +
+                                 listed(m.v_names) + ", or a position's name with _dot)");
+    v[iv - m.v_names.begin()] = value;
+    hold.locked_velocities.push_back(static_cast<int>(iv - m.v_names.begin()));
+  }
+  const AssemblyResult r = assemble(m, q, v, hold);
+  if (!r.converged) {
+    // say which values cannot be held, and where the loops would put them
+    const AssemblyResult free = assemble(m, q, v);
+    std::ostringstream os;
+    os.precision(8);
+    os << "the coordinates " << (field == "set" ? "set" : "of the initial state") << " cannot all be held: the loops close only to a residual of " << r.position_residual
+       << " (velocities " << r.velocity_residual << ")";
+    if (free.converged)
+      for (const auto& [name, value] : positions) {
+        const double there = free.q[std::find(m.q_names.begin(), m.q_names.end(), name) - m.q_names.begin()];
+        os << "; closing them freely puts " << name << " at " << there << " (" << value << " asked, off by "
+           << there - value << ")";
+      }
+    fail(m, field, os.str());
+  }
+  return {r.q, r.v, true};
+}
+
+}  // namespace
 
 Model study_model(const ModelSpec& spec_in, const std::string& file) {
   ModelSpec spec = spec_in;
@@ -287,59 +399,20 @@ Model study_model(const ModelSpec& spec_in, const std::string& file) {
   }
   Model m = compile(spec, file);
   m.spec.analysis = s;  // compile keeps the spec; the study travels with it
-  if (s.set.empty()) return m;
-  // coordinates set by the user are held exactly while the loops are closed (Adams' locked
-  // initial conditions); positions by q name, rates by "NAME_dot" or a rate's own name
-  AssemblyOptions hold;
-  std::vector<std::pair<std::string, double>> positions;  // what was asked, to check it afterwards
-  const auto joint_of_q = [&](int iq) {
-    for (int i = 1; i < m.nbodies; ++i)
-      if (iq >= m.joints[i].idx_q && iq < m.joints[i].idx_q + m.joints[i].nq) return i;
-    return 0;
-  };
-  for (const auto& [name, value] : s.set) {
-    if (!std::isfinite(value) || std::abs(value) > 1e6)
-      fail(m, "set/" + name, "expected a finite number of magnitude at most 1e6 (m, rad, m/s or rad/s)");
-    if (const auto it = std::find(m.q_names.begin(), m.q_names.end(), name); it != m.q_names.end()) {
-      const int iq = static_cast<int>(it - m.q_names.begin());
-      const JointModel& j = m.joints[joint_of_q(iq)];
-      m.q0[iq] = value;
-      if (j.nq == j.nv) {
-        hold.locked_positions.push_back(j.idx_v + iq - j.idx_q);
-      } else {  // a quaternion or a free joint's position: hold the whole joint
-        for (int k = 0; k < j.nv; ++k) hold.locked_positions.push_back(j.idx_v + k);
-      }
-      positions.emplace_back(name, value);
-      continue;
-    }
-    std::string rate = name;
-    if (rate.size() > 4 && rate.compare(rate.size() - 4, 4, "_dot") == 0) rate.resize(rate.size() - 4);
-    const auto iv = std::find(m.v_names.begin(), m.v_names.end(), rate);
-    if (iv == m.v_names.end() || (rate == name && std::count(m.q_names.begin(), m.q_names.end(), name)))
-      fail(m, "set/" + name, "unknown coordinate \"" + name + "\" (positions: " + listed(m.q_names) + "; rates: " +
-                                 listed(m.v_names) + ", or a position's name with _dot)");
-    m.v0[iv - m.v_names.begin()] = value;
-    hold.locked_velocities.push_back(static_cast<int>(iv - m.v_names.begin()));
+  if (!s.set.empty()) {
+    // the held coordinates move the model's own state: the operating-point search starts there
+    StudyInitialState held = set_coordinates(m, m.q0, m.v0, s.set, "set");
+    m.q0 = held.q;
+    m.v0 = held.v;
   }
-  const AssemblyResult r = assemble(m, m.q0, m.v0, hold);
-  if (!r.converged) {
-    // say which values cannot be held, and where the loops would put them
-    const AssemblyResult free = assemble(m, m.q0, m.v0);
-    std::ostringstream os;
-    os.precision(8);
-    os << "the coordinates set cannot all be held: the loops close only to a residual of " << r.position_residual
-       << " (velocities " << r.velocity_residual << ")";
-    if (free.converged)
-      for (const auto& [name, value] : positions) {
-        const double there = free.q[std::find(m.q_names.begin(), m.q_names.end(), name) - m.q_names.begin()];
-        os << "; closing them freely puts " << name << " at " << there << " (" << value << " asked, off by "
-           << there - value << ")";
-      }
-    fail(m, "set", os.str());
-  }
-  m.q0 = r.q;
-  m.v0 = r.v;
+  if (!s.initial.empty()) study_initial_state(m);  // its names and values are checked before any work
   return m;
+}
+
+StudyInitialState study_initial_state(const Model& m) {
+  const StudySpec& s = m.spec.analysis;
+  if (s.initial.empty()) return {m.q0, m.v0, false};
+  return set_coordinates(m, m.q0, m.v0, s.initial, "initial");
 }
 
 OperatingPoint study_operating_point(const Model& m, const std::string& which_in) {
@@ -378,19 +451,29 @@ OperatingPoint study_operating_point(const Model& m, const std::string& which_in
       return steady_state(m, start, spec, s.independent, which);
     } catch (const std::invalid_argument& e) {
       fail(m, "operating_point", std::string(which) + ": " + e.what());
+    } catch (const ConvergenceError& e) {
+      not_converged(m, which + ": " + e.what());
     }
   }
   if (which == "equilibrium") {
     const OperatingPoint op = static_equilibrium(m, start, s.independent);
-    if (!(op.residual < 1e-8)) {
-      std::ostringstream os;
-      os << "no static equilibrium found near the initial state (accelerations " << op.residual << " left after "
-         << op.iterations << " iterations); choose the operating point initial, trim or time=T";
-      fail(m, "operating_point", os.str());
+    try {
+      require_steady_state(m, op, s.independent);
+    } catch (const ConvergenceError& e) {
+      not_converged(m, std::string(e.what()) + "; searched from the model's initial state; or choose the operating point "
+                                               "initial, trim or time=T");
     }
     return op;
   }
-  if (which == "trim") return trim(m, start, s.independent);
+  if (which == "trim") {
+    try {
+      const OperatingPoint op = trim(m, start, s.independent);
+      require_steady_state(m, op, s.independent);
+      return op;
+    } catch (const ConvergenceError& e) {
+      not_converged(m, e.what());
+    }
+  }
   if (which.rfind("time=", 0) == 0) {
     char* end = nullptr;
     const double t = std::strtod(which.c_str() + 5, &end);
@@ -521,13 +604,32 @@ StudySimulation study_simulation(const Model& m) {
     }
     out.controller = load_controller(path, sys.nx(), sys.nu(), sys.ny(), sys.y0, sys.u0);
     out.controller_source = s.controller_file;
+    if (!vars.strings.count("codyna_study")) {
+      // nothing says where it was designed: say where it is applied, and how to carry the point
+      std::ostringstream os;
+      os.precision(10);
+      os << path << " carries no codyna_study: the controller is applied about this study's " << out.plant->op.kind
+         << " point (";
+      for (int k = 0; k < m.nq; ++k) os << (k ? ", " : "") << m.q_names[static_cast<std::size_t>(k)] << " = " << out.plant->op.q[k];
+      for (int k : m.plant_inputs) os << ", " << m.actuators[static_cast<std::size_t>(k)].name << " = " << out.plant->op.u[k];
+      os << "), which may not be the point it was designed about; to carry the design point, save the export's "
+            "codyna_study with it, e.g. in Octave after run('NAME.m'): save('-v7', 'K.mat', 'K', 'codyna_study', 'state_names')";
+      out.notes.push_back(os.str());
+    }
   } else {
     out.controller_source = "none";
+  }
+  if (!s.initial.empty()) {
+    // the run starts where the study's initial state says, about the operating point found above
+    const StudyInitialState start = study_initial_state(m);
+    out.options.q0 = start.q;
+    out.options.v0 = start.v;
   }
   attach_anti_windup(m, out);
   if (!s.references.empty()) attach_references(m, out);
   attach_disturbances(m, out);
   if (out.options.compare_linear && !out.plant) out.options.compare_linear = false;
+  attach_linear_poles(out);
   return out;
 }
 
@@ -539,7 +641,15 @@ SimulationResult study_simulate(const Model& m, const StudySimulation& setup, co
   settings << "{\"integrator\": \"" << o.integrator.method << "\", \"rtol\": " << o.integrator.rtol << ", \"atol\": "
            << o.integrator.atol << ", \"max_step\": " << o.integrator.max_step << ", \"t_end\": " << o.t_end
            << ", \"output_step\": " << o.output_step << ", \"operating_point\": \""
-           << (setup.plant ? setup.plant->op.kind : "") << "\", \"controller\": \"" << setup.controller_source << "\"}";
+           << (setup.plant ? setup.plant->op.kind : "") << "\", \"controller\": \"" << setup.controller_source << "\"";
+  if (setup.plant) {
+    // the point itself (coordinates by name, every actuator's nominal value), apart from the start
+    nlohmann::ordered_json q = nlohmann::ordered_json::object(), u = nlohmann::ordered_json::object();
+    for (int k = 0; k < m.nq; ++k) q[m.q_names[static_cast<std::size_t>(k)]] = setup.plant->op.q[k];
+    for (int k = 0; k < m.nu(); ++k) u[m.actuators[static_cast<std::size_t>(k)].name] = setup.plant->op.u[k];
+    settings << ", \"operating_point_q\": " << q.dump() << ", \"operating_point_u\": " << u.dump();
+  }
+  settings << ", \"initial_state\": \"" << (m.spec.analysis.initial.empty() ? "model" : "study initial") << "\"}";
   r.settings_json = settings.str();
   return r;
 }

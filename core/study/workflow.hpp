@@ -1,7 +1,9 @@
 // The workflow of one study (model/study_spec.hpp), one function per step:
 //
 //   study_model            the model as this study sees it: disabled effects left
-//                          out, coordinates set, loops re-assembled
+//                          out, held coordinates set, loops re-assembled
+//   study_initial_state    where a run starts (the study's `initial`), apart from the
+//                          operating point
 //   study_operating_point  initial / equilibrium / trim / time=T
 //   study_linearize        A, B, C, D there (exact or finite differences, ZOH on request)
 //   study_export           NAME.mat + NAME.m
@@ -41,8 +43,22 @@ Model study_model(const ModelSpec& spec, const std::string& file = "");
 // Returns true when it did.
 bool adopt_controller_study(ModelSpec& spec, const std::string& file);
 
+// The simulation's initial state: the model's state (held coordinates `set` included) with the
+// study's `initial` coordinates and rates set on it and the loops closed with those held
+// (ModelError at /analysis/initial/NAME for an unknown name, at /analysis/initial when the
+// loops cannot hold them). `given` is false when the study names none (q, v are the model's).
+// The operating point does not depend on it: it is searched from the model's state.
+struct StudyInitialState {
+  Eigen::VectorXd q, v;
+  bool given = false;
+};
+StudyInitialState study_initial_state(const Model& model);
+
 // The operating point the study asks for (`which` overrides study.operating_point
-// when not empty). An equilibrium that cannot be found is an error, not a best effort.
+// when not empty). An equilibrium or trim search ends with a verdict: one that does not
+// converge (residual accelerations of 1e-8 or more, outputs off their targets, inputs held
+// at their limits) throws ConvergenceError (model/errors.hpp) naming the residual, the
+// unknowns and what to free; nothing is linearized, exported or simulated about it.
 OperatingPoint study_operating_point(const Model& model, const std::string& which = "");
 
 struct StudyLinearization {
@@ -71,6 +87,14 @@ struct StudySimulation {
   Eigen::VectorXcd lqr_poles;                    // eig(A - B lqr_gain), when the source is "lqr"
   std::vector<HiddenMode> uncontrollable;        // lqr_controllable_part: the modes left as they are
   std::vector<std::string> notes;                // what a front end should tell the user
+  // a linear controller (state feedback, LQR, LTI; not PID, not open loop): the poles of the
+  // linear closed loop about the operating point (close_loop of analysis/closed_loop_linear.hpp,
+  // saturation left out), sorted by real part; `linear_unstable` when one has a real part
+  // above 1e-9 max(1, |Acl|) (continuous) or a magnitude above 1 + 1e-9 (a sampled controller).
+  // Empty when there is no such controller. The run is not refused for it.
+  Eigen::VectorXcd linear_poles;
+  bool linear_discrete = false;
+  bool linear_unstable = false;
 };
 
 // Controller and linear plant of the run (linearizing once if anything needs it).

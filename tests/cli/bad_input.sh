@@ -105,8 +105,11 @@ m["effects"].append({"name": "push", "type": "body_force", "body": m["bodies"][0
 m["controller"] = {"type": "lqr", "operating_point": "equilibrium"}
 json.dump(m, sys.stdout)
 PY
-expect 1 "no static equilibrium" -- "$codyna" simulate noeq.json --out noeq.h5 --quiet
-expect 1 "no static equilibrium" -- "$codyna" linearize noeq.json --out lin
+# (a search that does not converge is a failure of the work, exit code 2, and writes nothing)
+expect 2 "equilibrium: not converged: the residual accelerations are" -- "$codyna" simulate noeq.json --out noeq.h5 --quiet
+[ ! -e noeq.h5 ] || fail "noeq.h5 written about an equilibrium that was not found"
+expect 2 "equilibrium: not converged: the residual accelerations are" -- "$codyna" linearize noeq.json --out lin
+[ ! -e lin ] || fail "lin/ exported about an equilibrium that was not found"
 # an empty Plant/In is said
 python3 - "$src/examples/pendulum.json" > noin.json <<'PY'
 import json, sys

@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <tuple>
 
+#include <nlohmann/json.hpp>
+
 #include "control/lqr.hpp"
 #include "dynamics/constraints.hpp"
 #include "io/model_file.hpp"
@@ -30,6 +32,18 @@ void expect_model_error_at(F&& f, const std::string& path, const std::string& ph
   } catch (const ModelError& e) {
     EXPECT_EQ(e.path(), path) << e.what();
     EXPECT_NE(std::string(e.what()).find(phrase), std::string::npos) << e.what();
+  }
+}
+
+// a steady-state search that does not converge is a ConvergenceError (exit code 2 at the command
+// line), not bad input; its message names the field, the residual and the unknowns
+template <class F>
+void expect_not_converged(F&& f, const std::vector<std::string>& phrases) {
+  try {
+    f();
+    FAIL() << "no error, expected a ConvergenceError";
+  } catch (const ConvergenceError& e) {
+    for (const std::string& p : phrases) EXPECT_NE(std::string(e.what()).find(p), std::string::npos) << p << " in " << e.what();
   }
 }
 
@@ -154,7 +168,9 @@ TEST(Workflow, SetCoordinatesAndOperatingPoints) {
   EXPECT_EQ(study_operating_point(m).q[0], 1.0);
   // a set coordinate is held by the equilibrium search: at 1 rad gravity turns the rod, so there
   // is no equilibrium with pivot held (nothing is free to hold it), and the error says so
-  expect_model_error_at([&] { study_operating_point(m, "equilibrium"); }, "/analysis/operating_point", "held: pivot");
+  expect_not_converged([&] { study_operating_point(m, "equilibrium"); },
+                       {"/analysis/operating_point", "held: pivot", "residual accelerations are 3.97527 (tolerance 1e-08; largest on pivot)",
+                        "free inputs (none), free coordinates (none)", "free an input: free_inputs / --free-input torque"});
   // held upright (the com straight above the pivot) it is one, to the bit
   spec.analysis.set = {{"pivot", M_PI / 2}};
   const OperatingPoint eq = study_operating_point(study_model(spec), "equilibrium");
@@ -308,7 +324,7 @@ TEST(Workflow, TrimAgainstABindingLimitNamesIt) {
   try {
     study_operating_point(limited);
     FAIL() << "a trim beyond the limit was accepted";
-  } catch (const std::invalid_argument& e) {
+  } catch (const ConvergenceError& e) {
     EXPECT_NE(std::string(e.what()).find("torque = 93.7"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("above its max 50"), std::string::npos) << e.what();
   }
@@ -448,4 +464,77 @@ TEST(Workflow, LqrOnTheControllablePartOfASphericalPendulum) {
               r.y(N - 1, 0), r.y(N - 1, 1), r.t.back(), r.u.cwiseAbs().maxCoeff());
   EXPECT_GT(std::hypot(r.y(0, 0), r.y(0, 1)), 0.1);
   for (int k = N - 100; k < N; ++k) EXPECT_LT(std::hypot(r.y(k, 0), r.y(k, 1)), 1e-4) << r.t[k];
+}
+
+// The simulation's initial state is kept apart from the operating point (issue 21): the run
+// starts where `initial` says, the operating point is searched from the model's own state.
+TEST(Workflow, InitialStateApartFromTheOperatingPoint) {
+  ModelSpec spec = example_spec("pendulum.json");
+  const double q_model = spec.joints[0].q0[0];
+  spec.analysis.initial = {{"pivot", 0.6}, {"pivot_dot", -0.25}};
+  const Model m = study_model(spec);
+  EXPECT_EQ(m.q0[0], q_model);  // the model's state (and so the search's start) is untouched
+  const StudyInitialState start = study_initial_state(m);
+  EXPECT_TRUE(start.given);
+  EXPECT_EQ(start.q[0], 0.6);
+  EXPECT_EQ(start.v[0], -0.25);
+  const OperatingPoint eq = study_operating_point(m, "equilibrium");
+  EXPECT_NEAR(eq.q[0], M_PI / 2, 1e-12);
+  EXPECT_EQ(study_operating_point(m, "initial").q[0], q_model);
+  const StudySimulation setup = study_simulation(m);
+  ASSERT_TRUE(setup.plant);
+  EXPECT_NEAR(setup.plant->op.q[0], M_PI / 2, 1e-12);
+  ASSERT_EQ(setup.options.q0.size(), 1);
+  EXPECT_EQ(setup.options.q0[0], 0.6);
+  EXPECT_EQ(setup.options.v0[0], -0.25);
+  // without it a run starts at the model's state (the options leave the start to the model)
+  spec.analysis.initial.clear();
+  EXPECT_EQ(study_simulation(study_model(spec)).options.q0.size(), 0);
+  // unknown names are refused at their field, with the names there are
+  spec.analysis.initial = {{"pivto", 0.6}};
+  expect_model_error_at([&] { study_model(spec); }, "/analysis/initial/pivto", "positions: pivot; rates: pivot");
+  // the model file carries it and reads it back
+  spec.analysis.initial = {{"pivot", 0.6}};
+  const ModelSpec back = parse_model_spec(to_json(spec), "p.json");
+  EXPECT_EQ(back.analysis.initial, spec.analysis.initial);
+}
+
+// On a closed loop the initial coordinates are held while the loops close, exactly as held
+// coordinates are; the operating point does not move with them.
+TEST(Workflow, InitialStateOnALoopIsAssembledAroundTheNamedCoordinate) {
+  ModelSpec spec = example_spec("four_bar.json");
+  spec.analysis.set = {{"pivot_A", 1.3}};
+  const Model held = study_model(spec);
+  spec.analysis.set.clear();
+  spec.analysis.initial = {{"pivot_A", 1.3}};
+  const Model m = study_model(spec);
+  const StudyInitialState start = study_initial_state(m);
+  EXPECT_EQ(start.q, held.q0);  // the same assembly, to the bit
+  EXPECT_EQ(start.q[m.joints[m.find_joint("pivot_A")].idx_q], 1.3);
+  spec.analysis.initial.clear();
+  const Model plain = study_model(spec);
+  EXPECT_EQ(study_operating_point(m, "equilibrium").q, study_operating_point(plain, "equilibrium").q);
+}
+
+// A trim the inputs cannot make (a rod tilted on a cart, only the cart's force) is not a best
+// effort any more: a ConvergenceError naming the residual, the unknowns and what to free.
+TEST(Workflow, TrimThatDoesNotConvergeIsAnError) {
+  ModelSpec spec = load_model_spec(std::string(CODYNA_TEST_DATA_DIR) + "/trim_underactuated.json");
+  spec.analysis.operating_point = "trim";
+  const Model m = study_model(spec);
+  expect_not_converged([&] { study_operating_point(m); },
+                       {"/analysis/operating_point: trim: not converged", "largest on slider",
+                        "free inputs push, free coordinates (none); held: slider, tilt", "trim_free / --trim-free"});
+  expect_not_converged([&] { study_linearize(m); }, {"trim: not converged"});
+  // a run with nothing linear needs no operating point; one that compares with the linear loop does
+  EXPECT_FALSE(study_simulation(m).plant);
+  ModelSpec compared = spec;
+  compared.analysis.compare_linear = true;
+  const Model mc = study_model(compared);
+  expect_not_converged([&] { study_simulation(mc); }, {"trim: not converged"});
+  // the tilt freed: the upright trim
+  spec.analysis.trim_free = {"tilt"};
+  const OperatingPoint op = study_operating_point(study_model(spec));
+  EXPECT_LT(op.residual, 1e-10);
+  EXPECT_NEAR(op.q[1], 0.0, 1e-10);
 }
