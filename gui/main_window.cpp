@@ -105,7 +105,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
   centre->addWidget(tabs_);
   centre->setStretchFactor(0, 1);
   centre->setStretchFactor(1, 1);
-  centre->setSizes({470, 430});
+  centre->setSizes({330, 570});  // the analysis views hold tables and plots: the larger share
   setCentralWidget(centre);
 
   // left: model tree + properties
@@ -147,7 +147,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
   msg_dock->setObjectName("messageDock");
   msg_dock->setWidget(messages_);
   addDockWidget(Qt::BottomDockWidgetArea, msg_dock);
-  resizeDocks({left_dock, in_dock}, {320, 320}, Qt::Horizontal);
+  resizeDocks({left_dock, in_dock}, {290, 310}, Qt::Horizontal);
   resizeDocks({msg_dock}, {90}, Qt::Vertical);
 
   buildMenus();

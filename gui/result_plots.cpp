@@ -146,7 +146,7 @@ ResultPlots::ResultPlots(QWidget* parent)
   updateTimeAxis(1.0);
   updateYRange(in_, true);
   updateYRange(out_, true);
-  setMinimumSize(240, 160);  // the window fits 1024 x 700
+  setMinimumSize(240, 180);  // the window fits 1024 x 700
 }
 
 ResultPlots::~ResultPlots() = default;
@@ -189,7 +189,7 @@ void ResultPlots::buildPanel(Panel& p, const QString& title) {
   p.view = new ChartView(p.chart);  // takes ownership of the chart; zoom, pan, readout, copy
   p.view->setRenderHint(QPainter::Antialiasing, true);
   p.view->setRenderHint(QPainter::TextAntialiasing, true);
-  p.view->setMinimumHeight(70);
+  p.view->setMinimumHeight(85);
   p.view->setBackgroundBrush(Qt::white);
   p.view->setFrameShape(QFrame::NoFrame);
 

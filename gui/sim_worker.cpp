@@ -7,6 +7,10 @@
 
 namespace codyna::gui {
 
+namespace {
+constexpr double kMaxSamples = 1e6;
+}  // namespace
+
 SimWorker::SimWorker(QObject* parent) : QObject(parent) {
   qRegisterMetaType<codyna::gui::SampleBatch>("codyna::gui::SampleBatch");
   qRegisterMetaType<std::shared_ptr<const codyna::SimulationResult>>("std::shared_ptr<const codyna::SimulationResult>");
@@ -90,6 +94,9 @@ void SimWorker::runJob(std::shared_ptr<const codyna::Model> model) {
   // a Cancel pressed while the setup ran (it cannot be interrupted: the operating-point search,
   // a time=T pre-run) takes effect here, before the run starts
   if (cancel_.load()) return fail(QStringLiteral("cancelled during the setup (operating point, controller design)"));
+  // the window keeps a run several times (plots, the signal list, runs kept for comparison):
+  // it records at most kMaxSamples samples; longer records are the command line's (codyna simulate)
+  if (setup.options.max_samples > kMaxSamples) setup.options.max_samples = kMaxSamples;
   const QString source = QString::fromStdString(setup.controller_source);
   QStringList notes;
   for (const std::string& n : setup.notes) notes << QString::fromStdString(n);

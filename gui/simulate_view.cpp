@@ -37,6 +37,7 @@ namespace codyna::gui {
 namespace {
 
 constexpr int kMergeTEnd = 0x53490001;
+constexpr int kMergeInitial = 0x53490a;  // values stepped in the initial-state table
 constexpr int kMergeOutputStep = 0x53490002;
 constexpr int kMergeTracking = 0x53490003;
 constexpr int kMergeReferences = 0x53490004;    // numbers stepped in the references table
@@ -121,9 +122,22 @@ SimulateView::SimulateView(Document* doc, QWidget* parent) : QWidget(parent), do
   });
   connect(doc_, &Document::specChanged, this, &SimulateView::refreshFromDocument);
   connect(doc_, &Document::replaced, this, &SimulateView::clearResult);
-  connect(doc_, &Document::modelChanged, this, &SimulateView::updateStaleness);
+  connect(doc_, &Document::modelChanged, this, [this] {
+    updateStaleness();
+    refreshInitialChoices();
+  });
   refreshFromDocument();
   setRunning(false);
+}
+
+void SimulateView::refreshInitialChoices() {
+  // the names offered: the compiled model's coordinates and rates (kept while it does not compile)
+  const auto m = doc_->model();
+  if (!m) return;
+  QStringList coords;
+  for (const auto& q : m->q_names) coords << qs(q);
+  for (const auto& v : m->v_names) coords << (std::count(m->q_names.begin(), m->q_names.end(), v) ? qs(v + "_dot") : qs(v));
+  initial_->setChoices(coords);
 }
 
 bool SimulateView::isStale() const { return result_ && result_model_ != doc_->model(); }
@@ -241,6 +255,12 @@ void SimulateView::buildUi() {
   t_end_->setSuffix(QStringLiteral(" s"));
   t_end_->setKeyboardTracking(false);
   form->addRow(tr("End time"), t_end_);
+  initial_ = new NameValueTable(tr("Coordinate"), tr("Start value (m, rad, /s)"), solver_box);
+  initial_->setObjectName("initialState");
+  initial_->setToolTip(tr("Where the run starts, apart from the operating point (the file's analysis.initial, "
+                          "codyna simulate --initial): coordinates and rates (NAME_dot) set on the model's state, "
+                          "the loops closed with them held. The operating point is searched as before."));
+  form->addRow(tr("Initial state"), initial_);
   output_step_ = new QDoubleSpinBox(solver_box);
   output_step_->setRange(1e-6, 1e5);
   output_step_->setDecimals(6);
@@ -330,6 +350,7 @@ void SimulateView::buildUi() {
   right->addWidget(signals_box);
   right->setStretchFactor(0, 1);
   right->setStretchFactor(1, 0);
+  right->setSizes({400, 120});  // the plots first; the reference and disturbance tables below, smaller
   auto* left_scroll = new QScrollArea(this);
   left_scroll->setWidget(left);
   left_scroll->setWidgetResizable(true);
@@ -361,6 +382,10 @@ void SimulateView::buildUi() {
   connect(file_browse_, &QPushButton::clicked, this, &SimulateView::browseControllerFile);
   connect(q_weights_, &QLineEdit::editingFinished, this, [this] { weightsEdited(true); });
   connect(r_weights_, &QLineEdit::editingFinished, this, [this] { weightsEdited(false); });
+  connect(initial_, &NameValueTable::edited, this, [this](bool number) {
+    const auto v = initial_->pairs();
+    writeStudyChecked([&](StudySpec& s) { s.initial = v; }, tr("Change the initial state"), number ? kMergeInitial : -1);
+  });
   connect(t_end_, &QDoubleSpinBox::valueChanged, this, [this](double v) {
     writeSolver([&](SolverSpec& s) { s.t_end = v; }, tr("Change the end time"), kMergeTEnd);
   });
@@ -492,6 +517,8 @@ void SimulateView::refreshFromDocument() {
   const ModelSpec& spec = doc_->spec();
   const StudySpec& st = spec.analysis;
   const SolverSpec& so = spec.solver;
+  refreshInitialChoices();
+  initial_->setPairs(st.initial);
   {
     const QSignalBlocker b(controller_combo_);
     const int i = controller_combo_->findData(qs(st.controller));

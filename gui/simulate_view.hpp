@@ -55,6 +55,7 @@ namespace codyna::gui {
 class Document;
 class ResultPlots;
 class SignalPlot;
+class NameValueTable;
 class SignalTable;
 
 class SimulateView : public QWidget {
@@ -77,6 +78,7 @@ class SimulateView : public QWidget {
   std::shared_ptr<const codyna::Model> resultModel() const { return result_model_; }
   ResultPlots* plots() const { return plots_; }
   SignalPlot* signalPlot() const { return signal_plot_; }
+  NameValueTable* initialStateTable() const { return initial_; }
   // isStale(): the document's model changed since the run (the results stay, marked).
   bool isStale() const;
   // Forgets the result (the document now holds another model); a running simulation is cancelled.
@@ -143,12 +145,14 @@ class SimulateView : public QWidget {
   void restorePlotLimit();
   void saveResultsDialog();
   void updateStaleness();
+  void refreshInitialChoices();
   void savePlotDialog();
 
   Document* doc_;
   SimWorker* worker_ = nullptr;
   ResultPlots* plots_ = nullptr;
   SignalPlot* signal_plot_ = nullptr;
+  NameValueTable* initial_ = nullptr;
   QTabWidget* plot_tabs_ = nullptr;
   std::shared_ptr<const codyna::SimulationResult> result_;
   std::shared_ptr<const codyna::Model> result_model_;  // the model of the run (current or last)

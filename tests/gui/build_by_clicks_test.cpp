@@ -20,6 +20,7 @@
 #include <QUndoStack>
 #include <Eigen/Eigenvalues>
 
+#include "drive.hpp"
 #include "gui/linearize_view.hpp"
 #include "gui/main_window.hpp"
 #include "gui/plant_panel.hpp"
@@ -31,29 +32,6 @@ using namespace codyna;
 using namespace codyna::gui;
 
 namespace {
-
-QAbstractItemView* openPopup(QComboBox* c) {
-  QTest::mouseClick(c, Qt::LeftButton, {}, QPoint(c->width() - 6, c->height() / 2));
-  QAbstractItemView* v = c->view();
-  if (!QTest::qWaitFor([v] { return v->isVisible(); }, 2000)) return nullptr;
-  QTest::qWait(QApplication::doubleClickInterval() + 50);
-  return v;
-}
-
-// picks the entry that starts with `text` from the drop-down's open list, with the keys
-bool pick(QComboBox* c, const QString& text) {
-  if (!c) return false;
-  int row = -1;
-  for (int i = 0; i < c->count() && row < 0; ++i)
-    if (c->itemText(i) == text || c->itemText(i).startsWith(text + " ")) row = i;
-  if (row < 0) return false;
-  QAbstractItemView* v = openPopup(c);
-  if (!v) return false;
-  for (int guard = 0; v->currentIndex().row() != row && guard < 50; ++guard)
-    QTest::keyClick(v, v->currentIndex().row() < row ? Qt::Key_Down : Qt::Key_Up);
-  QTest::keyClick(v, Qt::Key_Return);
-  return QTest::qWaitFor([v] { return !v->isVisible(); }, 2000) && c->currentIndex() == row;
-}
 
 void toggle(PlantPanel* p, const QString& name) {
   QTreeView* v = p->view();
@@ -102,7 +80,7 @@ class BuildByClicksTest : public QObject {
 
   void choose(const QString& field, const QString& text) {
     const int before = w->document()->undoStack()->count();
-    QVERIFY2(pick(qobject_cast<QComboBox*>(props()->editorFor(field)), text), qPrintable(field + " <- " + text));
+    QVERIFY2(drive::pickWithKeys(qobject_cast<QComboBox*>(props()->editorFor(field)), text), qPrintable(field + " <- " + text));
     QCOMPARE(w->document()->undoStack()->count(), before + 1);
   }
 
@@ -116,18 +94,10 @@ class BuildByClicksTest : public QObject {
 
  private slots:
   void init() {
-    QCoreApplication::setOrganizationName("codyna-test");
-    QCoreApplication::setApplicationName("build_by_clicks_test");
-    w = std::make_unique<MainWindow>();
-    w->setQuestionHook([](const QString&, const QString&, int) { return int(QMessageBox::Discard); });
-    w->setFileHook([](const QString&, const QString&, const QString&, bool) { return QString(); });
-    w->show();
-    QVERIFY(QTest::qWaitForWindowExposed(w.get()));
+    w = drive::window("build_by_clicks_test");
+    QVERIFY(w);
   }
-  void cleanup() {
-    w->document()->undoStack()->setClean();
-    w.reset();
-  }
+  void cleanup() { drive::close(w); }
 
   void doublePendulumOnACartFromNew() {
     QVERIFY(w->newModel());
@@ -178,7 +148,7 @@ class BuildByClicksTest : public QObject {
     // linearize at the upright equilibrium
     LinearizeView* lv = w->linearizeView();
     w->analysisTabs()->setCurrentWidget(lv);
-    QVERIFY(pick(lv->operatingPointCombo(), "equilibrium"));
+    QVERIFY(drive::pickWithKeys(lv->operatingPointCombo(), "equilibrium"));
     QCOMPARE(w->document()->spec().analysis.operating_point, std::string("equilibrium"));
     QTest::mouseClick(lv->linearizeButton(), Qt::LeftButton);
     QVERIFY(lv->result());

@@ -17,6 +17,7 @@
 #include <complex>
 #include <numbers>
 
+#include "drive.hpp"
 #include "gui/chart_view.hpp"
 #include "gui/control_view.hpp"
 #include "gui/main_window.hpp"
@@ -54,61 +55,11 @@ class ControlViewTest : public QObject {
 
  private slots:
   void init() {
-    QCoreApplication::setOrganizationName("codyna-test");
-    QCoreApplication::setApplicationName("control_view_test");
-    w = std::make_unique<MainWindow>();
-    w->setQuestionHook([](const QString&, const QString&, int) { return int(QMessageBox::Discard); });
-    w->setFileHook([](const QString&, const QString&, const QString&, bool) { return QString(); });
-    w->show();
-    QVERIFY(QTest::qWaitForWindowExposed(w.get()));
+    w = drive::window("control_view_test");
+    QVERIFY(w);
     QVERIFY(w->openFile(kCart));
   }
-  void cleanup() {
-    w->document()->undoStack()->setClean();
-    w.reset();
-  }
-
-  void bodeEqualsTheExportedMatrices() {
-    ControlView* cv = w->controlView();
-    w->analysisTabs()->setCurrentWidget(cv);
-    QTest::mouseClick(cv->analyseButton(), Qt::LeftButton);
-    QVERIFY(cv->system(ControlView::Plant));
-    cv->systemCombo()->setCurrentIndex(ControlView::Plant);
-    cv->inputCombo()->setCurrentText("force");
-    QCOMPARE(cv->inputCombo()->currentText(), QString("force"));
-
-    // the exported plant, by the command line
-    QTemporaryDir tmp;
-    QProcess cli;
-    cli.start(CODYNA_CLI, {"linearize", kCart, "--out", tmp.path()});
-    QVERIFY(cli.waitForFinished(60000));
-    QCOMPARE(cli.exitCode(), 0);
-    const MatVariables mat = read_mat_file((tmp.path() + "/cart_pendulum.mat").toStdString());
-    const Eigen::MatrixXd &A = mat.matrices.at("A"), &B = mat.matrices.at("B"), &C = mat.matrices.at("C"),
-                          &D = mat.matrices.at("D");
-    const std::vector<std::string>& outs = mat.strings.at("output_names");
-    const std::vector<std::string>& ins = mat.strings.at("input_names");
-    QCOMPARE(ins.at(0), std::string("force"));
-    QVERIFY(outs.size() >= 2);
-    for (int o = 0; o < static_cast<int>(outs.size()); ++o) {
-      cv->outputCombo()->setCurrentText(QString::fromStdString(outs[o]));
-      const QList<QPointF> mag = cv->magnitudePoints(), ph = cv->phasePoints();
-      QVERIFY(mag.size() > 100);
-      QCOMPARE(ph.size(), mag.size());
-      // three frequencies: low, middle, high
-      for (int k : {2, int(mag.size()) / 2, int(mag.size()) - 3}) {
-        const double wk = mag[k].x();
-        const std::complex<double> h = transfer(A, B, C, D, o, 0, wk);
-        const double db = 20 * std::log10(std::abs(h));
-        QVERIFY2(std::abs(mag[k].y() - db) <= 1e-9 * std::max(1.0, std::abs(db)),
-                 qPrintable(QString("%1 at w = %2: %3 dB, expected %4").arg(QString::fromStdString(outs[o])).arg(wk).arg(mag[k].y()).arg(db)));
-        const double deg = std::arg(h) * 180 / std::numbers::pi;
-        QVERIFY2(std::abs(angleDiff(ph[k].y(), deg)) <= 1e-7,
-                 qPrintable(QString("phase at w = %1: %2, expected %3 (mod 360)").arg(wk).arg(ph[k].y()).arg(deg)));
-        QCOMPARE(ph[k].x(), wk);
-      }
-    }
-  }
+  void cleanup() { drive::close(w); }
 
   // the charts zoom by a dragged rectangle and back by a double click, read the value under the pointer,
   // and copy their curves as CSV

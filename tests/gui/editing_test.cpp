@@ -28,6 +28,7 @@
 #include <QSlider>
 #include <QSplitter>
 #include <QTableView>
+#include <QTableWidget>
 #include <QTemporaryDir>
 
 #include <QAction>
@@ -41,6 +42,7 @@
 #include "analysis/modal.hpp"
 #include "gui/control_view.hpp"
 #include "gui/linearize_view.hpp"
+#include "drive.hpp"
 #include "gui/main_window.hpp"
 #include "gui/matrix_models.hpp"
 #include "gui/matrix_view.hpp"
@@ -49,54 +51,15 @@
 #include "gui/result_plots.hpp"
 #include "gui/signal_plot.hpp"
 #include "gui/simulate_view.hpp"
+#include "gui/study_widgets.hpp"
 
 using namespace codyna;
 using namespace codyna::gui;
+using namespace codyna::gui::drive;
 
 namespace {
 
 // opens `c`'s list with a click on its arrow, as a person does
-QAbstractItemView* openPopup(QComboBox* c) {
-  QTest::mouseClick(c, Qt::LeftButton, {}, QPoint(c->width() - 6, c->height() / 2));
-  QAbstractItemView* v = c->view();
-  if (!QTest::qWaitFor([v] { return v->isVisible(); }, 2000)) return nullptr;
-  // a release right after the opening press is ignored by the popup: wait as a person would
-  QTest::qWait(QApplication::doubleClickInterval() + 50);
-  return v;
-}
-
-// picks `text` from `c`'s open list with the mouse: move onto the item, click it
-bool pickWithMouse(QComboBox* c, const QString& text) {
-  QAbstractItemView* v = openPopup(c);
-  if (!v) return false;
-  const int row = c->findText(text);
-  if (row < 0) return false;
-  const QPoint at = v->visualRect(v->model()->index(row, c->modelColumn())).center();
-  QTest::mouseMove(v->viewport(), at);
-  QTest::mouseClick(v->viewport(), Qt::LeftButton, {}, at);
-  return QTest::qWaitFor([v] { return !v->isVisible(); }, 2000);
-}
-
-// picks `text` from `c`'s open list with the arrow keys and Enter
-bool pickWithKeys(QComboBox* c, const QString& text) {
-  QAbstractItemView* v = openPopup(c);
-  if (!v) return false;
-  const int row = c->findText(text);
-  if (row < 0) return false;
-  for (int guard = 0; v->currentIndex().row() != row && guard < 50; ++guard)
-    QTest::keyClick(v, v->currentIndex().row() < row ? Qt::Key_Down : Qt::Key_Up);
-  QTest::keyClick(v, Qt::Key_Return);
-  return QTest::qWaitFor([v] { return !v->isVisible(); }, 2000);
-}
-
-// a wheel notch over the middle of `w` (delivered as Qt delivers one: to the widget under the mouse)
-void wheelOver(QWidget* w, int notches) {
-  const QPointF at(w->width() / 2.0, w->height() / 2.0);
-  QWheelEvent e(at, w->mapToGlobal(at), QPoint(), QPoint(0, 120 * notches), Qt::NoButton, Qt::NoModifier,
-                Qt::NoScrollPhase, false);
-  QApplication::sendEvent(w, &e);
-}
-
 const QString kCart = QStringLiteral(CODYNA_EXAMPLES_DIR "/cart_pendulum.json");
 const QString kPendulum = QStringLiteral(CODYNA_EXAMPLES_DIR "/pendulum.json");
 
@@ -170,18 +133,10 @@ class EditingTest : public QObject {
 
  private slots:
   void init() {
-    QCoreApplication::setOrganizationName("codyna-test");
-    QCoreApplication::setApplicationName("editing_test");
-    w = std::make_unique<MainWindow>();
-    w->setQuestionHook([](const QString&, const QString&, int) { return int(QMessageBox::Discard); });
-    w->setFileHook([](const QString&, const QString&, const QString&, bool) { return QString(); });
-    w->show();
-    QVERIFY(QTest::qWaitForWindowExposed(w.get()));
+    w = drive::window("editing_test");
+    QVERIFY(w);
   }
-  void cleanup() {
-    w->document()->undoStack()->setClean();
-    w.reset();
-  }
+  void cleanup() { drive::close(w); }
 
   // the issue's reproduction: a joint's parent set from the drop-down's list with the mouse
   void parentPickedWithTheMouseChainsTheJoint() {
@@ -421,6 +376,7 @@ class EditingTest : public QObject {
     QTest::keyClick(w.get(), Qt::Key_F5);
     QTRY_VERIFY(w->simulateView()->isRunning() || finished.count() > 0);
     QVERIFY(cancel->isEnabled() && !run->isEnabled());
+    QTRY_VERIFY(w->simulateView()->progressBar()->value() > 0);  // integrating (a Cancel in the setup leaves no result)
     cancel->trigger();
     QTRY_VERIFY_WITH_TIMEOUT(finished.count() == 1, 30000);
     QVERIFY(w->simulateView()->result() && w->simulateView()->result()->cancelled);
@@ -556,6 +512,44 @@ class EditingTest : public QObject {
     QVERIFY(w->newModel());
     QCOMPARE(sp->keptCount(), 0);
     QCOMPARE(sp->curveCount(), 0);
+  }
+
+  // the run's initial state apart from the operating point (issue 21, in the Simulate view)
+  void initialStateApartFromTheOperatingPoint() {
+    QVERIFY(w->openFile(kCart));
+    SimulateView* sv = w->simulateView();
+    w->analysisTabs()->setCurrentWidget(sv);
+    NameValueTable* init = sv->initialStateTable();
+    QTest::mouseClick(init->addButton(), Qt::LeftButton);
+    QCOMPARE(init->table()->rowCount(), 1);
+    init->nameCombo(0)->setCurrentIndex(init->nameCombo(0)->findText("rod_pivot"));
+    init->valueSpin(0)->setValue(0.2);
+    const auto& initial = w->document()->spec().analysis.initial;
+    QCOMPARE(initial.size(), std::size_t(1));
+    QCOMPARE(QString::fromStdString(initial[0].first), QString("rod_pivot"));
+    QCOMPARE(initial[0].second, 0.2);
+    sv->endTimeSpin()->setValue(0.2);
+    QSignalSpy finished(sv, &SimulateView::runFinished);
+    QTest::mouseClick(sv->runButton(), Qt::LeftButton);
+    QVERIFY(QTest::qWaitFor([&] { return finished.count() == 1; }, 60000));
+    QVERIFY(sv->result() && sv->result()->completed);
+    QCOMPARE(sv->result()->q(0, 1), 0.2);  // the run starts at the initial state
+    QVERIFY(w->linearizeView()->linearize());
+    QVERIFY(std::abs(w->linearizeView()->result()->op.q[1]) < 1e-9);  // the operating point is still upright
+  }
+
+  // a run the window could not hold is refused before it starts, with the numbers (the monkey test
+  // once filled 24 GB with runs of ten million samples)
+  void aRunTooLongToHoldIsRefused() {
+    QVERIFY(w->openFile(kCart));
+    SimulateView* sv = w->simulateView();
+    sv->endTimeSpin()->setValue(30000);  // at the example's 0.01 s output step: 3,000,001 samples
+    QSignalSpy finished(sv, &SimulateView::runFinished);
+    QTest::mouseClick(sv->runButton(), Qt::LeftButton);
+    QVERIFY(QTest::qWaitFor([&] { return finished.count() == 1; }, 60000));
+    QVERIFY(!sv->result());
+    QVERIFY2(sv->statusText().contains("more than the limit of 1e+06"), qPrintable(sv->statusText()));
+    QVERIFY(sv->runButton()->isEnabled());
   }
 
   // a wheel turned over a field that was not clicked into scrolls, and changes nothing

@@ -1,0 +1,90 @@
+// Driving codyna-gui's widgets as a person does, for the GUI tests: drop-downs
+// opened with a click on their arrow and an entry picked from the open list with
+// the mouse or the arrow keys, the window made and closed with its dialogs
+// answered, wheel notches delivered to the widget under the pointer.
+#pragma once
+
+#include <QAbstractItemView>
+#include <QApplication>
+#include <QComboBox>
+#include <QMessageBox>
+#include <QTest>
+#include <QUndoStack>
+#include <QWheelEvent>
+#include <memory>
+
+#include "gui/main_window.hpp"
+
+namespace codyna::gui::drive {
+
+// opens `c`'s list with a click on its arrow
+inline QAbstractItemView* openPopup(QComboBox* c) {
+  QTest::mouseClick(c, Qt::LeftButton, {}, QPoint(c->width() - 6, c->height() / 2));
+  QAbstractItemView* v = c->view();
+  if (!QTest::qWaitFor([v] { return v->isVisible(); }, 2000)) return nullptr;
+  // a release right after the opening press is ignored by the popup: wait as a person would
+  QTest::qWait(QApplication::doubleClickInterval() + 50);
+  return v;
+}
+
+// the row of `text` in `c`: the entry itself, or the one that starts with "text " (a label with a note)
+inline int rowOf(const QComboBox* c, const QString& text) {
+  for (int i = 0; i < c->count(); ++i)
+    if (c->itemText(i) == text || c->itemText(i).startsWith(text + " ")) return i;
+  return -1;
+}
+
+// picks `text` from `c`'s open list with the mouse: move onto the item, click it
+inline bool pickWithMouse(QComboBox* c, const QString& text) {
+  if (!c) return false;
+  const int row = rowOf(c, text);
+  if (row < 0) return false;
+  QAbstractItemView* v = openPopup(c);
+  if (!v) return false;
+  const QPoint at = v->visualRect(v->model()->index(row, c->modelColumn())).center();
+  QTest::mouseMove(v->viewport(), at);
+  QTest::mouseClick(v->viewport(), Qt::LeftButton, {}, at);
+  return QTest::qWaitFor([v] { return !v->isVisible(); }, 2000);
+}
+
+// picks `text` from `c`'s open list with the arrow keys and Enter
+inline bool pickWithKeys(QComboBox* c, const QString& text) {
+  if (!c) return false;
+  const int row = rowOf(c, text);
+  if (row < 0) return false;
+  QAbstractItemView* v = openPopup(c);
+  if (!v) return false;
+  for (int guard = 0; v->currentIndex().row() != row && guard < 50; ++guard)
+    QTest::keyClick(v, v->currentIndex().row() < row ? Qt::Key_Down : Qt::Key_Up);
+  QTest::keyClick(v, Qt::Key_Return);
+  return QTest::qWaitFor([v] { return !v->isVisible(); }, 2000);
+}
+
+// a wheel notch over the middle of `w` (delivered as Qt delivers one: to the widget under the mouse)
+inline void wheelOver(QWidget* w, int notches) {
+  const QPointF at(w->width() / 2.0, w->height() / 2.0);
+  QWheelEvent e(at, w->mapToGlobal(at), QPoint(), QPoint(0, 120 * notches), Qt::NoButton, Qt::NoModifier,
+                Qt::NoScrollPhase, false);
+  QApplication::sendEvent(w, &e);
+}
+
+// a shown main window whose questions answer Discard and whose file dialogs are cancelled
+inline std::unique_ptr<MainWindow> window(const char* testName) {
+  QCoreApplication::setOrganizationName("codyna-test");
+  QCoreApplication::setApplicationName(testName);
+  auto w = std::make_unique<MainWindow>();
+  w->setQuestionHook([](const QString&, const QString&, int) { return int(QMessageBox::Discard); });
+  w->setFileHook([](const QString&, const QString&, const QString&, bool) { return QString(); });
+  w->show();
+  if (!QTest::qWaitForWindowExposed(w.get())) return nullptr;
+  return w;
+}
+
+// closes it without a question
+inline void close(std::unique_ptr<MainWindow>& w) {
+  if (!w) return;
+  w->document()->undoStack()->setClean();
+  w.reset();
+}
+
+}  // namespace codyna::gui::drive
