@@ -291,7 +291,8 @@ bool adopt_controller_study(ModelSpec& spec, const std::string& file) {
     // a coordinate held by the study (analysis set, --hold / --set) must be one the controller's
     // own point holds, at the same value: the controller is applied about that point only
     for (const auto& [name, value] : s.set) {
-      const auto it = std::find_if(carried.begin(), carried.end(), [&](const auto& c) { return c.first == name; });
+      const std::string& held = name;  // a structured binding cannot be captured by clang 14's lambdas
+      const auto it = std::find_if(carried.begin(), carried.end(), [&](const auto& c) { return c.first == held; });
       if (it != carried.end() && it->second == value) continue;
       std::ostringstream os;
       os.precision(17);
