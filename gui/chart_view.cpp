@@ -6,9 +6,13 @@
 #include <QContextMenuEvent>
 #include <QLabel>
 #include <QLineSeries>
+#include <QLogValueAxis>
+#include <QValueAxis>
 #include <QMenu>
 #include <QMouseEvent>
 #include <QWheelEvent>
+#include <cmath>
+#include <limits>
 #include <map>
 
 namespace codyna::gui {
@@ -28,8 +32,77 @@ ChartView::ChartView(QChart* chart, QWidget* parent) : QChartView(chart, parent)
 
 bool ChartView::isZoomed() const { return chart() && chart()->isZoomed(); }
 
+namespace {
+
+// QValueAxis with dynamic ticks keeps its tick interval whatever the range: a view
+// zoomed out a hundred times would lay out 1.25^100 labels (the monkey test once
+// asked for 32 GB that way), and a reset from a deep zoom as many. Before a zoom
+// the interval is made coarser than any range, after it a round step with about
+// five ticks is chosen for the new range.
+QList<QValueAxis*> dynamicAxes(QChart* chart) {
+  QList<QValueAxis*> out;
+  if (!chart) return out;
+  for (QAbstractAxis* a : chart->axes())
+    if (auto* v = qobject_cast<QValueAxis*>(a); v && v->tickType() == QValueAxis::TicksDynamic) out << v;
+  return out;
+}
+
+struct SavedTicks {
+  QValueAxis* axis;
+  double min, max, interval;
+};
+
+QList<SavedTicks> coarsenTicks(QChart* chart) {
+  QList<SavedTicks> saved;
+  for (QValueAxis* v : dynamicAxes(chart)) {
+    saved << SavedTicks{v, v->min(), v->max(), v->tickInterval()};
+    v->setTickInterval(std::numeric_limits<double>::max() / 4);
+  }
+  return saved;
+}
+
+// an axis whose range did not change gets its own interval back, the others a round step
+void refitTicks(const QList<SavedTicks>& saved) {
+  for (const SavedTicks& s : saved)
+    s.axis->setTickInterval(s.axis->min() == s.min && s.axis->max() == s.max
+                                ? s.interval
+                                : ChartView::roundStep(s.axis->max() - s.axis->min(), 5));
+}
+
+}  // namespace
+
+double ChartView::roundStep(double width, int ticks) {
+  if (!(width > 0.0) || !std::isfinite(width) || ticks < 1) return 1.0;
+  const double raw = width / ticks, p10 = std::pow(10.0, std::floor(std::log10(raw)));
+  const double f = raw / p10;
+  return (f < 1.5 ? 1.0 : f < 3.5 ? 2.0 : f < 7.5 ? 5.0 : 10.0) * p10;
+}
+
+void ChartView::fitTicks() {
+  for (QValueAxis* v : dynamicAxes(chart())) v->setTickInterval(roundStep(v->max() - v->min(), 5));
+}
+
+bool ChartView::canZoom(double factor) const {
+  if (!chart()) return false;
+  for (QAbstractAxis* a : chart()->axes()) {
+    if (auto* v = qobject_cast<QValueAxis*>(a)) {
+      const double w = v->max() - v->min(), size = std::max(std::abs(v->min()), std::abs(v->max()));
+      if (factor < 1.0 && (w > 1e12 || size > 1e12)) return false;                  // far enough out
+      if (factor > 1.0 && (w < 1e-9 * size || w < 1e-200)) return false;           // the digits run out
+    } else if (auto* l = qobject_cast<QLogValueAxis*>(a)) {
+      const double decades = std::log10(l->max()) - std::log10(l->min());
+      if (factor < 1.0 && (decades > 30 || l->min() < 1e-100 || l->max() > 1e100)) return false;
+      if (factor > 1.0 && decades < 1e-6) return false;
+    }
+  }
+  return true;
+}
+
 void ChartView::resetZoom() {
-  if (chart()) chart()->zoomReset();
+  if (!chart()) return;
+  const auto saved = coarsenTicks(chart());
+  chart()->zoomReset();
+  refitTicks(saved);
 }
 
 void ChartView::mousePressEvent(QMouseEvent* e) {
@@ -66,6 +139,13 @@ void ChartView::mouseReleaseEvent(QMouseEvent* e) {
     e->accept();
     return;
   }
+  // a left release may end a rubber-band zoom
+  if (e->button() == Qt::LeftButton && chart()) {
+    const auto saved = coarsenTicks(chart());
+    QChartView::mouseReleaseEvent(e);
+    refitTicks(saved);
+    return;
+  }
   QChartView::mouseReleaseEvent(e);
 }
 
@@ -82,8 +162,11 @@ void ChartView::wheelEvent(QWheelEvent* e) {
   const QPointF at = chart()->mapFromScene(mapToScene(e->position().toPoint()));
   QRectF r(area.topLeft(), area.size() / factor);
   r.moveCenter(at - (at - area.center()) / factor);
-  chart()->zoomIn(r);
   e->accept();
+  if (!canZoom(factor)) return;
+  const auto saved = coarsenTicks(chart());
+  chart()->zoomIn(r);
+  refitTicks(saved);
 }
 
 void ChartView::leaveEvent(QEvent* e) {

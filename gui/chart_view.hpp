@@ -21,6 +21,12 @@ class ChartView : public QChartView {
   QString readout() const;  // what the corner shows ("" outside the plot area)
   bool isZoomed() const;
   void resetZoom();
+  // after a zoom, every axis with dynamic ticks gets a round step (1, 2 or 5 times a
+  // power of ten) with about five ticks; zooms stop at 1e12 wide (out) and at nine
+  // significant digits (in)
+  void fitTicks();
+  bool canZoom(double factor) const;  // factor > 1 zooms in
+  static double roundStep(double width, int ticks);
 
  protected:
   void mousePressEvent(QMouseEvent* e) override;

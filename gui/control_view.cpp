@@ -22,6 +22,7 @@
 #include "gui/document.hpp"
 #include "gui/matrix_models.hpp"
 #include "gui/matrix_view.hpp"
+#include "gui/result_plots.hpp"
 
 namespace codyna::gui {
 
@@ -417,13 +418,10 @@ void ControlView::redraw() {
     }
   }
   const double t_end = st->t.empty() ? 1.0 : st->t.back();
-  tx->setRange(0, t_end);
-  // ticks at round times (1, 2 or 5 times a power of ten), from 0
-  const double raw = t_end / 4, p10 = std::pow(10.0, std::floor(std::log10(raw)));
-  const double step = raw / p10 < 1.5 ? p10 : raw / p10 < 3.5 ? 2 * p10 : raw / p10 < 7.5 ? 5 * p10 : 10 * p10;
+  // ticks at round times (1, 2 or 5 times a power of ten), from 0; setAxisRange keeps the
+  // tick count bounded while the range changes
   tx->setTickType(QValueAxis::TicksDynamic);
-  tx->setTickAnchor(0);
-  tx->setTickInterval(step);
+  setAxisRange(tx, 0, t_end, ChartView::roundStep(t_end, 4));
   fitAxis(ty, ylo, yhi);
   step_chart_->setTitle(tr("Step on %1").arg(input_combo_->currentText()));
 }

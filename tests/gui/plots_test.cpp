@@ -14,6 +14,7 @@
 #include <QPainter>
 #include <QTemporaryDir>
 #include <QValueAxis>
+#include <QWheelEvent>
 #include <QtTest>
 #include <cmath>
 #include <numbers>
@@ -21,6 +22,7 @@
 #include "analysis/discretize.hpp"
 #include "analysis/linear_system.hpp"
 #include "analysis/modal.hpp"
+#include "gui/chart_view.hpp"
 #include "gui/matrix_models.hpp"
 #include "gui/pole_map.hpp"
 #include "gui/result_plots.hpp"
@@ -165,6 +167,7 @@ class PlotsTest : public QObject {
   void poleMapDiscrete();
   void matrixModel();
   void modeModel();
+  void zoomKeepsTicksBounded();
 };
 
 void PlotsTest::niceRanges() {
@@ -665,6 +668,65 @@ void PlotsTest::modeModel() {
   QVERIFY(model.data(model.index(0, 0), Qt::ToolTipRole).toString().contains("s = ln(z)/Ts = -0.2"));
   model.clear();
   QCOMPARE(model.rowCount(), 0);
+}
+
+// The wheel zooms a chart out and in a few hundred notches: the dynamic ticks follow
+// the range (at most 50 labels at any time; a fixed interval made 1.25^k labels, and
+// the monkey test ran out of memory on it), the zoom stops at 1e12 wide and at nine
+// digits, and a reset brings the first range back.
+void PlotsTest::zoomKeepsTicksBounded() {
+  auto* chart = new QChart;
+  chart->setAnimationOptions(QChart::NoAnimation);
+  auto* s = new QLineSeries;
+  for (int i = 0; i <= 100; ++i) s->append(0.1 * i, std::sin(0.1 * i));
+  chart->addSeries(s);
+  auto* x = new QValueAxis;
+  auto* y = new QValueAxis;
+  for (QValueAxis* a : {x, y}) {
+    a->setTickType(QValueAxis::TicksDynamic);
+    a->setTickAnchor(0.0);
+  }
+  chart->addAxis(x, Qt::AlignBottom);
+  chart->addAxis(y, Qt::AlignLeft);
+  s->attachAxis(x);
+  s->attachAxis(y);
+  codyna::gui::setAxisRange(x, 0, 10, 1);
+  codyna::gui::setAxisRange(y, -1, 1, 0.5);
+  codyna::gui::ChartView view(chart);
+  view.resize(600, 400);
+  view.show();
+  QVERIFY(QTest::qWaitForWindowExposed(&view));
+  const auto ticks = [](QValueAxis* a) { return (a->max() - a->min()) / a->tickInterval(); };
+  const auto wheel = [&](int delta) {
+    const QPointF at(300, 200);
+    QWheelEvent e(at, view.mapToGlobal(at), QPoint(), QPoint(0, delta), Qt::NoButton, Qt::NoModifier,
+                  Qt::NoScrollPhase, false);
+    QApplication::sendEvent(view.viewport(), &e);
+  };
+  // a click that is no drag leaves the ticks as the plot set them
+  QTest::mouseClick(view.viewport(), Qt::LeftButton, {}, QPoint(300, 200));
+  QCOMPARE(x->tickInterval(), 1.0);
+  for (int k = 0; k < 300; ++k) {
+    wheel(-120);
+    for (QValueAxis* a : {x, y}) {
+      QVERIFY2(std::isfinite(a->min()) && std::isfinite(a->max()), qPrintable(QString("notch %1").arg(k)));
+      QVERIFY2(ticks(a) <= 50 && ticks(a) >= 1, qPrintable(QString("notch %1: %2 ticks").arg(k).arg(ticks(a))));
+    }
+  }
+  QVERIFY(view.isZoomed());
+  QVERIFY(x->max() - x->min() > 1e11 && x->max() - x->min() < 1e13);  // stopped at 1e12, not before
+  view.resetZoom();
+  QVERIFY(std::abs(x->min()) < 1e-12 && std::abs(x->max() - 10) < 1e-12);
+  QVERIFY(ticks(x) <= 50 && ticks(x) >= 1);
+  for (int k = 0; k < 300; ++k) {
+    wheel(120);
+    for (QValueAxis* a : {x, y}) QVERIFY(ticks(a) <= 50 && ticks(a) >= 1);
+  }
+  const double w = x->max() - x->min(), size = std::max(std::abs(x->min()), std::abs(x->max()));
+  QVERIFY2(w > 1e-10 * size && w < 1e-8 * size, qPrintable(QString("width %1 at %2").arg(w).arg(size)));
+  view.resetZoom();
+  QVERIFY(!view.isZoomed());
+  QVERIFY(ticks(x) <= 50 && ticks(x) >= 1);
 }
 
 QTEST_MAIN(PlotsTest)
