@@ -33,7 +33,6 @@
 
 #include "io/model_file.hpp"
 
-#include "dynamics/assembly.hpp"
 #include "gui/autosave.hpp"
 #include "gui/control_view.hpp"
 #include "gui/linearize_view.hpp"
@@ -44,6 +43,7 @@
 #include "gui/view3d.hpp"
 #include "gui/wheel_guard.hpp"
 #include "simulation/result.hpp"
+#include "study/workflow.hpp"
 
 // the icon lives in codyna_gui, a static library: its resources must be registered by name
 static void init_codyna_resources() { Q_INIT_RESOURCE(codyna); }
@@ -674,25 +674,14 @@ void MainWindow::stepAnimation() {
     }
     return setPlaybackTime(t);
   }
-  // mode shape: the linearization's operating point plus Re(shape e^{i phase}) on the position
-  // states that are joint coordinates, loops re-assembled
+  // mode shape: the linearization's operating point moved along Re(shape e^{i phase}) on its
+  // position states (joint coordinates, and the rotations and translations of ball and free
+  // joints on their manifold), loops re-assembled
   const auto model = doc_->model();
   const auto* lin = lin_view_->result();
-  if (!model || !lin) return;
+  if (!model || !lin || lin->op.q.size() != model->nq) return;
   mode_phase_ += 2 * M_PI * kFrameMs / 1500.0;  // one period in 1.5 s whatever the frequency
-  const auto& names = lin->system.state_names;
-  const int npos = static_cast<int>(names.size()) / 2;
-  Eigen::VectorXd q = lin->op.q;
-  const double amp = 0.3 / std::max(1e-12, mode_shape_.head(std::min<int>(npos, mode_shape_.size())).cwiseAbs().maxCoeff());
-  const std::complex<double> rot = std::polar(1.0, mode_phase_);
-  for (int k = 0; k < npos && k < mode_shape_.size(); ++k) {
-    const auto it = std::find(model->q_names.begin(), model->q_names.end(), names[k]);
-    if (it != model->q_names.end()) q[it - model->q_names.begin()] += amp * (mode_shape_[k] * rot).real();
-  }
-  if (model->nc > 0) {
-    const AssemblyResult r = assemble(*model, q, Eigen::VectorXd::Zero(model->nv));
-    if (r.converged) q = r.q;
-  }
+  const Eigen::VectorXd q = study_mode_pose(*model, lin->op.q, lin->system.state_names, mode_shape_, mode_phase_);
   view_->setConfiguration(q);
 }
 

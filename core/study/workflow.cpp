@@ -16,6 +16,7 @@
 #include "control/lqr.hpp"
 #include "control/lqr_controllable.hpp"
 #include "dynamics/assembly.hpp"
+#include "dynamics/joint.hpp"
 #include "io/curves_file.hpp"
 #include "io/output_guard.hpp"
 #include "io/signal_file.hpp"
@@ -734,6 +735,52 @@ std::vector<std::string> study_export_closed_loop(const Model& m, const StudyClo
   write_step_csv(cl.loop, cl.step, step);
   write_frequency_csv(cl.loop, cl.frequency, freq);
   return {p.mat_file, p.m_file, step, freq};
+}
+
+Eigen::VectorXd study_mode_pose(const Model& model, const Eigen::VectorXd& q_op,
+                                const std::vector<std::string>& state_names, const Eigen::VectorXcd& shape,
+                                double phase, double amplitude) {
+  if (q_op.size() != model.nq) throw std::invalid_argument("study_mode_pose: q_op has the wrong size");
+  // the position states are the first half of the state; each names one tangent coordinate
+  const int npos = static_cast<int>(std::min<std::size_t>(state_names.size() / 2, static_cast<std::size_t>(shape.size())));
+  std::vector<int> index(npos, -1);
+  static const char* const local[] = {"rx", "ry", "rz", "dx", "dy", "dz"};
+  for (int k = 0; k < npos; ++k) {
+    const std::string& name = state_names[k];
+    const auto v = std::find(model.v_names.begin(), model.v_names.end(), name);
+    const bool plain = v != model.v_names.end();
+    const int i = plain ? static_cast<int>(v - model.v_names.begin()) : -1;
+    // a ball or free joint's velocity names a rate, not a coordinate: only its rx..dz name one
+    if (plain) {
+      const auto j = std::find_if(model.joints.begin(), model.joints.end(), [&](const JointModel& jm) {
+        return i >= jm.idx_v && i < jm.idx_v + jm.nv;
+      });
+      if (j != model.joints.end() && j->type != JointType::Spherical && j->type != JointType::Free) index[k] = i;
+      continue;
+    }
+    const auto dot = name.rfind('.');
+    if (dot == std::string::npos) continue;
+    const std::string joint = name.substr(0, dot), suffix = name.substr(dot + 1);
+    for (const JointModel& jm : model.joints) {
+      if (jm.name != joint || (jm.type != JointType::Spherical && jm.type != JointType::Free)) continue;
+      for (int c = 0; c < jm.nv; ++c)
+        if (suffix == local[c]) index[k] = jm.idx_v + c;
+    }
+  }
+  double largest = 0;
+  for (int k = 0; k < npos; ++k)
+    if (index[k] >= 0) largest = std::max(largest, std::abs(shape[k]));
+  if (!(largest > 0) || !std::isfinite(largest)) return q_op;
+  const std::complex<double> turn = std::polar(amplitude / largest, phase);
+  Eigen::VectorXd dv = Eigen::VectorXd::Zero(model.nv);
+  for (int k = 0; k < npos; ++k)
+    if (index[k] >= 0) dv[index[k]] += (shape[k] * turn).real();
+  Eigen::VectorXd q = integrate<double>(model, q_op, dv);
+  if (model.nc > 0) {
+    const AssemblyResult r = assemble(model, q, Eigen::VectorXd::Zero(model.nv));
+    if (r.converged) q = r.q;
+  }
+  return q;
 }
 
 }  // namespace codyna

@@ -97,6 +97,16 @@ struct StudySimulation {
   bool linear_unstable = false;
 };
 
+// The configuration the 3-D view draws for a linear mode: the operating point q_op moved
+// along Re(shape e^{i phase}) on the position states (named as the linearization names
+// them: joint coordinates, "J.rx".."J.rz" for the rotation of a ball or free joint J,
+// "J.dx".."J.dz" for a free joint's translation), scaled so that the largest of them
+// swings by `amplitude` (rad or m), mapped onto the manifold (q_op (+) dv: quaternions
+// stay unit), closed loops re-assembled. States that name no coordinate are skipped.
+Eigen::VectorXd study_mode_pose(const Model& model, const Eigen::VectorXd& q_op,
+                                const std::vector<std::string>& state_names, const Eigen::VectorXcd& shape,
+                                double phase, double amplitude = 0.3);
+
 // Controller and linear plant of the run (linearizing once if anything needs it).
 StudySimulation study_simulation(const Model& model);
 

@@ -12,6 +12,7 @@
 
 #include "control/lqr.hpp"
 #include "dynamics/constraints.hpp"
+#include "dynamics/joint.hpp"
 #include "io/model_file.hpp"
 #include "model/errors.hpp"
 #include "test_util.hpp"
@@ -208,6 +209,53 @@ TEST(Workflow, LinearizeAndExportFollowTheStudy) {
   std::filesystem::remove_all(dir);
   spec.analysis.export_name = "2bad";
   expect_model_error_at([&] { study_export_name(study_model(spec)); }, "/analysis/export_name", "m_2bad");
+}
+
+// A mode drawn in 3-D: the operating point moved along the mode on the manifold. The pose
+// differs from the operating point by exactly the scaled mode (difference() is integrate()'s
+// inverse), quaternions stay unit, plain coordinates add, closed loops stay closed.
+TEST(Workflow, ModePoseMovesAlongTheModeOnTheManifold) {
+  {
+    ModelSpec spec = example_spec("heavy_top.json");
+    spec.analysis.operating_point = "initial";  // the spinning top has no equilibrium
+    const Model m = study_model(spec);
+    const StudyLinearization l = study_linearize(m);
+    const auto& names = l.lin.system.state_names;
+    ASSERT_EQ(names.size(), 6u);
+    EXPECT_EQ(names[0], "support.rx");
+    EXPECT_EQ(names[2], "support.rz");
+    const Eigen::VectorXd q_op = integrate<double>(m, m.q0, Eigen::Vector3d(0.2, -0.1, 0.4));
+    Eigen::VectorXcd shape(6);
+    shape << 1.0, std::complex<double>(0, 2.0), 0.5, 7.0, 7.0, 7.0;  // the rates (last 3) play no part
+    for (double phase : {0.0, 0.7, 2.0}) {
+      const Eigen::VectorXd q = study_mode_pose(m, q_op, names, shape, phase, 0.3);
+      Eigen::Vector3d expected;
+      for (int k = 0; k < 3; ++k) expected[k] = (0.3 / 2.0 * shape[k] * std::polar(1.0, phase)).real();
+      EXPECT_TRUE(MatrixNear(difference(m, q_op, q), expected, 1e-12)) << phase;
+      EXPECT_NEAR(q.norm(), 1.0, 1e-14);
+    }
+  }
+  {
+    const Model m = study_model(example_spec("cart_pendulum.json"));
+    const auto names = study_linearize(m).lin.system.state_names;
+    Eigen::VectorXcd shape = Eigen::VectorXcd::Zero(static_cast<int>(names.size()));
+    shape[0] = 0.5, shape[1] = -1.0;
+    const Eigen::VectorXd q = study_mode_pose(m, m.q0, names, shape, 0.0, 0.3);
+    for (int k = 0; k < 2; ++k) {
+      const int i = static_cast<int>(std::find(m.v_names.begin(), m.v_names.end(), names[k]) - m.v_names.begin());
+      EXPECT_NEAR(q[i] - m.q0[i], 0.3 * shape[k].real(), 1e-15) << names[k];
+    }
+  }
+  {
+    const Model m = study_model(example_spec("four_bar.json"));
+    const auto names = study_linearize(m).lin.system.state_names;
+    Eigen::VectorXcd shape = Eigen::VectorXcd::Zero(static_cast<int>(names.size()));
+    shape[0] = 1.0;
+    const Eigen::VectorXd q = study_mode_pose(m, m.q0, names, shape, 0.0, 0.2);
+    Data d(m);
+    EXPECT_GT((q - m.q0).norm(), 0.1);
+    EXPECT_LT(constraint_residual<double>(m, d, q).lpNorm<Eigen::Infinity>(), 1e-10);
+  }
 }
 
 TEST(Workflow, SimulationControllerSources) {

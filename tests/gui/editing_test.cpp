@@ -20,6 +20,8 @@
 #include <QWheelEvent>
 
 #include <QDockWidget>
+#include <QFile>
+#include <nlohmann/json.hpp>
 #include <QElapsedTimer>
 #include <QLabel>
 #include <QPushButton>
@@ -435,6 +437,46 @@ class EditingTest : public QObject {
     QCOMPARE(second->size(), QSize(1500, 950));
     QCOMPARE(second->findChild<QSplitter*>("centreSplitter")->sizes(), sizes);
     QSettings().clear();  // the next test starts from the defaults
+  }
+
+  // a ball joint's mode moves the 3-D view (its rotation states are tangent coordinates,
+  // not entries of q): the pose leaves the operating point, quaternion unit, and comes back
+  void ballJointModeAnimates() {
+    QTemporaryDir dir;
+    QFile in(QStringLiteral(CODYNA_EXAMPLES_DIR "/heavy_top.json"));
+    QVERIFY(in.open(QIODevice::ReadOnly));
+    nlohmann::json j = nlohmann::json::parse(in.readAll().toStdString());
+    j["analysis"]["operating_point"] = "initial";  // a spinning top has no equilibrium
+    const QString path = dir.filePath("top.json");
+    QFile out(path);
+    QVERIFY(out.open(QIODevice::WriteOnly));
+    out.write(QByteArray::fromStdString(j.dump(2)));
+    out.close();
+    QVERIFY(w->openFile(path));
+    QVERIFY(w->linearizeView()->linearize());
+    const Eigen::VectorXd op = w->linearizeView()->result()->op.q;
+    // a mode whose rotation part is not small against its rates
+    const auto& modes = w->linearizeView()->modes().modes;
+    int pick = -1;
+    for (int k = 0; k < int(modes.size()) && pick < 0; ++k)
+      if (modes[k].shape.head(3).cwiseAbs().maxCoeff() > 0.01) pick = k;
+    QVERIFY(pick >= 0);
+    w->linearizeView()->selectMode(pick);
+    QVERIFY(w->isAnimatingMode());
+    double farthest = 0;
+    QElapsedTimer t;
+    t.start();
+    while (t.elapsed() < 1500) {
+      QTest::qWait(40);
+      const Eigen::VectorXd& q = w->view3d()->configuration();
+      QCOMPARE(q.size(), op.size());
+      QVERIFY(std::abs(q.norm() - 1.0) < 1e-12);
+      farthest = std::max(farthest, (q - op).norm());
+    }
+    QVERIFY2(farthest > 0.05, qPrintable(QString::number(farthest)));  // 0.3 rad swings move a unit quaternion by ~0.15
+    w->animateMode(-1, {});
+    QCOMPARE(w->view3d()->configuration(), op);
+    w->document()->undoStack()->setClean();
   }
 
   // the 3-D view shows the operating point after Linearize; the matrices copy as text that reads back exactly
