@@ -4,6 +4,22 @@
 #include <QChart>
 #include <QClipboard>
 #include <QContextMenuEvent>
+#include <QDialog>
+#include <QDialogButtonBox>
+#include <QDir>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QFormLayout>
+#include <QGraphicsLayout>
+#include <QGraphicsScene>
+#include <QHBoxLayout>
+#include <QLineEdit>
+#include <QMessageBox>
+#include <QPainter>
+#include <QPushButton>
+#include <QRegularExpression>
+#include <QSettings>
+#include <QSpinBox>
 #include <QLabel>
 #include <QLineSeries>
 #include <QLogValueAxis>
@@ -14,6 +30,8 @@
 #include <cmath>
 #include <limits>
 #include <map>
+
+#include "gui/image_export.hpp"
 
 namespace codyna::gui {
 
@@ -218,9 +236,88 @@ QString ChartView::dataCsv() const {
   return lines.join('\n') + '\n';
 }
 
+bool ChartView::saveImage(const QString& path, const QSize& size, QString* error) {
+  if (!chart() || !chart()->scene()) {
+    if (error) *error = QStringLiteral("%1: no chart to save").arg(path);
+    return false;
+  }
+  QChart* c = chart();
+  const QRectF before = c->geometry();
+  // lay the chart out at the asked size (axes, labels and legend placed for it), draw it, put it back
+  const auto layoutAt = [c](const QRectF& r) {
+    c->setGeometry(r);
+    if (c->layout()) c->layout()->activate();
+    QCoreApplication::sendPostedEvents(nullptr, QEvent::LayoutRequest);
+  };
+  const bool sized = size.width() >= 16 && size.height() >= 16 && size.width() <= 10000 && size.height() <= 10000;
+  if (sized) layoutAt(QRectF(before.topLeft(), QSizeF(size)));
+  const QString title = c->title().isEmpty() ? QStringLiteral("codyna chart") : c->title();
+  const bool ok = save_painted_image(path, size, title, [&](QPainter& p) {
+    c->scene()->render(&p, QRectF(QPointF(0, 0), QSizeF(size)), QRectF(before.topLeft(), QSizeF(size)));
+  }, error);
+  if (sized) layoutAt(before);
+  return ok;
+}
+
+QString ChartView::saveImageInteractive() {
+  QSettings settings;
+  const QString folder = settings.value(QStringLiteral("charts/imageFolder"), QDir::currentPath()).toString();
+  QString base = chart() ? chart()->title() : QString();
+  base.replace(QRegularExpression(QStringLiteral("[^A-Za-z0-9_-]+")), QStringLiteral("_"));
+  if (base.isEmpty()) base = QStringLiteral("chart");
+
+  QDialog dialog(this);
+  dialog.setWindowTitle(tr("Save chart image"));
+  auto* form = new QFormLayout(&dialog);
+  auto* path = new QLineEdit(QDir(folder).filePath(base + QStringLiteral(".png")), &dialog);
+  path->setObjectName("imagePath");
+  path->setToolTip(tr("The file to write: .png (pixels) or .svg (vectors)"));
+  auto* browse = new QPushButton(tr("Browse..."), &dialog);
+  auto* row = new QHBoxLayout;
+  row->addWidget(path, 1);
+  row->addWidget(browse);
+  form->addRow(tr("File"), row);
+  auto* w = new QSpinBox(&dialog);
+  auto* h = new QSpinBox(&dialog);
+  w->setObjectName("imageWidth");
+  h->setObjectName("imageHeight");
+  for (QSpinBox* b : {w, h}) {
+    b->setRange(16, 10000);
+    b->setSuffix(tr(" px"));
+  }
+  w->setValue(settings.value(QStringLiteral("charts/imageWidth"), 1200).toInt());
+  h->setValue(settings.value(QStringLiteral("charts/imageHeight"), 600).toInt());
+  w->setToolTip(tr("Width of the picture in pixels (the chart is laid out again at this size)"));
+  h->setToolTip(tr("Height of the picture in pixels"));
+  form->addRow(tr("Width"), w);
+  form->addRow(tr("Height"), h);
+  auto* buttons = new QDialogButtonBox(QDialogButtonBox::Save | QDialogButtonBox::Cancel, &dialog);
+  form->addRow(buttons);
+  connect(buttons, &QDialogButtonBox::accepted, &dialog, &QDialog::accept);
+  connect(buttons, &QDialogButtonBox::rejected, &dialog, &QDialog::reject);
+  connect(browse, &QPushButton::clicked, &dialog, [&] {
+    const QString p = QFileDialog::getSaveFileName(&dialog, tr("Save chart image"), path->text(),
+                                                   tr("PNG image (*.png);;SVG drawing (*.svg)"));
+    if (!p.isEmpty()) path->setText(p);
+  });
+  if (dialog.exec() != QDialog::Accepted) return {};
+  QString file = path->text().trimmed();
+  if (!file.isEmpty() && !is_image_path(file)) file += QStringLiteral(".png");
+  QString why;
+  if (file.isEmpty() || !saveImage(file, QSize(w->value(), h->value()), &why)) {
+    QMessageBox::warning(this, tr("Save chart image"), file.isEmpty() ? tr("No file name given.") : why);
+    return {};
+  }
+  settings.setValue(QStringLiteral("charts/imageFolder"), QFileInfo(file).absolutePath());
+  settings.setValue(QStringLiteral("charts/imageWidth"), w->value());
+  settings.setValue(QStringLiteral("charts/imageHeight"), h->value());
+  return file;
+}
+
 void ChartView::contextMenuEvent(QContextMenuEvent* e) {
   QMenu menu(this);
   menu.addAction(tr("Copy data (CSV)"), this, [this] { QApplication::clipboard()->setText(dataCsv()); });
+  menu.addAction(tr("Save image..."), this, [this] { saveImageInteractive(); });
   QAction* reset = menu.addAction(tr("Reset zoom"), this, [this] { resetZoom(); });
   reset->setEnabled(isZoomed());
   menu.exec(e->globalPos());

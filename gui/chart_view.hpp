@@ -3,7 +3,8 @@
 // Shift + left) drags the view, a double click or the context menu resets it;
 // the value under the pointer is shown in the corner (x, y in the axes' units);
 // the context menu copies every curve as CSV (x, then one column per curve,
-// full precision) and resets the zoom.
+// full precision), saves the chart as PNG or SVG at a chosen size, and resets
+// the zoom.
 #pragma once
 
 #include <QChartView>
@@ -27,6 +28,13 @@ class ChartView : public QChartView {
   void fitTicks();
   bool canZoom(double factor) const;  // factor > 1 zooms in
   static double roundStep(double width, int ticks);
+
+  // the chart alone (as zoomed, no readout) laid out at `size` pixels into a .png or
+  // .svg file, written atomically; the view on screen is left as it was
+  bool saveImage(const QString& path, const QSize& size, QString* error = nullptr);
+  // the context menu's "Save image...": a dialog for the file and the size, then saveImage
+  // (errors in a message box); returns the path written or ""
+  QString saveImageInteractive();
 
  protected:
   void mousePressEvent(QMouseEvent* e) override;

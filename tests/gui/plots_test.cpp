@@ -15,6 +15,9 @@
 #include <QTemporaryDir>
 #include <QValueAxis>
 #include <QWheelEvent>
+#include <QLineEdit>
+#include <QSpinBox>
+#include <QTimer>
 #include <QtTest>
 #include <cmath>
 #include <numbers>
@@ -168,6 +171,7 @@ class PlotsTest : public QObject {
   void matrixModel();
   void modeModel();
   void zoomKeepsTicksBounded();
+  void chartImageAtChosenSize();
 };
 
 void PlotsTest::niceRanges() {
@@ -727,6 +731,64 @@ void PlotsTest::zoomKeepsTicksBounded() {
   view.resetZoom();
   QVERIFY(!view.isZoomed());
   QVERIFY(ticks(x) <= 50 && ticks(x) >= 1);
+}
+
+// A chart saved at a size that is not the one on screen: the PNG has exactly that many
+// pixels, with the curve drawn across it (not the screen's picture scaled), the SVG
+// that size; the view on screen keeps its layout; a bad size or suffix writes nothing.
+void PlotsTest::chartImageAtChosenSize() {
+  auto* chart = new QChart;
+  chart->setAnimationOptions(QChart::NoAnimation);
+  chart->setTitle("Step on force");
+  auto* s = new QLineSeries;
+  s->setName("x");
+  QPen pen(QColor(255, 0, 0));
+  pen.setWidth(3);
+  s->setPen(pen);
+  for (int i = 0; i <= 100; ++i) s->append(0.1 * i, std::sin(0.3 * i));
+  chart->addSeries(s);
+  chart->createDefaultAxes();
+  codyna::gui::ChartView view(chart);
+  view.resize(500, 300);
+  view.show();
+  QVERIFY(QTest::qWaitForWindowExposed(&view));
+  QTest::qWait(20);
+  const QRectF area = chart->plotArea();
+  QTemporaryDir dir;
+  QString why;
+  const QString png = dir.filePath("step.png");
+  QVERIFY2(view.saveImage(png, QSize(1300, 520), &why), qPrintable(why));
+  QImage img(png);
+  QCOMPARE(img.size(), QSize(1300, 520));
+  // the red curve reaches far to the right and into the lower part of the large picture
+  int rightmost = 0;
+  for (int y = 0; y < img.height(); ++y)
+    for (int x = 0; x < img.width(); ++x) {
+      const QColor c = img.pixelColor(x, y);
+      if (c.red() > 200 && c.green() < 80 && c.blue() < 80) rightmost = std::max(rightmost, x);
+    }
+  QVERIFY2(rightmost > 1100, qPrintable(QString::number(rightmost)));
+  QCOMPARE(chart->plotArea(), area);  // the screen's layout is back
+  const QString svg = dir.filePath("step.svg");
+  QVERIFY2(view.saveImage(svg, QSize(800, 400), &why), qPrintable(why));
+  QCOMPARE(QSvgRenderer(svg).viewBoxF(), QRectF(0, 0, 800, 400));
+  QVERIFY(!view.saveImage(dir.filePath("bad.png"), QSize(5, 400), &why));
+  QVERIFY(why.contains("16 to 10000"));
+  QVERIFY(!QFile::exists(dir.filePath("bad.png")));
+  QVERIFY(!view.saveImage(dir.filePath("bad.jpg"), QSize(400, 400), &why));
+  QVERIFY(why.contains(".png or .svg"));
+  // through the dialog, as the context menu opens it
+  const QString viaDialog = dir.filePath("dialog.png");
+  QTimer::singleShot(0, [&] {
+    auto* d = QApplication::activeModalWidget();
+    QVERIFY(d);
+    d->findChild<QLineEdit*>("imagePath")->setText(viaDialog);
+    d->findChild<QSpinBox*>("imageWidth")->setValue(640);
+    d->findChild<QSpinBox*>("imageHeight")->setValue(480);
+    QTest::keyClick(d->findChild<QLineEdit*>("imagePath"), Qt::Key_Return);
+  });
+  QCOMPARE(view.saveImageInteractive(), viaDialog);
+  QCOMPARE(QImage(viaDialog).size(), QSize(640, 480));
 }
 
 QTEST_MAIN(PlotsTest)
