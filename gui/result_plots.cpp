@@ -235,21 +235,25 @@ void ResultPlots::clearPanel(Panel& p) {
     p.chart->removeSeries(s);
     delete s;
   }
-  for (QLineSeries* s : p.linear) {
-    p.chart->removeSeries(s);
-    delete s;
-  }
+  for (const auto* list : {&p.linear, &p.reference})
+    for (QLineSeries* s : *list) {
+      p.chart->removeSeries(s);
+      delete s;
+    }
   p.series.clear();
   p.linear.clear();
+  p.reference.clear();
   p.data.clear();
   p.linear_data.clear();
+  p.reference_data.clear();
   p.y_lo = 1.0;
   p.y_hi = 0.0;
   p.shown_lo = 1.0;
   p.shown_hi = 0.0;
 }
 
-void ResultPlots::setupSeries(Panel& p, const QStringList& names, const QStringList& units, bool withLinear) {
+void ResultPlots::setupSeries(Panel& p, const QStringList& names, const QStringList& units, bool withLinear,
+                              bool withReference) {
   clearPanel(p);
   // the cursor is re-added last so that it is drawn over the data
   p.chart->removeSeries(p.cursor);
@@ -281,6 +285,21 @@ void ResultPlots::setupSeries(Panel& p, const QStringList& names, const QStringL
       l->attachAxis(p.axis_y);
       p.linear.push_back(l);
       p.linear_data.emplace_back();
+    }
+    if (withReference) {
+      auto* l = new QLineSeries;
+      l->setName(nameWithUnit(names[k] + QStringLiteral(" (reference)"), at(units, k)));
+      QPen rpen(colour.darker(160));
+      rpen.setWidthF(1.3);
+      rpen.setStyle(Qt::CustomDashLine);
+      rpen.setDashPattern({1.0, 2.5});
+      rpen.setCapStyle(Qt::RoundCap);
+      l->setPen(rpen);
+      p.chart->addSeries(l);
+      l->attachAxis(p.axis_t);
+      l->attachAxis(p.axis_y);
+      p.reference.push_back(l);
+      p.reference_data.emplace_back();
     }
   }
   p.chart->addSeries(p.cursor);
@@ -350,6 +369,7 @@ void ResultPlots::redraw() {
   for (Panel* p : {&in_, &out_}) {
     for (std::size_t k = 0; k < p->series.size(); ++k) p->series[k]->replace(plotted(p->data[k]));
     for (std::size_t k = 0; k < p->linear.size(); ++k) p->linear[k]->replace(plotted(p->linear_data[k]));
+    for (std::size_t k = 0; k < p->reference.size(); ++k) p->reference[k]->replace(plotted(p->reference_data[k]));
     updateYRange(*p, false);
   }
   if (t_max_seen_ > in_.axis_t->max() * (1.0 + 1e-12)) updateTimeAxis(t_max_seen_);
@@ -446,7 +466,8 @@ void ResultPlots::setResult(const codyna::SimulationResult& r, const std::vector
   const Eigen::Index n = std::min<Eigen::Index>(static_cast<Eigen::Index>(r.t.size()), r.y.rows());
   const bool linear = r.y_linear.size() > 0 && r.y_linear.cols() == r.y.cols() && r.y_linear.rows() >= n;
   setupSeries(in_, inNames, inUnits, false);
-  setupSeries(out_, outNames, outUnits, linear);
+  const bool reference = r.y_reference.size() > 0 && r.y_reference.cols() == r.y.cols() && r.y_reference.rows() >= n;
+  setupSeries(out_, outNames, outUnits, linear, reference);
   in_.axis_y->setTitleText(yTitle(QStringLiteral("u"), inNames, inUnits));
   out_.axis_y->setTitleText(yTitle(QStringLiteral("y"), outNames, outUnits));
 
@@ -464,10 +485,13 @@ void ResultPlots::setResult(const codyna::SimulationResult& r, const std::vector
   for (Eigen::Index k = 0; k < r.y.cols(); ++k) fill(out_.data[k], out_, r.y, k, n);
   if (linear)
     for (Eigen::Index k = 0; k < r.y.cols(); ++k) fill(out_.linear_data[k], out_, r.y_linear, k, n);
+  if (reference)
+    for (Eigen::Index k = 0; k < r.y.cols(); ++k) fill(out_.reference_data[k], out_, r.y_reference, k, n);
 
   for (Panel* p : {&in_, &out_}) {
     for (std::size_t k = 0; k < p->series.size(); ++k) p->series[k]->replace(plotted(p->data[k]));
     for (std::size_t k = 0; k < p->linear.size(); ++k) p->linear[k]->replace(plotted(p->linear_data[k]));
+    for (std::size_t k = 0; k < p->reference.size(); ++k) p->reference[k]->replace(plotted(p->reference_data[k]));
     updateYRange(*p, true);
   }
   double t0 = 0.0, t1 = 0.0;
@@ -507,6 +531,9 @@ QList<QPointF> ResultPlots::inputPoints(int k) const {
 }
 QList<QPointF> ResultPlots::outputPoints(int k) const {
   return k >= 0 && k < outputSeriesCount() ? out_.series[k]->points() : QList<QPointF>();
+}
+QList<QPointF> ResultPlots::referencePoints(int k) const {
+  return k >= 0 && k < static_cast<int>(out_.reference.size()) ? out_.reference[k]->points() : QList<QPointF>();
 }
 QList<QPointF> ResultPlots::linearPoints(int k) const {
   return k >= 0 && k < static_cast<int>(out_.linear.size()) ? out_.linear[k]->points() : QList<QPointF>();

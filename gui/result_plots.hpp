@@ -71,7 +71,8 @@ class ResultPlots : public QWidget {
   // Shows a finished (or partial) result: the plant inputs are the columns
   // plantInputs of r.u (in that order; indices outside r.u are skipped), the
   // outputs r.y; r.y_linear, when it has as many columns as r.y and at least
-  // as many rows, is overlaid dashed. The t axis spans the result's times.
+  // as many rows, is overlaid dashed; r.y_reference (the references r(t) the controller
+  // followed) likewise, dotted in grey. The t axis spans the result's times.
   void setResult(const codyna::SimulationResult& r, const std::vector<int>& plantInputs);
 
   // Vertical marker at time t in both charts (playback); NaN hides it.
@@ -94,6 +95,7 @@ class ResultPlots : public QWidget {
   QList<QPointF> inputPoints(int k) const;               // Plant/In series k as plotted
   QList<QPointF> outputPoints(int k) const;              // Plant/Out series k as plotted
   QList<QPointF> linearPoints(int k) const;              // empty when no linear overlay
+  QList<QPointF> referencePoints(int k) const;           // r(t) of output k; empty without references
   int inputSeriesCount() const { return static_cast<int>(in_.series.size()); }
   int outputSeriesCount() const { return static_cast<int>(out_.series.size()); }
   QChart* inputChart() const { return in_.chart; }
@@ -107,15 +109,16 @@ class ResultPlots : public QWidget {
     QValueAxis* axis_t = nullptr;
     QValueAxis* axis_y = nullptr;
     QLineSeries* cursor = nullptr;
-    std::vector<QLineSeries*> series, linear;    // linear: empty or one per series
-    std::vector<QList<QPointF>> data, linear_data;  // all finite samples
+    std::vector<QLineSeries*> series, linear, reference;    // linear, reference: empty or one per series
+    std::vector<QList<QPointF>> data, linear_data, reference_data;  // all finite samples
     double y_lo = 0, y_hi = 0;                   // data range (y_lo > y_hi: no data)
     double shown_lo = 1, shown_hi = 0;           // current y axis range before niceness
     double extra_left = 0, extra_right = 0;      // margins added to line up the plot areas
   };
 
   void buildPanel(Panel& p, const QString& title);
-  void setupSeries(Panel& p, const QStringList& names, const QStringList& units, bool withLinear);
+  void setupSeries(Panel& p, const QStringList& names, const QStringList& units, bool withLinear,
+                   bool withReference = false);
   void clearPanel(Panel& p);
   void updateYRange(Panel& p, bool allowShrink);
   void updateTimeAxis(double tEnd);

@@ -72,59 +72,67 @@ SignalPlot::SignalPlot(QWidget* parent) : QWidget(parent) {
   setResult(nullptr);
 }
 
+namespace {
+
+// every recorded quantity of a result, named as the list shows it, with the way to read it:
+// one walk that both the names and the values come from
+struct Entry {
+  QString name;
+  const Eigen::MatrixXd* matrix = nullptr;  // a column of it
+  int column = 0;
+  const std::vector<double>* series = nullptr;
+  int sum = 0;  // 1: total energy (kinetic + potential)
+};
+
+std::vector<Entry> entries(const SimulationResult& r) {
+  std::vector<Entry> e;
+  const auto columns = [&](const Eigen::MatrixXd& m, const std::vector<std::string>& names, const QString& prefix,
+                           const QString& suffix, const std::vector<std::string>* units) {
+    for (std::size_t k = 0; k < names.size() && static_cast<Eigen::Index>(k) < m.cols(); ++k)
+      e.push_back({prefix + qs(names[k]) + suffix + (units ? unitSuffix(*units, k) : QString()), &m, static_cast<int>(k)});
+  };
+  columns(r.q, r.q_names, {}, {}, nullptr);
+  columns(r.v, r.v_names, {}, {}, nullptr);
+  columns(r.u, r.input_names, {}, {}, &r.input_units);
+  columns(r.y, r.output_names, QStringLiteral("y: "), {}, &r.output_units);
+  columns(r.y_reference, r.output_names, QStringLiteral("r: "), {}, &r.output_units);
+  columns(r.y_linear, r.output_names, QStringLiteral("y: "), QStringLiteral(" (linear)"), &r.output_units);
+  columns(r.u_disturbance, r.input_names, QStringLiteral("d: "), {}, &r.input_units);
+  columns(r.xc, r.controller_state_names, QStringLiteral("controller: "), {}, nullptr);
+  if (!r.kinetic_energy.empty()) {
+    e.push_back({QStringLiteral("kinetic energy [J]"), nullptr, 0, &r.kinetic_energy});
+    e.push_back({QStringLiteral("potential energy [J]"), nullptr, 0, &r.potential_energy});
+    e.push_back({QStringLiteral("total energy [J]"), nullptr, 0, nullptr, 1});
+  }
+  if (!r.constraint_violation.empty()) {
+    e.push_back({QStringLiteral("constraint drift |phi|"), nullptr, 0, &r.constraint_violation});
+    e.push_back({QStringLiteral("velocity drift |Jc v|"), nullptr, 0, &r.velocity_violation});
+  }
+  return e;
+}
+
+}  // namespace
+
 QStringList SignalPlot::signalNames(const SimulationResult& r) {
   QStringList n;
-  for (std::size_t k = 0; k < r.q_names.size() && static_cast<Eigen::Index>(k) < r.q.cols(); ++k) n << qs(r.q_names[k]);
-  for (std::size_t k = 0; k < r.v_names.size() && static_cast<Eigen::Index>(k) < r.v.cols(); ++k) n << qs(r.v_names[k]);
-  for (std::size_t k = 0; k < r.input_names.size() && static_cast<Eigen::Index>(k) < r.u.cols(); ++k)
-    n << qs(r.input_names[k]) + unitSuffix(r.input_units, k);
-  for (std::size_t k = 0; k < r.output_names.size() && static_cast<Eigen::Index>(k) < r.y.cols(); ++k)
-    n << QStringLiteral("y: ") + qs(r.output_names[k]) + unitSuffix(r.output_units, k);
-  for (std::size_t k = 0; k < r.controller_state_names.size() && static_cast<Eigen::Index>(k) < r.xc.cols(); ++k)
-    n << QStringLiteral("controller: ") + qs(r.controller_state_names[k]);
-  if (!r.kinetic_energy.empty()) n << QStringLiteral("kinetic energy [J]") << QStringLiteral("potential energy [J]")
-                                   << QStringLiteral("total energy [J]");
-  if (!r.constraint_violation.empty()) n << QStringLiteral("constraint drift |phi|") << QStringLiteral("velocity drift |Jc v|");
+  for (const Entry& e : entries(r)) n << e.name;
   return n;
 }
 
 std::vector<double> SignalPlot::signal(const SimulationResult& r, const QString& name) {
-  const QStringList names = signalNames(r);
-  const int at = static_cast<int>(names.indexOf(name));
   std::vector<double> out;
-  if (at < 0) return out;
-  const int N = r.samples();
-  auto column = [&](const Eigen::MatrixXd& m, int c) {
-    for (int i = 0; i < N && i < m.rows(); ++i) out.push_back(m(i, c));
-  };
-  int k = at;
-  const int nq = std::min<int>(static_cast<int>(r.q_names.size()), static_cast<int>(r.q.cols()));
-  if (k < nq) return column(r.q, k), out;
-  k -= nq;
-  const int nv = std::min<int>(static_cast<int>(r.v_names.size()), static_cast<int>(r.v.cols()));
-  if (k < nv) return column(r.v, k), out;
-  k -= nv;
-  const int nu = std::min<int>(static_cast<int>(r.input_names.size()), static_cast<int>(r.u.cols()));
-  if (k < nu) return column(r.u, k), out;
-  k -= nu;
-  const int ny = std::min<int>(static_cast<int>(r.output_names.size()), static_cast<int>(r.y.cols()));
-  if (k < ny) return column(r.y, k), out;
-  k -= ny;
-  const int nxc = std::min<int>(static_cast<int>(r.controller_state_names.size()), static_cast<int>(r.xc.cols()));
-  if (k < nxc) return column(r.xc, k), out;
-  k -= nxc;
-  if (!r.kinetic_energy.empty()) {
-    if (k == 0) return r.kinetic_energy;
-    if (k == 1) return r.potential_energy;
-    if (k == 2) {
+  for (const Entry& e : entries(r)) {
+    if (e.name != name) continue;
+    if (e.matrix) {
+      for (int i = 0; i < r.samples() && i < e.matrix->rows(); ++i) out.push_back((*e.matrix)(i, e.column));
+    } else if (e.series) {
+      out = *e.series;
+    } else if (e.sum == 1) {
       for (std::size_t i = 0; i < r.kinetic_energy.size() && i < r.potential_energy.size(); ++i)
         out.push_back(r.kinetic_energy[i] + r.potential_energy[i]);
-      return out;
     }
-    k -= 3;
+    break;
   }
-  if (k == 0) return r.constraint_violation;
-  if (k == 1) return r.velocity_violation;
   return out;
 }
 

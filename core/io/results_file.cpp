@@ -42,7 +42,21 @@ const MatrixField kMatrices[] = {
     {"/y", &R::y, "/names/outputs", &R::output_names},
     {"/xc", &R::xc, "/names/controller_states", &R::controller_state_names},
 };
-constexpr const char* kLinearOutputs = "/y_linear";
+
+// matrices present only when the run made them (0 x 0 otherwise), with as many columns as a kMatrices entry
+struct OptionalField {
+  const char* dataset;
+  Eigen::MatrixXd R::*values;
+  Eigen::MatrixXd R::*like;  // the matrix whose columns it has
+  const char* like_dataset;
+  Strings R::*names;
+  const char* csv_suffix;
+};
+const OptionalField kOptional[] = {
+    {"/y_linear", &R::y_linear, &R::y, "/y", &R::output_names, "_linear"},
+    {"/y_reference", &R::y_reference, &R::y, "/y", &R::output_names, "_reference"},
+    {"/u_disturbance", &R::u_disturbance, &R::u, "/u", &R::input_names, "_disturbance"},
+};
 
 struct SeriesField {
   const char* dataset;
@@ -111,10 +125,13 @@ std::string inconsistency(const R& r) {
     if (!(r.*f.units).empty() && (r.*f.units).size() != (r.*f.names).size())
       return std::string(f.dataset) + " has " + std::to_string((r.*f.units).size()) + " entries for " +
              std::to_string((r.*f.names).size()) + " names";
-  if (r.y_linear.cols() > 0 && (static_cast<std::size_t>(r.y_linear.rows()) != n || r.y_linear.cols() != r.y.cols()))
-    return std::string(kLinearOutputs) + " is " + std::to_string(r.y_linear.rows()) + " x " +
-           std::to_string(r.y_linear.cols()) + ", expected " + std::to_string(n) + " x " + std::to_string(r.y.cols()) +
-           " like /y";
+  for (const OptionalField& f : kOptional) {
+    const Eigen::MatrixXd& m = r.*f.values;
+    const Eigen::Index cols = (r.*f.like).cols();
+    if (m.cols() > 0 && (static_cast<std::size_t>(m.rows()) != n || m.cols() != cols))
+      return std::string(f.dataset) + " is " + std::to_string(m.rows()) + " x " + std::to_string(m.cols()) +
+             ", expected " + std::to_string(n) + " x " + std::to_string(cols) + " like " + f.like_dataset;
+  }
   return {};
 }
 
@@ -293,7 +310,8 @@ void write_contents(hid_t file, const R& r) {
     write_matrix(file, f.dataset, r.*f.values, samples);
     write_strings(file, f.names_dataset, r.*f.names);
   }
-  if (r.y_linear.cols() > 0) write_matrix(file, kLinearOutputs, r.y_linear, samples);
+  for (const OptionalField& f : kOptional)
+    if ((r.*f.values).cols() > 0) write_matrix(file, f.dataset, r.*f.values, samples);
   for (const SeriesField& f : kSeries) write_series(file, f.dataset, r.*f.values);
   for (const UnitsField& f : kUnits) write_strings(file, f.dataset, r.*f.units);
 
@@ -406,7 +424,8 @@ R read_contents(hid_t file) {
     r.*f.values = read_matrix(file, f.dataset);
     r.*f.names = read_strings(file, f.names_dataset);
   }
-  if (H5Lexists(file, kLinearOutputs, H5P_DEFAULT) > 0) r.y_linear = read_matrix(file, kLinearOutputs);
+  for (const OptionalField& f : kOptional)
+    if (H5Lexists(file, f.dataset, H5P_DEFAULT) > 0) r.*f.values = read_matrix(file, f.dataset);
   for (const SeriesField& f : kSeries) r.*f.values = read_series(file, f.dataset);
   for (const UnitsField& f : kUnits) r.*f.units = read_strings(file, f.dataset);
 
@@ -439,7 +458,7 @@ std::vector<CsvColumn> csv_columns(const R& r) {
   for (const MatrixField& f : kMatrices) add_matrix(r.*f.values, r.*f.names, "");
   for (const SeriesField& f : kSeries)
     if (f.csv_header) columns.push_back({f.csv_header, (r.*f.values).data()});
-  add_matrix(r.y_linear, r.output_names, "_linear");  // no columns without a linear run
+  for (const OptionalField& f : kOptional) add_matrix(r.*f.values, r.*f.names, f.csv_suffix);  // none when absent
   return columns;
 }
 

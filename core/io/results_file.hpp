@@ -6,6 +6,8 @@
 //   /time                            double (N)
 //   /q /v /u /y /xc                  double (N x nq), (N x nv), (N x nu), (N x ny), (N x nxc)
 //   /y_linear                        double (N x ny), only when y_linear has columns (a linear run)
+//   /y_reference                     double (N x ny), only when the run had references r(t)
+//   /u_disturbance                   double (N x nu), only when the run had disturbances d(t)
 //   /energy/kinetic                  double (N)
 //   /energy/potential                double (N)
 //   /constraints/position_violation  double (N)   (SimulationResult::constraint_violation)
@@ -61,13 +63,14 @@ namespace codyna {
 // way. Throws std::runtime_error naming `path` and the reason: a directory that
 // is missing or not writable, an HDF5 failure, or an inconsistent result
 // (a series or matrix whose length is not N, a name list whose size is not the
-// number of columns, unit lists neither empty nor one per column, y_linear
-// with other than ny columns).
+// number of columns, unit lists neither empty nor one per column, y_linear or
+// y_reference with other than ny columns, u_disturbance with other than nu).
 void write_results_hdf5(const SimulationResult& r, const std::string& path);
 
 // Writes `r` to `path` as CSV: the header row
 //   t,<q names>,<v names>,<input names>,<output names>,<controller state names>,
 //   kinetic_energy,potential_energy,constraint_violation[,<output name>_linear...]
+//   [,<output name>_reference...][,<input name>_disturbance...]
 // (one line), then one row per sample. Numbers are printed like "%.17g" in the
 // C locale whatever the current locale is (they read back to the same doubles;
 // "nan", "inf", "-inf" for non-finite values); lines end in "\n"; a name that
@@ -82,7 +85,7 @@ void write_results_csv(const SimulationResult& r, const std::string& path);
 void write_results(const SimulationResult& r, const std::string& hdf5_path, const std::string& csv_path);
 
 // Reads what write_results_hdf5 wrote; the result equals the one written
-// (bit for bit), except that a y_linear without columns comes back 0 x 0 and
+// (bit for bit), except that a y_linear, y_reference or u_disturbance without columns comes back 0 x 0 and
 // any other matrix without columns comes back N x 0. Throws std::runtime_error naming `path` and
 // the reason (no such file, not an HDF5 file, not a codyna results file, a
 // missing or malformed dataset or attribute, inconsistent sizes).

@@ -34,6 +34,8 @@ struct SimulationResult {
   std::vector<double> constraint_violation;    // [N] max |phi(q)| (0 for trees)
   std::vector<double> velocity_violation;      // [N] max |Jc v|
   Eigen::MatrixXd y_linear;                    // [N x ny] linear closed loop from the same start (empty if not run)
+  Eigen::MatrixXd y_reference;                 // [N x ny] r(t) the controller was given (empty: no reference)
+  Eigen::MatrixXd u_disturbance;               // [N x nu] d(t) added to each actuator (empty: no disturbance)
 
   std::vector<std::string> q_names, v_names, input_names, output_names, controller_state_names;
   std::vector<std::string> input_units, output_units;

@@ -21,6 +21,7 @@ struct Recorder {
   std::vector<Eigen::VectorXd> q, v, u, y, xc;
   std::vector<double> T, V, pv, vv;
   std::vector<Eigen::VectorXd> y_linear;
+  std::vector<Eigen::VectorXd> r, d;  // reference and disturbance at each sample (when the run has them)
 
   static Eigen::MatrixXd stack(const std::vector<Eigen::VectorXd>& rows, Eigen::Index cols) {
     Eigen::MatrixXd M(static_cast<Eigen::Index>(rows.size()), cols);
@@ -240,6 +241,8 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
     rec.V.push_back(potential_energy<double>(model, d, q));
     rec.pv.push_back(pv);
     rec.vv.push_back(vv);
+    if (o.reference) rec.r.push_back(o.reference(t));
+    if (o.disturbance) rec.d.push_back(o.disturbance(t));
     if (cb.on_sample) cb.on_sample(Snapshot{t, q, v, u, out});
     if (cb.progress) cb.progress(t, o.t_end);
   };
@@ -316,6 +319,8 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
   r.potential_energy = rec.V;
   r.constraint_violation = rec.pv;
   r.velocity_violation = rec.vv;
+  if (!rec.r.empty()) r.y_reference = Recorder::stack(rec.r, r.y.cols());
+  if (!rec.d.empty()) r.u_disturbance = Recorder::stack(rec.d, r.u.cols());
   r.q_names = model.q_names;
   // a scalar joint's position and rate share the joint's name in the model: keep results columns distinct
   for (const std::string& n : model.v_names)

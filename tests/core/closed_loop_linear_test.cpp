@@ -374,6 +374,13 @@ TEST(ClosedLoopLinear, DisturbanceStepMatchesTheLinearPrediction) {
   const int ipush = index_of(r.input_names, "push");
   EXPECT_EQ(r.u(40, ipush), 0.0);  // t = 0.4 s: not yet
   EXPECT_EQ(r.u(60, ipush), 2.0);
+  // the result records d(t) itself, one column per actuator, zero on the undisturbed
+  ASSERT_EQ(r.u_disturbance.rows(), N);
+  ASSERT_EQ(r.u_disturbance.cols(), r.u.cols());
+  EXPECT_EQ(r.u_disturbance(40, ipush), 0.0);
+  EXPECT_EQ(r.u_disturbance(60, ipush), 2.0);
+  EXPECT_EQ(r.u_disturbance.col(index_of(r.input_names, "force")).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(r.y_reference.size(), 0);  // no reference in this study
   double worst_lin = 0, worst_cl = 0, peak = 0;
   for (int k = 50; k < N; ++k) {  // from the step at t = 0.5 s
     for (int i = 0; i < 2; ++i) {

@@ -81,6 +81,8 @@ SimulationResult oscillator_result(int samples = 50) {
   r.y.resize(samples, 2);
   r.xc.resize(samples, 1);
   r.y_linear.resize(samples, 2);
+  r.y_reference.resize(samples, 2);
+  r.u_disturbance.resize(samples, 1);
   for (int i = 0; i < samples; ++i) {
     const double t = 0.02 * i;
     double kinetic = 0, potential = 0;
@@ -97,6 +99,8 @@ SimulationResult oscillator_result(int samples = 50) {
     r.y(i, 0) = r.q(i, 0);
     r.y(i, 1) = r.v(i, 1);
     r.y_linear.row(i) = r.y.row(i).array() + 1e-6 * t * t;
+    r.y_reference.row(i) << (t < 0.5 ? 0.0 : 0.25), std::sin(t);
+    r.u_disturbance(i, 0) = t < 0.3 ? 0.0 : -1.0 / 3.0;
     r.kinetic_energy.push_back(kinetic);
     r.potential_energy.push_back(potential);
     r.constraint_violation.push_back(1e-13 * std::abs(std::sin(7 * t)));
@@ -123,6 +127,8 @@ SimulationResult without_controller(SimulationResult r) {
   r.xc.resize(r.samples(), 0);
   r.controller_state_names.clear();
   r.y_linear.resize(0, 0);
+  r.y_reference.resize(0, 0);
+  r.u_disturbance.resize(0, 0);
   r.input_units.clear();
   r.controller.clear();
   return r;
@@ -151,6 +157,8 @@ void expect_same(const SimulationResult& a, const SimulationResult& b) {
   EXPECT_TRUE(SameMatrix(a.y, b.y)) << "y";
   EXPECT_TRUE(SameMatrix(a.xc, b.xc)) << "xc";
   EXPECT_TRUE(SameMatrix(a.y_linear, b.y_linear)) << "y_linear";
+  EXPECT_TRUE(SameMatrix(a.y_reference, b.y_reference)) << "y_reference";
+  EXPECT_TRUE(SameMatrix(a.u_disturbance, b.u_disturbance)) << "u_disturbance";
   EXPECT_EQ(a.kinetic_energy, b.kinetic_energy);
   EXPECT_EQ(a.potential_energy, b.potential_energy);
   EXPECT_EQ(a.constraint_violation, b.constraint_violation);
@@ -257,6 +265,9 @@ TEST(ResultsHdf5, InconsistentResultIsRejectedAndTheOldFileKept) {
   EXPECT_TRUE(rejected([](SimulationResult& r) { r.v_names.pop_back(); }, "/names/v has 1 entries for the 2 columns"));
   EXPECT_TRUE(rejected([](SimulationResult& r) { r.output_units.pop_back(); }, "/units/outputs has 1 entries for 2"));
   EXPECT_TRUE(rejected([](SimulationResult& r) { r.y_linear.conservativeResize(50, 1); }, "/y_linear is 50 x 1"));
+  EXPECT_TRUE(rejected([](SimulationResult& r) { r.y_reference.conservativeResize(49, 2); }, "/y_reference is 49 x 2"));
+  EXPECT_TRUE(rejected([](SimulationResult& r) { r.u_disturbance.conservativeResize(50, 2); },
+                       "/u_disturbance is 50 x 2, expected 50 x 1 like /u"));
   EXPECT_EQ(dir.entries(), Strings{"run.h5"});
   expect_same(read_results_hdf5(path), good);
   // and a good write replaces it
@@ -306,6 +317,8 @@ json expectations(const SimulationResult& r) {
   matrix("y", r.y);
   matrix("xc", r.xc);
   if (r.y_linear.cols() > 0) matrix("y_linear", r.y_linear);
+  if (r.y_reference.cols() > 0) matrix("y_reference", r.y_reference);
+  if (r.u_disturbance.cols() > 0) matrix("u_disturbance", r.u_disturbance);
   series("energy/kinetic", r.kinetic_energy);
   series("energy/potential", r.potential_energy);
   series("constraints/position_violation", r.constraint_violation);
@@ -433,6 +446,8 @@ std::vector<double> csv_row(const SimulationResult& r, int i) {
     for (Eigen::Index j = 0; j < m->cols(); ++j) row.push_back((*m)(i, j));
   row.insert(row.end(), {r.kinetic_energy[i], r.potential_energy[i], r.constraint_violation[i]});
   for (Eigen::Index j = 0; j < r.y_linear.cols(); ++j) row.push_back(r.y_linear(i, j));
+  for (Eigen::Index j = 0; j < r.y_reference.cols(); ++j) row.push_back(r.y_reference(i, j));
+  for (Eigen::Index j = 0; j < r.u_disturbance.cols(); ++j) row.push_back(r.u_disturbance(i, j));
   return row;
 }
 
@@ -463,7 +478,8 @@ TEST(ResultsCsv, HeaderAndRowsOfAFullResult) {
   ASSERT_FALSE(lines.empty());
   EXPECT_EQ(lines[0],
             "t,slider.x,rocker.angle,slider.x_dot,rocker.angle_dot,damper_force,\"x, measured\",omega,integral_x,"
-            "kinetic_energy,potential_energy,constraint_violation,\"x, measured_linear\",omega_linear");
+            "kinetic_energy,potential_energy,constraint_violation,\"x, measured_linear\",omega_linear,"
+            "\"x, measured_reference\",omega_reference,damper_force_disturbance");
   expect_csv_rows(lines, r);
   EXPECT_EQ(dir.entries(), Strings{"run.csv"});
 }

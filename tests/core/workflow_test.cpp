@@ -407,6 +407,15 @@ TEST(Workflow, StepReferenceOnTheCartIsFollowedByLqrAndPid) {
   EXPECT_NEAR(a.y(40, 0), 0.0, 1e-9);     // nothing moves before the step (t = 0.4 s)
   EXPECT_LT(a.y(100, 0), 0.0);            // the cart first backs off to tip the rod (non-minimum phase)
   EXPECT_GT(a.y(500, 0), 0.25);           // then goes to the reference
+  // the result records r(t): the operating point's y0 before the step, the step's value after,
+  // y0 for the output without a reference; no disturbance column
+  ASSERT_EQ(a.y_reference.rows(), N);
+  ASSERT_EQ(a.y_reference.cols(), 2);
+  EXPECT_EQ(a.y_reference(40, 0), 0.0);
+  EXPECT_EQ(a.y_reference(60, 0), 0.5);
+  EXPECT_EQ(a.y_reference(N - 1, 0), 0.5);
+  EXPECT_EQ(a.y_reference.col(1).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(a.u_disturbance.size(), 0);
   // PID with the LQR's gains split over the outputs (h, theta) and their rates
   const Eigen::MatrixXd K = lqr_setup.lqr_gain;
   ControllerSpec pid;

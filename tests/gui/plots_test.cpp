@@ -29,6 +29,7 @@
 #include "gui/matrix_models.hpp"
 #include "gui/pole_map.hpp"
 #include "gui/result_plots.hpp"
+#include "gui/signal_plot.hpp"
 #include "simulation/result.hpp"
 
 #ifndef CODYNA_SCREENSHOT_DIR
@@ -172,6 +173,7 @@ class PlotsTest : public QObject {
   void modeModel();
   void zoomKeepsTicksBounded();
   void chartImageAtChosenSize();
+  void referencesAndDisturbancesDrawn();
 };
 
 void PlotsTest::niceRanges() {
@@ -789,6 +791,49 @@ void PlotsTest::chartImageAtChosenSize() {
   });
   QCOMPARE(view.saveImageInteractive(), viaDialog);
   QCOMPARE(QImage(viaDialog).size(), QSize(640, 480));
+}
+
+// The references r(t) a run recorded are drawn dotted over the outputs (every sample, same
+// numbers) with "(reference)" in the legend; the picker offers r, d and the linear outputs
+// by name and reads them from the right columns.
+void PlotsTest::referencesAndDisturbancesDrawn() {
+  codyna::SimulationResult r = makeResult(true, 101);
+  const int n = r.samples();
+  r.y_reference.resize(n, 2);
+  r.u_disturbance = Eigen::MatrixXd::Zero(n, 3);
+  for (int i = 0; i < n; ++i) {
+    r.y_reference(i, 0) = 0.0;
+    r.y_reference(i, 1) = r.t[i] < 2.0 ? 0.0 : 0.8;
+    if (r.t[i] >= 3.0) r.u_disturbance(i, 1) = -2.5;
+  }
+  ResultPlots plots;
+  plots.setResult(r, {0, 2});
+  for (int k = 0; k < 2; ++k) {
+    const QList<QPointF> p = plots.referencePoints(k);
+    QCOMPARE(p.size(), n);
+    for (int i = 0; i < n; i += 9) QCOMPARE(p[i], QPointF(r.t[i], r.y_reference(i, k)));
+  }
+  int named = 0;
+  for (QAbstractSeries* s : plots.outputChart()->series()) named += s->name().contains("(reference)");
+  QCOMPARE(named, 2);
+  // a result without references: none drawn
+  plots.setResult(makeResult(false), {0});
+  QCOMPARE(plots.referencePoints(1).size(), 0);
+
+  const QStringList names = codyna::gui::SignalPlot::signalNames(r);
+  for (const char* want : {"r: x_cart [m]", "d: spare [-]", "y: theta (linear) [rad]", "y: x_cart [m]", "F_cart [N]"})
+    QVERIFY2(names.contains(want), qPrintable(names.join(" | ")));
+  const auto check = [&](const QString& name, const Eigen::MatrixXd& m, int col) {
+    const std::vector<double> v = codyna::gui::SignalPlot::signal(r, name);
+    QCOMPARE(int(v.size()), n);
+    for (int i = 0; i < n; ++i) QCOMPARE(v[i], m(i, col));
+  };
+  check("r: x_cart [m]", r.y_reference, 1);
+  check("d: spare [-]", r.u_disturbance, 1);
+  check("y: theta (linear) [rad]", r.y_linear, 0);
+  check("y: x_cart [m]", r.y, 1);
+  check("F_cart [N]", r.u, 2);
+  QVERIFY(codyna::gui::SignalPlot::signal(r, "no such signal").empty());
 }
 
 QTEST_MAIN(PlotsTest)
