@@ -271,12 +271,21 @@ OperatingPoint static_equilibrium(const Model& model, const OperatingPoint& star
     double t = 1.0;
     bool moved = false;
     for (int k = 0; k < 30 && !moved; ++k, t *= 0.5) {
-      const Eigen::VectorXd rn = rest_accelerations(f, t * dz, u);
-      if (rn.norm() < r.norm()) {
-        Eigen::VectorXd x = Eigen::VectorXd::Zero(f.nx()), v;
+      // a trial step may reach a configuration where the loops' constraints are singular (the
+      // Bricard linkage's bifurcations), in this chart or in the next iteration's: a step whose
+      // evaluation fails there is too long and is halved like one that does not lower the residual
+      try {
+        const Eigen::VectorXd rn = rest_accelerations(f, t * dz, u);
+        if (!rn.allFinite() || !(rn.norm() < r.norm())) continue;
+        Eigen::VectorXd x = Eigen::VectorXd::Zero(f.nx()), v, q;
         x.head(n) = t * dz;
-        f.state_to_qv(x, op.q, v);
+        f.state_to_qv(x, q, v);
+        const PlantFunction next(model, q, op.u, partition_coordinates(model, q, independent));
+        if (!rest_accelerations(next, Eigen::VectorXd::Zero(next.nz()), u).allFinite()) continue;
+        op.q = q;
         moved = true;
+      } catch (const std::runtime_error&) {
+        continue;
       }
     }
     if (!moved) break;

@@ -68,6 +68,46 @@ TEST(SteadyState, FourBarEquilibriumHoldsTheSetCrankWithAFreeInput) {
 
 // Without a free input nothing can hold the crank against gravity: refused, naming what is held,
 // instead of drifting the crank to the hanging equilibrium as before.
+// The Bricard linkage (overconstrained, one redundant loop equation): the equilibrium search's
+// Newton steps cross configurations where the kept loop equations are singular; such trial
+// steps are shortened instead of ending the search ("matrix is not positive definite" before).
+// The equilibrium found (joint_C = pi/2, residual ~1e-15) is checked by a second method: a small
+// nonlinear oscillation about it has the period 2 pi / w of the linearization's A.
+TEST(SteadyState, BricardEquilibriumThroughSingularTrialSteps) {
+  ModelSpec spec = example("bricard.json");
+  spec.analysis.operating_point = "equilibrium";
+  const Model m = study_model(spec);
+  const StudyLinearization l = study_linearize(m);
+  EXPECT_LT(l.op.residual, 1e-12);
+  const auto& names = l.lin.system.state_names;
+  ASSERT_EQ(names.size(), 2u);
+  const double a10 = l.lin.system.A(1, 0);
+  ASSERT_LT(a10, 0.0);  // a stable oscillation about the equilibrium
+  const double w = std::sqrt(-a10);
+  // the nonlinear run: 0.005 rad off the equilibrium in the independent coordinate, at rest
+  const int iq = static_cast<int>(std::find(m.q_names.begin(), m.q_names.end(), names[0]) - m.q_names.begin());
+  const double eq = l.op.q[iq];
+  spec.analysis.set.clear();
+  spec.analysis.initial = {{names[0], eq + 0.005}};
+  spec.analysis.controller = "none";
+  spec.solver.t_end = 6 * 2 * M_PI / w;
+  spec.solver.output_step = 1e-3;
+  spec.solver.rtol = 1e-10;
+  spec.solver.atol = 1e-12;
+  const Model mr = study_model(spec);
+  const SimulationResult r = study_simulate(mr, study_simulation(mr));
+  ASSERT_TRUE(r.completed) << r.failure;
+  // downward zero crossings of q - eq, interpolated: five full periods
+  std::vector<double> crossings;
+  for (int i = 1; i < r.samples(); ++i) {
+    const double a = r.q(i - 1, iq) - eq, b = r.q(i, iq) - eq;
+    if (a > 0 && b <= 0) crossings.push_back(r.t[i - 1] + (r.t[i] - r.t[i - 1]) * a / (a - b));
+  }
+  ASSERT_GE(crossings.size(), 5u);
+  const double period = (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
+  EXPECT_NEAR(period, 2 * M_PI / w, 2e-3 * period) << "w = " << w;
+}
+
 TEST(SteadyState, HeldCoordinateWithoutAFreeInputIsRefused) {
   ModelSpec spec = example("four_bar.json");
   spec.analysis.set = {{"pivot_A", 1.3}};
