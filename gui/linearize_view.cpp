@@ -205,8 +205,10 @@ void LinearizeView::buildUi() {
   auto* modes_split = new QSplitter(Qt::Horizontal, this);
   modes_split->addWidget(mode_view_);
   modes_split->addWidget(pole_map_);
-  modes_split->setStretchFactor(0, 3);
-  modes_split->setStretchFactor(1, 2);
+  modes_split->setObjectName("modesSplitter");
+  // the pole map as wide as the table: a plot of ~150 px cannot be read
+  modes_split->setStretchFactor(0, 1);
+  modes_split->setStretchFactor(1, 1);
 
   auto* results = new QWidget(this);
   auto* res_layout = new QVBoxLayout(results);
@@ -216,8 +218,14 @@ void LinearizeView::buildUi() {
   res_layout->addWidget(tabs_, 1);
 
   auto* vsplit = new QSplitter(Qt::Vertical, this);
+  vsplit->setObjectName("linearizeSplitter");
   vsplit->addWidget(results);
   vsplit->addWidget(modes_split);
+  // the matrices of most plants fit in half the height; the modes and the pole map take the rest
+  vsplit->setStretchFactor(0, 1);
+  vsplit->setStretchFactor(1, 1);
+  vsplit->setSizes({1000, 1000});
+  modes_split->setSizes({1000, 1000});
 
   // the settings keep a narrow column: the matrices, modes and pole map need the room
   auto* left_widget = new QWidget(this);

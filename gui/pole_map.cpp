@@ -164,11 +164,11 @@ PoleMap::PoleMap(QWidget* parent) : QWidget(parent) {
   lf.setPointSizeF(8.5);
   legend_->setFont(lf);
   legend_->setContentsMargins(4, 0, 4, 6);
-  auto* layout = new QVBoxLayout(this);
-  layout->setContentsMargins(0, 0, 0, 0);
-  layout->setSpacing(0);
-  layout->addWidget(view_, 1);
-  layout->addWidget(legend_);
+  box_ = new QBoxLayout(QBoxLayout::TopToBottom, this);
+  box_->setContentsMargins(0, 0, 0, 0);
+  box_->setSpacing(0);
+  box_->addWidget(view_, 1);
+  box_->addWidget(legend_);
 
   connect(axis_re_, &QValueAxis::rangeChanged, this, [this](qreal, qreal) { updateAxisLines(); });
   connect(axis_im_, &QValueAxis::rangeChanged, this, [this](qreal, qreal) { updateAxisLines(); });
@@ -314,7 +314,8 @@ void PoleMap::updateLegend() {
   if (marginal_->count() > 0) parts << entry(QStringLiteral("\u00d7"), QColor(0xe0, 0x8a, 0x00), tr("marginally stable"));
   if (unstable_->count() > 0) parts << entry(QStringLiteral("\u00d7"), QColor(0xd6, 0x27, 0x28), tr("unstable"));
   if (discrete_) parts << entry(QStringLiteral("- -"), QColor(0x50, 0x50, 0x50), tr("unit circle"));
-  QString html = parts.isEmpty() ? tr("no poles") : parts.join(QStringLiteral("&nbsp;&nbsp;&nbsp;&nbsp;"));
+  QString html = parts.isEmpty() ? tr("no poles")
+                                 : parts.join(legend_aside_ ? QStringLiteral("<br>") : QStringLiteral("&nbsp;&nbsp;&nbsp;&nbsp;"));
   if (selected_ >= 0) {
     const codyna::Mode& m = modal_.modes[selected_];
     const std::complex<double> e = m.eigenvalue;
@@ -387,6 +388,16 @@ void PoleMap::mousePressEvent(QMouseEvent* event) {
 
 void PoleMap::resizeEvent(QResizeEvent* event) {
   QWidget::resizeEvent(event);
+  // wider than tall: the legend goes to the side, one entry per line, and the plot keeps the height
+  const bool aside = width() > 1.4 * height() && width() >= 320;
+  if (aside != legend_aside_) {
+    legend_aside_ = aside;
+    box_->setDirection(aside ? QBoxLayout::LeftToRight : QBoxLayout::TopToBottom);
+    legend_->setAlignment(aside ? Qt::AlignLeft | Qt::AlignVCenter : Qt::AlignCenter);
+    updateLegend();
+  }
+  legend_->setFixedWidth(aside ? std::clamp(width() / 3, 120, 220) : QWIDGETSIZE_MAX);
+  if (!aside) legend_->setMinimumWidth(0);
   if (discrete_) updateRanges();
 }
 

@@ -19,6 +19,7 @@
 #include "analysis/modal.hpp"
 
 QT_BEGIN_NAMESPACE
+class QBoxLayout;
 class QChart;
 class QLabel;
 class QChartView;
@@ -76,6 +77,8 @@ class PoleMap : public QWidget {
 
   QChart* chart_ = nullptr;
   QChartView* view_ = nullptr;
+  QBoxLayout* box_ = nullptr;
+  bool legend_aside_ = false;  // a wide map keeps its legend at the side: the plot keeps its height
   QLabel* legend_ = nullptr;  // (the Qt Charts legend mislays scatter markers that come and go)
   QValueAxis* axis_re_ = nullptr;
   QValueAxis* axis_im_ = nullptr;

@@ -26,6 +26,7 @@
 #include "gui/linearize_view.hpp"
 #include "gui/main_window.hpp"
 #include "gui/pole_map.hpp"
+#include <QChart>
 #include "gui/result_plots.hpp"
 #include "gui/simulate_view.hpp"
 #include "gui/study_widgets.hpp"
@@ -216,6 +217,18 @@ class MainWindowXvfb : public QObject {
     QVERIFY2(difference(rest, moving) > 0.002, "the mode shape animation moves the mechanism");
     save(screenOf(&w), "linearize_view.png");
     save(screenOfChild(&w, lv->poleMap()), "pole_map.png");
+    // the pole map is a readable plot, and it grows with the window
+    const QRectF small = lv->poleMap()->chart()->plotArea();
+    QVERIFY2(small.height() >= 90 && small.width() >= 150,
+             qPrintable(QString("%1 x %2").arg(small.width()).arg(small.height())));
+    w.resize(2560, 1440);
+    QTest::qWait(400);
+    const QRectF large = lv->poleMap()->chart()->plotArea();
+    QVERIFY2(large.height() >= 1.3 * small.height() && large.width() >= 1.3 * small.width(),
+             qPrintable(QString("%1 x %2 at 2560 x 1440").arg(large.width()).arg(large.height())));
+    save(screenOf(&w), "linearize_view_2560.png");
+    w.resize(1600, 1000);
+    QTest::qWait(300);
     lv->selectMode(-1);
     w.animateMode(-1, {});
 
