@@ -289,6 +289,11 @@ void MainWindow::buildMenus() {
   frames->setCheckable(true);
   frames->setChecked(true);
   connect(frames, &QAction::toggled, view_, &View3D::setShowFrames);
+  QAction* com = view->addAction(tr("Show &centres of mass"));
+  com->setCheckable(true);
+  com->setChecked(false);
+  com->setToolTip(tr("A dark ball at each body's centre of mass"));
+  connect(com, &QAction::toggled, view_, &View3D::setShowCom);
 
   view->addSeparator();
   for (QDockWidget* d : findChildren<QDockWidget*>()) view->addAction(d->toggleViewAction());

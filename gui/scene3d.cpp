@@ -427,6 +427,19 @@ void Scene::build(const Model* model) {
     items_.push_back(it);
   }
 
+  // centres of mass: a small two-tone ball (black and white octants read as the usual symbol
+  // at a glance) of one size for all bodies, at com in body coordinates
+  for (int i = 1; i < m.nbodies; ++i) {
+    if (!(m.mass[i] > 0.0)) continue;
+    Item it;
+    it.kind = ItemKind::Com;
+    it.prim = Prim::Sphere;
+    it.body = i;
+    it.local = Eigen::Translation3d(m.com[i]) * Eigen::Scaling(0.025 * L);
+    it.color = {0.1f, 0.1f, 0.1f, 1.0f};
+    items_.push_back(it);
+  }
+
   update(data.oMi);
   placeGrid(data.oMi);
 }

@@ -45,6 +45,7 @@ enum class ItemKind {
   Axis,     // joint axis arrow (overlay)
   Frame,    // body frame triad (overlay)
   Spring,   // spring-damper between two bodies
+  Com,      // centre of mass marker (overlay, shown on request)
 };
 
 struct Item {

@@ -30,6 +30,7 @@ QSurfaceFormat requestedFormat() {
   f.setVersion(3, 3);
   f.setProfile(QSurfaceFormat::CoreProfile);
   f.setDepthBufferSize(24);
+  f.setStencilBufferSize(8);  // the selected body's outline
   // 4x multisampling; CODYNA_VIEW_SAMPLES=0 halves the frame time on software GL
   bool set = false;
   const int samples = qEnvironmentVariableIntValue("CODYNA_VIEW_SAMPLES", &set);
@@ -192,7 +193,7 @@ class GLCanvas : public QOpenGLWidget, protected QOpenGLExtraFunctions {
     const qreal dpr = devicePixelRatioF();
     glViewport(0, 0, int(width() * dpr), int(height() * dpr));
     glClearColor(0.9f, 0.9f, 0.92f, 1.0f);
-    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
     if (!ready_) return;
 
     owner_->syncViewport();
@@ -221,21 +222,64 @@ class GLCanvas : public QOpenGLWidget, protected QOpenGLExtraFunctions {
     }
 
     const int hl = owner_->highlight_body_;
+    const auto selected = [hl](const Item& it) { return it.kind == ItemKind::Shape && it.body == hl && hl > 0; };
     auto drawItems = [&](bool overlays, float alpha) {
       for (const Item& it : scene.items()) {
-        if ((it.kind == ItemKind::Axis || it.kind == ItemKind::Frame) != overlays) continue;
+        // overlays: frames and joint axes, centres of mass; drawn over the bodies (faint where hidden)
+        const bool overlay = it.kind == ItemKind::Axis || it.kind == ItemKind::Frame || it.kind == ItemKind::Com;
+        if (overlay != overlays) continue;
+        if (it.kind == ItemKind::Com ? !owner_->show_com_ : overlay && !owner_->show_frames_) continue;
         const Eigen::Matrix4f MV = V * it.world.matrix().cast<float>();
         const Eigen::Matrix3f A = MV.topLeftCorner<3, 3>();
         if (std::abs(A.determinant()) < 1e-30f) continue;  // degenerate (zero-length spring)
         setTransform(P * MV, MV, A.inverse().transpose());
         Eigen::Vector4f color = it.color;
         color[3] *= alpha;
-        setLook(color, true, it.kind == ItemKind::Shape && it.body == hl && hl > 0 ? 0.65f : 0.0f);
+        // the selected body's shapes mark their whole silhouette in the stencil (hidden parts too)
+        if (!overlays && selected(it)) {
+          glEnable(GL_STENCIL_TEST);
+          glStencilFunc(GL_ALWAYS, 1, 0xFF);
+          glStencilOp(GL_KEEP, GL_REPLACE, GL_REPLACE);
+          glStencilMask(0xFF);
+        }
+        setLook(color, true, selected(it) ? 0.35f : 0.0f);
         draw(prims_[int(it.prim)], GL_TRIANGLES);
+        if (!overlays && selected(it)) glDisable(GL_STENCIL_TEST);
       }
     };
     drawItems(false, 1.0f);
-    if (owner_->show_frames_) {
+    if (hl > 0) {
+      // the outline: the selected shapes grown by ~2.5 px, drawn where the stencil is not set,
+      // over everything (a body behind another still shows where it is)
+      glEnable(GL_STENCIL_TEST);
+      glStencilFunc(GL_NOTEQUAL, 1, 0xFF);
+      glStencilMask(0x00);
+      glDisable(GL_DEPTH_TEST);
+      const double px = 2.0 * std::tan(0.5 * cam.fovy) / std::max(1, cam.height);  // world per pixel at unit depth
+      for (const Item& it : scene.items()) {
+        if (!selected(it)) continue;
+        const double depth = std::max(cam.nearPlane(), (it.world.translation() - cam.eye()).dot(cam.forward()));
+        const double grow = 2.5 * px * depth;
+        // unit primitives: a box spans 1 along each axis, a sphere 2, a cylinder 2 across and 1 along
+        const bool round = it.prim == Prim::Sphere, tube = it.prim == Prim::Cylinder || it.prim == Prim::Cone;
+        Eigen::Vector3d f;
+        for (int a = 0; a < 3; ++a) {
+          const double n = it.world.linear().col(a).norm();
+          const double span = n * ((round || (tube && a < 2)) ? 2.0 : 1.0);
+          f[a] = span > 1e-12 ? (span + 2.0 * grow) / span : 1.0;
+        }
+        const Eigen::Matrix4f MV = V * (it.world * Eigen::Scaling(f)).matrix().cast<float>();
+        const Eigen::Matrix3f A = MV.topLeftCorner<3, 3>();
+        if (std::abs(A.determinant()) < 1e-30f) continue;
+        setTransform(P * MV, MV, A.inverse().transpose());
+        setLook(Eigen::Vector4f(1.0f, 0.5f, 0.0f, 1.0f), false, 0.0f);
+        draw(prims_[int(it.prim)], GL_TRIANGLES);
+      }
+      glEnable(GL_DEPTH_TEST);
+      glStencilMask(0xFF);
+      glDisable(GL_STENCIL_TEST);
+    }
+    if (owner_->show_frames_ || owner_->show_com_) {
       // frames and axes often sit inside bodies: show their hidden parts faintly first
       glDepthFunc(GL_GREATER);
       glDepthMask(GL_FALSE);
@@ -414,6 +458,11 @@ void View3D::setHighlight(const QString& bodyName) {
 
 void View3D::setShowFrames(bool on) {
   show_frames_ = on;
+  requestPaint();
+}
+
+void View3D::setShowCom(bool on) {
+  show_com_ = on;
   requestPaint();
 }
 

@@ -2,7 +2,9 @@
 //
 // Draws the bodies of a Model at a configuration q (declared shapes, or a
 // default ball-and-link look for bodies without shapes), joint axes, body
-// frames, ground anchors, springs and a ground grid normal to "up"
+// frames, centres of mass (on request), ground anchors, springs, the selected
+// body tinted and outlined (its silhouette, also where other bodies hide it),
+// and a ground grid normal to "up"
 // (-gravity, else +y), with an orbit camera:
 //   left drag: orbit    middle drag or shift + left drag: pan    wheel: zoom
 //   F or double click on the background: fit    left click: pick a body
@@ -57,6 +59,8 @@ class View3D : public QWidget {
   QString highlight() const { return highlight_; }
   void setShowFrames(bool on);                 // body triads and joint axes, default on
   bool showFrames() const { return show_frames_; }
+  void setShowCom(bool on);                    // centres of mass (a dark ball at each), default off
+  bool showCom() const { return show_com_; }
   void setShowGrid(bool on);                   // ground grid, default on
   bool showGrid() const { return show_grid_; }
 
@@ -105,7 +109,7 @@ class View3D : public QWidget {
   Camera camera_;
   QString highlight_;
   int highlight_body_ = -1;
-  bool show_frames_ = true, show_grid_ = true;
+  bool show_frames_ = true, show_grid_ = true, show_com_ = false;
   std::string fitted_for_;   // source file and name of the model the camera was fitted to
   bool auto_fit_ = true;      // refit on resize until the user moves the camera
 

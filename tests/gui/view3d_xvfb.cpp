@@ -165,6 +165,25 @@ class View3DXvfb : public QObject {
         orange += colorDistance(c, img.pixel(x, y)) > 40 && qRed(c) > qGreen(c) + 40 && qGreen(c) > qBlue(c) + 40;
       }
     QVERIFY2(orange > 150, qPrintable(QString("%1 orange pixels").arg(orange)));
+    // the outline: orange pixels where the picture without the selection shows the background
+    int rim = 0;
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW; ++x) {
+        const QRgb c = hl.pixel(x, y);
+        rim += colorDistance(img.pixel(x, y), background_.pixel(x, y)) < 10 && qRed(c) > 200 && qGreen(c) > 90 &&
+               qGreen(c) < 170 && qBlue(c) < 60;
+      }
+    QVERIFY2(rim > 40, qPrintable(QString("%1 outline pixels around %2").arg(rim).arg(biggest)));
+    // centres of mass on request: one marker per body with mass, drawn
+    int masses = 0, markers = 0;
+    for (int i = 1; i < m->nbodies; ++i) masses += m->mass[static_cast<size_t>(i)] > 0;
+    for (const auto& it : view.scene().items()) markers += it.kind == codyna::gui::ItemKind::Com;
+    QCOMPARE(markers, masses);
+    view.setShowCom(true);
+    const QImage com = grabOf(view);
+    view.setShowCom(false);
+    if (masses > 0) QVERIFY2(differingPixels(com, img, 40) > 10, qPrintable(name));
+    if (name == "four_bar") QVERIFY(com.save(QDir(CODYNA_SCREENSHOT_DIR).filePath("view3d_four_bar_com.png")));
     if (name == "four_bar") QVERIFY(hl.save(QDir(CODYNA_SCREENSHOT_DIR).filePath("view3d_four_bar_highlight.png")));
 
     // another configuration is another picture; the same one again is the same picture
