@@ -137,6 +137,7 @@ void ControlView::buildUi() {
   pole_model_ = new ModeTableModel(this);
   pole_view_ = new QTableView(this);
   pole_view_->setModel(pole_model_);
+  pole_view_->setToolTip(tr("The poles of the linear closed loop (plant and controller) with their frequency and damping"));
   pole_view_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
   pole_view_->setColumnHidden(ModeTableModel::DominantStates, true);
   auto* gain_box = new QGroupBox(tr("Gain K (u = u0 - K dx)"), this);

@@ -81,7 +81,11 @@ void LinearizeView::buildUi() {
   op_combo_->addItem(tr("equilibrium (static, at rest)"), QStringLiteral("equilibrium"));
   op_combo_->addItem(tr("trim (inputs that hold the initial configuration)"), QStringLiteral("trim"));
   op_combo_->addItem(tr("time=T (state of an open-loop run at T)"), QStringLiteral("time"));
+  op_combo_->setToolTip(tr("Where A, B, C, D are taken: the model's initial state, a static equilibrium (at rest, "
+                           "accelerations zero), a trim (the inputs that hold the initial configuration) or the "
+                           "state of an open-loop run at time T"));
   op_time_ = new QDoubleSpinBox(settings);
+  op_time_->setToolTip(tr("time=T: the run's end time T in s (open loop, actuators at u0)"));
   op_time_->setRange(0.0, 1e6);
   op_time_->setDecimals(4);
   op_time_->setSingleStep(0.1);
@@ -97,6 +101,8 @@ void LinearizeView::buildUi() {
   method_combo_->addItem(tr("exact (analytic derivatives)"), QStringLiteral("exact"));
   method_combo_->addItem(tr("fd-forward (forward differences)"), QStringLiteral("fd-forward"));
   method_combo_->addItem(tr("fd-central (central differences)"), QStringLiteral("fd-central"));
+  method_combo_->setToolTip(tr("How the Jacobians are computed: exact analytic derivatives of the recursive "
+                               "algorithms, or forward/central finite differences (a check)"));
   form->addRow(tr("Jacobians"), method_combo_);
 
   ts_spin_ = new QDoubleSpinBox(settings);
@@ -112,6 +118,8 @@ void LinearizeView::buildUi() {
   mat_combo_ = new QComboBox(settings);
   mat_combo_->addItem(tr("MAT v5 (MATLAB, Octave, SciPy)"), QStringLiteral("5"));
   mat_combo_->addItem(tr("MAT v7.3 (HDF5)"), QStringLiteral("7.3"));
+  mat_combo_->setToolTip(tr("Format of NAME.mat: v5 loads everywhere (MATLAB, GNU Octave, SciPy); v7.3 is HDF5 "
+                            "(Octave reads its matrices, not its name lists)"));
   form->addRow(tr("MAT version"), mat_combo_);
 
   export_dir_ = new QLineEdit(settings);
@@ -133,6 +141,7 @@ void LinearizeView::buildUi() {
   auto* ind_layout = new QVBoxLayout(independent_box_);
   independent_ = new QListWidget(independent_box_);
   independent_->setMaximumHeight(120);
+  independent_->setToolTip(independent_box_->toolTip());
   ind_layout->addWidget(independent_);
 
   // the steady-state search (operspec): what an equilibrium or a trim holds, solves and reaches
@@ -158,6 +167,7 @@ void LinearizeView::buildUi() {
 
   linearize_button_ = new QPushButton(tr("Linearize"), this);
   linearize_button_->setDefault(true);
+  linearize_button_->setToolTip(tr("Find the operating point and compute A, B, C, D there (Ctrl+L)"));
   export_button_ = new QPushButton(tr("Export…"), this);
   export_button_->setToolTip(tr("Write NAME.mat + NAME.m (as codyna linearize --out DIR)"));
   auto* buttons = new QHBoxLayout;
@@ -189,6 +199,8 @@ void LinearizeView::buildUi() {
   offsets_ = new QTableWidget(0, 4, tabs_);
   offsets_->setHorizontalHeaderLabels({tr("Vector"), tr("Name"), tr("Value"), tr("Unit")});
   offsets_->verticalHeader()->setVisible(false);
+  offsets_->setToolTip(tr("The operating point: x0 (states), u0 (Plant/In), y0 (Plant/Out) and xdot0 (zero at an "
+                          "equilibrium); the linear model is in deviations from these"));
   offsets_->setEditTriggers(QAbstractItemView::NoEditTriggers);
   offsets_->horizontalHeader()->setStretchLastSection(true);
   tabs_->addTab(offsets_, tr("Offsets x0, u0, y0"));
@@ -196,6 +208,8 @@ void LinearizeView::buildUi() {
   mode_model_ = new ModeTableModel(this);
   mode_view_ = new QTableView(this);
   mode_view_->setModel(mode_model_);
+  mode_view_->setToolTip(tr("The eigenvalues of A with their natural frequency, damping, time constant or period and "
+                            "the states that dominate the mode's shape; select one to animate it in the 3-D view"));
   mode_view_->setSelectionBehavior(QAbstractItemView::SelectRows);
   mode_view_->setSelectionMode(QAbstractItemView::SingleSelection);
   mode_view_->horizontalHeader()->setStretchLastSection(true);

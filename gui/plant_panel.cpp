@@ -148,6 +148,9 @@ PlantPanel::PlantPanel(Document* doc, PlantSide side, QWidget* parent) : QWidget
   view_ = new QTreeView(this);
   view_->setObjectName(side == PlantSide::In ? "plantInView" : "plantOutView");
   view_->setModel(model_);
+  view_->setToolTip(side == PlantSide::In
+                        ? tr("Candidate plant inputs (actuators): ticked ones are the columns of B and D, in this order")
+                        : tr("Candidate plant outputs (sensors): ticked ones are the rows of C and D, in this order"));
   view_->setRootIsDecorated(false);
   view_->setDragDropMode(QAbstractItemView::InternalMove);
   view_->setDragEnabled(true);
@@ -157,6 +160,8 @@ PlantPanel::PlantPanel(Document* doc, PlantSide side, QWidget* parent) : QWidget
   view_->header()->setSectionResizeMode(QHeaderView::ResizeToContents);
   up_ = new QPushButton(tr("Up"), this);
   down_ = new QPushButton(tr("Down"), this);
+  up_->setToolTip(tr("Move the selected signal one place earlier in the plant's order"));
+  down_->setToolTip(tr("Move the selected signal one place later in the plant's order"));
   up_->setObjectName("up");
   down_->setObjectName("down");
   summary_ = new QLabel(this);

@@ -178,6 +178,8 @@ void SimulateView::buildUi() {
   controller_combo_->addItem(tr("The model file's controller"), QStringLiteral("model"));
   controller_combo_->addItem(tr("From a .mat file (K, Kp/Ki/Kd or Ac..Dc)"), QStringLiteral("file"));
   controller_combo_->addItem(tr("LQR designed on the linearized plant"), QStringLiteral("lqr"));
+  controller_combo_->setToolTip(tr("The controller of the run: none (actuators at u0), the model file's, one read "
+                                   "from a .mat file, or an LQR designed on the plant linearized as in the Linearize tab"));
   ctrl_layout->addWidget(controller_combo_);
   controller_pages_ = new QStackedWidget(ctrl_box);
   ctrl_layout->addWidget(controller_pages_);
@@ -223,7 +225,10 @@ void SimulateView::buildUi() {
   file_layout->setContentsMargins(0, 0, 0, 0);
   file_edit_ = new QLineEdit(file_page);
   file_edit_->setPlaceholderText(tr("controller.mat (relative to the model file)"));
+  file_edit_->setToolTip(tr("A controller saved as a .mat (K, or the LTI Ac, Bc, Cc, Dc), e.g. from the exported "
+                            "NAME.m's design in MATLAB or Octave"));
   file_browse_ = new QPushButton(tr("…"), file_page);
+  file_browse_->setToolTip(tr("Choose the controller file"));
   file_layout->addWidget(file_edit_, 1);
   file_layout->addWidget(file_browse_);
   controller_pages_->addWidget(file_page);
@@ -233,7 +238,10 @@ void SimulateView::buildUi() {
   lqr_form->setContentsMargins(0, 0, 0, 0);
   q_weights_ = new QLineEdit(lqr_page);
   q_weights_->setPlaceholderText(tr("identity"));
+  q_weights_->setToolTip(tr("LQR state weights: the diagonal of Q, one number per state (A's order), separated by "
+                            "spaces or commas; empty = identity"));
   r_weights_ = new QLineEdit(lqr_page);
+  r_weights_->setToolTip(tr("LQR input weights: the diagonal of R, one positive number per Plant/In input; empty = identity"));
   r_weights_->setPlaceholderText(tr("identity"));
   lqr_hint_ = new QLabel(lqr_page);
   lqr_hint_->setWordWrap(true);
@@ -254,6 +262,7 @@ void SimulateView::buildUi() {
   t_end_->setDecimals(4);
   t_end_->setSuffix(QStringLiteral(" s"));
   t_end_->setKeyboardTracking(false);
+  t_end_->setToolTip(tr("End time of the run in s"));
   form->addRow(tr("End time"), t_end_);
   initial_ = new NameValueTable(tr("Coordinate"), tr("Start value (m, rad, /s)"), solver_box);
   initial_->setObjectName("initialState");
@@ -267,15 +276,23 @@ void SimulateView::buildUi() {
   output_step_->setSingleStep(0.001);
   output_step_->setSuffix(QStringLiteral(" s"));
   output_step_->setKeyboardTracking(false);
+  output_step_->setToolTip(tr("Time between recorded samples in s (the integrator chooses its own steps)"));
   form->addRow(tr("Output step"), output_step_);
   integrator_ = new QComboBox(solver_box);
   for (const char* name : kIntegrators) integrator_->addItem(QLatin1String(name), QLatin1String(name));
+  integrator_->setToolTip(tr("auto chooses from the eigenvalues at the start (stiff: cvode-bdf; otherwise cvode-adams "
+                             "for trees, arkode for closed loops; the choice is reported); or ida, cvode-bdf, "
+                             "cvode-adams, arkode, the fixed-step rk4"));
   form->addRow(tr("Integrator"), integrator_);
   rtol_ = new QLineEdit(solver_box);
   atol_ = new QLineEdit(solver_box);
+  rtol_->setToolTip(tr("Relative tolerance of the integrator (e.g. 1e-8)"));
+  atol_->setToolTip(tr("Absolute tolerance of the integrator, in the states' units (e.g. 1e-10)"));
   form->addRow(tr("Relative tolerance"), rtol_);
   form->addRow(tr("Absolute tolerance"), atol_);
   compare_linear_ = new QCheckBox(tr("Compare with the linear closed loop"), solver_box);
+  compare_linear_->setToolTip(tr("Also run the linear plant with the same controller from the same start; its outputs "
+                                 "are drawn dashed (codyna simulate --compare-linear)"));
   form->addRow(compare_linear_);
   closed_loop_ = new QCheckBox(tr("Export the linear closed loop with the plant"), solver_box);
   closed_loop_->setToolTip(tr("codyna linearize also writes NAME_cl.m/.mat (Acl, Bcl, Ccl, Dcl) and the step and "
@@ -305,6 +322,7 @@ void SimulateView::buildUi() {
 
   // ---- run
   run_button_ = new QPushButton(tr("Run"), this);
+  run_button_->setToolTip(tr("Simulate the nonlinear model with this controller (F5); plots follow live"));
   run_button_->setDefault(true);
   cancel_button_ = new QPushButton(tr("Cancel"), this);
   progress_ = new QProgressBar(this);
@@ -320,6 +338,7 @@ void SimulateView::buildUi() {
   stale_label_->setVisible(false);
   save_results_ = new QPushButton(tr("Save results…"), this);
   save_plot_ = new QPushButton(tr("Save plot…"), this);
+  save_plot_->setToolTip(tr("Save the Plant/In and Plant/Out plots as PNG or SVG"));
   auto* run_row = new QHBoxLayout;
   run_row->addWidget(run_button_);
   run_row->addWidget(cancel_button_);

@@ -43,6 +43,8 @@ void fillCombo(QComboBox* c, const QStringList& choices, const QString& current)
 QHBoxLayout* buttonRow(QWidget* parent, QPushButton** add, QPushButton** remove) {
   *add = new QPushButton(QObject::tr("Add"), parent);
   *remove = new QPushButton(QObject::tr("Remove"), parent);
+  (*add)->setToolTip(QObject::tr("Add a row (the first name not used yet)"));
+  (*remove)->setToolTip(QObject::tr("Remove the selected row"));
   auto* row = new QHBoxLayout;
   row->addWidget(*add);
   row->addWidget(*remove);
@@ -84,6 +86,7 @@ NameValueTable::NameValueTable(const QString& nameHeader, const QString& valueHe
   layout->setContentsMargins(0, 0, 0, 0);
   table_ = new QTableWidget(0, 2, this);
   table_->setHorizontalHeaderLabels({nameHeader, valueHeader});
+  setToolTip(QStringLiteral("%1: %2").arg(nameHeader, valueHeader));  // a caller's setToolTip says more
   table_->verticalHeader()->setVisible(false);
   table_->horizontalHeader()->setSectionResizeMode(0, QHeaderView::Stretch);
   table_->horizontalHeader()->setSectionResizeMode(1, QHeaderView::Stretch);
@@ -155,6 +158,9 @@ SignalTable::SignalTable(const QString& targetHeader, QWidget* parent) : QWidget
   table_->setHorizontalHeaderLabels(
       {targetHeader, tr("Type"), tr("Time [s]"), tr("Value"), tr("Frequency [Hz]"), tr("Phase [rad]"),
        tr("Points \"t r; t r\" or file")});
+  setToolTip(tr("One signal per row: its %1, the type (step, ramp, sine, table, file), the time it starts "
+                        "and its parameters")
+                         .arg(targetHeader));
   table_->horizontalHeaderItem(Value)->setToolTip(
       tr("step: the value after the time (absolute for a reference, added for a disturbance); ramp: the slope per s; "
          "sine: the amplitude"));

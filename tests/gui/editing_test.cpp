@@ -6,7 +6,9 @@
 // that changed settings while a user scrolled a panel.
 #include <QAbstractItemView>
 #include <QApplication>
+#include <QCheckBox>
 #include <QComboBox>
+#include <QHeaderView>
 #include <QDoubleSpinBox>
 #include <QLineEdit>
 #include <QMessageBox>
@@ -437,6 +439,39 @@ class EditingTest : public QObject {
     QCOMPARE(second->size(), QSize(1500, 950));
     QCOMPARE(second->findChild<QSplitter*>("centreSplitter")->sizes(), sizes);
     QSettings().clear();  // the next test starts from the defaults
+  }
+
+  // every field a person can change in the analysis views, the panels and the property editor
+  // says what it is: a tooltip on it (the meaning and the unit), none left blank
+  void everyFieldHasATooltip() {
+    QVERIFY(w->openFile(kCart));
+    w->selectElement(ElementId{ElementKind::Joint, 0});
+    QStringList missing;
+    const QList<QWidget*> roots{w->linearizeView(), w->simulateView(), w->findChild<ControlView*>(),
+                                w->propertyEditor(), w->findChild<QDockWidget*>("plantInDock"),
+                                w->findChild<QDockWidget*>("plantOutDock")};
+    for (QWidget* root : roots) {
+      QVERIFY(root);
+      for (QWidget* c : root->findChildren<QWidget*>()) {
+        const bool field = qobject_cast<QLineEdit*>(c) || qobject_cast<QComboBox*>(c) || qobject_cast<QAbstractSpinBox*>(c) ||
+                           qobject_cast<QCheckBox*>(c) || qobject_cast<QPushButton*>(c) || qobject_cast<QAbstractItemView*>(c);
+        if (!field || c->inherits("QComboBoxListView") || c->inherits("QComboBoxPrivateContainer") ||
+            qobject_cast<QHeaderView*>(c) || c->inherits("QTableCornerButton") || !c->isEnabledTo(root->window()))
+          continue;
+        if (qobject_cast<QLineEdit*>(c) && qobject_cast<QAbstractSpinBox*>(c->parentWidget())) continue;  // a spin box's own editor
+        if (qobject_cast<QLineEdit*>(c) && qobject_cast<QComboBox*>(c->parentWidget())) continue;
+        // Qt shows the nearest tooltip up the parent chain (a table's cell widget shows the table's)
+        bool shown = false;
+        for (QWidget* p = c; p && !shown; p = p == root ? nullptr : p->parentWidget()) shown = !p->toolTip().trimmed().isEmpty();
+        if (!shown)
+          missing << QStringLiteral("%1 %2 '%3' in %4")
+                         .arg(QString::fromLatin1(c->metaObject()->className()), c->objectName(),
+                              qobject_cast<QAbstractButton*>(c) ? qobject_cast<QAbstractButton*>(c)->text() : QString(),
+                              QString::fromLatin1(root->metaObject()->className()));
+      }
+    }
+    for (const QString& m : missing) qWarning("no tooltip: %s", qPrintable(m));
+    QVERIFY2(missing.isEmpty(), qPrintable(QString::number(missing.size()) + " fields without a tooltip (listed above)"));
   }
 
   // a ball joint's mode moves the 3-D view (its rotation states are tangent coordinates,
