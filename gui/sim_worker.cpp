@@ -85,14 +85,16 @@ void SimWorker::runJob(std::shared_ptr<const codyna::Model> model) {
 
   codyna::StudySimulation setup;
   try {
-    setup = codyna::study_simulation(*model);
+    setup = codyna::study_simulation(*model, &cancel_);
+  } catch (const codyna::StudyCancelled&) {
+    return fail(QStringLiteral("cancelled during the setup (the operating point's time=T run)"));
   } catch (const std::exception& e) {
     return fail(QString::fromStdString(e.what()));
   } catch (...) {
     return fail(QStringLiteral("the simulation setup failed (unknown error)"));
   }
-  // a Cancel pressed while the setup ran (it cannot be interrupted: the operating-point search,
-  // a time=T pre-run) takes effect here, before the run starts
+  // a Cancel pressed while the setup ran takes effect here, before the run starts (a time=T
+  // pre-run stops at its next step; the steady-state searches are short and run to their end)
   if (cancel_.load()) return fail(QStringLiteral("cancelled during the setup (operating point, controller design)"));
   // the window keeps a run several times (plots, the signal list, runs kept for comparison):
   // it records at most kMaxSamples samples; longer records are the command line's (codyna simulate)

@@ -417,7 +417,7 @@ StudyInitialState study_initial_state(const Model& m) {
   return set_coordinates(m, m.q0, m.v0, s.initial, "initial");
 }
 
-OperatingPoint study_operating_point(const Model& m, const std::string& which_in) {
+OperatingPoint study_operating_point(const Model& m, const std::string& which_in, const std::atomic<bool>* cancel) {
   const StudySpec& s = m.spec.analysis;
   const std::string which = which_in.empty() ? s.operating_point : which_in;
   const OperatingPoint start = initial_point(m);
@@ -486,7 +486,14 @@ OperatingPoint study_operating_point(const Model& m, const std::string& which_in
     SimulationOptions o = solver_options(m);
     o.t_end = t;
     o.output_step = t;
-    const SimulationResult r = simulate(m, nullptr, nullptr, o);
+    SimulationCallbacks cb;
+    cb.cancel = cancel;
+    const SimulationResult r = simulate(m, nullptr, nullptr, o, cb);
+    if (r.cancelled) {
+      std::ostringstream os;
+      os << "operating point " << which << ": cancelled at t = " << (r.t.empty() ? 0.0 : r.t.back()) << " s";
+      throw StudyCancelled(os.str());
+    }
     if (!r.completed) throw std::runtime_error("operating point " + which + ": the simulation failed: " + r.failure);
     const int last = r.samples() - 1;
     return snapshot_point(m, t, r.q.row(last).transpose(), r.v.row(last).transpose(), start.u);
@@ -534,7 +541,7 @@ ExportPaths study_export(const Model& m, const LinearSystem& sys, const std::str
   return export_plant(sys, dir, name, s.mat_version == "7.3" ? MatVersion::V73 : MatVersion::V5);
 }
 
-StudySimulation study_simulation(const Model& m) {
+StudySimulation study_simulation(const Model& m, const std::atomic<bool>* cancel) {
   const StudySpec& s = m.spec.analysis;
   StudySimulation out;
   out.options = solver_options(m);
@@ -550,7 +557,7 @@ StudySimulation study_simulation(const Model& m) {
     auto plant = std::make_shared<LinearPlant>();
     // a model's controller is linearized where it was designed; the others where the study says
     const std::string point = from_model ? m.spec.controller.operating_point : s.operating_point;
-    plant->op = study_operating_point(m, point);
+    plant->op = study_operating_point(m, point, cancel);
     LinearizeOptions lo;
     lo.independent = s.independent;
     plant->lin = linearize(m, plant->op, lo);

@@ -16,7 +16,9 @@
 // the file and the field ("/analysis/operating_point") or std::invalid_argument.
 #pragma once
 
+#include <atomic>
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 #include "analysis/closed_loop_linear.hpp"
@@ -59,7 +61,17 @@ StudyInitialState study_initial_state(const Model& model);
 // converge (residual accelerations of 1e-8 or more, outputs off their targets, inputs held
 // at their limits) throws ConvergenceError (model/errors.hpp) naming the residual, the
 // unknowns and what to free; nothing is linearized, exported or simulated about it.
-OperatingPoint study_operating_point(const Model& model, const std::string& which = "");
+//
+// `cancel` (may be null): a time=T pre-run stops at its next step once *cancel is true and
+// StudyCancelled is thrown (the searches are short and not interrupted).
+OperatingPoint study_operating_point(const Model& model, const std::string& which = "",
+                                     const std::atomic<bool>* cancel = nullptr);
+
+// What a study step throws when its caller cancelled it (a front end's Cancel): not an error of
+// the model, nothing was produced.
+struct StudyCancelled : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 struct StudyLinearization {
   OperatingPoint op;
@@ -108,7 +120,8 @@ Eigen::VectorXd study_mode_pose(const Model& model, const Eigen::VectorXd& q_op,
                                 double phase, double amplitude = 0.3);
 
 // Controller and linear plant of the run (linearizing once if anything needs it).
-StudySimulation study_simulation(const Model& model);
+// `cancel` as in study_operating_point (the plant's operating point may be a time=T pre-run).
+StudySimulation study_simulation(const Model& model, const std::atomic<bool>* cancel = nullptr);
 
 SimulationResult study_simulate(const Model& model, const StudySimulation& setup, const SimulationCallbacks& cb = {});
 

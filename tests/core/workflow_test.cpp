@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <atomic>
 #include <filesystem>
 #include <tuple>
 
@@ -256,6 +257,29 @@ TEST(Workflow, ModePoseMovesAlongTheModeOnTheManifold) {
     EXPECT_GT((q - m.q0).norm(), 0.1);
     EXPECT_LT(constraint_residual<double>(m, d, q).lpNorm<Eigen::Infinity>(), 1e-10);
   }
+}
+
+// A front end's Cancel reaches a time=T pre-run (the operating point of a run's plant):
+// StudyCancelled, not an error of the model, and nothing half made; without it the same
+// study runs to its point.
+TEST(Workflow, CancelStopsATimeOperatingPointRun) {
+  ModelSpec spec = example_spec("cart_pendulum.json");
+  spec.analysis.operating_point = "time=2";
+  spec.analysis.controller = "lqr";
+  const Model m = study_model(spec);
+  std::atomic<bool> cancel{true};
+  EXPECT_THROW(study_operating_point(m, "", &cancel), StudyCancelled);
+  try {
+    (void)study_simulation(m, &cancel);
+    FAIL() << "not cancelled";
+  } catch (const StudyCancelled& e) {
+    EXPECT_NE(std::string(e.what()).find("time=2: cancelled at t = 0"), std::string::npos) << e.what();
+  }
+  cancel = false;
+  const StudySimulation s = study_simulation(m, &cancel);
+  ASSERT_TRUE(s.plant);
+  EXPECT_EQ(s.plant->op.t, 2.0);
+  EXPECT_EQ(s.plant->op.kind, "time=2");
 }
 
 TEST(Workflow, SimulationControllerSources) {
