@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 
+#include "dynamics/kinematics.hpp"
+#include "model/errors.hpp"
 #include "spatial/autodiff.hpp"
 
 namespace codyna {
@@ -74,7 +76,35 @@ Eigen::MatrixXd plant_jacobian_fd_full(const PlantFunction& f, const Eigen::Vect
   return J;
 }
 
+namespace {
+
+// A spring-damper whose two points coincide has no direction there: its damping force
+// c (n . v) n and, with a rest length, its elastic force k (0 - L0) n have no limit, and so no
+// derivative (exact and finite differences would each report their own number). Refused with
+// the element and the way out; a rest length 0 spring without damping is smooth (k dp) and fine.
+void refuse_coincident_spring_dampers(const Model& model, const Eigen::VectorXd& q) {
+  if (model.springs.empty()) return;
+  Data d(model);
+  forward_kinematics<double>(model, d, q);
+  for (const SpringDamperModel& s : model.springs) {
+    const double L = (point_position<double>(d, s.body_b, s.point_b) - point_position<double>(d, s.body_a, s.point_a)).norm();
+    if (L > 1e-12 || (s.damping == 0.0 && s.rest_length == 0.0)) continue;
+    std::string path = "/effects";
+    for (std::size_t k = 0; k < model.spec.effects.size(); ++k)
+      if (model.spec.effects[k].name == s.name) path += "/" + std::to_string(k);
+    throw ModelError(model.source_file, path,
+                     "spring_damper \"" + s.name + "\": its two points coincide at the operating point (length " +
+                         std::to_string(L) + " m), where its " +
+                         (s.damping != 0.0 ? std::string("damping force c (n . v) n") : std::string("force k (0 - rest_length) n")) +
+                         " has no direction and no derivative; offset the points, or use rest_length 0 without damping "
+                         "(then the force k (x_b - x_a) is smooth), or linearize elsewhere");
+  }
+}
+
+}  // namespace
+
 Linearization linearize(const Model& model, const OperatingPoint& op, const LinearizeOptions& options) {
+  refuse_coincident_spring_dampers(model, op.q);
   Linearization out;
   out.partition = partition_coordinates(model, op.q, options.independent);
   const PlantFunction f(model, op.q, op.u, out.partition);

@@ -487,21 +487,30 @@ void TreeDerivatives::applied_force_derivatives(const Eigen::VectorXd& q, const 
     const LocalKin b = local_kin(d_.oMi[s.body_b], V_[s.body_b], Vec6::Zero(), s.point_b, false, s.body_b > 0);
     const Vec3 dp = b.x - a.x, vrel = b.xd - a.xd;
     const double L = dp.norm();
-    if (!(L > 1e-12)) continue;  // as applied_forces: no direction, no force
-    const Vec3 n = dp / L;
+    const bool coincident = !(L > 1e-12);
+    // as applied_forces: at coincident points only a rest length 0 spring acts, with F = k dp
+    if (coincident && !(s.rest_length == 0.0 && s.stiffness != 0.0)) continue;
     Mat3x24 Dxa = Mat3x24::Zero(), Dxb = Mat3x24::Zero(), Dvrel;
     Dxa.leftCols<12>() = a.Dx.leftCols<12>();
     Dxb.rightCols<12>() = b.Dx.leftCols<12>();
     Dvrel.leftCols<12>() = -a.Dxd.leftCols<12>();
     Dvrel.rightCols<12>() = b.Dxd.leftCols<12>();
     const Mat3x24 Ddp = Dxb - Dxa;
-    const Mat3x24 Dn = (Mat3::Identity() - n * n.transpose()) / L * Ddp;
-    const double Ld = n.dot(vrel);
-    const double T = s.stiffness * (L - s.rest_length) + s.damping * Ld;
-    const Eigen::Matrix<double, 1, 24> DT =
-        s.stiffness * n.transpose() * Ddp + s.damping * (vrel.transpose() * Dn + n.transpose() * Dvrel);
-    const Vec3 F = T * n;
-    const Mat3x24 DF = n * DT + T * Dn;
+    Vec3 F;
+    Mat3x24 DF;
+    if (coincident) {
+      F = s.stiffness * dp;
+      DF = s.stiffness * Ddp;
+    } else {
+      const Vec3 n = dp / L;
+      const Mat3x24 Dn = (Mat3::Identity() - n * n.transpose()) / L * Ddp;
+      const double Ld = n.dot(vrel);
+      const double T = s.stiffness * (L - s.rest_length) + s.damping * Ld;
+      const Eigen::Matrix<double, 1, 24> DT =
+          s.stiffness * n.transpose() * Ddp + s.damping * (vrel.transpose() * Dn + n.transpose() * Dvrel);
+      F = T * n;
+      DF = n * DT + T * Dn;
+    }
     const Mat3 Fx = skew<double>(F);
     w << a.x.cross(F), F;
     dw.topRows<3>().noalias() = skew<double>(a.x) * DF - Fx * Dxa;

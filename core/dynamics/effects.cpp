@@ -39,7 +39,18 @@ const VecXT<S>& applied_forces(const Model& model, DataT<S>& d, const VecXT<S>& 
     ++count.springs;
     const Vec3T<S> dp = point_position<S>(d, s.body_b, s.point_b) - point_position<S>(d, s.body_a, s.point_a);
     const S L = sqrt(dp.squaredNorm());
-    if (!(ad_value(L) > 1e-12)) continue;  // coincident points: direction undefined, no force
+    if (!(ad_value(L) > 1e-12)) {
+      // coincident points: no direction. With rest length 0 the elastic force k (L - 0) n = k dp
+      // is smooth through them and is applied (its derivative is k: exact and differences agree);
+      // otherwise, and for the damping term c (n . v) n, there is no force (linearize refuses
+      // such a point: spring_damper_singularity)
+      if (s.rest_length == 0.0 && s.stiffness != 0.0) {
+        add_world_force<S>(d, s.body_a, s.point_a, Vec3T<S>(S(s.stiffness) * dp), zero3);
+        add_world_force<S>(d, s.body_b, s.point_b, Vec3T<S>(-S(s.stiffness) * dp), zero3);
+        any_body_force = true;
+      }
+      continue;
+    }
     const Vec3T<S> n = dp / L;
     const S Ld = n.dot(point_velocity<S>(d, s.body_b, s.point_b) - point_velocity<S>(d, s.body_a, s.point_a));
     const S tension = S(s.stiffness) * (L - S(s.rest_length)) + S(s.damping) * Ld;
