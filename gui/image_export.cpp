@@ -16,37 +16,32 @@ bool is_image_path(const QString& path) {
   return suffix == QLatin1String("png") || suffix == QLatin1String("svg");
 }
 
+namespace {
+
+// the bytes into `path` atomically (QSaveFile: the old file stays until the new one is complete)
+bool commit(const QByteArray& bytes, const QString& path, QString* error) {
+  QSaveFile file(path);
+  if (file.open(QIODevice::WriteOnly) && file.write(bytes) == bytes.size() && file.commit()) return true;
+  if (error) *error = QStringLiteral("%1: %2").arg(path, file.errorString());
+  return false;
+}
+
+}  // namespace
+
 bool save_widget_image(QWidget* w, const QString& path, const QString& title,
                        const std::function<void(QPainter&)>& paint_svg, QString* error) {
-  const auto fail = [&](const QString& why) {
-    if (error) *error = QStringLiteral("%1: %2").arg(path, why);
-    return false;
-  };
-  if (!is_image_path(path)) return fail(QStringLiteral("unknown image type (use .png or .svg)"));
+  if (QFileInfo(path).suffix().toLower() != QLatin1String("png"))
+    return save_painted_image(path, w->size(), title, paint_svg, error);  // SVG, or the suffix's error
   QByteArray bytes;
   QBuffer buffer(&bytes);
   buffer.open(QIODevice::WriteOnly);
-  if (QFileInfo(path).suffix().toLower() == QLatin1String("png")) {
-    const QPixmap pixmap = w->grab();
-    if (pixmap.isNull() || !pixmap.save(&buffer, "PNG")) return fail(QStringLiteral("cannot render %1").arg(title));
-  } else {
-    QSvgGenerator svg;
-    svg.setOutputDevice(&buffer);
-    svg.setSize(w->size());
-    svg.setViewBox(QRect(QPoint(0, 0), w->size()));
-    svg.setTitle(title);
-    QPainter painter;
-    if (!painter.begin(&svg)) return fail(QStringLiteral("cannot start the SVG output"));
-    painter.setRenderHint(QPainter::Antialiasing);
-    painter.fillRect(w->rect(), Qt::white);
-    paint_svg(painter);
-    painter.end();
+  const QPixmap pixmap = w->grab();
+  if (pixmap.isNull() || !pixmap.save(&buffer, "PNG")) {
+    if (error) *error = QStringLiteral("%1: cannot render %2").arg(path, title);
+    return false;
   }
   buffer.close();
-  QSaveFile file(path);
-  if (!file.open(QIODevice::WriteOnly)) return fail(file.errorString());
-  if (file.write(bytes) != bytes.size() || !file.commit()) return fail(file.errorString());
-  return true;
+  return commit(bytes, path, error);
 }
 
 bool save_painted_image(const QString& path, const QSize& size, const QString& title,
@@ -85,10 +80,7 @@ bool save_painted_image(const QString& path, const QSize& size, const QString& t
     painter.end();
   }
   buffer.close();
-  QSaveFile file(path);
-  if (!file.open(QIODevice::WriteOnly)) return fail(file.errorString());
-  if (file.write(bytes) != bytes.size() || !file.commit()) return fail(file.errorString());
-  return true;
+  return commit(bytes, path, error);
 }
 
 }  // namespace codyna::gui

@@ -258,48 +258,39 @@ void ResultPlots::setupSeries(Panel& p, const QStringList& names, const QStringL
   // the cursor is re-added last so that it is drawn over the data
   p.chart->removeSeries(p.cursor);
   const int n = static_cast<int>(names.size());
-  for (int k = 0; k < n; ++k) {
-    const QColor colour = seriesColor(k);
+  // one curve of output k: the run's (solid), the linear prediction (dashed), the reference (dotted)
+  const auto curve = [&p](const QString& name, const QPen& pen, std::vector<QLineSeries*>& series,
+                          std::vector<QList<QPointF>>& data) {
     auto* s = new QLineSeries;
-    s->setName(nameWithUnit(names[k], at(units, k)));
-    QPen pen(colour);
-    pen.setWidthF(1.8);
-    pen.setCapStyle(Qt::RoundCap);
-    pen.setJoinStyle(Qt::RoundJoin);
+    s->setName(name);
     s->setPen(pen);
     p.chart->addSeries(s);
     s->attachAxis(p.axis_t);
     s->attachAxis(p.axis_y);
-    p.series.push_back(s);
-    p.data.emplace_back();
+    series.push_back(s);
+    data.emplace_back();
+  };
+  for (int k = 0; k < n; ++k) {
+    const QColor colour = seriesColor(k);
+    QPen pen(colour);
+    pen.setWidthF(1.8);
+    pen.setCapStyle(Qt::RoundCap);
+    pen.setJoinStyle(Qt::RoundJoin);
+    curve(nameWithUnit(names[k], at(units, k)), pen, p.series, p.data);
     if (withLinear) {
-      auto* l = new QLineSeries;
-      l->setName(nameWithUnit(names[k] + QStringLiteral(" (linear)"), at(units, k)));
       QPen lpen(colour);
       lpen.setWidthF(1.6);
       lpen.setStyle(Qt::CustomDashLine);
       lpen.setDashPattern({5.0, 3.0});
-      l->setPen(lpen);
-      p.chart->addSeries(l);
-      l->attachAxis(p.axis_t);
-      l->attachAxis(p.axis_y);
-      p.linear.push_back(l);
-      p.linear_data.emplace_back();
+      curve(nameWithUnit(names[k] + QStringLiteral(" (linear)"), at(units, k)), lpen, p.linear, p.linear_data);
     }
     if (withReference) {
-      auto* l = new QLineSeries;
-      l->setName(nameWithUnit(names[k] + QStringLiteral(" (reference)"), at(units, k)));
       QPen rpen(colour.darker(160));
       rpen.setWidthF(1.3);
       rpen.setStyle(Qt::CustomDashLine);
       rpen.setDashPattern({1.0, 2.5});
       rpen.setCapStyle(Qt::RoundCap);
-      l->setPen(rpen);
-      p.chart->addSeries(l);
-      l->attachAxis(p.axis_t);
-      l->attachAxis(p.axis_y);
-      p.reference.push_back(l);
-      p.reference_data.emplace_back();
+      curve(nameWithUnit(names[k] + QStringLiteral(" (reference)"), at(units, k)), rpen, p.reference, p.reference_data);
     }
   }
   p.chart->addSeries(p.cursor);
