@@ -22,7 +22,10 @@
 #include "gui/document.hpp"
 #include "gui/matrix_models.hpp"
 #include "gui/matrix_view.hpp"
+#include "gui/pole_map.hpp"
 #include "gui/result_plots.hpp"
+#include "analysis/modal.hpp"
+#include "analysis/zeros.hpp"
 
 namespace codyna::gui {
 
@@ -191,6 +194,11 @@ void ControlView::buildUi() {
   auto* plots = new QTabWidget(this);
   plots->addTab(bode, tr("Bode"));
   plots->addTab(view(step_chart_, "stepView"), tr("Step"));
+  pz_map_ = new PoleMap(this);
+  pz_map_->setObjectName("poleZeroMap");
+  pz_map_->setToolTip(tr("The chosen system's poles (x) and the zeros (o) of the chosen input-output pair: where "
+                         "its transfer function vanishes (MATLAB's zero(sys(out, in)))"));
+  plots->addTab(pz_map_, tr("Pole-zero map"));
 
   auto* body = new QSplitter(Qt::Horizontal, this);
   body->addWidget(left);
@@ -346,6 +354,18 @@ void ControlView::redraw() {
   const StepResponse* st = step(which);
   const LinearSystem* sys = system(which);
   const int in = input_combo_->currentIndex(), out = output_combo_->currentIndex();
+  // poles of the system, zeros of the pair
+  if (sys && in >= 0 && out >= 0 && in < sys->B.cols() && out < sys->C.rows()) {
+    pz_map_->setModes(modal_analysis(*sys));
+    try {
+      pz_map_->setZeros(transmission_zeros(*sys, in, out).zeros);
+    } catch (const std::exception&) {
+      pz_map_->setZeros({});
+    }
+  } else {
+    pz_map_->setModes({});
+    pz_map_->setZeros({});
+  }
   auto* mx = static_cast<QLogValueAxis*>(mag_chart_->axes(Qt::Horizontal).value(0));
   auto* my = static_cast<QValueAxis*>(mag_chart_->axes(Qt::Vertical).value(0));
   auto* px = static_cast<QLogValueAxis*>(phase_chart_->axes(Qt::Horizontal).value(0));

@@ -41,6 +41,8 @@ class Document;
 class MatrixTableModel;
 class ModeTableModel;
 
+class PoleMap;
+
 class ControlView : public QWidget {
   Q_OBJECT
  public:
@@ -77,6 +79,8 @@ class ControlView : public QWidget {
   MatrixTableModel* gainModel() const { return gain_model_; }
   ModeTableModel* poleModel() const { return pole_model_; }
   QLabel* statusLabel() const { return status_; }
+  // the chosen system's poles and the chosen pair's transmission zeros
+  PoleMap* poleZeroMap() const { return pz_map_; }
 
  signals:
   void message(const QString& text);
@@ -84,7 +88,7 @@ class ControlView : public QWidget {
  private:
   void buildUi();
   void fillPairs();  // input and output names of the chosen system
-  void redraw();     // the chosen pair's Bode and step curves
+  void redraw();     // the chosen pair's Bode and step curves, poles and zeros
   void updateStaleness();
 
   Document* doc_;
@@ -107,6 +111,7 @@ class ControlView : public QWidget {
   QChart* mag_chart_ = nullptr;
   QChart* phase_chart_ = nullptr;
   QChart* step_chart_ = nullptr;
+  PoleMap* pz_map_ = nullptr;
   QLineSeries* mag_series_ = nullptr;
   QLineSeries* phase_series_ = nullptr;
   std::vector<QLineSeries*> step_series_;

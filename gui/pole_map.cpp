@@ -138,7 +138,16 @@ PoleMap::PoleMap(QWidget* parent) : QWidget(parent) {
   QPen ring(QColor(0xff, 0x8c, 0x00));
   ring.setWidthF(2.2);
   selected_series_->setPen(ring);
-  for (QScatterSeries* s : {selected_series_, stable_, marginal_, unstable_}) {
+  // zeros: open circles, the usual symbol
+  zero_series_ = new QScatterSeries;
+  zero_series_->setName(QStringLiteral("zeros"));
+  zero_series_->setMarkerShape(QScatterSeries::MarkerShapeCircle);
+  zero_series_->setMarkerSize(kMarker - 2);
+  zero_series_->setBrush(Qt::NoBrush);
+  QPen zpen(QColor(0x2c, 0xa0, 0x2c));
+  zpen.setWidthF(2.0);
+  zero_series_->setPen(zpen);
+  for (QScatterSeries* s : {zero_series_, selected_series_, stable_, marginal_, unstable_}) {
     chart_->addSeries(s);
     s->attachAxis(axis_re_);
     s->attachAxis(axis_im_);
@@ -191,7 +200,15 @@ void PoleMap::setModes(const codyna::ModalAnalysis& modal) {
   rebuild();
 }
 
+void PoleMap::setZeros(const Eigen::VectorXcd& zeros) {
+  zeros_.clear();
+  for (const std::complex<double>& z : zeros)
+    if (std::isfinite(z.real()) && std::isfinite(z.imag())) zeros_.emplace_back(z.real(), z.imag());
+  rebuild();
+}
+
 void PoleMap::rebuild() {
+  zero_series_->replace(QList<QPointF>(zeros_.begin(), zeros_.end()));
   QList<QPointF> stable, marginal, unstable;
   for (std::size_t i = 0; i < modal_.modes.size(); ++i) {
     const std::complex<double> e = modal_.modes[i].eigenvalue;
@@ -217,11 +234,14 @@ void PoleMap::rebuild() {
   unit_circle_->setVisible(discrete_);
 
   if (discrete_) {
-    chart_->setTitle(QStringLiteral("Poles, z-plane (discrete, Ts = %1 s)").arg(QString::number(modal_.Ts, 'g', 6)));
+    chart_->setTitle(QStringLiteral("%1, z-plane (discrete, Ts = %2 s)")
+                         .arg(zeros_.empty() ? QStringLiteral("Poles") : QStringLiteral("Poles and zeros"),
+                              QString::number(modal_.Ts, 'g', 6)));
     axis_re_->setTitleText(QStringLiteral("Re(z)"));
     axis_im_->setTitleText(QStringLiteral("Im(z)"));
   } else {
-    chart_->setTitle(QStringLiteral("Poles, s-plane (continuous)"));
+    chart_->setTitle(zeros_.empty() ? QStringLiteral("Poles, s-plane (continuous)")
+                                    : QStringLiteral("Poles and zeros, s-plane (continuous)"));
     axis_re_->setTitleText(QStringLiteral("Re(\u03bb) [1/s]"));
     axis_im_->setTitleText(QStringLiteral("Im(\u03bb) [rad/s]"));
   }
@@ -236,7 +256,9 @@ void PoleMap::updateRanges() {
   if (updating_ranges_) return;
   updating_ranges_ = true;
   double xlo = 0, xhi = 0, ylo = 0, yhi = 0;
-  for (const QPointF& p : poles_) {
+  std::vector<QPointF> shown = poles_;
+  shown.insert(shown.end(), zeros_.begin(), zeros_.end());
+  for (const QPointF& p : shown) {
     if (!std::isfinite(p.x()) || !std::isfinite(p.y())) continue;
     xlo = std::min(xlo, p.x());
     xhi = std::max(xhi, p.x());
@@ -313,6 +335,7 @@ void PoleMap::updateLegend() {
   if (stable_->count() > 0) parts << entry(QStringLiteral("\u00d7"), QColor(0x1f, 0x77, 0xb4), tr("stable"));
   if (marginal_->count() > 0) parts << entry(QStringLiteral("\u00d7"), QColor(0xe0, 0x8a, 0x00), tr("marginally stable"));
   if (unstable_->count() > 0) parts << entry(QStringLiteral("\u00d7"), QColor(0xd6, 0x27, 0x28), tr("unstable"));
+  if (!zeros_.empty()) parts << entry(QStringLiteral("\u25cb"), QColor(0x2c, 0xa0, 0x2c), tr("zeros"));
   if (discrete_) parts << entry(QStringLiteral("- -"), QColor(0x50, 0x50, 0x50), tr("unit circle"));
   QString html = parts.isEmpty() ? tr("no poles")
                                  : parts.join(legend_aside_ ? QStringLiteral("<br>") : QStringLiteral("&nbsp;&nbsp;&nbsp;&nbsp;"));

@@ -10,6 +10,8 @@
 // damping in a tooltip.
 #pragma once
 
+#include <Eigen/Core>
+
 #include <QPoint>
 #include <QPointF>
 #include <QString>
@@ -38,6 +40,10 @@ class PoleMap : public QWidget {
 
   // Shows the modes (the selection is cleared).
   void setModes(const codyna::ModalAnalysis& modal);
+  // Zeros drawn as circles with the poles (a pole-zero map); empty: none. Kept by setModes.
+  void setZeros(const Eigen::VectorXcd& zeros);
+  int zeroCount() const { return static_cast<int>(zeros_.size()); }
+  QPointF zeroPosition(int k) const { return k >= 0 && k < zeroCount() ? zeros_[k] : QPointF(); }
   // Highlights mode `index` (-1 or out of range: none). Does not emit modeSelected.
   void selectMode(int index);
   int selectedMode() const { return selected_; }
@@ -92,6 +98,8 @@ class PoleMap : public QWidget {
 
   codyna::ModalAnalysis modal_;
   std::vector<QPointF> poles_;
+  std::vector<QPointF> zeros_;
+  QScatterSeries* zero_series_ = nullptr;
   bool discrete_ = false;
   int selected_ = -1;
   bool updating_ranges_ = false;

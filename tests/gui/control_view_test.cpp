@@ -19,6 +19,7 @@
 
 #include "drive.hpp"
 #include "gui/chart_view.hpp"
+#include "gui/pole_map.hpp"
 #include "gui/control_view.hpp"
 #include "gui/main_window.hpp"
 #include "gui/matrix_models.hpp"
@@ -90,6 +91,30 @@ class ControlViewTest : public QObject {
     QCOMPARE(row.size(), 2);
     QCOMPARE(row[0].toDouble(), mag[4].x());
     QCOMPARE(row[1].toDouble(), mag[4].y());
+  }
+
+  // the pole-zero map of the chosen pair: the plant's force-to-cart-position zeros are the held-cart
+  // pendulum's poles +-sqrt(3 g / (2 l)) (the rod, l = 2 m), drawn as circles beside A's poles;
+  // the force-to-angle pair's are at the origin
+  void poleZeroMapOfTheChosenPair() {
+    ControlView* cv = w->controlView();
+    w->analysisTabs()->setCurrentWidget(cv);
+    QVERIFY(cv->analyse());
+    cv->systemCombo()->setCurrentIndex(ControlView::Plant);
+    cv->inputCombo()->setCurrentIndex(cv->inputCombo()->findText("force", Qt::MatchContains));
+    cv->outputCombo()->setCurrentIndex(cv->outputCombo()->findText("h", Qt::MatchStartsWith));
+    PoleMap* map = cv->poleZeroMap();
+    QCOMPARE(map->poleCount(), 4);
+    QCOMPARE(map->zeroCount(), 2);
+    const double z = std::sqrt(3 * 9.81 / (2 * 2.0));
+    QVERIFY(std::abs(map->zeroPosition(0).x() + z) < 1e-9 && std::abs(map->zeroPosition(1).x() - z) < 1e-9);
+    QVERIFY(map->legendText().contains("zeros"));
+    // force to angle: theta follows the cart's acceleration, a double zero at s = 0 (it cancels the
+    // cart's double integrator)
+    cv->outputCombo()->setCurrentIndex(cv->outputCombo()->findText("theta", Qt::MatchStartsWith));
+    QCOMPARE(map->zeroCount(), 2);
+    for (int k = 0; k < 2; ++k) QVERIFY(std::hypot(map->zeroPosition(k).x(), map->zeroPosition(k).y()) < 1e-6);
+    QCOMPARE(map->poleCount(), 4);
   }
 
   void closedLoopStepGainAndPoles() {
