@@ -286,6 +286,14 @@ class MainWindowXvfb : public QObject {
     qobject_cast<QTabWidget*>(tabs)->setCurrentIndex(1);
     QTest::qWait(300);
     save(screenOf(&w), "step_response.png");
+    // the plant's pole-zero map for force -> h: the non-minimum-phase zero pair
+    cv->systemCombo()->setCurrentIndex(ControlView::Plant);
+    cv->inputCombo()->setCurrentText("force");
+    cv->outputCombo()->setCurrentText("h");
+    qobject_cast<QTabWidget*>(tabs)->setCurrentIndex(2);
+    QTest::qWait(300);
+    QCOMPARE(cv->poleZeroMap()->zeroCount(), 2);
+    save(screenOfChild(&w, cv->poleZeroMap()), "pole_zero_map.png");
 
     // the rod's joint, its fields typed; a refused mass, marked with the reason
     w.selectElement(ElementId{ElementKind::Joint, 1});
