@@ -255,6 +255,11 @@ void ResultPlots::clearPanel(Panel& p) {
 void ResultPlots::setupSeries(Panel& p, const QStringList& names, const QStringList& units, bool withLinear,
                               bool withReference) {
   clearPanel(p);
+  // attaching a series re-initializes the axes' ranges with the tick interval they have: after a
+  // zoom far in, that interval laid out billions of labels (the monkey test's 32 GB request under
+  // ASan, caught in gdb at ChartValueAxisY::calculateLayout from attachAxis). Coarse until the
+  // ranges are set again (setAxisRange sets the step).
+  for (QValueAxis* a : {p.axis_t, p.axis_y}) a->setTickInterval(std::numeric_limits<double>::max() / 4);
   // the cursor is re-added last so that it is drawn over the data
   p.chart->removeSeries(p.cursor);
   const int n = static_cast<int>(names.size());
