@@ -4,8 +4,8 @@
 # coverage, CODYNA_FUZZ) into build-asan/ (-O1, assertions on), and runs the
 # core GoogleTest suite and the CLI shell tests there (ctest -L "core|cli"),
 # then every offscreen GUI test program (tests/gui/*_test.cpp: they drive the
-# widgets as a person does; the monkey test, 5 seeds x 4000 random events, only with
-# CODYNA_SANITIZE_MONKEY=1: see below). Any ASan error, leak or undefined behaviour fails the test that hit it.
+# widgets as a person does; the monkey test with 5 seeds x 4000 random events).
+# Any ASan error, leak or undefined behaviour fails the test that hit it.
 # The same build then serves scripts/fuzz.sh (CODYNA_FUZZ_BUILD=build-asan),
 # as .ci/run does. Extra arguments go to ctest (e.g. -R ModelFile).
 # CODYNA_JOBS (default 2) sets the build and test parallelism.
@@ -45,12 +45,7 @@ ctest --output-on-failure -j "$jobs" -L "core|cli" "$@"
 # instrumented; what they keep until exit (fonts, the platform plugin) is
 # suppressed by name in tests/data/lsan_qt.supp, nothing of codyna's
 # (only in the full run: extra arguments select among the core and CLI tests)
-# The monkey test under ASan is opt-in (CODYNA_SANITIZE_MONKEY=1): on loaded CI machines it has
-# twice ended with one 32 GB request (QArrayData::reallocateUnaligned) whose cause is not found
-# yet (see docs/reliability.md); the monkey still runs in the release suite (1000 events x 5 seeds).
 if [ $# -eq 0 ]; then
-  skip_monkey=(-E '^gui\.monkey_test$')
-  [ "${CODYNA_SANITIZE_MONKEY:-0}" = 1 ] && skip_monkey=()
   LSAN_OPTIONS="suppressions=$PWD/../tests/data/lsan_qt.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}" \
-    ctest --output-on-failure -j 1 -R '^gui\.[a-z0-9_]+_test$' "${skip_monkey[@]}"
+    ctest --output-on-failure -j 1 -R '^gui\.[a-z0-9_]+_test$'
 fi
