@@ -22,6 +22,8 @@ void print_info(const Model& m) {
   }
   std::cout << "coordinates  ";
   for (int k = 0; k < m.nv; ++k) std::cout << (k ? ", " : "") << m.v_names[k] << " [" << m.v_units[k] << "]";
+  std::cout << "\nrates        ";
+  for (int k = 0; k < m.nv; ++k) std::cout << (k ? ", " : "") << m.rate_names[k] << " [" << m.v_units[k] << "/s]";
   std::cout << "\nconstraints  " << m.constraints.size() << " (" << m.nc << " equations, "
             << m.active_rows.size() << " independent)\n";
   for (const ConstraintModel& c : m.constraints)

@@ -34,27 +34,6 @@ struct LinearizeArgs {
   const CLI::App* cmd = nullptr;  // to tell given flags (they override the file's analysis section)
 };
 
-void print_matrix(const char* label, const Eigen::MatrixXd& M, const std::vector<std::string>& rows,
-                  const std::vector<std::string>& cols) {
-  std::cout << label << " (" << M.rows() << " x " << M.cols() << ")\n";
-  if (M.size() == 0) return;
-  const double scale = M.cwiseAbs().maxCoeff();
-  std::size_t w = 8;
-  for (const auto& r : rows) w = std::max(w, r.size() + 1);
-  std::cout << std::setw(static_cast<int>(w)) << "";
-  for (const auto& c : cols) std::cout << std::setw(14) << c.substr(0, 13);
-  std::cout << "\n";
-  for (Eigen::Index i = 0; i < M.rows(); ++i) {
-    std::cout << std::left << std::setw(static_cast<int>(w)) << rows[i] << std::right;
-    for (Eigen::Index j = 0; j < M.cols(); ++j) {
-      // round-off (an entry 1e-14 of the largest, e.g. 1e-44 beside 7.4) is printed as 0; the export keeps it
-      const double x = std::abs(M(i, j)) <= 1e-14 * scale ? 0.0 : M(i, j);
-      std::cout << std::setw(14) << std::setprecision(6) << x;
-    }
-    std::cout << "\n";
-  }
-}
-
 JacobianMethod method_of(const std::string& s) {
   if (s == "exact") return JacobianMethod::Exact;
   if (s == "fd-forward") return JacobianMethod::ForwardDifference;
@@ -234,11 +213,7 @@ void run(const LinearizeArgs& a) {
     std::cout << "\n";
   }
   std::cout << "\n";
-  auto labelled = [](const std::vector<std::string>& names, const Eigen::VectorXd& v) {
-    std::ostringstream os;
-    for (std::size_t k = 0; k < names.size(); ++k) os << "  " << names[k] << " = " << v[k] << "\n";
-    return os.str();
-  };
+  const auto labelled = [](const std::vector<std::string>& names, const Eigen::VectorXd& v) { return name_values(names, v); };
   std::cout << "x0\n" << labelled(sys.state_names, sys.x0) << "u0\n" << labelled(sys.input_names, sys.u0)
             << "y0\n" << labelled(sys.output_names, sys.y0) << "xdot0\n" << labelled(sys.state_names, sys.xdot0) << "\n";
   print_matrix("A", sys.A, sys.state_names, sys.state_names);

@@ -212,14 +212,14 @@ void run(const SimulateArgs& a) {
     std::cout << "operating point  " << plant->op.kind;
     if (plant->op.kind == "equilibrium" || plant->op.kind == "trim") std::cout << " (residual " << plant->op.residual << ")";
     std::cout << ":";
-    for (int k = 0; k < m.nq; ++k) std::cout << (k ? ", " : " ") << m.q_names[k] << " = " << std::setprecision(10) << plant->op.q[k];
+    std::cout << " " << name_values(m.v_names, study_coordinates(m, plant->op.q), true, 10) << std::setprecision(10);
     for (int k : m.plant_inputs) std::cout << ", " << m.actuators[k].name << " = " << plant->op.u[k];
     std::cout << std::setprecision(6) << "\n";
   }
   if (!m.spec.analysis.initial.empty()) {
     const Eigen::VectorXd& q0 = o.q0;
     std::cout << "initial state   ";
-    for (int k = 0; k < m.nq; ++k) std::cout << (k ? ", " : " ") << m.q_names[k] << " = " << std::setprecision(10) << q0[k];
+    std::cout << " " << name_values(m.v_names, study_coordinates(m, q0), true, 10);
     std::cout << std::setprecision(6) << " (the study's initial state, apart from the operating point)\n";
   }
 

@@ -1,7 +1,10 @@
 #include <cmath>
 #include "common.hpp"
 
+#include <algorithm>
+#include <iomanip>
 #include <iostream>
+#include <sstream>
 #include <stdexcept>
 
 #include "io/model_file.hpp"
@@ -47,6 +50,48 @@ void apply_initial(StudySpec& study, const std::vector<std::string>& initial) {
 
 void apply_targets(StudySpec& study, const std::vector<std::string>& targets) {
   apply_pairs(study.output_targets, targets, "--target");
+}
+
+double shown(double x, double scale) { return std::abs(x) <= 1e-12 * std::max(1.0, scale) ? 0.0 : x; }
+
+std::string name_values(const std::vector<std::string>& names, const Eigen::VectorXd& v, bool one_line, int precision) {
+  const double scale = v.size() ? v.cwiseAbs().maxCoeff() : 0.0;
+  std::ostringstream os;
+  os.precision(precision);
+  for (Eigen::Index k = 0; k < v.size(); ++k) {
+    const std::string& name = static_cast<std::size_t>(k) < names.size() ? names[static_cast<std::size_t>(k)] : "?";
+    if (one_line) os << (k ? ", " : "") << name << " = " << shown(v[k], scale);
+    else os << "  " << name << " = " << shown(v[k], scale) << "\n";
+  }
+  return os.str();
+}
+
+void print_matrix(const char* label, const Eigen::MatrixXd& M, const std::vector<std::string>& rows,
+                  const std::vector<std::string>& cols, int width) {
+  std::cout << label << " (" << M.rows() << " x " << M.cols() << ")\n";
+  if (M.size() == 0) return;
+  const double scale = M.cwiseAbs().maxCoeff();
+  std::size_t w = 8;
+  for (const auto& r : rows) w = std::max(w, r.size() + 1);
+  constexpr int kColumn = 14;
+  const Eigen::Index per_block = std::max<Eigen::Index>(1, (width - static_cast<int>(w)) / kColumn);
+  for (Eigen::Index first = 0; first < M.cols(); first += per_block) {
+    const Eigen::Index last = std::min(M.cols(), first + per_block);
+    if (first > 0 || last < M.cols())
+      std::cout << (first > 0 ? "\n" : "") << "  columns " << first + 1 << " to " << last << " of " << M.cols() << "\n";
+    std::cout << std::setw(static_cast<int>(w)) << "";
+    for (Eigen::Index j = first; j < last; ++j) {
+      const std::string& c = static_cast<std::size_t>(j) < cols.size() ? cols[static_cast<std::size_t>(j)] : "?";
+      std::cout << std::setw(kColumn) << c.substr(0, kColumn - 1);
+    }
+    std::cout << "\n";
+    for (Eigen::Index i = 0; i < M.rows(); ++i) {
+      const std::string& r = static_cast<std::size_t>(i) < rows.size() ? rows[static_cast<std::size_t>(i)] : "?";
+      std::cout << std::left << std::setw(static_cast<int>(w)) << r << std::right;
+      for (Eigen::Index j = first; j < last; ++j) std::cout << std::setw(kColumn) << std::setprecision(6) << shown(M(i, j), scale);
+      std::cout << "\n";
+    }
+  }
 }
 
 bool given(const CLI::App* cmd, const std::string& option) { return cmd->count(option) > 0; }

@@ -28,6 +28,18 @@ void apply_initial(StudySpec& study, const std::vector<std::string>& initial);
 // the same for --target NAME=VALUE (StudySpec::output_targets)
 void apply_targets(StudySpec& study, const std::vector<std::string>& targets);
 
+// Printing (docs/linearization.md, "What is printed"): an entry whose magnitude is at most
+// 1e-12 times the largest magnitude of its vector or matrix (at least 1) is round-off and prints
+// as 0; the exported and saved values keep it.
+double shown(double x, double scale);
+// "  name = value\n" per entry (or "name = value, " on one line when `one_line`), round-off as 0
+std::string name_values(const std::vector<std::string>& names, const Eigen::VectorXd& v, bool one_line = false,
+                        int precision = 6);
+// a matrix with its row and column names, in blocks of columns that fit `width` characters
+// ("columns 7 to 12 of 12" above each block after the first), round-off as 0
+void print_matrix(const char* label, const Eigen::MatrixXd& M, const std::vector<std::string>& rows,
+                  const std::vector<std::string>& cols, int width = 100);
+
 // true when the option was given on the command line (so it overrides the file)
 bool given(const CLI::App* cmd, const std::string& option);
 

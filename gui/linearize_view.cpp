@@ -405,9 +405,7 @@ void LinearizeView::refreshSteadyState() {
   syncing_ = true;
   // the names offered come from the compiled model (kept while it does not compile)
   if (const std::shared_ptr<const Model> m = doc_->model()) {
-    QStringList coords = qlist(m->q_names);
-    for (const auto& v : m->v_names)
-      coords << (std::count(m->q_names.begin(), m->q_names.end(), v) ? qs(v + "_dot") : qs(v));
+    QStringList coords = qlist(m->v_names) + qlist(m->rate_names);
     set_table_->setChoices(coords);
     setCheckList(trim_free_, qlist(m->v_names), s.trim_free);
   } else {

@@ -135,8 +135,8 @@ void SimulateView::refreshInitialChoices() {
   const auto m = doc_->model();
   if (!m) return;
   QStringList coords;
-  for (const auto& q : m->q_names) coords << qs(q);
-  for (const auto& v : m->v_names) coords << (std::count(m->q_names.begin(), m->q_names.end(), v) ? qs(v + "_dot") : qs(v));
+  for (const auto& n : m->v_names) coords << qs(n);
+  for (const auto& n : m->rate_names) coords << qs(n);
   initial_->setChoices(coords);
 }
 

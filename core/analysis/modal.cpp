@@ -1,6 +1,7 @@
 #include "analysis/modal.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -66,6 +67,25 @@ std::string dominant_states(const ModalAnalysis& m, const Eigen::VectorXcd& shap
   return out;
 }
 
+// An orthonormal basis of the generalized null space of M: null(M), then {x : M x in the span so
+// far}, until it stops growing (each step one SVD of (I - P) M, rank tolerance 1e-9 max(1, max|M_ij|))
+Eigen::MatrixXd generalized_null_space(const Eigen::MatrixXd& M) {
+  const Eigen::Index n = M.rows();
+  const double tol = 1e-9 * std::max(1.0, M.cwiseAbs().maxCoeff());
+  Eigen::MatrixXd basis(n, 0);
+  Eigen::MatrixXd P = Eigen::MatrixXd::Zero(n, n);  // projector onto the span so far
+  for (Eigen::Index step = 0; step < n; ++step) {
+    const Eigen::MatrixXd R = (Eigen::MatrixXd::Identity(n, n) - P) * M;
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(R, Eigen::ComputeFullV);
+    Eigen::Index rank = 0;
+    while (rank < n && svd.singularValues()(rank) > tol) ++rank;
+    if (n - rank <= basis.cols()) break;
+    basis = svd.matrixV().rightCols(n - rank);
+    P = basis * basis.transpose();
+  }
+  return basis;
+}
+
 }  // namespace
 
 ModalAnalysis modal_analysis(const LinearSystem& sys) {
@@ -81,24 +101,43 @@ ModalAnalysis modal_analysis(const LinearSystem& sys) {
   for (Eigen::Index i = 0; i < sys.A.rows(); ++i)
     out.modes.push_back(make_mode(es.eigenvalues()(i), es.eigenvectors().col(i), sys.Ts));
   std::sort(out.modes.begin(), out.modes.end(), mode_order);
+  const Eigen::MatrixXd N = generalized_null_space(
+      sys.Ts > 0.0 ? Eigen::MatrixXd(sys.A - Eigen::MatrixXd::Identity(sys.A.rows(), sys.A.cols())) : sys.A);
+  out.zero_count = static_cast<int>(N.cols());
+  for (Eigen::Index i = 0; i < N.rows(); ++i)
+    if (N.cols() > 0 && N.row(i).squaredNorm() >= 0.5) out.zero_states.push_back(static_cast<int>(i));
   return out;
 }
 
 std::string format_modes(const ModalAnalysis& m) {
   const bool discrete = m.Ts > 0.0;
   const int s_width = discrete ? 29 : 0;  // the s column only for discrete systems
-  char line[256];
-  std::snprintf(line, sizeof line, "%-3s %-28s %-*s%-13s %-13s %-9s ", "#", discrete ? "z" : "eigenvalue",
+  char line[512];
+  const std::size_t zeros = std::min<std::size_t>(static_cast<std::size_t>(m.zero_count), m.modes.size());
+  const std::string number = zeros == 1 ? "1" : "1-" + std::to_string(zeros);
+  const int n_width = zeros > 1 ? std::max(5, static_cast<int>(number.size())) : 3;  // "1-12" needs more than "12"
+  std::snprintf(line, sizeof line, "%-*s %-28s %-*s%-13s %-13s %-9s ", n_width, "#", discrete ? "z" : "eigenvalue",
                 s_width, discrete ? "s = log(z)/Ts" : "", "wn (rad/s)", "f (Hz)", "damping");
   std::string out = std::string(line) + "dominant states\n";
-  for (std::size_t k = 0; k < m.modes.size(); ++k) {
+  if (zeros > 0) {
+    // one row for the zero eigenvalue, however often it is repeated: its states, not one arbitrary vector each
+    std::string states;
+    for (int i : m.zero_states) states += (states.empty() ? "" : ", ") + state_name(m, i);
+    const std::string value = std::string(discrete ? "1" : "0") + (zeros > 1 ? " (x" + std::to_string(zeros) + ")" : "");
+    std::snprintf(line, sizeof line, "%-*s %-28s %-*s%-13s %-13s %-9s ", n_width, number.c_str(), value.c_str(), s_width,
+                  discrete ? "0" : "", "0", "0", "-");
+    out += std::string(line) + states + "\n";
+  }
+  for (std::size_t k = zeros; k < m.modes.size(); ++k) {
     const Mode& mode = m.modes[k];
-    std::snprintf(line, sizeof line, "%-3zu %-28s %-*s%-13.6g %-13.6g %-9.4f ", k + 1,
+    std::snprintf(line, sizeof line, "%-*zu %-28s %-*s%-13.6g %-13.6g %-9.4f ", n_width, k + 1,
                   format_complex(mode.eigenvalue).c_str(), s_width, discrete ? format_complex(mode.s).c_str() : "",
                   mode.natural_frequency, mode.natural_frequency / (2.0 * std::numbers::pi),
                   std::abs(mode.damping_ratio) < 5e-5 ? 0.0 : mode.damping_ratio);  // no "-0.0000"
     out += std::string(line) + dominant_states(m, mode.shape) + "\n";
   }
+  if (zeros > 0)
+    out += std::string(discrete ? "z = 1" : "0") + ": a rigid-body motion or an integrator (its damping is undefined: -)\n";
   if (discrete) {
     std::snprintf(line, sizeof line, "discrete, Ts = %g s\n", m.Ts);
     out += line;

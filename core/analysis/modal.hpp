@@ -33,13 +33,25 @@ struct ModalAnalysis {
   std::vector<Mode> modes;              // sorted by natural frequency, then Im(s), then Re(s)
   std::vector<std::string> state_names; // nx, as in the system
   double Ts = 0.0;                      // 0: continuous
+  // The eigenvalue s = 0 (z = 1 when discrete): a rigid-body motion or an integrator. Its
+  // multiplicity is the dimension of the generalized null space of A (of A - I), found by
+  // growing null(A), then {x : A x in it}, ... with a rank tolerance of 1e-9 max(1, max|A_ij|):
+  // a repeated zero's computed eigenvalues scatter by eps^(1/k) and its eigenvectors are
+  // arbitrary within that space, so the modes[0 .. zero_count) (the smallest) stand for it
+  // together, and `zero_states` lists the states that lie mostly in it (squared projection
+  // >= 0.5), in state order.
+  int zero_count = 0;
+  std::vector<int> zero_states;
 };
 
 // Throws std::invalid_argument if A is not square or has NaN/Inf entries.
 ModalAnalysis modal_analysis(const LinearSystem& sys);
 
 // A readable table: eigenvalue, frequency (rad/s and Hz), damping, and the
-// dominant states of each mode shape (|entry| >= 0.5, largest first).
+// dominant states of each mode shape (|entry| >= 0.5, largest first). The zero
+// eigenvalue is one row for all its modes ("1-12  0 (x12)") with the states of its
+// generalized eigenspace, and its damping, undefined, is printed "-" (the value kept
+// in Mode::damping_ratio is damp()'s -1).
 std::string format_modes(const ModalAnalysis& m);
 
 }  // namespace codyna

@@ -561,17 +561,12 @@ const JointModel& joint_of(const Model& m, int i, int& k) {
 }  // namespace
 
 std::vector<std::string> PlantFunction::state_names() const {
+  // Model::v_names and rate_names: for a ball or free joint the position states are the
+  // rotation vector (and displacement) of the deviation, in the joint's frame at the operating point
   std::vector<std::string> pos, vel;
-  static const char* rot[] = {"rx", "ry", "rz"};
-  static const char* lin[] = {"dx", "dy", "dz"};
   for (int i : part_.independent) {
-    int k = 0;
-    const JointModel& j = joint_of(model_, i, k);
-    if (j.type == JointType::Spherical) pos.push_back(j.name + "." + rot[k]);
-    else if (j.type == JointType::Free) pos.push_back(j.name + "." + (k < 3 ? rot[k] : lin[k - 3]));
-    else pos.push_back(model_.v_names[i]);
-    vel.push_back(j.type == JointType::Spherical || j.type == JointType::Free ? model_.v_names[i]
-                                                                              : model_.v_names[i] + "_dot");
+    pos.push_back(model_.v_names[static_cast<std::size_t>(i)]);
+    vel.push_back(model_.rate_names[static_cast<std::size_t>(i)]);
   }
   pos.insert(pos.end(), vel.begin(), vel.end());
   return pos;

@@ -290,19 +290,30 @@ class Compiler {
   }
 
   void add_coordinate_names(const JointModel& j) {
-    std::vector<std::string> qs, vs;
+    // see Model::v_names: one scheme for coordinates and rates of every joint type
+    std::vector<std::string> qs, vs, rs;
     switch (j.type) {
       case JointType::Revolute: case JointType::Prismatic: qs = vs = {""}; break;
       case JointType::Fixed: break;
-      case JointType::Spherical: qs = {"qw", "qx", "qy", "qz"}; vs = {"wx", "wy", "wz"}; break;
+      case JointType::Spherical:
+        qs = {"qw", "qx", "qy", "qz"};
+        vs = {"rx", "ry", "rz"};
+        rs = {"wx", "wy", "wz"};
+        break;
       case JointType::Universal: qs = vs = {"1", "2"}; break;
       case JointType::Cylindrical: qs = vs = {"angle", "slide"}; break;
       case JointType::Planar: qs = vs = {"x", "y", "angle"}; break;
-      case JointType::Free: qs = {"x", "y", "z", "qw", "qx", "qy", "qz"}; vs = {"wx", "wy", "wz", "vx", "vy", "vz"}; break;
+      case JointType::Free:
+        qs = {"x", "y", "z", "qw", "qx", "qy", "qz"};
+        vs = {"rx", "ry", "rz", "x", "y", "z"};
+        rs = {"wx", "wy", "wz", "vx", "vy", "vz"};
+        break;
     }
-    for (const auto& s : qs) m_.q_names.push_back(s.empty() ? j.name : j.name + "." + s);
+    const auto named = [&](const std::string& s) { return s.empty() ? j.name : j.name + "." + s; };
+    for (const auto& s : qs) m_.q_names.push_back(named(s));
     for (std::size_t k = 0; k < vs.size(); ++k) {
-      m_.v_names.push_back(vs[k].empty() ? j.name : j.name + "." + vs[k]);
+      m_.v_names.push_back(named(vs[k]));
+      m_.rate_names.push_back(rs.empty() ? named(vs[k]) + "_dot" : named(rs[k]));
       m_.v_units.push_back(is_angular(j.type, static_cast<int>(k)) ? "rad" : "m");
     }
   }

@@ -99,9 +99,19 @@ struct Model {
   std::vector<Mat6T<double>> inertia;    // [nbodies], spatial inertia in body coordinates
   std::vector<int> body_spec_index;      // [nbodies], position in ModelSpec::bodies (-1 for ground)
 
+  // One naming scheme (docs/model-format.md, "Coordinate and rate names"), the same in
+  // `info`, --hold/--initial, --trim-free/--independent, the exported state names and the GUI:
+  //   v_names: the coordinates, one per degree of freedom: J (revolute, prismatic), J.1 J.2
+  //     (universal), J.angle J.slide (cylindrical), J.x J.y J.angle (planar), J.rx J.ry J.rz
+  //     (ball: rotation vector), J.rx J.ry J.rz J.x J.y J.z (free: rotation vector, position).
+  //   rate_names: their rates: NAME_dot, except a ball's or free joint's angular velocity
+  //     J.wx J.wy J.wz and a free joint's linear velocity J.vx J.vy J.vz (child-frame axes;
+  //     not the derivatives of the rotation vector or of the parent-frame position).
+  //   q_names: the stored configuration (a quaternion's J.qw .. J.qz), for result files.
   std::vector<std::string> q_names;      // [nq]
-  std::vector<std::string> v_names;      // [nv]
+  std::vector<std::string> v_names;      // [nv] coordinates
   std::vector<std::string> v_units;      // [nv] "rad" or "m"
+  std::vector<std::string> rate_names;   // [nv] rates (units: v_units + "/s")
 
   // loop closures
   std::vector<ConstraintModel> constraints;

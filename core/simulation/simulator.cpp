@@ -279,7 +279,7 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
     if (!std::isfinite(largest) || largest > o.divergence_bound) {
       std::ostringstream os;
       const std::string what = worst < model.nq ? model.q_names[worst]
-                               : worst < model.nq + model.nv ? model.v_names[worst - model.nq] + " (rate)"
+                               : worst < model.nq + model.nv ? model.rate_names[worst - model.nq]
                                                              : "controller state " + std::to_string(worst - model.nq - model.nv);
       os << "t = " << t << " s: diverged: " << what << " = " << y[worst] << " is past the bound "
          << o.divergence_bound << " (the last sane sample is at t = " << (rec.t.empty() ? o.t0 : rec.t.back()) << " s)";
@@ -322,9 +322,7 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
   if (!rec.r.empty()) r.y_reference = Recorder::stack(rec.r, r.y.cols());
   if (!rec.d.empty()) r.u_disturbance = Recorder::stack(rec.d, r.u.cols());
   r.q_names = model.q_names;
-  // a scalar joint's position and rate share the joint's name in the model: keep results columns distinct
-  for (const std::string& n : model.v_names)
-    r.v_names.push_back(std::find(model.q_names.begin(), model.q_names.end(), n) != model.q_names.end() ? n + "_dot" : n);
+  r.v_names = model.rate_names;  // NAME_dot, a ball's or free joint's wx.., vx..
   for (const auto& a : model.actuators) {
     r.input_names.push_back(a.name);
     r.input_units.push_back(a.unit);

@@ -326,6 +326,49 @@ bool adopt_controller_study(ModelSpec& spec, const std::string& file) {
 }
 
 namespace {
+const JointModel& joint_of_v(const Model& m, int iv) {
+  for (int b = 1; b < m.nbodies; ++b)
+    if (iv >= m.joints[b].idx_v && iv < m.joints[b].idx_v + m.joints[b].nv) return m.joints[b];
+  throw std::logic_error("velocity index out of range");
+}
+
+// the rotation vector (|r| <= pi) of a stored quaternion (w, x, y, z), and back
+Eigen::Vector3d rotation_vector(const Eigen::Vector4d& wxyz) {
+  Eigen::Quaterniond h(wxyz[0], wxyz[1], wxyz[2], wxyz[3]);
+  if (!(h.norm() > 0)) return Eigen::Vector3d::Zero();
+  h.normalize();
+  if (h.w() < 0) h.coeffs() = -h.coeffs();  // the shorter way round
+  const double s = h.vec().norm();
+  if (s < 1e-12) return 2.0 * h.vec();       // 2 asin(s)/s -> 2
+  return (2.0 * std::atan2(s, h.w()) / s) * h.vec();
+}
+
+Eigen::Vector4d quaternion_of(const Eigen::Vector3d& r) {
+  const double a = r.norm();
+  const Eigen::Vector3d axis = a > 0 ? Eigen::Vector3d(r / a) : Eigen::Vector3d::UnitX();
+  const Eigen::Quaterniond h(Eigen::AngleAxisd(a, axis));
+  return {h.w(), h.x(), h.y(), h.z()};
+}
+}  // namespace
+
+Eigen::VectorXd study_coordinates(const Model& m, const Eigen::VectorXd& q) {
+  if (q.size() != m.nq) throw std::invalid_argument("study_coordinates: q has the wrong size");
+  Eigen::VectorXd c(m.nv);
+  for (int b = 1; b < m.nbodies; ++b) {
+    const JointModel& j = m.joints[b];
+    if (j.type == JointType::Spherical) {
+      c.segment<3>(j.idx_v) = rotation_vector(q.segment<4>(j.idx_q));
+    } else if (j.type == JointType::Free) {
+      c.segment<3>(j.idx_v) = rotation_vector(q.segment<4>(j.idx_q + 3));
+      c.segment<3>(j.idx_v + 3) = q.segment<3>(j.idx_q);
+    } else {
+      c.segment(j.idx_v, j.nv) = q.segment(j.idx_q, j.nq);
+    }
+  }
+  return c;
+}
+
+namespace {
 // `pairs` set on (q, v) and the loops closed with them held; errors at /analysis/FIELD[/NAME]
 StudyInitialState set_coordinates(const Model& m, Eigen::VectorXd q, Eigen::VectorXd v,
                                   const std::vector<std::pair<std::string, double>>& pairs, const std::string& field) {
@@ -341,26 +384,43 @@ StudyInitialState set_coordinates(const Model& m, Eigen::VectorXd q, Eigen::Vect
   for (const auto& [name, value] : pairs) {
     if (!std::isfinite(value) || std::abs(value) > 1e6)
       fail(m, field + "/" + name, "expected a finite number of magnitude at most 1e6 (m, rad, m/s or rad/s)");
-    if (const auto it = std::find(m.q_names.begin(), m.q_names.end(), name); it != m.q_names.end()) {
-      const int iq = static_cast<int>(it - m.q_names.begin());
-      const JointModel& j = m.joints[joint_of_q(iq)];
-      q[iq] = value;
+    const auto lock_joint = [&](const JointModel& j) {
+      for (int k = 0; k < j.nv; ++k) hold.locked_positions.push_back(j.idx_v + k);
+    };
+    if (const auto it = std::find(m.v_names.begin(), m.v_names.end(), name); it != m.v_names.end()) {
+      // a coordinate (Model::v_names)
+      const int iv = static_cast<int>(it - m.v_names.begin());
+      const JointModel& j = joint_of_v(m, iv);
+      const int c = iv - j.idx_v;
       if (j.nq == j.nv) {
-        hold.locked_positions.push_back(j.idx_v + iq - j.idx_q);
-      } else {  // a quaternion or a free joint's position: hold the whole joint
-        for (int k = 0; k < j.nv; ++k) hold.locked_positions.push_back(j.idx_v + k);
+        q[j.idx_q + c] = value;
+        hold.locked_positions.push_back(iv);
+      } else if (j.type == JointType::Free && c >= 3) {
+        q[j.idx_q + c - 3] = value;  // a free joint's position
+        lock_joint(j);
+      } else {  // a component of a ball's or free joint's rotation vector
+        const int iq = j.idx_q + (j.type == JointType::Free ? 3 : 0);
+        Eigen::Vector3d r = rotation_vector(q.segment<4>(iq));
+        r[c] = value;
+        q.segment<4>(iq) = quaternion_of(r);
+        lock_joint(j);
       }
       positions.emplace_back(name, value);
       continue;
     }
-    std::string rate = name;
-    if (rate.size() > 4 && rate.compare(rate.size() - 4, 4, "_dot") == 0) rate.resize(rate.size() - 4);
-    const auto iv = std::find(m.v_names.begin(), m.v_names.end(), rate);
-    if (iv == m.v_names.end() || (rate == name && std::count(m.q_names.begin(), m.q_names.end(), name)))
-      fail(m, field + "/" + name, "unknown coordinate \"" + name + "\" (positions: " + listed(m.q_names) + "; rates: " +
-                                 listed(m.v_names) + ", or a position's name with _dot)");
-    v[iv - m.v_names.begin()] = value;
-    hold.locked_velocities.push_back(static_cast<int>(iv - m.v_names.begin()));
+    if (const auto it = std::find(m.q_names.begin(), m.q_names.end(), name); it != m.q_names.end()) {
+      // a component of a stored quaternion (J.qw .. J.qz): the whole joint is held
+      const int iq = static_cast<int>(it - m.q_names.begin());
+      q[iq] = value;
+      lock_joint(m.joints[joint_of_q(iq)]);
+      continue;
+    }
+    const auto iv = std::find(m.rate_names.begin(), m.rate_names.end(), name);
+    if (iv == m.rate_names.end())
+      fail(m, field + "/" + name, "unknown coordinate \"" + name + "\" (coordinates: " + listed(m.v_names) + "; rates: " +
+                                 listed(m.rate_names) + ")");
+    v[iv - m.rate_names.begin()] = value;
+    hold.locked_velocities.push_back(static_cast<int>(iv - m.rate_names.begin()));
   }
   const AssemblyResult r = assemble(m, q, v, hold);
   if (!r.converged) {
@@ -372,7 +432,7 @@ StudyInitialState set_coordinates(const Model& m, Eigen::VectorXd q, Eigen::Vect
        << " (velocities " << r.velocity_residual << ")";
     if (free.converged)
       for (const auto& [name, value] : positions) {
-        const double there = free.q[std::find(m.q_names.begin(), m.q_names.end(), name) - m.q_names.begin()];
+        const double there = study_coordinates(m, free.q)[std::find(m.v_names.begin(), m.v_names.end(), name) - m.v_names.begin()];
         os << "; closing them freely puts " << name << " at " << there << " (" << value << " asked, off by "
            << there - value << ")";
       }
@@ -422,11 +482,11 @@ OperatingPoint study_operating_point(const Model& m, const std::string& which_in
   const std::string which = which_in.empty() ? s.operating_point : which_in;
   const OperatingPoint start = initial_point(m);
   if (which == "initial") return start;
-  // the positions set by the user (scalar coordinates: their q and v names agree) are held
+  // the coordinates set by the user (Model::v_names; not rates) are held; a ball's or free
+  // joint's component along the joint's axes at the start (hold all three for the whole rotation)
   std::vector<std::string> set_positions;
   for (const auto& [name, value] : s.set)
-    if (std::count(m.v_names.begin(), m.v_names.end(), name) && std::count(m.q_names.begin(), m.q_names.end(), name))
-      set_positions.push_back(name);
+    if (std::count(m.v_names.begin(), m.v_names.end(), name)) set_positions.push_back(name);
   const bool spec_given = !s.trim_free.empty() || !s.free_inputs.empty() || !s.output_targets.empty();
   if ((which == "equilibrium" && (spec_given || !set_positions.empty())) || (which == "trim" && spec_given)) {
     SteadyStateSpec spec;
@@ -619,7 +679,8 @@ StudySimulation study_simulation(const Model& m, const std::atomic<bool>* cancel
       os.precision(10);
       os << path << " carries no codyna_study: the controller is applied about this study's " << out.plant->op.kind
          << " point (";
-      for (int k = 0; k < m.nq; ++k) os << (k ? ", " : "") << m.q_names[static_cast<std::size_t>(k)] << " = " << out.plant->op.q[k];
+      const Eigen::VectorXd c = study_coordinates(m, out.plant->op.q);
+      for (int k = 0; k < m.nv; ++k) os << (k ? ", " : "") << m.v_names[static_cast<std::size_t>(k)] << " = " << c[k];
       for (int k : m.plant_inputs) os << ", " << m.actuators[static_cast<std::size_t>(k)].name << " = " << out.plant->op.u[k];
       os << "), which may not be the point it was designed about; to carry the design point, save the export's "
             "codyna_study with it, e.g. in Octave after run('NAME.m'): save('-v7', 'K.mat', 'K', 'codyna_study', 'state_names')";
@@ -751,28 +812,11 @@ Eigen::VectorXd study_mode_pose(const Model& model, const Eigen::VectorXd& q_op,
   // the position states are the first half of the state; each names one tangent coordinate
   const int npos = static_cast<int>(std::min<std::size_t>(state_names.size() / 2, static_cast<std::size_t>(shape.size())));
   std::vector<int> index(npos, -1);
-  static const char* const local[] = {"rx", "ry", "rz", "dx", "dy", "dz"};
   for (int k = 0; k < npos; ++k) {
-    const std::string& name = state_names[k];
-    const auto v = std::find(model.v_names.begin(), model.v_names.end(), name);
-    const bool plain = v != model.v_names.end();
-    const int i = plain ? static_cast<int>(v - model.v_names.begin()) : -1;
-    // a ball or free joint's velocity names a rate, not a coordinate: only its rx..dz name one
-    if (plain) {
-      const auto j = std::find_if(model.joints.begin(), model.joints.end(), [&](const JointModel& jm) {
-        return i >= jm.idx_v && i < jm.idx_v + jm.nv;
-      });
-      if (j != model.joints.end() && j->type != JointType::Spherical && j->type != JointType::Free) index[k] = i;
-      continue;
-    }
-    const auto dot = name.rfind('.');
-    if (dot == std::string::npos) continue;
-    const std::string joint = name.substr(0, dot), suffix = name.substr(dot + 1);
-    for (const JointModel& jm : model.joints) {
-      if (jm.name != joint || (jm.type != JointType::Spherical && jm.type != JointType::Free)) continue;
-      for (int c = 0; c < jm.nv; ++c)
-        if (suffix == local[c]) index[k] = jm.idx_v + c;
-    }
+    // every position state is a coordinate (Model::v_names; a ball's or free joint's rx..z
+    // the tangent of its rotation and translation); states that name none are skipped
+    const auto v = std::find(model.v_names.begin(), model.v_names.end(), state_names[k]);
+    if (v != model.v_names.end()) index[k] = static_cast<int>(v - model.v_names.begin());
   }
   double largest = 0;
   for (int k = 0; k < npos; ++k)

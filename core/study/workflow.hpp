@@ -56,6 +56,11 @@ struct StudyInitialState {
 };
 StudyInitialState study_initial_state(const Model& model);
 
+// The coordinates (Model::v_names) of a configuration q: the joints' values, a ball's or free
+// joint's rotation vector (the log of its quaternion, |r| <= pi) and a free joint's position.
+// What `info`, --hold and --initial name; the stored q keeps quaternions.
+Eigen::VectorXd study_coordinates(const Model& model, const Eigen::VectorXd& q);
+
 // The operating point the study asks for (`which` overrides study.operating_point
 // when not empty). An equilibrium or trim search ends with a verdict: one that does not
 // converge (residual accelerations of 1e-8 or more, outputs off their targets, inputs held
@@ -111,8 +116,8 @@ struct StudySimulation {
 
 // The configuration the 3-D view draws for a linear mode: the operating point q_op moved
 // along Re(shape e^{i phase}) on the position states (named as the linearization names
-// them: joint coordinates, "J.rx".."J.rz" for the rotation of a ball or free joint J,
-// "J.dx".."J.dz" for a free joint's translation), scaled so that the largest of them
+// them: the coordinates of Model::v_names; a ball's or free joint's "J.rx".."J.rz" and a free
+// joint's "J.x".."J.z" are tangent deviations in the joint's frame), scaled so that the largest of them
 // swings by `amplitude` (rad or m), mapped onto the manifold (q_op (+) dv: quaternions
 // stay unit), closed loops re-assembled. States that name no coordinate are skipped.
 Eigen::VectorXd study_mode_pose(const Model& model, const Eigen::VectorXd& q_op,

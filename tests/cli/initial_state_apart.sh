@@ -81,7 +81,7 @@ for flag in --initial --hold; do
   rc=0
   "$codyna" simulate "$src/examples/pendulum.json" $flag pivto=0.6 --quiet --out bad.h5 > /dev/null 2> bad.err || rc=$?
   [ "$rc" -eq 1 ] || fail "$flag pivto=0.6 exited $rc, expected 1: $(cat bad.err)"
-  grep -q 'unknown coordinate "pivto" (positions: pivot; rates: pivot, or a position' bad.err || fail "$flag: $(cat bad.err)"
+  grep -q 'unknown coordinate "pivto" (coordinates: pivot; rates: pivot_dot)' bad.err || fail "$flag: $(cat bad.err)"
   [ ! -e bad.h5 ] || fail "$flag: bad.h5 written"
 done
 rc=0

@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 
 #include "analysis/discretize.hpp"
 #include "test_util.hpp"
@@ -125,4 +127,62 @@ TEST(ModalAnalysis, RejectsNonSquareOrNonFiniteA) {
 }
 
 }  // namespace
+// A repeated zero eigenvalue (a floating body: twelve rigid-body modes in Jordan chains of
+// length 2 and 4) is one row with the states of its generalized eigenspace, whatever the
+// computed eigenvalues scatter to; its damping is "-". The chains are hidden by a similarity
+// with a well-conditioned random T, so the computed eigenvalues are eps^(1/4) ~ 1e-4 off zero.
+TEST(ModalAnalysis, RepeatedZeroIsOneRowWithItsStates) {
+  // a pendulum on a cart: x, theta, x_dot, theta_dot; zero (x2: position and rate of the cart) and +-wn
+  LinearSystem cart;
+  cart.A = Eigen::Matrix4d{{0, 0, 1, 0}, {0, 0, 0, 1}, {0, -2.0, 0, 0}, {0, 24.0, 0, 0}};
+  cart.B = Eigen::MatrixXd::Zero(4, 1);
+  cart.C = Eigen::MatrixXd::Zero(1, 4);
+  cart.D = Eigen::MatrixXd::Zero(1, 1);
+  cart.state_names = {"x", "theta", "x_dot", "theta_dot"};
+  const ModalAnalysis mc = modal_analysis(cart);
+  EXPECT_EQ(mc.zero_count, 2);
+  // the cart's position and velocity lie in the zero space; theta and theta_dot do not (the +-sqrt(24) modes)
+  EXPECT_EQ(mc.zero_states, (std::vector<int>{0, 2}));
+  const std::string table = format_modes(mc);
+  EXPECT_NE(table.find("1-2   0 (x2)"), std::string::npos) << table;
+  EXPECT_NE(table.find(" -         x, x_dot\n"), std::string::npos) << table;
+  EXPECT_NE(table.find("3     -4.89898 + 0j"), std::string::npos) << table;
+  EXPECT_NE(table.find("4     4.89898 + 0j                 4.89898       0.779697      -1.0000"), std::string::npos) << table;
+  EXPECT_NE(table.find("a rigid-body motion or an integrator"), std::string::npos) << table;
+
+  // a free body at hover: x'' = g ry, y'' = -g rx, z'' and the three angular accelerations are inputs
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(12, 12);
+  J.topRightCorner(6, 6).setIdentity();
+  J(9, 1) = 9.81;
+  J(10, 0) = -9.81;
+  LinearSystem body;
+  body.B = Eigen::MatrixXd::Zero(12, 1);
+  body.C = Eigen::MatrixXd::Zero(1, 12);
+  body.D = Eigen::MatrixXd::Zero(1, 1);
+  for (const char* n : {"rx", "ry", "rz", "x", "y", "z", "wx", "wy", "wz", "vx", "vy", "vz"}) body.state_names.push_back(n);
+  body.A = J;
+  const ModalAnalysis exact = modal_analysis(body);
+  EXPECT_EQ(exact.zero_count, 12);
+  EXPECT_EQ(exact.zero_states.size(), 12u);
+  const std::string t = format_modes(exact);
+  EXPECT_NE(t.find("1-12  0 (x12)"), std::string::npos) << t;
+  EXPECT_EQ(std::count(t.begin(), t.end(), '\n'), 3) << t;  // header, the one row, the note
+
+  // the same chains seen through a similarity: scattered eigenvalues, the same zero space
+  std::srand(7);
+  const Eigen::MatrixXd T = Eigen::MatrixXd::Identity(12, 12) + 0.2 * Eigen::MatrixXd::Random(12, 12);
+  body.A = T * J * T.inverse();
+  const ModalAnalysis scattered = modal_analysis(body);
+  double largest = 0;
+  for (const Mode& m : scattered.modes) largest = std::max(largest, std::abs(m.eigenvalue));
+  EXPECT_GT(largest, 1e-6);  // the computed eigenvalues are visibly not zero ...
+  EXPECT_EQ(scattered.zero_count, 12);  // ... but the zero space is found whole
+  EXPECT_NE(format_modes(scattered).find("1-12  0 (x12)"), std::string::npos);
+
+  // discrete: z = 1 (ZOH of the cart) is the same row
+  const ModalAnalysis d = modal_analysis(discretize_zoh(cart, 0.01));
+  EXPECT_EQ(d.zero_count, 2);
+  EXPECT_NE(format_modes(d).find("1-2   1 (x2)"), std::string::npos) << format_modes(d);
+}
+
 }  // namespace codyna

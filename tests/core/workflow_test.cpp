@@ -179,7 +179,7 @@ TEST(Workflow, SetCoordinatesAndOperatingPoints) {
   EXPECT_EQ(eq.q[0], M_PI / 2);
   EXPECT_LT(eq.residual, 1e-12);
   spec.analysis.set = {{"no_such_joint", 1.0}};
-  expect_model_error_at([&] { study_model(spec); }, "/analysis/set/no_such_joint", "positions: pivot");
+  expect_model_error_at([&] { study_model(spec); }, "/analysis/set/no_such_joint", "coordinates: pivot; rates: pivot_dot");
   spec.analysis.set.clear();
   spec.analysis.operating_point = "sideways";
   expect_model_error_at([&] { study_operating_point(study_model(spec)); }, "/analysis/operating_point", "unknown operating point");
@@ -573,7 +573,7 @@ TEST(Workflow, InitialStateApartFromTheOperatingPoint) {
   EXPECT_EQ(study_simulation(study_model(spec)).options.q0.size(), 0);
   // unknown names are refused at their field, with the names there are
   spec.analysis.initial = {{"pivto", 0.6}};
-  expect_model_error_at([&] { study_model(spec); }, "/analysis/initial/pivto", "positions: pivot; rates: pivot");
+  expect_model_error_at([&] { study_model(spec); }, "/analysis/initial/pivto", "coordinates: pivot; rates: pivot_dot");
   // the model file carries it and reads it back
   spec.analysis.initial = {{"pivot", 0.6}};
   const ModelSpec back = parse_model_spec(to_json(spec), "p.json");
@@ -618,4 +618,56 @@ TEST(Workflow, TrimThatDoesNotConvergeIsAnError) {
   const OperatingPoint op = study_operating_point(study_model(spec));
   EXPECT_LT(op.residual, 1e-10);
   EXPECT_NEAR(op.q[1], 0.0, 1e-10);
+}
+
+// One naming scheme (Model::v_names, docs/model-format.md "Coordinate and rate names"): every
+// coordinate and rate `info` lists is accepted by --hold (set), --initial and --trim-free, sets
+// exactly that value, and the linear model's state names are the same names.
+TEST(Workflow, OneNameForEveryCoordinateAndRate) {
+  const std::string data = CODYNA_TEST_DATA_DIR;
+  for (const std::string& path : {data + "/quadrotor.json", data + "/spherical_pendulum.json", example_path("cart_pendulum.json")}) {
+    SCOPED_TRACE(path);
+    ModelSpec spec = load_model_spec(path);
+    spec.analysis.operating_point = "initial";
+    const Model m = study_model(spec, path);
+    ASSERT_EQ(m.v_names.size(), static_cast<std::size_t>(m.nv));
+    ASSERT_EQ(m.rate_names.size(), static_cast<std::size_t>(m.nv));
+    // the linear model (no loops: every coordinate is a state) names its states alike
+    std::vector<std::string> names = m.v_names;
+    names.insert(names.end(), m.rate_names.begin(), m.rate_names.end());
+    EXPECT_EQ(study_linearize(m).lin.system.state_names, names);
+    for (int i = 0; i < m.nv; ++i) {
+      const std::string& c = m.v_names[static_cast<std::size_t>(i)];
+      const std::string& r = m.rate_names[static_cast<std::size_t>(i)];
+      for (const bool as_initial : {false, true}) {
+        ModelSpec s = spec;
+        (as_initial ? s.analysis.initial : s.analysis.set) = {{c, 0.125}, {r, -0.25}};
+        const Model held = study_model(s, path);
+        const StudyInitialState st = study_initial_state(held);
+        const Eigen::VectorXd coords = study_coordinates(held, st.q);
+        EXPECT_NEAR(coords[i], 0.125, 1e-14) << c;
+        EXPECT_EQ(st.v[i], -0.25) << r;
+        // the other coordinates keep their values
+        const Eigen::VectorXd before = study_coordinates(m, m.q0);
+        for (int k = 0; k < m.nv; ++k)
+          if (k != i) EXPECT_NEAR(coords[k], before[k], 1e-14) << c << " moved " << m.v_names[static_cast<std::size_t>(k)];
+      }
+      // --trim-free knows it (the search itself may or may not converge with it freed)
+      ModelSpec s = spec;
+      s.analysis.operating_point = "trim";
+      s.analysis.trim_free = {c};
+      try {
+        study_operating_point(study_model(s, path));
+      } catch (const ConvergenceError&) {
+      } catch (const ModelError& e) {
+        EXPECT_EQ(std::string(e.what()).find("unknown coordinate"), std::string::npos) << e.what();
+      } catch (const std::invalid_argument&) {
+      }
+    }
+  }
+  // a name that is none of them is refused with the lists
+  ModelSpec spec = load_model_spec(data + "/quadrotor.json");
+  spec.analysis.initial = {{"fly.dx", 1.0}};
+  expect_model_error_at([&] { study_model(spec); }, "/analysis/initial/fly.dx",
+                        "(coordinates: fly.rx, fly.ry, fly.rz, fly.x, fly.y, fly.z; rates: fly.wx");
 }
