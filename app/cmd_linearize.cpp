@@ -31,6 +31,7 @@ struct LinearizeArgs {
   bool closed_loop = false, lqr = false, lqr_controllable_part = false;
   std::vector<double> q_weights, r_weights;
   std::vector<std::string> independent, set, initial, trim_free, free_inputs, targets;
+  PlantFlags plant;
   const CLI::App* cmd = nullptr;  // to tell given flags (they override the file's analysis section)
 };
 
@@ -117,6 +118,7 @@ void run_closed_loop(const Model& m, const LinearizeArgs& a, const StudyClosedLo
 // the model file's study, with the flags given on the command line on top
 ModelSpec study_of(const LinearizeArgs& a) {
   ModelSpec spec = load_spec(a.model);
+  apply_plant_flags(spec, a.plant, a.cmd);
   StudySpec& s = spec.analysis;
   if (given(a.cmd, "--operating-point")) s.operating_point = a.op;
   if (given(a.cmd, "--method")) s.method = a.method;
@@ -258,6 +260,7 @@ void add_linearize(CLI::App& app) {
   cmd->add_flag("--lqr-controllable-part", a->lqr_controllable_part, "with --lqr on a plant that is not stabilizable: design on the controllable part");
   cmd->add_option("--q-weights", a->q_weights, "LQR state weights (diagonal of Q), in state order")->delimiter(',');
   cmd->add_option("--r-weights", a->r_weights, "LQR input weights (diagonal of R)")->delimiter(',');
+  add_plant_flags(cmd, a->plant);
   a->cmd = cmd;
   cmd->callback([a] { set_exit_code(run_guarded([&] { run(*a); })); });
 }

@@ -27,6 +27,7 @@ struct SimulateArgs {
   double t_end = 0, rtol = 0, atol = 0, max_step = -1, output_step = 0;
   double max_samples = 1e7, divergence_bound = 1e8;
   std::vector<std::string> independent, set, initial, trim_free, free_inputs, targets;
+  PlantFlags plant;
   const CLI::App* cmd = nullptr;  // to tell given flags (they override the file's analysis and solver sections)
 };
 
@@ -114,6 +115,7 @@ void summary(const SimulationResult& r, const Model& m, const LinearPlant* plant
 // the model file's study and solver settings, with the flags given on the command line on top
 ModelSpec study_of(const SimulateArgs& a) {
   ModelSpec spec = load_spec(a.model);
+  apply_plant_flags(spec, a.plant, a.cmd);
   StudySpec& s = spec.analysis;
   if (!a.controller.empty() + a.lqr + a.open_loop > 1)
     throw std::invalid_argument("--controller, --lqr and --open-loop: choose one");
@@ -281,6 +283,7 @@ void add_simulate(CLI::App& app) {
   cmd->add_flag("--quiet", a->quiet, "no progress bar");
   cmd->add_option("--max-samples", a->max_samples, "refuse runs that would record more output samples")->capture_default_str();
   cmd->add_option("--divergence-bound", a->divergence_bound, "end the run when a state entry grows past this")->capture_default_str();
+  add_plant_flags(cmd, a->plant);
   a->cmd = cmd;
   cmd->callback([a, cmd] {
     set_exit_code(run_guarded([&] { run(*a); }));

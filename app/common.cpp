@@ -7,6 +7,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <nlohmann/json.hpp>
+
 #include "io/model_file.hpp"
 
 namespace codyna::cli {
@@ -95,6 +97,97 @@ void print_matrix(const char* label, const Eigen::MatrixXd& M, const std::vector
 }
 
 bool given(const CLI::App* cmd, const std::string& option) { return cmd->count(option) > 0; }
+
+void add_plant_flags(CLI::App* cmd, PlantFlags& f) {
+  cmd->add_option("--inputs", f.inputs, "Plant/In for this run: actuator names, in order (comma-separated; replaces the file's plant.inputs)")->delimiter(',');
+  cmd->add_option("--outputs", f.outputs, "Plant/Out for this run: sensor names, in order (comma-separated; replaces the file's plant.outputs)")->delimiter(',');
+  cmd->add_option("--disable-effect", f.disabled_effects, "effects left out of this run (comma-separated names; replaces the file's analysis.disabled_effects)")->delimiter(',');
+  cmd->add_option("--reference", f.references, "a reference on a Plant/Out: OUTPUT=VALUE[@TIME] (r steps from y0 to VALUE at TIME, default 0) or a JSON object as in the file's analysis.references (repeatable; replaces the file's)");
+  cmd->add_option("--disturbance", f.disturbances, "a disturbance on an actuator that is not Plant/In: ACTUATOR=VALUE[@TIME] (a step adding VALUE at TIME, default 0) or a JSON object as in the file's analysis.disturbances (repeatable; replaces the file's)");
+}
+
+namespace {
+std::string names_of(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& n : v) s += (s.empty() ? "" : ", ") + n;
+  return s.empty() ? "none" : s;
+}
+
+// NAME=VALUE[@TIME] -> {"KEY": NAME, "type": "step", "value": VALUE, "time": TIME}, or a JSON object as it is
+nlohmann::json signal_json(const std::string& text, const char* key, const std::string& flag) {
+  const auto first = text.find_first_not_of(" \t");
+  if (first != std::string::npos && text[first] == '{') {
+    try {
+      return nlohmann::json::parse(text);
+    } catch (const nlohmann::json::exception& e) {
+      throw std::invalid_argument(flag + " " + text + ": not a JSON object (" + e.what() + ")");
+    }
+  }
+  const auto eq = text.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw std::invalid_argument(flag + " " + text + ": expected NAME=VALUE[@TIME] or a JSON object {\"" + key + "\": ...}");
+  const std::string rest = text.substr(eq + 1);
+  const auto at = rest.find('@');
+  const auto number = [&](const std::string& s, const char* what) {
+    std::size_t used = 0;
+    double x = 0;
+    try {
+      x = std::stod(s, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != s.size() || !std::isfinite(x))
+      throw std::invalid_argument(flag + " " + text + ": expected a finite number for the " + what);
+    return x;
+  };
+  nlohmann::json j = {{key, text.substr(0, eq)}, {"type", "step"}, {"value", number(rest.substr(0, at), "value")}};
+  if (at != std::string::npos) j["time"] = number(rest.substr(at + 1), "time after '@'");
+  return j;
+}
+}  // namespace
+
+void apply_plant_flags(ModelSpec& spec, const PlantFlags& f, const CLI::App* cmd) {
+  const auto check = [](const std::vector<std::string>& given_names, const std::vector<std::string>& known,
+                        const std::string& flag, const char* what) {
+    for (const std::string& n : given_names)
+      if (std::find(known.begin(), known.end(), n) == known.end())
+        throw std::invalid_argument(flag + ": no " + what + " named \"" + n + "\" (" + what + "s: " + names_of(known) + ")");
+  };
+  std::vector<std::string> actuators, sensors, effects;
+  for (const auto& a : spec.actuators) actuators.push_back(a.name);
+  for (const auto& s : spec.sensors) sensors.push_back(s.name);
+  for (const auto& e : spec.effects) effects.push_back(e.name);
+  if (given(cmd, "--inputs")) {
+    check(f.inputs, actuators, "--inputs", "actuator");
+    spec.plant.inputs = f.inputs;
+  }
+  if (given(cmd, "--outputs")) {
+    check(f.outputs, sensors, "--outputs", "sensor");
+    spec.plant.outputs = f.outputs;
+  }
+  if (given(cmd, "--disable-effect")) {
+    check(f.disabled_effects, effects, "--disable-effect", "effect");
+    spec.analysis.disabled_effects = f.disabled_effects;
+  }
+  if (!given(cmd, "--reference") && !given(cmd, "--disturbance")) return;
+  // the signals are read by the model file's reader, from the spec with the flags' lists in it
+  nlohmann::json j = to_json(spec);
+  std::string label = "--reference/--disturbance";
+  if (given(cmd, "--reference")) {
+    j["analysis"]["references"] = nlohmann::json::array();
+    for (const std::string& r : f.references) j["analysis"]["references"].push_back(signal_json(r, "output", "--reference"));
+  }
+  if (given(cmd, "--disturbance")) {
+    j["analysis"]["disturbances"] = nlohmann::json::array();
+    for (const std::string& d : f.disturbances)
+      j["analysis"]["disturbances"].push_back(signal_json(d, "actuator", "--disturbance"));
+  }
+  if (given(cmd, "--reference") && !given(cmd, "--disturbance")) label = "--reference";
+  if (!given(cmd, "--reference") && given(cmd, "--disturbance")) label = "--disturbance";
+  ModelSpec read = parse_model_spec(j, label);
+  spec.analysis.references = read.analysis.references;
+  spec.analysis.disturbances = read.analysis.disturbances;
+}
 
 int run_guarded(const std::function<void()>& f) {
   try {

@@ -28,6 +28,18 @@ void apply_initial(StudySpec& study, const std::vector<std::string>& initial);
 // the same for --target NAME=VALUE (StudySpec::output_targets)
 void apply_targets(StudySpec& study, const std::vector<std::string>& targets);
 
+// The plant selection and the study's signals for one run, over the model file's (each list
+// given replaces the file's): --inputs/--outputs (actuator and sensor names, in order),
+// --disable-effect (effect names), --reference and --disturbance (each either a JSON object
+// with the fields of the file's "references"/"disturbances" entries, or the step shorthand
+// NAME=VALUE[@TIME]). Unknown names are refused naming the flag and listing what exists; the
+// signals go through the model file's reader, so their errors name the flag and the field.
+struct PlantFlags {
+  std::vector<std::string> inputs, outputs, disabled_effects, references, disturbances;
+};
+void add_plant_flags(CLI::App* cmd, PlantFlags& f);
+void apply_plant_flags(ModelSpec& spec, const PlantFlags& f, const CLI::App* cmd);
+
 // Printing (docs/linearization.md, "What is printed"): an entry whose magnitude is at most
 // 1e-12 times the largest magnitude of its vector or matrix (at least 1) is round-off and prints
 // as 0; the exported and saved values keep it.
