@@ -109,6 +109,14 @@ void summary(const SimulationResult& r, const Model& m, const LinearPlant* plant
                               : "parts beyond 1 % at t = " + std::to_string(r.t[first]) + " s")
                 << "\n";
     }
+    // the two runs' own errors beside the gap: a gap near them is the integrators', not the model's
+    std::cout << "  nonlinear run: " << r.stats.integrator << " at rtol " << r.stats.rtol << ", atol " << r.stats.atol
+              << "; linear run: Dormand-Prince 5(4) at rtol " << r.linear_rtol << ", atol "
+              << r.linear_atol;
+    if (r.linear_error_estimate >= 0)
+      std::cout << " (a rerun at 100x looser tolerances differs by " << r.linear_error_estimate << ")";
+    std::cout << "\n";
+    if (!r.linear_failure.empty()) std::cout << "  " << r.linear_failure << "\n";
   }
 }
 

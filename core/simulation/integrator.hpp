@@ -12,6 +12,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -47,6 +48,26 @@ class Integrator {
   virtual Eigen::VectorXd state() const = 0;                    // ODE layout
   virtual bool projects() const { return false; }               // keeps loops on the manifold itself
   virtual void add_stats(SolverStats& s) const = 0;
+};
+
+// A plain ODE y' = f(t, y) by ARKODE's explicit Dormand-Prince 5(4) pair (ERKStep) at the given
+// tolerances, advanced to exact stop times; reset() after a discontinuity. For the linear
+// closed loop of --compare-linear, integrated far below the nonlinear run's tolerances.
+class OdeIntegrator {
+ public:
+  using Rhs = std::function<void(double t, const Eigen::VectorXd& y, Eigen::VectorXd& ydot)>;
+  OdeIntegrator(Rhs f, double rtol, double atol);
+  ~OdeIntegrator();
+  OdeIntegrator(const OdeIntegrator&) = delete;
+  OdeIntegrator& operator=(const OdeIntegrator&) = delete;
+  void reset(double t, const Eigen::VectorXd& y);
+  void advance(double t_out);  // throws IntegratorFailure
+  Eigen::VectorXd state() const;
+  long steps() const;          // accepted steps since construction
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
 };
 
 // throws std::invalid_argument for an unknown method or bad tolerances, and for "auto", which

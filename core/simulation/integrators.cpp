@@ -386,4 +386,89 @@ std::unique_ptr<Integrator> make_integrator(ClosedLoopSystem& system, const Inte
   throw std::invalid_argument("unknown integrator \"" + s.method + "\" (expected ida, cvode-bdf, cvode-adams, arkode or rk4)");
 }
 
+struct OdeIntegrator::Impl {
+  Rhs f;
+  double rtol, atol;
+  SUNContext ctx = nullptr;
+  N_Vector y = nullptr;
+  void* mem = nullptr;
+  double t = 0;
+  long steps_before = 0;  // of the runs before the last re-initialization
+  std::string error;
+
+  static int rhs(double t, N_Vector y, N_Vector yd, void* self) {
+    auto* me = static_cast<Impl*>(self);
+    try {
+      Eigen::VectorXd out;
+      me->f(t, view(y), out);
+      view(yd) = out;
+      return 0;
+    } catch (const std::exception& e) {
+      me->error = e.what();
+      return -1;
+    }
+  }
+  long current_steps() const {
+    long v = 0;
+    if (mem) ERKStepGetNumSteps(mem, &v);
+    return v;
+  }
+};
+
+OdeIntegrator::OdeIntegrator(Rhs f, double rtol, double atol) : impl_(std::make_unique<Impl>()) {
+  if (!(rtol > 0) || !(atol > 0)) throw std::invalid_argument("OdeIntegrator: tolerances must be > 0");
+  impl_->f = std::move(f);
+  impl_->rtol = rtol;
+  impl_->atol = atol;
+  if (SUNContext_Create(nullptr, &impl_->ctx) != 0) throw std::runtime_error("SUNDIALS: cannot create a context");
+}
+
+OdeIntegrator::~OdeIntegrator() {
+  if (impl_->mem) ERKStepFree(&impl_->mem);
+  if (impl_->y) N_VDestroy(impl_->y);
+  SUNContext_Free(&impl_->ctx);
+}
+
+void OdeIntegrator::reset(double t, const Eigen::VectorXd& y) {
+  Impl& m = *impl_;
+  m.t = t;
+  const auto check = [](int flag, const char* what) {
+    if (flag < 0) throw std::runtime_error(std::string("ARKODE setup: ") + what + " failed");
+  };
+  if (!m.y || N_VGetLength(m.y) != y.size()) {
+    if (m.mem) m.steps_before += m.current_steps(), ERKStepFree(&m.mem);
+    if (m.y) N_VDestroy(m.y);
+    m.y = N_VNew_Serial(y.size(), m.ctx);
+    view(m.y) = y;
+    m.mem = ERKStepCreate(&Impl::rhs, t, m.y, m.ctx);
+    if (!m.mem) throw std::runtime_error("ARKODE setup: ERKStepCreate failed");
+    check(ERKStepSetUserData(m.mem, &m), "ERKStepSetUserData");
+    check(ERKStepSetTableNum(m.mem, ARKODE_DORMAND_PRINCE_7_4_5), "ERKStepSetTableNum");
+    check(ERKStepSStolerances(m.mem, m.rtol, m.atol), "ERKStepSStolerances");
+    check(ERKStepSetMaxNumSteps(m.mem, 10000000), "ERKStepSetMaxNumSteps");
+  } else {
+    m.steps_before += m.current_steps();
+    view(m.y) = y;
+    check(ERKStepReInit(m.mem, &Impl::rhs, t, m.y), "ERKStepReInit");
+  }
+}
+
+void OdeIntegrator::advance(double t_out) {
+  Impl& m = *impl_;
+  if (!m.mem) throw std::logic_error("OdeIntegrator::advance before reset");
+  if (t_out <= m.t) return;
+  ERKStepSetStopTime(m.mem, t_out);
+  const int flag = ERKStepEvolve(m.mem, t_out, m.y, &m.t, ARK_NORMAL);
+  if (flag < 0) {
+    std::ostringstream os;
+    os << "ARKODE (linear closed loop) failed (flag " << flag << ")";
+    if (!m.error.empty()) os << ": " << m.error;
+    throw IntegratorFailure(m.t, os.str());
+  }
+}
+
+Eigen::VectorXd OdeIntegrator::state() const { return view(impl_->y); }
+
+long OdeIntegrator::steps() const { return impl_->steps_before + impl_->current_steps(); }
+
 }  // namespace codyna

@@ -34,6 +34,9 @@ struct SimulationResult {
   std::vector<double> constraint_violation;    // [N] max |phi(q)| (0 for trees)
   std::vector<double> velocity_violation;      // [N] max |Jc v|
   Eigen::MatrixXd y_linear;                    // [N x ny] linear closed loop from the same start (empty if not run)
+  double linear_rtol = 0, linear_atol = 0;     // its integration tolerances (Dormand-Prince 5(4))
+  double linear_error_estimate = -1;           // max |y_lin - the same at 100x looser tolerances| (-1: not known)
+  std::string linear_failure;                  // why y_linear ends in NaN (an unstable linear loop), or ""
   Eigen::MatrixXd y_reference;                 // [N x ny] r(t) the controller was given (empty: no reference)
   Eigen::MatrixXd u_disturbance;               // [N x nu] d(t) added to each actuator (empty: no disturbance)
 
