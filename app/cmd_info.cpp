@@ -34,7 +34,11 @@ void print_info(const Model& m) {
     for (std::size_t k = 0; k < m.redundant_rows.size(); ++k) std::cout << (k ? ", " : "") << m.row_names[m.redundant_rows[k]];
     std::cout << " (dependent on the other equations; kept out of the dynamics)\n";
   }
-  if (m.nc) std::cout << "assembly     residual " << m.assembly_residual << "\n";
+  if (m.nc) {
+    std::cout << "assembly     residual " << m.assembly_residual << "\n";
+    if (!m.assembly_moves.empty())
+      std::cout << "             moved to close the loops: " << assembly_moves_text(m) << "\n";
+  }
   std::cout << "effects      " << (m.has_gravity ? "gravity" : "no gravity");
   if (!m.springs.empty()) std::cout << ", " << m.springs.size() << " spring-damper(s)";
   if (!m.joint_springs.empty()) std::cout << ", " << m.joint_springs.size() << " joint spring(s)";

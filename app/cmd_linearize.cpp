@@ -163,6 +163,8 @@ ModelSpec study_of(const LinearizeArgs& a) {
 
 void run(const LinearizeArgs& a) {
   const Model m = study_model(study_of(a), a.model);
+  if (!m.assembly_moves.empty())
+    std::cerr << "codyna: note: closing the loops moved the joints' q0/v0: " << assembly_moves_text(m) << "\n";
   const std::string name = study_export_name(m);
   if (m.plant_inputs.empty() && m.plant_outputs.empty())
     std::cerr << "codyna: warning: the model selects no Plant/In or Plant/Out; exporting the state equations only\n";

@@ -173,6 +173,8 @@ ModelSpec study_of(const SimulateArgs& a) {
 void run(const SimulateArgs& a) {
   const ModelSpec spec = study_of(a);
   const Model m = study_model(spec, a.model);
+  if (!m.assembly_moves.empty())
+    std::cerr << "codyna: note: closing the loops moved the joints' q0/v0: " << assembly_moves_text(m) << "\n";
   for (std::size_t k = spec.notes.size(); k < m.spec.notes.size(); ++k) std::cerr << "codyna: note: " << m.spec.notes[k] << "\n";
   // outputs that would replace the model, the controller file or a file codyna did not write are refused
   // before any work

@@ -54,6 +54,22 @@ void apply_targets(StudySpec& study, const std::vector<std::string>& targets) {
   apply_pairs(study.output_targets, targets, "--target");
 }
 
+std::string assembly_moves_text(const Model& m) {
+  std::ostringstream os;
+  os.precision(6);
+  for (const Model::AssemblyMove& a : m.assembly_moves) {
+    const auto iv = std::find(m.v_names.begin(), m.v_names.end(), a.name);
+    const auto ir = std::find(m.rate_names.begin(), m.rate_names.end(), a.name);
+    const std::size_t i = iv != m.v_names.end() ? static_cast<std::size_t>(iv - m.v_names.begin())
+                                                : static_cast<std::size_t>(ir - m.rate_names.begin());
+    const std::string unit = i < m.v_units.size() ? m.v_units[i] + (iv != m.v_names.end() ? "" : "/s") : "";
+    os << (os.tellp() > 0 ? ", " : "") << a.name << " ";
+    if (std::isfinite(a.from)) os << a.from << " -> " << a.to << " ";
+    os << "(moved by " << a.by << " " << unit << ")";
+  }
+  return os.str();
+}
+
 double shown(double x, double scale) { return std::abs(x) <= 1e-12 * std::max(1.0, scale) ? 0.0 : x; }
 
 std::string name_values(const std::vector<std::string>& names, const Eigen::VectorXd& v, bool one_line, int precision) {

@@ -52,6 +52,9 @@ std::string name_values(const std::vector<std::string>& names, const Eigen::Vect
 void print_matrix(const char* label, const Eigen::MatrixXd& M, const std::vector<std::string>& rows,
                   const std::vector<std::string>& cols, int width = 100);
 
+// "crank 2.0944 -> 2.09842 (moved by 0.00402 rad), ..." for Model::assembly_moves; "" when none
+std::string assembly_moves_text(const Model& m);
+
 // true when the option was given on the command line (so it overrides the file)
 bool given(const CLI::App* cmd, const std::string& option);
 

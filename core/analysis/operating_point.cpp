@@ -284,7 +284,7 @@ OperatingPoint static_equilibrium(const Model& model, const OperatingPoint& star
         if (!rest_accelerations(next, Eigen::VectorXd::Zero(next.nz()), u).allFinite()) continue;
         op.q = q;
         moved = true;
-      } catch (const std::runtime_error&) {
+      } catch (const std::exception&) {  // singular constraints (runtime_error) or no chart there (invalid_argument)
         continue;
       }
     }

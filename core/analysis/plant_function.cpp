@@ -72,10 +72,31 @@ CoordinatePartition partition_coordinates(const Model& m, const Eigen::VectorXd&
   }
   const Eigen::MatrixXd J = active_jacobian(m, q, rows);
   if (preferred.empty()) {
-    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(J);
-    const auto& perm = qr.colsPermutation().indices();
-    std::set<int> dep;
-    for (Eigen::Index k = 0; k < J.rows(); ++k) dep.insert(perm[k]);
+    // the dependent coordinates: the pivots of a column-pivoted QR. The coordinates a joint_force
+    // actuator drives (a five-bar's cranks) are kept independent when that choice is well
+    // conditioned: their columns are shrunk so that they are pivoted last
+    const auto dependent_of = [&](const Eigen::MatrixXd& Jw) {
+      Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Jw);
+      const auto& perm = qr.colsPermutation().indices();
+      std::set<int> dep;
+      for (Eigen::Index k = 0; k < Jw.rows(); ++k) dep.insert(perm[k]);
+      return dep;
+    };
+    const auto conditioning = [&](const std::set<int>& dep) {
+      std::vector<int> cols(dep.begin(), dep.end());
+      const Eigen::VectorXd s = Eigen::JacobiSVD<Eigen::MatrixXd>(columns(J, cols)).singularValues();
+      return s.size() ? s[s.size() - 1] / std::max(1.0, s[0]) : 0.0;  // as the check below measures it
+    };
+    std::set<int> dep = dependent_of(J);
+    Eigen::MatrixXd Jw = J;
+    bool actuated = false;
+    for (const ActuatorModel& a : m.actuators)
+      if (a.type == ActuatorType::JointForce) Jw.col(a.iv) *= 1e-3, actuated = true;
+    if (actuated) {
+      const std::set<int> pref = dependent_of(Jw);
+      // kept when conditioned to 1e-3, or to a tenth of the unbiased choice (never below 1e-6)
+      if (pref != dep && conditioning(pref) >= std::max(1e-6, std::min(1e-3, 0.1 * conditioning(dep)))) dep = pref;
+    }
     for (int i = 0; i < m.nv; ++i) (dep.count(i) ? p.dependent : p.independent).push_back(i);
   } else {
     std::set<int> ind;

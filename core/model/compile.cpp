@@ -594,6 +594,22 @@ class Compiler {
     m_.q0 = r.q;
     m_.v0 = r.v;
     m_.assembly_residual = std::max(r.position_residual, r.velocity_residual);
+    // say what closing the loops moved (a rough q0 lands elsewhere than the user wrote)
+    constexpr double kMoved = 1e-6;
+    const Eigen::VectorXd dq = difference(m_, q, r.q);
+    for (int b = 1; b < m_.nbodies; ++b) {
+      const JointModel& j = m_.joints[b];
+      for (int k = 0; k < j.nv; ++k) {
+        const int i = j.idx_v + k;
+        if (std::abs(dq[i]) > kMoved) {
+          const bool scalar = j.nq == j.nv;
+          m_.assembly_moves.push_back({m_.v_names[static_cast<std::size_t>(i)], scalar ? q[j.idx_q + k] : std::nan(""),
+                                       scalar ? r.q[j.idx_q + k] : std::nan(""), dq[i]});
+        }
+      }
+    }
+    for (int i = 0; i < m_.nv; ++i)
+      if (std::abs(r.v[i] - v[i]) > kMoved) m_.assembly_moves.push_back({m_.rate_names[static_cast<std::size_t>(i)], v[i], r.v[i], r.v[i] - v[i]});
     Data d(m_);
     constraint_terms<double>(m_, d, m_.q0, m_.v0);
     const RowPartition rows = partition_rows(d.Jc);

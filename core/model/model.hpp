@@ -135,6 +135,14 @@ struct Model {
 
   Eigen::VectorXd q0, v0;                // assembled initial state
   double assembly_residual = 0.0;        // max |phi(q0)|, |J v0| after assembly
+  // what assembly changed in the joints' q0 and v0 to close the loops, by more than 1e-6 (m, rad,
+  // m/s, rad/s): a coordinate (Model::v_names; `from`, `to` its values for a scalar joint, NaN for
+  // a ball's or free joint's rotation, whose `by` is the tangent step) or a rate (rate_names)
+  struct AssemblyMove {
+    std::string name;
+    double from = 0, to = 0, by = 0;
+  };
+  std::vector<AssemblyMove> assembly_moves;
 
   ModelSpec spec;                        // the spec it was compiled from
   std::string source_file;               // where the spec was read, if from a file

@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "analysis/plant_function.hpp"
 #include "control/lqr.hpp"
 #include "dynamics/constraints.hpp"
 #include "dynamics/joint.hpp"
@@ -670,4 +671,46 @@ TEST(Workflow, OneNameForEveryCoordinateAndRate) {
   spec.analysis.initial = {{"fly.dx", 1.0}};
   expect_model_error_at([&] { study_model(spec); }, "/analysis/initial/fly.dx",
                         "(coordinates: fly.rx, fly.ry, fly.rz, fly.x, fly.y, fly.z; rates: fly.wx");
+}
+
+// Assembly says what it moved, and the automatic independent coordinates of a loop are the ones
+// the motors drive (issue 21): the five-bar's couplers typed to 0.1 rad move both cranks by
+// about 1.15 degrees, each move is listed with its values; the cranks are independent (the
+// unbiased column-pivoted QR, as without actuators, picks an elbow).
+TEST(Assembly, ReportsWhatItMovedAndPrefersActuatedCoordinates) {
+  const std::string path = std::string(CODYNA_TEST_DATA_DIR) + "/five_bar.json";
+  const ModelSpec spec = load_model_spec(path);
+  const Model m = compile(spec, path);
+  ASSERT_EQ(m.nc, 2);
+  std::vector<std::string> moved;
+  for (int b = 1; b < m.nbodies; ++b) {
+    const JointModel& j = m.joints[b];
+    const double typed = spec.joints[static_cast<std::size_t>(j.spec_index)].q0[0], now = m.q0[j.idx_q];
+    const auto it = std::find_if(m.assembly_moves.begin(), m.assembly_moves.end(),
+                                 [&](const Model::AssemblyMove& a) { return a.name == j.name; });
+    if (std::abs(now - typed) > 1e-6) {
+      ASSERT_NE(it, m.assembly_moves.end()) << j.name << " moved from " << typed << " to " << now << " unreported";
+      EXPECT_EQ(it->from, typed);
+      EXPECT_EQ(it->to, now);
+      EXPECT_EQ(it->by, now - typed);
+      moved.push_back(j.name);
+    } else {
+      EXPECT_EQ(it, m.assembly_moves.end()) << j.name;
+    }
+  }
+  EXPECT_EQ(moved, (std::vector<std::string>{"motor_L", "elbow_L", "motor_R", "elbow_R"}));
+  EXPECT_NEAR(m.q0[0] * 180 / M_PI, 121.15, 0.01);  // the crank typed at 120 degrees
+  // independent coordinates: the motors' joints
+  const CoordinatePartition p = partition_coordinates(m, m.q0);
+  std::vector<std::string> independent;
+  for (int i : p.independent) independent.push_back(m.v_names[static_cast<std::size_t>(i)]);
+  EXPECT_EQ(independent, (std::vector<std::string>{"motor_L", "motor_R"}));
+  ModelSpec bare = spec;
+  bare.actuators.clear();
+  bare.plant = {};
+  const Model mb = compile(bare, path);
+  const CoordinatePartition pb = partition_coordinates(mb, mb.q0);
+  EXPECT_NE(pb.independent, p.independent);  // without the motors the QR picks otherwise
+  // a tree reports nothing
+  EXPECT_TRUE(compile(load_model_spec(example_path("pendulum.json"))).assembly_moves.empty());
 }
