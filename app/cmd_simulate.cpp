@@ -23,6 +23,7 @@ namespace {
 struct SimulateArgs {
   std::string model, out, csv, controller, op = "equilibrium", integrator;
   bool lqr = false, lqr_controllable_part = false, compare_linear = false, quiet = false, open_loop = false;
+  double linear_region = 0;
   std::vector<double> q_weights, r_weights;
   double t_end = 0, rtol = 0, atol = 0, max_step = -1, output_step = 0;
   double max_samples = 1e7, divergence_bound = 1e8;
@@ -146,6 +147,11 @@ ModelSpec study_of(const SimulateArgs& a) {
   }
   if (given(a.cmd, "--independent")) s.independent = a.independent;
   if (a.compare_linear) s.compare_linear = true;
+  if (given(a.cmd, "--linear-region")) {
+    if (!(a.linear_region > 0) || !std::isfinite(a.linear_region))
+      throw std::invalid_argument("--linear-region: expected a bound > 0 (rad or m)");
+    s.linear_region = a.linear_region;
+  }
   apply_set(s, a.set);
   apply_initial(s, a.initial);
   if (given(a.cmd, "--trim-free")) s.trim_free = a.trim_free;
@@ -258,6 +264,26 @@ void run(const SimulateArgs& a) {
   if (bar) std::fprintf(stderr, "\n");
   write_results(r, a.out, a.csv);
   summary(r, m, plant, setup);
+  if (plant) {
+    // how far the run went from the point the linear parts are about
+    const LinearRegion lr = study_linear_region(m, setup, r);
+    if (!lr.measured.empty()) {
+      std::string names;
+      for (const auto& n : lr.measured) names += (names.empty() ? "" : ", ") + n;
+      std::cout << "linear region    |q - q_op| <= " << lr.bound << " on " << names << ": ";
+      if (lr.left_at < 0) std::cout << "stayed within (largest " << lr.largest << ", " << lr.largest_on << ")\n";
+      else
+        std::cout << "left at t = " << lr.left_at << " s (" << lr.left_on << "), largest " << lr.largest << " ("
+                  << lr.largest_on << ")\n";
+      if (lr.settled && lr.final_distance > lr.bound)
+        std::cout << "                 the run ends at rest " << lr.final_distance << " from the operating point ("
+                  << lr.final_on << "): it settled elsewhere\n";
+      if (lr.left_at >= 0)
+        std::cerr << "codyna: warning: the state left the region where the linear model holds: |" << lr.left_on
+                  << " - its operating-point value| > " << lr.bound << " at t = " << lr.left_at << " s"
+                  << (lr.settled && lr.final_distance > lr.bound ? ", and settled elsewhere" : "") << "\n";
+    }
+  }
   std::cout << "wrote " << a.out << (a.csv.empty() ? "" : "\nwrote " + a.csv) << "\n";
   if (!r.completed && !r.cancelled) throw std::runtime_error("the run failed at " + r.failure + "; the partial result is in " + a.out);
 }
@@ -278,6 +304,7 @@ void add_simulate(CLI::App& app) {
   cmd->add_option("--r-weights", a->r_weights, "LQR input weights (diagonal of R)")->delimiter(',');
   cmd->add_option("--operating-point", a->op, "where the controller's plant is linearized: initial | equilibrium | trim | time=T")->capture_default_str();
   cmd->add_flag("--compare-linear", a->compare_linear, "also simulate the linear closed loop and report where it parts from the nonlinear one");
+  cmd->add_option("--linear-region", a->linear_region, "R: report when a coordinate the linear dynamics depend on is more than R (rad or m) from its operating-point value (default 0.5, or the file's analysis.linear_region)");
   cmd->add_option("--t-end", a->t_end, "end time [s] (default: the model's solver settings)");
   cmd->add_option("--integrator", a->integrator, "auto | ida | cvode-bdf | cvode-adams | arkode | rk4 (default: the model file's solver, auto when it names none)");
   cmd->add_option("--rtol", a->rtol, "relative tolerance");

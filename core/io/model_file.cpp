@@ -1131,6 +1131,13 @@ const Schema<StudySpec>& schema<StudySpec>() {
       field("lqr_controllable_part", &T::lqr_controllable_part, read_bool, [](bool b) { return b ? ojson(true) : ojson(); }),
       list_field("references", &T::references),
       field("compare_linear", &T::compare_linear, read_bool, [](bool b) { return b ? ojson(true) : ojson(); }),
+      field("linear_region", &T::linear_region,
+            [](const Node& n) {
+              const double x = read_number(n);
+              if (!(x > 0)) n.expected("a bound > 0 (rad or m)");
+              return x;
+            },
+            [](double x) { return x != 0.5 ? ojson(x) : ojson(); }),
       list_field("disturbances", &T::disturbances),
       field("anti_windup", &T::anti_windup,
             [](const Node& n) { return read_word(n, anti_windup_methods(), "anti-windup method"); },

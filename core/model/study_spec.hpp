@@ -103,6 +103,9 @@ struct StudySpec {
   // they are. Off by default: without it such a plant is an error that names those modes.
   bool lqr_controllable_part = false;
   bool compare_linear = false;       // also run the linear closed loop beside the nonlinear one
+  // the region where the linear parts are trusted: |coordinate - its operating-point value| <= this
+  // (rad or m) on the coordinates the linear dynamics depend on (study_linear_region)
+  double linear_region = 0.5;
   // time-varying references on Plant/Out outputs (the others stay at y0); every controller
   // type follows them: PID acts on r - y, state feedback adds Nbar (r - y0), LTI sees y - r
   std::vector<SignalSpec> references;

@@ -834,4 +834,36 @@ Eigen::VectorXd study_mode_pose(const Model& model, const Eigen::VectorXd& q_op,
   return q;
 }
 
+LinearRegion study_linear_region(const Model& m, const StudySimulation& setup, const SimulationResult& r) {
+  LinearRegion out;
+  out.bound = m.spec.analysis.linear_region;
+  if (!setup.plant || r.samples() == 0 || r.q.cols() != m.nq) return out;
+  const Linearization& lin = setup.plant->lin;
+  const Eigen::MatrixXd& A = lin.system.A;
+  const int nz = static_cast<int>(lin.partition.independent.size());
+  std::vector<int> coords;
+  for (int k = 0; k < nz && k < A.cols(); ++k)
+    if (A.col(k).cwiseAbs().maxCoeff() > 0) {
+      coords.push_back(lin.partition.independent[static_cast<std::size_t>(k)]);
+      out.measured.push_back(m.v_names[static_cast<std::size_t>(coords.back())]);
+    }
+  if (coords.empty()) return out;
+  const Eigen::VectorXd& q_op = setup.plant->op.q;
+  double vmax = 0;
+  for (int i = 0; i < r.samples(); ++i) {
+    const Eigen::VectorXd d = difference(m, q_op, Eigen::VectorXd(r.q.row(i).transpose()));
+    double dist = 0;
+    std::string on;
+    for (std::size_t c = 0; c < coords.size(); ++c)
+      if (std::abs(d[coords[c]]) > dist) dist = std::abs(d[coords[c]]), on = out.measured[c];
+    if (out.left_at < 0 && dist > out.bound) out.left_at = r.t[static_cast<std::size_t>(i)], out.left_on = on;
+    if (dist > out.largest) out.largest = dist, out.largest_on = on;
+    if (i == r.samples() - 1) out.final_distance = dist, out.final_on = on;
+    if (r.v.cols()) vmax = std::max(vmax, r.v.row(i).cwiseAbs().maxCoeff());
+  }
+  const double v_end = r.v.cols() ? r.v.row(r.samples() - 1).cwiseAbs().maxCoeff() : 0.0;
+  out.settled = v_end <= std::max(1e-9, 1e-4 * vmax);
+  return out;
+}
+
 }  // namespace codyna

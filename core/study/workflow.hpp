@@ -130,6 +130,26 @@ StudySimulation study_simulation(const Model& model, const std::atomic<bool>* ca
 
 SimulationResult study_simulate(const Model& model, const StudySimulation& setup, const SimulationCallbacks& cb = {});
 
+// How far a closed-loop run went from the operating point its linear parts are about: the
+// distance is |coordinate - its value there| (the tangent difference; rad or m) on the
+// independent coordinates the linear dynamics depend on (a nonzero column of A: a cart's
+// position or a free body's position and heading, on which nothing depends, are not measured),
+// against study.linear_region. `left_at` is the first sample beyond it (-1: never); `settled`
+// says the run ends at rest (every rate below 1e-4 of its largest in the run, or 1e-9), so a
+// final distance beyond the bound is a settling elsewhere. Empty (`measured` empty) without a plant.
+struct LinearRegion {
+  double bound = 0;
+  std::vector<std::string> measured;  // the coordinates measured
+  double left_at = -1;
+  std::string left_on;                // the coordinate first beyond the bound
+  double largest = 0;                 // the largest distance in the run, and where
+  std::string largest_on;
+  double final_distance = 0;
+  std::string final_on;
+  bool settled = false;
+};
+LinearRegion study_linear_region(const Model& model, const StudySimulation& setup, const SimulationResult& r);
+
 // The linear closed loop of the study's plant and controller (analysis/closed_loop_linear.hpp):
 // the plant and controller study_simulation makes (same operating point, same Nbar), the
 // study's disturbance actuators as extra inputs, the poles, and the step and frequency

@@ -83,4 +83,35 @@ if (max(z.real for z in lti) > 0) != ("unstable linear closed loop" in lti_text)
 print("UNSTABLE_OK")
 PY
 grep -q "codyna: warning: unstable linear closed loop" Kflip.err || fail "no warning on stderr: $(cat Kflip.err)"
+# the nonlinear run says when it leaves the region where the linear model holds (issue 21): the
+# flipped gain sends the pendulum down (rod_pivot, on which A depends, more than 0.5 rad from its
+# operating-point value) while the cart's position (A's column zero) is not measured; the LQR
+# stays within; --linear-region moves the bound
+for c in K Kflip; do
+  "$codyna" simulate "$model" --controller $c.mat --t-end 4 --quiet --out ${c}_long.h5 > ${c}_long.txt 2> ${c}_long.err ||
+    fail "simulate --controller $c.mat --t-end 4: $(cat ${c}_long.err)"
+done
+grep -Eq '^linear region    \|q - q_op\| <= 0\.5 on rod_pivot: stayed within \(largest [0-9.e-]+, rod_pivot\)$' K_long.txt ||
+  fail "the LQR run: $(grep -A1 'linear region' K_long.txt)"
+grep -Eq '^linear region    \|q - q_op\| <= 0\.5 on rod_pivot: left at t = [0-9.]+ s \(rod_pivot\), largest' Kflip_long.txt ||
+  fail "the flipped run: $(grep -A1 'linear region' Kflip_long.txt)"
+grep -q "codyna: warning: the state left the region where the linear model holds: |rod_pivot - its operating-point value| > 0.5 at t = " Kflip_long.err ||
+  fail "no warning on stderr: $(cat Kflip_long.err)"
+"$PY" - <<'PY'
+import h5py, re, sys, json
+import numpy as np
+text = open("Kflip_long.txt").read()
+t_left = float(re.search(r"left at t = (\S+) s", text).group(1))
+with h5py.File("Kflip_long.h5", "r") as f:
+    t, q = f["time"][()], f["q"][()]
+    names = [n.decode() if isinstance(n, bytes) else n for n in f["names/q"][()]]
+    op = json.loads(f["provenance"].attrs["settings_json"])["operating_point_q"]
+k = names.index("rod_pivot")
+d = np.abs(q[:, k] - op["rod_pivot"])
+first = t[np.argmax(d > 0.5)]
+if not (d > 0.5).any() or abs(first - t_left) > 1e-9: sys.exit(f"printed t = {t_left}, the file's first sample beyond 0.5 is {first}")
+print(f"REGION_OK the flipped gain leaves |rod_pivot - op| <= 0.5 at t = {t_left} s, as the file's samples show")
+PY
+"$codyna" simulate "$model" --controller K.mat --t-end 4 --linear-region 1e-4 --quiet --out tight.h5 > tight.txt 2> tight.err || fail "--linear-region"
+grep -q '^linear region    |q - q_op| <= 0.0001 on rod_pivot: left at' tight.txt || fail "--linear-region 1e-4: $(grep 'linear region' tight.txt)"
 echo "unstable_closed_loop: all checks passed"
