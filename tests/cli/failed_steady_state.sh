@@ -90,4 +90,20 @@ expected = 10 * 9.81 * 1.0 * math.cos(1.0)
 print(f"HELD_OK torque {u0!r} (m g l/2 cos 1 = {expected!r}), pivot {x0!r}")
 if abs(u0 - expected) > 1e-9 or x0 != 1.0: sys.exit("wrong holding torque")
 PY
+# the quadrotor tilted 10 degrees (--hold fly.rx): its thrust cannot hold it in place; the trim's
+# residual is the sideways acceleration g sin(10 deg) = 1.70349 on fly.y, exit 2, nothing written
+rc=0
+"$codyna" linearize "$src/tests/data/quadrotor.json" --operating-point trim --hold fly.rx=0.17453292519943295 --out tilt \
+  > tilt.txt 2> tilt.err || rc=$?
+[ "$rc" -eq 2 ] || fail "the tilted quadrotor's trim exited $rc, expected 2: $(cat tilt.txt tilt.err)"
+[ ! -e tilt ] || fail "the failed trim wrote tilt/"
+"$PY" - <<'PY'
+import math, re, sys
+err = open("tilt.err").read()
+m = re.search(r"the residual accelerations are (\S+) after \d+ iterations \(tolerance 1e-08; largest on fly\.y: (\S+)\)", err)
+if not m: sys.exit(f"message: {err}")
+g = 9.81 * math.sin(math.radians(10))
+if abs(float(m.group(1)) - g) > 1e-5 * g: sys.exit(f"residual {m.group(1)} != g sin(10 deg) = {g}")
+print(f"TILT_OK the tilted quadrotor's trim fails with residual {m.group(1)} = g sin(10 deg) on fly.y, exit 2, nothing written")
+PY
 echo "failed_steady_state: all checks passed"
