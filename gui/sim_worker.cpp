@@ -135,11 +135,23 @@ void SimWorker::runJob(std::shared_ptr<const codyna::Model> model) {
   }
   postBatch(true);  // the rest, before finished()
   const double seconds = wall.nsecsElapsed() * 1e-9;
+  // what the command line warns about, said in the status too: an unstable linear closed loop,
+  // a run that left the region where the linear model holds (core's study_linear_region)
+  QStringList after;
+  if (setup.linear_unstable) after << QStringLiteral("the linear closed loop is unstable about the operating point");
+  const codyna::LinearRegion lr = codyna::study_linear_region(*model, setup, *result);
+  if (lr.left_at >= 0)
+    after << QStringLiteral("the state left the linear region (|%1 - its operating-point value| > %2) at t = %3 s%4")
+                 .arg(QString::fromStdString(lr.left_on))
+                 .arg(lr.bound)
+                 .arg(lr.left_at)
+                 .arg(lr.settled && lr.final_distance > lr.bound ? QStringLiteral(" and settled elsewhere") : QString());
   QMetaObject::invokeMethod(
       this,
-      [this, result, seconds] {
+      [this, result, seconds, after] {
         wall_time_ = seconds;
         running_ = false;
+        notes_ << after;
         emit finished(result);
       },
       Qt::QueuedConnection);

@@ -704,6 +704,34 @@ class ViewsTest : public QObject {
     QVERIFY(std::abs(r->y(r->samples() - 1, 1)) < 0.5 * std::abs(r->y(0, 1)));
   }
 
+  // The run's status says, as the command line does, when the state left the region where the
+  // linear model holds (core's study_linear_region against the study's linear_region): the
+  // cart-pendulum starts 0.1 rad off upright, beyond a bound of 0.01 rad, and the LQR brings it back
+  void leavingTheLinearRegionIsSaid() {
+    Document doc;
+    QVERIFY(doc.load(kCart));
+    StudySpec study = doc.spec().analysis;
+    study.controller = "lqr";
+    study.linear_region = 0.01;
+    QVERIFY(doc.setStudy(study));
+    SimulateView view(&doc);
+    view.show();
+    view.endTimeSpin()->setValue(1.0);
+    QSignalSpy finished(&view, &SimulateView::runFinished);
+    QTest::mouseClick(view.runButton(), Qt::LeftButton);
+    QVERIFY(waitFor([&] { return finished.count() == 1; }));
+    QVERIFY(view.result() && view.result()->completed);
+    QVERIFY2(view.statusText().contains("; note: the state left the linear region (|rod_pivot - its operating-point value| > 0.01) at t = 0 s"),
+             qPrintable(view.statusText()));
+    QVERIFY2(!view.statusText().contains("unstable"), qPrintable(view.statusText()));
+    // within the default 0.5 rad nothing is said
+    study.linear_region = 0.5;
+    QVERIFY(doc.setStudy(study));
+    QTest::mouseClick(view.runButton(), Qt::LeftButton);
+    QVERIFY(waitFor([&] { return finished.count() == 2; }));
+    QVERIFY2(!view.statusText().contains("linear region"), qPrintable(view.statusText()));
+  }
+
   // An LQR on the controllable part of the spherical pendulum (the study field set through the
   // Document): the run stabilizes the tilt, and the note naming the yaw reaches the status line
   // and the messages
