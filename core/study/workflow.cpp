@@ -680,7 +680,9 @@ StudySimulation study_simulation(const Model& m, const std::atomic<bool>* cancel
       os << path << " carries no codyna_study: the controller is applied about this study's " << out.plant->op.kind
          << " point (";
       const Eigen::VectorXd c = study_coordinates(m, out.plant->op.q);
-      for (int k = 0; k < m.nv; ++k) os << (k ? ", " : "") << m.v_names[static_cast<std::size_t>(k)] << " = " << c[k];
+      const double scale = std::max(1.0, c.size() ? c.cwiseAbs().maxCoeff() : 0.0);  // round-off prints as 0
+      for (int k = 0; k < m.nv; ++k)
+        os << (k ? ", " : "") << m.v_names[static_cast<std::size_t>(k)] << " = " << (std::abs(c[k]) <= 1e-12 * scale ? 0.0 : c[k]);
       for (int k : m.plant_inputs) os << ", " << m.actuators[static_cast<std::size_t>(k)].name << " = " << out.plant->op.u[k];
       os << "), which may not be the point it was designed about; to carry the design point, save the export's "
             "codyna_study with it, e.g. in Octave after run('NAME.m'): save('-v7', 'K.mat', 'K', 'codyna_study', 'state_names')";
