@@ -37,7 +37,7 @@ void print_info(const Model& m) {
   if (m.nc) {
     std::cout << "assembly     residual " << m.assembly_residual << "\n";
     if (!m.assembly_moves.empty())
-      std::cout << "             moved to close the loops: " << assembly_moves_text(m) << "\n";
+      std::cout << "             moved to close the loops: " << study_assembly_moves_text(m) << "\n";
   }
   std::cout << "effects      " << (m.has_gravity ? "gravity" : "no gravity");
   if (!m.springs.empty()) std::cout << ", " << m.springs.size() << " spring-damper(s)";
@@ -77,7 +77,7 @@ void add_info(CLI::App& app) {
   cmd->add_option("model", *file, "model file (JSON)")->required();
   cmd->callback([file] {
     set_exit_code(run_guarded([&] {
-      const Model m = load_model(*file);
+      const Model m = study_compile(load_spec(*file), *file);
       print_info(m);
     }));
   });

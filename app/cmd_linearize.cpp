@@ -1,25 +1,11 @@
-#include <Eigen/Eigenvalues>
-#include <cmath>
-#include <filesystem>
+// codyna linearize: flags -> a LinearizeRequest, one study call (study_linearize_job), and the
+// printing. What the flags mean and every computation live in core/study/.
 #include <iomanip>
 #include <iostream>
-#include <optional>
-#include <sstream>
 
-#include "analysis/discretize.hpp"
-#include "analysis/linearize.hpp"
-#include "analysis/modal.hpp"
-#include "analysis/operating_point.hpp"
 #include "commands.hpp"
-#include "control/controllability.hpp"
-#include "io/model_file.hpp"
-#include "io/output_guard.hpp"
 #include "common.hpp"
-#include "io/mat_export.hpp"
-#include "simulation/model_controller.hpp"
-#include "simulation/simulator.hpp"
-#include "simulation/trajectory_linearization.hpp"
-#include "study/workflow.hpp"
+#include "study/jobs.hpp"
 
 namespace codyna::cli {
 
@@ -35,73 +21,54 @@ struct LinearizeArgs {
   const CLI::App* cmd = nullptr;  // to tell given flags (they override the file's analysis section)
 };
 
-JacobianMethod method_of(const std::string& s) {
-  if (s == "exact") return JacobianMethod::Exact;
-  if (s == "fd-forward") return JacobianMethod::ForwardDifference;
-  if (s == "fd-central") return JacobianMethod::CentralDifference;
-  throw std::invalid_argument("--method " + s + ": expected exact, fd-forward or fd-central");
+LinearizeRequest request_of(const LinearizeArgs& a) {
+  LinearizeRequest r;
+  r.model = a.model;
+  r.out = a.out;
+  r.plant = plant_request(a.plant, a.cmd);
+  if (given(a.cmd, "--operating-point")) r.point.operating_point = a.op;
+  if (given(a.cmd, "--method")) r.method = a.method;
+  if (given(a.cmd, "--discrete")) r.discrete = a.discrete;
+  if (given(a.cmd, "--mat-version")) r.mat_version = a.mat_version;
+  if (given(a.cmd, "--independent")) r.point.independent = a.independent;
+  if (given(a.cmd, "--name")) r.name = a.name;
+  r.closed_loop = a.closed_loop;
+  r.lqr = a.lqr;
+  if (!a.controller.empty()) r.controller = a.controller;
+  if (given(a.cmd, "--q-weights")) r.q_weights = a.q_weights;
+  if (given(a.cmd, "--r-weights")) r.r_weights = a.r_weights;
+  r.lqr_controllable_part = a.lqr_controllable_part;
+  r.point.hold = a.set;
+  r.point.initial = a.initial;
+  if (given(a.cmd, "--trim-free")) r.point.trim_free = a.trim_free;
+  if (given(a.cmd, "--free-input")) r.point.free_inputs = a.free_inputs;
+  r.point.targets = a.targets;
+  if (given(a.cmd, "--trajectory")) r.trajectory = a.trajectory;
+  if (given(a.cmd, "--trajectory-step")) r.trajectory_step = a.trajectory_step;
+  return r;
 }
 
-// --trajectory: simulate (with the model's controller, if it declares one) and linearize
-// the plant about every output sample
-void run_trajectory(const Model& m, const LinearizeArgs& a, const std::string& name) {
-  if (m.spec.analysis.discrete != 0) throw std::invalid_argument("--trajectory: export is continuous-time only (drop --discrete)");
-  if (m.spec.analysis.mat_version != "5") throw std::invalid_argument("--trajectory: export is MAT v5 only");
-  SimulationOptions o;
-  o.integrator.method = m.spec.solver.integrator;
-  o.integrator.rtol = m.spec.solver.rtol;
-  o.integrator.atol = m.spec.solver.atol;
-  o.integrator.max_step = m.spec.solver.max_step;
-  o.t_end = a.trajectory;
-  o.output_step = a.trajectory_step > 0 ? a.trajectory_step : m.spec.solver.output_step;
-  if (!std::isfinite(a.trajectory) || (given(a.cmd, "--trajectory-step") && !(a.trajectory_step > 0 && std::isfinite(a.trajectory_step))))
-    throw std::invalid_argument("--trajectory, --trajectory-step: expected finite numbers of seconds > 0");
-  if (!m.spec.analysis.initial.empty()) {  // the run starts at the study's initial state
-    const StudyInitialState start = study_initial_state(m);
-    o.q0 = start.q;
-    o.v0 = start.v;
-  }
-  const double points = a.trajectory / o.output_step + 1;
-  if (points > 100000)
-    throw std::invalid_argument("--trajectory " + std::to_string(a.trajectory) + " with a step of " +
-                                std::to_string(o.output_step) + " s gives " + std::to_string(static_cast<long long>(points)) +
-                                " linearizations (at most 100000): raise --trajectory-step");
-  const std::filesystem::path base = std::filesystem::path(a.out) / name;
-  guard_output(base.string() + ".mat", OutputKind::PlantMat, {a.model});
-  guard_output(base.string() + ".m", OutputKind::PlantScript, {a.model});
-  std::unique_ptr<LinearPlant> plant;
-  std::unique_ptr<Controller> controller;
-  if (has_model_controller(m)) {
-    plant = std::make_unique<LinearPlant>(controller_plant(m));
-    controller = make_model_controller(m, *plant);
-  }
-  const SimulationResult r = simulate(m, controller.get(), plant.get(), o);
-  if (!r.completed) throw std::runtime_error("--trajectory: the simulation failed: " + r.failure);
-  LinearizeOptions lo;
-  lo.method = method_of(m.spec.analysis.method);
-  lo.independent = m.spec.analysis.independent;
-  const std::vector<Linearization> lin = linearize_along(m, r, lo);
-  std::vector<LinearSystem> systems;
-  for (const Linearization& l : lin) systems.push_back(l.system);
+void print_trajectory(const LinearizeJob& job) {
+  const Model& m = job.model;
   std::cout << "model            " << m.name << " (" << m.dof() << " DOF)\n"
-            << "trajectory       " << lin.size() << " points, t = 0 .. " << r.t.back() << " s, "
-            << (controller ? controller->describe() : std::string("open loop")) << "\n"
-            << "method           " << to_string(lo.method) << "\n"
+            << "trajectory       " << job.systems.size() << " points, t = 0 .. " << job.times.back() << " s, "
+            << job.trajectory_controller << "\n"
+            << "method           " << job.method << "\n"
             << "states           ";
-  for (std::size_t k = 0; k < systems[0].state_names.size(); ++k) std::cout << (k ? ", " : "") << systems[0].state_names[k];
+  for (std::size_t k = 0; k < job.systems[0].state_names.size(); ++k)
+    std::cout << (k ? ", " : "") << job.systems[0].state_names[k];
   std::cout << "\n\n     t [s]   max Re(eig A)   min Re(eig A)\n";
-  const std::size_t every = std::max<std::size_t>(1, lin.size() / 10);
-  for (std::size_t k = 0; k < lin.size(); k += every) {
-    const Eigen::VectorXcd ev = systems[k].A.eigenvalues();
-    std::cout << std::setw(10) << r.t[k] << std::setw(16) << ev.real().maxCoeff() << std::setw(16) << ev.real().minCoeff() << "\n";
+  const std::size_t every = std::max<std::size_t>(1, job.systems.size() / 10);
+  for (std::size_t k = 0; k < job.systems.size(); k += every) {
+    const auto i = static_cast<Eigen::Index>(k);
+    std::cout << std::setw(10) << job.times[k] << std::setw(16) << job.max_real[i] << std::setw(16) << job.min_real[i] << "\n";
   }
-  std::filesystem::create_directories(a.out);
-  const ExportPaths p = export_trajectory(systems, std::vector<double>(r.t.begin(), r.t.end()), a.out, name);
-  std::cout << "\nwrote " << p.mat_file << "\nwrote " << p.m_file << "\n";
+  std::cout << "\nwrote " << job.written[0] << "\nwrote " << job.written[1] << "\n";
 }
 
 // the study's controller around the plant: NAME_cl.{mat,m} and the step and frequency curves
-void run_closed_loop(const Model& m, const LinearizeArgs& a, const StudyClosedLoop& cl) {
+void print_closed_loop(const LinearizeJob& job) {
+  const StudyClosedLoop& cl = *job.closed_loop;
   for (const std::string& n : cl.setup.notes) std::cerr << "codyna: note: " << n << "\n";
   for (const std::string& n : cl.notes) std::cerr << "codyna: note: closed loop: " << n << "\n";
   const LinearSystem& s = cl.loop.system;
@@ -111,104 +78,21 @@ void run_closed_loop(const Model& m, const LinearizeArgs& a, const StudyClosedLo
   for (std::size_t k = 0; k < s.input_names.size(); ++k) std::cout << (k ? ", " : "") << s.input_names[k];
   std::cout << "\noutputs          ";
   for (std::size_t k = 0; k < s.output_names.size(); ++k) std::cout << (k ? ", " : "") << s.output_names[k];
-  std::cout << "\n\n" << format_modes(cl.poles) << "\n";
-  for (const std::string& f : study_export_closed_loop(m, cl, a.out)) std::cout << "wrote " << f << "\n";
+  std::cout << "\n\n" << study_format_modes(cl.poles) << "\n";
+  for (const std::string& f : job.closed_loop_written) std::cout << "wrote " << f << "\n";
 }
 
-// the model file's study, with the flags given on the command line on top
-ModelSpec study_of(const LinearizeArgs& a) {
-  ModelSpec spec = load_spec(a.model);
-  apply_plant_flags(spec, a.plant, a.cmd);
-  StudySpec& s = spec.analysis;
-  if (given(a.cmd, "--operating-point")) s.operating_point = a.op;
-  if (given(a.cmd, "--method")) s.method = a.method;
-  if (given(a.cmd, "--discrete")) {
-    if (!(a.discrete >= 0) || !std::isfinite(a.discrete))
-      throw std::invalid_argument("--discrete: the sample time must be positive (0 = continuous)");
-    s.discrete = a.discrete;
-  }
-  if (given(a.cmd, "--mat-version")) {
-    if (a.mat_version != "5" && a.mat_version != "7.3") throw std::invalid_argument("--mat-version: expected 5 or 7.3");
-    s.mat_version = a.mat_version;
-  }
-  if (given(a.cmd, "--independent")) s.independent = a.independent;
-  if (given(a.cmd, "--name")) {
-    if (a.name != matlab_identifier(a.name))
-      throw std::invalid_argument("--name " + a.name + ": not a valid MATLAB identifier (try " + matlab_identifier(a.name) + ")");
-    s.export_name = a.name;
-  }
-  if (given(a.cmd, "--method")) method_of(a.method);  // a clear message for a bad flag
-  if (a.closed_loop) s.closed_loop.enabled = true;
-  if (a.lqr && !a.controller.empty()) throw std::invalid_argument("--controller and --lqr: choose one");
-  if ((a.lqr || !a.controller.empty()) && !a.closed_loop && !s.closed_loop.enabled)
-    throw std::invalid_argument(std::string(a.lqr ? "--lqr" : "--controller") + ": a controller is used by --closed-loop only (add it)");
-  if (a.lqr) s.controller = "lqr";
-  if (!a.controller.empty()) {
-    s.controller = "file";
-    s.controller_file = std::filesystem::absolute(a.controller).string();  // a flag's path is relative to here
-  }
-  if (given(a.cmd, "--q-weights")) s.q_weights = a.q_weights;
-  if (given(a.cmd, "--r-weights")) s.r_weights = a.r_weights;
-  if (a.lqr_controllable_part) {
-    if (s.controller != "lqr") throw std::invalid_argument("--lqr-controllable-part: goes with --lqr (or \"controller\": \"lqr\" in the study)");
-    s.lqr_controllable_part = true;
-  }
-  apply_set(s, a.set);
-  apply_initial(s, a.initial);
-  if (given(a.cmd, "--trim-free")) s.trim_free = a.trim_free;
-  if (given(a.cmd, "--free-input")) s.free_inputs = a.free_inputs;
-  apply_targets(s, a.targets);
-  return spec;
-}
-
-void run(const LinearizeArgs& a) {
-  const Model m = study_model(study_of(a), a.model);
-  if (!m.assembly_moves.empty())
-    std::cerr << "codyna: note: closing the loops moved the joints' q0/v0: " << assembly_moves_text(m) << "\n";
-  const std::string name = study_export_name(m);
-  if (m.plant_inputs.empty() && m.plant_outputs.empty())
-    std::cerr << "codyna: warning: the model selects no Plant/In or Plant/Out; exporting the state equations only\n";
-  else if (m.plant_inputs.empty())
-    std::cerr << "codyna: warning: the model selects no Plant/In (plant.inputs): B and D have no columns, no controller can act\n";
-  else if (m.plant_outputs.empty())
-    std::cerr << "codyna: warning: the model selects no Plant/Out (plant.outputs): C and D have no rows\n";
-  if (given(a.cmd, "--trajectory")) {
-    if (!(a.trajectory > 0) || !std::isfinite(a.trajectory))
-      throw std::invalid_argument("--trajectory: expected an end time of seconds > 0");
-    if (m.spec.analysis.closed_loop.enabled) throw std::invalid_argument("--closed-loop: not along a --trajectory (one operating point)");
-    return run_trajectory(m, a, name);
-  }
-  {  // an export that would replace the model (or a file codyna did not write) fails before the work
-    const std::filesystem::path base = std::filesystem::path(a.out) / name;
-    guard_output(base.string() + ".mat", OutputKind::PlantMat, {a.model});
-    guard_output(base.string() + ".m", OutputKind::PlantScript, {a.model});
-    if (m.spec.analysis.closed_loop.enabled) {
-      guard_output(base.string() + "_cl.mat", OutputKind::PlantMat, {a.model});
-      guard_output(base.string() + "_cl.m", OutputKind::PlantScript, {a.model});
-      guard_output(base.string() + "_cl_step.csv", OutputKind::CurvesCsv, {a.model});
-      guard_output(base.string() + "_cl_freq.csv", OutputKind::CurvesCsv, {a.model});
-    }
-  }
-  if (!a.initial.empty())
-    throw std::invalid_argument("--initial: the initial state of a run; linearize uses it with --trajectory only (the "
-                                "operating point's coordinates are --hold NAME=VALUE)");
-  const StudyLinearization sl = study_linearize(m);
-  // the closed loop's operating point (the model controller's own may differ) is found before
-  // anything is written, so that a search that fails leaves no export behind
-  std::optional<StudyClosedLoop> cl;
-  if (m.spec.analysis.closed_loop.enabled) cl = study_closed_loop(m);
-  const OperatingPoint& op = sl.op;
-  const Linearization& lin = sl.lin;
-  const LinearSystem& sys = sl.system;
-  LinearizeOptions opt;
-  opt.method = method_of(m.spec.analysis.method);
-
+void print(const LinearizeJob& job) {
+  const Model& m = job.model;
+  const OperatingPoint& op = job.linearization.op;
+  const Linearization& lin = job.linearization.lin;
+  const LinearSystem& sys = job.linearization.system;
   std::cout << "model            " << m.name << " (" << m.dof() << " DOF)\n"
             << "operating point  " << op.kind;
   if (op.kind == "equilibrium" || op.kind == "trim")
     std::cout << " (residual " << op.residual << ", " << op.iterations << " iterations)";
-  std::cout << "\nmethod           " << to_string(opt.method);
-  if (opt.method != JacobianMethod::Exact) std::cout << " (max relative difference from exact: " << lin.fd_error << ")";
+  std::cout << "\nmethod           " << job.method;
+  if (job.method != "exact") std::cout << " (max relative difference from exact: " << lin.fd_error << ")";
   std::cout << "\ntime             " << (sys.Ts > 0 ? "discrete, Ts = " + std::to_string(sys.Ts) : std::string("continuous")) << "\n";
   if (!lin.partition.dependent.empty()) {
     std::cout << "independent      ";
@@ -217,23 +101,28 @@ void run(const LinearizeArgs& a) {
     std::cout << "\n";
   }
   std::cout << "\n";
-  const auto labelled = [](const std::vector<std::string>& names, const Eigen::VectorXd& v) { return name_values(names, v); };
-  std::cout << "x0\n" << labelled(sys.state_names, sys.x0) << "u0\n" << labelled(sys.input_names, sys.u0)
-            << "y0\n" << labelled(sys.output_names, sys.y0) << "xdot0\n" << labelled(sys.state_names, sys.xdot0) << "\n";
+  std::cout << "x0\n" << name_values(sys.state_names, sys.x0) << "u0\n" << name_values(sys.input_names, sys.u0)
+            << "y0\n" << name_values(sys.output_names, sys.y0) << "xdot0\n" << name_values(sys.state_names, sys.xdot0) << "\n";
   print_matrix("A", sys.A, sys.state_names, sys.state_names);
   print_matrix("B", sys.B, sys.state_names, sys.input_names);
   print_matrix("C", sys.C, sys.output_names, sys.state_names);
   print_matrix("D", sys.D, sys.output_names, sys.input_names);
-  std::cout << "\n" << format_modes(modal_analysis(sys)) << "\n";
-  // what the inputs cannot move and the outputs cannot see, named (continuous plant)
-  const LinearSystem& c = lin.system;
-  const auto uc = uncontrollable_modes(c.A, c.B, c.state_names), uo = unobservable_modes(c.A, c.C, c.state_names);
-  std::cout << "controllable     " << (uc.empty() ? std::string("yes, every mode") : "no: " + describe(uc)) << "\n"
-            << "observable       " << (uo.empty() ? std::string("yes, every mode") : "no: " + describe(uo)) << "\n\n";
+  std::cout << "\n" << study_format_modes(job.modes) << "\n";
+  std::cout << "controllable     "
+            << (job.uncontrollable.empty() ? std::string("yes, every mode") : "no: " + study_describe_modes(job.uncontrollable))
+            << "\n"
+            << "observable       "
+            << (job.unobservable.empty() ? std::string("yes, every mode") : "no: " + study_describe_modes(job.unobservable))
+            << "\n\n";
+  std::cout << "wrote " << job.written[0] << "\nwrote " << job.written[1] << "\n";
+  if (job.closed_loop) print_closed_loop(job);
+}
 
-  const ExportPaths p = study_export(m, sys, a.out);
-  std::cout << "wrote " << p.mat_file << "\nwrote " << p.m_file << "\n";
-  if (cl) run_closed_loop(m, a, *cl);
+void run(const LinearizeArgs& a) {
+  const LinearizeRequest r = request_of(a);
+  const LinearizeJob job = study_linearize_job(r, load_spec(a.model), print_message);
+  if (job.trajectory) print_trajectory(job);
+  else print(job);
 }
 
 }  // namespace

@@ -1,20 +1,16 @@
+// codyna simulate: flags -> a SimulateRequest, one study call (study_simulate_job), and the
+// printing. What the flags mean and every computation live in core/study/.
 #include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <iomanip>
 #include <iostream>
-#include <memory>
+#include <sstream>
 
-#include "analysis/linearize.hpp"
 #include "commands.hpp"
 #include "common.hpp"
-#include "control/lqr.hpp"
-#include "io/output_guard.hpp"
-#include "io/results_file.hpp"
-#include "simulation/model_controller.hpp"
-#include "simulation/simulator.hpp"
+#include "study/jobs.hpp"
 
 namespace codyna::cli {
 
@@ -49,7 +45,87 @@ std::string poles_text(const Eigen::VectorXcd& p, int precision) {
   return os.str();
 }
 
-void summary(const SimulationResult& r, const Model& m, const LinearPlant* plant, const StudySimulation& setup) {
+SimulateRequest request_of(const SimulateArgs& a) {
+  SimulateRequest r;
+  r.model = a.model;
+  r.out = a.out;
+  r.csv = a.csv;
+  r.plant = plant_request(a.plant, a.cmd);
+  if (!a.controller.empty()) r.controller = a.controller;
+  r.lqr = a.lqr;
+  r.open_loop = a.open_loop;
+  r.lqr_controllable_part = a.lqr_controllable_part;
+  if (given(a.cmd, "--q-weights")) r.q_weights = a.q_weights;
+  if (given(a.cmd, "--r-weights")) r.r_weights = a.r_weights;
+  if (given(a.cmd, "--operating-point")) r.point.operating_point = a.op;
+  if (given(a.cmd, "--independent")) r.point.independent = a.independent;
+  r.compare_linear = a.compare_linear;
+  if (given(a.cmd, "--linear-region")) r.linear_region = a.linear_region;
+  r.point.hold = a.set;
+  r.point.initial = a.initial;
+  if (given(a.cmd, "--trim-free")) r.point.trim_free = a.trim_free;
+  if (given(a.cmd, "--free-input")) r.point.free_inputs = a.free_inputs;
+  r.point.targets = a.targets;
+  if (!a.integrator.empty()) r.integrator = a.integrator;
+  if (given(a.cmd, "--rtol")) r.rtol = a.rtol;
+  if (given(a.cmd, "--atol")) r.atol = a.atol;
+  if (given(a.cmd, "--max-step")) r.max_step = a.max_step;
+  if (given(a.cmd, "--t-end")) r.t_end = a.t_end;
+  if (given(a.cmd, "--output-step")) r.output_step = a.output_step;
+  r.max_samples = a.max_samples;
+  r.divergence_bound = a.divergence_bound;
+  return r;
+}
+
+// what is known before the run: the controller, the linear closed loop, the operating point and the start
+void print_setup(const SimulateJob& job, const SimulateArgs& a) {
+  const Model& m = job.model;
+  const StudySimulation& setup = job.setup;
+  const LinearPlant* plant = setup.plant.get();
+  if (setup.controller) {
+    const std::string& src = m.spec.analysis.controller;
+    if (src == "lqr") {
+      const LinearSystem& s = plant->lin.system;
+      std::cout << "LQR about the " << plant->op.kind << " point, states (";
+      for (std::size_t k = 0; k < s.state_names.size(); ++k) std::cout << (k ? ", " : "") << s.state_names[k];
+      std::cout << "):\n";
+      for (int r = 0; r < setup.lqr_gain.rows(); ++r) std::cout << "K(" << s.input_names[r] << ") = [" << row(setup.lqr_gain, r) << "]\n";
+      std::cout << "closed-loop poles";
+      for (Eigen::Index k = 0; k < setup.lqr_poles.size(); ++k)
+        std::cout << (k ? ", " : " ") << setup.lqr_poles[k].real() << (setup.lqr_poles[k].imag() < 0 ? "-" : "+")
+                  << std::abs(setup.lqr_poles[k].imag()) << "i";
+      std::cout << "\n";
+    } else if (src == "file") {
+      std::cout << "controller from " << a.controller << ": " << setup.controller->describe() << "\n";
+    } else {
+      std::cout << "controller from the model file: " << setup.controller->describe() << " (about the " << plant->op.kind
+                << " point)\n";
+    }
+  }
+  if (setup.linear_poles.size())
+    std::cout << "linear closed-loop poles (" << (setup.linear_discrete ? "discrete, z" : "continuous, s") << ", about the "
+              << plant->op.kind << " point): " << poles_text(setup.linear_poles, 12) << "\n";
+  if (plant) {
+    // the point the linear parts (controller, comparison) are about, apart from where the run starts
+    std::cout << "operating point  " << plant->op.kind;
+    if (plant->op.kind == "equilibrium" || plant->op.kind == "trim") std::cout << " (residual " << plant->op.residual << ")";
+    std::cout << ":";
+    std::cout << " " << name_values(m.v_names, job.op_coordinates, true, 10) << std::setprecision(10);
+    for (int k : m.plant_inputs) std::cout << ", " << m.actuators[k].name << " = " << plant->op.u[k];
+    std::cout << std::setprecision(6) << "\n";
+  }
+  if (!m.spec.analysis.initial.empty()) {
+    std::cout << "initial state   ";
+    std::cout << " " << name_values(m.v_names, job.initial_coordinates, true, 10);
+    std::cout << std::setprecision(6) << " (the study's initial state, apart from the operating point)\n";
+  }
+}
+
+void summary(const SimulateJob& job) {
+  const SimulationResult& r = job.result;
+  const Model& m = job.model;
+  const StudySimulation& setup = job.setup;
+  const LinearPlant* plant = setup.plant.get();
   const int N = r.samples();
   std::cout << "\nsimulation       " << (r.completed ? "completed" : r.cancelled ? "cancelled" : "FAILED") << ", t = "
             << r.t.front() << " .. " << r.t.back() << " s, " << N << " samples\n";
@@ -84,7 +160,7 @@ void summary(const SimulationResult& r, const Model& m, const LinearPlant* plant
   for (int k : m.plant_inputs)
     std::cout << "input  " << std::left << std::setw(10) << m.actuators[k].name << std::right << " max |u| "
               << r.u.col(k).cwiseAbs().maxCoeff() << " [" << m.actuators[k].unit << "]\n";
-  for (const Saturation& s : saturation_report(m, r))
+  for (const Saturation& s : job.saturation)
     std::cout << "saturation       " << s.actuator << " at its limit from t = " << s.first << " s: " << s.at_max
               << " s at max, " << s.at_min << " s at min\n";
   const double E0 = r.kinetic_energy[0] + r.potential_energy[0], E1 = r.kinetic_energy[N - 1] + r.potential_energy[N - 1];
@@ -93,21 +169,13 @@ void summary(const SimulationResult& r, const Model& m, const LinearPlant* plant
     std::cout << "constraint drift max |phi| " << *std::max_element(r.constraint_violation.begin(), r.constraint_violation.end())
               << ", max |Jc v| " << *std::max_element(r.velocity_violation.begin(), r.velocity_violation.end()) << "\n";
   }
-  if (r.y_linear.rows() == N && N > 0) {
+  if (job.linear_gap.size()) {
     std::cout << "linear vs nonlinear (same controller, same start):\n";
     for (int k = 0; k < r.y.cols(); ++k) {
-      const Eigen::VectorXd d = (r.y.col(k) - r.y_linear.col(k)).cwiseAbs();
-      const double range = std::max((r.y.col(k).array() - r.y(N - 1, k)).abs().maxCoeff(), 1e-12);
-      int first = -1;
-      for (int i = 0; i < N; ++i)
-        if (d[i] > 0.01 * range) {
-          first = i;
-          break;
-        }
       std::cout << "  " << std::left << std::setw(10) << r.output_names[k] << std::right << " max |y - y_lin| "
-                << d.maxCoeff() << " (" << 100 * d.maxCoeff() / range << " % of its excursion); "
-                << (first < 0 ? std::string("within 1 % throughout")
-                              : "parts beyond 1 % at t = " + std::to_string(r.t[first]) + " s")
+                << job.linear_gap[k] << " (" << job.linear_gap_percent[k] << " % of its excursion); "
+                << (job.linear_gap_from[k] < 0 ? std::string("within 1 % throughout")
+                                               : "parts beyond 1 % at t = " + std::to_string(job.linear_gap_from[k]) + " s")
                 << "\n";
     }
     // the two runs' own errors beside the gap: a gap near them is the integrators', not the model's
@@ -119,154 +187,9 @@ void summary(const SimulationResult& r, const Model& m, const LinearPlant* plant
     std::cout << "\n";
     if (!r.linear_failure.empty()) std::cout << "  " << r.linear_failure << "\n";
   }
-}
-
-// the model file's study and solver settings, with the flags given on the command line on top
-ModelSpec study_of(const SimulateArgs& a) {
-  ModelSpec spec = load_spec(a.model);
-  apply_plant_flags(spec, a.plant, a.cmd);
-  StudySpec& s = spec.analysis;
-  if (!a.controller.empty() + a.lqr + a.open_loop > 1)
-    throw std::invalid_argument("--controller, --lqr and --open-loop: choose one");
-  if (!a.controller.empty()) {
-    s.controller = "file";
-    s.controller_file = std::filesystem::absolute(a.controller).string();  // a flag's path is relative to here
-  }
-  if (a.lqr) s.controller = "lqr";
-  if (a.open_loop) s.controller = "none";
-  if (a.lqr_controllable_part) {
-    if (s.controller != "lqr") throw std::invalid_argument("--lqr-controllable-part: goes with --lqr (or \"controller\": \"lqr\" in the study)");
-    s.lqr_controllable_part = true;
-  }
-  if (given(a.cmd, "--q-weights")) s.q_weights = a.q_weights;
-  if (given(a.cmd, "--r-weights")) s.r_weights = a.r_weights;
-  if (given(a.cmd, "--operating-point")) {
-    s.operating_point = a.op;
-    // the command line's point also overrides where the model's own controller is linearized
-    if (spec.controller.type != ControllerType::None) spec.controller.operating_point = a.op;
-  }
-  if (given(a.cmd, "--independent")) s.independent = a.independent;
-  if (a.compare_linear) s.compare_linear = true;
-  if (given(a.cmd, "--linear-region")) {
-    if (!(a.linear_region > 0) || !std::isfinite(a.linear_region))
-      throw std::invalid_argument("--linear-region: expected a bound > 0 (rad or m)");
-    s.linear_region = a.linear_region;
-  }
-  apply_set(s, a.set);
-  apply_initial(s, a.initial);
-  if (given(a.cmd, "--trim-free")) s.trim_free = a.trim_free;
-  if (given(a.cmd, "--free-input")) s.free_inputs = a.free_inputs;
-  apply_targets(s, a.targets);
-  SolverSpec& sp = spec.solver;
-  // each number given is checked where it enters, with its flag named
-  const auto check = [&](const char* flag, double x, bool ok, const char* expected) {
-    if (!given(a.cmd, flag)) return false;
-    if (!std::isfinite(x) || !ok)
-      throw std::invalid_argument(std::string(flag) + " " + std::to_string(x) + ": expected " + expected);
-    return true;
-  };
-  if (!a.integrator.empty()) sp.integrator = a.integrator;
-  if (check("--rtol", a.rtol, a.rtol > 0 && a.rtol < 1, "a number in (0, 1)")) sp.rtol = a.rtol;
-  if (check("--atol", a.atol, a.atol > 0, "a number > 0")) sp.atol = a.atol;
-  if (check("--max-step", a.max_step, a.max_step >= 0, "a number >= 0 (0 = no limit)")) sp.max_step = a.max_step;
-  if (check("--t-end", a.t_end, a.t_end > 0, "a number of seconds > 0")) sp.t_end = a.t_end;
-  if (check("--output-step", a.output_step, a.output_step > 0, "a number of seconds > 0")) sp.output_step = a.output_step;
-  check("--max-samples", a.max_samples, a.max_samples >= 1, "a number >= 1");
-  check("--divergence-bound", a.divergence_bound, a.divergence_bound > 0, "a number > 0");
-  return spec;
-}
-
-void run(const SimulateArgs& a) {
-  const ModelSpec spec = study_of(a);
-  const Model m = study_model(spec, a.model);
-  if (!m.assembly_moves.empty())
-    std::cerr << "codyna: note: closing the loops moved the joints' q0/v0: " << assembly_moves_text(m) << "\n";
-  for (std::size_t k = spec.notes.size(); k < m.spec.notes.size(); ++k) std::cerr << "codyna: note: " << m.spec.notes[k] << "\n";
-  // outputs that would replace the model, the controller file or a file codyna did not write are refused
-  // before any work
-  const std::vector<std::string> inputs{a.model, a.controller};
-  guard_output(a.out, OutputKind::ResultsHdf5, inputs);
-  if (!a.csv.empty()) {
-    guard_output(a.csv, OutputKind::ResultsCsv, inputs);
-    if (a.csv == a.out || same_file(a.csv, a.out))
-      throw std::invalid_argument("--csv " + a.csv + ": the same file as --out");
-  }
-  StudySimulation setup = study_simulation(m);
-  for (const std::string& n : setup.notes) std::cerr << "codyna: note: " << n << "\n";
-  setup.options.max_samples = a.max_samples;
-  setup.options.divergence_bound = a.divergence_bound;
-  const LinearPlant* plant = setup.plant.get();
-  const SimulationOptions& o = setup.options;
-  if (setup.controller) {
-    const std::string& src = m.spec.analysis.controller;
-    if (src == "lqr") {
-      const LinearSystem& s = plant->lin.system;
-      std::cout << "LQR about the " << plant->op.kind << " point, states (";
-      for (std::size_t k = 0; k < s.state_names.size(); ++k) std::cout << (k ? ", " : "") << s.state_names[k];
-      std::cout << "):\n";
-      for (int r = 0; r < setup.lqr_gain.rows(); ++r) std::cout << "K(" << s.input_names[r] << ") = [" << row(setup.lqr_gain, r) << "]\n";
-      std::cout << "closed-loop poles";
-      for (Eigen::Index k = 0; k < setup.lqr_poles.size(); ++k)
-        std::cout << (k ? ", " : " ") << setup.lqr_poles[k].real() << (setup.lqr_poles[k].imag() < 0 ? "-" : "+")
-                  << std::abs(setup.lqr_poles[k].imag()) << "i";
-      std::cout << "\n";
-    } else if (src == "file") {
-      std::cout << "controller from " << a.controller << ": " << setup.controller->describe() << "\n";
-    } else {
-      std::cout << "controller from the model file: " << setup.controller->describe() << " (about the " << plant->op.kind
-                << " point)\n";
-    }
-  }
-
-  if (setup.linear_poles.size()) {
-    std::cout << "linear closed-loop poles (" << (setup.linear_discrete ? "discrete, z" : "continuous, s") << ", about the "
-              << plant->op.kind << " point): " << poles_text(setup.linear_poles, 12) << "\n";
-    if (setup.linear_unstable)
-      std::cerr << "codyna: warning: unstable linear closed loop: the controller does not stabilize the plant about the "
-                << plant->op.kind << " point (check the sign of the gain: u = u0 - K (x - x0))\n";
-  }
-  if (plant) {
-    // the point the linear parts (controller, comparison) are about, apart from where the run starts
-    std::cout << "operating point  " << plant->op.kind;
-    if (plant->op.kind == "equilibrium" || plant->op.kind == "trim") std::cout << " (residual " << plant->op.residual << ")";
-    std::cout << ":";
-    std::cout << " " << name_values(m.v_names, study_coordinates(m, plant->op.q), true, 10) << std::setprecision(10);
-    for (int k : m.plant_inputs) std::cout << ", " << m.actuators[k].name << " = " << plant->op.u[k];
-    std::cout << std::setprecision(6) << "\n";
-  }
-  if (!m.spec.analysis.initial.empty()) {
-    const Eigen::VectorXd& q0 = o.q0;
-    std::cout << "initial state   ";
-    std::cout << " " << name_values(m.v_names, study_coordinates(m, q0), true, 10);
-    std::cout << std::setprecision(6) << " (the study's initial state, apart from the operating point)\n";
-  }
-
-  // check the output paths before spending time on the run
-  for (const std::string& p : {a.out, a.csv}) {
-    if (p.empty()) continue;
-    const auto dir = std::filesystem::path(p).parent_path();
-    if (!dir.empty() && !std::filesystem::is_directory(dir))
-      throw std::invalid_argument(p + ": the directory " + dir.string() + " does not exist");
-  }
-  SimulationCallbacks cb;
-  const bool bar = !a.quiet && isatty(STDERR_FILENO);
-  int last = -1;
-  if (bar)
-    cb.progress = [&](double t, double t_end) {
-      const int pct = static_cast<int>(100 * (t - o.t0) / (t_end - o.t0));
-      if (pct == last) return;
-      last = pct;
-      const int w = 40, filled = pct * w / 100;
-      std::fprintf(stderr, "\r[%s%s] %3d%%  t = %.3f s", std::string(filled, '#').c_str(), std::string(w - filled, '.').c_str(), pct, t);
-      std::fflush(stderr);
-    };
-  const SimulationResult r = study_simulate(m, setup, cb);
-  if (bar) std::fprintf(stderr, "\n");
-  write_results(r, a.out, a.csv);
-  summary(r, m, plant, setup);
   if (plant) {
     // how far the run went from the point the linear parts are about
-    const LinearRegion lr = study_linear_region(m, setup, r);
+    const LinearRegion& lr = job.region;
     if (!lr.measured.empty()) {
       std::string names;
       for (const auto& n : lr.measured) names += (names.empty() ? "" : ", ") + n;
@@ -278,12 +201,45 @@ void run(const SimulateArgs& a) {
       if (lr.settled && lr.final_distance > lr.bound)
         std::cout << "                 the run ends at rest " << lr.final_distance << " from the operating point ("
                   << lr.final_on << "): it settled elsewhere\n";
-      if (lr.left_at >= 0)
-        std::cerr << "codyna: warning: the state left the region where the linear model holds: |" << lr.left_on
-                  << " - its operating-point value| > " << lr.bound << " at t = " << lr.left_at << " s"
-                  << (lr.settled && lr.final_distance > lr.bound ? ", and settled elsewhere" : "") << "\n";
     }
   }
+}
+
+void run(const SimulateArgs& a) {
+  const SimulateRequest req = request_of(a);
+  SimulationCallbacks cb;
+  const bool bar = !a.quiet && isatty(STDERR_FILENO);
+  int last = -1;
+  double t0 = 0;
+  if (bar)
+    cb.progress = [&](double t, double t_end) {
+      const int pct = static_cast<int>(100 * (t - t0) / (t_end - t0));
+      if (pct == last) return;
+      last = pct;
+      const int w = 40, filled = pct * w / 100;
+      std::fprintf(stderr, "\r[%s%s] %3d%%  t = %.3f s", std::string(filled, '#').c_str(), std::string(w - filled, '.').c_str(), pct, t);
+      std::fflush(stderr);
+    };
+  const auto ready = [&](const SimulateJob& job) {
+    t0 = job.setup.options.t0;
+    print_setup(job, a);
+  };
+  bool bar_open = false;  // the progress bar's line is not ended yet
+  const auto tell = [&](const StudyMessage& msg) {
+    if (bar_open) std::fprintf(stderr, "\n");
+    bar_open = false;
+    print_message(msg);
+  };
+  const auto progress = cb.progress;
+  if (bar)
+    cb.progress = [&](double t, double t_end) {
+      progress(t, t_end);
+      bar_open = true;
+    };
+  const SimulateJob job = study_simulate_job(req, load_spec(a.model), cb, ready, tell);
+  if (bar && bar_open) std::fprintf(stderr, "\n");
+  summary(job);
+  const SimulationResult& r = job.result;
   std::cout << "wrote " << a.out << (a.csv.empty() ? "" : "\nwrote " + a.csv) << "\n";
   if (!r.completed && !r.cancelled) throw std::runtime_error("the run failed at " + r.failure + "; the partial result is in " + a.out);
 }

@@ -9,14 +9,14 @@
 #include <unistd.h>
 
 #include "commands.hpp"
-#include "io/atomic_file.hpp"
+#include "study/files.hpp"
 
 namespace {
 
 // SIGINT / SIGTERM: remove the temporary files of writes in progress (the final
 // files are only ever renamed into place complete), then end as the signal would.
 extern "C" void on_signal(int sig) {
-  codyna::remove_temporary_files();
+  codyna::study_remove_temporary_files();
   std::signal(sig, SIG_DFL);
   std::raise(sig);
 }

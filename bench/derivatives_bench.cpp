@@ -19,7 +19,7 @@
 #include "analysis/operating_point.hpp"
 #include "dynamics/forward_dynamics.hpp"
 #include "io/model_file.hpp"
-#include "model/compile.hpp"
+#include "dynamics/prepare.hpp"
 
 namespace {
 

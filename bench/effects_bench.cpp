@@ -6,7 +6,7 @@
 #include <benchmark/benchmark.h>
 
 #include "dynamics/forward_dynamics.hpp"
-#include "model/compile.hpp"
+#include "dynamics/prepare.hpp"
 
 namespace {
 

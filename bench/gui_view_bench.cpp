@@ -23,7 +23,7 @@
 
 #include "gui/view3d.hpp"
 #include "io/model_file.hpp"
-#include "model/compile.hpp"
+#include "dynamics/prepare.hpp"
 
 namespace {
 

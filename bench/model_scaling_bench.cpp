@@ -8,7 +8,7 @@
 #include <string>
 
 #include "io/model_file.hpp"
-#include "model/compile.hpp"
+#include "dynamics/prepare.hpp"
 
 namespace {
 

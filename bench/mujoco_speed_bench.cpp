@@ -64,8 +64,8 @@
 #include "dynamics/forward_dynamics.hpp"
 #include "dynamics/joint.hpp"
 #include "dynamics/kinematics.hpp"
-#include "model/compile.hpp"
-#include "model/data.hpp"
+#include "dynamics/prepare.hpp"
+#include "dynamics/data.hpp"
 #include "models/speed_models.hpp"
 #include "peers_mujoco/mjcf.hpp"
 

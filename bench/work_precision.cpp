@@ -51,7 +51,7 @@
 #include "dynamics/kinematics.hpp"
 #include "io/atomic_file.hpp"
 #include "io/model_file.hpp"
-#include "model/compile.hpp"
+#include "dynamics/prepare.hpp"
 #include "models/iftomm_a02.hpp"
 #include "simulation/simulator.hpp"
 #ifdef CODYNA_HAVE_SIMBODY

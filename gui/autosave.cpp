@@ -13,7 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "gui/document.hpp"
-#include "io/model_file.hpp"
+#include "study/files.hpp"
 
 namespace codyna::gui {
 
@@ -55,7 +55,7 @@ void Autosave::writeNow() {
   j["file"] = ss(doc_->filePath());
   j["saved"] = ss(QDateTime::currentDateTimeUtc().toString(Qt::ISODate));
   j["pid"] = QCoreApplication::applicationPid();
-  j["model"] = to_json(doc_->spec());
+  j["model"] = study_model_json(doc_->spec());
   QSaveFile out(file());
   if (!out.open(QIODevice::WriteOnly)) return;  // nowhere to write: editing goes on
   out.write(QByteArray::fromStdString(j.dump(1)));

@@ -24,8 +24,7 @@
 #include "gui/matrix_view.hpp"
 #include "gui/pole_map.hpp"
 #include "gui/result_plots.hpp"
-#include "analysis/modal.hpp"
-#include "analysis/zeros.hpp"
+#include "study/tools.hpp"
 
 namespace codyna::gui {
 
@@ -246,7 +245,7 @@ bool ControlView::analyse() {
   try {
     StudyLinearization lin = study_linearize(*m);
     // the plant's curves on the grids the closed loop uses (core's defaults from the poles)
-    const ModalAnalysis poles = modal_analysis(lin.system);
+    const ModalAnalysis poles = study_modes(lin.system);
     const auto [w_lo, w_hi] = default_frequency_range(poles, lin.system.Ts);
     const double t_step = default_step_time(poles);
     plant_frequency_ = frequency_response(lin.system, log_grid(w_lo, w_hi, 400));
@@ -356,9 +355,9 @@ void ControlView::redraw() {
   const int in = input_combo_->currentIndex(), out = output_combo_->currentIndex();
   // poles of the system, zeros of the pair
   if (sys && in >= 0 && out >= 0 && in < sys->B.cols() && out < sys->C.rows()) {
-    pz_map_->setModes(modal_analysis(*sys));
+    pz_map_->setModes(study_modes(*sys));
     try {
-      pz_map_->setZeros(transmission_zeros(*sys, in, out).zeros);
+      pz_map_->setZeros(study_zeros(*sys, in, out).zeros);
     } catch (const std::exception&) {
       pz_map_->setZeros({});
     }

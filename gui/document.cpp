@@ -4,7 +4,7 @@
 #include <QUndoCommand>
 #include <nlohmann/json.hpp>
 
-#include "io/model_file.hpp"
+#include "study/files.hpp"
 #include "model/errors.hpp"
 #include "study/workflow.hpp"
 
@@ -36,7 +36,7 @@ class SpecCommand : public QUndoCommand {
   int key_;
 };
 
-bool same(const ModelSpec& a, const ModelSpec& b) { return to_json(a) == to_json(b); }
+bool same(const ModelSpec& a, const ModelSpec& b) { return study_model_json(a) == study_model_json(b); }
 
 }  // namespace
 
@@ -122,7 +122,7 @@ bool Document::setStudyChecked(const StudySpec& study, const QString& text, QStr
             if (e.path().rfind("/analysis", 0) == 0) throw;
           }
         };
-        check([&] { (void)parse_model_spec(to_json(s), ss(displayName())); });  // the reader's checks
+        check([&] { (void)study_parse_model(study_model_json(s), ss(displayName())); });  // the reader's checks
         if (compiled) check([&] { (void)study_model(s, ss(path_)); });          // names, coordinates held
       },
       error, mergeKey);
@@ -135,7 +135,7 @@ bool Document::setSolver(const SolverSpec& solver, const QString& text, int merg
         s.solver = solver;
         // the reader's checks on the solver section (an end time of 0 would save a file that does not load)
         try {
-          (void)parse_model_spec(to_json(s), ss(displayName()));
+          (void)study_parse_model(study_model_json(s), ss(displayName()));
         } catch (const ModelError& e) {
           if (e.path().rfind("/solver", 0) == 0) throw;
         }
@@ -146,7 +146,7 @@ bool Document::setSolver(const SolverSpec& solver, const QString& text, int merg
 bool Document::load(const QString& path, QString* error) {
   ModelSpec spec;
   try {
-    spec = load_model_spec(ss(path));
+    spec = study_read_model(ss(path));
   } catch (const std::exception& e) {
     if (error) *error = qs(e.what());
     return false;  // the open document stays as it was
@@ -171,8 +171,8 @@ bool Document::save(QString* error) {
 bool Document::saveAs(const QString& path, QString* error) {
   try {
     // a file that would not load again is not written (the one on disk stays as it was)
-    (void)parse_model_spec(to_json(spec_), ss(path));
-    save_model_spec(spec_, ss(path));
+    (void)study_parse_model(study_model_json(spec_), ss(path));
+    study_save_model(spec_, ss(path));
   } catch (const std::exception& e) {
     if (error) *error = qs(e.what());
     return false;  // still modified

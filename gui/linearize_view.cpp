@@ -392,7 +392,7 @@ void LinearizeView::refreshFromDocument() {
   {
     const QSignalBlocker b(export_name_);
     if (export_name_->text() != qs(s.export_name)) export_name_->setText(qs(s.export_name));
-    export_name_->setPlaceholderText(qs(matlab_identifier(doc_->spec().name)));
+    export_name_->setPlaceholderText(qs(study_matlab_identifier(doc_->spec().name)));
   }
   syncing_ = false;
   refreshIndependent();
@@ -488,7 +488,7 @@ bool LinearizeView::linearize() {
     StudyLinearization r = study_linearize(*m);
     ModalAnalysis modal;
     try {
-      modal = modal_analysis(r.system);
+      modal = study_modes(r.system);
     } catch (const std::exception& e) {
       emit message(tr("Linearize: no modal analysis: %1").arg(qs(e.what())));
     }

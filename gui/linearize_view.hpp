@@ -32,7 +32,7 @@
 #include <memory>
 #include <optional>
 
-#include "analysis/modal.hpp"
+#include "study/tools.hpp"
 #include "model/model.hpp"
 #include "study/workflow.hpp"
 

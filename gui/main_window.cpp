@@ -31,7 +31,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
-#include "io/model_file.hpp"
+#include "study/files.hpp"
 
 #include "gui/autosave.hpp"
 #include "gui/control_view.hpp"
@@ -42,7 +42,6 @@
 #include "gui/simulate_view.hpp"
 #include "gui/view3d.hpp"
 #include "gui/wheel_guard.hpp"
-#include "simulation/result.hpp"
 #include "study/workflow.hpp"
 
 // the icon lives in codyna_gui, a static library: its resources must be registered by name
@@ -532,7 +531,7 @@ bool MainWindow::offerRecovery() {
     }
     ModelSpec spec;
     try {
-      spec = parse_model_spec(nlohmann::json::parse(r.model_json.toStdString()), ss(r.model_file));
+      spec = study_parse_model(nlohmann::json::parse(r.model_json.toStdString()), ss(r.model_file));
     } catch (const std::exception& e) {
       message(tr("Cannot recover %1 (%2): %3").arg(what, r.recovery_file, qs(e.what())), true);
       continue;  // the recovery file stays for a look by hand

@@ -9,7 +9,7 @@
 #include <QStringList>
 #include <Eigen/Core>
 
-#include "analysis/modal.hpp"
+#include "study/tools.hpp"
 
 namespace codyna::gui {
 

@@ -18,7 +18,7 @@
 #include <QWidget>
 #include <vector>
 
-#include "analysis/modal.hpp"
+#include "study/tools.hpp"
 
 QT_BEGIN_NAMESPACE
 class QBoxLayout;

@@ -18,7 +18,7 @@
 #include <numbers>
 #include <nlohmann/json.hpp>
 
-#include "io/model_file.hpp"
+#include "study/files.hpp"
 #include "model/errors.hpp"
 
 namespace codyna::gui {
@@ -139,7 +139,7 @@ bool is_clearable(ElementKind k, const QString& key) {
 // field the reader takes for its type that the file leaves out while it holds its
 // default (a joint's q0 and v0, units, an actuator's limits, a body's shape list).
 json shown_element(const ModelSpec& spec, ElementKind k, int index) {
-  json e = to_json(spec)[section_of(k)][index];
+  json e = study_model_json(spec)[section_of(k)][index];
   switch (k) {
     case ElementKind::Joint: {
       const JointSpec& jt = spec.joints[index];
@@ -288,7 +288,7 @@ bool PropertyEditor::applyText(const QString& field, const QString& text, QStrin
     if (!doc_->rename(id_->kind, id_->index, text.trimmed(), &e)) return reject(e);
     return true;
   }
-  json j = to_json(spec);
+  json j = study_model_json(spec);
   const QString base = QStringLiteral("/%1/%2").arg(section_of(id_->kind)).arg(id_->index);
   const json shown = shown_element(spec, id_->kind, id_->index);
   const json::json_pointer at(("/" + field).toStdString());
@@ -314,7 +314,7 @@ bool PropertyEditor::applyText(const QString& field, const QString& text, QStrin
     // initial values sized for the old type (a joint's q0, v0)
     for (int tries = 0; tries < 40; ++tries) {
       try {
-        parse_model_spec(j, ss(doc_->filePath()));
+        study_parse_model(j, ss(doc_->filePath()));
         break;
       } catch (const ModelError& e) {
         const std::string p = e.path();
@@ -331,7 +331,7 @@ bool PropertyEditor::applyText(const QString& field, const QString& text, QStrin
   }
   ModelSpec next;
   try {
-    next = parse_model_spec(j, ss(doc_->filePath()));
+    next = study_parse_model(j, ss(doc_->filePath()));
   } catch (const ModelError& e) {
     const QString p = qs(e.path());
     const QString f = p.startsWith(base + "/") ? p.mid(base.size() + 1) : field;

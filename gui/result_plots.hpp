@@ -23,7 +23,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "simulation/result.hpp"
+#include "study/workflow.hpp"
 
 QT_BEGIN_NAMESPACE
 class QTimer;

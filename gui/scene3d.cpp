@@ -6,7 +6,7 @@
 #include <functional>
 #include <limits>
 
-#include "dynamics/kinematics.hpp"
+#include "study/tools.hpp"
 
 namespace codyna::gui {
 
@@ -282,8 +282,8 @@ void Scene::build(const Model* model) {
   const Model& m = *model;
   if (m.has_gravity && m.gravity.norm() > 0) up_ = -m.gravity.normalized();
 
-  Data data(m);
-  forward_kinematics(m, data, m.q0);
+  codyna::StudyPoses poses(m);
+  const std::vector<codyna::SE3>& oMi = poses.at(m.q0);
 
   // declared shapes
   std::vector<bool> has_shapes(m.nbodies, false);
@@ -318,14 +318,14 @@ void Scene::build(const Model* model) {
   Eigen::AlignedBox3d joints_box;
   joints_box.extend(Eigen::Vector3d::Zero());
   for (int i = 1; i < m.nbodies; ++i) {
-    joints_box.extend(data.oMi[i].p);
-    joints_box.extend(data.oMi[i].act_point(m.com[i]));
+    joints_box.extend(oMi[i].p);
+    joints_box.extend(oMi[i].act_point(m.com[i]));
   }
   length_ = std::max(joints_box.diagonal().norm(), 1e-3);
   for (int i = 1; i < m.nbodies; ++i)
     if (!has_shapes[i]) addDefaultLook(i);
 
-  update(data.oMi);
+  update(oMi);
   const Eigen::AlignedBox3d box = bounds();
   length_ = std::max(box.diagonal().norm(), 1e-6);
   const double L = length_;
@@ -440,8 +440,8 @@ void Scene::build(const Model* model) {
     items_.push_back(it);
   }
 
-  update(data.oMi);
-  placeGrid(data.oMi);
+  update(oMi);
+  placeGrid(oMi);
 }
 
 void Scene::addDefaultLook(int i) {

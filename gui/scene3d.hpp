@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "model/data.hpp"
+#include "study/tools.hpp"
 #include "model/model.hpp"
 
 namespace codyna::gui {

@@ -12,7 +12,7 @@
 #include <memory>
 #include <vector>
 
-#include "simulation/result.hpp"
+#include "study/workflow.hpp"
 
 QT_BEGIN_NAMESPACE
 class QChart;

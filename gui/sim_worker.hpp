@@ -30,8 +30,7 @@
 #include <memory>
 
 #include "model/model.hpp"
-#include "simulation/result.hpp"
-#include "simulation/simulator.hpp"
+#include "study/workflow.hpp"
 
 namespace codyna::gui {
 

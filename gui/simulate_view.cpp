@@ -29,7 +29,7 @@
 #include "gui/result_plots.hpp"
 #include "gui/signal_plot.hpp"
 #include "gui/study_widgets.hpp"
-#include "io/results_file.hpp"
+#include "study/files.hpp"
 #include "model/model_spec.hpp"
 
 namespace codyna::gui {
@@ -854,9 +854,9 @@ bool SimulateView::saveResults(const QString& path, QString* error) {
   const QString suffix = QFileInfo(path).suffix().toLower();
   try {
     if (suffix == QLatin1String("h5") || suffix == QLatin1String("hdf5"))
-      write_results_hdf5(*result_, ss(path));
+      study_write_results_hdf5(*result_, ss(path));
     else if (suffix == QLatin1String("csv"))
-      write_results_csv(*result_, ss(path));
+      study_write_results_csv(*result_, ss(path));
     else
       return fail(tr("%1: choose .h5 (HDF5) or .csv").arg(path));
   } catch (const std::exception& e) {

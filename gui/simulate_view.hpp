@@ -34,7 +34,7 @@
 #include <vector>
 
 #include "model/model.hpp"
-#include "simulation/result.hpp"
+#include "study/workflow.hpp"
 #include "gui/sim_worker.hpp"
 
 QT_BEGIN_NAMESPACE

@@ -18,7 +18,7 @@
 #include <array>
 #include <memory>
 
-#include "dynamics/kinematics.hpp"
+#include "study/tools.hpp"
 
 namespace codyna::gui {
 
@@ -421,13 +421,13 @@ QString View3D::openGLUnavailableReason() {
 bool View3D::hasGL() const { return canvas_ != nullptr; }
 
 void View3D::setModel(std::shared_ptr<const codyna::Model> model) {
+  poses_.reset();
   model_ = std::move(model);
-  data_ = model_ ? std::make_unique<codyna::Data>(*model_) : nullptr;
+  poses_ = model_ ? std::make_unique<codyna::StudyPoses>(*model_) : nullptr;
   q_ = model_ ? model_->q0 : Eigen::VectorXd();
   scene_.build(model_.get());
   if (model_ && q_.size() == model_->nq) {
-    forward_kinematics(*model_, *data_, q_);
-    scene_.update(data_->oMi);
+    scene_.update(poses_->at(q_));
   }
   highlight_body_ = model_ ? model_->find_body(highlight_.toStdString()) : -1;
   camera_.setUp(scene_.up());
@@ -445,8 +445,7 @@ void View3D::setModel(std::shared_ptr<const codyna::Model> model) {
 void View3D::setConfiguration(const Eigen::VectorXd& q) {
   if (!model_ || q.size() != model_->nq) return;
   q_ = q;
-  forward_kinematics(*model_, *data_, q_);
-  scene_.update(data_->oMi);
+  scene_.update(poses_->at(q_));
   requestPaint();
 }
 

@@ -24,7 +24,7 @@
 #include <string>
 
 #include "gui/scene3d.hpp"
-#include "model/data.hpp"
+#include "study/tools.hpp"
 #include "model/model.hpp"
 
 class QLabel;
@@ -103,7 +103,7 @@ class View3D : public QWidget {
   void requestPaint();
 
   std::shared_ptr<const codyna::Model> model_;
-  std::unique_ptr<codyna::Data> data_;
+  std::unique_ptr<codyna::StudyPoses> poses_;  // the body poses at q_
   Eigen::VectorXd q_;
   Scene scene_;
   Camera camera_;

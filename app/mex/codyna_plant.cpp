@@ -17,9 +17,9 @@
 #include <stdexcept>
 #include <string>
 
-#include "io/model_file.hpp"
-#include "model/compile.hpp"
-#include "simulation/stepper.hpp"
+#include "study/files.hpp"
+#include "study/jobs.hpp"
+#include "study/tools.hpp"
 
 namespace {
 
@@ -81,14 +81,9 @@ Session& session(const mxArray* h) {
 void open(int nlhs, mxArray* plhs[], int nrhs, const mxArray* prhs[]) {
   if (nrhs < 2 || nrhs % 2) throw std::invalid_argument("usage: h = codyna_plant('open', 'model.json', [name, value, ...])");
   const std::string path = text(prhs[1], "the model file");
-  codyna::IntegratorSettings s;
   auto session_ptr = std::make_unique<Session>();
-  session_ptr->model = codyna::compile(codyna::load_model_spec(path), path);
-  const codyna::SolverSpec& sp = session_ptr->model.spec.solver;
-  s.method = sp.integrator;
-  s.rtol = sp.rtol;
-  s.atol = sp.atol;
-  s.max_step = sp.max_step;
+  session_ptr->model = codyna::study_compile(codyna::study_read_model(path), path);
+  codyna::IntegratorSettings s = codyna::study_integrator_settings(session_ptr->model);
   for (int k = 2; k + 1 < nrhs; k += 2) {
     const std::string key = text(prhs[k], "an option name");
     if (key == "integrator") s.method = text(prhs[k + 1], "integrator");
@@ -97,7 +92,7 @@ void open(int nlhs, mxArray* plhs[], int nrhs, const mxArray* prhs[]) {
     else if (key == "max_step") s.max_step = scalar(prhs[k + 1], "max_step");
     else throw std::invalid_argument("unknown option '" + key + "' (integrator, rtol, atol, max_step)");
   }
-  session_ptr->stepper = std::make_unique<Stepper>(session_ptr->model, s);
+  session_ptr->stepper = codyna::study_stepper(session_ptr->model, s);
   const int id = next_handle++;
   sessions()[id] = std::move(session_ptr);
   plhs[0] = mxCreateDoubleScalar(id);

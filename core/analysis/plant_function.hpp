@@ -19,7 +19,7 @@
 
 #include <Eigen/LU>
 
-#include "model/data.hpp"
+#include "dynamics/data.hpp"
 
 namespace codyna {
 

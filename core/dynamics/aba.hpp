@@ -4,7 +4,7 @@
 // Writes liMi, oMi, Sb, v, cJ, IA, Ia, pB, pA, U, Dinv, u, c, a, qdd; returns data.qdd.
 #pragma once
 
-#include "model/data.hpp"
+#include "dynamics/data.hpp"
 
 namespace codyna {
 

@@ -7,7 +7,7 @@
 
 #include <vector>
 
-#include "model/data.hpp"
+#include "dynamics/data.hpp"
 
 namespace codyna {
 

@@ -9,7 +9,7 @@
 //                           so that d2/dt2 phi = Jc qdd + gamma.
 #pragma once
 
-#include "model/data.hpp"
+#include "dynamics/data.hpp"
 
 namespace codyna {
 

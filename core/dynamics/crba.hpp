@@ -4,7 +4,7 @@
 // M is allocated by the first call on a Data; later calls do not allocate.
 #pragma once
 
-#include "model/data.hpp"
+#include "dynamics/data.hpp"
 
 namespace codyna {
 

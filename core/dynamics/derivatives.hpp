@@ -50,7 +50,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "model/data.hpp"
+#include "dynamics/data.hpp"
 #include "model/model.hpp"
 
 namespace codyna {

@@ -6,7 +6,7 @@
 // Needs forward_kinematics(q, v) on data; writes fext, Q; returns data.Q.
 #pragma once
 
-#include "model/data.hpp"
+#include "dynamics/data.hpp"
 
 namespace codyna {
 

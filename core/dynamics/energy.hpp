@@ -3,7 +3,7 @@
 // 1/2 k (q - q_rest)^2. Each runs forward_kinematics itself.
 #pragma once
 
-#include "model/data.hpp"
+#include "dynamics/data.hpp"
 
 namespace codyna {
 

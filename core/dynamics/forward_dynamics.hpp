@@ -8,7 +8,7 @@
 // Writes everything the algorithms it calls write; returns data.qdd.
 #pragma once
 
-#include "model/data.hpp"
+#include "dynamics/data.hpp"
 
 namespace codyna {
 

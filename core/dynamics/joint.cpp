@@ -286,16 +286,6 @@ void normalize(const Model& model, Eigen::VectorXd& q) {
   }
 }
 
-Eigen::VectorXd neutral(const Model& model) {
-  Eigen::VectorXd q = Eigen::VectorXd::Zero(model.nq);
-  for (int b = 1; b < model.nbodies; ++b) {
-    const JointModel& j = model.joints[b];
-    if (j.type == JointType::Spherical) q[j.idx_q] = 1.0;
-    if (j.type == JointType::Free) q[j.idx_q + 3] = 1.0;
-  }
-  return q;
-}
-
 #define CODYNA_INSTANTIATE(S)                                                                   \
   template void joint_transform<S>(const JointModel&, const VecXT<S>&, SE3T<S>&, Mat6xT<S>&); \
   template Vec6T<S> joint_bias<S>(const JointModel&, const VecXT<S>&, const VecXT<S>&);       \

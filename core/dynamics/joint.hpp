@@ -51,7 +51,5 @@ void tangent_rate_into(const Model& model, const VecXT<S>& dq, const VecXT<S>& v
 // unit quaternions, in place
 void normalize(const Model& model, Eigen::VectorXd& q);
 
-// the zero configuration (identity quaternions)
-Eigen::VectorXd neutral(const Model& model);
 
 }  // namespace codyna

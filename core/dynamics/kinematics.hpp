@@ -7,7 +7,7 @@
 // The point/body functions read what forward_kinematics wrote; body 0 is ground.
 #pragma once
 
-#include "model/data.hpp"
+#include "dynamics/data.hpp"
 #include "model/model.hpp"
 
 namespace codyna {

@@ -6,7 +6,7 @@
 // nonlinear_effects = rnea(q, v, 0), written to data.nle.
 #pragma once
 
-#include "model/data.hpp"
+#include "dynamics/data.hpp"
 
 namespace codyna {
 

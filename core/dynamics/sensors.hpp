@@ -9,7 +9,7 @@
 #include <unsupported/Eigen/AutoDiff>
 #include <vector>
 
-#include "model/data.hpp"
+#include "dynamics/data.hpp"
 
 namespace codyna {
 

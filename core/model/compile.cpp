@@ -8,12 +8,6 @@
 #include <set>
 #include <sstream>
 
-#include "dynamics/assembly.hpp"
-#include "dynamics/crba.hpp"
-#include "dynamics/constraints.hpp"
-#include "dynamics/joint.hpp"
-#include "dynamics/kinematics.hpp"
-#include "model/data.hpp"
 
 namespace codyna {
 
@@ -71,7 +65,6 @@ class Compiler {
     build_plant();
     check_solver();
     initial_state();
-    check_mass_matrix();
     return std::move(m_);
   }
 
@@ -523,11 +516,6 @@ class Compiler {
       if (!s.unit.empty()) o.unit = s.unit;
       m_.sensors.push_back(o);
     }
-    // body_angle measures from the orientation at the zero configuration
-    Data d(m_);
-    forward_kinematics<double>(m_, d, neutral(m_));
-    for (SensorModel& o : m_.sensors)
-      if (o.type == SensorType::BodyAngle) o.R0 = d.oMi[o.body].R;
   }
 
   void build_plant() {
@@ -582,92 +570,6 @@ class Compiler {
     }
     m_.q0 = q;
     m_.v0 = v;
-    if (m_.nc == 0) return;
-    const AssemblyResult r = assemble(m_, q, v);
-    if (r.position_residual > 1e-9) {
-      int k = 0;
-      while (k + 1 < static_cast<int>(m_.constraints.size()) && m_.constraints[k + 1].row <= r.worst_row) ++k;
-      fail(at("constraints", k), "the loop cannot be assembled from the joints' q0: residual " + fmt(r.position_residual) +
-                                     " on " + m_.row_names[r.worst_row] + " after " + std::to_string(r.iterations) +
-                                     " iterations (check the constraint points and the joints' q0)");
-    }
-    m_.q0 = r.q;
-    m_.v0 = r.v;
-    m_.assembly_residual = std::max(r.position_residual, r.velocity_residual);
-    // say what closing the loops moved (a rough q0 lands elsewhere than the user wrote)
-    constexpr double kMoved = 1e-6;
-    const Eigen::VectorXd dq = difference(m_, q, r.q);
-    for (int b = 1; b < m_.nbodies; ++b) {
-      const JointModel& j = m_.joints[b];
-      for (int k = 0; k < j.nv; ++k) {
-        const int i = j.idx_v + k;
-        if (std::abs(dq[i]) > kMoved) {
-          const bool scalar = j.nq == j.nv;
-          m_.assembly_moves.push_back({m_.v_names[static_cast<std::size_t>(i)], scalar ? q[j.idx_q + k] : std::nan(""),
-                                       scalar ? r.q[j.idx_q + k] : std::nan(""), dq[i]});
-        }
-      }
-    }
-    for (int i = 0; i < m_.nv; ++i)
-      if (std::abs(r.v[i] - v[i]) > kMoved) m_.assembly_moves.push_back({m_.rate_names[static_cast<std::size_t>(i)], v[i], r.v[i], r.v[i] - v[i]});
-    Data d(m_);
-    constraint_terms<double>(m_, d, m_.q0, m_.v0);
-    const RowPartition rows = partition_rows(d.Jc);
-    m_.active_rows = rows.independent;
-    m_.redundant_rows = rows.redundant;
-  }
-
-  // The tree's mass matrix is positive definite exactly when every joint's articulated
-  // inertia D_i = S_i^T IA_i S_i is: one backward pass, O(n), instead of an O(n^3) eigen
-  // decomposition. Scale-aware: D_i is judged against the same joint's composite (rigid
-  // subtree) inertia S_i^T Ic_i S_i, so a long chain whose mass matrix spans many decades
-  // passes while a coordinate that truly moves nothing fails.
-  void check_mass_matrix() {
-    if (m_.nv == 0) return;
-    Data d(m_);
-    forward_kinematics<double>(m_, d, m_.q0);
-    std::vector<Mat6T<double>> IA(m_.inertia.begin(), m_.inertia.end()), Ic = IA;
-    for (int i = m_.nbodies - 1; i >= 1; --i) {
-      const JointModel& j = m_.joints[i];
-      const Mat6T<double> Xi = d.liMi[i].inverse().motion_matrix();
-      Mat6T<double> Ia = IA[i];
-      if (j.nv > 0) {
-        const Mat6xT<double>& S = d.Sb[i];
-        const Eigen::MatrixXd U = IA[i] * S;
-        const Eigen::MatrixXd D = S.transpose() * U;
-        const Eigen::MatrixXd Dc = S.transpose() * Ic[i] * S;
-        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(D);
-        const double reference = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Dc).eigenvalues().maxCoeff();
-        if (!(es.eigenvalues()[0] > 1e-12 * reference) || !(reference > 0)) {
-          Eigen::Index k;
-          es.eigenvectors().col(0).cwiseAbs().maxCoeff(&k);
-          fail("/bodies", "the mass matrix is singular at the initial state: coordinate " +
-                              quoted(m_.v_names[j.idx_v + k]) + " moves no mass or inertia (give the bodies it moves mass and inertia)" +
-                              semi_definite_note(i));
-        }
-        Ia -= U * D.inverse() * U.transpose();
-      }
-      const int p = j.parent;
-      IA[p] += Xi.transpose() * Ia * Xi;
-      Ic[p] += Xi.transpose() * Ic[i] * Xi;
-    }
-  }
-
-  // Names a body moved by joint i whose inertia is only positive semi-definite
-  // (a slender rod turned about its own axis), the usual cause of a singular
-  // mass matrix in a model that passed the per-body checks.
-  std::string semi_definite_note(int i) const {
-    for (int k = i; k < m_.nbodies; ++k) {
-      int a = k;
-      while (a > i) a = m_.parent[a];
-      if (a != i || m_.body_spec_index[k] < 0) continue;
-      const BodySpec& b = spec_.bodies[m_.body_spec_index[k]];
-      const Eigen::Vector3d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(b.inertia).eigenvalues();
-      if (b.mass > 0 && !(ev[0] > 1e-12 * std::max(ev[2], 1e-300)))
-        return "; body " + quoted(b.name) + " has no inertia about one of its axes (principal moments " + fmt(ev[0]) + ", " +
-               fmt(ev[1]) + ", " + fmt(ev[2]) + "): a joint that turns it about that axis alone moves nothing";
-    }
-    return "";
   }
 
   const ModelSpec& spec_;
@@ -679,6 +581,6 @@ class Compiler {
 
 }  // namespace
 
-Model compile(const ModelSpec& spec, const std::string& file) { return Compiler(spec, file).run(); }
+Model compile_structure(const ModelSpec& spec, const std::string& file) { return Compiler(spec, file).run(); }
 
 }  // namespace codyna

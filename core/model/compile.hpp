@@ -1,6 +1,8 @@
-// compile(spec) -> Model: validates a ModelSpec, orders the joint tree,
-// assigns indices, resolves names, assembles the initial state onto the
-// loop-closure constraints and finds redundant constraint rows.
+// compile_structure(spec) -> Model: validates a ModelSpec, orders the joint tree, assigns
+// indices, resolves names, and sets the initial state as the joints' q0/v0 write it. It calls
+// nothing of the dynamics: dynamics/prepare.hpp's compile() adds what needs the algorithms
+// (loops assembled, redundant rows, the mass-matrix check), and study_model (study/workflow.hpp)
+// is what front ends call.
 // Any problem throws ModelError naming `file` (may be empty), the JSON path of
 // the offending field (e.g. "/joints/2/parent") and what was expected.
 #pragma once
@@ -13,6 +15,6 @@
 
 namespace codyna {
 
-Model compile(const ModelSpec& spec, const std::string& file = "");
+Model compile_structure(const ModelSpec& spec, const std::string& file = "");
 
 }  // namespace codyna

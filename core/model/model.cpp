@@ -30,4 +30,14 @@ int Model::find_joint(const std::string& n) const {
   return -1;
 }
 
+Eigen::VectorXd neutral(const Model& model) {
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(model.nq);
+  for (int b = 1; b < model.nbodies; ++b) {
+    const JointModel& j = model.joints[b];
+    if (j.type == JointType::Spherical) q[j.idx_q] = 1.0;
+    if (j.type == JointType::Free) q[j.idx_q + 3] = 1.0;
+  }
+  return q;
+}
+
 }  // namespace codyna

@@ -1,7 +1,7 @@
 // Model: the immutable, index-based form of a ModelSpec, made by compile().
 // Body 0 is the ground; body i >= 1 is moved by joint i relative to its
 // parent body parent[i] < i (topological order). Algorithms read a Model
-// and write into a Data (model/data.hpp); they never change a Model.
+// and write into a Data (dynamics/data.hpp); they never change a Model.
 #pragma once
 
 #include <Eigen/Core>
@@ -156,5 +156,8 @@ struct Model {
   int find_sensor(const std::string& name) const;
   int find_joint(const std::string& name) const;  // body index of the joint, -1 if absent
 };
+
+// the zero configuration (identity quaternions)
+Eigen::VectorXd neutral(const Model& model);
 
 }  // namespace codyna

@@ -19,7 +19,7 @@
 #include "analysis/plant_function.hpp"
 #include "dynamics/derivatives.hpp"
 #include "dynamics/forward_dynamics.hpp"
-#include "model/data.hpp"
+#include "dynamics/data.hpp"
 #include "spatial/autodiff.hpp"
 #include "simulation/controller.hpp"
 

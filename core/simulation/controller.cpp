@@ -8,7 +8,6 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "io/mat_export.hpp"
 
 namespace codyna {
 
@@ -232,17 +231,11 @@ std::unique_ptr<Controller> make_lti(const Eigen::MatrixXd& Ac, const Eigen::Mat
   return std::make_unique<Lti>(Ac, Bc, Cc, Dc, Ts, y0, u0);
 }
 
-std::unique_ptr<Controller> load_controller(const std::string& path, int nx, int nu, int ny, const Eigen::VectorXd& y0,
-                                            const Eigen::VectorXd& u0) {
-  MatVariables vars;
-  try {
-    vars = read_mat_file(path);
-  } catch (const std::runtime_error& e) {
-    throw std::invalid_argument(e.what());
-  }
+std::unique_ptr<Controller> controller_from_matrices(const ControllerMatrices& vars, const std::string& path, int nx,
+                                                     int nu, int ny, const Eigen::VectorXd& y0, const Eigen::VectorXd& u0) {
   const auto& m = vars.matrices;
   // a controller variable that is there but not a real 2-D matrix is named with the reason
-  for (const SkippedVariable& v : vars.skipped)
+  for (const ControllerMatrices::Skipped& v : vars.skipped)
     for (const char* n : {"K", "Kp", "Ki", "Kd", "r", "Ac", "Bc", "Cc", "Dc", "Ts"})
       if (v.name == n)
         throw std::invalid_argument(path + ": the variable " + v.name + " cannot be used (" + v.reason + ")" +
@@ -270,7 +263,7 @@ std::unique_ptr<Controller> load_controller(const std::string& path, int nx, int
   }
   std::string found;
   for (const auto& [k, v] : m) found += (found.empty() ? "" : ", ") + k;
-  for (const SkippedVariable& v : vars.skipped) found += (found.empty() ? "" : ", ") + v.name + " (" + v.reason + ", not read)";
+  for (const ControllerMatrices::Skipped& v : vars.skipped) found += (found.empty() ? "" : ", ") + v.name + " (" + v.reason + ", not read)";
   throw std::invalid_argument(path + ": no controller found: expected K (state feedback), Kp [Ki Kd] (PID) or Ac Bc Cc Dc "
                               "(LTI); the file holds " + (found.empty() ? std::string("no variable codyna can read (is it truncated or corrupt?)") : found));
 }

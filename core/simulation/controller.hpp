@@ -13,6 +13,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -94,14 +95,23 @@ std::unique_ptr<Controller> make_lti(const Eigen::MatrixXd& Ac, const Eigen::Mat
                                      const Eigen::MatrixXd& Dc, double Ts, const Eigen::VectorXd& y0,
                                      const Eigen::VectorXd& u0);
 
-// Reads a controller from a .mat file of plain matrices (Octave save -v7, MATLAB save):
+// The controller a file of plain matrices holds (io/controller_file.hpp reads it from a .mat:
+// Octave save -v7, MATLAB save):
 //   K                        -> state feedback
 //   Kp [, Ki] [, Kd] [, r]   -> PID on the outputs
 //   Ac, Bc, Cc, Dc [, Ts]    -> LTI (discrete when Ts > 0)
-// u0, y0 come from the operating point; nx, nu, ny are the plant's sizes.
-// Wrong sizes, missing variables, NaN, or an unreadable file give std::invalid_argument
-// naming the file, the variable and the expected size.
-std::unique_ptr<Controller> load_controller(const std::string& path, int nx, int nu, int ny, const Eigen::VectorXd& y0,
-                                            const Eigen::VectorXd& u0);
+// u0, y0 come from the operating point; nx, nu, ny are the plant's sizes. `path` names the file
+// in messages. Wrong sizes, missing variables or NaN give std::invalid_argument naming the file,
+// the variable and the expected size; a controller variable that could not be read as a real 2-D
+// matrix (in `skipped`) is named with the reason.
+struct ControllerMatrices {
+  struct Skipped {
+    std::string name, reason;
+  };
+  std::map<std::string, Eigen::MatrixXd> matrices;
+  std::vector<Skipped> skipped;
+};
+std::unique_ptr<Controller> controller_from_matrices(const ControllerMatrices& vars, const std::string& path, int nx,
+                                                     int nu, int ny, const Eigen::VectorXd& y0, const Eigen::VectorXd& u0);
 
 }  // namespace codyna

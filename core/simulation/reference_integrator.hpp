@@ -6,7 +6,7 @@
 
 #include <Eigen/Core>
 
-#include "model/data.hpp"
+#include "dynamics/data.hpp"
 
 namespace codyna {
 

@@ -17,10 +17,11 @@
 #include "control/lqr_controllable.hpp"
 #include "dynamics/assembly.hpp"
 #include "dynamics/joint.hpp"
+#include "io/controller_file.hpp"
 #include "io/curves_file.hpp"
 #include "io/output_guard.hpp"
 #include "io/signal_file.hpp"
-#include "model/compile.hpp"
+#include "dynamics/prepare.hpp"
 #include "model/errors.hpp"
 #include "simulation/model_controller.hpp"
 

@@ -17,7 +17,7 @@
 #include "dynamics/forward_dynamics.hpp"
 #include "dynamics/joint.hpp"
 #include "io/model_file.hpp"
-#include "model/compile.hpp"
+#include "dynamics/prepare.hpp"
 #include "models/speed_models.hpp"
 
 namespace codyna {

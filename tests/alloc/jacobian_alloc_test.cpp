@@ -10,7 +10,7 @@
 #include "analysis/operating_point.hpp"
 #include "dynamics/derivatives.hpp"
 #include "io/model_file.hpp"
-#include "model/compile.hpp"
+#include "dynamics/prepare.hpp"
 #include "counting_allocator.hpp"
 
 namespace codyna {

@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "io/model_file.hpp"
-#include "model/compile.hpp"
+#include "dynamics/prepare.hpp"
 #include "model/errors.hpp"
 
 namespace {

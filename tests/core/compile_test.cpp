@@ -1,6 +1,6 @@
 // compile(): indices, ordering, and one test per kind of bad model, each
 // checking that the error names the file, the field path and what was expected.
-#include "model/compile.hpp"
+#include "dynamics/prepare.hpp"
 
 #include "io/model_file.hpp"
 #include "test_util.hpp"

@@ -18,7 +18,7 @@
 #include "dynamics/kinematics.hpp"
 #include "dynamics/rnea.hpp"
 #include "dynamics/sensors.hpp"
-#include "model/compile.hpp"
+#include "dynamics/prepare.hpp"
 #include "spatial/autodiff.hpp"
 
 namespace codyna {

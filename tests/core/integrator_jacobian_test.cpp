@@ -13,7 +13,7 @@
 #include "dynamics/constraints.hpp"
 #include <Eigen/SVD>
 #include "dynamics/joint.hpp"
-#include "model/compile.hpp"
+#include "dynamics/prepare.hpp"
 #include "simulation/closed_loop.hpp"
 #include "simulation/simulator.hpp"
 

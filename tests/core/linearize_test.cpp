@@ -8,7 +8,7 @@
 #include "dynamics/constraints.hpp"
 #include "dynamics/energy.hpp"
 #include "io/model_file.hpp"
-#include "model/compile.hpp"
+#include "dynamics/prepare.hpp"
 #include "model/errors.hpp"
 #include "test_util.hpp"
 

@@ -1,6 +1,6 @@
 #include "io/model_file.hpp"
 
-#include "model/compile.hpp"
+#include "dynamics/prepare.hpp"
 
 #include <gtest/gtest.h>
 

@@ -22,7 +22,7 @@
 #include "dynamics/kinematics.hpp"
 #include "dynamics/sensors.hpp"
 #include "io/model_file.hpp"
-#include "model/compile.hpp"
+#include "dynamics/prepare.hpp"
 #include "model/errors.hpp"
 
 namespace codyna {

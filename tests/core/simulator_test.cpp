@@ -8,7 +8,7 @@
 
 #include "analysis/operating_point.hpp"
 #include "io/model_file.hpp"
-#include "model/compile.hpp"
+#include "dynamics/prepare.hpp"
 #include "test_util.hpp"
 
 namespace codyna {

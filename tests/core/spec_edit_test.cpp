@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "io/model_file.hpp"
-#include "model/compile.hpp"
+#include "dynamics/prepare.hpp"
 #include "test_util.hpp"
 
 using namespace codyna;

@@ -10,7 +10,7 @@
 
 #include "dynamics/energy.hpp"
 #include "io/model_file.hpp"
-#include "model/data.hpp"
+#include "dynamics/data.hpp"
 #include "study/workflow.hpp"
 #include "test_util.hpp"
 

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "io/model_file.hpp"
-#include "model/compile.hpp"
+#include "dynamics/prepare.hpp"
 
 // EXPECT_INVALID_ARGUMENT_WITH(statement, "part", ...): the statement throws
 // std::invalid_argument and its message contains every part

@@ -18,7 +18,7 @@
 #include <string>
 
 #include "io/model_file.hpp"
-#include "model/compile.hpp"
+#include "dynamics/prepare.hpp"
 #include "model/errors.hpp"
 
 namespace {

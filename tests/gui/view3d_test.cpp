@@ -11,7 +11,7 @@
 #include "gui/view3d.hpp"
 #include "dynamics/kinematics.hpp"
 #include "io/model_file.hpp"
-#include "model/compile.hpp"
+#include "dynamics/prepare.hpp"
 
 using codyna::gui::Camera;
 using codyna::gui::ItemKind;

@@ -14,7 +14,7 @@
 
 #include "gui/view3d.hpp"
 #include "io/model_file.hpp"
-#include "model/compile.hpp"
+#include "dynamics/prepare.hpp"
 
 using codyna::gui::View3D;
 

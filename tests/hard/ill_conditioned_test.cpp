@@ -24,7 +24,7 @@
 #include "dynamics/effects.hpp"
 #include "dynamics/kinematics.hpp"
 #include "dynamics/rnea.hpp"
-#include "model/data.hpp"
+#include "dynamics/data.hpp"
 #include "model/errors.hpp"
 #include "simulation/simulator.hpp"
 

@@ -34,8 +34,8 @@
 #include "core/test_util.hpp"
 #include "dynamics/crba.hpp"
 #include "dynamics/forward_dynamics.hpp"
-#include "model/compile.hpp"
-#include "model/data.hpp"
+#include "dynamics/prepare.hpp"
+#include "dynamics/data.hpp"
 #include "peers_mujoco/mjcf.hpp"
 
 namespace codyna::test {

@@ -1,4 +1,4 @@
-#include "model/data.hpp"
+#include "dynamics/data.hpp"
 
 #include "dynamics/joint.hpp"
 #include "spatial/autodiff.hpp"

@@ -1,0 +1,140 @@
+// The jobs of a front end, one call each: what `codyna info|linearize|simulate`, the Python
+// module's Study.model_info / linearize / simulate and codyna-gui ask of the core. A front end
+// turns its flags, keywords or widgets into a request (every option optional: what is not given
+// keeps the model file's "analysis" and "solver" sections), makes one call, and shows the job it
+// gets back. The job carries the messages a user must see (notes, warnings): the core prints
+// nothing.
+//
+// Option names in messages follow the front end (OptionStyle): the CLI's "--trim-free", the
+// Python module's "trim_free". Bad options throw std::invalid_argument naming the option; a bad
+// model throws ModelError naming the file and the field; a failed search throws ConvergenceError.
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "model/model.hpp"
+#include "study/tools.hpp"
+#include "study/workflow.hpp"
+
+namespace codyna {
+
+// A message a user must see, handed to the front end as it arises (the jobs also keep them).
+struct StudyMessage {
+  enum Kind { Note, Warning } kind = Note;
+  std::string text;
+};
+using StudyMessages = std::function<void(const StudyMessage&)>;
+
+enum class OptionStyle {
+  Flag,     // --trim-free
+  Keyword,  // trim_free
+};
+// "trim-free" written as the front end writes it
+std::string option_name(OptionStyle style, const std::string& dashed);
+
+// The plant selection and the study's signals for one run, over the model file's (each list given
+// replaces the file's): inputs/outputs (actuator and sensor names, in order), disabled effects
+// (effect names), references and disturbances (each a JSON object with the fields of the file's
+// "references"/"disturbances" entries, or the step shorthand NAME=VALUE[@TIME]). Unknown names
+// are refused naming the option and listing what exists; the signals go through the model file's
+// reader, so their errors name the option and the field.
+struct PlantRequest {
+  std::optional<std::vector<std::string>> inputs, outputs, disabled_effects, references, disturbances;
+};
+
+// The operating point's choices shared by linearize and simulate. hold, initial and targets are
+// NAME=VALUE texts (a name given again replaces its value), added to the file's lists.
+struct PointRequest {
+  std::optional<std::string> operating_point;  // initial | equilibrium | trim | time=T
+  std::optional<std::vector<std::string>> independent, trim_free, free_inputs;
+  std::vector<std::string> hold, initial, targets;
+};
+
+struct LinearizeRequest {
+  OptionStyle style = OptionStyle::Flag;
+  std::string model;  // the model file (messages, relative paths, outputs that must not replace it)
+  std::string out;    // export folder ("" = compute only: the job exports nothing)
+  PointRequest point;
+  PlantRequest plant;
+  std::optional<std::string> method, mat_version, name, controller;
+  std::optional<double> discrete, trajectory, trajectory_step;
+  bool closed_loop = false, lqr = false, lqr_controllable_part = false;
+  std::optional<std::vector<double>> q_weights, r_weights;
+};
+
+struct LinearizeJob {
+  Model model;                                          // as the study sees it
+  std::string name;                                     // the export's NAME
+  std::string method;                                   // the Jacobians': "exact", "fd-forward", "fd-central"
+  std::vector<std::string> notes, warnings;             // for the user, each in order
+  // one operating point (not trajectory)
+  StudyLinearization linearization;                     // op, continuous lin, exported system
+  ModalAnalysis modes;                                  // of the exported system
+  std::vector<HiddenMode> uncontrollable, unobservable;  // of the continuous plant
+  std::vector<std::string> written;                     // files written, in order
+  std::optional<StudyClosedLoop> closed_loop;           // with closed_loop
+  std::vector<std::string> closed_loop_written;
+  // along a trajectory (request.trajectory): one continuous system per output sample
+  bool trajectory = false;
+  std::vector<double> times;
+  std::vector<LinearSystem> systems;
+  std::string trajectory_controller;                    // "open loop" or the controller's description
+  Eigen::VectorXd max_real, min_real;                   // the largest and smallest Re(eig A) per point
+};
+
+// The whole `codyna linearize`: the study's model, the operating point, A, B, C, D, modes,
+// controllability, the closed loop when asked, and (when r.out is given) the exports, each
+// checked before any work against replacing an input. `spec` is the model file as read.
+LinearizeJob study_linearize_job(const LinearizeRequest& r, const ModelSpec& spec, const StudyMessages& tell = {});
+
+struct SimulateRequest {
+  OptionStyle style = OptionStyle::Flag;
+  std::string model;        // the model file
+  std::string out, csv;     // results (HDF5, CSV); "" = not written
+  PointRequest point;
+  PlantRequest plant;
+  std::optional<std::string> controller;  // a .mat (relative to the working folder)
+  bool lqr = false, lqr_controllable_part = false, compare_linear = false, open_loop = false;
+  std::optional<double> linear_region;
+  std::optional<std::vector<double>> q_weights, r_weights;
+  std::optional<std::string> integrator;
+  std::optional<double> t_end, rtol, atol, max_step, output_step, max_samples, divergence_bound;
+};
+
+struct SimulateJob {
+  Model model;
+  std::vector<std::string> notes, warnings;  // each in order (the ready callback sees those before the run)
+  StudySimulation setup;
+  Eigen::VectorXd op_coordinates;            // the operating point's coordinates (Model::v_names), with a plant
+  Eigen::VectorXd initial_coordinates;       // the run's start, when the study names an initial state
+  SimulationResult result;
+  LinearRegion region;                       // with a plant
+  std::vector<Saturation> saturation;
+  // with compare_linear: per Plant/Out, the largest |y - y_linear|, that as a percentage of the
+  // output's excursion (its largest distance from its final value), and the first time the gap
+  // passes 1 % of the excursion (-1: never)
+  Eigen::VectorXd linear_gap, linear_gap_percent, linear_gap_from;
+  std::vector<std::string> written;
+};
+
+// The whole `codyna simulate`: the study's model, controller and plant, the run, the linear
+// region, the saturation report and (when r.out/r.csv are given) the results written, each
+// output checked before any work. `ready` (may be empty) sees the job once set up, before the run
+// (what the CLI prints ahead of its progress bar). A run that fails is returned (result.completed
+// false, result.failure) after its partial result is written; the caller decides what it means.
+SimulateJob study_simulate_job(const SimulateRequest& r, const ModelSpec& spec, const SimulationCallbacks& cb = {},
+                               const std::function<void(const SimulateJob&)>& ready = {},
+                               const StudyMessages& tell = {});
+
+// The model compiled as its file writes it, no study applied (validated, indexed, loops assembled,
+// redundant rows found): what `codyna info` summarizes (Model has every name, index and unit) and
+// what the co-simulation steps. ModelError names `file` and the field.
+Model study_compile(const ModelSpec& spec, const std::string& file = "");
+// What closing the loops moved, as text ("crank 2.0944 -> 2.09842 (moved by 0.00402 rad), ...";
+// "" when nothing moved).
+std::string study_assembly_moves_text(const Model& m);
+
+}  // namespace codyna

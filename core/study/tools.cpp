@@ -1,0 +1,54 @@
+#include "study/tools.hpp"
+
+#include "control/place.hpp"
+#include "dynamics/data.hpp"
+#include "dynamics/kinematics.hpp"
+
+namespace codyna {
+
+ModalAnalysis study_modes(const LinearSystem& sys) { return modal_analysis(sys); }
+std::string study_format_modes(const ModalAnalysis& modes) { return format_modes(modes); }
+
+ChannelZeros study_zeros(const LinearSystem& sys, int input, int output) { return transmission_zeros(sys, input, output); }
+
+std::vector<HiddenMode> study_uncontrollable(const LinearSystem& sys) {
+  return uncontrollable_modes(sys.A, sys.B, sys.state_names);
+}
+std::vector<HiddenMode> study_unobservable(const LinearSystem& sys) {
+  return unobservable_modes(sys.A, sys.C, sys.state_names);
+}
+std::string study_describe_modes(const std::vector<HiddenMode>& modes) { return describe(modes); }
+
+LqrResult study_lqr(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& Q,
+                    const Eigen::MatrixXd& R, bool discrete) {
+  return discrete ? dlqr(A, B, Q, R) : lqr(A, B, Q, R);
+}
+Eigen::MatrixXd study_place(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::VectorXcd& poles) {
+  return place(A, B, poles);
+}
+
+struct StudyPoses::Workspace {
+  explicit Workspace(const Model& m) : data(m) {}
+  Data data;
+};
+StudyPoses::StudyPoses(const Model& model) : model_(model), ws_(std::make_unique<Workspace>(model)) {}
+StudyPoses::~StudyPoses() = default;
+const std::vector<SE3>& StudyPoses::at(const Eigen::VectorXd& q) {
+  forward_kinematics(model_, ws_->data, q);
+  return ws_->data.oMi;
+}
+
+IntegratorSettings study_integrator_settings(const Model& model) {
+  IntegratorSettings s;
+  const SolverSpec& sp = model.spec.solver;
+  s.method = sp.integrator;
+  s.rtol = sp.rtol;
+  s.atol = sp.atol;
+  s.max_step = sp.max_step;
+  return s;
+}
+std::unique_ptr<Stepper> study_stepper(const Model& model, const IntegratorSettings& settings) {
+  return std::make_unique<Stepper>(model, settings);
+}
+
+}  // namespace codyna

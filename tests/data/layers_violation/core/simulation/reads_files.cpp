@@ -1,0 +1,2 @@
+// The simulation layer reading a file itself: refused (layers.violation_refused).
+#include "io/mat_export.hpp"
