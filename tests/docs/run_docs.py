@@ -3,8 +3,8 @@
 
 usage: run_docs.py CODYNA SOURCE_DIR WORK_DIR [PAGE...]
 
-CODYNA is the built codyna binary (its folder's neighbours, build/bin/* and build/mex/*, are
-offered too), SOURCE_DIR the repository, WORK_DIR a scratch folder (emptied). Without PAGE it runs
+CODYNA is the built codyna binary (its folder's neighbours, build/bin/*, build/mex/*,
+build/python/*, are offered too), SOURCE_DIR the repository, WORK_DIR a scratch folder (emptied). Without PAGE it runs
 SOURCE_DIR/README.md and every SOURCE_DIR/docs/*.md. Exit code 0 when every page tells the truth,
 1 when one does not (each difference is printed as PAGE:LINE: what was shown, what was printed),
 2 on a usage error.
@@ -15,7 +15,8 @@ for readers):
 * Every fenced block has a language. Blocks in `console` hold `$ ` commands, each followed by the
   output it prints (stdout and stderr as a terminal shows them, both line-buffered); blocks in `sh`
   or `bash` hold commands only; `octave` blocks run as one script through octave-cli, `python`
-  blocks through /usr/bin/python3. Any other language (json, text, csv, ...) is data, not run.
+  blocks through /usr/bin/python3 with PYTHONPATH=build/python (codyna's module). Any other
+  language (json, text, csv, ...) is data, not run.
   A fence without a language is an error: it would be unclear whether it runs.
 * A shell, Octave or Python block whose first line is a comment starting `# not run` (`% not run`)
   or `# syntax, not run` is not run: the comment says why (it builds, it opens a window, it is a
@@ -26,7 +27,7 @@ for readers):
   a line elides any text within that line. Runs of spaces compare equal to any run of spaces.
   Text compares exactly; numbers compare to the tolerance below, written once here.
 * Each page runs in its own scratch folder WORK_DIR/PAGE holding a copy of examples/ and
-  tests/data/, and build/bin/*, build/mex/* linked to the built ones, so the paths shown
+  tests/data/, and build/bin/*, build/mex/*, build/python/* linked to the built ones, so the paths shown
   (build/bin/codyna, examples/pendulum.json) work as shown from the repository root. A page's
   blocks run in order in that folder, so a file written by one command is there for the next.
   `/tmp/` in a command is that folder's tmp/ (and shows as /tmp/ in the output compared), so two
@@ -257,7 +258,8 @@ def compare_output(shown, printed):
 
 def link_build(codyna, scratch):
     bin_dir = os.path.dirname(os.path.abspath(codyna))
-    for sub, real in (("bin", bin_dir), ("mex", os.path.join(os.path.dirname(bin_dir), "mex"))):
+    build = os.path.dirname(bin_dir)
+    for sub, real in (("bin", bin_dir), ("mex", os.path.join(build, "mex")), ("python", os.path.join(build, "python"))):
         dst = os.path.join(scratch, "build", sub)
         os.makedirs(dst, exist_ok=True)
         if os.path.isdir(real):
@@ -326,7 +328,8 @@ def run_page(page, source, codyna, scratch):
     shutil.copytree(os.path.join(source, "examples"), os.path.join(scratch, "examples"))
     shutil.copytree(os.path.join(source, "tests", "data"), os.path.join(scratch, "tests", "data"))
     link_build(codyna, scratch)
-    env = dict(os.environ, PYTHONUNBUFFERED="1", LC_NUMERIC="C", TMPDIR=os.path.join(scratch, "tmp"))
+    env = dict(os.environ, PYTHONUNBUFFERED="1", PYTHONDONTWRITEBYTECODE="1", LC_NUMERIC="C",
+               TMPDIR=os.path.join(scratch, "tmp"))
     with open(page.path, encoding="utf-8") as f:
         lines = f.read().split("\n")
     n = 0
@@ -349,7 +352,7 @@ def run_page(page, source, codyna, scratch):
             script = os.path.join(scratch, f"docs_block_{n}{ext}")
             with open(script, "w", encoding="utf-8") as f:
                 f.write("\n".join(body).replace("/tmp/", os.path.join(scratch, "tmp") + "/") + "\n")
-            runner = "octave-cli --no-gui --quiet" if ext == ".m" else "/usr/bin/python3"
+            runner = "octave-cli --no-gui --quiet" if ext == ".m" else "PYTHONPATH=build/python /usr/bin/python3"
             cmd = Command(first, f"{runner} {os.path.basename(script)}")
             page.commands += 1
             code, printed = run(cmd.text, scratch, env)
