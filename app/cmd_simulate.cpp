@@ -137,16 +137,11 @@ void summary(const SimulateJob& job) {
             << " s\n" << std::setprecision(6);
   if (!r.stats.integrator_choice.empty()) std::cout << "                 " << r.stats.integrator_choice << "\n";
   if (setup.linear_unstable) {
-    std::vector<std::string> bad;
-    for (Eigen::Index k = 0; k < setup.linear_poles.size(); ++k)
-      if (setup.linear_discrete ? std::abs(setup.linear_poles[k]) > 1 + 1e-9 : setup.linear_poles[k].real() > 0) {
-        Eigen::VectorXcd one(1);
-        one << setup.linear_poles[k];
-        bad.push_back(poles_text(one, 6));
-      }
-    std::cout << "warning          unstable linear closed loop: " << bad.size() << " of " << setup.linear_poles.size()
-              << " poles " << (setup.linear_discrete ? "outside the unit circle" : "with positive real part") << " (";
-    for (std::size_t k = 0; k < bad.size(); ++k) std::cout << (k ? ", " : "") << bad[k];
+    std::cout << "warning          unstable linear closed loop: " << job.unstable_poles.size() << " of "
+              << setup.linear_poles.size() << " poles "
+              << (setup.linear_discrete ? "outside the unit circle" : "with positive real part") << " (";
+    for (Eigen::Index k = 0; k < job.unstable_poles.size(); ++k)
+      std::cout << (k ? ", " : "") << poles_text(job.unstable_poles.segment(k, 1), 6);
     std::cout << ")\n";
   }
   if (N == 0) return;
@@ -157,18 +152,18 @@ void summary(const SimulateJob& job) {
               << (plant ? "y0 at the " + plant->op.kind + " point: " : std::string("start: ")) << y0 << ") ["
               << r.output_units[k] << "]\n";
   }
-  for (int k : m.plant_inputs)
-    std::cout << "input  " << std::left << std::setw(10) << m.actuators[k].name << std::right << " max |u| "
-              << r.u.col(k).cwiseAbs().maxCoeff() << " [" << m.actuators[k].unit << "]\n";
+  for (std::size_t i = 0; i < m.plant_inputs.size(); ++i) {
+    const ActuatorModel& act = m.actuators[m.plant_inputs[i]];
+    std::cout << "input  " << std::left << std::setw(10) << act.name << std::right << " max |u| "
+              << job.max_abs_input[static_cast<Eigen::Index>(i)] << " [" << act.unit << "]\n";
+  }
   for (const Saturation& s : job.saturation)
     std::cout << "saturation       " << s.actuator << " at its limit from t = " << s.first << " s: " << s.at_max
               << " s at max, " << s.at_min << " s at min\n";
-  const double E0 = r.kinetic_energy[0] + r.potential_energy[0], E1 = r.kinetic_energy[N - 1] + r.potential_energy[N - 1];
-  std::cout << "energy           " << E0 << " -> " << E1 << " J\n";
-  if (m.nc) {
-    std::cout << "constraint drift max |phi| " << *std::max_element(r.constraint_violation.begin(), r.constraint_violation.end())
-              << ", max |Jc v| " << *std::max_element(r.velocity_violation.begin(), r.velocity_violation.end()) << "\n";
-  }
+  std::cout << "energy           " << job.energy_start << " -> " << job.energy_end << " J\n";
+  if (m.nc)
+    std::cout << "constraint drift max |phi| " << job.max_constraint_violation << ", max |Jc v| " << job.max_velocity_violation
+              << "\n";
   if (job.linear_gap.size()) {
     std::cout << "linear vs nonlinear (same controller, same start):\n";
     for (int k = 0; k < r.y.cols(); ++k) {

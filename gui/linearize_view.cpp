@@ -1,4 +1,5 @@
 #include "gui/linearize_view.hpp"
+#include "study/files.hpp"
 
 #include <QComboBox>
 #include <QDir>

@@ -439,6 +439,24 @@ SimulateJob study_simulate_job(const SimulateRequest& a, const ModelSpec& file_s
   }
   job.saturation = saturation_report(m, r);
   const int N = r.samples();
+  {
+    std::vector<std::complex<double>> bad;
+    for (Eigen::Index k = 0; k < setup.linear_poles.size(); ++k)
+      if (setup.linear_discrete ? std::abs(setup.linear_poles[k]) > 1 + 1e-9 : setup.linear_poles[k].real() > 0)
+        bad.push_back(setup.linear_poles[k]);
+    job.unstable_poles = Eigen::Map<const Eigen::VectorXcd>(bad.data(), static_cast<Eigen::Index>(bad.size()));
+  }
+  if (N > 0) {
+    job.max_abs_input.resize(static_cast<Eigen::Index>(m.plant_inputs.size()));
+    for (std::size_t k = 0; k < m.plant_inputs.size(); ++k)
+      job.max_abs_input[static_cast<Eigen::Index>(k)] = r.u.col(m.plant_inputs[k]).cwiseAbs().maxCoeff();
+    job.energy_start = r.kinetic_energy[0] + r.potential_energy[0];
+    job.energy_end = r.kinetic_energy[N - 1] + r.potential_energy[N - 1];
+    if (m.nc) {
+      job.max_constraint_violation = *std::max_element(r.constraint_violation.begin(), r.constraint_violation.end());
+      job.max_velocity_violation = *std::max_element(r.velocity_violation.begin(), r.velocity_violation.end());
+    }
+  }
   if (r.y_linear.rows() == N && N > 0) {
     const auto ny = r.y.cols();
     job.linear_gap.resize(ny);

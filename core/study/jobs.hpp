@@ -117,6 +117,14 @@ struct SimulateJob {
   // output's excursion (its largest distance from its final value), and the first time the gap
   // passes 1 % of the excursion (-1: never)
   Eigen::VectorXd linear_gap, linear_gap_percent, linear_gap_from;
+  // the linear closed-loop poles that are unstable (right half-plane, or outside the unit circle
+  // for a sampled controller), in setup.linear_poles' order
+  Eigen::VectorXcd unstable_poles;
+  // over the run: the largest |u| of each Plant/In (in plant_inputs order), the total energy at the
+  // first and last samples, and the largest constraint drift |phi|, |Jc v| (models with loops)
+  Eigen::VectorXd max_abs_input;
+  double energy_start = 0, energy_end = 0;
+  double max_constraint_violation = 0, max_velocity_violation = 0;
   std::vector<std::string> written;
 };
 
