@@ -1,0 +1,253 @@
+"""codyna: multibody dynamics with a control module, from Python.
+
+A thin binding of codyna's core study layer (core/study/): every call below is one call of
+the same C++ function `codyna linearize` and `codyna simulate` make, so the numbers are the
+command line's, bit for bit. docs/python.md has a tour.
+
+    import codyna
+    study = codyna.Study("examples/cart_pendulum.json")
+    lin = study.linearize(operating_point="equilibrium")
+    lin.A, lin.B, lin.C, lin.D            # numpy float64
+    run = study.simulate(lqr=True, t_end=2, compare_linear=True)
+    run.t, run.y, run.y_linear
+    run.save("run.h5")
+
+Errors: a bad model or a bad choice in it raises ModelError (a ValueError) whose message names
+the file and the field, as the command line prints it; a bad keyword value raises ValueError
+(naming the keyword) or TypeError; an equilibrium or trim that does not converge raises
+ConvergenceError (a RuntimeError). Ctrl+C interrupts a simulation (KeyboardInterrupt).
+"""
+
+from ._codyna import (  # noqa: F401  (the public names)
+    ClosedLoop,
+    ConvergenceError,
+    Linearization,
+    ModelError,
+    Simulation,
+    __version__,
+    lqr,
+    place,
+)
+from . import _codyna
+
+__all__ = [
+    "Study",
+    "Linearization",
+    "ClosedLoop",
+    "Simulation",
+    "ModelError",
+    "ConvergenceError",
+    "lqr",
+    "place",
+    "__version__",
+]
+
+
+def _given(options):
+    """The keywords given (None means: not given, the model file's value stays)."""
+    return {k: v for k, v in options.items() if k != "self" and v is not None}
+
+
+class Study:
+    """A model file and its study (the file's "analysis" and "solver" sections).
+
+    Study(path) reads and checks the file (ModelError names the file and the field);
+    Study.from_json(text, base_dir=".") does the same for a JSON text. The keywords of
+    linearize() and simulate() override the file's choices for that one call, as the command
+    line's flags do; the file is not changed.
+    """
+
+    def __init__(self, path):
+        """Reads the model file at `path` (str or os.PathLike)."""
+        self._study = _codyna._Study(path)
+
+    @classmethod
+    def from_json(cls, text, base_dir="."):
+        """A study from a model file's JSON text. Paths in it (a controller file, the export
+        folder) are relative to `base_dir`; messages name the text "<json>"."""
+        study = cls.__new__(cls)
+        study._study = _codyna._Study.from_json(text, base_dir)
+        return study
+
+    @property
+    def file(self):
+        """The model file's path (or the label of a JSON text)."""
+        return self._study.file
+
+    @property
+    def notes(self):
+        """The model reader's notes (list of str): what it read in a way worth saying."""
+        return self._study.notes
+
+    def model_info(self):
+        """What `codyna info` shows, as a dict: name, file, dof, nq, nv; bodies (name, mass, com,
+        joint, parent), joints (name, type, parent, child, coordinates, rates, q_names);
+        coordinates with their units, rates, q_names; constraints (name, type, bodies,
+        equations), constraint_equations, independent_equations, redundant_equations,
+        assembly_residual, assembly_moves; effects; gravity; actuators (name, type, unit, gain,
+        u0, min, max) and sensors (name, type, unit), plant_inputs and plant_outputs (names);
+        the model's controller type; initial_coordinates and initial_rates by name."""
+        return self._study.model_info()
+
+    def to_json(self):
+        """The model as the file format writes it (JSON text)."""
+        return self._study.to_json()
+
+    def __repr__(self):
+        return "codyna.Study(%r)" % self.file
+
+    def linearize(
+        self,
+        *,
+        operating_point=None,
+        method=None,
+        discrete=None,
+        mat_version=None,
+        independent=None,
+        hold=None,
+        initial=None,
+        trim_free=None,
+        free_input=None,
+        free_inputs=None,
+        target=None,
+        targets=None,
+        trajectory=None,
+        trajectory_step=None,
+        name=None,
+        closed_loop=None,
+        lqr=None,
+        controller=None,
+        lqr_controllable_part=None,
+        q_weights=None,
+        r_weights=None,
+        inputs=None,
+        outputs=None,
+        disable_effect=None,
+        reference=None,
+        disturbance=None,
+    ):
+        """Linearizes the plant (Plant/In -> Plant/Out) as `codyna linearize` does.
+
+        Returns a Linearization: A, B, C, D (numpy float64), state_names, input_names,
+        output_names, x0, u0, y0, xdot0, Ts, operating_point, modes, eigenvalues(), notes,
+        warnings, and export(dir), which writes the command line's NAME.mat + NAME.m.
+
+        Every keyword is a flag of `codyna linearize` (dashes become underscores); one left
+        out (or None) keeps the model file's choice:
+
+        operating_point   "initial", "equilibrium", "trim" or "time=T"
+        method            "exact", "fd-forward" or "fd-central"
+        discrete          sample time Ts > 0: the exact zero-order-hold model (0: continuous)
+        mat_version       "5" or "7.3" (export)
+        independent       closed loops: the independent coordinates (list of names)
+        hold              {name: value}: coordinates (or rates, NAME_dot) held in the
+                          operating-point search (also "NAME=VALUE" strings)
+        initial           {name: value}: with trajectory only, the run's initial state
+        trim_free         trim: coordinates solved instead of held (list of names)
+        free_input        equilibrium/trim: Plant/In inputs solved for (alias free_inputs)
+        target            {output: value}: Plant/Out values the search must reach (alias targets)
+        trajectory        T: linearize along a simulation from 0 to T (the model's controller
+                          in the loop); A, B, C, D are then stacked along a first axis, one per
+                          time (times)
+        trajectory_step   spacing of the trajectory's points, s
+        name              the export's NAME (a MATLAB identifier)
+        closed_loop       True: also the linear closed loop with the study's controller
+                          (Linearization.closed_loop: Acl, Bcl, Ccl, Dcl, poles, responses)
+        lqr               True: the closed loop's controller is an LQR designed on this plant
+        controller        the closed loop's controller from a .mat (K, Kp/Ki/Kd or Ac..Dc)
+        lqr_controllable_part  with lqr on a plant that is not stabilizable: design on the
+                          controllable part
+        q_weights, r_weights   LQR weights (diagonals of Q and R)
+        inputs, outputs   Plant/In actuators and Plant/Out sensors for this call (lists of names)
+        disable_effect    effects left out (list of names)
+        reference         a reference on a Plant/Out: "OUTPUT=VALUE[@TIME]" or a dict as in the
+                          file's analysis.references (or a list of them)
+        disturbance       a disturbance on an actuator that is not Plant/In: "ACTUATOR=VALUE[@TIME]"
+                          or a dict as in the file's analysis.disturbances (or a list of them)
+
+        Raises ModelError (bad model or choice, naming the file and the field), ValueError
+        (a bad keyword value, naming the keyword), ConvergenceError (an equilibrium or trim
+        that did not converge: nothing is returned), TypeError (an unknown keyword).
+        """
+        return _codyna._linearize(self._study, _given(locals()))
+
+    def simulate(
+        self,
+        *,
+        t_end=None,
+        integrator=None,
+        rtol=None,
+        atol=None,
+        max_step=None,
+        output_step=None,
+        controller=None,
+        open_loop=None,
+        lqr=None,
+        lqr_controllable_part=None,
+        q_weights=None,
+        r_weights=None,
+        operating_point=None,
+        compare_linear=None,
+        linear_region=None,
+        independent=None,
+        hold=None,
+        initial=None,
+        trim_free=None,
+        free_input=None,
+        free_inputs=None,
+        target=None,
+        targets=None,
+        inputs=None,
+        outputs=None,
+        disable_effect=None,
+        reference=None,
+        disturbance=None,
+        max_samples=None,
+        divergence_bound=None,
+    ):
+        """Simulates the nonlinear model with its controller in the loop, as `codyna simulate`.
+
+        Returns a Simulation: t, q, v, x (= [q v]), u, y (numpy, one row per sample) with their
+        names, y_linear (compare_linear=True, else None), completed, failure, controller,
+        lqr_gain, operating_point, linear_region, notes, warnings, and save(path, csv=None),
+        which writes the command line's HDF5 (and CSV). A run whose integrator fails is
+        returned with completed=False and the reason in failure (its samples up to then kept;
+        a RuntimeWarning says so). Ctrl+C stops the run and raises KeyboardInterrupt.
+
+        Every keyword is a flag of `codyna simulate` (dashes become underscores); one left out
+        (or None) keeps the model file's choice (its "solver" and "analysis" sections):
+
+        t_end             end time, s
+        integrator        "auto", "ida", "cvode-bdf", "cvode-adams", "arkode" or "rk4"
+        rtol, atol        tolerances
+        max_step          largest step, s (rk4: its fixed step)
+        output_step       output interval, s
+        controller        a controller .mat: K (state feedback), Kp/Ki/Kd (PID) or Ac, Bc, Cc, Dc
+                          [, Ts] (LTI); default the model file's controller
+        open_loop         True: ignore the model's controller (actuators at their nominal values)
+        lqr               True: design an LQR on the linearized plant and use it
+        lqr_controllable_part  with lqr on a plant that is not stabilizable: the controllable part
+        q_weights, r_weights   LQR weights (diagonals of Q and R)
+        operating_point   where the controller's plant is linearized: "initial", "equilibrium",
+                          "trim" or "time=T"
+        compare_linear    True: also run the linear closed loop from the same start (y_linear)
+        linear_region     R (rad or m): report when the run goes farther than R from the
+                          operating point (linear_region)
+        independent       closed loops: the independent coordinates of the linearization
+        hold              {name: value}: coordinates held in the operating-point search (they
+                          also move the run's start unless initial says otherwise)
+        initial           {name: value}: the run's initial state (coordinates or rates)
+        trim_free, free_input (free_inputs), target (targets)   the steady-state search
+        inputs, outputs, disable_effect, reference, disturbance   as in linearize()
+        max_samples       refuse a run that would record more output samples
+        divergence_bound  end the run when a state entry grows past this
+
+        Raises ModelError, ValueError, ConvergenceError, TypeError as linearize() does.
+        """
+        run = _codyna._simulate(self._study, _given(locals()))
+        if not run.completed:
+            import warnings
+
+            warnings.warn("codyna: the run failed: %s (the samples up to it are kept)" % run.failure,
+                          RuntimeWarning, stacklevel=2)
+        return run

@@ -1,0 +1,853 @@
+// _codyna: the C++ half of the Python module `codyna` (docs/python.md).
+//
+// It binds core's study/ layer and the model/ types it hands back, and nothing below them:
+// each Python call is one study call. What this file does is conversion only: Python keywords
+// into a LinearizeRequest / SimulateRequest (OptionStyle::Keyword, so the core's messages name
+// the keywords), Eigen matrices into numpy arrays, names into lists, C++ exceptions into
+// Python ones. It decides nothing, computes nothing and reads or writes no file itself.
+//
+// The pure-Python package (python/codyna/__init__.py) gives Study its keyword signatures and
+// docstrings and calls the functions below with a dict of the keywords given.
+#include <pybind11/complex.h>
+#include <pybind11/eigen.h>
+#include <pybind11/functional.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "model/errors.hpp"
+#include "model/model.hpp"
+#include "model/model_spec.hpp"
+#include "study/files.hpp"
+#include "study/jobs.hpp"
+#include "study/tools.hpp"
+#include "study/workflow.hpp"
+
+namespace py = pybind11;
+using namespace pybind11::literals;
+
+namespace codyna::python {
+
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Exceptions
+
+PyObject* g_model_error = nullptr;        // codyna.ModelError(ValueError)
+PyObject* g_convergence_error = nullptr;  // codyna.ConvergenceError(RuntimeError)
+
+[[noreturn]] void type_error(const std::string& what) { throw py::type_error(what); }
+
+// ---------------------------------------------------------------------------------------------
+// Keywords -> request fields. `Keywords` holds the dict the Python layer passes (only the
+// keywords given, None left out); every field taken is removed, and what is left at the end is
+// a keyword this function does not know (TypeError naming it, as Python says it).
+
+std::string type_name(const py::handle& o) { return py::str(py::type::handle_of(o).attr("__name__")); }
+
+class Keywords {
+ public:
+  Keywords(const py::dict& given, std::string function) : function_(std::move(function)) {
+    for (const auto& kv : given) {
+      if (!py::isinstance<py::str>(kv.first)) type_error(function_ + "() keywords must be strings");
+      if (kv.second.is_none()) continue;  // None: not given (the model file's value stays)
+      items_.emplace_back(kv.first.cast<std::string>(), py::reinterpret_borrow<py::object>(kv.second));
+    }
+  }
+
+  // the value of `key` (or of its alias), if given
+  std::optional<py::object> take(const std::string& key, const std::string& alias = "") {
+    std::optional<py::object> found;
+    std::string found_key;
+    for (auto it = items_.begin(); it != items_.end();) {
+      if (it->first == key || (!alias.empty() && it->first == alias)) {
+        if (found) type_error(function_ + "(): " + found_key + " and " + it->first + " are the same keyword: give one");
+        found = it->second;
+        found_key = it->first;
+        it = items_.erase(it);
+      } else {
+        ++it;
+      }
+    }
+    return found;
+  }
+
+  std::optional<std::string> text(const std::string& key) {
+    const auto o = take(key);
+    if (!o) return std::nullopt;
+    return text_of(*o, key);
+  }
+  // a path: str or os.PathLike
+  std::optional<std::string> path(const std::string& key) {
+    const auto o = take(key);
+    if (!o) return std::nullopt;
+    if (py::hasattr(*o, "__fspath__") && !py::isinstance<py::str>(*o))
+      return text_of(py::module_::import("os").attr("fspath")(*o), key);
+    return text_of(*o, key);
+  }
+  std::optional<double> number(const std::string& key) {
+    const auto o = take(key);
+    if (!o) return std::nullopt;
+    return number_of(*o, key);
+  }
+  bool flag(const std::string& key) {
+    const auto o = take(key);
+    if (!o) return false;
+    if (py::isinstance<py::str>(*o) || py::isinstance<py::bytes>(*o))
+      type_error(function_ + "(): " + key + ": expected True or False, got " + type_name(*o));
+    return py::bool_(*o);
+  }
+  // names: one str, or an iterable of str
+  std::optional<std::vector<std::string>> names(const std::string& key, const std::string& alias = "") {
+    const auto o = take(key, alias);
+    if (!o) return std::nullopt;
+    if (py::isinstance<py::str>(*o)) return std::vector<std::string>{o->cast<std::string>()};
+    std::vector<std::string> v;
+    for (const auto& item : iterable(*o, key, "a str or a list of str")) v.push_back(text_of(item, key));
+    return v;
+  }
+  // numbers: one number, or an iterable (list, numpy array) of numbers
+  std::optional<std::vector<double>> numbers(const std::string& key) {
+    const auto o = take(key);
+    if (!o) return std::nullopt;
+    if (!py::isinstance<py::str>(*o) && !py::hasattr(*o, "__iter__")) return std::vector<double>{number_of(*o, key)};
+    std::vector<double> v;
+    for (const auto& item : iterable(*o, key, "a number or a sequence of numbers")) v.push_back(number_of(item, key));
+    return v;
+  }
+  // NAME=VALUE texts: a dict {name: value} (each value written with 17 significant digits, so
+  // that the core reads back the same double), or "NAME=VALUE" strings (one, or a list)
+  std::vector<std::string> pairs(const std::string& key, const std::string& alias = "") {
+    const auto o = take(key, alias);
+    if (!o) return {};
+    std::vector<std::string> v;
+    if (py::isinstance<py::dict>(*o)) {
+      for (const auto& kv : o->cast<py::dict>()) {
+        char value[64];
+        std::snprintf(value, sizeof value, "%.17g", number_of(kv.second, key));
+        v.push_back(text_of(kv.first, key) + "=" + value);
+      }
+      return v;
+    }
+    if (py::isinstance<py::str>(*o)) return {o->cast<std::string>()};
+    for (const auto& item : iterable(*o, key, "a dict {name: value} or \"NAME=VALUE\" strings")) v.push_back(text_of(item, key));
+    return v;
+  }
+  // signals: a "NAME=VALUE[@TIME]" string or a dict (the model file's object, as JSON text),
+  // one or a list of them
+  std::optional<std::vector<std::string>> signals(const std::string& key, const std::string& alias = "") {
+    const auto o = take(key, alias);
+    if (!o) return std::nullopt;
+    if (py::isinstance<py::str>(*o) || py::isinstance<py::dict>(*o)) return std::vector<std::string>{signal_of(*o, key)};
+    std::vector<std::string> v;
+    for (const auto& item : iterable(*o, key, "a str, a dict or a list of them")) v.push_back(signal_of(item, key));
+    return v;
+  }
+
+  // what is left was not asked for
+  void finish() const {
+    if (!items_.empty()) type_error(function_ + "() got an unexpected keyword argument '" + items_.front().first + "'");
+  }
+
+ private:
+  py::iterable iterable(const py::object& o, const std::string& key, const char* expected) const {
+    if (py::isinstance<py::dict>(o) || py::isinstance<py::bytes>(o) || !py::isinstance<py::iterable>(o))
+      type_error(function_ + "(): " + key + ": expected " + expected + ", got " + type_name(o));
+    return o.cast<py::iterable>();
+  }
+  std::string text_of(const py::handle& o, const std::string& key) const {
+    if (!py::isinstance<py::str>(o)) type_error(function_ + "(): " + key + ": expected a str, got " + type_name(o));
+    return o.cast<std::string>();
+  }
+  double number_of(const py::handle& o, const std::string& key) const {
+    if (py::isinstance<py::str>(o) || py::isinstance<py::bool_>(o) || py::isinstance<py::bytes>(o) ||
+        !py::hasattr(o, "__float__"))
+      type_error(function_ + "(): " + key + ": expected a number, got " + type_name(o));
+    return py::float_(py::reinterpret_borrow<py::object>(o)).cast<double>();
+  }
+  std::string signal_of(const py::handle& o, const std::string& key) const {
+    if (py::isinstance<py::dict>(o)) return py::str(py::module_::import("json").attr("dumps")(o));
+    if (!py::isinstance<py::str>(o))
+      type_error(function_ + "(): " + key + ": expected a \"NAME=VALUE[@TIME]\" str or a dict, got " + type_name(o));
+    return o.cast<std::string>();
+  }
+
+  std::string function_;
+  std::vector<std::pair<std::string, py::object>> items_;
+};
+
+void take_point(Keywords& k, PointRequest& p) {
+  p.operating_point = k.text("operating_point");
+  p.independent = k.names("independent");
+  p.trim_free = k.names("trim_free");
+  p.free_inputs = k.names("free_input", "free_inputs");
+  p.hold = k.pairs("hold");
+  p.initial = k.pairs("initial");
+  p.targets = k.pairs("target", "targets");
+}
+
+void take_plant(Keywords& k, PlantRequest& p) {
+  p.inputs = k.names("inputs");
+  p.outputs = k.names("outputs");
+  p.disabled_effects = k.names("disable_effect", "disable_effects");
+  p.references = k.signals("reference", "references");
+  p.disturbances = k.signals("disturbance", "disturbances");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Results -> Python values
+
+py::array_t<double> vector_of(const std::vector<double>& v) {
+  py::array_t<double> a(static_cast<py::ssize_t>(v.size()));
+  std::copy(v.begin(), v.end(), a.mutable_data());
+  return a;
+}
+
+py::dict named(const std::vector<std::string>& names, const Eigen::VectorXd& v) {
+  py::dict d;
+  for (Eigen::Index k = 0; k < v.size() && static_cast<std::size_t>(k) < names.size(); ++k)
+    d[py::str(names[static_cast<std::size_t>(k)])] = v[k];
+  return d;
+}
+
+py::array_t<std::complex<double>> eigenvalues_of(const ModalAnalysis& m) {
+  py::array_t<std::complex<double>> a(static_cast<py::ssize_t>(m.modes.size()));
+  for (std::size_t k = 0; k < m.modes.size(); ++k) a.mutable_at(static_cast<py::ssize_t>(k)) = m.modes[k].eigenvalue;
+  return a;
+}
+
+py::list modes_of(const ModalAnalysis& m) {
+  py::list l;
+  for (const Mode& mode : m.modes)
+    l.append(py::dict("eigenvalue"_a = mode.eigenvalue, "s"_a = mode.s, "natural_frequency"_a = mode.natural_frequency,
+                      "damping_ratio"_a = mode.damping_ratio, "shape"_a = mode.shape));
+  return l;
+}
+
+py::list hidden_of(const std::vector<HiddenMode>& modes) {
+  py::list l;
+  for (const HiddenMode& h : modes) l.append(py::dict("eigenvalue"_a = h.eigenvalue, "states"_a = h.states, "margin"_a = h.margin));
+  return l;
+}
+
+py::dict operating_point_of(const Model& m, const OperatingPoint& op, const Eigen::VectorXd& coordinates) {
+  std::vector<std::string> actuators;
+  for (const ActuatorModel& a : m.actuators) actuators.push_back(a.name);
+  return py::dict("kind"_a = op.kind, "t"_a = op.t, "residual"_a = op.residual, "iterations"_a = op.iterations,
+                  "coordinates"_a = named(m.v_names, coordinates), "rates"_a = named(m.rate_names, op.v),
+                  "inputs"_a = named(actuators, op.u), "q"_a = op.q, "v"_a = op.v, "u"_a = op.u);
+}
+
+// the stack of one matrix of every system along a trajectory: (N, rows, cols)
+template <class Get>
+py::array_t<double> stacked(const std::vector<LinearSystem>& systems, Get get) {
+  const Eigen::Index rows = systems.empty() ? 0 : get(systems[0]).rows(), cols = systems.empty() ? 0 : get(systems[0]).cols();
+  py::array_t<double> a({static_cast<py::ssize_t>(systems.size()), static_cast<py::ssize_t>(rows), static_cast<py::ssize_t>(cols)});
+  auto r = a.mutable_unchecked<3>();
+  for (std::size_t k = 0; k < systems.size(); ++k)
+    for (Eigen::Index i = 0; i < rows; ++i)
+      for (Eigen::Index j = 0; j < cols; ++j) r(static_cast<py::ssize_t>(k), i, j) = get(systems[k])(i, j);
+  return a;
+}
+template <class Get>
+py::array_t<double> stacked_vector(const std::vector<LinearSystem>& systems, Get get) {
+  const Eigen::Index n = systems.empty() ? 0 : get(systems[0]).size();
+  py::array_t<double> a({static_cast<py::ssize_t>(systems.size()), static_cast<py::ssize_t>(n)});
+  auto r = a.mutable_unchecked<2>();
+  for (std::size_t k = 0; k < systems.size(); ++k)
+    for (Eigen::Index i = 0; i < n; ++i) r(static_cast<py::ssize_t>(k), i) = get(systems[k])[i];
+  return a;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The bound objects
+
+struct Study {
+  std::shared_ptr<const ModelSpec> spec;
+  std::string file;  // the request's `model`: messages, relative paths, outputs that must not replace it
+};
+
+struct LinearizationResult {
+  LinearizeRequest request;  // to export: the same job again with `out`
+  std::shared_ptr<const ModelSpec> spec;
+  std::shared_ptr<const LinearizeJob> job;
+
+  const LinearSystem& system() const {
+    if (job->trajectory) throw py::attribute_error("along a trajectory: the systems are stacked (see times)");
+    return job->linearization.system;
+  }
+};
+
+struct ClosedLoopResult {
+  std::shared_ptr<const LinearizeJob> job;
+  const StudyClosedLoop& cl() const { return *job->closed_loop; }
+  const LinearSystem& system() const { return job->closed_loop->loop.system; }
+};
+
+struct SimulationRun {
+  SimulateRequest request;
+  SimulateJob job;
+};
+
+// Ctrl+C during a run: the progress callback (called after every recorded sample, without the
+// GIL) takes the GIL every 50 ms to let Python run its signal handlers; a handler that raised
+// (KeyboardInterrupt) sets the run's cancel flag, and the exception is raised again once the
+// run has returned its partial result.
+struct Interrupt {
+  std::atomic<bool> cancel{false};
+  std::optional<py::error_already_set> error;
+  std::chrono::steady_clock::time_point last = std::chrono::steady_clock::now();
+
+  void check() {
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last < std::chrono::milliseconds(50) || cancel) return;
+    last = now;
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() != 0) {
+      error.emplace();  // fetches (and clears) the handler's exception
+      cancel = true;
+    }
+  }
+  [[noreturn]] void raise() {
+    if (error) throw *error;
+    PyErr_SetNone(PyExc_KeyboardInterrupt);
+    throw py::error_already_set();
+  }
+};
+
+// ---------------------------------------------------------------------------------------------
+// The calls
+
+Study study_from_file(const py::object& path_object) {
+  const std::string path = py::str(py::module_::import("os").attr("fspath")(path_object));
+  Study s;
+  s.spec = std::make_shared<const ModelSpec>(study_read_model(path));
+  s.file = path;
+  return s;
+}
+
+Study study_from_json(const std::string& text, const py::object& base_dir_object) {
+  const std::string base_dir = py::str(py::module_::import("os").attr("fspath")(base_dir_object));
+  // the label names the text in messages; its folder is where relative paths of the model lead
+  const std::string label = base_dir == "." || base_dir.empty() ? "<json>" : base_dir + "/<json>";
+  Study s;
+  s.spec = std::make_shared<const ModelSpec>(study_parse_model_text(text, label));
+  s.file = label;
+  return s;
+}
+
+py::dict model_info(const Study& s) {
+  const Model m = study_compile(*s.spec, s.file);
+  const auto body = [&](int i) { return i >= 0 && i < static_cast<int>(m.body_names.size()) ? m.body_names[i] : std::string(); };
+  const auto slice = [](const std::vector<std::string>& v, int first, int n) {
+    return std::vector<std::string>(v.begin() + first, v.begin() + first + n);
+  };
+  py::list bodies, joints, constraints, effects, actuators, sensors;
+  for (int i = 1; i < m.nbodies; ++i) {
+    const JointModel& j = m.joints[i];
+    bodies.append(py::dict("name"_a = m.body_names[i], "mass"_a = m.mass[i], "com"_a = m.com[i], "joint"_a = j.name,
+                           "parent"_a = body(m.parent[i])));
+    joints.append(py::dict("name"_a = j.name, "type"_a = to_string(j.type), "parent"_a = body(j.parent),
+                           "child"_a = m.body_names[i], "coordinates"_a = slice(m.v_names, j.idx_v, j.nv),
+                           "rates"_a = slice(m.rate_names, j.idx_v, j.nv), "q_names"_a = slice(m.q_names, j.idx_q, j.nq)));
+  }
+  for (const ConstraintModel& c : m.constraints)
+    constraints.append(py::dict("name"_a = c.name, "type"_a = to_string(c.type), "body_a"_a = body(c.body_a),
+                                "body_b"_a = body(c.body_b), "equations"_a = slice(m.row_names, c.row, c.nrows)));
+  for (const EffectSpec& e : m.spec.effects) effects.append(py::dict("name"_a = e.name, "type"_a = to_string(e.type)));
+  std::vector<std::string> plant_inputs, plant_outputs, redundant;
+  for (int k : m.plant_inputs) plant_inputs.push_back(m.actuators[k].name);
+  for (int k : m.plant_outputs) plant_outputs.push_back(m.sensors[k].name);
+  for (int k : m.redundant_rows) redundant.push_back(m.row_names[k]);
+  for (const ActuatorModel& a : m.actuators)
+    actuators.append(py::dict("name"_a = a.name, "type"_a = to_string(a.type), "unit"_a = a.unit, "gain"_a = a.gain,
+                              "u0"_a = a.u0, "min"_a = a.min, "max"_a = a.max));
+  for (const SensorModel& y : m.sensors) sensors.append(py::dict("name"_a = y.name, "type"_a = to_string(y.type), "unit"_a = y.unit));
+  return py::dict("name"_a = m.name, "file"_a = m.source_file, "dof"_a = m.dof(), "nq"_a = m.nq, "nv"_a = m.nv,
+                  "bodies"_a = bodies, "joints"_a = joints, "coordinates"_a = m.v_names, "units"_a = m.v_units,
+                  "rates"_a = m.rate_names, "q_names"_a = m.q_names, "constraints"_a = constraints,
+                  "constraint_equations"_a = m.nc, "independent_equations"_a = m.active_rows.size(),
+                  "redundant_equations"_a = redundant, "assembly_residual"_a = m.assembly_residual,
+                  "assembly_moves"_a = study_assembly_moves_text(m), "effects"_a = effects, "gravity"_a = m.gravity,
+                  "actuators"_a = actuators, "sensors"_a = sensors, "plant_inputs"_a = plant_inputs,
+                  "plant_outputs"_a = plant_outputs, "controller"_a = to_string(m.spec.controller.type),
+                  "initial_coordinates"_a = named(m.v_names, study_coordinates(m, m.q0)),
+                  "initial_rates"_a = named(m.rate_names, m.v0));
+}
+
+LinearizeRequest linearize_request(const Study& s, const py::dict& options) {
+  Keywords k(options, "linearize");
+  LinearizeRequest r;
+  r.style = OptionStyle::Keyword;
+  r.model = s.file;
+  take_point(k, r.point);
+  take_plant(k, r.plant);
+  r.method = k.text("method");
+  if (const auto v = k.take("mat_version")) r.mat_version = py::str(*v).cast<std::string>();  // 5, "5", "7.3"
+  r.name = k.text("name");
+  r.controller = k.path("controller");
+  r.discrete = k.number("discrete");
+  r.trajectory = k.number("trajectory");
+  r.trajectory_step = k.number("trajectory_step");
+  r.closed_loop = k.flag("closed_loop");
+  r.lqr = k.flag("lqr");
+  r.lqr_controllable_part = k.flag("lqr_controllable_part");
+  r.q_weights = k.numbers("q_weights");
+  r.r_weights = k.numbers("r_weights");
+  k.finish();
+  return r;
+}
+
+LinearizationResult do_linearize(const Study& s, const py::dict& options) {
+  LinearizationResult l;
+  l.request = linearize_request(s, options);
+  l.spec = s.spec;
+  {
+    py::gil_scoped_release release;
+    l.job = std::make_shared<const LinearizeJob>(study_linearize_job(l.request, *l.spec));
+  }
+  return l;
+}
+
+py::tuple export_linearization(const LinearizationResult& l, const py::object& dir_object) {
+  LinearizeRequest r = l.request;
+  r.out = py::str(py::module_::import("os").attr("fspath")(dir_object));
+  if (r.out.empty()) throw py::value_error("export: a folder is needed (\".\" for this one)");
+  LinearizeJob job;
+  {
+    py::gil_scoped_release release;
+    job = study_linearize_job(r, *l.spec);
+  }
+  std::vector<std::string> written = job.written;
+  written.insert(written.end(), job.closed_loop_written.begin(), job.closed_loop_written.end());
+  return py::tuple(py::cast(written));
+}
+
+SimulateRequest simulate_request(const Study& s, const py::dict& options) {
+  Keywords k(options, "simulate");
+  SimulateRequest r;
+  r.style = OptionStyle::Keyword;
+  r.model = s.file;
+  take_point(k, r.point);
+  take_plant(k, r.plant);
+  r.controller = k.path("controller");
+  r.lqr = k.flag("lqr");
+  r.lqr_controllable_part = k.flag("lqr_controllable_part");
+  r.compare_linear = k.flag("compare_linear");
+  r.open_loop = k.flag("open_loop");
+  r.linear_region = k.number("linear_region");
+  r.q_weights = k.numbers("q_weights");
+  r.r_weights = k.numbers("r_weights");
+  r.integrator = k.text("integrator");
+  r.t_end = k.number("t_end");
+  r.rtol = k.number("rtol");
+  r.atol = k.number("atol");
+  r.max_step = k.number("max_step");
+  r.output_step = k.number("output_step");
+  r.max_samples = k.number("max_samples");
+  r.divergence_bound = k.number("divergence_bound");
+  k.finish();
+  return r;
+}
+
+std::unique_ptr<SimulationRun> do_simulate(const Study& s, const py::dict& options) {
+  auto run = std::make_unique<SimulationRun>();
+  run->request = simulate_request(s, options);
+  Interrupt interrupt;
+  SimulationCallbacks cb;
+  cb.cancel = &interrupt.cancel;
+  cb.progress = [&interrupt](double, double) { interrupt.check(); };
+  try {
+    py::gil_scoped_release release;
+    run->job = study_simulate_job(run->request, *s.spec, cb);
+  } catch (const StudyCancelled&) {
+    if (interrupt.cancel) interrupt.raise();
+    throw;
+  }
+  if (interrupt.cancel || run->job.result.cancelled) interrupt.raise();
+  return run;
+}
+
+void save_simulation(const SimulationRun& run, const py::object& path_object, const py::object& csv_object) {
+  const auto fspath = py::module_::import("os").attr("fspath");
+  const std::string path = path_object.is_none() ? std::string() : py::str(fspath(path_object)).cast<std::string>();
+  const std::string csv = csv_object.is_none() ? std::string() : py::str(fspath(csv_object)).cast<std::string>();
+  if (path.empty() && csv.empty()) throw py::value_error("save: give an HDF5 path, a csv path or both");
+  // the rule every front end keeps: an output never replaces the model, the controller file or a
+  // file codyna did not write (checked by the core)
+  const std::vector<std::string> inputs{run.request.model, run.request.controller.value_or("")};
+  if (!path.empty()) study_guard_output(path, OutputKind::ResultsHdf5, inputs);
+  if (!csv.empty()) {
+    study_guard_output(csv, OutputKind::ResultsCsv, inputs);
+    if (!path.empty() && study_same_file(csv, path)) throw py::value_error("save: csv " + csv + " is the same file as " + path);
+  }
+  // the GIL stays held: the HDF5 library is serial, and h5py may be in this process
+  study_write_results(run.job.result, path, csv);
+}
+
+py::tuple do_lqr(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& Q, const Eigen::MatrixXd& R,
+              bool discrete) {
+  LqrResult r;
+  {
+    py::gil_scoped_release release;
+    r = study_lqr(A, B, Q, R, discrete);
+  }
+  return py::make_tuple(r.K, r.X, r.closed_loop_poles);
+}
+
+Eigen::MatrixXd do_place(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::VectorXcd& poles) {
+  py::gil_scoped_release release;
+  return study_place(A, B, poles);
+}
+
+}  // namespace
+
+}  // namespace codyna::python
+
+PYBIND11_MODULE(_codyna, m) {
+  using namespace codyna;
+  using namespace codyna::python;
+  m.doc() = "The C++ half of codyna's Python module: bindings of core/study (import codyna, not this).";
+  m.attr("__version__") = CODYNA_VERSION;
+
+  g_model_error = PyErr_NewExceptionWithDoc(
+      "codyna.ModelError",
+      "A bad model or a bad choice in it: the message is the command line's, naming the file and the\n"
+      "field (\"pendulum.json: /bodies/0/mass: ...\"). Attributes: file, path (the field, JSON-pointer\n"
+      "like), detail (what was expected).",
+      PyExc_ValueError, nullptr);
+  g_convergence_error = PyErr_NewExceptionWithDoc(
+      "codyna.ConvergenceError",
+      "An equilibrium or trim search that did not converge: the message names the residual, the\n"
+      "unknowns and what to free. Nothing is linearized, exported or simulated about such a point.",
+      PyExc_RuntimeError, nullptr);
+  m.add_object("ModelError", py::handle(g_model_error));
+  m.add_object("ConvergenceError", py::handle(g_convergence_error));
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const ModelError& e) {
+      py::object type = py::reinterpret_borrow<py::object>(g_model_error);
+      py::object exc = type(py::str(e.what()));
+      exc.attr("file") = e.file();
+      exc.attr("path") = e.path();
+      exc.attr("detail") = e.detail();
+      PyErr_SetObject(g_model_error, exc.ptr());
+    } catch (const ConvergenceError& e) {
+      PyErr_SetString(g_convergence_error, e.what());
+    } catch (const StudyCancelled& e) {
+      PyErr_SetString(PyExc_KeyboardInterrupt, e.what());
+    }
+  });
+
+  py::class_<Study>(m, "_Study", "A model file as read (codyna.Study wraps it).")
+      .def(py::init(&study_from_file), "path"_a)
+      .def_static("from_json", &study_from_json, "text"_a, "base_dir"_a = ".")
+      .def_readonly("file", &Study::file)
+      .def_property_readonly("notes", [](const Study& s) { return s.spec->notes; })
+      .def("model_info", &model_info)
+      .def("to_json", [](const Study& s) { return study_model_json(*s.spec).dump(2); });
+
+  m.def("_linearize", &do_linearize, "study"_a, "options"_a);
+  m.def("_simulate", &do_simulate, "study"_a, "options"_a);
+
+  py::class_<ClosedLoopResult>(m, "ClosedLoop",
+                               "The linear closed loop of the study's plant and controller (linearize(closed_loop=True)).\n"
+                               "A, B, C, D are the command line's Acl, Bcl, Ccl, Dcl (NAME_cl.mat).")
+      .def_property_readonly("A", [](const ClosedLoopResult& c) { return c.system().A; })
+      .def_property_readonly("B", [](const ClosedLoopResult& c) { return c.system().B; })
+      .def_property_readonly("C", [](const ClosedLoopResult& c) { return c.system().C; })
+      .def_property_readonly("D", [](const ClosedLoopResult& c) { return c.system().D; })
+      .def_property_readonly("x0", [](const ClosedLoopResult& c) { return c.system().x0; })
+      .def_property_readonly("u0", [](const ClosedLoopResult& c) { return c.system().u0; })
+      .def_property_readonly("y0", [](const ClosedLoopResult& c) { return c.system().y0; })
+      .def_property_readonly("Ts", [](const ClosedLoopResult& c) { return c.system().Ts; })
+      .def_property_readonly("state_names", [](const ClosedLoopResult& c) { return c.system().state_names; })
+      .def_property_readonly("input_names", [](const ClosedLoopResult& c) { return c.system().input_names; })
+      .def_property_readonly("output_names", [](const ClosedLoopResult& c) { return c.system().output_names; })
+      .def_property_readonly("state_units", [](const ClosedLoopResult& c) { return c.system().state_units; })
+      .def_property_readonly("input_units", [](const ClosedLoopResult& c) { return c.system().input_units; })
+      .def_property_readonly("output_units", [](const ClosedLoopResult& c) { return c.system().output_units; })
+      .def_property_readonly("controller", [](const ClosedLoopResult& c) { return c.cl().loop.controller; },
+                             "the controller's description")
+      .def_property_readonly("controller_source", [](const ClosedLoopResult& c) { return c.cl().setup.controller_source; })
+      .def_property_readonly("sizes", [](const ClosedLoopResult& c) {
+        const ClosedLoopLinear& l = c.cl().loop;
+        return py::dict("nx"_a = l.nx, "nxc"_a = l.nxc, "nr"_a = l.nr, "nd"_a = l.nd, "ny"_a = l.ny, "nu"_a = l.nu);
+      }, "plant states nx, controller states nxc, reference inputs nr, disturbance inputs nd, outputs ny, efforts nu")
+      .def("poles", [](const ClosedLoopResult& c) { return eigenvalues_of(c.cl().poles); },
+           "The closed loop's poles (numpy complex), sorted as the printed table.")
+      .def_property_readonly("poles_text", [](const ClosedLoopResult& c) { return study_format_modes(c.cl().poles); },
+                             "the poles table the command line prints")
+      .def_property_readonly("step", [](const ClosedLoopResult& c) {
+        const StepResponse& s = c.cl().step;
+        return py::dict("t"_a = vector_of(s.t), "y"_a = s.y);
+      }, "step responses: t and, per input, an array (len(t), outputs)")
+      .def_property_readonly("frequency", [](const ClosedLoopResult& c) {
+        const FrequencyResponse& f = c.cl().frequency;
+        return py::dict("w"_a = vector_of(f.w), "H"_a = f.H, "magnitude"_a = f.magnitude, "phase_deg"_a = f.phase_deg);
+      }, "frequency responses: w [rad/s] and, per frequency, H, |H| and the unwrapped phase (outputs x inputs)")
+      .def_property_readonly("notes", [](const ClosedLoopResult& c) {
+        std::vector<std::string> n = c.cl().setup.notes;
+        n.insert(n.end(), c.cl().notes.begin(), c.cl().notes.end());
+        return n;
+      });
+
+  py::class_<LinearizationResult>(m, "Linearization",
+                                  "What Study.linearize returns: the command line's A, B, C, D with their names and\n"
+                                  "offsets (x = x0 + dx, u = u0 + du, y = y0 + dy), the operating point, the modes\n"
+                                  "and what is uncontrollable or unobservable. Along a trajectory (trajectory=T),\n"
+                                  "A, B, C, D, x0, u0, y0, xdot0 are stacked along a first axis, one per time.")
+      .def_property_readonly("A", [](const LinearizationResult& l) -> py::object {
+        if (l.job->trajectory) return stacked(l.job->systems, [](const LinearSystem& s) -> const Eigen::MatrixXd& { return s.A; });
+        return py::cast(l.system().A);
+      })
+      .def_property_readonly("B", [](const LinearizationResult& l) -> py::object {
+        if (l.job->trajectory) return stacked(l.job->systems, [](const LinearSystem& s) -> const Eigen::MatrixXd& { return s.B; });
+        return py::cast(l.system().B);
+      })
+      .def_property_readonly("C", [](const LinearizationResult& l) -> py::object {
+        if (l.job->trajectory) return stacked(l.job->systems, [](const LinearSystem& s) -> const Eigen::MatrixXd& { return s.C; });
+        return py::cast(l.system().C);
+      })
+      .def_property_readonly("D", [](const LinearizationResult& l) -> py::object {
+        if (l.job->trajectory) return stacked(l.job->systems, [](const LinearSystem& s) -> const Eigen::MatrixXd& { return s.D; });
+        return py::cast(l.system().D);
+      })
+      .def_property_readonly("x0", [](const LinearizationResult& l) -> py::object {
+        if (l.job->trajectory) return stacked_vector(l.job->systems, [](const LinearSystem& s) -> const Eigen::VectorXd& { return s.x0; });
+        return py::cast(l.system().x0);
+      })
+      .def_property_readonly("u0", [](const LinearizationResult& l) -> py::object {
+        if (l.job->trajectory) return stacked_vector(l.job->systems, [](const LinearSystem& s) -> const Eigen::VectorXd& { return s.u0; });
+        return py::cast(l.system().u0);
+      })
+      .def_property_readonly("y0", [](const LinearizationResult& l) -> py::object {
+        if (l.job->trajectory) return stacked_vector(l.job->systems, [](const LinearSystem& s) -> const Eigen::VectorXd& { return s.y0; });
+        return py::cast(l.system().y0);
+      })
+      .def_property_readonly("xdot0", [](const LinearizationResult& l) -> py::object {
+        if (l.job->trajectory)
+          return stacked_vector(l.job->systems, [](const LinearSystem& s) -> const Eigen::VectorXd& { return s.xdot0; });
+        return py::cast(l.system().xdot0);
+      })
+      .def_property_readonly("Ts", [](const LinearizationResult& l) {
+        return l.job->trajectory ? 0.0 : l.system().Ts;
+      }, "the sample time (0: continuous)")
+      .def_property_readonly("state_names", [](const LinearizationResult& l) {
+        return l.job->trajectory ? (l.job->systems.empty() ? std::vector<std::string>() : l.job->systems[0].state_names)
+                                 : l.system().state_names;
+      })
+      .def_property_readonly("input_names", [](const LinearizationResult& l) {
+        return l.job->trajectory ? (l.job->systems.empty() ? std::vector<std::string>() : l.job->systems[0].input_names)
+                                 : l.system().input_names;
+      })
+      .def_property_readonly("output_names", [](const LinearizationResult& l) {
+        return l.job->trajectory ? (l.job->systems.empty() ? std::vector<std::string>() : l.job->systems[0].output_names)
+                                 : l.system().output_names;
+      })
+      .def_property_readonly("state_units", [](const LinearizationResult& l) {
+        return l.job->trajectory ? (l.job->systems.empty() ? std::vector<std::string>() : l.job->systems[0].state_units)
+                                 : l.system().state_units;
+      })
+      .def_property_readonly("input_units", [](const LinearizationResult& l) {
+        return l.job->trajectory ? (l.job->systems.empty() ? std::vector<std::string>() : l.job->systems[0].input_units)
+                                 : l.system().input_units;
+      })
+      .def_property_readonly("output_units", [](const LinearizationResult& l) {
+        return l.job->trajectory ? (l.job->systems.empty() ? std::vector<std::string>() : l.job->systems[0].output_units)
+                                 : l.system().output_units;
+      })
+      .def_property_readonly("name", [](const LinearizationResult& l) { return l.job->name; }, "the export's NAME")
+      .def_property_readonly("method", [](const LinearizationResult& l) { return l.job->method; },
+                             "the Jacobians': exact, fd-forward or fd-central")
+      .def_property_readonly("fd_error", [](const LinearizationResult& l) {
+        return l.job->trajectory ? 0.0 : l.job->linearization.lin.fd_error;
+      }, "finite differences: max |J_fd - J_exact| / max |J_exact| (0 for exact)")
+      .def_property_readonly("independent", [](const LinearizationResult& l) {
+        std::vector<std::string> names;
+        if (!l.job->trajectory)
+          for (int i : l.job->linearization.lin.partition.independent) names.push_back(l.job->model.v_names[i]);
+        return names;
+      }, "the independent coordinates of the state (closed loops: the partition chosen or given)")
+      .def_property_readonly("operating_point", [](const LinearizationResult& l) -> py::object {
+        if (l.job->trajectory) return py::none();
+        const OperatingPoint& op = l.job->linearization.op;
+        return operating_point_of(l.job->model, op, study_coordinates(l.job->model, op.q));
+      }, "kind (initial, equilibrium, trim, time=T), t, residual, iterations, coordinates and rates by\n"
+         "name, inputs (every actuator) by name, and q, v, u as arrays; None along a trajectory")
+      .def_property_readonly("notes", [](const LinearizationResult& l) { return l.job->notes; })
+      .def_property_readonly("warnings", [](const LinearizationResult& l) { return l.job->warnings; })
+      .def("eigenvalues", [](const LinearizationResult& l) -> py::object {
+        if (l.job->trajectory) throw py::attribute_error("along a trajectory: see max_real and min_real");
+        return eigenvalues_of(l.job->modes);
+      }, "The eigenvalues of A (numpy complex; z when discrete), in the order of the modes table\n"
+         "(by natural frequency).")
+      .def_property_readonly("modes", [](const LinearizationResult& l) { return modes_of(l.job->modes); },
+                             "one dict per mode: eigenvalue, s (continuous equivalent), natural_frequency [rad/s],\n"
+                             "damping_ratio, shape (numpy complex, state order)")
+      .def_property_readonly("modes_text", [](const LinearizationResult& l) { return study_format_modes(l.job->modes); },
+                             "the modes table the command line prints")
+      .def_property_readonly("uncontrollable", [](const LinearizationResult& l) { return hidden_of(l.job->uncontrollable); },
+                             "modes the inputs cannot move (continuous plant): eigenvalue, states, margin")
+      .def_property_readonly("unobservable", [](const LinearizationResult& l) { return hidden_of(l.job->unobservable); },
+                             "modes the outputs cannot see (continuous plant): eigenvalue, states, margin")
+      .def_property_readonly("closed_loop", [](const LinearizationResult& l) -> py::object {
+        if (!l.job->closed_loop) return py::none();
+        return py::cast(ClosedLoopResult{l.job});
+      }, "the linear closed loop (a ClosedLoop) with closed_loop=True, else None")
+      .def_property_readonly("trajectory", [](const LinearizationResult& l) { return l.job->trajectory; })
+      .def_property_readonly("times", [](const LinearizationResult& l) -> py::object {
+        if (!l.job->trajectory) return py::none();
+        return vector_of(l.job->times);
+      }, "along a trajectory: the times of the systems, else None")
+      .def_property_readonly("max_real", [](const LinearizationResult& l) -> py::object {
+        if (!l.job->trajectory) return py::none();
+        return py::cast(l.job->max_real);
+      }, "along a trajectory: the largest Re(eig A) per time")
+      .def_property_readonly("min_real", [](const LinearizationResult& l) -> py::object {
+        if (!l.job->trajectory) return py::none();
+        return py::cast(l.job->min_real);
+      }, "along a trajectory: the smallest Re(eig A) per time")
+      .def_property_readonly("trajectory_controller", [](const LinearizationResult& l) { return l.job->trajectory_controller; })
+      .def("export", &export_linearization, "dir"_a,
+           "export(dir) -> tuple of paths\n\n"
+           "Writes what `codyna linearize MODEL --out dir` with the same options writes: dir/NAME.mat and\n"
+           "dir/NAME.m (and, with closed_loop=True, NAME_cl.mat, NAME_cl.m, NAME_cl_step.csv,\n"
+           "NAME_cl_freq.csv), refusing to replace the model or a file codyna did not write. The folder\n"
+           "is created if missing. Returns the paths written, in order.");
+
+  py::class_<SimulationRun>(m, "Simulation",
+                            "What Study.simulate returns: the run's samples (one row per output time), names,\n"
+                            "the linear prediction when compare_linear=True, and the reports of `codyna simulate`.")
+      .def_property_readonly("t", [](const SimulationRun& s) { return vector_of(s.job.result.t); }, "output times (N)")
+      .def_property_readonly("q", [](const SimulationRun& s) { return s.job.result.q; }, "configuration (N x nq), q_names")
+      .def_property_readonly("v", [](const SimulationRun& s) { return s.job.result.v; }, "velocities (N x nv), v_names")
+      .def_property_readonly("x", [](const SimulationRun& s) {
+        const SimulationResult& r = s.job.result;
+        Eigen::MatrixXd x(r.q.rows(), r.q.cols() + r.v.cols());
+        x << r.q, r.v;
+        return x;
+      }, "[q v] (N x (nq + nv)), x_names: the stored state of the run (quaternions for ball and free\n"
+         "joints), not the linear model's minimal state")
+      .def_property_readonly("u", [](const SimulationRun& s) { return s.job.result.u; },
+                             "every actuator's value after saturation (N x nu), input_names")
+      .def_property_readonly("y", [](const SimulationRun& s) { return s.job.result.y; }, "Plant/Out (N x ny), output_names")
+      .def_property_readonly("xc", [](const SimulationRun& s) { return s.job.result.xc; },
+                             "controller states (N x nxc), controller_state_names")
+      .def_property_readonly("y_linear", [](const SimulationRun& s) -> py::object {
+        const SimulationResult& r = s.job.result;
+        if (r.y_linear.size() == 0) return py::none();
+        return py::cast(r.y_linear);
+      }, "the linear closed loop's outputs from the same start (compare_linear=True), else None")
+      .def_property_readonly("y_reference", [](const SimulationRun& s) -> py::object {
+        if (s.job.result.y_reference.size() == 0) return py::none();
+        return py::cast(s.job.result.y_reference);
+      }, "r(t) the controller was given (N x ny), None without references")
+      .def_property_readonly("u_disturbance", [](const SimulationRun& s) -> py::object {
+        if (s.job.result.u_disturbance.size() == 0) return py::none();
+        return py::cast(s.job.result.u_disturbance);
+      }, "d(t) added to each actuator (N x nu), None without disturbances")
+      .def_property_readonly("kinetic_energy", [](const SimulationRun& s) { return vector_of(s.job.result.kinetic_energy); })
+      .def_property_readonly("potential_energy", [](const SimulationRun& s) { return vector_of(s.job.result.potential_energy); })
+      .def_property_readonly("constraint_violation", [](const SimulationRun& s) { return vector_of(s.job.result.constraint_violation); })
+      .def_property_readonly("velocity_violation", [](const SimulationRun& s) { return vector_of(s.job.result.velocity_violation); })
+      .def_property_readonly("q_names", [](const SimulationRun& s) { return s.job.result.q_names; })
+      .def_property_readonly("v_names", [](const SimulationRun& s) { return s.job.result.v_names; })
+      .def_property_readonly("x_names", [](const SimulationRun& s) {
+        std::vector<std::string> n = s.job.result.q_names;
+        n.insert(n.end(), s.job.result.v_names.begin(), s.job.result.v_names.end());
+        return n;
+      })
+      .def_property_readonly("input_names", [](const SimulationRun& s) { return s.job.result.input_names; })
+      .def_property_readonly("output_names", [](const SimulationRun& s) { return s.job.result.output_names; })
+      .def_property_readonly("input_units", [](const SimulationRun& s) { return s.job.result.input_units; })
+      .def_property_readonly("output_units", [](const SimulationRun& s) { return s.job.result.output_units; })
+      .def_property_readonly("controller_state_names", [](const SimulationRun& s) { return s.job.result.controller_state_names; })
+      .def_property_readonly("completed", [](const SimulationRun& s) { return s.job.result.completed; }, "reached t_end")
+      .def_property_readonly("failure", [](const SimulationRun& s) { return s.job.result.failure; },
+                             "a failed run: the time and reason (the samples up to it are kept); \"\" otherwise")
+      .def_property_readonly("controller", [](const SimulationRun& s) { return s.job.result.controller; },
+                             "the controller's description")
+      .def_property_readonly("controller_source", [](const SimulationRun& s) { return s.job.setup.controller_source; })
+      .def_property_readonly("lqr_gain", [](const SimulationRun& s) -> py::object {
+        if (s.job.setup.lqr_gain.size() == 0) return py::none();
+        return py::cast(s.job.setup.lqr_gain);
+      }, "the gain K designed with lqr=True (u = u0 - K (x - x0), the export's state order), else None")
+      .def_property_readonly("lqr_poles", [](const SimulationRun& s) -> py::object {
+        if (s.job.setup.lqr_poles.size() == 0) return py::none();
+        return py::cast(s.job.setup.lqr_poles);
+      }, "eig(A - B K) of that design, else None")
+      .def_property_readonly("linear_poles", [](const SimulationRun& s) -> py::object {
+        if (s.job.setup.linear_poles.size() == 0) return py::none();
+        return py::cast(s.job.setup.linear_poles);
+      }, "a linear controller: the linear closed loop's poles about the operating point, else None")
+      .def_property_readonly("linear_discrete", [](const SimulationRun& s) { return s.job.setup.linear_discrete; })
+      .def_property_readonly("linear_unstable", [](const SimulationRun& s) { return s.job.setup.linear_unstable; })
+      .def_property_readonly("operating_point", [](const SimulationRun& s) -> py::object {
+        const LinearPlant* plant = s.job.setup.plant.get();
+        if (!plant) return py::none();
+        return operating_point_of(s.job.model, plant->op, s.job.op_coordinates);
+      }, "the point the controller and the linear comparison are about (as Linearization.operating_point),\n"
+         "None when nothing needs a plant")
+      .def_property_readonly("initial_coordinates", [](const SimulationRun& s) -> py::object {
+        if (s.job.initial_coordinates.size() == 0) return py::none();
+        return named(s.job.model.v_names, s.job.initial_coordinates);
+      }, "the run's start by coordinate, when the study names an initial state, else None")
+      .def_property_readonly("linear_region", [](const SimulationRun& s) -> py::object {
+        const LinearRegion& r = s.job.region;
+        if (r.measured.empty()) return py::none();
+        return py::dict("bound"_a = r.bound, "measured"_a = r.measured, "left_at"_a = r.left_at, "left_on"_a = r.left_on,
+                        "largest"_a = r.largest, "largest_on"_a = r.largest_on, "final_distance"_a = r.final_distance,
+                        "final_on"_a = r.final_on, "settled"_a = r.settled);
+      }, "how far the run went from the operating point (left_at = -1: stayed within), None without a plant")
+      .def_property_readonly("linear_gap", [](const SimulationRun& s) -> py::object {
+        if (s.job.linear_gap.size() == 0) return py::none();
+        return py::dict("max_abs"_a = named(s.job.result.output_names, s.job.linear_gap),
+                        "percent"_a = named(s.job.result.output_names, s.job.linear_gap_percent),
+                        "from_time"_a = named(s.job.result.output_names, s.job.linear_gap_from));
+      }, "compare_linear=True: per output, the largest |y - y_linear|, that in % of the output's\n"
+         "excursion, and the first time the gap passes 1 % (-1: never); else None")
+      .def_property_readonly("linear_failure", [](const SimulationRun& s) { return s.job.result.linear_failure; })
+      .def_property_readonly("linear_error_estimate", [](const SimulationRun& s) { return s.job.result.linear_error_estimate; })
+      .def_property_readonly("saturation", [](const SimulationRun& s) {
+        py::list l;
+        for (const Saturation& x : s.job.saturation)
+          l.append(py::dict("actuator"_a = x.actuator, "at_max"_a = x.at_max, "at_min"_a = x.at_min, "first"_a = x.first));
+        return l;
+      }, "actuators that sat at a limit: seconds at max and at min, first time")
+      .def_property_readonly("stats", [](const SimulationRun& s) {
+        const SolverStats& x = s.job.result.stats;
+        return py::dict("integrator"_a = x.integrator, "rtol"_a = x.rtol, "atol"_a = x.atol, "max_step"_a = x.max_step,
+                        "steps"_a = x.steps, "rhs_evals"_a = x.rhs_evals, "jac_evals"_a = x.jac_evals,
+                        "error_test_failures"_a = x.error_test_failures, "nonlinear_iterations"_a = x.nonlinear_iterations,
+                        "nonlinear_failures"_a = x.nonlinear_failures, "projections"_a = x.projections,
+                        "restarts"_a = x.restarts, "wall_time"_a = x.wall_time, "integrator_choice"_a = x.integrator_choice);
+      })
+      .def_property_readonly("settings_json", [](const SimulationRun& s) { return s.job.result.settings_json; })
+      .def_property_readonly("notes", [](const SimulationRun& s) { return s.job.notes; })
+      .def_property_readonly("warnings", [](const SimulationRun& s) { return s.job.warnings; })
+      .def("save", &save_simulation, "path"_a, "csv"_a = py::none(),
+           "save(path, csv=None)\n\n"
+           "Writes the results as `codyna simulate --out path [--csv csv]` does (HDF5, and CSV when csv\n"
+           "is given; path may be None for CSV only), each atomically, refusing to replace the model,\n"
+           "the controller file or a file codyna did not write.");
+
+  m.def("lqr", &do_lqr, "A"_a, "B"_a, "Q"_a, "R"_a, "discrete"_a = false,
+        "lqr(A, B, Q, R, discrete=False) -> (K, X, poles)\n\n"
+        "The linear-quadratic regulator, MATLAB's sign convention u = -K x: K (m x n), the stabilizing\n"
+        "Riccati solution X and the closed-loop poles eig(A - B K) (sorted by real, then imaginary\n"
+        "part). discrete=True: for x[k+1] = A x[k] + B u[k] (dlqr). Bad sizes or weights, or a pair\n"
+        "that cannot be stabilized, raise ValueError with the reason.");
+  m.def("place", &do_place, "A"_a, "B"_a, "poles"_a,
+        "place(A, B, poles) -> K\n\n"
+        "Pole placement as MATLAB's place: u = -K x puts eig(A - B K) at `poles` (complex ones in\n"
+        "conjugate pairs). Raises ValueError when it cannot.");
+}

@@ -1,0 +1,434 @@
+"""The Python module `codyna` against the command line (CTest: python.pytest, label python).
+
+The module binds the same study calls the `codyna` command makes, so what it returns must be
+the command line's output bit for bit (np.array_equal, never allclose):
+  * every example's A, B, C, D, x0, u0, y0, xdot0 and names equal the CLI's NAME.mat, also
+    discrete (Ts = 0.01) and by central differences on the cart-pendulum, along a trajectory,
+    with held coordinates given as a dict, and for the linear closed loop (NAME_cl.mat);
+  * Linearization.export writes the CLI's files (every variable of NAME.mat, the NAME.m text);
+  * the cart-pendulum's closed loop (lqr=True, t_end=2) equals the CLI's HDF5 trajectory, and
+    Simulation.save writes an HDF5 whose every dataset equals the CLI's;
+  * a bad field raises codyna.ModelError (a ValueError) with the CLI's message, the file and
+    the field path; a failed trim raises codyna.ConvergenceError; an unknown keyword raises
+    TypeError naming it; a bad value raises ValueError naming the keyword;
+  * codyna.lqr agrees with scipy.linalg.solve_continuous_are (K = R^-1 B' X, 1e-9 relative),
+    codyna.place puts eig(A - B K) at the poles;
+  * Ctrl+C (SIGINT) stops a long simulation within a second, as KeyboardInterrupt;
+  * examples/python/cart_pendulum_lqr.py runs and writes its PNG.
+
+Environment (set by CTest): PYTHONPATH=build/python, CODYNA_BIN (the codyna command),
+CODYNA_SOURCE_DIR (the source tree). Nothing is skipped: a missing piece fails.
+"""
+import glob
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import h5py
+import numpy as np
+import pytest
+import scipy.io
+import scipy.linalg
+
+import codyna
+
+SOURCE_DIR = os.environ.get("CODYNA_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
+EXAMPLES = sorted(glob.glob(os.path.join(SOURCE_DIR, "examples", "*.json")))
+CART = os.path.join(SOURCE_DIR, "examples", "cart_pendulum.json")
+PENDULUM = os.path.join(SOURCE_DIR, "examples", "pendulum.json")
+
+
+def codyna_bin():
+    path = os.environ.get("CODYNA_BIN")
+    assert path and os.access(path, os.X_OK), "CODYNA_BIN must name the codyna command (CTest sets it)"
+    return path
+
+
+def cli(*args, cwd=None, expect=0):
+    """Runs the codyna command; returns (stdout, stderr)."""
+    p = subprocess.run([codyna_bin(), *map(str, args)], cwd=cwd, capture_output=True, text=True)
+    assert p.returncode == expect, "codyna %s: exit %d\n%s%s" % (" ".join(map(str, args)), p.returncode, p.stdout, p.stderr)
+    return p.stdout, p.stderr
+
+
+def mat_names(d, key):
+    return [str(x[0]) if x.size else "" for x in d[key].ravel()]
+
+
+def same(actual, expected):
+    """Bit for bit: the same shape (empty matrices: the same size) and the same doubles."""
+    actual, expected = np.asarray(actual, dtype=float), np.asarray(expected, dtype=float)
+    if actual.size == 0 and expected.size == 0:
+        return True
+    return actual.shape == expected.shape and np.array_equal(actual, expected)
+
+
+def check_against_mat(lin, mat_path):
+    d = scipy.io.loadmat(mat_path)
+    for key in ("A", "B", "C", "D"):
+        assert same(getattr(lin, key), d[key]), "%s differs from %s" % (key, mat_path)
+    for key in ("x0", "u0", "y0", "xdot0"):
+        assert same(getattr(lin, key), d[key].ravel()), "%s differs from %s" % (key, mat_path)
+    assert lin.Ts == float(d["Ts"].ravel()[0])
+    assert lin.state_names == mat_names(d, "state_names")
+    assert lin.input_names == mat_names(d, "input_names")
+    assert lin.output_names == mat_names(d, "output_names")
+    return d
+
+
+def mat_path(out_dir, stdout):
+    mats = [l.split(" ", 1)[1] for l in stdout.splitlines() if l.startswith("wrote ") and l.endswith(".mat")]
+    assert mats, stdout
+    return os.path.join(out_dir, os.path.basename(mats[0])) if not os.path.isabs(mats[0]) else mats[0]
+
+
+# ------------------------------------------------------------------------- linearize
+
+def test_examples_exist():
+    assert len(EXAMPLES) >= 10, EXAMPLES
+
+
+def cli_messages(stderr, kind):
+    prefix = "codyna: %s: " % kind
+    return [l[len(prefix):] for l in stderr.splitlines() if l.startswith(prefix)]
+
+
+@pytest.mark.parametrize("model", EXAMPLES, ids=[os.path.basename(m)[:-5] for m in EXAMPLES])
+def test_linearize_equals_cli(model, tmp_path):
+    # the model file's own study; three examples have no equilibrium to find (no Plant/In to hold
+    # them): the CLI exits 2 and the module raises ConvergenceError with the same message, and both
+    # are compared again at the initial point
+    study = codyna.Study(model)
+    p = subprocess.run([codyna_bin(), "linearize", model, "--out", str(tmp_path / "cli")], capture_output=True, text=True)
+    options, flags = {}, []
+    if p.returncode == 2:
+        with pytest.raises(codyna.ConvergenceError) as e:
+            study.linearize()
+        assert cli_messages(p.stderr, "error") == [str(e.value)]
+        assert not (tmp_path / "cli").exists() or not os.listdir(tmp_path / "cli")
+        options, flags = {"operating_point": "initial"}, ["--operating-point", "initial"]
+        p = subprocess.run([codyna_bin(), "linearize", model, "--out", str(tmp_path / "cli"), *flags],
+                           capture_output=True, text=True)
+    assert p.returncode == 0, p.stdout + p.stderr
+    lin = study.linearize(**options)
+    check_against_mat(lin, mat_path(tmp_path / "cli", p.stdout))
+    assert lin.A.dtype == np.float64 and lin.A.shape == (len(lin.state_names),) * 2
+    ev = lin.eigenvalues()
+    assert ev.dtype == np.complex128 and ev.shape == (lin.A.shape[0],)
+    assert lin.operating_point["kind"] == options.get("operating_point", lin.operating_point["kind"])
+    # the messages the CLI prints are the ones the module returns
+    assert lin.warnings == cli_messages(p.stderr, "warning")
+    assert study.notes + lin.notes == cli_messages(p.stderr, "note")
+
+
+@pytest.mark.parametrize("options,flags", [
+    (dict(discrete=0.01), ["--discrete", "0.01"]),
+    (dict(method="fd-central"), ["--method", "fd-central"]),
+    (dict(operating_point="initial", method="fd-forward", discrete=0.05), ["--operating-point", "initial", "--method", "fd-forward", "--discrete", "0.05"]),
+], ids=["discrete", "fd-central", "initial-fd-forward-discrete"])
+def test_linearize_options_equal_cli(options, flags, tmp_path):
+    stdout, _ = cli("linearize", CART, "--out", tmp_path, *flags)
+    lin = codyna.Study(CART).linearize(**options)
+    check_against_mat(lin, tmp_path / "cart_pendulum.mat")
+    if "discrete" in options:
+        assert lin.Ts == options["discrete"]
+    assert lin.method == options.get("method", "exact")
+
+
+def test_hold_dict_is_exact(tmp_path):
+    # a dict's values go to the core with 17 significant digits: the same double as the flag's
+    value = 0.1 + 0.2  # 0.30000000000000004
+    cli("linearize", PENDULUM, "--out", tmp_path, "--operating-point", "initial", "--hold", "pivot=%r" % value)
+    lin = codyna.Study(PENDULUM).linearize(operating_point="initial", hold={"pivot": value})
+    check_against_mat(lin, tmp_path / "pendulum.mat")
+    assert lin.operating_point["coordinates"]["pivot"] == value
+
+
+def test_plant_keywords_equal_cli(tmp_path):
+    cli("linearize", PENDULUM, "--out", tmp_path, "--outputs", "theta,tip_x", "--operating-point", "initial")
+    lin = codyna.Study(PENDULUM).linearize(outputs=["theta", "tip_x"], operating_point="initial")
+    check_against_mat(lin, tmp_path / "pendulum.mat")
+    assert lin.output_names == ["theta", "tip_x"]
+
+
+def test_trajectory_equals_cli(tmp_path):
+    cli("linearize", PENDULUM, "--out", tmp_path, "--trajectory", "0.5", "--trajectory-step", "0.05")
+    lin = codyna.Study(PENDULUM).linearize(trajectory=0.5, trajectory_step=0.05)
+    d = scipy.io.loadmat(tmp_path / "pendulum.mat")
+    assert lin.trajectory and len(lin.times) == 11
+    assert np.array_equal(lin.times, d["t"].ravel())
+    for key in ("A", "B", "C", "D"):
+        assert np.array_equal(getattr(lin, key), np.moveaxis(d[key].reshape(getattr(lin, key).shape[1:] + (-1,)), -1, 0)), key
+    for key in ("x0", "u0", "y0", "xdot0"):
+        assert np.array_equal(getattr(lin, key), d[key].T), key
+
+
+def test_closed_loop_equals_cli(tmp_path):
+    cli("linearize", CART, "--out", tmp_path, "--closed-loop", "--lqr")
+    lin = codyna.Study(CART).linearize(closed_loop=True, lqr=True)
+    check_against_mat(lin, tmp_path / "cart_pendulum.mat")
+    cl = lin.closed_loop
+    d = scipy.io.loadmat(tmp_path / "cart_pendulum_cl.mat")
+    for key in ("A", "B", "C", "D"):
+        assert same(getattr(cl, key), d[key + "cl"]), key
+    assert np.all(cl.poles().real < 0)
+    assert codyna.Study(CART).linearize().closed_loop is None
+
+
+def test_export_writes_the_cli_files(tmp_path):
+    cli("linearize", CART, "--out", tmp_path / "cli", "--closed-loop", "--lqr")
+    lin = codyna.Study(CART).linearize(closed_loop=True, lqr=True)
+    written = lin.export(tmp_path / "py")
+    assert [os.path.basename(p) for p in written] == [
+        "cart_pendulum.mat", "cart_pendulum.m", "cart_pendulum_cl.mat", "cart_pendulum_cl.m",
+        "cart_pendulum_cl_step.csv", "cart_pendulum_cl_freq.csv"]
+    for name in ("cart_pendulum.mat", "cart_pendulum_cl.mat"):
+        a, b = scipy.io.loadmat(tmp_path / "py" / name), scipy.io.loadmat(tmp_path / "cli" / name)
+        assert sorted(k for k in a if not k.startswith("__")) == sorted(k for k in b if not k.startswith("__"))
+        for k in a:
+            if k.startswith("__") or k == "info":
+                continue
+            if a[k].dtype.kind in "fiu":
+                assert a[k].shape == b[k].shape and np.array_equal(a[k], b[k]), (name, k)
+            else:
+                assert str(a[k]) == str(b[k]), (name, k)
+    for name in ("cart_pendulum.m", "cart_pendulum_cl.m", "cart_pendulum_cl_step.csv", "cart_pendulum_cl_freq.csv"):
+        assert (tmp_path / "py" / name).read_text() == (tmp_path / "cli" / name).read_text(), name
+    check_against_mat(lin, written[0])
+
+
+def test_export_refuses_to_replace_the_model(tmp_path):
+    model = tmp_path / "pendulum.json"
+    model.write_text(open(PENDULUM).read())
+    lin = codyna.Study(model).linearize(name="pendulum")
+    (tmp_path / "pendulum.m").write_text("% a user's script\n")
+    with pytest.raises(ValueError):
+        lin.export(tmp_path)
+    assert (tmp_path / "pendulum.m").read_text() == "% a user's script\n"
+
+
+def test_from_json_equals_file():
+    text = open(PENDULUM).read()
+    a = codyna.Study(PENDULUM).linearize()
+    b = codyna.Study.from_json(text).linearize()
+    for key in ("A", "B", "C", "D", "x0", "u0", "y0", "xdot0"):
+        assert np.array_equal(getattr(a, key), getattr(b, key)), key
+
+
+def test_model_info():
+    info = codyna.Study(CART).model_info()
+    assert info["name"] == "cart_pendulum" and info["dof"] == 2
+    assert [b["name"] for b in info["bodies"]] == ["cart", "rod"] or len(info["bodies"]) == 2
+    assert info["plant_inputs"] == ["force"]
+    assert info["plant_outputs"] == ["h", "theta"]
+    assert [a["name"] for a in info["actuators"]] == ["force"]
+    assert [s["name"] for s in info["sensors"]] == ["h", "theta", "h_dot", "theta_dot"]
+    assert len(info["coordinates"]) == 2 and len(info["rates"]) == 2
+    assert info["controller"] == "lqr"
+    four_bar = codyna.Study(os.path.join(SOURCE_DIR, "examples", "four_bar.json")).model_info()
+    assert four_bar["constraints"] and four_bar["dof"] == 1
+
+
+# ---------------------------------------------------------------------------- errors
+
+def test_bad_field_raises_model_error(tmp_path):
+    model = json.load(open(PENDULUM))
+    model["bodies"][0]["mass"] = -10.0
+    path = tmp_path / "negative_mass.json"
+    path.write_text(json.dumps(model))
+    _, stderr = cli("linearize", path, "--out", tmp_path / "out", expect=1)
+    with pytest.raises(codyna.ModelError) as e:
+        codyna.Study(path).linearize()
+    assert isinstance(e.value, ValueError)
+    message = str(e.value)
+    assert "/bodies/0/mass" in message and "negative_mass.json" in message, message
+    assert e.value.path == "/bodies/0/mass" and e.value.file == str(path)
+    assert stderr.strip() == "codyna: error: " + message  # the CLI's message
+    assert not (tmp_path / "out").exists()
+
+
+def test_malformed_json_raises_model_error():
+    with pytest.raises(codyna.ModelError) as e:
+        codyna.Study.from_json('{"codyna_model": 1, "bodies": [}')
+    assert "<json>" in str(e.value)
+
+
+def test_failed_trim_raises_convergence_error(tmp_path):
+    model = os.path.join(SOURCE_DIR, "tests", "data", "trim_underactuated.json")
+    _, stderr = cli("linearize", model, "--operating-point", "trim", "--out", tmp_path, expect=2)
+    with pytest.raises(codyna.ConvergenceError) as e:
+        codyna.Study(model).linearize(operating_point="trim")
+    assert isinstance(e.value, RuntimeError)
+    assert "/analysis/operating_point: trim: not converged" in str(e.value)
+    assert stderr.strip() == "codyna: error: " + str(e.value)
+
+
+def test_unknown_keyword_raises_type_error():
+    study = codyna.Study(PENDULUM)
+    with pytest.raises(TypeError, match="operating_pont"):
+        study.linearize(operating_pont="initial")
+    with pytest.raises(TypeError, match="t_ned"):
+        study.simulate(t_ned=1)
+    with pytest.raises(TypeError, match="discrete"):
+        study.linearize(discrete="0.01")  # a str where a number goes
+
+
+def test_bad_values_name_the_keyword():
+    study = codyna.Study(PENDULUM)
+    with pytest.raises(ValueError, match="^discrete"):
+        study.linearize(discrete=-1)
+    with pytest.raises(ValueError, match="method"):
+        study.linearize(method="exactly")
+    with pytest.raises(ValueError, match="inputs"):
+        study.linearize(inputs=["nothing"])
+    with pytest.raises(ValueError, match="t_end"):
+        study.simulate(t_end=-1)
+    with pytest.raises(ValueError, match="hold"):
+        study.linearize(hold={"pivot": float("nan")})
+
+
+# ---------------------------------------------------------------------------- simulate
+
+def read_h5(path):
+    """Every dataset of an HDF5 file, by path."""
+    out = {}
+    with h5py.File(path, "r") as f:
+        def visit(name, obj):
+            if isinstance(obj, h5py.Dataset):
+                out[name] = obj[()]
+        f.visititems(visit)
+        out["@status"] = dict(f["status"].attrs)
+    return out
+
+
+@pytest.fixture(scope="module")
+def cart_lqr(tmp_path_factory):
+    """The cart-pendulum's closed loop with an LQR for 2 s: the CLI's HDF5 and the module's run."""
+    d = tmp_path_factory.mktemp("cart_lqr")
+    stdout, _ = cli("simulate", CART, "--lqr", "--t-end", "2", "--quiet", "--out", d / "cli.h5", "--csv", d / "cli.csv")
+    run = codyna.Study(CART).simulate(lqr=True, t_end=2)
+    return d, stdout, run
+
+
+def test_closed_loop_simulation_equals_cli(cart_lqr):
+    d, _, run = cart_lqr
+    ref = read_h5(d / "cli.h5")
+    assert run.completed and run.failure == ""
+    assert np.array_equal(run.t, ref["time"])
+    for key in ("q", "v", "u", "y", "xc"):
+        assert same(getattr(run, key), ref[key]), key
+    assert np.array_equal(run.x, np.hstack([ref["q"], ref["v"]]))
+    assert run.output_names == [s.decode() for s in ref["names/outputs"]]
+    assert run.x_names == [s.decode() for s in ref["names/q"]] + [s.decode() for s in ref["names/v"]]
+    assert run.y_linear is None
+    assert run.t[-1] == 2.0
+
+
+def test_lqr_gain_is_the_clis(cart_lqr):
+    _, stdout, run = cart_lqr
+    line = [l for l in stdout.splitlines() if l.startswith("K(force) = [")][0]
+    K = np.array([float(x) for x in line[len("K(force) = ["):-1].split()])
+    assert np.array_equal(run.lqr_gain.ravel(), K)  # printed with 17 digits: exact
+    assert run.controller_source == "lqr"
+    assert np.all(run.lqr_poles.real < 0)
+
+
+def test_save_writes_the_cli_hdf5(cart_lqr, tmp_path):
+    d, _, run = cart_lqr
+    run.save(tmp_path / "py.h5", csv=tmp_path / "py.csv")
+    a, b = read_h5(tmp_path / "py.h5"), read_h5(d / "cli.h5")
+    assert sorted(a) == sorted(b)
+    for key in a:
+        if isinstance(a[key], np.ndarray) and a[key].dtype.kind == "f":
+            assert a[key].shape == b[key].shape and np.array_equal(a[key], b[key]), key
+        else:
+            assert str(a[key]) == str(b[key]), key
+    assert (tmp_path / "py.csv").read_text() == (d / "cli.csv").read_text()
+
+
+def test_save_refuses_to_replace_the_model(cart_lqr, tmp_path):
+    _, _, run = cart_lqr
+    with pytest.raises(ValueError):
+        run.save(CART)
+    (tmp_path / "notes.h5").write_text("not codyna's")
+    with pytest.raises(ValueError):
+        run.save(tmp_path / "notes.h5")
+    assert (tmp_path / "notes.h5").read_text() == "not codyna's"
+
+
+def test_compare_linear_equals_cli(tmp_path):
+    cli("simulate", PENDULUM, "--compare-linear", "--t-end", "1", "--quiet", "--out", tmp_path / "cli.h5")
+    run = codyna.Study(PENDULUM).simulate(compare_linear=True, t_end=1)
+    ref = read_h5(tmp_path / "cli.h5")
+    assert np.array_equal(run.y, ref["y"]) and np.array_equal(run.y_linear, ref["y_linear"])
+    gap = run.linear_gap
+    assert gap["max_abs"]["theta"] == np.abs(run.y[:, 0] - run.y_linear[:, 0]).max()
+
+
+def test_ctrl_c_interrupts_a_simulation():
+    # a run of hours (the double pendulum, open loop, 20000 s), interrupted after a second
+    child = r"""
+import sys, time, codyna
+study = codyna.Study(sys.argv[1])
+print("start", flush=True)
+t0 = time.monotonic()
+try:
+    study.simulate(open_loop=True, t_end=20000)
+    print("completed")
+except KeyboardInterrupt:
+    print("interrupted after %.3f s" % (time.monotonic() - t0), flush=True)
+"""
+    model = os.path.join(SOURCE_DIR, "examples", "double_pendulum.json")
+    p = subprocess.Popen([sys.executable, "-c", child, model], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert p.stdout.readline().strip() == "start"
+    time.sleep(1.0)
+    sent = time.monotonic()
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate(timeout=60)
+    waited = time.monotonic() - sent
+    assert p.returncode == 0, err
+    assert out.startswith("interrupted after"), out + err
+    assert waited < 2.0, waited
+
+
+# ---------------------------------------------------------------------------- control
+
+def test_lqr_against_scipy():
+    lin = codyna.Study(CART).linearize()
+    A, B = lin.A, lin.B
+    Q, R = np.diag([10.0, 100.0, 1.0, 1.0]), np.array([[0.01]])
+    K, X, poles = codyna.lqr(A, B, Q, R)
+    X_scipy = scipy.linalg.solve_continuous_are(A, B, Q, R)
+    K_scipy = np.linalg.solve(R, B.T @ X_scipy)
+    assert np.abs(K - K_scipy).max() <= 1e-9 * np.abs(K_scipy).max()
+    assert np.abs(X - X_scipy).max() <= 1e-9 * np.abs(X_scipy).max()
+    assert np.allclose(np.sort_complex(poles), np.sort_complex(np.linalg.eigvals(A - B @ K)), rtol=1e-9, atol=0)
+    Kd, _, pd = codyna.lqr(scipy.linalg.expm(A * 0.01), B * 0.01, Q, R, discrete=True)
+    assert np.all(np.abs(pd) < 1)
+    with pytest.raises(ValueError):
+        codyna.lqr(A, B, Q[:2, :2], R)
+
+
+def test_place():
+    lin = codyna.Study(CART).linearize()
+    A, B = lin.A, lin.B
+    poles = np.array([-1.0, -2.0, -3.0 + 1.0j, -3.0 - 1.0j])
+    K = codyna.place(A, B, poles)
+    assert K.shape == (1, 4)
+    got = np.sort_complex(np.linalg.eigvals(A - B @ K))
+    assert np.allclose(got, np.sort_complex(poles), rtol=1e-8, atol=1e-8), got
+
+
+# ---------------------------------------------------------------------------- the example
+
+def test_example_script_writes_its_png(tmp_path):
+    script = os.path.join(SOURCE_DIR, "examples", "python", "cart_pendulum_lqr.py")
+    png = tmp_path / "cart_pendulum_lqr.png"
+    p = subprocess.run([sys.executable, script, str(png)], capture_output=True, text=True, cwd=tmp_path,
+                       env=dict(os.environ, MPLBACKEND="Agg"), timeout=300)
+    assert p.returncode == 0, p.stdout + p.stderr
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 20000
+    assert "K =" in p.stdout and "closed-loop poles" in p.stdout and "max |y - y_lin|" in p.stdout, p.stdout
