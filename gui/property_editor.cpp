@@ -32,7 +32,7 @@ const QStringList kBodyRefs{"parent", "child", "body", "body_a", "body_b", "fram
 QStringList type_names(ElementKind k) {
   switch (k) {
     case ElementKind::Joint: return {"revolute", "prismatic", "fixed", "spherical", "universal", "cylindrical", "planar", "free"};
-    case ElementKind::Constraint: return {"ball", "revolute", "planar_revolute"};
+    case ElementKind::Constraint: return {"ball", "revolute", "planar_revolute", "coupler"};
     case ElementKind::Effect: return {"gravity", "spring_damper", "joint_spring_damper", "joint_friction", "joint_damper", "body_force"};
     case ElementKind::Actuator: return {"joint_force", "body_force", "body_torque"};
     case ElementKind::Sensor: return {"joint_position", "joint_velocity", "point_position", "point_velocity", "body_angle", "distance"};
@@ -132,7 +132,8 @@ json rotation_value(const QString& text) {
 
 // Fields that are empty by default (a number that may be left out: an actuator's limits)
 bool is_clearable(ElementKind k, const QString& key) {
-  return k == ElementKind::Actuator && (key == QLatin1String("min") || key == QLatin1String("max"));
+  return (k == ElementKind::Actuator && (key == QLatin1String("min") || key == QLatin1String("max"))) ||
+         (k == ElementKind::Constraint && key == QLatin1String("offset"));
 }
 
 // The element as the editor shows it: what the model file writes, and every optional
@@ -164,6 +165,13 @@ json shown_element(const ModelSpec& spec, ElementKind k, int index) {
       break;
     case ElementKind::Sensor:
       if (!e.contains("unit")) e["unit"] = "";
+      break;
+    case ElementKind::Constraint:
+      if (spec.constraints[index].type == ConstraintType::Coupler) {
+        if (!e.contains("joint_c")) e["joint_c"] = "";
+        if (!e.contains("ratio_c")) e["ratio_c"] = 0.0;
+        if (!e.contains("offset")) e["offset"] = nullptr;
+      }
       break;
     default: break;
   }
@@ -214,6 +222,15 @@ QString PropertyEditor::fieldHelp(ElementKind kind, const QString& key, const QS
       {"radius", "Radius"},
       {"length", "Length along the shape frame's z"},
       {"color", "Colour: red, green, blue, alpha in 0..1"},
+      {"axis_a", "Axis on the first body, in its frame"},
+      {"axis_b", "Axis on the second body, in its frame"},
+      {"joint_a", "Coupler: first joint (revolute or prismatic)"},
+      {"joint_b", "Coupler: second joint (revolute or prismatic)"},
+      {"joint_c", "Coupler: an optional third joint (a differential; empty: none)"},
+      {"ratio_a", "Coupler: ratio_a q_a + ratio_b q_b + ratio_c q_c = offset"},
+      {"ratio_b", "Coupler: the second joint's ratio (a gear N:1 is ratio_a 1, ratio_b -N)"},
+      {"ratio_c", "Coupler: the third joint's ratio (0 without a third joint)"},
+      {"offset", "Coupler: the relation's constant (empty: the joints' q0 satisfy it)"},
   };
   const auto it = meaning.find(key.section('/', -1));
   QString text = it == meaning.end() ? QString(key).replace('/', '.') : it->second;
@@ -436,10 +453,11 @@ void PropertyEditor::rebuild() {
         if (isCurrent(key, c)) applyText(key, c->currentText());
       });
       editor = c;
-    } else if (v.is_string() && (kBodyRefs.contains(last) || last == "joint")) {
+    } else if (v.is_string() && (kBodyRefs.contains(last) || last == "joint" || last.startsWith("joint_"))) {
+      const bool joint_ref = last == "joint" || last.startsWith("joint_");
       auto* c = new QComboBox;
       c->setEditable(true);
-      c->addItems(last == "joint" ? joints : bodies);
+      c->addItems(joint_ref ? joints : bodies);
       // the entry itself when it is one (so that arrow keys step from it), else the text as typed
       const int at = c->findText(qs(v.get<std::string>()));
       if (at >= 0) c->setCurrentIndex(at);

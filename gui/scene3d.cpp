@@ -364,6 +364,7 @@ void Scene::build(const Model* model) {
   for (int i = 1; i < m.nbodies; ++i)
     if (m.parent[i] == 0) anchor(m.joints[i].X_PF.p, m.joints[i].X_PF.R, anchorSize(i, m.joints[i].X_CM.p));
   for (const ConstraintModel& c : m.constraints) {
+    if (c.type == ConstraintType::Coupler) continue;  // couples coordinates, at no point
     if (c.body_a == 0) anchor(c.point_a, Eigen::Matrix3d::Identity(), anchorSize(c.body_b, c.point_b));
     if (c.body_b == 0) anchor(c.point_b, Eigen::Matrix3d::Identity(), anchorSize(c.body_a, c.point_a));
   }
@@ -452,6 +453,7 @@ void Scene::addDefaultLook(int i) {
   for (int c = i + 1; c < m.nbodies; ++c)
     if (m.parent[c] == i) ends.push_back(m.joints[c].X_PF.p);
   for (const ConstraintModel& c : m.constraints) {
+    if (c.type == ConstraintType::Coupler) continue;
     if (c.body_a == i) ends.push_back(c.point_a);
     if (c.body_b == i) ends.push_back(c.point_b);
   }

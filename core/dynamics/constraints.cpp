@@ -46,10 +46,29 @@ Attached<S> attached(const DataT<S>& d, int body, const Eigen::Vector3d& local, 
   return {xc, xd, xdd};
 }
 
+// a coupler's row: sum_k ratio_k q_k - offset; Jc holds the ratios, gamma is zero
 template <class S>
-void fill_rows(const Model& model, DataT<S>& d, bool with_velocity, Eigen::Index nd) {
+void coupler_row(const ConstraintModel& c, DataT<S>& d, const VecXT<S>& q, bool with_velocity, Eigen::Index nd) {
+  S phi = ad_coherent(S(-c.offset), nd);
+  for (int k = 0; k < c.ncoupled; ++k) {
+    const S term = ad_coherent(S(c.ratio[k] * q[c.iq[k]]), nd);
+    phi = phi + term;
+  }
+  d.phi[c.row] = phi;
+  if (!with_velocity) return;
+  for (Eigen::Index j = 0; j < d.Jc.cols(); ++j) d.Jc(c.row, j) = ad_coherent(S(0), nd);
+  for (int k = 0; k < c.ncoupled; ++k) d.Jc(c.row, c.iv[k]) = ad_coherent(S(c.ratio[k]), nd);
+  d.gamma[c.row] = ad_coherent(S(0), nd);
+}
+
+template <class S>
+void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool with_velocity, Eigen::Index nd) {
   auto coh = [nd](auto& m) { ad_make_coherent(m, nd); };
   for (const ConstraintModel& c : model.constraints) {
+    if (c.type == ConstraintType::Coupler) {
+      coupler_row<S>(c, d, q, with_velocity, nd);
+      continue;
+    }
     const Vec3T<S> pa = point_position<S>(d, c.body_a, c.point_a), pb = point_position<S>(d, c.body_b, c.point_b);
     const Vec3T<S> dp = pa - pb;
     Vec3T<S> dpd, dpdd;
@@ -127,6 +146,7 @@ void fill_rows(const Model& model, DataT<S>& d, bool with_velocity, Eigen::Index
           ++r;
         }
         break;
+      case ConstraintType::Coupler: break;  // coupler_row
     }
   }
 }
@@ -136,7 +156,7 @@ void fill_rows(const Model& model, DataT<S>& d, bool with_velocity, Eigen::Index
 template <class S>
 const VecXT<S>& constraint_residual(const Model& model, DataT<S>& d, const VecXT<S>& q) {
   forward_kinematics<S>(model, d, q);
-  fill_rows<S>(model, d, false, ad_size(q));
+  fill_rows<S>(model, d, q, false, ad_size(q));
   return d.phi;
 }
 
@@ -144,7 +164,7 @@ template <class S>
 void constraint_terms(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>& v) {
   if (d.zero_v.size() != model.nv) d.zero_v = VecXT<S>::Zero(model.nv);
   forward_kinematics<S>(model, d, q, v, d.zero_v);
-  fill_rows<S>(model, d, true, std::max(ad_size(q), ad_size(v)));
+  fill_rows<S>(model, d, q, true, std::max(ad_size(q), ad_size(v)));
 }
 
 #define CODYNA_INSTANTIATE(S)                                                                           \

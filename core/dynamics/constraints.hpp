@@ -4,6 +4,7 @@
 //   revolute         ball rows, then a . b1, a . b2            (a = axis_a on body_a,
 //                                                               b1, b2 perpendicular to axis_b on body_b)
 //   planar_revolute  e1 . (p_a - p_b), e2 . (p_a - p_b)         (e1, e2 perpendicular to axis_a, on body_a)
+//   coupler          sum_k ratio_k q_k - offset                  (scalar joint coordinates, 1 row; Jc constant)
 // constraint_residual(q):   writes liMi, oMi, Sb, phi.
 // constraint_terms(q, v):   + v, cJ, a (at qdd = 0), Jc = d phi/dq (tangent), gamma = dJc/dt v,
 //                           so that d2/dt2 phi = Jc qdd + gamma.

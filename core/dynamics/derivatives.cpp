@@ -700,7 +700,7 @@ void TreeDerivatives::chain_constraint_row(int row, const Grad36& gc, const Grad
 }
 
 // the loop closures: reactions -Jc^T lambda into Q and dQ_dq, and the rows' derivatives
-void TreeDerivatives::constraint_derivatives(const Eigen::VectorXd& lambda) {
+void TreeDerivatives::constraint_derivatives(const Eigen::VectorXd& lambda, const Eigen::VectorXd& a) {
   Jc.setZero();
   dc_dq.setZero();
   dc_dv.setZero();
@@ -720,6 +720,18 @@ void TreeDerivatives::constraint_derivatives(const Eigen::VectorXd& lambda) {
   Vec6 w;
   Eigen::Matrix<double, 6, 24> dw;
   for (const ConstraintModel& cm : m_.constraints) {
+    if (cm.type == ConstraintType::Coupler) {
+      // sum_k ratio_k q_k = offset: Jc is the ratios, c = Jc a, and the reaction -Jc^T lambda acts on
+      // the coordinates themselves; nothing here depends on q or v
+      double value = 0;
+      for (int k = 0; k < cm.ncoupled; ++k) {
+        Jc(cm.row, cm.iv[k]) = cm.ratio[k];
+        Q[cm.iv[k]] -= cm.ratio[k] * lambda[cm.row];
+        value += cm.ratio[k] * a[cm.iv[k]];
+      }
+      c[cm.row] = value;
+      continue;
+    }
     const int ba = cm.body_a, bb = cm.body_b;
     const LocalKin xa = kin(ba, cm.point_a, false), xb = kin(bb, cm.point_b, false);
     int r = cm.row;
@@ -826,6 +838,7 @@ void TreeDerivatives::constraint_derivatives(const Eigen::VectorXd& lambda) {
         }
         break;
       }
+      case ConstraintType::Coupler: break;  // above
     }
   }
 }
@@ -841,7 +854,7 @@ void TreeDerivatives::compute_constrained(const Eigen::VectorXd& q, const Eigen:
   forces();
   differentiate_rnea();
   applied_force_derivatives(q, v, u_all);
-  constraint_derivatives(lambda);
+  constraint_derivatives(lambda, a);
   mass_matrix();
   llt_.compute(M);
   if (llt_.info() != Eigen::Success)

@@ -120,7 +120,7 @@ class TreeDerivatives {
   void add_body_wrench(int body, const Vec6T<double>& w, const Eigen::Matrix<double, 6, 24>& dw, int body_a,
                        int body_b);
   void sensor_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const std::vector<int>& outputs);
-  void constraint_derivatives(const Eigen::VectorXd& lambda);
+  void constraint_derivatives(const Eigen::VectorXd& lambda, const Eigen::VectorXd& a);
   // one constraint row's local derivatives (36 = [pose, V, A] of body_a then body_b), chained
   void chain_constraint_row(int row, const Eigen::Matrix<double, 36, 1>& gc, const Eigen::Matrix<double, 36, 1>& gp,
                             int body_a, int body_b);

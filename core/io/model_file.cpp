@@ -726,7 +726,16 @@ const Schema<ConstraintSpec>& schema<ConstraintSpec>() {
           {name_field<ConstraintSpec>(), type_field<ConstraintSpec>("constraint type", constraint_type_from_string)},
           point_pair_fields<ConstraintSpec>(),
           {field("axis_a", &ConstraintSpec::axis_a, read_direction),
-           field("axis_b", &ConstraintSpec::axis_b, read_direction)},
+           field("axis_b", &ConstraintSpec::axis_b, read_direction),
+           field("joint_a", &ConstraintSpec::joint_a, read_string, Need::Required),
+           field("joint_b", &ConstraintSpec::joint_b, read_string, Need::Required),
+           field("joint_c", &ConstraintSpec::joint_c, read_string,
+                 [](const std::string& s) { return s.empty() ? ojson() : ojson(s); }),
+           field("ratio_a", &ConstraintSpec::ratio_a, read_number, Need::Required),
+           field("ratio_b", &ConstraintSpec::ratio_b, read_number, Need::Required),
+           field("ratio_c", &ConstraintSpec::ratio_c, read_number,
+                 [](double r) { return r == 0 ? ojson() : ojson(r); }),
+           field("offset", &ConstraintSpec::offset, [](const Node& n) { return std::optional<double>(read_number(n)); })},
       }),
       "constraint",
       [](const ConstraintSpec& c) {
@@ -734,6 +743,8 @@ const Schema<ConstraintSpec>& schema<ConstraintSpec>() {
           case ConstraintType::Ball: return element_keys(point_pair_and({}));
           case ConstraintType::Revolute: return element_keys(point_pair_and({"axis_a", "axis_b"}));
           case ConstraintType::PlanarRevolute: return element_keys(point_pair_and({"axis_a"}));
+          case ConstraintType::Coupler:
+            return element_keys({"joint_a", "ratio_a", "joint_b", "ratio_b", "joint_c", "ratio_c", "offset"});
         }
         return element_keys({});
       }};

@@ -319,6 +319,15 @@ class Compiler {
       ConstraintModel c;
       c.name = cs.name;
       c.type = cs.type;
+      if (cs.type == ConstraintType::Coupler) {
+        coupler(cs, p, c);
+        c.row = row;
+        c.nrows = 1;
+        m_.row_names.push_back(c.name);
+        row += 1;
+        m_.constraints.push_back(c);
+        continue;
+      }
       c.body_a = body(cs.body_a, p + "/body_a");
       c.body_b = body(cs.body_b, p + "/body_b");
       if (c.body_a == c.body_b) fail(p + "/body_b", "expected two different bodies");
@@ -343,6 +352,41 @@ class Compiler {
       m_.constraints.push_back(c);
     }
     m_.nc = row;
+  }
+
+  // a coupler's joints: scalar coordinates (revolute, prismatic), two or three different ones,
+  // finite ratios, at least two of them non-zero
+  void coupler(const ConstraintSpec& cs, const std::string& p, ConstraintModel& c) {
+    const std::string* names[3] = {&cs.joint_a, &cs.joint_b, &cs.joint_c};
+    const double ratios[3] = {cs.ratio_a, cs.ratio_b, cs.ratio_c};
+    const char* keys[3] = {"joint_a", "joint_b", "joint_c"};
+    const char* ratio_keys[3] = {"ratio_a", "ratio_b", "ratio_c"};
+    int nonzero = 0;
+    for (int k = 0; k < 3; ++k) {
+      if (k == 2 && names[k]->empty()) {
+        if (ratios[k] != 0) fail(p + "/ratio_c", "a ratio_c needs a joint_c (or leave ratio_c at 0)");
+        break;
+      }
+      const int jb = joint(*names[k], p + "/" + keys[k]);
+      const JointModel& j = m_.joints[jb];
+      if (j.type != JointType::Revolute && j.type != JointType::Prismatic)
+        fail(p + "/" + keys[k], "a coupler relates scalar coordinates; " + quoted(j.name) + " is " + to_string(j.type) +
+                                    " (expected a revolute or prismatic joint)");
+      for (int i = 0; i < c.ncoupled; ++i)
+        if (c.iv[i] == j.idx_v) fail(p + "/" + keys[k], quoted(j.name) + " is coupled to itself (expected different joints)");
+      if (!std::isfinite(ratios[k])) fail(p + "/" + ratio_keys[k], "expected a finite ratio");
+      if (ratios[k] != 0) ++nonzero;
+      c.iq[c.ncoupled] = j.idx_q;
+      c.iv[c.ncoupled] = j.idx_v;
+      c.ratio[c.ncoupled] = ratios[k];
+      if (k == 0) c.body_a = jb;
+      if (k == 1) c.body_b = jb;
+      ++c.ncoupled;
+    }
+    if (nonzero < 2) fail(p + "/ratio_b", "a coupler needs at least two non-zero ratios (it would hold a joint still)");
+    if (cs.offset && !std::isfinite(*cs.offset)) fail(p + "/offset", "expected a finite number (or leave it out)");
+    c.offset_given = cs.offset.has_value();
+    c.offset = cs.offset.value_or(0.0);
   }
 
   void non_negative(double x, const std::string& path, const char* what) const {
@@ -570,6 +614,12 @@ class Compiler {
     }
     m_.q0 = q;
     m_.v0 = v;
+    // a coupler without an offset holds the joints as their q0 write them
+    for (ConstraintModel& c : m_.constraints) {
+      if (c.type != ConstraintType::Coupler || c.offset_given) continue;
+      c.offset = 0;
+      for (int k = 0; k < c.ncoupled; ++k) c.offset += c.ratio[k] * q[c.iq[k]];
+    }
   }
 
   const ModelSpec& spec_;

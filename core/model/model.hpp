@@ -36,6 +36,13 @@ struct ConstraintModel {
   Eigen::Vector3d perp_a1 = Eigen::Vector3d::UnitX(), perp_a2 = Eigen::Vector3d::UnitY();  // unit, body_a, perpendicular to axis_a
   Eigen::Vector3d perp_b1 = Eigen::Vector3d::UnitX(), perp_b2 = Eigen::Vector3d::UnitY();  // unit, body_b, perpendicular to axis_b
   int row = 0, nrows = 0;          // rows in the stacked constraint vector
+  // coupler: sum_k ratio[k] q[iq[k]] = offset over ncoupled scalar coordinates (iv[k] their
+  // velocity indices); body_a, body_b are the first two joints' child bodies (for messages)
+  int ncoupled = 0;
+  int iq[3] = {0, 0, 0}, iv[3] = {0, 0, 0};
+  double ratio[3] = {0, 0, 0};
+  double offset = 0;
+  bool offset_given = false;
 };
 
 struct SpringDamperModel {

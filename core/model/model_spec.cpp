@@ -29,10 +29,11 @@ constexpr std::array<std::pair<JointType, const char*>, 8> kJoints{{
     {JointType::Planar, "planar"},
     {JointType::Free, "free"},
 }};
-constexpr std::array<std::pair<ConstraintType, const char*>, 3> kConstraints{{
+constexpr std::array<std::pair<ConstraintType, const char*>, 4> kConstraints{{
     {ConstraintType::Ball, "ball"},
     {ConstraintType::Revolute, "revolute"},
     {ConstraintType::PlanarRevolute, "planar_revolute"},
+    {ConstraintType::Coupler, "coupler"},
 }};
 constexpr std::array<std::pair<EffectType, const char*>, 6> kEffects{{
     {EffectType::Gravity, "gravity"},

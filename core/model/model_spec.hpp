@@ -77,7 +77,7 @@ struct JointSpec {
 //   revolute         ball + axis_a (on body_a) stays parallel to axis_b (on body_b) (5)
 //   planar_revolute  the two points coincide in the plane normal to axis_a (2);
 //                    for planar mechanisms, whose loops would be redundant in 3-D
-enum class ConstraintType { Ball, Revolute, PlanarRevolute };
+enum class ConstraintType { Ball, Revolute, PlanarRevolute, Coupler };
 
 struct ConstraintSpec {
   std::string name;
@@ -87,6 +87,13 @@ struct ConstraintSpec {
   Eigen::Vector3d point_b = Eigen::Vector3d::Zero();  // body_b frame
   Eigen::Vector3d axis_a = Eigen::Vector3d::UnitZ();  // body_a frame (revolute, planar_revolute)
   Eigen::Vector3d axis_b = Eigen::Vector3d::UnitZ();  // body_b frame (revolute)
+  // coupler: a linear relation among two or three scalar joint coordinates (revolute, prismatic),
+  //   ratio_a q(joint_a) + ratio_b q(joint_b) + ratio_c q(joint_c) = offset
+  // (a gear, a belt, a rack and pinion, a disc rolling on a line, a differential); joint_c may be
+  // empty; without an offset, the joints' q0 as written satisfy it
+  std::string joint_a, joint_b, joint_c;
+  double ratio_a = 1, ratio_b = -1, ratio_c = 0;
+  std::optional<double> offset;
 };
 
 // Force elements. Only those listed in a model are ever evaluated.

@@ -46,6 +46,7 @@ void for_each_body_ref(ModelSpec& s, F&& f) {  // f(std::string& ref, const std:
     f(j.child, "joint " + j.name + ": child");
   }
   for (auto& c : s.constraints) {
+    if (c.type == ConstraintType::Coupler) continue;  // joints, not bodies
     f(c.body_a, "constraint " + c.name + ": body_a");
     f(c.body_b, "constraint " + c.name + ": body_b");
   }
@@ -78,6 +79,12 @@ void for_each_body_ref(ModelSpec& s, F&& f) {  // f(std::string& ref, const std:
 
 template <class F>
 void for_each_joint_ref(ModelSpec& s, F&& f) {
+  for (auto& c : s.constraints)
+    if (c.type == ConstraintType::Coupler) {
+      f(c.joint_a, "constraint " + c.name + ": joint_a");
+      f(c.joint_b, "constraint " + c.name + ": joint_b");
+      if (!c.joint_c.empty()) f(c.joint_c, "constraint " + c.name + ": joint_c");
+    }
   for (auto& e : s.effects)
     if (e.type == EffectType::JointSpringDamper || e.type == EffectType::JointFriction ||
         e.type == EffectType::JointDamper)
