@@ -8,7 +8,9 @@ PKGS=(
   build-essential cmake pkg-config
   libeigen3-dev libsundials-dev libhdf5-dev libmatio-dev
   nlohmann-json3-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
-  libmujoco-dev  # the MuJoCo peer test (tests/peers_mujoco); the build skips it without
+  libmujoco-dev  # the MuJoCo peer test (tests/peers_mujoco) and MJCF import; the build skips both without
+  libmujoco-samples  # MuJoCo's own MJCF models (/usr/share/mujoco/model): imported by the peer and CLI tests
+  liburdfdom-dev  # URDF import (core/io/import_urdf.cpp, the ROS parser); the build works without it
   libsimbody-dev  # the Simbody peer of the work-precision study (bench/simbody_*.cpp, peer.simbody_agrees)
   clang libclang-rt-14-dev  # the libFuzzer target (scripts/fuzz.sh): clang 14 with its fuzzer/sanitizer runtimes
   octave octave-control liboctave-dev python3 python3-scipy python3-h5py python3-numpy
