@@ -9,6 +9,7 @@ namespace codyna::cli {
 void add_info(CLI::App& app);
 void add_linearize(CLI::App& app);
 void add_simulate(CLI::App& app);
+void add_import(CLI::App& app);
 int exit_code();
 void set_exit_code(int code);
 
