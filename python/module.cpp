@@ -548,36 +548,40 @@ PYBIND11_MODULE(_codyna, m) {
   });
 
   py::class_<Study>(m, "_Study", "A model file as read (codyna.Study wraps it).")
-      .def(py::init(&study_from_file), "path"_a)
-      .def_static("from_json", &study_from_json, "text"_a, "base_dir"_a = ".")
-      .def_readonly("file", &Study::file)
-      .def_property_readonly("notes", [](const Study& s) { return s.spec->notes; })
-      .def("model_info", &model_info)
-      .def("to_json", [](const Study& s) { return study_model_json(*s.spec).dump(2); });
+      .def(py::init(&study_from_file), "path"_a, "Reads and checks a model file (ModelError names the file and the field).")
+      .def_static("from_json", &study_from_json, "text"_a, "base_dir"_a = ".",
+                  "A model from a JSON text; relative paths in it are relative to base_dir.")
+      .def_readonly("file", &Study::file, "the model file (or the label of a JSON text)")
+      .def_property_readonly("notes", [](const Study& s) { return s.spec->notes; }, "the model reader's notes")
+      .def("model_info", &model_info, "What `codyna info` shows, as a dict (see codyna.Study.model_info).")
+      .def("to_json", [](const Study& s) { return study_model_json(*s.spec).dump(2); },
+           "The model as the file format writes it (JSON text).");
 
-  m.def("_linearize", &do_linearize, "study"_a, "options"_a);
-  m.def("_simulate", &do_simulate, "study"_a, "options"_a);
+  m.def("_linearize", &do_linearize, "study"_a, "options"_a,
+        "study_linearize_job with the keywords given (a dict); codyna.Study.linearize documents them.");
+  m.def("_simulate", &do_simulate, "study"_a, "options"_a,
+        "study_simulate_job with the keywords given (a dict); codyna.Study.simulate documents them.");
 
   py::class_<ClosedLoopResult>(m, "ClosedLoop",
                                "The linear closed loop of the study's plant and controller (linearize(closed_loop=True)).\n"
                                "A, B, C, D are the command line's Acl, Bcl, Ccl, Dcl (NAME_cl.mat).")
-      .def_property_readonly("A", [](const ClosedLoopResult& c) { return c.system().A; })
-      .def_property_readonly("B", [](const ClosedLoopResult& c) { return c.system().B; })
-      .def_property_readonly("C", [](const ClosedLoopResult& c) { return c.system().C; })
-      .def_property_readonly("D", [](const ClosedLoopResult& c) { return c.system().D; })
-      .def_property_readonly("x0", [](const ClosedLoopResult& c) { return c.system().x0; })
-      .def_property_readonly("u0", [](const ClosedLoopResult& c) { return c.system().u0; })
-      .def_property_readonly("y0", [](const ClosedLoopResult& c) { return c.system().y0; })
-      .def_property_readonly("Ts", [](const ClosedLoopResult& c) { return c.system().Ts; })
-      .def_property_readonly("state_names", [](const ClosedLoopResult& c) { return c.system().state_names; })
-      .def_property_readonly("input_names", [](const ClosedLoopResult& c) { return c.system().input_names; })
-      .def_property_readonly("output_names", [](const ClosedLoopResult& c) { return c.system().output_names; })
-      .def_property_readonly("state_units", [](const ClosedLoopResult& c) { return c.system().state_units; })
-      .def_property_readonly("input_units", [](const ClosedLoopResult& c) { return c.system().input_units; })
-      .def_property_readonly("output_units", [](const ClosedLoopResult& c) { return c.system().output_units; })
+      .def_property_readonly("A", [](const ClosedLoopResult& c) { return c.system().A; }, "Acl (closed-loop states: the plant's deviations, then the controller's states)")
+      .def_property_readonly("B", [](const ClosedLoopResult& c) { return c.system().B; }, "Bcl (inputs: references dr = r - y0, then disturbances)")
+      .def_property_readonly("C", [](const ClosedLoopResult& c) { return c.system().C; }, "Ccl (outputs: the plant's outputs dy, then the efforts du)")
+      .def_property_readonly("D", [](const ClosedLoopResult& c) { return c.system().D; }, "Dcl")
+      .def_property_readonly("x0", [](const ClosedLoopResult& c) { return c.system().x0; }, "the closed loop's operating point (states)")
+      .def_property_readonly("u0", [](const ClosedLoopResult& c) { return c.system().u0; }, "its inputs' nominal values")
+      .def_property_readonly("y0", [](const ClosedLoopResult& c) { return c.system().y0; }, "its outputs' nominal values")
+      .def_property_readonly("Ts", [](const ClosedLoopResult& c) { return c.system().Ts; }, "sample time (0: continuous; > 0: a sampled controller around the plant's ZOH model)")
+      .def_property_readonly("state_names", [](const ClosedLoopResult& c) { return c.system().state_names; }, "names of the closed loop's states")
+      .def_property_readonly("input_names", [](const ClosedLoopResult& c) { return c.system().input_names; }, "names of its inputs")
+      .def_property_readonly("output_names", [](const ClosedLoopResult& c) { return c.system().output_names; }, "names of its outputs")
+      .def_property_readonly("state_units", [](const ClosedLoopResult& c) { return c.system().state_units; }, "units of its states")
+      .def_property_readonly("input_units", [](const ClosedLoopResult& c) { return c.system().input_units; }, "units of its inputs")
+      .def_property_readonly("output_units", [](const ClosedLoopResult& c) { return c.system().output_units; }, "units of its outputs")
       .def_property_readonly("controller", [](const ClosedLoopResult& c) { return c.cl().loop.controller; },
                              "the controller's description")
-      .def_property_readonly("controller_source", [](const ClosedLoopResult& c) { return c.cl().setup.controller_source; })
+      .def_property_readonly("controller_source", [](const ClosedLoopResult& c) { return c.cl().setup.controller_source; }, "where the controller came from: the model file's, lqr, a .mat")
       .def_property_readonly("sizes", [](const ClosedLoopResult& c) {
         const ClosedLoopLinear& l = c.cl().loop;
         return py::dict("nx"_a = l.nx, "nxc"_a = l.nxc, "nr"_a = l.nr, "nd"_a = l.nd, "ny"_a = l.ny, "nu"_a = l.nu);
@@ -598,7 +602,7 @@ PYBIND11_MODULE(_codyna, m) {
         std::vector<std::string> n = c.cl().setup.notes;
         n.insert(n.end(), c.cl().notes.begin(), c.cl().notes.end());
         return n;
-      });
+      }, "what the closed loop's setup and analysis said (the CLI's notes)");
 
   py::class_<LinearizationResult>(m, "Linearization",
                                   "What Study.linearize returns: the command line's A, B, C, D with their names and\n"
@@ -608,63 +612,63 @@ PYBIND11_MODULE(_codyna, m) {
       .def_property_readonly("A", [](const LinearizationResult& l) -> py::object {
         if (l.job->trajectory) return stacked(l.job->systems, [](const LinearSystem& s) -> const Eigen::MatrixXd& { return s.A; });
         return py::cast(l.system().A);
-      })
+      }, "A (nx x nx; stacked (N, nx, nx) along a trajectory): the matrices x' = A x + B u, y = C x + D u in deviations (x = x0 + dx, u = u0 + du, y = y0 + dy)")
       .def_property_readonly("B", [](const LinearizationResult& l) -> py::object {
         if (l.job->trajectory) return stacked(l.job->systems, [](const LinearSystem& s) -> const Eigen::MatrixXd& { return s.B; });
         return py::cast(l.system().B);
-      })
+      }, "B (nx x nu; stacked along a trajectory)")
       .def_property_readonly("C", [](const LinearizationResult& l) -> py::object {
         if (l.job->trajectory) return stacked(l.job->systems, [](const LinearSystem& s) -> const Eigen::MatrixXd& { return s.C; });
         return py::cast(l.system().C);
-      })
+      }, "C (ny x nx; stacked along a trajectory)")
       .def_property_readonly("D", [](const LinearizationResult& l) -> py::object {
         if (l.job->trajectory) return stacked(l.job->systems, [](const LinearSystem& s) -> const Eigen::MatrixXd& { return s.D; });
         return py::cast(l.system().D);
-      })
+      }, "D (ny x nu; stacked along a trajectory)")
       .def_property_readonly("x0", [](const LinearizationResult& l) -> py::object {
         if (l.job->trajectory) return stacked_vector(l.job->systems, [](const LinearSystem& s) -> const Eigen::VectorXd& { return s.x0; });
         return py::cast(l.system().x0);
-      })
+      }, "the operating point's state (nx; stacked (N, nx) along a trajectory)")
       .def_property_readonly("u0", [](const LinearizationResult& l) -> py::object {
         if (l.job->trajectory) return stacked_vector(l.job->systems, [](const LinearSystem& s) -> const Eigen::VectorXd& { return s.u0; });
         return py::cast(l.system().u0);
-      })
+      }, "the Plant/In values there (nu)")
       .def_property_readonly("y0", [](const LinearizationResult& l) -> py::object {
         if (l.job->trajectory) return stacked_vector(l.job->systems, [](const LinearSystem& s) -> const Eigen::VectorXd& { return s.y0; });
         return py::cast(l.system().y0);
-      })
+      }, "the Plant/Out values there (ny)")
       .def_property_readonly("xdot0", [](const LinearizationResult& l) -> py::object {
         if (l.job->trajectory)
           return stacked_vector(l.job->systems, [](const LinearSystem& s) -> const Eigen::VectorXd& { return s.xdot0; });
         return py::cast(l.system().xdot0);
-      })
+      }, "the state's derivative there (not 0 away from an equilibrium)")
       .def_property_readonly("Ts", [](const LinearizationResult& l) {
         return l.job->trajectory ? 0.0 : l.system().Ts;
       }, "the sample time (0: continuous)")
       .def_property_readonly("state_names", [](const LinearizationResult& l) {
         return l.job->trajectory ? (l.job->systems.empty() ? std::vector<std::string>() : l.job->systems[0].state_names)
                                  : l.system().state_names;
-      })
+      }, "names of the states, in the order of A's rows")
       .def_property_readonly("input_names", [](const LinearizationResult& l) {
         return l.job->trajectory ? (l.job->systems.empty() ? std::vector<std::string>() : l.job->systems[0].input_names)
                                  : l.system().input_names;
-      })
+      }, "Plant/In names, B's columns")
       .def_property_readonly("output_names", [](const LinearizationResult& l) {
         return l.job->trajectory ? (l.job->systems.empty() ? std::vector<std::string>() : l.job->systems[0].output_names)
                                  : l.system().output_names;
-      })
+      }, "Plant/Out names, C's rows")
       .def_property_readonly("state_units", [](const LinearizationResult& l) {
         return l.job->trajectory ? (l.job->systems.empty() ? std::vector<std::string>() : l.job->systems[0].state_units)
                                  : l.system().state_units;
-      })
+      }, "units of the states")
       .def_property_readonly("input_units", [](const LinearizationResult& l) {
         return l.job->trajectory ? (l.job->systems.empty() ? std::vector<std::string>() : l.job->systems[0].input_units)
                                  : l.system().input_units;
-      })
+      }, "units of the inputs")
       .def_property_readonly("output_units", [](const LinearizationResult& l) {
         return l.job->trajectory ? (l.job->systems.empty() ? std::vector<std::string>() : l.job->systems[0].output_units)
                                  : l.system().output_units;
-      })
+      }, "units of the outputs")
       .def_property_readonly("name", [](const LinearizationResult& l) { return l.job->name; }, "the export's NAME")
       .def_property_readonly("method", [](const LinearizationResult& l) { return l.job->method; },
                              "the Jacobians': exact, fd-forward or fd-central")
@@ -683,8 +687,8 @@ PYBIND11_MODULE(_codyna, m) {
         return operating_point_of(l.job->model, op, study_coordinates(l.job->model, op.q));
       }, "kind (initial, equilibrium, trim, time=T), t, residual, iterations, coordinates and rates by\n"
          "name, inputs (every actuator) by name, and q, v, u as arrays; None along a trajectory")
-      .def_property_readonly("notes", [](const LinearizationResult& l) { return l.job->notes; })
-      .def_property_readonly("warnings", [](const LinearizationResult& l) { return l.job->warnings; })
+      .def_property_readonly("notes", [](const LinearizationResult& l) { return l.job->notes; }, "notes for the user (what codyna linearize prints as notes)")
+      .def_property_readonly("warnings", [](const LinearizationResult& l) { return l.job->warnings; }, "warnings for the user (what codyna linearize prints as warnings)")
       .def("eigenvalues", [](const LinearizationResult& l) -> py::object {
         if (l.job->trajectory) throw py::attribute_error("along a trajectory: see max_real and min_real");
         return eigenvalues_of(l.job->modes);
@@ -703,7 +707,7 @@ PYBIND11_MODULE(_codyna, m) {
         if (!l.job->closed_loop) return py::none();
         return py::cast(ClosedLoopResult{l.job});
       }, "the linear closed loop (a ClosedLoop) with closed_loop=True, else None")
-      .def_property_readonly("trajectory", [](const LinearizationResult& l) { return l.job->trajectory; })
+      .def_property_readonly("trajectory", [](const LinearizationResult& l) { return l.job->trajectory; }, "True along a trajectory (linearize(trajectory=T))")
       .def_property_readonly("times", [](const LinearizationResult& l) -> py::object {
         if (!l.job->trajectory) return py::none();
         return vector_of(l.job->times);
@@ -716,7 +720,7 @@ PYBIND11_MODULE(_codyna, m) {
         if (!l.job->trajectory) return py::none();
         return py::cast(l.job->min_real);
       }, "along a trajectory: the smallest Re(eig A) per time")
-      .def_property_readonly("trajectory_controller", [](const LinearizationResult& l) { return l.job->trajectory_controller; })
+      .def_property_readonly("trajectory_controller", [](const LinearizationResult& l) { return l.job->trajectory_controller; }, "along a trajectory: the controller in the loop (\"open loop\" or its description)")
       .def("export", &export_linearization, "dir"_a,
            "export(dir) -> tuple of paths\n\n"
            "Writes what `codyna linearize MODEL --out dir` with the same options writes: dir/NAME.mat and\n"
@@ -755,28 +759,28 @@ PYBIND11_MODULE(_codyna, m) {
         if (s.job.result.u_disturbance.size() == 0) return py::none();
         return py::cast(s.job.result.u_disturbance);
       }, "d(t) added to each actuator (N x nu), None without disturbances")
-      .def_property_readonly("kinetic_energy", [](const SimulationRun& s) { return vector_of(s.job.result.kinetic_energy); })
-      .def_property_readonly("potential_energy", [](const SimulationRun& s) { return vector_of(s.job.result.potential_energy); })
-      .def_property_readonly("constraint_violation", [](const SimulationRun& s) { return vector_of(s.job.result.constraint_violation); })
-      .def_property_readonly("velocity_violation", [](const SimulationRun& s) { return vector_of(s.job.result.velocity_violation); })
-      .def_property_readonly("q_names", [](const SimulationRun& s) { return s.job.result.q_names; })
-      .def_property_readonly("v_names", [](const SimulationRun& s) { return s.job.result.v_names; })
+      .def_property_readonly("kinetic_energy", [](const SimulationRun& s) { return vector_of(s.job.result.kinetic_energy); }, "kinetic energy per sample (J)")
+      .def_property_readonly("potential_energy", [](const SimulationRun& s) { return vector_of(s.job.result.potential_energy); }, "potential energy per sample (J)")
+      .def_property_readonly("constraint_violation", [](const SimulationRun& s) { return vector_of(s.job.result.constraint_violation); }, "max |phi(q)| per sample (0 for trees)")
+      .def_property_readonly("velocity_violation", [](const SimulationRun& s) { return vector_of(s.job.result.velocity_violation); }, "max |Jc v| per sample")
+      .def_property_readonly("q_names", [](const SimulationRun& s) { return s.job.result.q_names; }, "names of q's columns")
+      .def_property_readonly("v_names", [](const SimulationRun& s) { return s.job.result.v_names; }, "names of v's columns")
       .def_property_readonly("x_names", [](const SimulationRun& s) {
         std::vector<std::string> n = s.job.result.q_names;
         n.insert(n.end(), s.job.result.v_names.begin(), s.job.result.v_names.end());
         return n;
-      })
-      .def_property_readonly("input_names", [](const SimulationRun& s) { return s.job.result.input_names; })
-      .def_property_readonly("output_names", [](const SimulationRun& s) { return s.job.result.output_names; })
-      .def_property_readonly("input_units", [](const SimulationRun& s) { return s.job.result.input_units; })
-      .def_property_readonly("output_units", [](const SimulationRun& s) { return s.job.result.output_units; })
-      .def_property_readonly("controller_state_names", [](const SimulationRun& s) { return s.job.result.controller_state_names; })
+      }, "q_names + v_names")
+      .def_property_readonly("input_names", [](const SimulationRun& s) { return s.job.result.input_names; }, "every actuator's name (u's columns)")
+      .def_property_readonly("output_names", [](const SimulationRun& s) { return s.job.result.output_names; }, "Plant/Out names (y's columns)")
+      .def_property_readonly("input_units", [](const SimulationRun& s) { return s.job.result.input_units; }, "units of u's columns")
+      .def_property_readonly("output_units", [](const SimulationRun& s) { return s.job.result.output_units; }, "units of y's columns")
+      .def_property_readonly("controller_state_names", [](const SimulationRun& s) { return s.job.result.controller_state_names; }, "names of xc's columns")
       .def_property_readonly("completed", [](const SimulationRun& s) { return s.job.result.completed; }, "reached t_end")
       .def_property_readonly("failure", [](const SimulationRun& s) { return s.job.result.failure; },
                              "a failed run: the time and reason (the samples up to it are kept); \"\" otherwise")
       .def_property_readonly("controller", [](const SimulationRun& s) { return s.job.result.controller; },
                              "the controller's description")
-      .def_property_readonly("controller_source", [](const SimulationRun& s) { return s.job.setup.controller_source; })
+      .def_property_readonly("controller_source", [](const SimulationRun& s) { return s.job.setup.controller_source; }, "\"the model file's ...\", \"lqr\", a .mat, or \"none\"")
       .def_property_readonly("lqr_gain", [](const SimulationRun& s) -> py::object {
         if (s.job.setup.lqr_gain.size() == 0) return py::none();
         return py::cast(s.job.setup.lqr_gain);
@@ -789,8 +793,8 @@ PYBIND11_MODULE(_codyna, m) {
         if (s.job.setup.linear_poles.size() == 0) return py::none();
         return py::cast(s.job.setup.linear_poles);
       }, "a linear controller: the linear closed loop's poles about the operating point, else None")
-      .def_property_readonly("linear_discrete", [](const SimulationRun& s) { return s.job.setup.linear_discrete; })
-      .def_property_readonly("linear_unstable", [](const SimulationRun& s) { return s.job.setup.linear_unstable; })
+      .def_property_readonly("linear_discrete", [](const SimulationRun& s) { return s.job.setup.linear_discrete; }, "the linear closed-loop poles are z (a sampled controller)")
+      .def_property_readonly("linear_unstable", [](const SimulationRun& s) { return s.job.setup.linear_unstable; }, "a linear closed-loop pole is unstable (the run is not refused for it)")
       .def_property_readonly("operating_point", [](const SimulationRun& s) -> py::object {
         const LinearPlant* plant = s.job.setup.plant.get();
         if (!plant) return py::none();
@@ -815,8 +819,8 @@ PYBIND11_MODULE(_codyna, m) {
                         "from_time"_a = named(s.job.result.output_names, s.job.linear_gap_from));
       }, "compare_linear=True: per output, the largest |y - y_linear|, that in % of the output's\n"
          "excursion, and the first time the gap passes 1 % (-1: never); else None")
-      .def_property_readonly("linear_failure", [](const SimulationRun& s) { return s.job.result.linear_failure; })
-      .def_property_readonly("linear_error_estimate", [](const SimulationRun& s) { return s.job.result.linear_error_estimate; })
+      .def_property_readonly("linear_failure", [](const SimulationRun& s) { return s.job.result.linear_failure; }, "why y_linear ends in NaN (an unstable linear loop), or \"\"")
+      .def_property_readonly("linear_error_estimate", [](const SimulationRun& s) { return s.job.result.linear_error_estimate; }, "max |y_linear - the same at 100x looser tolerances| (-1: not known)")
       .def_property_readonly("saturation", [](const SimulationRun& s) {
         py::list l;
         for (const Saturation& x : s.job.saturation)
@@ -830,15 +834,17 @@ PYBIND11_MODULE(_codyna, m) {
                         "error_test_failures"_a = x.error_test_failures, "nonlinear_iterations"_a = x.nonlinear_iterations,
                         "nonlinear_failures"_a = x.nonlinear_failures, "projections"_a = x.projections,
                         "restarts"_a = x.restarts, "wall_time"_a = x.wall_time, "integrator_choice"_a = x.integrator_choice);
-      })
-      .def_property_readonly("settings_json", [](const SimulationRun& s) { return s.job.result.settings_json; })
-      .def_property_readonly("notes", [](const SimulationRun& s) { return s.job.notes; })
-      .def_property_readonly("warnings", [](const SimulationRun& s) { return s.job.warnings; })
+      }, "the integrator's statistics (integrator, tolerances, steps, evaluations, wall_time ...)")
+      .def_property_readonly("settings_json", [](const SimulationRun& s) { return s.job.result.settings_json; }, "the run's settings as JSON text (what the HDF5 file's provenance holds)")
+      .def_property_readonly("notes", [](const SimulationRun& s) { return s.job.notes; }, "notes for the user (what codyna simulate prints as notes)")
+      .def_property_readonly("warnings", [](const SimulationRun& s) { return s.job.warnings; }, "warnings for the user (unstable linear loop, leaving the linear region ...)")
       .def("save", &save_simulation, "path"_a, "csv"_a = py::none(),
            "save(path, csv=None)\n\n"
            "Writes the results as `codyna simulate --out path [--csv csv]` does (HDF5, and CSV when csv\n"
            "is given; path may be None for CSV only), each atomically, refusing to replace the model,\n"
            "the controller file or a file codyna did not write.");
+
+  for (const char* name : {"ClosedLoop", "Linearization", "Simulation"}) m.attr(name).attr("__module__") = "codyna";
 
   m.def("lqr", &do_lqr, "A"_a, "B"_a, "Q"_a, "R"_a, "discrete"_a = false,
         "lqr(A, B, Q, R, discrete=False) -> (K, X, poles)\n\n"

@@ -391,7 +391,27 @@ except KeyboardInterrupt:
     waited = time.monotonic() - sent
     assert p.returncode == 0, err
     assert out.startswith("interrupted after"), out + err
+    assert float(out.split()[2]) < 5, out  # stopped about a second in (the whole run takes about 25 s)
     assert waited < 2.0, waited
+
+
+def test_a_simulation_releases_the_gil():
+    # another Python thread keeps running while a run of about a second goes on
+    import threading
+    study = codyna.Study(os.path.join(SOURCE_DIR, "examples", "double_pendulum.json"))
+    done, runs = threading.Event(), []
+    worker = threading.Thread(target=lambda: (runs.append(study.simulate(open_loop=True, t_end=1000)), done.set()))
+    start = time.monotonic()
+    worker.start()
+    beats = [start]
+    while not done.is_set():
+        beats.append(time.monotonic())
+    worker.join()
+    duration = time.monotonic() - start
+    gaps = np.diff(beats)
+    assert runs and runs[0].completed
+    assert duration > 0.3, duration  # long enough to tell
+    assert gaps.max() < 0.1 * duration, (gaps.max(), duration)  # never blocked for the run
 
 
 # ---------------------------------------------------------------------------- control
