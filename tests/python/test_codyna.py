@@ -391,8 +391,9 @@ except KeyboardInterrupt:
     waited = time.monotonic() - sent
     assert p.returncode == 0, err
     assert out.startswith("interrupted after"), out + err
-    assert float(out.split()[2]) < 5, out  # stopped about a second in (the whole run takes about 25 s)
-    assert waited < 2.0, waited
+    # stopped about a second in, not after the whole run (about 25 s alone; margins for a loaded machine)
+    assert float(out.split()[2]) < 8, out
+    assert waited < 5.0, waited
 
 
 def test_a_simulation_releases_the_gil():
