@@ -73,7 +73,10 @@ QVariant PlantListModel::data(const QModelIndex& index, int role) const {
     const ActuatorSpec& a = s.actuators[k];
     switch (index.column()) {
       case 0: return on ? QStringLiteral("u%1  %2").arg(index.row() + 1).arg(name) : name;
-      case 1: return QStringLiteral("%1 on %2").arg(to_string(a.type), qs(a.type == ActuatorType::JointForce ? a.joint : a.body));
+      case 1:
+        return QStringLiteral("%1 on %2").arg(to_string(a.type), qs(a.type == ActuatorType::JointForce  ? a.joint
+                                                                   : a.type == ActuatorType::LineForce ? a.body_a + " - " + a.body_b
+                                                                                                       : a.body));
       case 2: return qs(a.unit.empty() ? (a.type == ActuatorType::JointForce ? "N | N m" : a.type == ActuatorType::BodyTorque ? "N m" : "N") : a.unit);
       case 3: return a.u0;
       case 4: return limit_text(a.min);
@@ -88,7 +91,8 @@ QVariant PlantListModel::data(const QModelIndex& index, int role) const {
       case 1: return qs(to_string(x.type));
       case 2: return qs(x.unit);
       case 3: return qs(!x.joint.empty() && (x.type == SensorType::JointPosition || x.type == SensorType::JointVelocity) ? x.joint
-                        : x.type == SensorType::Distance ? x.body_a + " - " + x.body_b : x.body);
+                        : x.type == SensorType::Distance || x.type == SensorType::DistanceRate ? x.body_a + " - " + x.body_b
+                                                                                           : x.body);
     }
   }
   return {};

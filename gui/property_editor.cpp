@@ -34,8 +34,9 @@ QStringList type_names(ElementKind k) {
     case ElementKind::Joint: return {"revolute", "prismatic", "fixed", "spherical", "universal", "cylindrical", "planar", "free"};
     case ElementKind::Constraint: return {"ball", "revolute", "planar_revolute", "coupler"};
     case ElementKind::Effect: return {"gravity", "spring_damper", "joint_spring_damper", "joint_friction", "joint_damper", "body_force"};
-    case ElementKind::Actuator: return {"joint_force", "body_force", "body_torque"};
-    case ElementKind::Sensor: return {"joint_position", "joint_velocity", "point_position", "point_velocity", "body_angle", "distance"};
+    case ElementKind::Actuator: return {"joint_force", "body_force", "body_torque", "line_force"};
+    case ElementKind::Sensor:
+      return {"joint_position", "joint_velocity", "point_position", "point_velocity", "body_angle", "distance", "distance_rate"};
     default: return {};
   }
 }

@@ -531,11 +531,53 @@ void TreeDerivatives::applied_force_derivatives(const Eigen::VectorXd& q, const 
     wrench_value(a.point(f.point), F, T, w, dw);
     add_body_wrench(f.body, w, dw, f.body, 0);
   }
+  // a wrench per unit input on `body` into the input's column of dQ/du
+  auto input_wrench = [&](int body, const Vec6& wu, int k) {
+    if (body <= 0) return;
+    for (int pu : path_[body]) {
+      const Unit& up = units_[pu];
+      dQ_du.block(up.iv, k, up.n, 1).noalias() += S_[up.body].middleCols(up.iv - m_.joints[up.body].idx_v, up.n).transpose() * wu;
+    }
+  };
   for (int k = 0; k < m_.nu(); ++k) {
     const ActuatorModel& act = m_.actuators[k];
     if (act.type == ActuatorType::JointForce) {
       Q[act.iv] += act.gain * u[k];
       dQ_du(act.iv, k) += act.gain;
+      continue;
+    }
+    if (act.type == ActuatorType::LineForce) {
+      // as a spring-damper whose tension is T = -gain u (pushing apart): F = T n on x_a, -F on x_b,
+      // dF = T dn with dn = (I - n n^T) / L d(dp); per unit input, F_u = -gain n
+      const LocalKin a = local_kin(d_.oMi[act.body], V_[act.body], Vec6::Zero(), act.point, false, act.body > 0);
+      const LocalKin b = local_kin(d_.oMi[act.body_b], V_[act.body_b], Vec6::Zero(), act.point_b, false, act.body_b > 0);
+      const Vec3 dp = b.x - a.x;
+      const double L = dp.norm();
+      if (!(L > 1e-12)) continue;
+      const Vec3 n = dp / L;
+      const Vec3 Fu = -act.gain * n;
+      Vec6 wu;
+      wu << a.x.cross(Fu), Fu;
+      input_wrench(act.body, wu, k);
+      wu << -b.x.cross(Fu), -Fu;
+      input_wrench(act.body_b, wu, k);
+      if (u[k] == 0.0) continue;
+      Mat3x24 Dxa = Mat3x24::Zero(), Dxb = Mat3x24::Zero();
+      Dxa.leftCols<12>() = a.Dx.leftCols<12>();
+      Dxb.rightCols<12>() = b.Dx.leftCols<12>();
+      const Mat3x24 Dn = (Mat3::Identity() - n * n.transpose()) / L * (Dxb - Dxa);
+      const double T = -act.gain * u[k];
+      const Vec3 F = T * n;
+      const Mat3x24 DF = T * Dn;
+      const Mat3 Fx = skew<double>(F);
+      w << a.x.cross(F), F;
+      dw.topRows<3>().noalias() = skew<double>(a.x) * DF - Fx * Dxa;
+      dw.bottomRows<3>() = DF;
+      add_body_wrench(act.body, w, dw, act.body, act.body_b);
+      w << -b.x.cross(F), -F;
+      dw.topRows<3>().noalias() = Fx * Dxb - skew<double>(b.x) * DF;
+      dw.bottomRows<3>() = -DF;
+      add_body_wrench(act.body_b, w, dw, act.body, act.body_b);
       continue;
     }
     if (act.body == 0) continue;
@@ -604,6 +646,17 @@ void TreeDerivatives::sensor_derivatives(const Eigen::VectorXd& q, const Eigen::
         const BodyAD a = body_ad(d_.oMi[ba], V_[ba], 0, ba > 0);
         const BodyAD b = body_ad(d_.oMi[bb], V_[bb], 12, bb > 0);
         value = sqrt((b.point(s.point_b) - a.point(s.point_a)).squaredNorm());
+        break;
+      }
+      case SensorType::DistanceRate: {
+        ba = s.body_a;
+        bb = s.body_b;
+        const BodyAD a = body_ad(d_.oMi[ba], V_[ba], 0, ba > 0);
+        const BodyAD b = body_ad(d_.oMi[bb], V_[bb], 12, bb > 0);
+        const Vec3A xa = a.point(s.point_a), xb = b.point(s.point_b);
+        const Vec3A dp = xb - xa, dv = b.point_velocity(xb) - a.point_velocity(xa);
+        const AD L = sqrt(dp.squaredNorm());
+        value = L.value() > 1e-12 ? AD(dp.dot(dv) / L) : AD(0.0);
         break;
       }
       default:

@@ -82,6 +82,15 @@ const VecXT<S>& applied_forces(const Model& model, DataT<S>& d, const VecXT<S>& 
     const S value = S(a.gain) * u[k];
     if (a.type == ActuatorType::JointForce) {
       d.Q[a.iv] += value;
+    } else if (a.type == ActuatorType::LineForce) {
+      // along the line from a to b, pushing the points apart for value > 0; no direction where they meet
+      const Vec3T<S> dp = point_position<S>(d, a.body_b, a.point_b) - point_position<S>(d, a.body, a.point);
+      const S L = sqrt(dp.squaredNorm());
+      if (!(ad_value(L) > 1e-12)) continue;
+      const Vec3T<S> F = dp / L * value;
+      add_world_force<S>(d, a.body, a.point, Vec3T<S>(-F), zero3);
+      add_world_force<S>(d, a.body_b, a.point_b, F, zero3);
+      any_body_force = true;
     } else if (a.type == ActuatorType::BodyTorque) {
       Vec3T<S> T = a.direction.cast<S>() * value;
       if (!a.in_world) T = d.oMi[a.body].R * T;

@@ -35,6 +35,13 @@ S sensor_value(const Model& model, const DataT<S>& d, const SensorModel& s, cons
       const Vec3T<S> dp = point_position<S>(d, s.body_b, s.point_b) - point_position<S>(d, s.body_a, s.point_a);
       return sqrt(dp.squaredNorm());
     }
+    case SensorType::DistanceRate: {
+      const Vec3T<S> dp = point_position<S>(d, s.body_b, s.point_b) - point_position<S>(d, s.body_a, s.point_a);
+      const S L = sqrt(dp.squaredNorm());
+      if (!(ad_value(L) > 1e-12)) return S(0);
+      const Vec3T<S> dv = point_velocity<S>(d, s.body_b, s.point_b) - point_velocity<S>(d, s.body_a, s.point_a);
+      return S(dp.dot(dv)) / L;
+    }
   }
   return S(0);
 }

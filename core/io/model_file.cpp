@@ -798,6 +798,7 @@ const Schema<ActuatorSpec>& schema<ActuatorSpec>() {
            field("gain", &ActuatorSpec::gain, read_number), field("u0", &ActuatorSpec::u0, read_number),
            field("min", &ActuatorSpec::min, read_number), field("max", &ActuatorSpec::max, read_number),
            field("unit", &ActuatorSpec::unit, read_string, encode_optional_text)},
+          point_pair_fields<ActuatorSpec>(),
       }),
       "actuator",
       [](const ActuatorSpec& a) {
@@ -806,6 +807,7 @@ const Schema<ActuatorSpec>& schema<ActuatorSpec>() {
           case ActuatorType::JointForce: return element_keys({"joint", "dof"}, tail);
           case ActuatorType::BodyForce: return element_keys({"body", "point", "direction", "frame"}, tail);
           case ActuatorType::BodyTorque: return element_keys({"body", "direction", "frame"}, tail);
+          case ActuatorType::LineForce: return element_keys(point_pair_and({}), tail);
         }
         return element_keys({}, tail);
       }};
@@ -833,7 +835,8 @@ const Schema<SensorSpec>& schema<SensorSpec>() {
           case SensorType::PointPosition:
           case SensorType::PointVelocity: return element_keys({"body", "point", "component", "frame"}, {"unit"});
           case SensorType::BodyAngle: return element_keys({"body", "axis"}, {"unit"});
-          case SensorType::Distance: return element_keys(point_pair_and({}), {"unit"});
+          case SensorType::Distance:
+          case SensorType::DistanceRate: return element_keys(point_pair_and({}), {"unit"});
         }
         return element_keys({}, {"unit"});
       }};

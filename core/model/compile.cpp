@@ -493,6 +493,15 @@ class Compiler {
         check_dof(jb, s.dof, p + "/dof");
         a.iv = m_.joints[jb].idx_v + s.dof;
         a.unit = is_angular(m_.joints[jb].type, s.dof) ? "N m" : "N";
+      } else if (s.type == ActuatorType::LineForce) {
+        a.body = body(s.body_a, p + "/body_a");
+        a.body_b = body(s.body_b, p + "/body_b");
+        if (a.body == a.body_b) fail(p + "/body_b", "expected two different bodies");
+        if (!s.point_a.allFinite()) fail(p + "/point_a", "expected finite coordinates");
+        if (!s.point_b.allFinite()) fail(p + "/point_b", "expected finite coordinates");
+        a.point = s.point_a;
+        a.point_b = s.point_b;
+        a.unit = "N";
       } else {
         a.body = body(s.body, p + "/body", false);
         a.point = s.type == ActuatorType::BodyTorque ? Eigen::Vector3d::Zero() : s.point;
@@ -550,11 +559,12 @@ class Compiler {
           o.unit = "rad";
           break;
         case SensorType::Distance:
+        case SensorType::DistanceRate:
           o.body_a = body(s.body_a, p + "/body_a");
           o.body_b = body(s.body_b, p + "/body_b");
           o.point_a = s.point_a;
           o.point_b = s.point_b;
-          o.unit = "m";
+          o.unit = s.type == SensorType::Distance ? "m" : "m/s";
           break;
       }
       if (!s.unit.empty()) o.unit = s.unit;

@@ -75,6 +75,8 @@ struct ActuatorModel {
   double gain = 1.0, u0 = 0.0;
   double min = -std::numeric_limits<double>::infinity(), max = std::numeric_limits<double>::infinity();
   std::string unit;
+  int body_b = 0;                  // line_force: from body/point to body_b/point_b
+  Eigen::Vector3d point_b = Eigen::Vector3d::Zero();
 };
 
 struct SensorModel {

@@ -43,18 +43,20 @@ constexpr std::array<std::pair<EffectType, const char*>, 6> kEffects{{
     {EffectType::JointDamper, "joint_damper"},
     {EffectType::BodyForce, "body_force"},
 }};
-constexpr std::array<std::pair<ActuatorType, const char*>, 3> kActuators{{
+constexpr std::array<std::pair<ActuatorType, const char*>, 4> kActuators{{
     {ActuatorType::JointForce, "joint_force"},
     {ActuatorType::BodyForce, "body_force"},
     {ActuatorType::BodyTorque, "body_torque"},
+    {ActuatorType::LineForce, "line_force"},
 }};
-constexpr std::array<std::pair<SensorType, const char*>, 6> kSensors{{
+constexpr std::array<std::pair<SensorType, const char*>, 7> kSensors{{
     {SensorType::JointPosition, "joint_position"},
     {SensorType::JointVelocity, "joint_velocity"},
     {SensorType::PointPosition, "point_position"},
     {SensorType::PointVelocity, "point_velocity"},
     {SensorType::BodyAngle, "body_angle"},
     {SensorType::Distance, "distance"},
+    {SensorType::DistanceRate, "distance_rate"},
 }};
 constexpr std::array<std::pair<ShapeType, const char*>, 3> kShapes{{
     {ShapeType::Box, "box"},

@@ -129,6 +129,8 @@ enum class ActuatorType {
   JointForce,  // generalized force/torque on one coordinate of a joint: tau = gain * u
   BodyForce,   // force gain * u * direction at point of body; direction in world or body axes
   BodyTorque,  // torque gain * u * direction on body (a couple: no point); direction in world or body axes
+  LineForce,   // force gain * u along the line from body_a/point_a to body_b/point_b, pushing the points
+               // apart for u > 0 (a hydraulic cylinder, an active suspension strut): -F on a, +F on b
 };
 
 struct ActuatorSpec {
@@ -144,6 +146,8 @@ struct ActuatorSpec {
   double u0 = 0.0;  // nominal value (used when the actuator is not driven)
   std::optional<double> min, max;
   std::string unit;  // shown with the input; default from the type
+  std::string body_a, body_b;  // line_force
+  Eigen::Vector3d point_a = Eigen::Vector3d::Zero(), point_b = Eigen::Vector3d::Zero();
 };
 
 // Sensors are the candidate plant outputs: each gives one scalar y.
@@ -154,6 +158,7 @@ enum class SensorType {
   PointVelocity,   // same, velocity relative to ground, in the axes of `frame`
   BodyAngle,       // rotation of body about `axis` (world axes), measured from its zero-configuration orientation
   Distance,        // |p_b - p_a| between body_a/point_a and body_b/point_b
+  DistanceRate,    // its rate d|p_b - p_a|/dt = n . (v_b - v_a) (0 where the points coincide)
 };
 
 struct SensorSpec {
@@ -166,7 +171,7 @@ struct SensorSpec {
   int component = 0;
   std::string frame = kGroundName;
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
-  std::string body_a, body_b;  // distance
+  std::string body_a, body_b;  // distance, distance_rate
   Eigen::Vector3d point_a = Eigen::Vector3d::Zero();
   Eigen::Vector3d point_b = Eigen::Vector3d::Zero();
   std::string unit;

@@ -58,8 +58,13 @@ void for_each_body_ref(ModelSpec& s, F&& f) {  // f(std::string& ref, const std:
       f(e.body_a, "effect " + e.name + ": body");
     }
   }
-  for (auto& a : s.actuators)
+  for (auto& a : s.actuators) {
     if (a.type == ActuatorType::BodyForce || a.type == ActuatorType::BodyTorque) f(a.body, "actuator " + a.name + ": body");
+    if (a.type == ActuatorType::LineForce) {
+      f(a.body_a, "actuator " + a.name + ": body_a");
+      f(a.body_b, "actuator " + a.name + ": body_b");
+    }
+  }
   for (auto& x : s.sensors) {
     switch (x.type) {
       case SensorType::PointPosition:
@@ -69,6 +74,7 @@ void for_each_body_ref(ModelSpec& s, F&& f) {  // f(std::string& ref, const std:
         break;
       case SensorType::BodyAngle: f(x.body, "sensor " + x.name + ": body"); break;
       case SensorType::Distance:
+      case SensorType::DistanceRate:
         f(x.body_a, "sensor " + x.name + ": body_a");
         f(x.body_b, "sensor " + x.name + ": body_b");
         break;
