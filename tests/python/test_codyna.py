@@ -39,6 +39,8 @@ SOURCE_DIR = os.environ.get("CODYNA_SOURCE_DIR", os.path.join(os.path.dirname(__
 EXAMPLES = sorted(glob.glob(os.path.join(SOURCE_DIR, "examples", "*.json")))
 CART = os.path.join(SOURCE_DIR, "examples", "cart_pendulum.json")
 PENDULUM = os.path.join(SOURCE_DIR, "examples", "pendulum.json")
+# the folder this codyna was imported from, for child processes started elsewhere
+CHILD_ENV = dict(os.environ, PYTHONPATH=os.path.dirname(os.path.dirname(os.path.abspath(codyna.__file__))))
 
 
 def codyna_bin():
@@ -382,7 +384,8 @@ except KeyboardInterrupt:
     print("interrupted after %.3f s" % (time.monotonic() - t0), flush=True)
 """
     model = os.path.join(SOURCE_DIR, "examples", "double_pendulum.json")
-    p = subprocess.Popen([sys.executable, "-c", child, model], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    p = subprocess.Popen([sys.executable, "-c", child, model], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         env=CHILD_ENV)
     assert p.stdout.readline().strip() == "start"
     time.sleep(1.0)
     sent = time.monotonic()
@@ -449,7 +452,7 @@ def test_example_script_writes_its_png(tmp_path):
     script = os.path.join(SOURCE_DIR, "examples", "python", "cart_pendulum_lqr.py")
     png = tmp_path / "cart_pendulum_lqr.png"
     p = subprocess.run([sys.executable, script, str(png)], capture_output=True, text=True, cwd=tmp_path,
-                       env=dict(os.environ, MPLBACKEND="Agg"), timeout=300)
+                       env=dict(CHILD_ENV, MPLBACKEND="Agg"), timeout=300)
     assert p.returncode == 0, p.stdout + p.stderr
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 20000
     assert "K =" in p.stdout and "closed-loop poles" in p.stdout and "max |y - y_lin|" in p.stdout, p.stdout
