@@ -412,7 +412,7 @@ class MjcfImporter {
 
   void equalities() {
     std::vector<std::string> other, inactive, soft;
-    int nconnect = 0;
+    int nconnect = 0, ncoupler = 0;
     for (int e = 0; e < m_->neq; ++e) {
       const char* n = mjname(m_->name_eqadr, e);
       const std::string label = n ? n : "equality" + std::to_string(e);
@@ -431,15 +431,40 @@ class MjcfImporter {
         r_.spec.constraints.push_back(c);
         ++nconnect;
         soft.push_back(label + " (solref " + num(m_->eq_solref[mjNREF * e]) + " " + num(m_->eq_solref[mjNREF * e + 1]) + ")");
+      } else if (m_->eq_type[e] == mjEQ_JOINT && linear_joint_equality(e)) {
+        // MuJoCo: q1 - qpos0_1 = data0 + data1 (q2 - qpos0_2): a coupler q1 - data1 q2 = offset
+        const int j1 = m_->eq_obj1id[e], j2 = m_->eq_obj2id[e];
+        const mjtNum* d = m_->eq_data + mjNEQDATA * e;
+        ConstraintSpec c;
+        c.name = constraints_.unique(label);
+        c.type = ConstraintType::Coupler;
+        c.joint_a = joint_name_[j1];
+        c.joint_b = joint_name_[j2];
+        c.ratio_a = 1;
+        c.ratio_b = -d[1];
+        c.offset = m_->qpos0[m_->jnt_qposadr[j1]] + d[0] - d[1] * m_->qpos0[m_->jnt_qposadr[j2]];
+        r_.spec.constraints.push_back(c);
+        ++ncoupler;
+        soft.push_back(label + " (solref " + num(m_->eq_solref[mjNREF * e]) + " " + num(m_->eq_solref[mjNREF * e + 1]) + ")");
       } else {
         static const char* types[] = {"connect", "weld", "joint", "tendon", "distance"};
         other.push_back(label + " (" + types[m_->eq_type[e]] + ")");
       }
     }
     if (nconnect) r_.report.mapped.push_back(std::to_string(nconnect) + " connect equalities -> ball loop closures");
-    add("equality", "equality constraints other than connect have no codyna equivalent yet", other, true);
+    if (ncoupler) r_.report.mapped.push_back(std::to_string(ncoupler) + " joint equalities (linear) -> couplers");
+    add("equality", "equality constraints other than connect and linear joint couplings have no codyna equivalent yet "
+        "(weld, tendon, a polynomial or a single joint held)", other, true);
     add("other", "inactive equality constraints (not imported)", inactive, false);
     add("soft_constraints", "MuJoCo's equality constraints are soft; codyna closes the loops exactly", soft, false);
+  }
+
+  // a joint equality between two scalar joints with a polynomial of degree 1 (a coupler)
+  bool linear_joint_equality(int e) const {
+    const int j1 = m_->eq_obj1id[e], j2 = m_->eq_obj2id[e];
+    const mjtNum* d = m_->eq_data + mjNEQDATA * e;
+    auto scalar = [&](int j) { return j >= 0 && (m_->jnt_type[j] == mjJNT_HINGE || m_->jnt_type[j] == mjJNT_SLIDE); };
+    return scalar(j1) && scalar(j2) && j1 != j2 && d[1] != 0 && d[2] == 0 && d[3] == 0 && d[4] == 0;
   }
 
   void tendons() {

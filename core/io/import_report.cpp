@@ -12,14 +12,14 @@ const std::vector<std::pair<std::string, std::string>>& import_kinds() {
       {"frictionloss", "dry joint friction (MJCF frictionloss, URDF dynamics friction) (refused unless ignored)"},
       {"springs", "joint stiffness on ball and free joints (refused unless ignored)"},
       {"fluid", "fluid forces (MJCF density, viscosity, wind) (refused unless ignored)"},
-      {"equality", "equality constraints other than connect (weld, joint, tendon) (refused unless ignored)"},
+      {"equality", "equality constraints other than connect and linear joint couplings (weld, tendon, polynomial) (refused unless ignored)"},
       {"soft_constraints", "MuJoCo's constraint softness (solref, solimp): codyna closes loops exactly (reported)"},
       {"tendons", "tendons, and actuators that pull on them (refused unless ignored when they act)"},
       {"muscles", "muscle actuators (refused unless ignored)"},
       {"actuators", "actuators codyna cannot represent: slider-crank, site and adhesion transmissions, "
                     "activation dynamics, gains that vary (refused unless ignored)"},
       {"forcerange", "force limits of servo actuators (reported)"},
-      {"mimic", "URDF mimic joints: coupled coordinates (refused unless ignored)"},
+      {"mimic", "URDF mimic joints that are not between two scalar joints (refused unless ignored)"},
       {"sensors", "sensors with no codyna equivalent (reported)"},
       {"shapes", "geometry shown approximately or not at all (reported)"},
       {"other", "sites, cameras, lights, keyframes, mocap bodies and other elements with no effect on the "

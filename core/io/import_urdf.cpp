@@ -98,6 +98,7 @@ class UrdfImporter {
   ImportResult r_;
   NameSet bodies_, joints_, effects_, actuators_, sensors_;
   std::map<std::string, std::string> link_names_;
+  std::vector<const urdf::Joint*> mimics_;
   std::vector<std::string> limits_, friction_, mimic_, collisions_, meshes_, massless_;
   std::map<std::string, int> types_;
   int nshapes_ = 0, nroot_ = 0, ndampers_ = 0;
@@ -218,7 +219,7 @@ class UrdfImporter {
       }
       if (uj.dynamics->friction != 0) friction_.push_back(uj.name + " " + num(uj.dynamics->friction));
     }
-    if (uj.mimic) mimic_.push_back(uj.name + " = " + num(uj.mimic->multiplier) + " " + uj.mimic->joint_name + " + " + num(uj.mimic->offset));
+    if (uj.mimic) mimics_.push_back(&uj);
     if (scalar) {
       ActuatorSpec a;
       a.name = actuators_.unique(j.name + "_motor");
@@ -239,7 +240,36 @@ class UrdfImporter {
     }
   }
 
+  // mimic: q(joint) = multiplier q(mimicked) + offset, a coupler between two scalar joints
+  void couplers() {
+    ModelSpec& s = r_.spec;
+    int n = 0;
+    for (const urdf::Joint* uj : mimics_) {
+      const auto other = m_.getJoint(uj->mimic->joint_name);
+      auto scalar = [](int t) {
+        return t == urdf::Joint::REVOLUTE || t == urdf::Joint::CONTINUOUS || t == urdf::Joint::PRISMATIC;
+      };
+      const std::string text = uj->name + " = " + num(uj->mimic->multiplier) + " " + uj->mimic->joint_name + " + " + num(uj->mimic->offset);
+      if (!other || !scalar(uj->type) || !scalar(other->type) || uj->mimic->multiplier == 0 || other->name == uj->name) {
+        mimic_.push_back(text + (other ? "" : " (no such joint)"));
+        continue;
+      }
+      ConstraintSpec c;
+      c.name = uj->name + "_mimic";
+      c.type = ConstraintType::Coupler;
+      c.joint_a = uj->name;
+      c.joint_b = other->name;
+      c.ratio_a = 1;
+      c.ratio_b = -uj->mimic->multiplier;
+      c.offset = uj->mimic->offset;
+      s.constraints.push_back(c);
+      ++n;
+    }
+    if (n) r_.report.mapped.push_back(std::to_string(n) + " mimic joints -> couplers (q = multiplier q_mimicked + offset, exact)");
+  }
+
   void finish() {
+    couplers();
     ModelSpec& s = r_.spec;
     EffectSpec g;
     g.name = effects_.unique("gravity");
@@ -261,7 +291,7 @@ class UrdfImporter {
     mp.push_back("plant: every actuator as Plant/In (" + std::to_string(s.plant.inputs.size()) +
                  "), every joint coordinate as Plant/Out (" + std::to_string(s.plant.outputs.size()) + ")");
     add_finding(r_.report, opt_, "frictionloss", "dry joint friction (dynamics friction) is not modelled", friction_, true);
-    add_finding(r_.report, opt_, "mimic", "mimic joints (coupled coordinates) have no codyna equivalent yet", mimic_, true);
+    add_finding(r_.report, opt_, "mimic", "mimic joints codyna cannot couple (not between two revolute, continuous or prismatic joints)", mimic_, true);
     add_finding(r_.report, opt_, "limits", "joint limits: not modelled, kept in the description", limits_, false);
     add_finding(r_.report, opt_, "contacts", "collision geometry is not modelled (codyna's dynamics has no contact)", collisions_, false);
     add_finding(r_.report, opt_, "shapes", "meshes are not shown (codyna reads no mesh files)", meshes_, false);

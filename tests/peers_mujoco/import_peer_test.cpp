@@ -324,6 +324,40 @@ TEST(ImportMjcf, ConnectEqualityClosesTheLoop) {
   EXPECT_LE(m.assembly_residual, 1e-12);
 }
 
+TEST(ImportMjcf, LinearJointEqualityIsACouplerAndAgreesToMuJoCosSoftness) {
+  // MuJoCo's equality constraints are soft: with solimp 0.99999 its constraint keeps ~1e-5 of the
+  // unconstrained acceleration along the coupling, which bounds the agreement
+  const std::string path = kData + "geared_pair.xml";
+  const ImportResult r = study_import(path);
+  ASSERT_EQ(r.spec.constraints.size(), 1u);
+  const ConstraintSpec& c = r.spec.constraints[0];
+  EXPECT_EQ(c.type, ConstraintType::Coupler);
+  EXPECT_EQ(c.joint_a, "drive");
+  EXPECT_EQ(c.joint_b, "driven");
+  EXPECT_EQ(c.ratio_b, 2.0);
+  EXPECT_NEAR(*c.offset, 0.2 + 2 * -0.1, 1e-15);  // q1 + 2 q2 = ref1 + 2 ref2
+  const Model m = compile(r.spec);
+  EXPECT_EQ(m.dof(), 1);
+  MjModelPtr mm = load_file(path);
+  ASSERT_TRUE(mm);
+  MjDataPtr md(mj_makeData(mm.get()));
+  Data d(m);
+  double worst = 0;
+  for (double u : {0.0, 0.7}) {
+    // at qpos0 (the coupling holds), at rest, with and without the motor
+    mj_resetData(mm.get(), md.get());
+    md->ctrl[0] = u;
+    mj_forward(mm.get(), md.get());
+    const Eigen::VectorXd qdd = forward_dynamics<double>(m, d, m.q0, Eigen::VectorXd::Zero(2), Eigen::VectorXd::Constant(1, u));
+    const Eigen::VectorXd acc_mj = Eigen::Map<const Eigen::VectorXd>(md->qacc, 2);
+    worst = std::max(worst, rel_diff(qdd, acc_mj));
+    EXPECT_NEAR(qdd[0] + 2 * qdd[1], 0, 1e-12);  // codyna keeps the coupling exactly
+  }
+  std::cout << "[mujoco import] geared_pair.xml: coupler vs MuJoCo's soft joint equality: max rel diff qacc " << worst
+            << std::endl;
+  EXPECT_LE(worst, 1e-3);
+}
+
 TEST(ImportMjcf, MalformedFileNamesTheFileAndTheElement) {
   try {
     (void)study_import(kData + "bad.xml");
@@ -390,6 +424,26 @@ TEST(ImportUrdf, DoublePendulumAgreesWithMuJoCo) {
   ASSERT_TRUE(mm);
   const Agreement a = compare("double_pendulum.urdf (MuJoCo's URDF reader)", r.spec, mm.get(), true, 8);
   EXPECT_LE(a.qacc, 1e-10);
+}
+
+TEST(ImportUrdf, MimicJointIsACoupler) {
+  const ImportResult r = study_import(kData + "gripper_mimic.urdf");
+  ASSERT_EQ(r.spec.constraints.size(), 1u);
+  const ConstraintSpec& c = r.spec.constraints[0];
+  EXPECT_EQ(c.type, ConstraintType::Coupler);
+  EXPECT_EQ(c.joint_a, "right_slide");
+  EXPECT_EQ(c.joint_b, "left_slide");
+  EXPECT_EQ(c.ratio_b, 1.0);  // q_right = -q_left + 0.01
+  EXPECT_EQ(*c.offset, 0.01);
+  const Model m = compile(r.spec);
+  EXPECT_EQ(m.dof(), 1);
+  // a force on the left finger alone moves both fingers, mirrored: (m_l + m_r) a = F
+  Data d(m);
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(m.nu());
+  u[0] = 1.0;
+  const Eigen::VectorXd qdd = forward_dynamics<double>(m, d, m.q0, Eigen::VectorXd::Zero(m.nv), u);
+  EXPECT_NEAR(qdd[0], 1.0 / 0.1, 1e-12);
+  EXPECT_NEAR(qdd[1], -1.0 / 0.1, 1e-12);
 }
 
 TEST(ImportUrdf, MalformedFileNamesTheFileAndTheElement) {
