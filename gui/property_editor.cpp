@@ -329,13 +329,34 @@ bool PropertyEditor::applyText(const QString& field, const QString& text, QStrin
   }
   if (field.section('/', -1) == QLatin1String("type")) {
     // keep only what the new type accepts: drop the fields the reader calls unknown, and
-    // initial values sized for the old type (a joint's q0, v0)
+    // initial values sized for the old type (a joint's q0, v0); give the fields the new type
+    // requires and the old one lacked a first value (a coupler's joints: the model's first two;
+    // its ratios 1 and -1), which the user then picks
     for (int tries = 0; tries < 40; ++tries) {
       try {
         study_parse_model(j, ss(doc_->filePath()));
         break;
       } catch (const ModelError& e) {
         const std::string p = e.path();
+        const std::string missing = "missing required field \"";
+        if (p == ss(base) && e.detail().rfind(missing, 0) == 0) {
+          const std::string key = e.detail().substr(missing.size(), e.detail().find('"', missing.size()) - missing.size());
+          json& element = j[json::json_pointer(p)];
+          if (!element.is_object() || element.contains(key)) break;
+          if (key.rfind("joint", 0) == 0) {
+            const std::size_t nth = key == "joint_b" ? 1 : 0;
+            element[key] = nth < spec.joints.size() ? spec.joints[nth].name : std::string();
+          } else if (key == "body_a") {
+            element[key] = kGroundName;
+          } else if (key == "body" || key == "body_b") {
+            element[key] = spec.bodies.empty() ? std::string(kGroundName) : spec.bodies.front().name;
+          } else if (key == "ratio_a" || key == "ratio_b") {
+            element[key] = key == "ratio_a" ? 1.0 : -1.0;
+          } else {
+            break;
+          }
+          continue;
+        }
         if (p.rfind(ss(base) + "/", 0) != 0) break;
         const std::string last = p.substr(p.rfind('/') + 1);
         const bool unknown = e.detail().find("unknown field") != std::string::npos;

@@ -171,6 +171,54 @@ class BuildByClicksTest : public QObject {
     // the pendulum is unstable upright: A has a pole in the right half plane (not a trivial model)
     QVERIFY(ref.system.A.eigenvalues().real().maxCoeff() > 1.0);
   }
+
+  // a geared motor from File > New: two discs on revolute joints, a constraint switched to a coupler
+  // in its type drop-down, its joints picked, the ratio typed; the linearization reflects the rotor
+  // inertia as N^2 Jm (the closed form of tests/core/coupler_test.cpp)
+  void gearedMotorFromNew() {
+    QVERIFY(w->newModel());
+    body("rotor", "1", "", "0.01, 0.01, 0.02");
+    add("joint");
+    type("name", "motor");
+    body("load", "2", "", "0.3, 0.3, 0.5");
+    add("joint");
+    type("name", "wheel");
+    type("parent_frame/position", "1, 0, 0");
+    add("constraint");
+    choose("type", "coupler");
+    QCOMPARE(qobject_cast<QComboBox*>(props()->editorFor("joint_a"))->currentText(), QString("motor"));
+    QCOMPARE(qobject_cast<QComboBox*>(props()->editorFor("joint_b"))->currentText(), QString("wheel"));
+    QVERIFY(props()->editorFor("joint_c"));
+    QVERIFY(props()->editorFor("offset"));
+    type("ratio_b", "-7");
+    type("name", "gearbox");
+    add("actuator");
+    type("name", "torque");
+    QCOMPARE(qobject_cast<QComboBox*>(props()->editorFor("joint"))->currentText(), QString("motor"));
+    add("sensor");
+    type("name", "angle");
+    choose("joint", "wheel");
+    QVERIFY2(w->document()->model(), qPrintable(w->document()->errorText()));
+    const ConstraintSpec& c = w->document()->spec().constraints.at(0);
+    QCOMPARE(c.type, ConstraintType::Coupler);
+    QCOMPARE(c.ratio_a, 1.0);
+    QCOMPARE(c.ratio_b, -7.0);
+    toggle(w->plantInPanel(), "torque");
+    toggle(w->plantOutPanel(), "angle");
+
+    LinearizeView* lv = w->linearizeView();
+    w->analysisTabs()->setCurrentWidget(lv);
+    QVERIFY(drive::pickWithKeys(lv->operatingPointCombo(), "initial"));
+    QTest::mouseClick(lv->linearizeButton(), Qt::LeftButton);
+    QVERIFY(lv->result());
+    const LinearSystem& s = lv->result()->system;
+    QCOMPARE(s.A.rows(), 2);  // one degree of freedom
+    const double N = 7, Jm = 0.02, Jl = 0.5;
+    // the automatic choice keeps the actuated motor: (Jm + Jl / N^2) motor'' = torque
+    const double expected = s.state_names[0] == "motor" ? N * N / (N * N * Jm + Jl) : N / (Jl + N * N * Jm);
+    QVERIFY2(std::abs(s.B(1, 0) - expected) <= 1e-12 * expected,
+             qPrintable(QString("B = %1, expected %2 (%3)").arg(s.B(1, 0)).arg(expected).arg(QString::fromStdString(s.state_names[0]))));
+  }
 };
 
 QTEST_MAIN(BuildByClicksTest)
