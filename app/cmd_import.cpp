@@ -29,7 +29,7 @@ void run(const ImportArgs& a) {
               << j.dof << " (nq " << j.nq << ", nv " << j.nv << "), " << j.spec.plant.inputs.size() << " Plant/In, "
               << j.spec.plant.outputs.size() << " Plant/Out\n";
   } catch (const ImportRefused& e) {
-    if (!e.report().mapped.empty()) std::cout << e.report().text();  // what was read, before the refusal
+    if (!e.report().mapped.empty()) std::cout << e.report().text() << std::flush;  // what was read, before the refusal
     throw;
   }
 }
