@@ -74,6 +74,11 @@ QVariant PlantListModel::data(const QModelIndex& index, int role) const {
     switch (index.column()) {
       case 0: return on ? QStringLiteral("u%1  %2").arg(index.row() + 1).arg(name) : name;
       case 1:
+        if (a.type == ActuatorType::Mix) {
+          QStringList driven;
+          for (const auto& d : a.drives) driven << qs(d);
+          return QStringLiteral("mix of %1").arg(driven.join(", "));
+        }
         return QStringLiteral("%1 on %2").arg(to_string(a.type), qs(a.type == ActuatorType::JointForce  ? a.joint
                                                                    : a.type == ActuatorType::LineForce ? a.body_a + " - " + a.body_b
                                                                                                        : a.body));

@@ -34,7 +34,7 @@ QStringList type_names(ElementKind k) {
     case ElementKind::Joint: return {"revolute", "prismatic", "fixed", "spherical", "universal", "cylindrical", "planar", "free"};
     case ElementKind::Constraint: return {"ball", "revolute", "planar_revolute", "coupler"};
     case ElementKind::Effect: return {"gravity", "spring_damper", "joint_spring_damper", "joint_friction", "joint_damper", "body_force"};
-    case ElementKind::Actuator: return {"joint_force", "body_force", "body_torque", "line_force"};
+    case ElementKind::Actuator: return {"joint_force", "body_force", "body_torque", "line_force", "mix"};
     case ElementKind::Sensor:
       return {"joint_position", "joint_velocity", "point_position", "point_velocity", "body_angle", "distance", "distance_rate"};
     default: return {};
@@ -57,6 +57,11 @@ QString value_text(const json& v) {
   if (is_number_array(v)) {
     QStringList l;
     for (const auto& e : v) l << number_text(e);
+    return l.join(", ");
+  }
+  if (v.is_array() && !v.empty() && std::all_of(v.begin(), v.end(), [](const json& e) { return e.is_string(); })) {
+    QStringList l;  // names (a mix's drives): "motor, jet"
+    for (const auto& e : v) l << QString::fromStdString(e.get<std::string>());
     return l.join(", ");
   }
   if (is_matrix(v)) {
@@ -88,6 +93,11 @@ json parse_text(const QString& text, const json& old) {
     json m = json::array();
     for (const QString& r : t.split(';', Qt::SkipEmptyParts)) m.push_back(numbers(r));
     return m;
+  }
+  if (old.is_array() && !old.empty() && std::all_of(old.begin(), old.end(), [](const json& e) { return e.is_string(); })) {
+    json a = json::array();
+    for (const QString& p : t.split(',', Qt::SkipEmptyParts)) a.push_back(p.trimmed().toStdString());
+    return a;
   }
   if (is_number_array(old) || (old.is_array() && old.empty())) return numbers(t);
   return json::parse(t.toStdString());  // objects, lists of objects: JSON text
@@ -232,6 +242,8 @@ QString PropertyEditor::fieldHelp(ElementKind kind, const QString& key, const QS
       {"ratio_b", "Coupler: the second joint's ratio (a gear N:1 is ratio_a 1, ratio_b -N)"},
       {"ratio_c", "Coupler: the third joint's ratio (0 without a third joint)"},
       {"offset", "Coupler: the relation's constant (empty: the joints' q0 satisfy it)"},
+      {"drives", "Mix: the actuators its input drives, comma-separated"},
+      {"weights", "Mix: each driven actuator's input grows by weight * u"},
   };
   const auto it = meaning.find(key.section('/', -1));
   QString text = it == meaning.end() ? QString(key).replace('/', '.') : it->second;
@@ -352,6 +364,16 @@ bool PropertyEditor::applyText(const QString& field, const QString& text, QStrin
             element[key] = spec.bodies.empty() ? std::string(kGroundName) : spec.bodies.front().name;
           } else if (key == "ratio_a" || key == "ratio_b") {
             element[key] = key == "ratio_a" ? 1.0 : -1.0;
+          } else if (key == "drives") {  // a mix: the first other actuator, weight 1
+            json names = json::array();
+            for (const auto& a : spec.actuators)
+              if (a.name != element_name(spec, id_->kind, id_->index) && a.type != ActuatorType::Mix) {
+                names.push_back(a.name);
+                break;
+              }
+            element[key] = names;
+          } else if (key == "weights") {
+            element[key] = json::array({1.0});
           } else {
             break;
           }

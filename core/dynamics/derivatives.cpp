@@ -531,19 +531,27 @@ void TreeDerivatives::applied_force_derivatives(const Eigen::VectorXd& q, const 
     wrench_value(a.point(f.point), F, T, w, dw);
     add_body_wrench(f.body, w, dw, f.body, 0);
   }
-  // a wrench per unit input on `body` into the input's column of dQ/du
+  // a wrench per unit input of actuator k on `body` into dQ/du: its own column, and the columns of
+  // the mixes that drive it, weighted
   auto input_wrench = [&](int body, const Vec6& wu, int k) {
     if (body <= 0) return;
     for (int pu : path_[body]) {
       const Unit& up = units_[pu];
-      dQ_du.block(up.iv, k, up.n, 1).noalias() += S_[up.body].middleCols(up.iv - m_.joints[up.body].idx_v, up.n).transpose() * wu;
+      const auto Sp = S_[up.body].middleCols(up.iv - m_.joints[up.body].idx_v, up.n);
+      dQ_du.block(up.iv, k, up.n, 1).noalias() += Sp.transpose() * wu;
+      for (const auto& [mix, weight] : m_.actuators[k].driven_by)
+        dQ_du.block(up.iv, mix, up.n, 1).noalias() += weight * (Sp.transpose() * wu);
     }
   };
   for (int k = 0; k < m_.nu(); ++k) {
     const ActuatorModel& act = m_.actuators[k];
+    if (act.type == ActuatorType::Mix) continue;  // acts through the actuators it drives
+    double uk_in = u[k];  // the input with the mixes' shares
+    for (const auto& [mix, weight] : act.driven_by) uk_in += weight * u[mix];
     if (act.type == ActuatorType::JointForce) {
-      Q[act.iv] += act.gain * u[k];
+      Q[act.iv] += act.gain * uk_in;
       dQ_du(act.iv, k) += act.gain;
+      for (const auto& [mix, weight] : act.driven_by) dQ_du(act.iv, mix) += act.gain * weight;
       continue;
     }
     if (act.type == ActuatorType::LineForce) {
@@ -561,12 +569,12 @@ void TreeDerivatives::applied_force_derivatives(const Eigen::VectorXd& q, const 
       input_wrench(act.body, wu, k);
       wu << -b.x.cross(Fu), -Fu;
       input_wrench(act.body_b, wu, k);
-      if (u[k] == 0.0) continue;
+      if (uk_in == 0.0) continue;
       Mat3x24 Dxa = Mat3x24::Zero(), Dxb = Mat3x24::Zero();
       Dxa.leftCols<12>() = a.Dx.leftCols<12>();
       Dxb.rightCols<12>() = b.Dx.leftCols<12>();
       const Mat3x24 Dn = (Mat3::Identity() - n * n.transpose()) / L * (Dxb - Dxa);
-      const double T = -act.gain * u[k];
+      const double T = -act.gain * uk_in;
       const Vec3 F = T * n;
       const Mat3x24 DF = T * Dn;
       const Mat3 Fx = skew<double>(F);
@@ -588,13 +596,9 @@ void TreeDerivatives::applied_force_derivatives(const Eigen::VectorXd& q, const 
     const Vec3A x = a.point(act.point);
     // per unit input (linear in u); a body_torque actuator applies a couple
     wrench_value(x, torque ? zero3 : F, torque ? F : zero3, w, dw);
-    for (int pu : path_[act.body]) {
-      const Unit& up = units_[pu];
-      dQ_du.block(up.iv, k, up.n, 1).noalias() +=
-          S_[up.body].middleCols(up.iv - m_.joints[up.body].idx_v, up.n).transpose() * w;
-    }
-    if (u[k] == 0.0) continue;
-    const AD uk(u[k]);
+    input_wrench(act.body, w, k);
+    if (uk_in == 0.0) continue;
+    const AD uk(uk_in);
     wrench_value(x, torque ? zero3 : Vec3A(F * uk), torque ? Vec3A(F * uk) : zero3, w, dw);
     add_body_wrench(act.body, w, dw, act.body, 0);
   }

@@ -79,7 +79,10 @@ const VecXT<S>& applied_forces(const Model& model, DataT<S>& d, const VecXT<S>& 
   for (int k = 0; k < model.nu(); ++k) {
     ++count.actuators;
     const ActuatorModel& a = model.actuators[k];
-    const S value = S(a.gain) * u[k];
+    if (a.type == ActuatorType::Mix) continue;  // acts through the actuators it drives
+    S input = u[k];
+    for (const auto& [mix, weight] : a.driven_by) input = input + S(weight) * u[mix];
+    const S value = S(a.gain) * input;
     if (a.type == ActuatorType::JointForce) {
       d.Q[a.iv] += value;
     } else if (a.type == ActuatorType::LineForce) {

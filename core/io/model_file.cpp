@@ -799,6 +799,8 @@ const Schema<ActuatorSpec>& schema<ActuatorSpec>() {
            field("min", &ActuatorSpec::min, read_number), field("max", &ActuatorSpec::max, read_number),
            field("unit", &ActuatorSpec::unit, read_string, encode_optional_text)},
           point_pair_fields<ActuatorSpec>(),
+          {field("drives", &ActuatorSpec::drives, read_names, Need::Required),
+           field("weights", &ActuatorSpec::weights, read_vector, Need::Required)},
       }),
       "actuator",
       [](const ActuatorSpec& a) {
@@ -808,6 +810,7 @@ const Schema<ActuatorSpec>& schema<ActuatorSpec>() {
           case ActuatorType::BodyForce: return element_keys({"body", "point", "direction", "frame"}, tail);
           case ActuatorType::BodyTorque: return element_keys({"body", "direction", "frame"}, tail);
           case ActuatorType::LineForce: return element_keys(point_pair_and({}), tail);
+          case ActuatorType::Mix: return element_keys({"drives", "weights"}, {"u0", "min", "max", "unit"});
         }
         return element_keys({}, tail);
       }};

@@ -493,6 +493,8 @@ class Compiler {
         check_dof(jb, s.dof, p + "/dof");
         a.iv = m_.joints[jb].idx_v + s.dof;
         a.unit = is_angular(m_.joints[jb].type, s.dof) ? "N m" : "N";
+      } else if (s.type == ActuatorType::Mix) {
+        a.unit = "";  // its drives are resolved once every actuator is known (below)
       } else if (s.type == ActuatorType::LineForce) {
         a.body = body(s.body_a, p + "/body_a");
         a.body_b = body(s.body_b, p + "/body_b");
@@ -518,6 +520,31 @@ class Compiler {
       if (a.min > a.max) fail(p + "/min", "expected min <= max");
       if (!s.unit.empty()) a.unit = s.unit;
       m_.actuators.push_back(a);
+    }
+    // mixes: each drives other actuators (no mix), each at most once, with finite weights
+    for (std::size_t k = 0; k < spec_.actuators.size(); ++k) {
+      const ActuatorSpec& s = spec_.actuators[k];
+      if (s.type != ActuatorType::Mix) continue;
+      const std::string p = at("actuators", k);
+      if (s.drives.empty()) fail(p + "/drives", "expected the names of the actuators the mix drives");
+      if (static_cast<Eigen::Index>(s.drives.size()) != s.weights.size())
+        fail(p + "/weights", "expected one weight per driven actuator (" + std::to_string(s.drives.size()) + "), got " +
+                                 std::to_string(s.weights.size()));
+      std::set<int> seen;
+      for (std::size_t i = 0; i < s.drives.size(); ++i) {
+        const std::string pi = p + "/drives/" + std::to_string(i);
+        const int j = m_.find_actuator(s.drives[i]);
+        if (j < 0) {
+          std::vector<std::string> all;
+          for (const auto& a : m_.actuators) all.push_back(a.name);
+          fail(pi, "unknown actuator " + quoted(s.drives[i]) + " (actuators: " + join_names(all) + ")");
+        }
+        if (m_.actuators[j].type == ActuatorType::Mix) fail(pi, quoted(s.drives[i]) + " is a mix (a mix drives actuators, not mixes)");
+        if (!seen.insert(j).second) fail(pi, quoted(s.drives[i]) + " is listed twice");
+        const double w = s.weights[static_cast<Eigen::Index>(i)];
+        if (!std::isfinite(w)) fail(p + "/weights/" + std::to_string(i), "expected a finite weight");
+        m_.actuators[j].driven_by.emplace_back(static_cast<int>(k), w);
+      }
     }
   }
 

@@ -77,6 +77,9 @@ struct ActuatorModel {
   std::string unit;
   int body_b = 0;                  // line_force: from body/point to body_b/point_b
   Eigen::Vector3d point_b = Eigen::Vector3d::Zero();
+  // the mixes that drive this actuator, (mix index, weight): its input is u + sum weight * u_mix;
+  // a mix itself acts only through the actuators it drives
+  std::vector<std::pair<int, double>> driven_by;
 };
 
 struct SensorModel {

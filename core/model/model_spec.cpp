@@ -43,11 +43,12 @@ constexpr std::array<std::pair<EffectType, const char*>, 6> kEffects{{
     {EffectType::JointDamper, "joint_damper"},
     {EffectType::BodyForce, "body_force"},
 }};
-constexpr std::array<std::pair<ActuatorType, const char*>, 4> kActuators{{
+constexpr std::array<std::pair<ActuatorType, const char*>, 5> kActuators{{
     {ActuatorType::JointForce, "joint_force"},
     {ActuatorType::BodyForce, "body_force"},
     {ActuatorType::BodyTorque, "body_torque"},
     {ActuatorType::LineForce, "line_force"},
+    {ActuatorType::Mix, "mix"},
 }};
 constexpr std::array<std::pair<SensorType, const char*>, 7> kSensors{{
     {SensorType::JointPosition, "joint_position"},

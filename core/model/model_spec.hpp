@@ -131,6 +131,8 @@ enum class ActuatorType {
   BodyTorque,  // torque gain * u * direction on body (a couple: no point); direction in world or body axes
   LineForce,   // force gain * u along the line from body_a/point_a to body_b/point_b, pushing the points
                // apart for u > 0 (a hydraulic cylinder, an active suspension strut): -F on a, +F on b
+  Mix,         // one input driving several actuators: each of `drives` adds weight * u to its own input
+               // (a rotor's thrust and reaction torque, a differential drive, a collective); acts through them
 };
 
 struct ActuatorSpec {
@@ -148,6 +150,8 @@ struct ActuatorSpec {
   std::string unit;  // shown with the input; default from the type
   std::string body_a, body_b;  // line_force
   Eigen::Vector3d point_a = Eigen::Vector3d::Zero(), point_b = Eigen::Vector3d::Zero();
+  std::vector<std::string> drives;  // mix: the actuators it drives (none of them a mix)
+  Eigen::VectorXd weights;          // mix: one per driven actuator
 };
 
 // Sensors are the candidate plant outputs: each gives one scalar y.

@@ -195,6 +195,8 @@ std::vector<std::string> references_to(const ModelSpec& spec, ElementKind k, con
       break;
     case ElementKind::Actuator:
       if (std::count(s.plant.inputs.begin(), s.plant.inputs.end(), name)) out.push_back("Plant/In");
+      for (const auto& a : s.actuators)
+        if (std::count(a.drives.begin(), a.drives.end(), name)) out.push_back("actuator " + a.name + ": drives");
       break;
     case ElementKind::Sensor:
       if (std::count(s.plant.outputs.begin(), s.plant.outputs.end(), name)) out.push_back("Plant/Out");
@@ -226,7 +228,10 @@ void rename_element(ModelSpec& s, ElementKind k, int index, const std::string& n
       for (auto& [n, v] : s.analysis.set) n = renamed_coordinate(n, old, now);
       for (auto& n : s.analysis.independent) n = renamed_coordinate(n, old, now);
       break;
-    case ElementKind::Actuator: std::replace(s.plant.inputs.begin(), s.plant.inputs.end(), old, now); break;
+    case ElementKind::Actuator:
+      std::replace(s.plant.inputs.begin(), s.plant.inputs.end(), old, now);
+      for (auto& a : s.actuators) std::replace(a.drives.begin(), a.drives.end(), old, now);
+      break;
     case ElementKind::Sensor: std::replace(s.plant.outputs.begin(), s.plant.outputs.end(), old, now); break;
     case ElementKind::Effect:
       std::replace(s.analysis.disabled_effects.begin(), s.analysis.disabled_effects.end(), old, now);

@@ -16,7 +16,7 @@ expect() {
   "$@" > out.txt 2> err.txt
   local rc=$?
   [ "$rc" -eq "$code" ] || fail "$* exited $rc, expected $code: $(cat err.txt)"
-  cat out.txt err.txt | grep -qF -- "$phrase" || fail "$*: output lacks \"$phrase\": $(cat out.txt err.txt)"
+  grep -qF -- "$phrase" out.txt err.txt || fail "$*: output lacks \"$phrase\": $(cat out.txt err.txt)"
 }
 
 data="$src/tests/data/import"
