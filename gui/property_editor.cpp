@@ -33,7 +33,8 @@ QStringList type_names(ElementKind k) {
   switch (k) {
     case ElementKind::Joint: return {"revolute", "prismatic", "fixed", "spherical", "universal", "cylindrical", "planar", "free"};
     case ElementKind::Constraint: return {"ball", "revolute", "planar_revolute", "coupler"};
-    case ElementKind::Effect: return {"gravity", "spring_damper", "joint_spring_damper", "joint_friction", "joint_damper", "body_force"};
+    case ElementKind::Effect:
+      return {"gravity", "spring_damper", "joint_spring_damper", "joint_friction", "joint_damper", "body_force", "bushing"};
     case ElementKind::Actuator: return {"joint_force", "body_force", "body_torque", "line_force", "mix"};
     case ElementKind::Sensor:
       return {"joint_position", "joint_velocity", "point_position", "point_velocity", "body_angle", "distance", "distance_rate"};
@@ -243,6 +244,12 @@ QString PropertyEditor::fieldHelp(ElementKind kind, const QString& key, const QS
       {"ratio_c", "Coupler: the third joint's ratio (0 without a third joint)"},
       {"offset", "Coupler: the relation's constant (empty: the joints' q0 satisfy it)"},
       {"drives", "Mix: the actuators its input drives, comma-separated"},
+      {"frame_a", "Bushing: its frame on the first body (at rest it coincides with frame_b)"},
+      {"frame_b", "Bushing: its frame on the second body"},
+      {"translational_stiffness", "Bushing: stiffness along frame_a's x, y, z"},
+      {"translational_damping", "Bushing: damping along frame_a's x, y, z"},
+      {"rotational_stiffness", "Bushing: stiffness about frame_a's x, y, z (small rotations)"},
+      {"rotational_damping", "Bushing: damping about frame_a's x, y, z"},
       {"weights", "Mix: each driven actuator's input grows by weight * u"},
   };
   const auto it = meaning.find(key.section('/', -1));

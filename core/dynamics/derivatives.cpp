@@ -521,6 +521,28 @@ void TreeDerivatives::applied_force_derivatives(const Eigen::VectorXd& q, const 
     dw.bottomRows<3>() = -DF;
     add_body_wrench(s.body_b, w, dw, s.body_a, s.body_b);
   }
+  // bushings: the wrench of core/dynamics/effects.cpp as a function of both bodies' local variables
+  for (const BushingModel& bm : m_.bushings) {
+    const BodyAD a = body_ad(d_.oMi[bm.body_a], V_[bm.body_a], 0, bm.body_a > 0);
+    const BodyAD b = body_ad(d_.oMi[bm.body_b], V_[bm.body_b], 12, bm.body_b > 0);
+    const Mat3A RA = a.R * bm.X_a.R.cast<AD>(), RB = b.R * bm.X_b.R.cast<AD>();
+    const Vec3A xA = a.point(bm.X_a.p), xB = b.point(bm.X_b.p);
+    const Mat3A Rrel = RA.transpose() * RB;
+    const Vec3A dist = RA.transpose() * (xB - xA);
+    const Vec3A vel = RA.transpose() * (b.point_velocity(xB) - a.point_velocity(xB));
+    const Vec3A wrel = RA.transpose() * (b.w - a.w);
+    Vec3A F, T;
+    for (int k = 0; k < 3; ++k) {
+      const AD theta = rotation_about_axis<AD>(Rrel, Eigen::Vector3d::Unit(k));
+      F[k] = -(bm.kt[k] * dist[k] + bm.ct[k] * vel[k]);
+      T[k] = -(bm.kr[k] * theta + bm.cr[k] * wrel[k]);
+    }
+    wrench_value(xB, Vec3A(RA * F), Vec3A(RA * T), w, dw);
+    add_body_wrench(bm.body_b, w, dw, bm.body_a, bm.body_b);
+    w = -w;
+    dw = -dw;
+    add_body_wrench(bm.body_a, w, dw, bm.body_a, bm.body_b);
+  }
   for (const BodyForceModel& f : m_.body_forces) {
     const BodyAD a = body_ad(d_.oMi[f.body], V_[f.body], 0, f.body > 0);
     Vec3A F = f.force.cast<AD>(), T = f.torque.cast<AD>();

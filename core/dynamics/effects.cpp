@@ -4,6 +4,7 @@
 
 #include "dynamics/kinematics.hpp"
 #include "dynamics/rnea.hpp"
+#include "dynamics/sensors.hpp"
 #include "spatial/autodiff.hpp"
 
 namespace codyna {
@@ -74,6 +75,27 @@ const VecXT<S>& applied_forces(const Model& model, DataT<S>& d, const VecXT<S>& 
       T = d.oMi[b.body].R * T;
     }
     add_world_force<S>(d, b.body, b.point, F, T);
+    any_body_force = true;
+  }
+  for (const BushingModel& b : model.bushings) {
+    // frame A on body_a, frame B on body_b; B's displacement, small rotation and velocities in A's axes
+    const Mat3T<S> RA = d.oMi[b.body_a].R * b.X_a.R.cast<S>(), RB = d.oMi[b.body_b].R * b.X_b.R.cast<S>();
+    const Vec3T<S> xA = point_position<S>(d, b.body_a, b.X_a.p), xB = point_position<S>(d, b.body_b, b.X_b.p);
+    const Mat3T<S> Rrel = RA.transpose() * RB;
+    const Vec3T<S> wa = angular_velocity<S>(d, b.body_a), wb = angular_velocity<S>(d, b.body_b);
+    // the velocity of B's origin less that of the point of body_a it passes
+    const Vec3T<S> va = point_velocity<S>(d, b.body_a, b.X_a.p) + wa.cross(Vec3T<S>(xB - xA));
+    const Vec3T<S> dist = RA.transpose() * (xB - xA), vel = RA.transpose() * (point_velocity<S>(d, b.body_b, b.X_b.p) - va);
+    const Vec3T<S> wrel = RA.transpose() * (wb - wa);
+    Vec3T<S> F, T;
+    for (int k = 0; k < 3; ++k) {
+      const S theta = rotation_about_axis<S>(Rrel, Eigen::Vector3d::Unit(k));
+      F[k] = -(S(b.kt[k]) * dist[k] + S(b.ct[k]) * vel[k]);
+      T[k] = -(S(b.kr[k]) * theta + S(b.cr[k]) * wrel[k]);
+    }
+    const Vec3T<S> Fw = RA * F, Tw = RA * T;
+    add_world_force<S>(d, b.body_b, b.X_b.p, Fw, Tw);  // on B at its origin, the reaction on A at the same point
+    add_world_force<S>(d, b.body_a, b.X_a.p, Vec3T<S>(-Fw), Vec3T<S>(-(Tw + Vec3T<S>(xB - xA).cross(Fw))));
     any_body_force = true;
   }
   for (int k = 0; k < model.nu(); ++k) {

@@ -767,7 +767,12 @@ const Schema<EffectSpec>& schema<EffectSpec>() {
            field("point", &EffectSpec::point_a, read_vec3),
            field("force", &EffectSpec::force, read_vec3),
            field("torque", &EffectSpec::torque, read_vec3),
-           field("frame", &EffectSpec::in_world, read_in_world, encode_in_world)},
+           field("frame", &EffectSpec::in_world, read_in_world, encode_in_world),
+           struct_field("frame_a", &EffectSpec::frame_a), struct_field("frame_b", &EffectSpec::frame_b),
+           field("translational_stiffness", &EffectSpec::translational_stiffness, read_vec3),
+           field("translational_damping", &EffectSpec::translational_damping, read_vec3),
+           field("rotational_stiffness", &EffectSpec::rotational_stiffness, read_vec3),
+           field("rotational_damping", &EffectSpec::rotational_damping, read_vec3)},
       }),
       "effect",
       [](const EffectSpec& e) {
@@ -779,6 +784,9 @@ const Schema<EffectSpec>& schema<EffectSpec>() {
           case EffectType::JointFriction: return element_keys({"joint", "dof", "damping"});
           case EffectType::JointDamper: return element_keys({"joint", "damping"});
           case EffectType::BodyForce: return element_keys({"body", "point", "force", "torque", "frame"});
+          case EffectType::Bushing:
+            return element_keys({"body_a", "frame_a", "body_b", "frame_b", "translational_stiffness", "translational_damping",
+                                 "rotational_stiffness", "rotational_damping"});
         }
         return element_keys({});
       }};

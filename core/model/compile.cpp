@@ -460,6 +460,32 @@ class Compiler {
           m_.body_forces.push_back(b);
           break;
         }
+        case EffectType::Bushing: {
+          BushingModel b;
+          b.name = e.name;
+          b.body_a = body(e.body_a, p + "/body_a");
+          b.body_b = body(e.body_b, p + "/body_b");
+          if (b.body_a == b.body_b) fail(p + "/body_b", "expected two different bodies");
+          for (const auto& [f, key] : {std::pair{&e.frame_a, "/frame_a"}, std::pair{&e.frame_b, "/frame_b"}}) {
+            const Eigen::Matrix3d& R = f->rotation;
+            if (!R.allFinite() || !f->position.allFinite() || (R.transpose() * R - Eigen::Matrix3d::Identity()).norm() > 1e-9 ||
+                R.determinant() < 0)
+              fail(p + key, "expected a finite position and a proper rotation");
+          }
+          b.X_a = SE3(e.frame_a.rotation, e.frame_a.position);
+          b.X_b = SE3(e.frame_b.rotation, e.frame_b.position);
+          const std::pair<const Eigen::Vector3d*, const char*> values[] = {
+              {&e.translational_stiffness, "/translational_stiffness"}, {&e.translational_damping, "/translational_damping"},
+              {&e.rotational_stiffness, "/rotational_stiffness"}, {&e.rotational_damping, "/rotational_damping"}};
+          for (const auto& [v, key] : values)
+            if (!v->allFinite() || v->minCoeff() < 0) fail(p + key, "expected three non-negative numbers (x, y, z of the bushing's axes)");
+          b.kt = e.translational_stiffness;
+          b.ct = e.translational_damping;
+          b.kr = e.rotational_stiffness;
+          b.cr = e.rotational_damping;
+          m_.bushings.push_back(b);
+          break;
+        }
         case EffectType::JointDamper: {
           // one damping value on every velocity coordinate of the joint: -damping * v
           // (for a spherical joint an isotropic viscous torque -damping * omega)

@@ -65,6 +65,14 @@ struct BodyForceModel {
   bool in_world = true;
 };
 
+struct BushingModel {
+  std::string name;
+  int body_a = 0, body_b = 0;
+  SE3 X_a, X_b;  // the bushing's frames in body_a's and body_b's frames
+  Eigen::Vector3d kt = Eigen::Vector3d::Zero(), ct = Eigen::Vector3d::Zero();  // translational, A's axes
+  Eigen::Vector3d kr = Eigen::Vector3d::Zero(), cr = Eigen::Vector3d::Zero();  // rotational, A's axes
+};
+
 struct ActuatorModel {
   std::string name;
   ActuatorType type = ActuatorType::JointForce;
@@ -139,6 +147,7 @@ struct Model {
   std::vector<JointSpringModel> joint_springs;
   std::vector<JointSpringModel> joint_frictions;  // damping only
   std::vector<BodyForceModel> body_forces;
+  std::vector<BushingModel> bushings;
 
   std::vector<ActuatorModel> actuators;  // [nu_all]
   std::vector<SensorModel> sensors;      // [ny_all]

@@ -35,13 +35,14 @@ constexpr std::array<std::pair<ConstraintType, const char*>, 4> kConstraints{{
     {ConstraintType::PlanarRevolute, "planar_revolute"},
     {ConstraintType::Coupler, "coupler"},
 }};
-constexpr std::array<std::pair<EffectType, const char*>, 6> kEffects{{
+constexpr std::array<std::pair<EffectType, const char*>, 7> kEffects{{
     {EffectType::Gravity, "gravity"},
     {EffectType::SpringDamper, "spring_damper"},
     {EffectType::JointSpringDamper, "joint_spring_damper"},
     {EffectType::JointFriction, "joint_friction"},
     {EffectType::JointDamper, "joint_damper"},
     {EffectType::BodyForce, "body_force"},
+    {EffectType::Bushing, "bushing"},
 }};
 constexpr std::array<std::pair<ActuatorType, const char*>, 5> kActuators{{
     {ActuatorType::JointForce, "joint_force"},

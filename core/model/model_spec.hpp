@@ -104,6 +104,8 @@ enum class EffectType {
   JointFriction,     // viscous, on one joint coordinate: damping
   JointDamper,       // viscous, on every coordinate of a joint with one value: damping
   BodyForce,         // constant force at a body point and constant torque; in world or body axes
+  Bushing,           // linear 6-component spring-damper between frame_a on body_a and frame_b on body_b
+                     // (Adams' BUSHING): translations and small rotations of B in A's axes
 };
 
 struct EffectSpec {
@@ -122,6 +124,14 @@ struct EffectSpec {
   Eigen::Vector3d force = Eigen::Vector3d::Zero();    // body_force, N
   Eigen::Vector3d torque = Eigen::Vector3d::Zero();   // body_force, N m
   bool in_world = true;                               // body_force: axes of force/torque ("world" or "body")
+  // bushing: frames on body_a and body_b that coincide at rest; the force on B in A's axes is
+  // -K d - C v (d, v: B's origin relative to A's, in A's axes) and the torque -Kr theta - Cr w
+  // (theta: the rotation vector of B relative to A, w the relative angular velocity, in A's axes)
+  FrameSpec frame_a, frame_b;
+  Eigen::Vector3d translational_stiffness = Eigen::Vector3d::Zero();  // N/m
+  Eigen::Vector3d translational_damping = Eigen::Vector3d::Zero();    // N s/m
+  Eigen::Vector3d rotational_stiffness = Eigen::Vector3d::Zero();     // N m/rad
+  Eigen::Vector3d rotational_damping = Eigen::Vector3d::Zero();       // N m s/rad
 };
 
 // Actuators are the candidate plant inputs: each takes one scalar u.

@@ -51,7 +51,7 @@ void for_each_body_ref(ModelSpec& s, F&& f) {  // f(std::string& ref, const std:
     f(c.body_b, "constraint " + c.name + ": body_b");
   }
   for (auto& e : s.effects) {
-    if (e.type == EffectType::SpringDamper) {
+    if (e.type == EffectType::SpringDamper || e.type == EffectType::Bushing) {
       f(e.body_a, "effect " + e.name + ": body_a");
       f(e.body_b, "effect " + e.name + ": body_b");
     } else if (e.type == EffectType::BodyForce) {
