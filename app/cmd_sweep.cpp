@@ -1,0 +1,86 @@
+// codyna sweep: flags -> a SweepRequest, one study call (study_sweep_job), the progress line and
+// the printed summary. The variants, their numbering and the files live in core/study/sweep.
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "study/sweep.hpp"
+
+namespace codyna::cli {
+
+namespace {
+
+struct SweepArgs {
+  std::string model, out, csv, redesign;
+  std::vector<std::string> vary;
+  long long samples = 0;
+  std::uint64_t seed = 0;
+  int threads = 0;
+  bool quiet = false;
+  const CLI::App* cmd = nullptr;
+};
+
+void run(const SweepArgs& a) {
+  SweepRequest r;
+  r.model = a.model;
+  r.vary = a.vary;
+  if (given(a.cmd, "--samples")) r.samples = a.samples;
+  if (given(a.cmd, "--seed")) r.seed = a.seed;
+  r.threads = a.threads;
+  r.redesign = a.redesign;
+  r.out = a.out;
+  r.csv = a.csv;
+  SweepProgress progress;
+  const bool bar = !a.quiet && isatty(STDERR_FILENO);
+  const auto start = std::chrono::steady_clock::now();
+  bool bar_open = false;
+  auto last = start - std::chrono::seconds(1);
+  if (bar)
+    progress.done = [&](long long done, long long total) {
+      const auto now = std::chrono::steady_clock::now();
+      if (done < total && now - last < std::chrono::milliseconds(100)) return;
+      last = now;
+      const double elapsed = std::chrono::duration<double>(now - start).count();
+      const double eta = done > 0 ? elapsed / static_cast<double>(done) * static_cast<double>(total - done) : 0.0;
+      std::fprintf(stderr, "\r%lld/%lld variants  %3d%%  %.1f s, ETA %.1f s   ", done, total,
+                   static_cast<int>(100 * done / total), elapsed, eta);
+      std::fflush(stderr);
+      bar_open = true;
+    };
+  const auto tell = [&](const StudyMessage& m) {
+    if (bar_open) std::fprintf(stderr, "\n");
+    bar_open = false;
+    print_message(m);
+  };
+  const SweepJob job = study_sweep_job(r, tell, progress);
+  if (bar_open) std::fprintf(stderr, "\n");
+  std::cout << study_sweep_summary(job);
+  for (const std::string& f : job.written) std::cout << "wrote " << f << "\n";
+}
+
+}  // namespace
+
+void add_sweep(CLI::App& app) {
+  auto a = std::make_shared<SweepArgs>();
+  auto* cmd = app.add_subcommand("sweep", "Parameter study: linearize (and close the loop of) every variant of a model over a grid or random samples");
+  cmd->add_option("model", a->model, "model file (JSON)")->required();
+  cmd->add_option("--vary", a->vary,
+                  "FIELD=SPEC (repeatable): FIELD a JSON pointer into the model file (/bodies/1/mass), SPEC a:b:n, "
+                  "[v1,v2,...], normal(mu,sigma) or uniform(a,b)")
+      ->required();
+  cmd->add_option("--samples", a->samples, "random studies: the number of variants");
+  cmd->add_option("--seed", a->seed, "random studies: the seed (variant i depends only on the specs, the seed and i)");
+  cmd->add_option("--threads", a->threads, "worker threads (default: every core)");
+  cmd->add_option("--redesign", a->redesign, "lqr: design the study's LQR again for every variant (default: K of the nominal model, fixed)");
+  cmd->add_option("--out", a->out, "results (HDF5)")->required();
+  cmd->add_option("--csv", a->csv, "the per-variant figures as CSV");
+  cmd->add_flag("--quiet", a->quiet, "no progress line");
+  a->cmd = cmd;
+  cmd->callback([a] { set_exit_code(run_guarded([&] { run(*a); })); });
+}
+
+}  // namespace codyna::cli

@@ -1,0 +1,886 @@
+#include "study/sweep.hpp"
+
+#include <hdf5.h>
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <limits>
+#include <mutex>
+#include <numeric>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+#include <utility>
+
+#include "io/atomic_file.hpp"
+#include "io/hdf5_quiet.hpp"
+#include "model/errors.hpp"
+#include "study/files.hpp"
+#include "study/tools.hpp"
+
+namespace codyna {
+
+namespace {
+
+constexpr int kFormatVersion = 1;
+constexpr long long kMaxVariants = 10'000'000;
+constexpr const char* kCsvHeadStart = "variant,status";
+
+struct Names {
+  OptionStyle style;
+  std::string operator()(const std::string& dashed) const { return option_name(style, dashed); }
+};
+
+std::string trim(std::string s) {
+  const auto a = s.find_first_not_of(" \t");
+  if (a == std::string::npos) return {};
+  const auto b = s.find_last_not_of(" \t");
+  return s.substr(a, b - a + 1);
+}
+
+bool parse_number(const std::string& text, double& out) {
+  const std::string t = trim(text);
+  if (t.empty()) return false;
+  const char* first = t.data();
+  if (*first == '+') ++first;
+  const auto [ptr, ec] = std::from_chars(first, t.data() + t.size(), out);
+  return ec == std::errc() && ptr == t.data() + t.size() && std::isfinite(out);
+}
+
+std::string fmt(double x) {
+  std::ostringstream os;
+  os << std::setprecision(10) << x;
+  return os.str();
+}
+
+// ------------------------------------------------------------------ random numbers
+// Counter-based: every number is a hash of (seed, variant, field, draw), so variant i never
+// depends on which variants ran before it, on which thread, or in which process.
+
+std::uint64_t splitmix64(std::uint64_t z) {
+  z += 0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+// uniform on the open interval (0, 1), 53 bits
+double unit_draw(std::uint64_t seed, long long i, std::size_t k, int draw) {
+  std::uint64_t h = splitmix64(seed);
+  h = splitmix64(h ^ static_cast<std::uint64_t>(i));
+  h = splitmix64(h ^ static_cast<std::uint64_t>(k));
+  h = splitmix64(h ^ static_cast<std::uint64_t>(draw));
+  return (static_cast<double>(h >> 11) + 0.5) * 0x1.0p-53;
+}
+
+// ------------------------------------------------------------------ --vary parsing
+
+SweepVary parse_vary(const std::string& text, const nlohmann::json& file, const std::string& model, const Names& opt) {
+  const std::string label = opt("vary") + " " + text;
+  const auto eq = text.find('=');
+  if (eq == std::string::npos)
+    throw std::invalid_argument(label + ": expected FIELD=SPEC (e.g. /bodies/1/mass=5:15:11)");
+  SweepVary v;
+  v.field = trim(text.substr(0, eq));
+  v.spec = trim(text.substr(eq + 1));
+  if (v.field.empty() || v.field[0] != '/')
+    throw std::invalid_argument(label + ": the field must be a JSON pointer into the model file, starting with / "
+                                "(e.g. /bodies/1/mass, /effects/0/stiffness, /joints/2/q0)");
+  nlohmann::json::json_pointer ptr;
+  try {
+    ptr = nlohmann::json::json_pointer(v.field);
+  } catch (const nlohmann::json::exception& e) {
+    throw std::invalid_argument(label + ": " + v.field + " is not a JSON pointer (" + e.what() + ")");
+  }
+  const nlohmann::json* at = nullptr;
+  try {
+    if (file.contains(ptr)) at = &file.at(ptr);
+  } catch (const nlohmann::json::exception&) {
+    at = nullptr;
+  }
+  if (!at) {
+    // the longest part of the path that exists, to say where it went wrong
+    nlohmann::json::json_pointer have = ptr;
+    while (!have.empty()) {
+      have = have.parent_pointer();
+      bool ok = false;
+      try {
+        ok = file.contains(have);
+      } catch (const nlohmann::json::exception&) {
+      }
+      if (ok) break;
+    }
+    std::string where;
+    const nlohmann::json& p = have.empty() ? file : file.at(have);
+    if (p.is_array()) where = " (" + (have.empty() ? std::string("/") : have.to_string()) + " has " + std::to_string(p.size()) + " entries)";
+    else if (p.is_object()) {
+      where = " (" + (have.empty() ? std::string("the top level") : have.to_string()) + " has ";
+      int n = 0;
+      for (auto it = p.begin(); it != p.end(); ++it) where += std::string(n++ ? ", " : "") + it.key();
+      where += ")";
+    }
+    throw std::invalid_argument(label + ": the model file " + model + " has no field " + v.field + where);
+  }
+  if (!at->is_number())
+    throw std::invalid_argument(label + ": " + v.field + " in " + model + " is not a number (it is " + at->type_name() +
+                                "); vary one number, e.g. " + v.field + "/0");
+  v.nominal = at->get<double>();
+  const std::string& s = v.spec;
+  const std::string grammar = "expected a:b:n (n values from a to b), [v1,v2,...], normal(mu,sigma) or uniform(a,b)";
+  if (s.empty()) throw std::invalid_argument(label + ": no SPEC after = (" + grammar + ")");
+  const auto two_args = [&](const char* name, double& x, double& y) {
+    const std::string head = std::string(name) + "(";
+    if (s.rfind(head, 0) != 0) return false;
+    if (s.back() != ')') throw std::invalid_argument(label + ": " + name + "(...) is not closed by )");
+    const std::string inner = s.substr(head.size(), s.size() - head.size() - 1);
+    const auto comma = inner.find(',');
+    if (comma == std::string::npos || !parse_number(inner.substr(0, comma), x) || !parse_number(inner.substr(comma + 1), y))
+      throw std::invalid_argument(label + ": expected " + name + "(NUMBER,NUMBER)");
+    return true;
+  };
+  if (s[0] == '[') {
+    nlohmann::json list;
+    try {
+      list = nlohmann::json::parse(s);
+    } catch (const nlohmann::json::exception&) {
+      throw std::invalid_argument(label + ": the list is not [v1,v2,...] of numbers");
+    }
+    if (!list.is_array() || list.empty()) throw std::invalid_argument(label + ": the list is empty or not a list");
+    for (const auto& x : list) {
+      if (!x.is_number()) throw std::invalid_argument(label + ": the list holds " + x.dump() + ", not a number");
+      v.values.push_back(x.get<double>());
+    }
+    v.kind = SweepVary::Grid;
+  } else if (two_args("normal", v.a, v.b)) {
+    if (!(v.b >= 0)) throw std::invalid_argument(label + ": normal(mu,sigma) needs sigma >= 0");
+    v.kind = SweepVary::Normal;
+  } else if (two_args("uniform", v.a, v.b)) {
+    if (!(v.b > v.a)) throw std::invalid_argument(label + ": uniform(a,b) needs a < b");
+    v.kind = SweepVary::Uniform;
+  } else if (std::count(s.begin(), s.end(), ':') == 2) {
+    const auto c1 = s.find(':'), c2 = s.find(':', c1 + 1);
+    double a = 0, b = 0, n = 0;
+    if (!parse_number(s.substr(0, c1), a) || !parse_number(s.substr(c1 + 1, c2 - c1 - 1), b) ||
+        !parse_number(s.substr(c2 + 1), n))
+      throw std::invalid_argument(label + ": " + grammar);
+    if (n < 1 || n != std::floor(n) || n > kMaxVariants)
+      throw std::invalid_argument(label + ": n in a:b:n must be a whole number from 1 to " + std::to_string(kMaxVariants));
+    const long long count = static_cast<long long>(n);
+    if (count == 1 && a != b) throw std::invalid_argument(label + ": a:b:1 holds one value; give a:a:1 or [a]");
+    for (long long k = 0; k < count; ++k)
+      v.values.push_back(k == count - 1 ? b : a + (b - a) * static_cast<double>(k) / static_cast<double>(count - 1));
+    v.kind = SweepVary::Grid;
+  } else {
+    throw std::invalid_argument(label + ": " + grammar);
+  }
+  return v;
+}
+
+// ------------------------------------------------------------------ per variant
+
+void sort_poles(Eigen::VectorXcd& p) {
+  std::sort(p.data(), p.data() + p.size(), [](const std::complex<double>& a, const std::complex<double>& b) {
+    return a.real() < b.real() || (a.real() == b.real() && a.imag() < b.imag());
+  });
+}
+
+Eigen::VectorXcd poles_of(const Eigen::MatrixXd& A) {
+  Eigen::VectorXcd p = A.size() ? Eigen::VectorXcd(A.eigenvalues()) : Eigen::VectorXcd();
+  sort_poles(p);
+  return p;
+}
+
+double max_real(const Eigen::VectorXcd& p) {
+  return p.size() ? p.real().maxCoeff() : -std::numeric_limits<double>::infinity();
+}
+
+// asymptotically stable: every pole left of the imaginary axis by more than round-off
+bool stable_poles(const Eigen::VectorXcd& p, const Eigen::MatrixXd& A) {
+  return max_real(p) < -1e-9 * std::max(1.0, A.norm());
+}
+
+std::string joined(const std::vector<std::string>& v) {
+  std::string s;
+  for (const std::string& x : v) s += (s.empty() ? "" : ", ") + x;
+  return s;
+}
+
+struct Context {
+  const SweepRequest* request;
+  const SweepPlan* plan;
+  const nlohmann::json* file;
+  std::vector<nlohmann::json::json_pointer> pointers;
+  LinearizeRequest linearize;
+  int nx = 0, nu = 0, ny = 0;
+  std::vector<std::string> state_names;
+  bool closed_loop = false, redesign = false;
+  Eigen::MatrixXd K;
+};
+
+void run_variant(const Context& c, long long i, SweepVariant& v) {
+  v.values = c.plan->values(i);
+  try {
+    nlohmann::json j = *c.file;
+    for (std::size_t k = 0; k < c.pointers.size(); ++k) j[c.pointers[k]] = v.values[k];
+    const ModelSpec spec = study_parse_model(j, c.request->model);
+    const LinearizeJob lj = study_linearize_job(c.linearize, spec);
+    const LinearSystem& sys = lj.linearization.lin.system;  // continuous
+    if (sys.nx() != c.nx || sys.nu() != c.nu || sys.ny() != c.ny) {
+      v.status = SweepStatus::SizeDiffers;
+      v.reason = "A, B, C, D are " + std::to_string(sys.nx()) + " states, " + std::to_string(sys.nu()) + " inputs, " +
+                 std::to_string(sys.ny()) + " outputs where the nominal model's are " + std::to_string(c.nx) + ", " +
+                 std::to_string(c.nu) + ", " + std::to_string(c.ny);
+      return;
+    }
+    if (sys.state_names != c.state_names) {
+      v.status = SweepStatus::SizeDiffers;
+      v.reason = "its states are (" + joined(sys.state_names) + ") where the nominal model's are (" +
+                 joined(c.state_names) + ")";
+      return;
+    }
+    v.A = sys.A;
+    v.B = sys.B;
+    v.C = sys.C;
+    v.D = sys.D;
+    v.open_poles = poles_of(sys.A);
+    v.open_max_real = max_real(v.open_poles);
+    v.uncontrollable = static_cast<int>(lj.uncontrollable.size());
+    if (v.uncontrollable) v.uncontrollable_text = study_describe_modes(lj.uncontrollable);
+    if (c.closed_loop) {
+      Eigen::MatrixXd K = c.K;
+      if (c.redesign) {
+        const StudySimulation setup = study_simulation(lj.model);
+        const Eigen::MatrixXd* g = setup.controller ? setup.controller->gain() : nullptr;
+        if (!g) throw std::invalid_argument("the LQR was not designed again for this variant");
+        K = *g;
+        v.K = K;
+      }
+      const Eigen::MatrixXd Acl = sys.A - sys.B * K;
+      v.closed_poles = poles_of(Acl);
+      v.closed_max_real = max_real(v.closed_poles);
+      v.stable = stable_poles(v.closed_poles, Acl);
+    } else {
+      v.stable = stable_poles(v.open_poles, sys.A);
+    }
+    v.status = SweepStatus::Ok;
+  } catch (const ModelError& e) {
+    v.status = SweepStatus::ModelError;
+    v.reason = e.what();
+  } catch (const ConvergenceError& e) {
+    v.status = SweepStatus::NotConverged;
+    v.reason = e.what();
+  } catch (const std::invalid_argument& e) {
+    v.status = SweepStatus::Refused;
+    v.reason = e.what();
+  } catch (const std::exception& e) {
+    v.status = SweepStatus::Failed;
+    v.reason = e.what();
+  }
+  if (v.status != SweepStatus::Ok) {
+    v.A.resize(0, 0);
+    v.B.resize(0, 0);
+    v.C.resize(0, 0);
+    v.D.resize(0, 0);
+    v.K.resize(0, 0);
+    v.open_poles.resize(0);
+    v.closed_poles.resize(0);
+    v.stable = false;
+    v.uncontrollable = 0;
+    v.uncontrollable_text.clear();
+  }
+}
+
+// ------------------------------------------------------------------ output checks
+
+// the CSV is checked as the other outputs are (io/output_guard.hpp), by its own header
+void guard_csv(const std::string& path, const std::string& model) {
+  if (study_same_file(path, model))
+    throw std::invalid_argument(path + ": this is the input file " + model +
+                                " (the same file); codyna never writes an output over its input: choose another name");
+  struct stat st{};
+  if (::stat(path.c_str(), &st) != 0) return;
+  if (!S_ISREG(st.st_mode)) throw std::invalid_argument(path + ": exists and is not a regular file; choose another name");
+  if (st.st_size == 0) return;
+  std::ifstream in(path, std::ios::binary);
+  std::string head(std::strlen(kCsvHeadStart), '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  if (head != kCsvHeadStart)
+    throw std::invalid_argument(path + ": exists and is not a sweep CSV written by codyna (it does not begin \"" +
+                                kCsvHeadStart + "\"); codyna never replaces a file it did not write: remove it or choose another name");
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------ plan
+
+std::vector<double> SweepPlan::values(long long i) const {
+  std::vector<double> out(vary.size());
+  if (!random) {
+    long long rest = i;
+    for (std::size_t k = vary.size(); k-- > 0;) {
+      const long long n = static_cast<long long>(vary[k].values.size());
+      out[k] = vary[k].values[static_cast<std::size_t>(rest % n)];
+      rest /= n;
+    }
+    return out;
+  }
+  for (std::size_t k = 0; k < vary.size(); ++k) {
+    const SweepVary& v = vary[k];
+    if (v.kind == SweepVary::Uniform) {
+      out[k] = v.a + (v.b - v.a) * unit_draw(seed, i, k, 0);
+    } else {  // Box-Muller on two draws of its own
+      const double u1 = unit_draw(seed, i, k, 0), u2 = unit_draw(seed, i, k, 1);
+      out[k] = v.a + v.b * std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
+    }
+  }
+  return out;
+}
+
+SweepPlan study_sweep_plan(const SweepRequest& r, const nlohmann::json& file) {
+  const Names opt{r.style};
+  SweepPlan plan;
+  if (r.vary.empty()) throw std::invalid_argument(opt("vary") + ": give at least one FIELD=SPEC (e.g. /bodies/1/mass=5:15:11)");
+  std::vector<std::string> seen;
+  for (const std::string& text : r.vary) {
+    SweepVary v = parse_vary(text, file, r.model, opt);
+    if (std::find(seen.begin(), seen.end(), v.field) != seen.end())
+      throw std::invalid_argument(opt("vary") + " " + text + ": " + v.field + " is varied twice");
+    seen.push_back(v.field);
+    plan.vary.push_back(std::move(v));
+  }
+  long long grids = 0;
+  std::string a_grid, a_random;
+  for (const SweepVary& v : plan.vary) {
+    if (v.kind == SweepVary::Grid) {
+      ++grids;
+      if (a_grid.empty()) a_grid = v.field + "=" + v.spec;
+    } else if (a_random.empty()) {
+      a_random = v.field + "=" + v.spec;
+    }
+  }
+  if (grids > 0 && grids < static_cast<long long>(plan.vary.size()))
+    throw std::invalid_argument(opt("vary") + ": a grid (" + a_grid + ") cannot be mixed with a distribution (" + a_random +
+                                ") yet: vary grids only (a full grid) or distributions only (joint random samples)");
+  plan.random = grids == 0;
+  if (plan.random) {
+    if (!r.samples) throw std::invalid_argument(opt("samples") + ": a random study (" + a_random + ") needs the number of samples");
+    if (!r.seed) throw std::invalid_argument(opt("seed") + ": a random study (" + a_random + ") needs a seed (any whole number), so that it can be repeated");
+    if (*r.samples < 1 || *r.samples > kMaxVariants)
+      throw std::invalid_argument(opt("samples") + ": expected 1 to " + std::to_string(kMaxVariants));
+    plan.count = *r.samples;
+    plan.seed = *r.seed;
+  } else {
+    if (r.samples) throw std::invalid_argument(opt("samples") + ": a grid study's size is its grid's; " + opt("samples") + " is for distributions");
+    if (r.seed) throw std::invalid_argument(opt("seed") + ": a grid study draws nothing; " + opt("seed") + " is for distributions");
+    plan.count = 1;
+    for (const SweepVary& v : plan.vary) {
+      plan.count *= static_cast<long long>(v.values.size());
+      if (plan.count > kMaxVariants)
+        throw std::invalid_argument(opt("vary") + ": the full grid has more than " + std::to_string(kMaxVariants) + " variants");
+    }
+  }
+  return plan;
+}
+
+const char* to_string(SweepStatus s) {
+  switch (s) {
+    case SweepStatus::Ok: return "ok";
+    case SweepStatus::ModelError: return "model error";
+    case SweepStatus::NotConverged: return "not converged";
+    case SweepStatus::Refused: return "refused";
+    case SweepStatus::Failed: return "failed";
+    case SweepStatus::SizeDiffers: return "sizes differ";
+  }
+  return "failed";
+}
+
+// ------------------------------------------------------------------ the job
+
+SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const SweepProgress& progress) {
+  const Names opt{r.style};
+  SweepJob job;
+  const auto note = [&](const std::string& text) {
+    job.notes.push_back(text);
+    if (tell) tell({StudyMessage::Note, text});
+  };
+  if (r.redesign != "" && r.redesign != "lqr")
+    throw std::invalid_argument(opt("redesign") + " " + r.redesign + ": expected lqr");
+  if (r.threads < 0) throw std::invalid_argument(opt("threads") + ": expected 1 or more (0: every core)");
+  // the outputs, before any work
+  if (!r.out.empty()) study_guard_output(r.out, OutputKind::ResultsHdf5, {r.model});
+  if (!r.csv.empty()) {
+    guard_csv(r.csv, r.model);
+    if (!r.out.empty() && (r.csv == r.out || study_same_file(r.csv, r.out)))
+      throw std::invalid_argument(opt("csv") + " " + r.csv + ": the same file as " + opt("out"));
+  }
+  const ModelSpec nominal_spec = study_read_model(r.model);  // errors name the file and the field
+  for (const std::string& n : nominal_spec.notes) note(n);
+  nlohmann::json file;
+  {
+    std::ifstream in(r.model, std::ios::binary);
+    file = nlohmann::json::parse(in);
+  }
+  job.plan = study_sweep_plan(r, file);
+  job.model_file = r.model;
+  job.model_name = nominal_spec.name;
+
+  // the nominal model: its linearization and controller must work, or there is no study
+  Context c;
+  c.request = &r;
+  c.plan = &job.plan;
+  c.file = &file;
+  for (const SweepVary& v : job.plan.vary) c.pointers.emplace_back(v.field);
+  c.linearize.style = r.style;
+  c.linearize.model = r.model;
+  const LinearizeJob nominal = study_linearize_job(c.linearize, nominal_spec);
+  const Model& m = nominal.model;
+  const StudySpec& s = m.spec.analysis;
+  if (s.discrete != 0)
+    throw std::invalid_argument(r.model + ": /analysis/discrete: a sweep linearizes in continuous time only (not built yet: "
+                                "discrete studies)");
+  const LinearSystem& sys = nominal.linearization.lin.system;
+  c.nx = sys.nx();
+  c.nu = sys.nu();
+  c.ny = sys.ny();
+  c.state_names = sys.state_names;
+  job.state_names = sys.state_names;
+  job.input_names = sys.input_names;
+  job.output_names = sys.output_names;
+  job.operating_point = nominal.linearization.op.kind;
+  job.method = nominal.method;
+  job.nominal_open_poles = poles_of(sys.A);
+  const bool model_controller = s.controller == "model" && m.spec.controller.type != ControllerType::None;
+  const bool is_lqr = s.controller == "lqr" || (model_controller && m.spec.controller.type == ControllerType::Lqr);
+  if (model_controller && m.spec.controller.operating_point != s.operating_point)
+    throw std::invalid_argument(r.model + ": the model file's controller is designed at its " +
+                                m.spec.controller.operating_point + " point, the study linearizes at " + s.operating_point +
+                                ": a sweep closes the loop where it linearizes (set /analysis/operating_point to \"" +
+                                m.spec.controller.operating_point + "\")");
+  if (!r.redesign.empty() && !is_lqr)
+    throw std::invalid_argument(opt("redesign") + " lqr: the study's controller is not an LQR (the model file's "
+                                "controller of type lqr, or \"controller\": \"lqr\" in its analysis section)");
+  if (s.controller != "none" && (model_controller || s.controller != "model")) {
+    const StudySimulation setup = study_simulation(m);
+    const Eigen::MatrixXd* g = setup.controller ? setup.controller->gain() : nullptr;
+    if (g && g->rows() == c.nu && g->cols() == c.nx) {
+      c.closed_loop = true;
+      c.K = *g;
+      c.redesign = r.redesign == "lqr";
+      job.closed_loop = true;
+      job.K = *g;
+      job.redesigned = c.redesign;
+      job.controller = setup.controller_source + (c.redesign ? ", designed again for every variant"
+                                                             : ", K designed on the nominal model and fixed");
+      job.nominal_closed_poles = poles_of(sys.A - sys.B * c.K);
+    } else if (setup.controller) {
+      note("the study's controller (" + setup.controller_source + ") is not a state feedback: open-loop figures only");
+    }
+  }
+  if (!job.closed_loop && job.controller.empty()) job.controller = "none (open loop)";
+
+  // the variants
+  const long long n = job.plan.count;
+  job.variants.resize(static_cast<std::size_t>(n));
+  unsigned threads = r.threads > 0 ? static_cast<unsigned>(r.threads) : std::max(1u, std::thread::hardware_concurrency());
+  if (s.controller == "file" && threads > 1) {
+    // the controller file is read again with every variant's model (matio, HDF5 for v7.3: not thread-safe)
+    note("the study's controller is a file: variants run on one thread");
+    threads = 1;
+  }
+  threads = static_cast<unsigned>(std::min<long long>(threads, n));
+  std::atomic<long long> next{0}, done{0};
+  std::mutex report;
+  std::exception_ptr fatal;
+  const auto worker = [&] {
+    for (;;) {
+      if (progress.cancel && progress.cancel->load()) return;
+      const long long i = next.fetch_add(1);
+      if (i >= n) return;
+      try {
+        run_variant(c, i, job.variants[static_cast<std::size_t>(i)]);
+      } catch (...) {  // not a failure of the variant (out of memory): the study stops
+        const std::lock_guard<std::mutex> lock(report);
+        if (!fatal) fatal = std::current_exception();
+        next.store(n);
+        return;
+      }
+      const long long d = done.fetch_add(1) + 1;
+      if (progress.done) {
+        const std::lock_guard<std::mutex> lock(report);
+        progress.done(d, n);
+      }
+    }
+  };
+  if (threads <= 1) {
+    worker();
+  } else {
+    std::vector<std::thread> pool;
+    for (unsigned t = 0; t < threads; ++t) pool.emplace_back(worker);
+    for (std::thread& t : pool) t.join();
+  }
+  if (fatal) std::rethrow_exception(fatal);
+  if (done.load() < n) throw StudyCancelled("the sweep was cancelled after " + std::to_string(done.load()) + " of " +
+                                            std::to_string(n) + " variants");
+
+  // the summary: the worst case is the completed variant with the largest max real part (first on ties)
+  double worst = -std::numeric_limits<double>::infinity();
+  for (long long i = 0; i < n; ++i) {
+    const SweepVariant& v = job.variants[static_cast<std::size_t>(i)];
+    if (v.status != SweepStatus::Ok) {
+      ++job.failed;
+      continue;
+    }
+    if (v.stable) ++job.stable;
+    const double x = job.closed_loop ? v.closed_max_real : v.open_max_real;
+    if (job.worst < 0 || x > worst) {
+      worst = x;
+      job.worst = i;
+    }
+  }
+
+  if (!r.out.empty()) {
+    study_write_sweep_hdf5(job, r.out);
+    job.written.push_back(r.out);
+  }
+  if (!r.csv.empty()) {
+    study_write_sweep_csv(job, r.csv);
+    job.written.push_back(r.csv);
+  }
+  return job;
+}
+
+// ------------------------------------------------------------------ HDF5
+
+namespace {
+
+class FileError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+[[noreturn]] void fail(const std::string& what) { throw FileError(what); }
+void check(herr_t rc, const std::string& what) {
+  if (rc < 0) fail(what);
+}
+
+class Handle {
+ public:
+  using Close = herr_t (*)(hid_t);
+  Handle(hid_t id, Close close, const std::string& what) : id_(id), close_(close) {
+    if (id_ < 0) fail(what);
+  }
+  Handle(Handle&& other) noexcept : id_(std::exchange(other.id_, -1)), close_(other.close_) {}
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  ~Handle() {
+    if (id_ >= 0) close_(id_);
+  }
+  operator hid_t() const { return id_; }
+  void close(const std::string& what) { check(close_(std::exchange(id_, -1)), what); }
+
+ private:
+  hid_t id_;
+  Close close_;
+};
+
+// no modification times in the object headers: the same study gives the same bytes
+Handle untimed(hid_t cls, const std::string& what) {
+  Handle p(H5Pcreate(cls), H5Pclose, what);
+  check(H5Pset_obj_track_times(p, 0), what);
+  return p;
+}
+
+void create_group(hid_t file, const std::string& name) {
+  const std::string what = "cannot create group " + name;
+  const Handle gcpl = untimed(H5P_GROUP_CREATE, what);
+  Handle g(H5Gcreate2(file, name.c_str(), H5P_DEFAULT, gcpl, H5P_DEFAULT), H5Gclose, what);
+}
+
+void write_dataset(hid_t file, const std::string& name, hid_t file_type, hid_t memory_type, const std::vector<hsize_t>& dims,
+                   const void* data) {
+  const std::string what = "cannot write " + name;
+  Handle space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), H5Sclose, what);
+  const Handle dcpl = untimed(H5P_DATASET_CREATE, what);
+  Handle d(H5Dcreate2(file, name.c_str(), file_type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT), H5Dclose, what);
+  std::size_t count = 1;
+  for (hsize_t x : dims) count *= static_cast<std::size_t>(x);
+  if (count > 0) check(H5Dwrite(d, memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), what);
+}
+
+void write_doubles(hid_t file, const std::string& name, const std::vector<hsize_t>& dims, const std::vector<double>& v) {
+  write_dataset(file, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, dims, v.data());
+}
+
+void write_ints(hid_t file, const std::string& name, const std::vector<int>& v) {
+  write_dataset(file, name, H5T_STD_I32LE, H5T_NATIVE_INT, {v.size()}, v.data());
+}
+
+void write_strings(hid_t file, const std::string& name, const std::vector<std::string>& list) {
+  std::size_t width = 1;
+  for (const std::string& s : list) width = std::max(width, s.size());
+  std::vector<char> packed(list.size() * width, '\0');
+  for (std::size_t i = 0; i < list.size(); ++i) std::memcpy(packed.data() + i * width, list[i].data(), list[i].size());
+  const std::string what = "cannot write " + name;
+  Handle type(H5Tcopy(H5T_C_S1), H5Tclose, what);
+  check(H5Tset_size(type, width), what);
+  check(H5Tset_strpad(type, H5T_STR_NULLPAD), what);
+  write_dataset(file, name, type, type, {list.size()}, packed.data());
+}
+
+void write_attribute(hid_t file, const char* object, const char* name, hid_t ftype, hid_t mtype, const void* value) {
+  const std::string what = std::string("cannot write attribute ") + name + " of " + object;
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose, what);
+  Handle a(H5Acreate_by_name(file, object, name, ftype, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Aclose, what);
+  check(H5Awrite(a, mtype, value), what);
+}
+void write_attribute(hid_t file, const char* object, const char* name, const std::string& value) {
+  const std::string what = std::string("cannot write attribute ") + name;
+  Handle type(H5Tcopy(H5T_C_S1), H5Tclose, what);
+  check(H5Tset_size(type, H5T_VARIABLE), what);
+  check(H5Tset_cset(type, H5T_CSET_UTF8), what);
+  const char* text = value.c_str();
+  write_attribute(file, object, name, type, type, &text);
+}
+void write_attribute(hid_t file, const char* object, const char* name, long long value) {
+  write_attribute(file, object, name, H5T_STD_I64LE, H5T_NATIVE_LLONG, &value);
+}
+void write_attribute_u64(hid_t file, const char* object, const char* name, std::uint64_t value) {
+  write_attribute(file, object, name, H5T_STD_U64LE, H5T_NATIVE_UINT64, &value);
+}
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// variants x rows x cols, row-major per variant (what MATLAB/Octave read as rows x cols x variants)
+std::vector<double> stack(const std::vector<SweepVariant>& vs, Eigen::MatrixXd SweepVariant::*field, Eigen::Index rows,
+                          Eigen::Index cols) {
+  std::vector<double> out(vs.size() * static_cast<std::size_t>(rows * cols), kNaN);
+  std::size_t at = 0;
+  for (const SweepVariant& v : vs) {
+    const Eigen::MatrixXd& M = v.*field;
+    if (v.status == SweepStatus::Ok && M.rows() == rows && M.cols() == cols)
+      for (Eigen::Index a = 0; a < rows; ++a)
+        for (Eigen::Index b = 0; b < cols; ++b) out[at + static_cast<std::size_t>(a * cols + b)] = M(a, b);
+    at += static_cast<std::size_t>(rows * cols);
+  }
+  return out;
+}
+
+void write_poles(hid_t file, const std::string& group, const std::vector<SweepVariant>& vs,
+                 Eigen::VectorXcd SweepVariant::*field, double SweepVariant::*maxr, Eigen::Index n) {
+  std::vector<double> re(vs.size() * static_cast<std::size_t>(n), kNaN), im = re, mr(vs.size(), kNaN);
+  for (std::size_t i = 0; i < vs.size(); ++i) {
+    const Eigen::VectorXcd& p = vs[i].*field;
+    if (vs[i].status != SweepStatus::Ok || p.size() != n) continue;
+    for (Eigen::Index k = 0; k < n; ++k) {
+      re[i * static_cast<std::size_t>(n) + static_cast<std::size_t>(k)] = p[k].real();
+      im[i * static_cast<std::size_t>(n) + static_cast<std::size_t>(k)] = p[k].imag();
+    }
+    mr[i] = vs[i].*maxr;
+  }
+  write_doubles(file, group + "/poles_real", {vs.size(), static_cast<hsize_t>(n)}, re);
+  write_doubles(file, group + "/poles_imag", {vs.size(), static_cast<hsize_t>(n)}, im);
+  write_doubles(file, group + "/max_real", {vs.size()}, mr);
+}
+
+void write_contents(hid_t file, const SweepJob& job) {
+  const auto& vs = job.variants;
+  const std::size_t n = vs.size(), nv = job.plan.vary.size();
+  const Eigen::Index nx = static_cast<Eigen::Index>(job.state_names.size()), nu = static_cast<Eigen::Index>(job.input_names.size()),
+                     ny = static_cast<Eigen::Index>(job.output_names.size());
+  write_attribute(file, "/", "format", std::string("codyna sweep"));
+  write_attribute(file, "/", "format_version", static_cast<long long>(kFormatVersion));
+  write_attribute(file, "/", "model_file", job.model_file);
+  write_attribute(file, "/", "model_name", job.model_name);
+  write_attribute(file, "/", "codyna_version", std::string(CODYNA_VERSION));
+  write_attribute(file, "/", "design", std::string(job.plan.random ? "random" : "grid"));
+  write_attribute(file, "/", "variants", static_cast<long long>(n));
+  if (job.plan.random) write_attribute_u64(file, "/", "seed", job.plan.seed);
+  write_attribute(file, "/", "operating_point", job.operating_point);
+  write_attribute(file, "/", "method", job.method);
+  write_attribute(file, "/", "controller", job.controller);
+  write_attribute(file, "/", "gain", std::string(!job.closed_loop ? "none" : job.redesigned ? "redesigned" : "fixed"));
+
+  create_group(file, "/parameters");
+  std::vector<std::string> fields, specs;
+  std::vector<double> nominal, values(n * nv, kNaN);
+  for (const SweepVary& v : job.plan.vary) {
+    fields.push_back(v.field);
+    specs.push_back(v.spec);
+    nominal.push_back(v.nominal);
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t k = 0; k < nv && k < vs[i].values.size(); ++k) values[i * nv + k] = vs[i].values[k];
+  write_doubles(file, "/parameters/values", {n, nv}, values);
+  write_strings(file, "/parameters/fields", fields);
+  write_strings(file, "/parameters/specs", specs);
+  write_doubles(file, "/parameters/nominal", {nv}, nominal);
+
+  create_group(file, "/status");
+  std::vector<int> codes;
+  std::vector<std::string> reasons;
+  for (const SweepVariant& v : vs) {
+    codes.push_back(static_cast<int>(v.status));
+    reasons.push_back(v.reason);
+  }
+  write_ints(file, "/status/code", codes);
+  write_strings(file, "/status/reason", reasons);
+  write_attribute(file, "/status", "codes",
+                  std::string("0 ok, 1 model error, 2 not converged, 3 refused, 4 failed, 5 sizes differ"));
+
+  create_group(file, "/names");
+  write_strings(file, "/names/states", job.state_names);
+  write_strings(file, "/names/inputs", job.input_names);
+  write_strings(file, "/names/outputs", job.output_names);
+
+  create_group(file, "/linear");
+  write_doubles(file, "/linear/A", {n, static_cast<hsize_t>(nx), static_cast<hsize_t>(nx)}, stack(vs, &SweepVariant::A, nx, nx));
+  write_doubles(file, "/linear/B", {n, static_cast<hsize_t>(nx), static_cast<hsize_t>(nu)}, stack(vs, &SweepVariant::B, nx, nu));
+  write_doubles(file, "/linear/C", {n, static_cast<hsize_t>(ny), static_cast<hsize_t>(nx)}, stack(vs, &SweepVariant::C, ny, nx));
+  write_doubles(file, "/linear/D", {n, static_cast<hsize_t>(ny), static_cast<hsize_t>(nu)}, stack(vs, &SweepVariant::D, ny, nu));
+
+  create_group(file, "/open_loop");
+  write_poles(file, "/open_loop", vs, &SweepVariant::open_poles, &SweepVariant::open_max_real, nx);
+  std::vector<int> unc, stable;
+  for (const SweepVariant& v : vs) {
+    unc.push_back(v.status == SweepStatus::Ok ? v.uncontrollable : -1);
+    stable.push_back(v.stable ? 1 : 0);
+  }
+  write_ints(file, "/open_loop/uncontrollable", unc);
+  if (!job.closed_loop) {
+    write_ints(file, "/open_loop/stable", stable);
+    return;
+  }
+  create_group(file, "/closed_loop");
+  if (job.redesigned) {
+    write_doubles(file, "/closed_loop/K", {n, static_cast<hsize_t>(nu), static_cast<hsize_t>(nx)}, stack(vs, &SweepVariant::K, nu, nx));
+  } else {
+    std::vector<double> k(static_cast<std::size_t>(nu * nx));
+    for (Eigen::Index a = 0; a < nu; ++a)
+      for (Eigen::Index b = 0; b < nx; ++b) k[static_cast<std::size_t>(a * nx + b)] = job.K(a, b);
+    write_doubles(file, "/closed_loop/K", {static_cast<hsize_t>(nu), static_cast<hsize_t>(nx)}, k);
+  }
+  write_poles(file, "/closed_loop", vs, &SweepVariant::closed_poles, &SweepVariant::closed_max_real, nx);
+  write_ints(file, "/closed_loop/stable", stable);
+}
+
+void append_number(std::string& line, double x) {
+  if (!std::isfinite(x)) {
+    line += std::isnan(x) ? "nan" : (x > 0 ? "inf" : "-inf");
+    return;
+  }
+  char buf[32];
+  const auto res = std::to_chars(buf, buf + sizeof buf, x, std::chars_format::general, 17);
+  line.append(buf, res.ptr);
+}
+
+void append_csv_field(std::string& line, const std::string& text) {
+  if (text.find_first_of(",\"\r\n") == std::string::npos) {
+    line += text;
+    return;
+  }
+  line += '"';
+  for (char ch : text) line.append(ch == '"' ? 2 : 1, ch);
+  line += '"';
+}
+
+}  // namespace
+
+void study_write_sweep_hdf5(const SweepJob& job, const std::string& path) {
+  study_guard_output(path, OutputKind::ResultsHdf5, {job.model_file});
+  AtomicFile out(path);
+  try {
+    const QuietHdf5 quiet;
+    Handle file(H5Fcreate(out.temp_path().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose,
+                "cannot create " + out.temp_path());
+    write_contents(file, job);
+    file.close("cannot finish " + out.temp_path());
+  } catch (const FileError& e) {
+    throw std::runtime_error(path + ": " + e.what());
+  }
+  out.commit();
+}
+
+void study_write_sweep_csv(const SweepJob& job, const std::string& path) {
+  guard_csv(path, job.model_file);
+  std::string text = kCsvHeadStart;
+  for (const SweepVary& v : job.plan.vary) {
+    text += ',';
+    append_csv_field(text, v.field);
+  }
+  text += ",open_loop_max_real";
+  if (job.closed_loop) text += ",closed_loop_max_real";
+  text += ",stable,uncontrollable,reason\n";
+  for (std::size_t i = 0; i < job.variants.size(); ++i) {
+    const SweepVariant& v = job.variants[i];
+    const bool ok = v.status == SweepStatus::Ok;
+    text += std::to_string(i) + ',' + to_string(v.status);
+    for (double x : v.values) {
+      text += ',';
+      append_number(text, x);
+    }
+    text += ',';
+    append_number(text, ok ? v.open_max_real : kNaN);
+    if (job.closed_loop) {
+      text += ',';
+      append_number(text, ok ? v.closed_max_real : kNaN);
+    }
+    text += std::string(",") + (v.stable ? "1" : "0") + ',' + (ok ? std::to_string(v.uncontrollable) : std::string()) + ',';
+    append_csv_field(text, v.reason);
+    text += '\n';
+  }
+  write_file_atomically(path, text);
+}
+
+std::string study_sweep_summary(const SweepJob& job) {
+  std::ostringstream os;
+  const long long n = static_cast<long long>(job.variants.size());
+  const std::size_t fields = job.plan.vary.size();
+  os << "sweep            " << job.model_name << ": " << n << " variants, "
+     << (job.plan.random ? "joint random samples (seed " + std::to_string(job.plan.seed) + ")" : std::string("a full grid"))
+     << " of " << fields << (fields == 1 ? " field" : " fields") << "\n";
+  for (const SweepVary& v : job.plan.vary) os << "  " << v.field << " = " << v.spec << " (nominal " << fmt(v.nominal) << ")\n";
+  os << "operating point  " << job.operating_point << ", " << job.method << " Jacobians\n";
+  os << "closed loop      " << job.controller << "\n";
+  if (job.closed_loop) {
+    os << "nominal          max Re(closed-loop pole) = " << fmt(max_real(job.nominal_closed_poles)) << "\n";
+  }
+  os << "completed        " << (n - job.failed) << " of " << n << " (" << job.failed << " failed)\n";
+  const long long completed = n - job.failed;
+  os << "stable           " << job.stable << " of " << completed << " completed";
+  if (completed > 0) {
+    char pct[32];
+    std::snprintf(pct, sizeof pct, "%.1f", 100.0 * static_cast<double>(job.stable) / static_cast<double>(completed));
+    os << " (" << pct << " %)";
+  }
+  os << (job.closed_loop ? ", closed loop" : ", open loop") << "\n";
+  if (job.worst >= 0) {
+    const SweepVariant& w = job.variants[static_cast<std::size_t>(job.worst)];
+    os << "worst case       variant " << job.worst << ":";
+    for (std::size_t k = 0; k < fields; ++k) os << (k ? "," : "") << " " << job.plan.vary[k].field << " = " << fmt(w.values[k]);
+    os << ", max Re(" << (job.closed_loop ? "closed" : "open") << "-loop pole) = "
+       << fmt(job.closed_loop ? w.closed_max_real : w.open_max_real) << "\n";
+  }
+  long long listed = 0;
+  for (long long i = 0; i < n; ++i) {
+    const SweepVariant& v = job.variants[static_cast<std::size_t>(i)];
+    if (v.status == SweepStatus::Ok) continue;
+    if (listed++ == 10) {
+      os << "                 ... and " << (job.failed - 10) << " more (the file's /status/reason)\n";
+      break;
+    }
+    os << (listed == 1 ? "failed           " : "                 ") << "variant " << i << " (" << to_string(v.status)
+       << "): " << v.reason << "\n";
+  }
+  return os.str();
+}
+
+}  // namespace codyna

@@ -1,0 +1,131 @@
+// Parameter studies (issue 22, first slice: one machine): `codyna sweep MODEL.json --vary
+// FIELD=SPEC ... --out STUDY.h5`. Every variant is the model file with some numbers replaced
+// (FIELD is a JSON pointer into the file, the paths ModelError prints: /bodies/1/mass), read,
+// compiled and linearized by the file's "analysis" choices through study_linearize_job; its open-
+// loop poles, controllability and, when the study has a linear state feedback (the model's LQR,
+// a state_feedback, analysis "controller": "lqr" or a K file), the closed-loop poles
+// eig(A - B K) with K designed ONCE on the nominal model and kept (or redesigned per variant with
+// redesign = "lqr").
+//
+// Variant numbering, so that a later split over threads, MPI ranks or Slurm shards gives the same
+// file bit for bit: variant i's values depend only on (the --vary specs, the seed, i).
+//   grid     every --vary is a grid (a:b:n) or a list ([v1,...]): the full grid, the LAST --vary
+//            varying fastest (row-major: i = ((i1 n2 + i2) n3 + i3) ...);
+//   random   every --vary is a distribution (normal(mu,sigma), uniform(a,b)): `samples` joint
+//            samples, entry k of variant i drawn from a counter-based generator
+//            (splitmix64 of (seed, i, k, draw)): no state is carried from one variant to the next.
+// A grid mixed with distributions is refused (not defined yet).
+//
+// A variant that fails (a ModelError, an operating point that does not converge, an LQR that
+// cannot be designed, A of another size than the nominal's) is recorded with its status and
+// reason; it never stops the study. Results are stored in variant order whatever the order the
+// threads finish in. Nothing here prints: progress is a callback.
+#pragma once
+
+#include <atomic>
+#include <complex>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+#include <nlohmann/json.hpp>
+
+#include "study/jobs.hpp"
+
+namespace codyna {
+
+struct SweepRequest {
+  OptionStyle style = OptionStyle::Flag;
+  std::string model;                        // the model file
+  std::vector<std::string> vary;            // FIELD=SPEC, in order
+  std::optional<long long> samples;         // random studies: the number of variants
+  std::optional<std::uint64_t> seed;        // random studies
+  int threads = 0;                          // 0: std::thread::hardware_concurrency()
+  std::string redesign;                     // "" (K fixed) or "lqr" (designed again per variant)
+  std::string out, csv;                     // HDF5 and CSV results; "" = not written
+};
+
+// One --vary, parsed.
+struct SweepVary {
+  std::string field;               // a JSON pointer into the model file
+  std::string spec;                // as given
+  enum Kind { Grid, Normal, Uniform } kind = Grid;
+  std::vector<double> values;      // Grid: the values (linspace or the list)
+  double a = 0, b = 0;             // Normal: mu, sigma; Uniform: a, b
+  double nominal = 0;              // the model file's value
+};
+
+// The variants' values, a function of the specs, the seed and the index only.
+struct SweepPlan {
+  std::vector<SweepVary> vary;
+  bool random = false;
+  std::uint64_t seed = 0;
+  long long count = 0;
+  std::vector<double> values(long long i) const;  // one per --vary
+};
+
+// Parses the --vary texts against the model file's JSON (the field must hold a number) and the
+// sampling options; std::invalid_argument naming the option for anything wrong.
+SweepPlan study_sweep_plan(const SweepRequest& r, const nlohmann::json& model_file);
+
+enum class SweepStatus : int {
+  Ok = 0,
+  ModelError = 1,       // the variant's model is refused (ModelError)
+  NotConverged = 2,     // its operating point search did not converge (ConvergenceError)
+  Refused = 3,          // a choice cannot be applied to it (std::invalid_argument: an LQR not stabilizable)
+  Failed = 4,           // any other failure
+  SizeDiffers = 5,      // its A, B, C, D are not the nominal's sizes
+};
+const char* to_string(SweepStatus s);
+
+struct SweepVariant {
+  std::vector<double> values;                 // one per --vary
+  SweepStatus status = SweepStatus::Failed;
+  std::string reason;                         // "" when Ok
+  Eigen::MatrixXd A, B, C, D, K;              // continuous plant; K only when redesigned
+  Eigen::VectorXcd open_poles, closed_poles;  // sorted by real part, then imaginary part
+  double open_max_real = 0, closed_max_real = 0;
+  bool stable = false;                        // closed loop (no closed loop: open loop)
+  int uncontrollable = 0;                     // modes the Plant/In inputs cannot move
+  std::string uncontrollable_text;            // study_describe_modes of them
+};
+
+struct SweepJob {
+  std::string model_name, model_file;
+  SweepPlan plan;
+  std::vector<std::string> state_names, input_names, output_names;
+  std::string operating_point, method;
+  bool closed_loop = false;                   // a state feedback closes the loop
+  std::string controller;                     // what the closed loop is ("the model file's lqr controller, K fixed")
+  bool redesigned = false;
+  Eigen::MatrixXd K;                          // the nominal gain (nu x nx), when closed_loop
+  Eigen::VectorXcd nominal_closed_poles, nominal_open_poles;
+  std::vector<SweepVariant> variants;
+  std::vector<std::string> notes, warnings;
+  std::vector<std::string> written;
+  // summary
+  long long failed = 0, stable = 0;
+  long long worst = -1;                       // the completed variant with the largest max real part
+};
+
+struct SweepProgress {
+  std::function<void(long long done, long long total)> done;  // called from the workers (serialised)
+  const std::atomic<bool>* cancel = nullptr;                  // stops taking new variants
+};
+
+// The whole `codyna sweep`: the plan, the nominal model (its linearization and controller, which
+// must work), every variant on `threads` workers, and the files (each output checked against the
+// model file before any work, written through a temporary file renamed into place).
+SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell = {}, const SweepProgress& progress = {});
+
+// Writes the HDF5 results / the CSV (each atomically; see docs/parameter-studies.md).
+void study_write_sweep_hdf5(const SweepJob& job, const std::string& path);
+void study_write_sweep_csv(const SweepJob& job, const std::string& path);
+
+// The summary `codyna sweep` prints.
+std::string study_sweep_summary(const SweepJob& job);
+
+}  // namespace codyna
