@@ -1,0 +1,260 @@
+// Parameter studies (core/study/sweep, issue 22): the cart-pendulum's rod mass over 11 values
+// with the nominal LQR fixed (every variant's closed-loop poles against eig(A - B K) from that
+// variant's own linearization, made here through the linearize job), a Monte Carlo of 200
+// samples repeated and on 1 and 2 threads (the same file, byte for byte), variants that fail
+// recorded with their reason, and bad --vary options named.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <complex>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+
+#include "study/files.hpp"
+#include "study/jobs.hpp"
+#include "study/sweep.hpp"
+#include "study/tools.hpp"
+
+namespace codyna {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kModel = std::string(CODYNA_EXAMPLES_DIR) + "/cart_pendulum.json";
+
+class TempDir {
+ public:
+  TempDir() {
+    std::string pattern = (fs::temp_directory_path() / "codyna_sweep_XXXXXX").string();
+    if (!::mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
+    path_ = pattern;
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  std::string file(const std::string& name) const { return (fs::path(path_) / name).string(); }
+
+ private:
+  std::string path_;
+};
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+nlohmann::json model_json() {
+  std::ifstream in(kModel);
+  return nlohmann::json::parse(in);
+}
+
+// the continuous A, B of the model file with /bodies/1/mass = mass, through the linearize job
+LinearSystem linearized_with_rod_mass(double mass) {
+  nlohmann::json j = model_json();
+  j["bodies"][1]["mass"] = mass;
+  LinearizeRequest r;
+  r.model = kModel;
+  return study_linearize_job(r, study_parse_model(j, kModel)).linearization.lin.system;
+}
+
+Eigen::VectorXcd sorted(Eigen::VectorXcd p) {
+  std::sort(p.data(), p.data() + p.size(), [](const std::complex<double>& a, const std::complex<double>& b) {
+    return a.real() < b.real() || (a.real() == b.real() && a.imag() < b.imag());
+  });
+  return p;
+}
+
+SweepRequest rod_mass_grid() {
+  SweepRequest r;
+  r.model = kModel;
+  r.vary = {"/bodies/1/mass=5:15:11"};
+  r.threads = 2;
+  return r;
+}
+
+TEST(Sweep, FixedLqrClosedLoopPolesAreEigOfEachVariantsOwnLinearization) {
+  const SweepJob job = study_sweep_job(rod_mass_grid());
+  ASSERT_EQ(job.variants.size(), 11u);
+  ASSERT_TRUE(job.closed_loop);
+  EXPECT_FALSE(job.redesigned);
+  // the nominal LQR designed here from the file's weights (Q = diag(10, 100, 1, 1), R = 0.01)
+  const LinearSystem nominal = linearized_with_rod_mass(10.0);
+  Eigen::MatrixXd Q = Eigen::Vector4d(10, 100, 1, 1).asDiagonal(), R(1, 1);
+  R(0, 0) = 0.01;
+  const Eigen::MatrixXd K = study_lqr(nominal.A, nominal.B, Q, R).K;
+  ASSERT_EQ(job.K.rows(), 1);
+  ASSERT_EQ(job.K.cols(), 4);
+  EXPECT_LE((job.K - K).norm(), 1e-10 * K.norm());
+  double spread = 0;
+  for (int i = 0; i < 11; ++i) {
+    const SweepVariant& v = job.variants[static_cast<std::size_t>(i)];
+    const double mass = 5.0 + i;
+    ASSERT_EQ(v.status, SweepStatus::Ok) << v.reason;
+    ASSERT_EQ(v.values.size(), 1u);
+    EXPECT_NEAR(v.values[0], mass, 1e-14);
+    const LinearSystem own = linearized_with_rod_mass(mass);
+    EXPECT_LE((v.A - own.A).norm(), 1e-12 * own.A.norm()) << "variant " << i;
+    EXPECT_LE((v.B - own.B).norm(), 1e-12 * own.B.norm()) << "variant " << i;
+    const Eigen::VectorXcd expected = sorted((own.A - own.B * K).eigenvalues());
+    ASSERT_EQ(v.closed_poles.size(), 4);
+    EXPECT_LE((v.closed_poles - expected).cwiseAbs().maxCoeff(), 1e-10) << "variant " << i;
+    EXPECT_NEAR(v.closed_max_real, expected.real().maxCoeff(), 1e-10);
+    EXPECT_TRUE(v.stable);
+    const Eigen::VectorXcd open = sorted(own.A.eigenvalues());
+    EXPECT_LE((v.open_poles - open).cwiseAbs().maxCoeff(), 1e-10);
+    EXPECT_GT(v.open_max_real, 0);  // upright: unstable without the controller
+    EXPECT_EQ(v.uncontrollable, 0);
+    // with K designed again the poles are not those of the fixed K (except at the nominal mass)
+    if (i != 5) {
+      const Eigen::MatrixXd Ki = study_lqr(own.A, own.B, Q, R).K;
+      spread = std::max(spread, (sorted((own.A - own.B * Ki).eigenvalues()) - expected).cwiseAbs().maxCoeff());
+    }
+  }
+  EXPECT_GT(spread, 1e-3);  // so the test above can tell a fixed K from a redesigned one
+  EXPECT_EQ(job.failed, 0);
+  EXPECT_EQ(job.stable, 11);
+  EXPECT_EQ(job.worst, 0);  // the lightest rod is the least damped closed loop
+}
+
+TEST(Sweep, RedesignedLqrIsDesignedOnEachVariant) {
+  SweepRequest r = rod_mass_grid();
+  r.vary = {"/bodies/1/mass=[6,14]"};
+  r.redesign = "lqr";
+  const SweepJob job = study_sweep_job(r);
+  ASSERT_TRUE(job.redesigned);
+  Eigen::MatrixXd Q = Eigen::Vector4d(10, 100, 1, 1).asDiagonal(), R(1, 1);
+  R(0, 0) = 0.01;
+  for (int i = 0; i < 2; ++i) {
+    const SweepVariant& v = job.variants[static_cast<std::size_t>(i)];
+    ASSERT_EQ(v.status, SweepStatus::Ok) << v.reason;
+    const LinearSystem own = linearized_with_rod_mass(i == 0 ? 6 : 14);
+    const Eigen::MatrixXd K = study_lqr(own.A, own.B, Q, R).K;
+    EXPECT_LE((v.K - K).norm(), 1e-9 * K.norm());
+    EXPECT_LE((v.closed_poles - sorted((own.A - own.B * K).eigenvalues())).cwiseAbs().maxCoeff(), 1e-10);
+  }
+}
+
+TEST(Sweep, MonteCarloIsTheSameFileTwiceAndOnOneOrTwoThreads) {
+  TempDir dir;
+  SweepRequest r;
+  r.model = kModel;
+  r.vary = {"/bodies/1/mass=normal(10,2)", "/bodies/0/mass=uniform(15,25)"};
+  r.samples = 200;
+  r.seed = 12345;
+  const auto run = [&](int threads, const std::string& name) {
+    SweepRequest x = r;
+    x.threads = threads;
+    x.out = dir.file(name + ".h5");
+    x.csv = dir.file(name + ".csv");
+    return study_sweep_job(x);
+  };
+  const SweepJob a = run(1, "a"), b = run(1, "b"), c = run(2, "c");
+  ASSERT_EQ(a.variants.size(), 200u);
+  EXPECT_EQ(slurp(dir.file("a.h5")), slurp(dir.file("b.h5")));
+  EXPECT_EQ(slurp(dir.file("a.h5")), slurp(dir.file("c.h5")));
+  EXPECT_EQ(slurp(dir.file("a.csv")), slurp(dir.file("c.csv")));
+  EXPECT_GT(slurp(dir.file("a.h5")).size(), 200u * 16u * 8u);  // the A stack is there
+  double mean = 0, lo = 1e300, hi = -1e300;
+  for (std::size_t i = 0; i < 200; ++i) {
+    ASSERT_EQ(a.variants[i].values, c.variants[i].values);
+    // variant i is a function of (specs, seed, i) alone
+    ASSERT_EQ(a.variants[i].values, a.plan.values(static_cast<long long>(i)));
+    EXPECT_EQ(a.variants[i].closed_poles, c.variants[i].closed_poles);
+    mean += a.variants[i].values[0] / 200;
+    lo = std::min(lo, a.variants[i].values[1]);
+    hi = std::max(hi, a.variants[i].values[1]);
+  }
+  EXPECT_NEAR(mean, 10.0, 0.6);  // 3 standard errors of the mean (2 / sqrt(200) = 0.14) and then some
+  EXPECT_GE(lo, 15.0);
+  EXPECT_LE(hi, 25.0);
+  EXPECT_LT(lo, 15.5);
+  EXPECT_GT(hi, 24.5);
+  // another seed draws other values
+  SweepRequest other = r;
+  other.seed = 12346;
+  EXPECT_NE(study_sweep_plan(other, model_json()).values(0), a.plan.values(0));
+  // a sample never depends on how many there are (a shard of a larger study draws the same)
+  SweepRequest more = r;
+  more.samples = 1000;
+  EXPECT_EQ(study_sweep_plan(more, model_json()).values(199), a.plan.values(199));
+}
+
+TEST(Sweep, FailedVariantsAreRecordedWithTheirReasonAndTheOthersComplete) {
+  SweepRequest r;
+  r.model = kModel;
+  r.vary = {"/bodies/1/mass=[10,-1,0,12]"};
+  r.threads = 2;
+  const SweepJob job = study_sweep_job(r);
+  ASSERT_EQ(job.variants.size(), 4u);
+  EXPECT_EQ(job.variants[0].status, SweepStatus::Ok);
+  EXPECT_EQ(job.variants[1].status, SweepStatus::ModelError);
+  EXPECT_NE(job.variants[1].reason.find("/bodies/1/mass"), std::string::npos) << job.variants[1].reason;
+  EXPECT_NE(job.variants[1].reason.find("non-negative mass"), std::string::npos) << job.variants[1].reason;
+  // a massless rod is a valid model (nothing holds it up): the fixed K does not stabilize it
+  EXPECT_EQ(job.variants[2].status, SweepStatus::Ok) << job.variants[2].reason;
+  EXPECT_FALSE(job.variants[2].stable);
+  EXPECT_EQ(job.variants[2].uncontrollable, 1);
+  EXPECT_EQ(job.variants[3].status, SweepStatus::Ok);
+  EXPECT_EQ(job.failed, 1);
+  EXPECT_EQ(job.stable, 2);
+  EXPECT_EQ(job.worst, 2);
+  const std::string summary = study_sweep_summary(job);
+  EXPECT_NE(summary.find("variant 1 (model error)"), std::string::npos) << summary;
+  // redesigned, the massless rod's LQR cannot be made: refused, with the reason
+  r.redesign = "lqr";
+  const SweepJob again = study_sweep_job(r);
+  EXPECT_EQ(again.variants[2].status, SweepStatus::Refused);
+  EXPECT_NE(again.variants[2].reason.find("not stabilizable"), std::string::npos) << again.variants[2].reason;
+  EXPECT_EQ(again.variants[3].status, SweepStatus::Ok);
+}
+
+void expect_refused(const std::vector<std::string>& vary, const std::vector<std::string>& words,
+                    std::optional<long long> samples = {}, std::optional<std::uint64_t> seed = {}) {
+  SweepRequest r;
+  r.model = kModel;
+  r.vary = vary;
+  r.samples = samples;
+  r.seed = seed;
+  try {
+    study_sweep_job(r);
+    ADD_FAILURE() << "accepted " << vary[0];
+  } catch (const std::invalid_argument& e) {
+    for (const std::string& w : words) EXPECT_NE(std::string(e.what()).find(w), std::string::npos) << e.what();
+  }
+}
+
+TEST(Sweep, BadVaryIsNamed) {
+  expect_refused({"/bodies/7/mass=1:2:3"}, {"--vary", "/bodies/7/mass", "has 2 entries"});
+  expect_refused({"/bodies/1/weight=1:2:3"}, {"--vary", "no field /bodies/1/weight", "mass"});
+  expect_refused({"/bodies/1/name=1:2:3"}, {"--vary", "not a number"});
+  expect_refused({"/bodies/1/com=1:2:3"}, {"--vary", "not a number", "/bodies/1/com/0"});
+  expect_refused({"bodies/1/mass=1:2:3"}, {"--vary", "JSON pointer"});
+  expect_refused({"/bodies/1/mass"}, {"--vary", "FIELD=SPEC"});
+  expect_refused({"/bodies/1/mass=5:15"}, {"--vary", "a:b:n"});
+  expect_refused({"/bodies/1/mass=5:15:2.5"}, {"--vary", "whole number"});
+  expect_refused({"/bodies/1/mass=[1,\"a\"]"}, {"--vary", "not a number"});
+  expect_refused({"/bodies/1/mass=gauss(1,2)"}, {"--vary", "normal(mu,sigma)"});
+  expect_refused({"/bodies/1/mass=normal(1,-2)"}, {"--vary", "sigma >= 0"});
+  expect_refused({"/bodies/1/mass=uniform(3,2)"}, {"--vary", "a < b"});
+  expect_refused({"/bodies/1/mass=1:2:3", "/bodies/0/mass=normal(20,1)"}, {"--vary", "cannot be mixed"});
+  expect_refused({"/bodies/1/mass=normal(10,1)"}, {"--samples"}, {}, 1);
+  expect_refused({"/bodies/1/mass=normal(10,1)"}, {"--seed"}, 10, {});
+  expect_refused({"/bodies/1/mass=1:2:3"}, {"--samples"}, 10, {});
+  expect_refused({"/bodies/1/mass=1:2:3", "/bodies/1/mass=[4]"}, {"--vary", "twice"});
+}
+
+TEST(Sweep, TheOutputNeverReplacesTheModel) {
+  SweepRequest r = rod_mass_grid();
+  r.out = kModel;
+  EXPECT_THROW(study_sweep_job(r), std::invalid_argument);
+  r.out = "";
+  r.csv = kModel;
+  EXPECT_THROW(study_sweep_job(r), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace codyna
