@@ -1,0 +1,105 @@
+#!/usr/bin/env bash
+# codyna sweep (issue 22, docs/parameter-studies.md), read back with h5py:
+#   * the cart-pendulum's rod mass over 11 values with the model's LQR fixed: the file's
+#     /closed_loop/poles_* equal eig(A - B K) of the stored A, B stacks and K to 1e-10, and its
+#     /linear/A equals the linearize command's A of the same model with that mass (1e-12);
+#   * a Monte Carlo of 200 samples run twice with one thread and once with two: every dataset and
+#     attribute equal, variable by variable (and the CSVs equal);
+#   * a variant that fails (mass -1) is recorded with status 1 and its reason, the others complete,
+#     exit code 0;
+#   * bad --vary, a missing --seed, and --out over the model exit 1 naming the option, writing nothing.
+# Usage: sweep.sh CODYNA SOURCE_DIR WORK_DIR
+set -euo pipefail
+codyna="$1"; src="$2"; work="$3"
+rm -rf "$work"; mkdir -p "$work"; cd "$work"
+fail() { echo "FAIL: $*"; exit 1; }
+PY=/usr/bin/python3
+model="$src/examples/cart_pendulum.json"
+
+"$codyna" sweep "$model" --vary /bodies/1/mass=5:15:11 --out grid.h5 --csv grid.csv > grid.txt ||
+  fail "the grid sweep exited non-zero"
+grep -q "completed        11 of 11 (0 failed)" grid.txt || fail "summary: $(cat grid.txt)"
+grep -q "stable           11 of 11 completed (100.0 %), closed loop" grid.txt || fail "summary: $(cat grid.txt)"
+# the linearize command on the model with a rod of 13 kg (variant 8)
+"$PY" -c "
+import json; j = json.load(open('$model')); j['bodies'][1]['mass'] = 13.0; json.dump(j, open('m13.json', 'w'))"
+"$codyna" linearize m13.json --out m13 > /dev/null
+
+"$PY" - <<'PY'
+import h5py, numpy as np, scipy.io
+f = h5py.File("grid.h5", "r")
+assert f.attrs["format"] == "codyna sweep", f.attrs["format"]
+assert f.attrs["gain"] == "fixed" and f.attrs["design"] == "grid" and f.attrs["variants"] == 11
+assert [s.decode() for s in f["parameters/fields"][:]] == ["/bodies/1/mass"]
+m = f["parameters/values"][:]
+assert m.shape == (11, 1) and np.allclose(m[:, 0], np.linspace(5, 15, 11), rtol=0, atol=1e-14), m
+assert (f["status/code"][:] == 0).all()
+A, B, K = f["linear/A"][:], f["linear/B"][:], f["closed_loop/K"][:]
+assert A.shape == (11, 4, 4) and B.shape == (11, 4, 1) and K.shape == (1, 4) and f["linear/C"].shape == (11, 2, 4)
+pr, pi = f["closed_loop/poles_real"][:], f["closed_loop/poles_imag"][:]
+worst = 0
+for i in range(11):
+    e = np.linalg.eigvals(A[i] - B[i] @ K)
+    e = e[np.lexsort((e.imag, e.real))]
+    stored = pr[i] + 1j * pi[i]
+    worst = max(worst, np.abs(stored - e).max())
+    assert abs(f["closed_loop/max_real"][i] - e.real.max()) < 1e-10
+assert worst < 1e-10, worst
+assert (f["closed_loop/stable"][:] == 1).all()
+lin = scipy.io.loadmat("m13/cart_pendulum.mat")
+assert np.abs(A[8] - lin["A"]).max() <= 1e-12 * np.abs(lin["A"]).max(), (A[8], lin["A"])
+print("grid: stored closed-loop poles vs eig(A - B K): %.1e" % worst)
+PY
+
+mc() { "$codyna" sweep "$model" --vary '/bodies/1/mass=normal(10,2)' --vary '/bodies/0/mass=uniform(15,25)' \
+         --samples 200 --seed 2026 --threads "$1" --out "$2.h5" --csv "$2.csv" > "$2.txt"; }
+mc 1 mc1; mc 1 mc1b; mc 2 mc2
+cmp -s mc1.csv mc2.csv || fail "the CSVs of 1 and 2 threads differ"
+"$PY" - <<'PY'
+import h5py, numpy as np
+def items(path):
+    out = {}
+    def visit(name, obj):
+        for k, v in obj.attrs.items(): out[name + "@" + k] = v
+        if isinstance(obj, h5py.Dataset): out[name] = obj[()]
+    f = h5py.File(path, "r")
+    for k, v in f.attrs.items(): out["@" + k] = v
+    f.visititems(visit)
+    return out
+a, b, c = items("mc1.h5"), items("mc1b.h5"), items("mc2.h5")
+assert a.keys() == b.keys() == c.keys(), (a.keys() ^ c.keys())
+for k in a:
+    for other in (b, c):
+        x, y = np.asarray(a[k]), np.asarray(other[k])
+        assert x.shape == y.shape and x.dtype == y.dtype, k
+        assert (x.tobytes() == y.tobytes()), k   # bit for bit (NaN included)
+assert a["parameters/values"].shape == (200, 2) and a["@seed"] == 2026
+print("monte carlo: %d variables equal bit for bit (twice, 1 and 2 threads)" % len(a))
+PY
+
+"$codyna" sweep "$model" --vary '/bodies/1/mass=[10,-1,12]' --out fail.h5 > fail.txt || fail "a failed variant stopped the study"
+grep -q "completed        2 of 3 (1 failed)" fail.txt || fail "summary: $(cat fail.txt)"
+grep -q "variant 1 (model error): .*/bodies/1/mass: expected a non-negative mass" fail.txt || fail "summary: $(cat fail.txt)"
+"$PY" - <<'PY'
+import h5py, numpy as np
+f = h5py.File("fail.h5", "r")
+assert list(f["status/code"][:]) == [0, 1, 0]
+r = [s.decode() for s in f["status/reason"][:]]
+assert r[0] == "" and "/bodies/1/mass" in r[1] and r[2] == "", r
+assert np.isnan(f["linear/A"][1]).all() and not np.isnan(f["linear/A"][2]).any()
+PY
+
+refused() {  # refused OUTPUT_WORDS -- ARGS...
+  local words="$1"; shift
+  local rc=0
+  "$codyna" sweep "$model" "$@" > out.txt 2> err.txt || rc=$?
+  [ $rc -eq 1 ] || fail "for $*: exit code $rc, expected 1"
+  grep -q -- "$words" err.txt || fail "for $*: expected \"$words\" in: $(cat err.txt)"
+}
+rm -f none.h5
+refused "--vary /bodies/9/mass=1:2:3: the model file .* has no field /bodies/9/mass" --vary /bodies/9/mass=1:2:3 --out none.h5
+refused "--vary /bodies/1/mass=1..3: expected a:b:n" --vary /bodies/1/mass=1..3 --out none.h5
+refused "--seed: a random study" --vary '/bodies/1/mass=normal(10,1)' --samples 5 --out none.h5
+refused "this is the input file" --vary /bodies/1/mass=1:2:3 --out "$model"
+[ ! -e none.h5 ] || fail "a refused sweep wrote none.h5"
+echo "sweep: ok"
