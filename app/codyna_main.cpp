@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
   codyna::cli::add_linearize(app);
   codyna::cli::add_simulate(app);
   codyna::cli::add_import(app);
+  codyna::cli::add_export_mjcf(app);
   codyna::cli::add_sweep(app);
   try {
     app.parse(argc, argv);
@@ -48,7 +49,7 @@ int main(int argc, char** argv) {
     else
       std::cerr << "codyna: error: " << e.what() << "\n";
     if (app.get_subcommands().empty())
-      std::cerr << "commands: info, linearize, simulate, import, sweep (codyna COMMAND --help for each)\n";
+      std::cerr << "commands: info, linearize, simulate, import, export-mjcf, sweep (codyna COMMAND --help for each)\n";
     else
       std::cerr << "see codyna " << app.get_subcommands().front()->get_name() << " --help\n";
     return 1;

@@ -10,6 +10,7 @@ void add_info(CLI::App& app);
 void add_linearize(CLI::App& app);
 void add_simulate(CLI::App& app);
 void add_import(CLI::App& app);
+void add_export_mjcf(CLI::App& app);
 void add_sweep(CLI::App& app);
 int exit_code();
 void set_exit_code(int code);

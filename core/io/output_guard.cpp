@@ -39,6 +39,8 @@ bool written_by_codyna(const std::string& path, OutputKind k) {
              h.find("codyna") != std::string::npos;
     case OutputKind::PlantScript:
       return starts_with(h, "% ") && h.substr(0, h.find('\n')).find("exported by codyna") != std::string::npos;
+    case OutputKind::Mjcf:
+      return starts_with(h, "<!-- MJCF written by codyna");  // io/export_mjcf.hpp's kMjcfHeader
   }
   return false;
 }
@@ -60,6 +62,7 @@ const char* describe(OutputKind k) {
     case OutputKind::CurvesCsv: return "a CSV of closed-loop responses";
     case OutputKind::PlantMat: return "a plant .mat export";
     case OutputKind::PlantScript: return "a plant .m export";
+    case OutputKind::Mjcf: return "an MJCF export";
   }
   return "an output";
 }

@@ -20,6 +20,7 @@ enum class OutputKind {
   PlantMat,     // NAME.mat of an export (MAT v5 or v7.3)
   PlantScript,  // NAME.m of an export
   CurvesCsv,    // step or frequency responses of a closed loop (io/curves_file.hpp)
+  Mjcf,         // a model exported as MJCF (io/export_mjcf.hpp; its first line says codyna wrote it)
 };
 
 const char* describe(OutputKind k);  // "an HDF5 results file", ...

@@ -8,6 +8,8 @@
 #include <fstream>
 
 #include "dynamics/prepare.hpp"
+#include "io/atomic_file.hpp"
+#include "io/export_mjcf.hpp"
 #include "io/import_mjcf.hpp"
 #include "io/import_urdf.hpp"
 #include "io/model_file.hpp"
@@ -62,6 +64,37 @@ ImportResult study_import(const std::string& path, const ImportOptions& options)
     throw std::runtime_error(path + ": the imported model does not compile (a fault of the importer, please report it): " +
                              e.detail() + (e.path().empty() ? "" : " at " + e.path()));
   }
+  return r;
+}
+
+ExportMjcfResult study_mjcf(const ModelSpec& spec, const std::string& label) {
+  const Model m = compile(spec, label);
+  MjcfExport e = export_mjcf(m, label);
+  ExportMjcfResult r;
+  if (mjcf_load_check_available()) {
+    const std::string err = mjcf_load_check(e.xml);
+    if (!err.empty())
+      throw std::invalid_argument((label.empty() ? "model " + spec.name : label) + ": " + mjcf_load_check_version() +
+                                  " does not load the MJCF written for it: " + err);
+    r.checked_by = mjcf_load_check_version();
+  }
+  r.xml = std::move(e.xml);
+  r.written = std::move(e.written);
+  r.not_written = std::move(e.not_written);
+  r.nbodies = e.nbodies;
+  r.njoints = e.njoints;
+  r.nactuators = e.nactuators;
+  r.nequalities = e.nequalities;
+  r.notes = spec.notes;
+  return r;
+}
+
+ExportMjcfResult study_export_mjcf(const ExportMjcfRequest& request) {
+  if (request.out.empty()) throw std::invalid_argument("the output MJCF file is not given (--out FILE.xml)");
+  guard_output(request.out, OutputKind::Mjcf, {request.model});
+  const ModelSpec spec = load_model_spec(request.model);
+  ExportMjcfResult r = study_mjcf(spec, request.model);
+  write_file_atomically(request.out, r.xml);
   return r;
 }
 

@@ -41,6 +41,32 @@ struct ImportJobResult {
 // std::invalid_argument), imports, compiles, writes the model file atomically.
 ImportJobResult study_import_job(const ImportRequest& request);
 
+// codyna export-mjcf MODEL.json --out FILE.xml: the model as MJCF that MuJoCo loads as the same
+// mechanism (io/export_mjcf.hpp says what maps; an element without an exact MJCF equivalent
+// refuses the export, naming it: std::invalid_argument).
+struct ExportMjcfRequest {
+  std::string model;  // the codyna model file
+  std::string out;    // the MJCF file written
+};
+struct ExportMjcfResult {
+  std::string xml;                       // the MJCF text (what is written)
+  std::vector<std::string> written;      // what was written, one line per kind
+  std::vector<std::string> not_written;  // what MJCF does not hold (no effect on the dynamics)
+  std::vector<std::string> notes;        // the model file reader's notes
+  int nbodies = 0, njoints = 0, nactuators = 0, nequalities = 0;  // MuJoCo's counts
+  std::string checked_by;                // "MuJoCo 2.2.2" when MuJoCo loaded the text, else ""
+};
+// The MJCF of a model, not written anywhere (the GUI, tests); `label` names the model in messages
+// and in the text's first line. Throws ModelError for a model that does not compile,
+// std::invalid_argument naming every element without an MJCF equivalent, and
+// std::invalid_argument with MuJoCo's message if this build has MuJoCo and MuJoCo does not load it.
+ExportMjcfResult study_mjcf(const ModelSpec& spec, const std::string& label = "");
+// Checks the output first (never the model file itself, never an existing file that is not an
+// MJCF codyna wrote: std::invalid_argument), reads and compiles the model, exports it, loads
+// the text with MuJoCo where this build has it, then writes the file atomically (a reader sees
+// the old file or the whole new one).
+ExportMjcfResult study_export_mjcf(const ExportMjcfRequest& request);
+
 // Refuses (std::invalid_argument) a model-file output that is one of `inputs` (the same file,
 // through links too), not a regular file, or an existing file that is not a codyna model file.
 void study_guard_model_output(const std::string& path, const std::vector<std::string>& inputs);
