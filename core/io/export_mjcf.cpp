@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -25,9 +26,10 @@ namespace {
 std::string num(double x) {
   if (x == 0) return "0";  // also -0
   if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
+  // the shortest text that reads back as the same double
   char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", x);
-  return buf;
+  const auto r = std::to_chars(buf, buf + sizeof buf, x);
+  return std::string(buf, r.ptr);
 }
 std::string brief(double x) {
   char buf[40];
