@@ -164,6 +164,7 @@ json shown_element(const ModelSpec& spec, ElementKind k, int index) {
         if (nq > 0) e["q0"] = q;
       }
       if (!e.contains("v0") && joint_nv(jt.type) > 0) e["v0"] = json(std::vector<double>(joint_nv(jt.type), 0.0));
+      if (!e.contains("armature") && joint_nv(jt.type) > 0) e["armature"] = 0.0;  // none: one value, every coordinate
       break;
     }
     case ElementKind::Body:
@@ -207,6 +208,8 @@ QString PropertyEditor::fieldHelp(ElementKind kind, const QString& key, const QS
       {"axis2", "Second axis of a universal joint"},
       {"q0", "Initial joint coordinates (rad for rotations, m for translations; quaternion w, x, y, z for ball joints)"},
       {"v0", "Initial joint rates (rad/s, m/s)"},
+      {"armature", "Rotor inertia on the joint's coordinates, added to the mass matrix's diagonal (>= 0; one value for "
+                   "every coordinate, or one per coordinate)"},
       {"g", "Gravity acceleration vector (x, y, z)"},
       {"stiffness", "Spring stiffness"},
       {"damping", "Damping coefficient"},
@@ -264,7 +267,7 @@ QString PropertyEditor::unitOf(const QString& key) {
       {"mass", "kg"}, {"inertia", "kg m²"}, {"com", "m"}, {"position", "m"}, {"point", "m"}, {"point_a", "m"},
       {"point_b", "m"}, {"size", "m"}, {"radius", "m"}, {"length", "m"}, {"rest_length", "m"},
       {"stiffness", "N/m | N m/rad"}, {"damping", "N s/m | N m s/rad"}, {"rest_position", "rad | m"},
-      {"force", "N"}, {"torque", "N m"}, {"g", "m/s²"}, {"q0", "rad | m"}, {"v0", "rad/s | m/s"},
+      {"force", "N"}, {"torque", "N m"}, {"g", "m/s²"}, {"q0", "rad | m"}, {"v0", "rad/s | m/s"}, {"armature", "kg m² | kg"},
       {"rotation", "matrix | axis-angle"}, {"axis", "unit vector"}, {"axis2", "unit vector"}, {"direction", "unit vector"},
       {"color", "rgba 0..1"}};
   const QString last = key.section('/', -1);
@@ -389,7 +392,7 @@ bool PropertyEditor::applyText(const QString& field, const QString& text, QStrin
         if (p.rfind(ss(base) + "/", 0) != 0) break;
         const std::string last = p.substr(p.rfind('/') + 1);
         const bool unknown = e.detail().find("unknown field") != std::string::npos;
-        const bool sized = last == "q0" || last == "v0";
+        const bool sized = last == "q0" || last == "v0" || last == "armature";
         if (!unknown && !sized) break;
         json& parent = j[json::json_pointer(p).parent_pointer()];
         if (!parent.is_object() || !parent.contains(last)) break;

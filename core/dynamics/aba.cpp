@@ -131,7 +131,10 @@ const VecXT<S>& aba_after_kinematics(const Model& model, DataT<S>& d, const VecX
     if (j.nv == 1) {
       const Vec6T<S> s = d.Sb[i].col(0);
       const Vec6T<S> Ui = d.IA[i] * s;
-      const S Dinv = S(1) / s.dot(Ui);
+      // D = S^T IA S plus the coordinate's rotor inertia (armature)
+      S D = s.dot(Ui);
+      if (model.armature.size() != 0) D += S(model.armature[j.idx_v]);
+      const S Dinv = S(1) / D;
       const S ui = tau[j.idx_v] - s.dot(d.pA[i]);
       d.U[i] = Ui;
       d.Dinv[i].resize(1, 1);
@@ -145,7 +148,9 @@ const VecXT<S>& aba_after_kinematics(const Model& model, DataT<S>& d, const VecX
       pa = d.pA[i] + Ia * c[i] + UD * ui;
     } else {
       d.U[i].noalias() = d.IA[i] * d.Sb[i];
-      const SmallMatT<S> D = d.Sb[i].transpose() * d.U[i];
+      SmallMatT<S> D = d.Sb[i].transpose() * d.U[i];
+      if (model.armature.size() != 0)
+        for (int c = 0; c < j.nv; ++c) D(c, c) += S(model.armature[j.idx_v + c]);
       small_inverse<S>(D, d.Dinv[i]);
       d.u[i] = tau.segment(j.idx_v, j.nv);  // in two steps: tau.segment - product would evaluate into a heap temporary
       d.u[i].noalias() -= d.Sb[i].transpose() * d.pA[i];

@@ -57,6 +57,9 @@ const MatXT<S>& crba_composite(const Model& model, DataT<S>& d) {
       M[b + static_cast<std::ptrdiff_t>(a) * nv] = m;
     }
   }
+  // rotor inertia (armature) on the diagonal
+  if (model.armature.size() != 0)
+    for (int a = 0; a < nv; ++a) M[a + static_cast<std::ptrdiff_t>(a) * nv] += S(model.armature[a]);
   return d.M;
 }
 

@@ -130,6 +130,11 @@ LocalKin local_kin(const SE3& g, const Vec6& V, const Vec6& A, const Vec3& l, bo
   return k;
 }
 
+// rotor inertia (armature): tau += armature a on each coordinate (constant: no q or v derivative)
+void add_armature_force(const Model& m, const Eigen::VectorXd& a, Eigen::VectorXd& tau) {
+  if (m.armature.size() != 0) tau.array() += m.armature.array() * a.array();
+}
+
 using Grad36 = Eigen::Matrix<double, 36, 1>;
 // g += D^T f on the 18 variables of `slot`
 void add_grad(Grad36& g, int slot, const Vec3& f, const Eigen::Matrix<double, 3, 18>& D) {
@@ -326,6 +331,7 @@ void TreeDerivatives::mass_matrix() {
       }
     }
   }
+  if (m_.armature.size() != 0) M.diagonal() += m_.armature;  // rotor inertia
 }
 
 void TreeDerivatives::differentiate_rnea() {
@@ -403,6 +409,7 @@ void TreeDerivatives::rnea_derivatives(const Eigen::VectorXd& q, const Eigen::Ve
   accelerations(v, a);
   composites();
   forces();
+  add_armature_force(m_, a, tau);
   differentiate_rnea();
 }
 
@@ -727,6 +734,7 @@ void TreeDerivatives::compute(const Eigen::VectorXd& q, const Eigen::VectorXd& v
   // inverse dynamics at the true accelerations, and its derivatives
   accelerations(v, qdd);
   forces();
+  add_armature_force(m_, qdd, tau);
   differentiate_rnea();
   // M^-1 once (nv right-hand sides), then products: on these sizes a matrix
   // product runs faster than triangular solves with 2 nv + nu right-hand
@@ -931,6 +939,7 @@ void TreeDerivatives::compute_constrained(const Eigen::VectorXd& q, const Eigen:
   accelerations(v, a);
   composites();
   forces();
+  add_armature_force(m_, a, tau);
   differentiate_rnea();
   applied_force_derivatives(q, v, u_all);
   constraint_derivatives(lambda, a);

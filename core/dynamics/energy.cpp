@@ -12,6 +12,12 @@ S kinetic_energy(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT
   forward_kinematics<S>(model, d, q, v);
   S T(0);
   for (int i = 1; i < model.nbodies; ++i) T += S(0.5) * d.v[i].dot(model.inertia[i].cast<S>() * d.v[i]);
+  if (model.armature.size() != 0)  // the rotors' (armature): 1/2 armature v^2 on each coordinate
+    for (int k = 0; k < model.nv; ++k)
+      if (model.armature[k] != 0) {
+        const S t = S(0.5 * model.armature[k]) * v[k] * v[k];  // evaluated: see rnea
+        T += t;
+      }
   return T;
 }
 

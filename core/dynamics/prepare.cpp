@@ -106,8 +106,12 @@ class Preparer {
       if (j.nv > 0) {
         const Mat6xT<double>& S = d.Sb[i];
         const Eigen::MatrixXd U = IA[i] * S;
-        const Eigen::MatrixXd D = S.transpose() * U;
-        const Eigen::MatrixXd Dc = S.transpose() * Ic[i] * S;
+        Eigen::MatrixXd D = S.transpose() * U;
+        Eigen::MatrixXd Dc = S.transpose() * Ic[i] * S;
+        if (m_.armature.size() != 0) {  // rotor inertia (armature) on the joint's coordinates
+          D.diagonal() += m_.armature.segment(j.idx_v, j.nv);
+          Dc.diagonal() += m_.armature.segment(j.idx_v, j.nv);
+        }
         Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(D);
         const double reference = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Dc).eigenvalues().maxCoeff();
         if (!(es.eigenvalues()[0] > 1e-12 * reference) || !(reference > 0)) {

@@ -20,6 +20,14 @@ const VecXT<S>& rnea(const Model& model, DataT<S>& d, const VecXT<S>& q, const V
     if (j.nv > 0) d.tau.segment(j.idx_v, j.nv) = d.Sb[i].transpose() * d.f[i];
     if (j.parent > 0) d.f[j.parent] += d.liMi[i].act_force(d.f[i]);
   }
+  // rotor inertia (armature): armature qdd on each coordinate (the product evaluated first, so that
+  // an autodiff constant's empty derivative vector is made coherent by +=, not mixed in an expression)
+  if (model.armature.size() != 0)
+    for (int k = 0; k < model.nv; ++k)
+      if (model.armature[k] != 0) {
+        const S t = S(model.armature[k]) * a[k];
+        d.tau[k] += t;
+      }
   return d.tau;
 }
 

@@ -330,16 +330,37 @@ class MjcfImporter {
 
   void passive() {
     ModelSpec& s = r_.spec;
-    std::vector<std::string> armature, friction, ball_springs, damped;
-    int nsprings = 0, ndampers = 0;
+    std::vector<std::string> armature, armature_uneven, armature_free, friction, ball_springs, damped;
+    int nsprings = 0, ndampers = 0, narmatures = 0;
+    const bool keep_armature = !opt_.ignore.count("armature");
     for (int j = 0; j < m_->njnt; ++j) {
       const int type = m_->jnt_type[j];
       const int da = m_->jnt_dofadr[j];
       const int ndof = type == mjJNT_FREE ? 6 : type == mjJNT_BALL ? 3 : 1;
+      // armature: MuJoCo adds it to the diagonal of M in its dof space; a hinge's or slide's dof is
+      // codyna's coordinate, and a ball's rates differ from codyna's by a constant rotation, under
+      // which one value on the three dofs stays the same diagonal. A free joint's linear dofs are
+      // world-axes velocities in MuJoCo, body-axes ones in codyna: the same diagonal there differs
+      // by the velocity term armature (w x v), so it is refused
+      bool uneven = false, any = false;
       for (int k = 0; k < ndof; ++k) {
-        if (m_->dof_armature[da + k] != 0)
-          armature.push_back(joint_name_[j] + (ndof > 1 ? "[" + std::to_string(k) + "]" : "") + " " +
-                             num(m_->dof_armature[da + k]));
+        any = any || m_->dof_armature[da + k] != 0;
+        uneven = uneven || m_->dof_armature[da + k] != m_->dof_armature[da];
+      }
+      if (any) {
+        std::string e = joint_name_[j] + " " + num(m_->dof_armature[da]);
+        for (int k = 1; uneven && k < ndof; ++k) e += " " + num(m_->dof_armature[da + k]);
+        if (type == mjJNT_FREE) armature_free.push_back(e);
+        else if (uneven) armature_uneven.push_back(e);
+        else if (!keep_armature) armature.push_back(e);
+        else
+          for (JointSpec& js : s.joints)
+            if (js.name == joint_name_[j]) {
+              js.armature = Eigen::VectorXd::Constant(1, m_->dof_armature[da]);
+              ++narmatures;
+            }
+      }
+      for (int k = 0; k < ndof; ++k) {
         if (m_->dof_frictionloss[da + k] != 0 && !dis(mjDSBL_FRICTIONLOSS))
           friction.push_back(joint_name_[j] + (ndof > 1 ? "[" + std::to_string(k) + "]" : "") + " " +
                              num(m_->dof_frictionloss[da + k]));
@@ -384,7 +405,13 @@ class MjcfImporter {
     }
     if (nsprings) r_.report.mapped.push_back(std::to_string(nsprings) + " joint stiffnesses (with their damping, springref as rest position) -> joint_spring_damper");
     if (ndampers) r_.report.mapped.push_back(std::to_string(ndampers) + " joint dampings -> joint_damper");
-    add("armature", "rotor inertia on a coordinate (armature) has no codyna equivalent", armature, true);
+    if (narmatures) r_.report.mapped.push_back(std::to_string(narmatures) + " joint armatures (rotor inertia) -> joint armature");
+    add("armature", "rotor inertia (armature) left out as --ignore armature asks", armature, true);
+    add("armature", "different armatures on the coordinates of one ball joint", armature_uneven, true);
+    add("armature",
+        "armature on a free joint (MuJoCo's linear dofs are world-axes velocities, codyna's body-axes ones: "
+        "the same diagonal differs by armature (w x v))",
+        armature_free, true);
     add("frictionloss", "dry friction (frictionloss) is not modelled", friction, true);
     add("springs", "stiffness of a ball or free joint has no codyna equivalent", ball_springs, true);
     add("springs", "different dampings on the coordinates of one joint", damped, true);

@@ -8,7 +8,8 @@ const std::vector<std::pair<std::string, std::string>>& import_kinds() {
   static const std::vector<std::pair<std::string, std::string>> kinds = {
       {"contacts", "collision geometry and contact pairs (reported; the geoms become display shapes)"},
       {"limits", "joint limits and velocity limits (reported; kept in the model's description)"},
-      {"armature", "rotor inertia (MJCF armature) on a coordinate (refused unless ignored)"},
+      {"armature", "rotor inertia (MJCF armature): mapped to the joints' armature, refused on free joints "
+                   "(refused unless ignored); --ignore armature leaves it out"},
       {"frictionloss", "dry joint friction (MJCF frictionloss, URDF dynamics friction) (refused unless ignored)"},
       {"springs", "joint stiffness on ball and free joints (refused unless ignored)"},
       {"fluid", "fluid forces (MJCF density, viscosity, wind) (refused unless ignored)"},

@@ -338,6 +338,27 @@ Eigen::VectorXd read_coordinates(const Node& n, int size, const std::string& wha
   return j.is_number() ? Eigen::VectorXd::Constant(1, read_number(n)) : read_numbers(n, count);
 }
 
+// a joint's armature (rotor inertia): a number >= 0 for every coordinate, or (joints with several
+// coordinates) an array of one number >= 0 per coordinate
+Eigen::VectorXd read_armature(const Node& n, JointType type) {
+  const int nv = joint_nv(type);
+  auto one = [](const Node& e) {
+    if (!e.value().is_number()) e.expected("a number >= 0 (kg m^2 on a rotation, kg on a translation)");
+    const double x = read_number(e);
+    if (!(x >= 0)) e.expected("a number >= 0 (kg m^2 on a rotation, kg on a translation)");
+    return x;
+  };
+  if (n.value().is_array() && nv > 1) {
+    if (n.value().size() != static_cast<std::size_t>(nv))
+      n.fail("expected one number (every coordinate) or an array of " + std::to_string(nv) + " numbers (one per coordinate of a " +
+             std::string(to_string(type)) + " joint), got " + std::to_string(n.value().size()));
+    Eigen::VectorXd a(nv);
+    for (int k = 0; k < nv; ++k) a[k] = one(n.element(k));
+    return a;
+  }
+  return Eigen::VectorXd::Constant(1, one(n));
+}
+
 int quaternion_index(JointType t) { return t == JointType::Spherical ? 0 : t == JointType::Free ? 3 : -1; }
 
 FrameSpec read_frame(const Node& n);
@@ -682,13 +703,19 @@ const Schema<JointSpec>& schema<JointSpec>() {
              j.v0 = read_coordinates(n, joint_nv(j.type), "nv of a " + std::string(to_string(j.type)) + " joint");
            },
            [](ojson& o, const JointSpec& j) { if (j.v0.size() > 0) o["v0"] = encode(j.v0); }},
+          {"armature", Need::Optional, [](const Node& n, JointSpec& j) { j.armature = read_armature(n, j.type); },
+           [](ojson& o, const JointSpec& j) {
+             if (j.armature.size() == 1) o["armature"] = j.armature[0];
+             else if (j.armature.size() > 1) o["armature"] = encode(j.armature);
+           }},
       },
       "joint",
       [](const JointSpec& j) {
         std::vector<std::string_view> own{"parent", "child", "parent_frame", "child_frame"};
         if (joint_has_axis(j.type)) own.push_back("axis");
         if (j.type == JointType::Universal) own.push_back("axis2");
-        return element_keys(own, {"q0", "v0"});
+        if (joint_nv(j.type) == 0) return element_keys(own, {"q0", "v0"});
+        return element_keys(own, {"q0", "v0", "armature"});
       }};
   return s;
 }

@@ -197,6 +197,17 @@ class Compiler {
       if (j.v0.size() != 0 && j.v0.size() != joint_nv(j.type))
         fail(p + "/v0", "expected " + std::to_string(joint_nv(j.type)) + " values for a " + to_string(j.type) + " joint, got " + std::to_string(j.v0.size()));
       if ((j.q0.size() && !j.q0.allFinite()) || (j.v0.size() && !j.v0.allFinite())) fail(p, "expected finite q0 and v0");
+      if (j.armature.size() != 0) {
+        const int nv = joint_nv(j.type);
+        if (nv == 0) fail(p + "/armature", "a fixed joint has no coordinate to carry an armature (rotor inertia)");
+        if (j.armature.size() != 1 && j.armature.size() != nv)
+          fail(p + "/armature", "expected one number (every coordinate) or " + std::to_string(nv) + " numbers (one per coordinate of a " +
+                                    to_string(j.type) + " joint), got " + std::to_string(j.armature.size()));
+        for (Eigen::Index k = 0; k < j.armature.size(); ++k)
+          if (!(std::isfinite(j.armature[k]) && j.armature[k] >= 0))
+            fail(p + "/armature" + (j.armature.size() > 1 ? "/" + std::to_string(k) : std::string()),
+                 "expected a number >= 0 (rotor inertia: kg m^2 on a rotation, kg on a translation)");
+      }
     }
     for (std::size_t i = 0; i < spec_.bodies.size(); ++i)
       if (!child_of.count(spec_.bodies[i].name))
@@ -240,6 +251,7 @@ class Compiler {
     m_.body_spec_index = {-1};
     compiled_[kGroundName] = 0;
     int iq = 0, iv = 0;
+    std::vector<double> armature;  // [nv] as the joints give it
     for (std::size_t k : order) {
       const JointSpec& js = joints[k];
       const std::string p = at("joints", k);
@@ -268,6 +280,8 @@ class Compiler {
           fail(p + (f == &js.parent_frame ? "/parent_frame" : "/child_frame"), "expected a finite position and a proper rotation");
       }
       add_coordinate_names(j);
+      for (int c = 0; c < j.nv; ++c)
+        armature.push_back(js.armature.size() == 0 ? 0.0 : js.armature[js.armature.size() == 1 ? 0 : c]);
       iq += j.nq;
       iv += j.nv;
       m_.body_names.push_back(b.name);
@@ -280,6 +294,9 @@ class Compiler {
     }
     m_.nq = iq;
     m_.nv = iv;
+    m_.armature.resize(0);  // empty without any rotor inertia: the algorithms then add nothing
+    if (std::any_of(armature.begin(), armature.end(), [](double a) { return a != 0; }))
+      m_.armature = Eigen::Map<const Eigen::VectorXd>(armature.data(), iv);
   }
 
   void add_coordinate_names(const JointModel& j) {

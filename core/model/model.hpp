@@ -158,6 +158,10 @@ struct Model {
   double assembly_residual = 0.0;        // max |phi(q0)|, |J v0| after assembly
   // what assembly changed in the joints' q0 and v0 to close the loops, by more than 1e-6 (m, rad,
   // m/s, rad/s): a coordinate (Model::v_names; `from`, `to` its values for a scalar joint, NaN for
+  // rotor inertia per velocity index, added to the mass matrix's diagonal by every algorithm
+  // (crba, aba, rnea, energy, derivatives); empty when no joint has any (JointSpec::armature)
+  Eigen::VectorXd armature;              // [nv] or empty
+
   // a ball's or free joint's rotation, whose `by` is the tangent step) or a rate (rate_names)
   struct AssemblyMove {
     std::string name;

@@ -70,6 +70,10 @@ struct JointSpec {
   Eigen::Vector3d axis2 = Eigen::Vector3d::UnitY();  // universal (second), in the joint frame at zero angle
   Eigen::VectorXd q0;   // initial position (size nq of the type); empty = zero position
   Eigen::VectorXd v0;   // initial velocity (size nv of the type); empty = zero
+  // rotor inertia on the coordinates (MJCF's armature; a geared motor's N^2 J_rotor): added to the
+  // mass matrix's diagonal, kg m^2 on a rotation, kg on a translation; empty = none, one value =
+  // the same on every coordinate of the joint, else nv values (one per coordinate, v's order)
+  Eigen::VectorXd armature;
 };
 
 // Loop-closure constraints close kinematic loops that the joint tree leaves open.

@@ -14,6 +14,8 @@
 #include "analysis/operating_point.hpp"
 #include "counting_allocator.hpp"
 #include "dynamics/crba.hpp"
+#include "dynamics/energy.hpp"
+#include "dynamics/rnea.hpp"
 #include "dynamics/forward_dynamics.hpp"
 #include "dynamics/joint.hpp"
 #include "io/model_file.hpp"
@@ -155,6 +157,58 @@ TEST(NoAllocation, ForwardDynamicsAndPlantOnEveryClosedLoopExample) {
     EXPECT_EQ(plant_eval_allocations(m), 0) << name << ": PlantFunction::eval<double>";
   }
   EXPECT_GE(loops, 3);
+}
+
+// rotor inertia (armature) on every joint with coordinates: one value on odd joints, one per
+// coordinate on even ones
+ModelSpec with_armature(ModelSpec s) {
+  for (std::size_t k = 0; k < s.joints.size(); ++k) {
+    JointSpec& j = s.joints[k];
+    const int nv = joint_nv(j.type);
+    if (nv == 0) continue;
+    if (k % 2) j.armature = Eigen::VectorXd::Constant(1, 0.01 + 0.001 * k);
+    else j.armature = Eigen::VectorXd::LinSpaced(nv, 0.02, 0.05);
+  }
+  return s;
+}
+
+TEST(NoAllocation, WithArmature) {
+  for (const auto& [name, spec] : {std::pair<std::string, ModelSpec>{"chain_7", speed_models::chain(7)},
+                                   std::pair<std::string, ModelSpec>{"tree28", speed_models::tree28()}}) {
+    const Model m = compile(with_armature(spec));
+    ASSERT_EQ(m.armature.size(), m.nv) << name;
+    EXPECT_EQ(forward_dynamics_allocations(m), 0) << name << " with armature: forward_dynamics";
+    EXPECT_EQ(crba_allocations(m), 0) << name << " with armature: crba";
+    EXPECT_EQ(plant_eval_allocations(m), 0) << name << " with armature: PlantFunction::eval<double>";
+    EXPECT_EQ(fd_jacobian_allocations(m), 0) << name << " with armature: PlantFunction::fd_jacobian";
+    const State st(m, m.q0);
+    Data d(m);
+    rnea<double>(m, d, st.q, st.v, st.v);
+    kinetic_energy<double>(m, d, st.q, st.v);
+    long n = 0;
+    {
+      Count c;
+      rnea<double>(m, d, st.q, st.v, st.v);
+      kinetic_energy<double>(m, d, st.q, st.v);
+      n = c.n();
+    }
+    EXPECT_EQ(n, 0) << name << " with armature: rnea, kinetic_energy";
+  }
+  // a closed loop through CRBA: the four-bar example with armature on its joints
+  const Model m = compile(with_armature(load_model_spec(std::string(CODYNA_EXAMPLES_DIR) + "/four_bar.json")));
+  ASSERT_GT(m.nc, 0);
+  ASSERT_EQ(m.armature.size(), m.nv);
+  Data d(m);
+  const Eigen::VectorXd u = m.u_nominal();
+  forward_dynamics<double>(m, d, m.q0, m.v0, u);
+  long n = 0;
+  {
+    Count c;
+    forward_dynamics<double>(m, d, m.q0, m.v0, u);
+    n = c.n();
+  }
+  EXPECT_EQ(n, 0) << "four_bar with armature: forward_dynamics";
+  EXPECT_EQ(plant_eval_allocations(m), 0) << "four_bar with armature: PlantFunction::eval<double>";
 }
 
 }  // namespace

@@ -56,6 +56,19 @@ TEST(NoAllocation, ExactJacobianEveryExample) {
 }
 
 // a long chain: blocked factorizations and solves stay on the stack too
+// rotor inertia (armature) on every joint of a branched tree (ball joints among them) and of a
+// closed loop: the exact Jacobian stays on the stack
+TEST(NoAllocation, ExactJacobianWithArmature) {
+  for (const std::string name : {"double_pendulum.json", "four_bar.json", "heavy_top.json"}) {
+    ModelSpec s = load_model_spec(std::string(CODYNA_EXAMPLES_DIR) + "/" + name);
+    for (JointSpec& j : s.joints)
+      if (joint_nv(j.type) > 0) j.armature = Eigen::VectorXd::LinSpaced(joint_nv(j.type), 0.02, 0.05);
+    const Model m = compile(s);
+    ASSERT_EQ(m.armature.size(), m.nv) << name;
+    expect_no_allocation(m, name + " with armature");
+  }
+}
+
 TEST(NoAllocation, ExactJacobianNinetyLinkChain) {
   ModelSpec s;
   s.name = "chain90";

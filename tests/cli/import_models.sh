@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# codyna import (issue 20): MuJoCo's own humanoid (libmujoco-samples) refused for its armature,
-# then imported with --ignore armature and linearized at once; a URDF imported and linearized;
+# codyna import (issue 20): MuJoCo's own humanoid (libmujoco-samples) imported with its armature
+# (rotor inertia, as the joints' armature) and linearized at once, then with --ignore armature; a URDF imported and linearized;
 # the refusals (no file, a malformed file, an output over the input or over a file codyna did
 # not write, an unknown --ignore kind) with exit code 1 and the input left as it was.
 # usage: import_models.sh CODYNA SOURCE_DIR WORK_DIR
@@ -35,17 +35,20 @@ expect 0 "A (4 x 4)" -- "$codyna" linearize dp.json --operating-point initial --
 if [ -f "$humanoid" ] && ! "$codyna" import "$humanoid" --out probe.json 2>&1 | grep -q "built without"; then
   cp "$humanoid" humanoid.xml
   sum0=$(sha256sum humanoid.xml | cut -d' ' -f1)
-  # the armature (rotor inertia) changes the dynamics and codyna cannot hold it: refused, named
-  expect 1 "armature: rotor inertia on a coordinate (armature) has no codyna equivalent: abdomen_z 0.01" -- \
-    "$codyna" import humanoid.xml --out h.json
-  grep -qF -- "--ignore armature" err.txt || fail "the refusal does not say --ignore armature: $(cat err.txt)"
-  [ ! -e h.json ] || fail "h.json written although the import was refused"
-  # accepted: the report names what is not modelled, once per kind
+  # the armature (rotor inertia) is the joints' armature: the issue's command as it is
+  expect 0 "wrote h.json: 25 bodies, 25 joints, DOF 27 (nq 28, nv 27), 21 Plant/In, 27 Plant/Out" -- \
+    "$codyna" import humanoid.xml --ignore contacts --out h.json
+  grep -qF "21 joint armatures (rotor inertia) -> joint armature" out.txt || fail "no armature mapped line: $(cat out.txt)"
+  grep -qF "contacts (ignored): contacts are not modelled" out.txt || fail "no contacts line: $(cat out.txt)"
+  grep -qF "limits: joint limits" out.txt || fail "no limits line: $(cat out.txt)"
+  [ "$(grep -c '"armature": 0.01' h.json)" -eq 21 ] || fail "h.json does not hold 21 armatures of 0.01: $(grep -c armature h.json)"
+  expect 0 "A (54 x 54)" -- "$codyna" linearize h.json --operating-point initial --out lin_arm
+  # --ignore armature leaves it out, and says so once
   expect 0 "wrote h.json: 25 bodies, 25 joints, DOF 27 (nq 28, nv 27), 21 Plant/In, 27 Plant/Out" -- \
     "$codyna" import humanoid.xml --ignore armature,contacts --out h.json
-  grep -qF "contacts (ignored): contacts are not modelled" out.txt || fail "no contacts line: $(cat out.txt)"
-  grep -qF "armature (changes the dynamics; ignored by --ignore armature)" out.txt || fail "no armature line: $(cat out.txt)"
-  grep -qF "limits: joint limits" out.txt || fail "no limits line: $(cat out.txt)"
+  grep -qF "armature (changes the dynamics; ignored by --ignore armature): rotor inertia (armature) left out as --ignore armature asks: abdomen_z 0.01" out.txt ||
+    fail "no armature line: $(cat out.txt)"
+  ! grep -qF '"armature"' h.json || fail "h.json holds an armature although --ignore armature"
   expect 0 "DOF          27" -- "$codyna" info h.json
   expect 0 "A (54 x 54)" -- "$codyna" linearize h.json --operating-point initial --out lin
   [ -f lin/Humanoid.mat ] && [ -f lin/Humanoid.m ] || fail "lin/Humanoid.mat, .m not written: $(ls lin)"
