@@ -20,7 +20,7 @@ struct SweepArgs {
   long long samples = 0;
   std::uint64_t seed = 0;
   int threads = 0;
-  bool quiet = false;
+  bool quiet = false, simulate = false;
   const CLI::App* cmd = nullptr;
 };
 
@@ -34,6 +34,7 @@ void run(const SweepArgs& a) {
   r.redesign = a.redesign;
   r.out = a.out;
   r.csv = a.csv;
+  r.simulate = a.simulate;
   SweepProgress progress;
   const bool bar = !a.quiet && isatty(STDERR_FILENO);
   const auto start = std::chrono::steady_clock::now();
@@ -78,6 +79,7 @@ void add_sweep(CLI::App& app) {
   cmd->add_option("--redesign", a->redesign, "lqr: design the study's LQR again for every variant (default: K of the nominal model, fixed)");
   cmd->add_option("--out", a->out, "results (HDF5)")->required();
   cmd->add_option("--csv", a->csv, "the per-variant figures as CSV");
+  cmd->add_flag("--simulate", a->simulate, "also run every variant's nonlinear closed loop (the file's solver settings): status, peak |u|, final error");
   cmd->add_flag("--quiet", a->quiet, "no progress line");
   a->cmd = cmd;
   cmd->callback([a] { set_exit_code(run_guarded([&] { run(*a); })); });

@@ -222,9 +222,47 @@ struct Context {
   LinearizeRequest linearize;
   int nx = 0, nu = 0, ny = 0;
   std::vector<std::string> state_names;
-  bool closed_loop = false, redesign = false;
+  bool closed_loop = false, redesign = false, simulate = false;
+  bool replace_controller = false;  // simulate with K fixed: the file's controller becomes a state feedback K
+  std::string controller_point;     // where that state feedback is applied
   Eigen::MatrixXd K;
 };
+
+// The variant's nonlinear closed-loop run with the sweep's controller.
+void simulate_variant(const Context& c, nlohmann::json j, SweepVariant& v) {
+  try {
+    if (c.replace_controller) {
+      nlohmann::json K = nlohmann::json::array();
+      for (Eigen::Index a = 0; a < c.K.rows(); ++a) {
+        nlohmann::json row = nlohmann::json::array();
+        for (Eigen::Index b = 0; b < c.K.cols(); ++b) row.push_back(c.K(a, b));
+        K.push_back(row);
+      }
+      j["controller"] = {{"type", "state_feedback"}, {"K", K}, {"operating_point", c.controller_point}};
+      if (j.contains("analysis") && j["analysis"].is_object()) j["analysis"]["controller"] = "model";
+    }
+    SimulateRequest sr;
+    sr.model = c.request->model;
+    const SimulateJob sj = study_simulate_job(sr, study_parse_model(j, c.request->model));
+    const SimulationResult& r = sj.result;
+    v.sim_status = r.completed ? 0 : 1;
+    v.sim_reason = r.completed ? std::string() : r.failure;
+    v.sim_t_end = r.t.empty() ? 0.0 : r.t.back();
+    v.peak_input = sj.max_abs_input;
+    v.final_error = 0;
+    if (!r.t.empty() && r.y.cols() > 0) {
+      const Eigen::Index last = r.y.rows() - 1;
+      Eigen::VectorXd target = sj.setup.plant ? sj.setup.plant->lin.system.y0 : Eigen::VectorXd::Zero(r.y.cols());
+      if (r.y_reference.cols() == r.y.cols() && r.y_reference.rows() == r.y.rows()) target = r.y_reference.row(last).transpose();
+      if (target.size() == r.y.cols()) v.final_error = (r.y.row(last).transpose() - target).cwiseAbs().maxCoeff();
+      else v.final_error = std::numeric_limits<double>::quiet_NaN();
+    }
+  } catch (const std::exception& e) {
+    v.sim_status = 2;
+    v.sim_reason = e.what();
+    v.peak_input.resize(0);
+  }
+}
 
 void run_variant(const Context& c, long long i, SweepVariant& v) {
   v.values = c.plan->values(i);
@@ -232,6 +270,9 @@ void run_variant(const Context& c, long long i, SweepVariant& v) {
     nlohmann::json j = *c.file;
     for (std::size_t k = 0; k < c.pointers.size(); ++k) j[c.pointers[k]] = v.values[k];
     const ModelSpec spec = study_parse_model(j, c.request->model);
+    const auto simulate_after = [&] {
+      if (c.simulate) simulate_variant(c, std::move(j), v);
+    };
     const LinearizeJob lj = study_linearize_job(c.linearize, spec);
     const LinearSystem& sys = lj.linearization.lin.system;  // continuous
     if (sys.nx() != c.nx || sys.nu() != c.nu || sys.ny() != c.ny) {
@@ -272,6 +313,7 @@ void run_variant(const Context& c, long long i, SweepVariant& v) {
       v.stable = stable_poles(v.open_poles, sys.A);
     }
     v.status = SweepStatus::Ok;
+    simulate_after();
   } catch (const ModelError& e) {
     v.status = SweepStatus::ModelError;
     v.reason = e.what();
@@ -486,6 +528,16 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
     }
   }
   if (!job.closed_loop && job.controller.empty()) job.controller = "none (open loop)";
+  if (r.simulate) {
+    c.simulate = true;
+    job.simulated = true;
+    // K fixed: the file's own LQR (or the study's) would be designed again on each variant; the
+    // nominal K is handed to the run as the model file's state feedback instead
+    if (c.closed_loop && !c.redesign && (is_lqr || (model_controller && m.spec.controller.type == ControllerType::StateFeedback))) {
+      c.replace_controller = true;
+      c.controller_point = model_controller ? m.spec.controller.operating_point : s.operating_point;
+    }
+  }
 
   // the variants
   const long long n = job.plan.count;
@@ -540,6 +592,11 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
       continue;
     }
     if (v.stable) ++job.stable;
+    if (v.sim_status == 0) ++job.sim_completed;
+    if (v.peak_input.size() > 0 &&
+        (job.largest_input < 0 ||
+         v.peak_input.maxCoeff() > job.variants[static_cast<std::size_t>(job.largest_input)].peak_input.maxCoeff()))
+      job.largest_input = i;
     const double x = job.closed_loop ? v.closed_max_real : v.open_max_real;
     if (job.worst < 0 || x > worst) {
       worst = x;
@@ -755,6 +812,30 @@ void write_contents(hid_t file, const SweepJob& job) {
     stable.push_back(v.stable ? 1 : 0);
   }
   write_ints(file, "/open_loop/uncontrollable", unc);
+  if (job.simulated) {
+    create_group(file, "/simulation");
+    std::vector<int> st;
+    std::vector<std::string> why;
+    std::vector<double> reached(n, kNaN), err(n, kNaN), peak(n * static_cast<std::size_t>(nu), kNaN);
+    for (std::size_t i = 0; i < n; ++i) {
+      const SweepVariant& v = vs[i];
+      st.push_back(v.sim_status);
+      why.push_back(v.sim_reason);
+      if (v.sim_status == 0 || v.sim_status == 1) {
+        reached[i] = v.sim_t_end;
+        err[i] = v.final_error;
+      }
+      if (v.peak_input.size() == nu)
+        for (Eigen::Index k = 0; k < nu; ++k) peak[i * static_cast<std::size_t>(nu) + static_cast<std::size_t>(k)] = v.peak_input[k];
+    }
+    write_ints(file, "/simulation/status", st);
+    write_strings(file, "/simulation/reason", why);
+    write_doubles(file, "/simulation/t_reached", {n}, reached);
+    write_doubles(file, "/simulation/peak_input", {n, static_cast<hsize_t>(nu)}, peak);
+    write_doubles(file, "/simulation/final_error", {n}, err);
+    write_attribute(file, "/simulation", "status_codes",
+                    std::string("-1 not run (the variant failed), 0 reached t_end, 1 the run failed, 2 it could not be set up"));
+  }
   if (!job.closed_loop) {
     write_ints(file, "/open_loop/stable", stable);
     return;
@@ -818,7 +899,9 @@ void study_write_sweep_csv(const SweepJob& job, const std::string& path) {
   }
   text += ",open_loop_max_real";
   if (job.closed_loop) text += ",closed_loop_max_real";
-  text += ",stable,uncontrollable,reason\n";
+  text += ",stable,uncontrollable";
+  if (job.simulated) text += ",sim_status,peak_input,final_error";
+  text += ",reason\n";
   for (std::size_t i = 0; i < job.variants.size(); ++i) {
     const SweepVariant& v = job.variants[i];
     const bool ok = v.status == SweepStatus::Ok;
@@ -833,8 +916,15 @@ void study_write_sweep_csv(const SweepJob& job, const std::string& path) {
       text += ',';
       append_number(text, ok ? v.closed_max_real : kNaN);
     }
-    text += std::string(",") + (v.stable ? "1" : "0") + ',' + (ok ? std::to_string(v.uncontrollable) : std::string()) + ',';
-    append_csv_field(text, v.reason);
+    text += std::string(",") + (v.stable ? "1" : "0") + ',' + (ok ? std::to_string(v.uncontrollable) : std::string());
+    if (job.simulated) {
+      text += ',' + std::to_string(v.sim_status) + ',';
+      append_number(text, v.peak_input.size() ? v.peak_input.maxCoeff() : kNaN);
+      text += ',';
+      append_number(text, v.sim_status == 0 || v.sim_status == 1 ? v.final_error : kNaN);
+    }
+    text += ',';
+    append_csv_field(text, v.reason.empty() ? v.sim_reason : v.reason);
     text += '\n';
   }
   write_file_atomically(path, text);
@@ -868,6 +958,30 @@ std::string study_sweep_summary(const SweepJob& job) {
     for (std::size_t k = 0; k < fields; ++k) os << (k ? "," : "") << " " << job.plan.vary[k].field << " = " << fmt(w.values[k]);
     os << ", max Re(" << (job.closed_loop ? "closed" : "open") << "-loop pole) = "
        << fmt(job.closed_loop ? w.closed_max_real : w.open_max_real) << "\n";
+  }
+  if (job.simulated) {
+    os << "simulated        " << job.sim_completed << " of " << completed << " completed variants reached t_end\n";
+    if (job.largest_input >= 0) {
+      const SweepVariant& w = job.variants[static_cast<std::size_t>(job.largest_input)];
+      os << "largest input    variant " << job.largest_input << ": peak |u| = " << fmt(w.peak_input.maxCoeff())
+         << ", final error " << fmt(w.final_error) << "\n";
+    }
+    long long far = -1;
+    for (long long i = 0; i < n; ++i) {
+      const SweepVariant& v = job.variants[static_cast<std::size_t>(i)];
+      if ((v.sim_status == 0 || v.sim_status == 1) &&
+          (far < 0 || v.final_error > job.variants[static_cast<std::size_t>(far)].final_error))
+        far = i;
+    }
+    if (far >= 0)
+      os << "largest error    variant " << far << ": final error " << fmt(job.variants[static_cast<std::size_t>(far)].final_error)
+         << " (the largest |y - y0| over Plant/Out at t_end)\n";
+    long long shown = 0;
+    for (long long i = 0; i < n && shown < 5; ++i) {
+      const SweepVariant& v = job.variants[static_cast<std::size_t>(i)];
+      if (v.sim_status <= 0) continue;
+      os << (shown++ ? "                 " : "run failed       ") << "variant " << i << ": " << v.sim_reason << "\n";
+    }
   }
   long long listed = 0;
   for (long long i = 0; i < n; ++i) {

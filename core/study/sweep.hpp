@@ -46,6 +46,10 @@ struct SweepRequest {
   int threads = 0;                          // 0: std::thread::hardware_concurrency()
   std::string redesign;                     // "" (K fixed) or "lqr" (designed again per variant)
   std::string out, csv;                     // HDF5 and CSV results; "" = not written
+  // also a nonlinear closed-loop run per variant (the file's solver settings and initial state),
+  // with the same controller as the linear figures: the nominal K as a state feedback about the
+  // variant's own operating point, or the LQR designed again with redesign = "lqr"
+  bool simulate = false;
 };
 
 // One --vary, parsed.
@@ -91,6 +95,13 @@ struct SweepVariant {
   bool stable = false;                        // closed loop (no closed loop: open loop)
   int uncontrollable = 0;                     // modes the Plant/In inputs cannot move
   std::string uncontrollable_text;            // study_describe_modes of them
+  // simulate: the run's status (-1 not run, 0 reached t_end, 1 the run failed, 2 it could not be
+  // set up), its reason, the time reached, the largest |u| of each Plant/In and the final error
+  // (the largest |y - target| over Plant/Out at the last sample: the reference there, or y0)
+  int sim_status = -1;
+  std::string sim_reason;
+  double sim_t_end = 0, final_error = 0;
+  Eigen::VectorXd peak_input;
 };
 
 struct SweepJob {
@@ -101,6 +112,7 @@ struct SweepJob {
   bool closed_loop = false;                   // a state feedback closes the loop
   std::string controller;                     // what the closed loop is ("the model file's lqr controller, K fixed")
   bool redesigned = false;
+  bool simulated = false;
   Eigen::MatrixXd K;                          // the nominal gain (nu x nx), when closed_loop
   Eigen::VectorXcd nominal_closed_poles, nominal_open_poles;
   std::vector<SweepVariant> variants;
@@ -109,6 +121,8 @@ struct SweepJob {
   // summary
   long long failed = 0, stable = 0;
   long long worst = -1;                       // the completed variant with the largest max real part
+  long long sim_completed = 0;                // simulate: runs that reached t_end
+  long long largest_input = -1;               // simulate: the run with the largest peak |u|
 };
 
 struct SweepProgress {

@@ -212,6 +212,46 @@ TEST(Sweep, FailedVariantsAreRecordedWithTheirReasonAndTheOthersComplete) {
   EXPECT_EQ(again.variants[3].status, SweepStatus::Ok);
 }
 
+TEST(Sweep, SimulateRunsEachVariantWithTheNominalGain) {
+  SweepRequest r;
+  r.model = kModel;
+  r.vary = {"/bodies/1/mass=[10,15,-1,20]"};
+  r.simulate = true;
+  r.threads = 1;
+  const SweepJob one = study_sweep_job(r);
+  r.threads = 2;
+  const SweepJob two = study_sweep_job(r);
+  ASSERT_TRUE(one.simulated);
+  // the nominal variant's run is `codyna simulate` of the model file (its LQR designed there: the same K)
+  SimulateRequest sr;
+  sr.model = kModel;
+  const SimulateJob nominal = study_simulate_job(sr, study_read_model(kModel));
+  ASSERT_TRUE(nominal.result.completed);
+  const SweepVariant& v0 = one.variants[0];
+  ASSERT_EQ(v0.sim_status, 0) << v0.sim_reason;
+  ASSERT_EQ(v0.peak_input.size(), 1);
+  EXPECT_NEAR(v0.peak_input[0], nominal.max_abs_input[0], 1e-9 * nominal.max_abs_input[0]);
+  const SimulationResult& n = nominal.result;
+  const double final_theta = std::abs(n.y(n.y.rows() - 1, 1) - nominal.setup.plant->lin.system.y0[1]);
+  const double final_h = std::abs(n.y(n.y.rows() - 1, 0) - nominal.setup.plant->lin.system.y0[0]);
+  EXPECT_NEAR(v0.final_error, std::max(final_theta, final_h), 1e-9);
+  EXPECT_NEAR(v0.sim_t_end, 5.0, 1e-12);
+  // the failed variant is not run; the others are, the same on 1 and 2 threads
+  EXPECT_EQ(one.variants[2].sim_status, -1);
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(one.variants[i].sim_status, two.variants[i].sim_status);
+    EXPECT_EQ(one.variants[i].final_error, two.variants[i].final_error);
+    EXPECT_EQ(one.variants[i].peak_input, two.variants[i].peak_input);
+  }
+  EXPECT_EQ(one.variants[3].sim_status, 0);
+  // with the LQR designed again, the 15 kg rod's run is another run (K fixed is what was run above)
+  r.redesign = "lqr";
+  const SweepJob again = study_sweep_job(r);
+  EXPECT_EQ(again.variants[1].sim_status, 0);
+  EXPECT_GT(std::abs(again.variants[1].final_error - one.variants[1].final_error), 1e-6);
+  EXPECT_NEAR(again.variants[0].final_error, one.variants[0].final_error, 1e-9);  // the nominal: the same K
+}
+
 void expect_refused(const std::vector<std::string>& vary, const std::vector<std::string>& words,
                     std::optional<long long> samples = {}, std::optional<std::uint64_t> seed = {}) {
   SweepRequest r;
