@@ -20,7 +20,7 @@ struct SweepArgs {
   long long samples = 0;
   std::uint64_t seed = 0;
   int threads = 0;
-  bool quiet = false, simulate = false;
+  bool quiet = false, simulate = false, restart = false;
   const CLI::App* cmd = nullptr;
 };
 
@@ -35,6 +35,7 @@ void run(const SweepArgs& a) {
   r.out = a.out;
   r.csv = a.csv;
   r.simulate = a.simulate;
+  r.resume = !a.restart;
   SweepProgress progress;
   const bool bar = !a.quiet && isatty(STDERR_FILENO);
   const auto start = std::chrono::steady_clock::now();
@@ -80,6 +81,7 @@ void add_sweep(CLI::App& app) {
   cmd->add_option("--out", a->out, "results (HDF5)")->required();
   cmd->add_option("--csv", a->csv, "the per-variant figures as CSV");
   cmd->add_flag("--simulate", a->simulate, "also run every variant's nonlinear closed loop (the file's solver settings): status, peak |u|, final error");
+  cmd->add_flag("--restart", a->restart, "ignore the journal of an interrupted run (OUT.partial) and run every variant again");
   cmd->add_flag("--quiet", a->quiet, "no progress line");
   a->cmd = cmd;
   cmd->callback([a] { set_exit_code(run_guarded([&] { run(*a); })); });

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <iterator>
 #include <limits>
 #include <mutex>
 #include <numeric>
@@ -360,7 +361,125 @@ void guard_csv(const std::string& path, const std::string& model) {
                                 kCsvHeadStart + "\"); codyna never replaces a file it did not write: remove it or choose another name");
 }
 
+// ------------------------------------------------------------------ the journal (resume)
+// One line per finished variant, a JSON object whose numbers are hexadecimal texts (exact, NaN
+// and infinities included), after a first line naming the study by a hash of the model file's
+// bytes and every option that changes a result.
+
+std::uint64_t hash_text(std::uint64_t h, const std::string& text) {
+  for (unsigned char ch : text) h = (h ^ ch) * 0x100000001b3ULL;  // FNV-1a
+  return splitmix64(h ^ text.size());
+}
+
+std::string hex(double x) {
+  char buf[64];
+  const auto res = std::to_chars(buf, buf + sizeof buf, x, std::chars_format::hex);
+  return std::string(buf, res.ptr);
+}
+
+double unhex(const nlohmann::json& j) {
+  const std::string t = j.get<std::string>();
+  double x = 0;
+  const char* first = t.data();
+  const auto [ptr, ec] = std::from_chars(first, t.data() + t.size(), x, std::chars_format::hex);
+  if (ec != std::errc() || ptr != t.data() + t.size()) throw std::runtime_error("not a number: " + t);
+  return x;
+}
+
+nlohmann::json encode(const Eigen::MatrixXd& m) {
+  nlohmann::json d = nlohmann::json::array();
+  for (Eigen::Index k = 0; k < m.size(); ++k) d.push_back(hex(m.data()[k]));
+  return {m.rows(), m.cols(), d};
+}
+Eigen::MatrixXd decode_matrix(const nlohmann::json& j) {
+  Eigen::MatrixXd m(j.at(0).get<Eigen::Index>(), j.at(1).get<Eigen::Index>());
+  if (static_cast<Eigen::Index>(j.at(2).size()) != m.size()) throw std::runtime_error("matrix size");
+  for (Eigen::Index k = 0; k < m.size(); ++k) m.data()[k] = unhex(j.at(2).at(static_cast<std::size_t>(k)));
+  return m;
+}
+nlohmann::json encode(const Eigen::VectorXcd& p) {
+  Eigen::MatrixXd m(p.size(), 2);
+  m.col(0) = p.real();
+  m.col(1) = p.imag();
+  return encode(m);
+}
+Eigen::VectorXcd decode_poles(const nlohmann::json& j) {
+  const Eigen::MatrixXd m = decode_matrix(j);
+  Eigen::VectorXcd p(m.rows());
+  for (Eigen::Index k = 0; k < m.rows(); ++k) p[k] = {m(k, 0), m(k, 1)};
+  return p;
+}
+
+std::string journal_line(long long i, const SweepVariant& v) {
+  nlohmann::json values = nlohmann::json::array();
+  for (double x : v.values) values.push_back(hex(x));
+  const nlohmann::json j = {{"i", i},
+                            {"values", values},
+                            {"status", static_cast<int>(v.status)},
+                            {"reason", v.reason},
+                            {"A", encode(v.A)},
+                            {"B", encode(v.B)},
+                            {"C", encode(v.C)},
+                            {"D", encode(v.D)},
+                            {"K", encode(v.K)},
+                            {"open_poles", encode(v.open_poles)},
+                            {"closed_poles", encode(v.closed_poles)},
+                            {"open_max_real", hex(v.open_max_real)},
+                            {"closed_max_real", hex(v.closed_max_real)},
+                            {"stable", v.stable},
+                            {"uncontrollable", v.uncontrollable},
+                            {"uncontrollable_text", v.uncontrollable_text},
+                            {"sim_status", v.sim_status},
+                            {"sim_reason", v.sim_reason},
+                            {"sim_t_end", hex(v.sim_t_end)},
+                            {"final_error", hex(v.final_error)},
+                            {"peak_input", encode(Eigen::MatrixXd(v.peak_input))}};
+  return j.dump() + "\n";
+}
+
+SweepVariant journal_variant(const nlohmann::json& j) {
+  SweepVariant v;
+  for (const auto& x : j.at("values")) v.values.push_back(unhex(x));
+  v.status = static_cast<SweepStatus>(j.at("status").get<int>());
+  v.reason = j.at("reason").get<std::string>();
+  v.A = decode_matrix(j.at("A"));
+  v.B = decode_matrix(j.at("B"));
+  v.C = decode_matrix(j.at("C"));
+  v.D = decode_matrix(j.at("D"));
+  v.K = decode_matrix(j.at("K"));
+  v.open_poles = decode_poles(j.at("open_poles"));
+  v.closed_poles = decode_poles(j.at("closed_poles"));
+  v.open_max_real = unhex(j.at("open_max_real"));
+  v.closed_max_real = unhex(j.at("closed_max_real"));
+  v.stable = j.at("stable").get<bool>();
+  v.uncontrollable = j.at("uncontrollable").get<int>();
+  v.uncontrollable_text = j.at("uncontrollable_text").get<std::string>();
+  v.sim_status = j.at("sim_status").get<int>();
+  v.sim_reason = j.at("sim_reason").get<std::string>();
+  v.sim_t_end = unhex(j.at("sim_t_end"));
+  v.final_error = unhex(j.at("final_error"));
+  const Eigen::MatrixXd peak = decode_matrix(j.at("peak_input"));
+  v.peak_input = peak.size() ? Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(peak.data(), peak.size())) : Eigen::VectorXd();
+  return v;
+}
+
+// the first line of a study's journal: what makes its variants what they are
+std::string journal_head(const SweepRequest& r, const std::string& model_bytes, long long count) {
+  std::uint64_t h = hash_text(0xcbf29ce484222325ULL, model_bytes);
+  for (const std::string& v : r.vary) h = hash_text(h, v);
+  h = hash_text(h, r.seed ? std::to_string(*r.seed) : "-");
+  h = hash_text(h, r.samples ? std::to_string(*r.samples) : "-");
+  h = hash_text(h, r.redesign);
+  h = hash_text(h, r.simulate ? "simulate" : "");
+  h = hash_text(h, CODYNA_VERSION);
+  char key[17];
+  std::snprintf(key, sizeof key, "%016llx", static_cast<unsigned long long>(h));
+  return std::string("codyna sweep journal 1 ") + key + " " + std::to_string(count) + "\n";
+}
+
 }  // namespace
+
+std::string study_sweep_journal_path(const std::string& out) { return out + ".partial"; }
 
 // ------------------------------------------------------------------ plan
 
@@ -466,11 +585,12 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
   }
   const ModelSpec nominal_spec = study_read_model(r.model);  // errors name the file and the field
   for (const std::string& n : nominal_spec.notes) note(n);
-  nlohmann::json file;
+  std::string model_bytes;
   {
     std::ifstream in(r.model, std::ios::binary);
-    file = nlohmann::json::parse(in);
+    model_bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
+  const nlohmann::json file = nlohmann::json::parse(model_bytes);
   job.plan = study_sweep_plan(r, file);
   job.model_file = r.model;
   job.model_name = nominal_spec.name;
@@ -549,7 +669,48 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
     threads = 1;
   }
   threads = static_cast<unsigned>(std::min<long long>(threads, n));
-  std::atomic<long long> next{0}, done{0};
+  // the journal: the variants an interrupted run of this very study finished
+  std::vector<char> have(static_cast<std::size_t>(n), 0);
+  std::ofstream journal;
+  const std::string journal_path = r.out.empty() ? std::string() : study_sweep_journal_path(r.out);
+  if (!journal_path.empty()) {
+    const std::string head = journal_head(r, model_bytes, n);
+    std::error_code ec;
+    if (r.resume && std::filesystem::exists(journal_path, ec)) {
+      std::ifstream in(journal_path, std::ios::binary);
+      std::string line;
+      if (!std::getline(in, line) || line + "\n" != head)
+        throw std::invalid_argument(journal_path + ": the journal of another study (other model file contents or options) "
+                                    "is in the way: remove it to start afresh");
+      std::string kept = head;
+      while (std::getline(in, line)) {
+        if (in.eof()) break;  // a last line without its newline was cut by the interruption
+        try {
+          const nlohmann::json j = nlohmann::json::parse(line);
+          const long long i = j.at("i").get<long long>();
+          if (i < 0 || i >= n || have[static_cast<std::size_t>(i)]) continue;
+          SweepVariant v = journal_variant(j);
+          if (v.values != job.plan.values(i)) continue;
+          job.variants[static_cast<std::size_t>(i)] = std::move(v);
+          have[static_cast<std::size_t>(i)] = 1;
+          ++job.resumed;
+          kept += line + "\n";
+        } catch (const std::exception&) {
+          // a damaged line: that variant runs again
+        }
+      }
+      in.close();
+      write_file_atomically(journal_path, kept);  // without the damaged lines, then appended to
+      if (job.resumed > 0)
+        note("resuming: " + std::to_string(job.resumed) + " of " + std::to_string(n) + " variants were done (" +
+             journal_path + ")");
+    } else {
+      write_file_atomically(journal_path, head);
+    }
+    journal.open(journal_path, std::ios::binary | std::ios::app);
+    if (!journal) throw std::runtime_error(journal_path + ": cannot append to the journal");
+  }
+  std::atomic<long long> next{0}, done{job.resumed};
   std::mutex report;
   std::exception_ptr fatal;
   const auto worker = [&] {
@@ -557,8 +718,10 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
       if (progress.cancel && progress.cancel->load()) return;
       const long long i = next.fetch_add(1);
       if (i >= n) return;
+      if (have[static_cast<std::size_t>(i)]) continue;
+      SweepVariant& v = job.variants[static_cast<std::size_t>(i)];
       try {
-        run_variant(c, i, job.variants[static_cast<std::size_t>(i)]);
+        run_variant(c, i, v);
       } catch (...) {  // not a failure of the variant (out of memory): the study stops
         const std::lock_guard<std::mutex> lock(report);
         if (!fatal) fatal = std::current_exception();
@@ -566,10 +729,9 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
         return;
       }
       const long long d = done.fetch_add(1) + 1;
-      if (progress.done) {
-        const std::lock_guard<std::mutex> lock(report);
-        progress.done(d, n);
-      }
+      const std::lock_guard<std::mutex> lock(report);
+      if (journal.is_open()) journal << journal_line(i, v) << std::flush;
+      if (progress.done) progress.done(d, n);
     }
   };
   if (threads <= 1) {
@@ -611,6 +773,11 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
   if (!r.csv.empty()) {
     study_write_sweep_csv(job, r.csv);
     job.written.push_back(r.csv);
+  }
+  if (journal.is_open()) {
+    journal.close();
+    std::error_code ec;
+    std::filesystem::remove(journal_path, ec);
   }
   return job;
 }

@@ -50,7 +50,16 @@ struct SweepRequest {
   // with the same controller as the linear figures: the nominal K as a state feedback about the
   // variant's own operating point, or the LQR designed again with redesign = "lqr"
   bool simulate = false;
+  // Resume: with `out`, every finished variant is appended to the journal OUT.partial (one line
+  // each, numbers exact), so that a study interrupted (Ctrl+C, a killed job) and started again
+  // with the same model file and options skips the variants done and writes the same file as an
+  // uninterrupted run. The journal is removed once the results are written; a journal of another
+  // study (other file contents or options) is refused. resume = false starts afresh.
+  bool resume = true;
 };
+
+// OUT.partial: where the journal of a study writing `out` is kept
+std::string study_sweep_journal_path(const std::string& out);
 
 // One --vary, parsed.
 struct SweepVary {
@@ -118,6 +127,7 @@ struct SweepJob {
   std::vector<SweepVariant> variants;
   std::vector<std::string> notes, warnings;
   std::vector<std::string> written;
+  long long resumed = 0;                      // variants read back from the journal
   // summary
   long long failed = 0, stable = 0;
   long long worst = -1;                       // the completed variant with the largest max real part

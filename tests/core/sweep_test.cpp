@@ -252,6 +252,52 @@ TEST(Sweep, SimulateRunsEachVariantWithTheNominalGain) {
   EXPECT_NEAR(again.variants[0].final_error, one.variants[0].final_error, 1e-9);  // the nominal: the same K
 }
 
+TEST(Sweep, AnInterruptedStudyResumesToTheSameFile) {
+  TempDir dir;
+  SweepRequest r;
+  r.model = kModel;
+  r.vary = {"/bodies/1/mass=normal(10,2)", "/bodies/0/mass=uniform(15,25)"};
+  r.samples = 120;
+  r.seed = 99;
+  r.simulate = true;
+  r.threads = 2;
+  r.out = dir.file("whole.h5");
+  r.csv = dir.file("whole.csv");
+  study_sweep_job(r);
+  EXPECT_FALSE(fs::exists(study_sweep_journal_path(r.out)));  // removed once the results are written
+  // stopped after 50 variants (as a Ctrl+C would: the journal stays, no result file)
+  r.out = dir.file("cut.h5");
+  r.csv = dir.file("cut.csv");
+  std::atomic<bool> stop{false};
+  SweepProgress p;
+  p.cancel = &stop;
+  p.done = [&](long long done, long long) {
+    if (done >= 50) stop = true;
+  };
+  EXPECT_THROW(study_sweep_job(r, {}, p), StudyCancelled);
+  EXPECT_FALSE(fs::exists(r.out));
+  ASSERT_TRUE(fs::exists(study_sweep_journal_path(r.out)));
+  // another study may not take that journal over
+  SweepRequest other = r;
+  other.seed = 100;
+  try {
+    study_sweep_job(other);
+    ADD_FAILURE() << "another seed resumed the journal";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("another study"), std::string::npos) << e.what();
+  }
+  // the same study started again skips what was done and writes the uninterrupted file
+  std::vector<std::string> notes;
+  const SweepJob resumed = study_sweep_job(r, [&](const StudyMessage& m) { notes.push_back(m.text); });
+  EXPECT_GE(resumed.resumed, 50);
+  EXPECT_LT(resumed.resumed, 120);
+  EXPECT_EQ(slurp(dir.file("cut.h5")), slurp(dir.file("whole.h5")));
+  EXPECT_EQ(slurp(dir.file("cut.csv")), slurp(dir.file("whole.csv")));
+  EXPECT_FALSE(fs::exists(study_sweep_journal_path(r.out)));
+  ASSERT_FALSE(notes.empty());
+  EXPECT_NE(notes.back().find("resuming: "), std::string::npos) << notes.back();
+}
+
 void expect_refused(const std::vector<std::string>& vary, const std::vector<std::string>& words,
                     std::optional<long long> samples = {}, std::optional<std::uint64_t> seed = {}) {
   SweepRequest r;
