@@ -339,6 +339,7 @@ bool PropertyEditor::applyText(const QString& field, const QString& text, QStrin
     if (is_rotation_key(field)) value = rotation_value(text);
     else if (is_clearable(id_->kind, field) && text.trimmed().isEmpty()) clear = true;
     else if (old.is_null() && is_clearable(id_->kind, field)) value = parse_text(text, json(0.0));
+    else if (field == QLatin1String("armature")) value = parse_text(text, json::array());  // one value, or one per coordinate
     else value = parse_text(text, old);
   } catch (const std::exception& e) {
     return reject(tr("%1: %2").arg(field, qs(e.what())));

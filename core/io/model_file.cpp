@@ -338,8 +338,8 @@ Eigen::VectorXd read_coordinates(const Node& n, int size, const std::string& wha
   return j.is_number() ? Eigen::VectorXd::Constant(1, read_number(n)) : read_numbers(n, count);
 }
 
-// a joint's armature (rotor inertia): a number >= 0 for every coordinate, or (joints with several
-// coordinates) an array of one number >= 0 per coordinate
+// a joint's armature (rotor inertia): a number >= 0 for every coordinate (also as an array of one),
+// or (joints with several coordinates) an array of one number >= 0 per coordinate
 Eigen::VectorXd read_armature(const Node& n, JointType type) {
   const int nv = joint_nv(type);
   auto one = [](const Node& e) {
@@ -348,6 +348,12 @@ Eigen::VectorXd read_armature(const Node& n, JointType type) {
     if (!(x >= 0)) e.expected("a number >= 0 (kg m^2 on a rotation, kg on a translation)");
     return x;
   };
+  if (n.value().is_array() && n.value().size() == 1) {  // (a bad value is named at the array: the field)
+    const json& e = n.value()[0];
+    if (!e.is_number() || !std::isfinite(e.get<double>()) || !(e.get<double>() >= 0))
+      n.fail("expected a number >= 0 (kg m^2 on a rotation, kg on a translation), got " + describe(e));
+    return Eigen::VectorXd::Constant(1, read_number(n.element(0)));
+  }
   if (n.value().is_array() && nv > 1) {
     if (n.value().size() != static_cast<std::size_t>(nv))
       n.fail("expected one number (every coordinate) or an array of " + std::to_string(nv) + " numbers (one per coordinate of a " +

@@ -125,6 +125,11 @@ TEST(Armature, ReadWrittenAndRefusedAtTheField) {
   refused_at(pendulum(0.5, 0.4, "-0.1"), "/joints/0/armature", "expected a number >= 0");
   refused_at(pendulum(0.5, 0.4, "\"big\""), "/joints/0/armature", "expected a number >= 0");
   refused_at(pendulum(0.5, 0.4, "[0.1, 0.2]"), "/joints/0/armature", "expected a number >= 0");
+  refused_at(pendulum(0.5, 0.4, "[-0.1]"), "/joints/0/armature", "expected a number >= 0");
+  // an array of one is one value (what the GUI's field gives): written back as a number
+  const ModelSpec one = parse(pendulum(0.5, 0.4, "[0.125]"));
+  ASSERT_EQ(one.joints[0].armature.size(), 1);
+  EXPECT_EQ(study_model_json(one)["joints"][0]["armature"], 0.125);
   const nlohmann::json written = study_model_json(spec);
   EXPECT_EQ(written["joints"][0]["armature"], 0.25);  // one value: a number
   EXPECT_EQ(written["joints"][1]["armature"].size(), 3u) << written.dump();

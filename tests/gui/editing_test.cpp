@@ -223,6 +223,51 @@ class EditingTest : public QObject {
     QCOMPARE(joint(1).type, JointType::Revolute);
   }
 
+  // a joint's armature (rotor inertia) typed in its field: taken into the model's mass matrix,
+  // a negative one refused at the field with the reader's reason, dropped by a change to a fixed
+  // joint (which has no coordinate to carry it), one value per coordinate on a ball joint
+  void jointArmatureTypedInTheField() {
+    buildChainOfTwo();  // the second joint selected (revolute)
+    QCOMPARE(joint(1).type, JointType::Revolute);
+    auto type = [&](const QString& field, const QString& text) {
+      QLineEdit* e = qobject_cast<QLineEdit*>(props()->editorFor(field));
+      QVERIFY(e);
+      e->setFocus();
+      e->selectAll();
+      QTest::keyClicks(e, text);
+      QTest::keyClick(e, Qt::Key_Return);
+    };
+    QLineEdit* field = qobject_cast<QLineEdit*>(props()->editorFor("armature"));
+    QVERIFY(field);  // shown at its default, none
+    QCOMPARE(field->text().toDouble(), 0.0);
+    QVERIFY(joint(1).armature.size() == 0);
+    type("armature", "0.02");
+    QCOMPARE(joint(1).armature.size(), Eigen::Index(1));
+    QCOMPARE(joint(1).armature[0], 0.02);
+    QVERIFY(w->document()->model());
+    QCOMPARE(w->document()->model()->armature.size(), Eigen::Index(2));
+    QCOMPARE(w->document()->model()->armature[1], 0.02);
+    const int steps = w->document()->undoStack()->count();
+    type("armature", "-1");
+    QCOMPARE(joint(1).armature[0], 0.02);
+    QCOMPARE(w->document()->undoStack()->count(), steps);
+    QCOMPARE(props()->markedField(), QString("armature"));
+    QVERIFY2(props()->errorText().contains("expected a number >= 0"), qPrintable(props()->errorText()));
+    QVERIFY(pickWithMouse(combo("type"), "spherical"));
+    QCOMPARE(joint(1).type, JointType::Spherical);
+    QCOMPARE(joint(1).armature[0], 0.02);  // one value: every coordinate of the ball
+    QVERIFY(w->document()->model());
+    QCOMPARE(w->document()->model()->armature.size(), Eigen::Index(4));
+    type("armature", "0.01, 0.02, 0.03");
+    QCOMPARE(joint(1).armature.size(), Eigen::Index(3));
+    QCOMPARE(joint(1).armature[2], 0.03);
+    QVERIFY(pickWithMouse(combo("type"), "fixed"));
+    QCOMPARE(joint(1).type, JointType::Fixed);
+    QVERIFY(joint(1).armature.size() == 0);
+    QVERIFY(!props()->editorFor("armature"));
+    QVERIFY(w->document()->model());
+  }
+
   // every drop-down of every element kind, each of its entries picked in turn: no crash
   void everyDropDownOfEveryKind() {
     buildChainOfTwo();
