@@ -5,6 +5,8 @@
 #include <QCloseEvent>
 #include <QComboBox>
 #include <QDateTime>
+#include <QDialog>
+#include <QDialogButtonBox>
 #include <QDesktopServices>
 #include <QIcon>
 #include <QUrl>
@@ -32,6 +34,7 @@
 #include <nlohmann/json.hpp>
 
 #include "study/files.hpp"
+#include "study/import.hpp"
 
 #include "gui/autosave.hpp"
 #include "gui/control_view.hpp"
@@ -256,6 +259,17 @@ void MainWindow::buildMenus() {
   a_save->setToolTip(tr("Save the model to its file"));
   a_save_as->setShortcut(QKeySequence::SaveAs);
   file->addSeparator();
+  a_import_ = file->addAction(tr("&Import (MJCF, URDF)..."), this, [this] {
+    const QString p = chooseFile(tr("Import model"), QFileInfo(doc_->filePath()).absolutePath(),
+                                 tr("MJCF and URDF (*.xml *.mjcf *.urdf);;MJCF (*.xml *.mjcf);;URDF (*.urdf);;All files (*)"),
+                                 false);
+    if (!p.isEmpty()) importFile(p);
+  });
+  a_import_->setObjectName("actionImport");
+  a_import_->setShortcut(QKeySequence(Qt::CTRL | Qt::Key_I));
+  a_import_->setToolTip(tr("Read an MJCF (MuJoCo) or URDF (ROS) model into a new, unsaved model; the report says what "
+                           "was not modelled (Ctrl+I)"));
+  file->addSeparator();
   QAction* a_export = file->addAction(tr("&Export plant (NAME.m + NAME.mat)..."), this, [this] {
     const QString d = QFileDialog::getExistingDirectory(this, tr("Export plant to folder"), QFileInfo(doc_->filePath()).absolutePath());
     if (!d.isEmpty()) exportPlant(d);
@@ -459,6 +473,93 @@ bool MainWindow::newModel() {
   if (!maybeSave()) return false;
   sim_view_->cancel();
   doc_->clear();
+  return true;
+}
+
+int MainWindow::showReport(const QString& title, const QString& intro, const QString& report, int buttons) {
+  if (ask_) return ask_(title, intro + QStringLiteral("\n\n") + report, buttons);
+  QDialog dlg(this);
+  dlg.setObjectName("importReportDialog");
+  dlg.setWindowTitle(title);
+  auto* lay = new QVBoxLayout(&dlg);
+  auto* label = new QLabel(intro, &dlg);
+  label->setWordWrap(true);
+  label->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  lay->addWidget(label);
+  auto* text = new QPlainTextEdit(report, &dlg);
+  text->setObjectName("importReport");
+  text->setReadOnly(true);
+  text->setLineWrapMode(QPlainTextEdit::WidgetWidth);
+  lay->addWidget(text, 1);
+  auto* box = new QDialogButtonBox(QDialogButtonBox::StandardButtons(buttons), &dlg);
+  int pressed = QMessageBox::Cancel;
+  connect(box, &QDialogButtonBox::clicked, &dlg, [&](QAbstractButton* b) {
+    pressed = int(box->standardButton(b));
+    dlg.accept();
+  });
+  lay->addWidget(box);
+  dlg.resize(820, 520);
+  dlg.exec();
+  return pressed;
+}
+
+bool MainWindow::importFile(const QString& path) {
+  if (!maybeSave()) return false;
+  return importNow(path, {});
+}
+
+bool MainWindow::importNow(const QString& path, const QStringList& ignore) {
+  ImportOptions options;
+  for (const QString& k : ignore) options.ignore.insert(ss(k));
+  ImportResult r;
+  try {
+    r = study_import(ss(path), options);
+  } catch (const ImportRefused& e) {
+    QStringList kinds;
+    for (const ImportFinding* f : e.report().refusals())
+      if (!kinds.contains(qs(f->kind))) kinds << qs(f->kind);
+    message(tr("Not imported: %1").arg(qs(e.what())), true);
+    if (kinds.isEmpty()) {  // the file itself: missing, malformed, not a model
+      showReport(tr("Cannot import"), tr("%1 cannot be imported:").arg(QFileInfo(path).fileName()), qs(e.what()),
+                 QMessageBox::Ok);
+      return false;
+    }
+    const QString intro =
+        tr("%1 holds elements that change the dynamics and that codyna cannot represent: %2. Import it again "
+           "without them (as codyna import --ignore %3)?")
+            .arg(QFileInfo(path).fileName(), kinds.join(", "), kinds.join(","));
+    const QString report = qs(e.what()) + (e.report().mapped.empty() ? QString() : "\n\n" + qs(e.report().text()));
+    if (showReport(tr("Import refused"), intro, report, QMessageBox::Yes | QMessageBox::No) != QMessageBox::Yes) return false;
+    return importNow(path, ignore + kinds);
+  } catch (const std::exception& e) {
+    message(tr("Not imported: %1").arg(qs(e.what())), true);
+    showReport(tr("Cannot import"), tr("%1 cannot be imported:").arg(QFileInfo(path).fileName()), qs(e.what()),
+               QMessageBox::Ok);
+    return false;
+  }
+  // a new document that has no file: the source is never written, Save asks for a name
+  sim_view_->cancel();
+  doc_->clear();
+  QString error;
+  if (!doc_->edit(tr("Import %1").arg(QFileInfo(path).fileName()), [&](ModelSpec& s) { s = r.spec; }, &error)) {
+    message(tr("Not imported: %1").arg(error), true);
+    return false;
+  }
+  result_.reset();
+  slider_->setRange(0, 0);
+  slider_->setEnabled(false);
+  play_->setEnabled(false);
+  time_label_->setText(tr("no result"));
+  view_->fitView();
+  message(tr("Imported %1 (%2, %3): %4 bodies, %5 joints; not saved yet")
+              .arg(path, qs(r.report.format), qs(r.report.reader))
+              .arg(r.spec.bodies.size())
+              .arg(r.spec.joints.size()));
+  for (const std::string& n : r.spec.notes) message(tr("note: %1").arg(qs(n)));
+  showReport(tr("Import report"),
+             tr("%1 was imported as a new, unsaved model (Save asks for a file name; %1 is not changed).")
+                 .arg(QFileInfo(path).fileName()),
+             qs(r.report.text()), QMessageBox::Ok);
   return true;
 }
 

@@ -66,6 +66,13 @@ class MainWindow : public QMainWindow {
   bool saveFileAs(const QString& path);
   bool newModel();
   bool exportPlant(const QString& dir);  // NAME.m + NAME.mat through core's study_export
+  // File > Import: an MJCF (.xml) or URDF (.urdf) file read by core's study_import (what
+  // `codyna import` runs), opened as a new, unsaved document (no file: Save asks for a name, the
+  // source is never written); the import report is shown. A refused import (elements that change
+  // the dynamics) shows the reason and offers to import again ignoring those kinds (the CLI's
+  // --ignore); a file that cannot be read gives its message. True when a model was imported.
+  bool importFile(const QString& path);
+  QAction* importAction() const { return a_import_; }
 
   // Asks before unsaved changes are lost: true when it may go on (saved or discarded).
   bool maybeSave();
@@ -118,6 +125,9 @@ class MainWindow : public QMainWindow {
   void onResult(std::shared_ptr<const SimulationResult> r);
   void stepAnimation();
   int ask(const QString& title, const QString& text, int buttons);
+  // a report in a scrollable dialog (the question hook gets intro + "\n\n" + report)
+  int showReport(const QString& title, const QString& intro, const QString& report, int buttons);
+  bool importNow(const QString& path, const QStringList& ignore);
   QString chooseFile(const QString& title, const QString& dir, const QString& filter, bool save);
 
   Document* doc_;
@@ -141,6 +151,7 @@ class MainWindow : public QMainWindow {
   std::shared_ptr<const SimulationResult> result_;
   double play_t_ = 0;
   QAction* a_linearize_ = nullptr;
+  QAction* a_import_ = nullptr;
   QAction* a_run_ = nullptr;
   QAction* a_cancel_ = nullptr;
   int mode_ = -1;
