@@ -705,6 +705,11 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
         note("resuming: " + std::to_string(job.resumed) + " of " + std::to_string(n) + " variants were done (" +
              journal_path + ")");
     } else {
+      std::ifstream in(journal_path, std::ios::binary);
+      std::string first;
+      if (in && std::getline(in, first) && !first.empty() && first.rfind("codyna sweep journal ", 0) != 0)
+        throw std::invalid_argument(journal_path + ": exists and is not the journal of a codyna sweep; codyna never "
+                                    "replaces a file it did not write: remove it or choose another --out");
       write_file_atomically(journal_path, head);
     }
     journal.open(journal_path, std::ios::binary | std::ios::app);

@@ -7,6 +7,7 @@
 #     attribute equal, variable by variable (and the CSVs equal);
 #   * a variant that fails (mass -1) is recorded with status 1 and its reason, the others complete,
 #     exit code 0;
+#   * a study interrupted by SIGINT and started again writes the uninterrupted file, byte for byte;
 #   * bad --vary, a missing --seed, and --out over the model exit 1 naming the option, writing nothing.
 # Usage: sweep.sh CODYNA SOURCE_DIR WORK_DIR
 set -euo pipefail
@@ -88,6 +89,27 @@ r = [s.decode() for s in f["status/reason"][:]]
 assert r[0] == "" and "/bodies/1/mass" in r[1] and r[2] == "", r
 assert np.isnan(f["linear/A"][1]).all() and not np.isnan(f["linear/A"][2]).any()
 PY
+
+# interrupted by SIGINT, then started again: the same bytes as an uninterrupted run
+study=(sweep "$model" --vary '/bodies/1/mass=normal(10,2)' --samples 800 --seed 11 --simulate --threads 1 --quiet)
+"$codyna" "${study[@]}" --out whole.h5 --csv whole.csv > /dev/null
+"$codyna" "${study[@]}" --out cut.h5 --csv cut.csv > cut1.txt 2>&1 &
+pid=$!
+for _ in $(seq 400); do
+  [ -f cut.h5.partial ] && [ "$(wc -l < cut.h5.partial)" -ge 20 ] && break
+  sleep 0.05
+done
+kill -INT $pid
+rc=0; wait $pid || rc=$?
+[ $rc -ne 0 ] || fail "the study finished before it was interrupted (make it longer)"
+[ ! -e cut.h5 ] || fail "an interrupted study left cut.h5"
+done_before=$(( $(wc -l < cut.h5.partial) - 1 ))
+"$codyna" "${study[@]}" --out cut.h5 --csv cut.csv > cut2.txt 2> cut2.err || fail "the restart failed: $(cat cut2.err)"
+grep -q "codyna: note: resuming: [0-9]* of 800 variants were done (cut.h5.partial)" cut2.err || fail "no resume note: $(cat cut2.err)"
+cmp -s cut.h5 whole.h5 || fail "the resumed cut.h5 differs from the uninterrupted whole.h5"
+cmp -s cut.csv whole.csv || fail "the resumed cut.csv differs"
+[ ! -e cut.h5.partial ] || fail "the journal was left behind"
+echo "interrupted after $done_before of 800 variants, resumed: the same bytes"
 
 refused() {  # refused OUTPUT_WORDS -- ARGS...
   local words="$1"; shift
