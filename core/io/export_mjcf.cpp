@@ -98,6 +98,7 @@ struct MjJoint {
   double ref = 0;
   SE3 G;                     // the element's frame in the MuJoCo body's frame (qpos = ref)
   double stiffness = 0, kref = 0, damping = 0;  // summed springs (kref = sum k r)
+  double armature = 0;       // rotor inertia on its coordinates
   bool has_spring = false;
 };
 
@@ -286,6 +287,7 @@ class Exporter {
         if (j.damping != 0) ++njoint_dampers_;
       }
     }
+    armature();
     for (const MjJoint& j : mj_joints_)
       if (j.has_spring && j.stiffness == 0)
         refuse("joint " + m_.joints[j.body].name + ": springs whose stiffnesses sum to zero (a constant torque " +
@@ -299,6 +301,32 @@ class Exporter {
       ++nsprings_;
     }
   }
+
+  // rotor inertia (JointSpec::armature, per velocity index in Model::armature) -> MuJoCo's joint
+  // armature: exact on a hinge or slide; on a ball or free joint only when the same on all its
+  // coordinates (MuJoCo's adds diag(a) in its own rates, T^T a I T = a I in codyna's)
+  void armature() {
+    const Eigen::VectorXd& arm = m_.armature;
+    if (arm.size() != m_.nv) return;
+    for (MjJoint& j : mj_joints_) {
+      const JointModel& jm = m_.joints[j.body];
+      if (j.kind == Elem::Hinge || j.kind == Elem::Slide) {
+        j.armature = arm[j.iv];
+      } else {
+        bool same = true;
+        for (int k = 1; k < jm.nv; ++k) same = same && arm[jm.idx_v + k] == arm[jm.idx_v];
+        if (!same) {
+          std::string values;
+          for (int k = 0; k < jm.nv; ++k) values += (k ? " " : "") + brief(arm[jm.idx_v + k]);
+          refuse("joint " + jm.name + ": armatures that differ between the coordinates of a " + to_string(jm.type) +
+                 " joint (" + values + "; MuJoCo's " + (j.kind == Elem::Ball ? "ball" : "free") + " joint has one for all)");
+        }
+        j.armature = arm[jm.idx_v];
+      }
+      if (j.armature != 0) ++narmatures_;
+    }
+  }
+  int narmatures_ = 0;
 
   // a site at a point of a body (body axes), written in that body's MuJoCo body
   std::string site(int body, const Eigen::Vector3d& p, const std::string& base) {
@@ -581,6 +609,7 @@ class Exporter {
       if (mj.kind == Elem::Free) {
         x_ << ind << "  <joint name=" << q(mj.name) << " type=\"free\"";
         if (mj.damping != 0) x_ << " damping=\"" << num(mj.damping) << "\"";
+        if (mj.armature != 0) x_ << " armature=\"" << num(mj.armature) << "\"";
         x_ << "/>\n";
         mj.G = SE3();
         continue;
@@ -595,6 +624,7 @@ class Exporter {
       if (mj.has_spring)
         x_ << " stiffness=\"" << num(mj.stiffness) << "\" springref=\"" << num(mj.kref / mj.stiffness) << "\"";
       if (mj.damping != 0) x_ << " damping=\"" << num(mj.damping) << "\"";
+      if (mj.armature != 0) x_ << " armature=\"" << num(mj.armature) << "\"";
       x_ << "/>\n";
     }
     if (bs) {
@@ -760,6 +790,7 @@ class Exporter {
     if (nshapes_) w.push_back(std::to_string(nshapes_) + " display shapes -> geoms without contacts (contype = conaffinity = 0)");
     w.push_back(ngravity ? "gravity [" + brief(g.x()) + " " + brief(g.y()) + " " + brief(g.z()) + "] m/s^2" : "no gravity");
     if (njoint_springs_) w.push_back(std::to_string(njoint_springs_) + " joint springs -> joint stiffness, springref");
+    if (narmatures_) w.push_back(std::to_string(narmatures_) + " joint armatures (rotor inertia) -> joint armature");
     if (njoint_dampers_) w.push_back(std::to_string(njoint_dampers_) + " joint dampings -> joint damping");
     if (nsprings_) w.push_back(std::to_string(nsprings_) + " spring_damper -> spatial tendons (stiffness, damping, springlength)");
     if (nconnect_) w.push_back(std::to_string(nconnect_) + " loop closures -> connect equalities (solimp 0.9999: MuJoCo's stay soft)");

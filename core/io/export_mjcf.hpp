@@ -17,7 +17,8 @@
 //                   first. Each body is placed (pos, quat) where the model's initial state q0
 //                   puts it and each hinge and slide has ref = its q0, so that MuJoCo's qpos is
 //                   codyna's q (and qpos0 its q0); a ball's quaternion in the MuJoCo body's
-//                   axes is q_c q q_c^-1 (q_c the rotation of the joint's child frame M)
+//                   axes is q_c q q_c^-1 (q_c the rotation of the joint's child frame M); rotor
+//                   inertia -> armature (a ball's or free joint's the same on all its coordinates)
 //   effects         gravity (summed) -> option gravity; joint_spring_damper, joint_friction,
 //                   joint_damper -> joint stiffness, springref, damping (summed per coordinate;
 //                   a ball's or free joint's damping must be the same on all its coordinates);

@@ -140,6 +140,18 @@ TEST(ExportMjcf, UnequalDampingsOnABallAreRefused) {
             std::string::npos) << w;
 }
 
+TEST(ExportMjcf, UnequalArmaturesOnABallAreRefused) {
+  ModelSpec s = three_pendulums();
+  s.joints[0].type = JointType::Spherical;
+  s.joints[0].armature = Eigen::Vector3d(0.1, 0.1, 0.2);
+  const std::string w = refusal(s);
+  EXPECT_NE(w.find("joint h0: armatures that differ between the coordinates of a spherical joint (0.1 0.1 0.2"),
+            std::string::npos) << w;
+  s.joints[0].armature = Eigen::VectorXd::Constant(1, 0.1);  // one value: the same on all three
+  const MjcfExport e = export_mjcf(compile(s), "three.json");
+  EXPECT_NE(e.xml.find("<joint name=\"h0\" type=\"ball\" pos=\"0 0 0\" armature=\"0.1\"/>"), std::string::npos) << e.xml;
+}
+
 // --- the study call: the output guard ----------------------------------------------------------
 
 class ExportMjcfFiles : public ::testing::Test {

@@ -480,6 +480,56 @@ TEST(ExportMjcf, ImportedHumanoidExportedBack) {
   EXPECT_LE(worst, 1e-12);
 }
 
+TEST(ExportMjcf, ImportedHumanoidWithItsArmatureExportedBack) {
+  // the armature (rotor inertia) imported as the joints' armature and written back as MuJoCo's
+  const std::string path = kMj + "/humanoid/humanoid.xml";
+  if (!have(path)) GTEST_SKIP() << path << " missing (apt-get install libmujoco-samples)";
+  ImportOptions o;
+  o.ignore = {"contacts"};
+  const ImportResult r = study_import(path, o);
+  const Agreement a = compare_tree("humanoid.xml imported with its armature, exported", r.spec, 6);
+  EXPECT_LE(a.M, 1e-12);
+  char err[1000] = "";
+  MjModelPtr orig(mj_loadXML(path.c_str(), nullptr, err, sizeof err));
+  ASSERT_TRUE(orig) << err;
+  MjModelPtr mm = export_and_load(r.spec, "humanoid");
+  ASSERT_TRUE(mm);
+  ASSERT_EQ(orig->nv, mm->nv);
+  double arm = 0;
+  for (int i = 0; i < orig->nv; ++i) arm = std::max(arm, std::abs(mm->dof_armature[i] - orig->dof_armature[i]));
+  EXPECT_EQ(arm, 0.0) << "MuJoCo's dof_armature of the export vs the original";
+  MjDataPtr d0(mj_makeData(orig.get())), d1(mj_makeData(mm.get()));
+  std::mt19937 rng(12);
+  double worst = 0;
+  for (int s = 0; s < 6; ++s) {
+    for (int j = 0; j < orig->njnt; ++j) {
+      const int je = peer::mj_joint(mm.get(), mj_id2name(orig.get(), mjOBJ_JOINT, j));
+      const int a0 = orig->jnt_qposadr[j], a1 = mm->jnt_qposadr[je];
+      if (orig->jnt_type[j] == mjJNT_FREE) {
+        const Eigen::Quaterniond qr(random_rotation(rng));
+        const Eigen::Vector3d p = random_vec(rng);
+        const double x[7] = {p.x(), p.y(), p.z(), qr.w(), qr.x(), qr.y(), qr.z()};
+        for (int k = 0; k < 7; ++k) d0->qpos[a0 + k] = d1->qpos[a1 + k] = x[k];
+      } else {
+        d0->qpos[a0] = d1->qpos[a1] = std::uniform_real_distribution<double>(-1, 1)(rng);
+      }
+    }
+    mj_forward(orig.get(), d0.get());
+    mj_forward(mm.get(), d1.get());
+    worst = std::max(worst, rel_diff(full_M(mm.get(), d1.get()), full_M(orig.get(), d0.get())));
+  }
+  std::cout << "[mujoco export] humanoid.xml with armature: MuJoCo's M of the export vs of the original file: max rel diff "
+            << worst << std::endl;
+  EXPECT_LE(worst, 1e-12);
+}
+
+TEST(ExportMjcf, ArmatureOnAFreeJointABallAHingeAndASlide) {
+  const ImportResult r = study_import(kData + "armature_ball_free.xml");
+  const Agreement a = compare_tree("armature_ball_free.xml imported, exported", r.spec, 8);
+  EXPECT_LE(a.M, 1e-12);
+  EXPECT_LE(a.qacc, 1e-10);
+}
+
 TEST(ExportMjcf, ImportedCouplerIsAJointEquality) {
   // geared_pair.xml: a joint equality imported as a coupler, exported as a joint equality again
   const ImportResult r = study_import(kData + "geared_pair.xml");
