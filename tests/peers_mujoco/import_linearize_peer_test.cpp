@@ -44,6 +44,7 @@
 #include "dynamics/data.hpp"
 #include "dynamics/forward_dynamics.hpp"
 #include "dynamics/prepare.hpp"
+#include "dynamics/rnea.hpp"
 #include "io/mat_export.hpp"
 #include "peers_mujoco/mjcf.hpp"
 #include "simulation/reference_integrator.hpp"
@@ -194,9 +195,11 @@ class Peer {
   }
 
   // MuJoCo's accelerations in codyna's rates at MuJoCo's qpos, codyna's v and u; `M` receives
-  // MuJoCo's mass matrix in codyna's rates (T^T M_mj T) when given
+  // MuJoCo's mass matrix in codyna's rates (T^T M_mj T) when given, `bias` MuJoCo's bias forces
+  // (qfrc_bias: Coriolis, centrifugal, gravity) in codyna's rates, T^T (qfrc_bias + M_mj c) (from
+  // M_mj qacc + qfrc_bias = Q_mj with qacc = T qdd + c and Q = T^T Q_mj)
   Eigen::VectorXd wdot(const Eigen::VectorXd& qpos, const Eigen::VectorXd& v, const Eigen::VectorXd& u,
-                       Eigen::MatrixXd* M = nullptr) {
+                       Eigen::MatrixXd* M = nullptr, Eigen::VectorXd* bias = nullptr) {
     const Eigen::MatrixXd Tq = T(qpos);
     mj_resetData(mm_, md_.get());
     Eigen::Map<Eigen::VectorXd>(md_->qpos, mm_->nq) = qpos;
@@ -207,10 +210,11 @@ class Peer {
       for (int k = 0; k < m_.nu(); ++k) md_->ctrl[k] = u[k];
     mj_forward(mm_, md_.get());
     EXPECT_EQ(md_->nefc, 0) << "MuJoCo has constraint rows";
-    if (M) {
+    if (M || bias) {
       RowMat Mmj(mm_->nv, mm_->nv);
       mj_fullM(mm_, Mmj.data(), md_->qM);
-      *M = Tq.transpose() * Mmj * Tq;
+      if (M) *M = Tq.transpose() * Mmj * Tq;
+      if (bias) *bias = Tq.transpose() * (Eigen::Map<const Eigen::VectorXd>(md_->qfrc_bias, mm_->nv) + Mmj * c(qpos, v));
     }
     const Eigen::VectorXd qacc = Eigen::Map<const Eigen::VectorXd>(md_->qacc, mm_->nv);
     return Tq.fullPivLu().solve(qacc - c(qpos, v));
@@ -270,7 +274,7 @@ Eigen::VectorXd random_u(const ModelSpec& spec, int nu, std::mt19937& rng) {
 }
 
 struct Worst {
-  double M = 0, wdot = 0, A = 0, B = 0;
+  double M = 0, bias = 0, wdot = 0, A = 0, B = 0;
 };
 
 // M and the accelerations at qpos0 and `nstates` random states (random inputs on the odd ones)
@@ -286,8 +290,12 @@ Worst compare_dynamics(const std::string& label, Peer& p, int nstates, unsigned 
     }
     if (s % 2 == 1) u = random_u(m.spec, m.nu(), rng);
     Eigen::MatrixXd Mmj;
-    const Eigen::VectorXd wmj = p.wdot(p.qpos(q), v, u, &Mmj);
+    Eigen::VectorXd bmj;
+    const Eigen::VectorXd wmj = p.wdot(p.qpos(q), v, u, &Mmj, &bmj);
     const double eM = rel_diff(crba<double>(m, p.data(), q), Mmj);
+    const double eB = rel_diff(nonlinear_effects<double>(m, p.data(), q, v), bmj);
+    EXPECT_LE(eB, 1e-10) << label << " state " << s;
+    w.bias = std::max(w.bias, eB);
     const double eW = rel_diff(forward_dynamics<double>(m, p.data(), q, v, u), wmj);
     EXPECT_LE(eM, 1e-10) << label << " state " << s;
     EXPECT_LE(eW, 1e-10) << label << " state " << s;
@@ -295,7 +303,8 @@ Worst compare_dynamics(const std::string& label, Peer& p, int nstates, unsigned 
     w.wdot = std::max(w.wdot, eW);
   }
   std::cout << "[mujoco import] " << label << ": nv " << m.nv << ", nu " << m.nu() << ", qpos0 + " << nstates
-            << " random states; max rel diff M " << w.M << ", accelerations " << w.wdot << std::endl;
+            << " random states; max rel diff M " << w.M << ", bias forces " << w.bias << ", accelerations " << w.wdot
+            << std::endl;
   return w;
 }
 
@@ -427,6 +436,8 @@ TEST(ImportLinearize, MugFreeJointAgreesWithMuJoCo) {
   ASSERT_TRUE(mm);
   Peer p(r.spec, mm.get(), false);
   ASSERT_TRUE(p.ok());
+  const Worst d = compare_dynamics("mug.xml", p, 6, 42);
+  EXPECT_LE(d.bias, 1e-10);
   const Worst w = linearize_and_compare("mug.xml", p, 3, 2);
   EXPECT_LE(w.A, 1e-6);
 }
@@ -442,6 +453,8 @@ TEST(ImportLinearize, SliderCrankLinksAgreeWithMuJoCo) {
   mm->nu = 0;
   Peer p(r.spec, mm.get(), false);
   ASSERT_TRUE(p.ok());
+  const Worst d = compare_dynamics("slider_crank.xml (--ignore actuators)", p, 6, 43);
+  EXPECT_LE(d.bias, 1e-10);
   const Worst w = linearize_and_compare("slider_crank.xml (--ignore actuators)", p, 3, 3);
   EXPECT_LE(w.A, 1e-6);
 }
@@ -452,6 +465,8 @@ TEST(ImportLinearize, Arm7UrdfAgreesWithMuJoCo) {
   ASSERT_TRUE(mm);
   Peer p(r.spec, mm.get(), true);
   ASSERT_TRUE(p.ok());
+  const Worst d = compare_dynamics("arm7.urdf", p, 6, 44);
+  EXPECT_LE(d.bias, 1e-10);
   const Worst w = linearize_and_compare("arm7.urdf", p, 3, 4);
   EXPECT_LE(w.A, 1e-6);
   EXPECT_LE(w.B, 1e-6);
