@@ -541,6 +541,12 @@ TEST(ExportMjcf, ImportedMimicWithOffset) {
   compare_loop("gripper_mimic.urdf imported (coupler with an offset), exported", r.spec, 6, 1);
 }
 
+TEST(ExportMjcf, ImportedSliderCrankLoop) {
+  // a crank, rod and slider closed by a connect: hinges and a slide in one loop
+  const ImportResult r = study_import(kData + "slider_crank_loop.xml");
+  compare_loop("slider_crank_loop.xml imported (ball closure over a slide), exported", r.spec, 6, 3);
+}
+
 TEST(ExportMjcf, ImportedConnectClosure) {
   const ImportResult r = study_import(kData + "four_bar_connect.xml");
   compare_loop("four_bar_connect.xml imported (ball closure), exported", r.spec, 6, 3);
