@@ -15,7 +15,7 @@ namespace codyna::cli {
 namespace {
 
 struct SweepArgs {
-  std::string model, out, csv, redesign;
+  std::string model, out, csv, mat, redesign;
   std::vector<std::string> vary;
   long long samples = 0;
   std::uint64_t seed = 0;
@@ -34,6 +34,7 @@ void run(const SweepArgs& a) {
   r.redesign = a.redesign;
   r.out = a.out;
   r.csv = a.csv;
+  r.mat = a.mat;
   r.simulate = a.simulate;
   r.resume = !a.restart;
   SweepProgress progress;
@@ -80,6 +81,7 @@ void add_sweep(CLI::App& app) {
   cmd->add_option("--redesign", a->redesign, "lqr: design the study's LQR again for every variant (default: K of the nominal model, fixed)");
   cmd->add_option("--out", a->out, "results (HDF5)")->required();
   cmd->add_option("--csv", a->csv, "the per-variant figures as CSV");
+  cmd->add_option("--mat", a->mat, "DIR/NAME.mat + DIR/NAME.m: the stacks for MATLAB/Octave, NAME.m builds the ss array over the variants");
   cmd->add_flag("--simulate", a->simulate, "also run every variant's nonlinear closed loop (the file's solver settings): status, peak |u|, final error");
   cmd->add_flag("--restart", a->restart, "ignore the journal of an interrupted run (OUT.partial) and run every variant again");
   cmd->add_flag("--quiet", a->quiet, "no progress line");

@@ -1,6 +1,7 @@
 #include "study/sweep.hpp"
 
 #include <hdf5.h>
+#include <matio.h>
 #include <sys/stat.h>
 
 #include <algorithm>
@@ -583,6 +584,20 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
     if (!r.out.empty() && (r.csv == r.out || study_same_file(r.csv, r.out)))
       throw std::invalid_argument(opt("csv") + " " + r.csv + ": the same file as " + opt("out"));
   }
+  if (!r.mat.empty()) {
+    const std::filesystem::path p(r.mat);
+    if (p.extension() != ".mat") throw std::invalid_argument(opt("mat") + " " + r.mat + ": expected DIR/NAME.mat");
+    if (study_matlab_identifier(p.stem().string()) != p.stem().string())
+      throw std::invalid_argument(opt("mat") + " " + r.mat + ": '" + p.stem().string() + "' is not a MATLAB identifier (try " +
+                                  study_matlab_identifier(p.stem().string()) + ".mat)");
+    if (!p.parent_path().empty()) {
+      std::error_code ec;
+      std::filesystem::create_directories(p.parent_path(), ec);
+      if (ec) throw std::runtime_error(p.parent_path().string() + ": cannot create the folder: " + ec.message());
+    }
+    study_guard_output(r.mat, OutputKind::PlantMat, {r.model});
+    study_guard_output((p.parent_path() / (p.stem().string() + ".m")).string(), OutputKind::PlantScript, {r.model});
+  }
   const ModelSpec nominal_spec = study_read_model(r.model);  // errors name the file and the field
   for (const std::string& n : nominal_spec.notes) note(n);
   std::string model_bytes;
@@ -778,6 +793,12 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
   if (!r.csv.empty()) {
     study_write_sweep_csv(job, r.csv);
     job.written.push_back(r.csv);
+  }
+  if (!r.mat.empty()) {
+    study_write_sweep_mat(job, r.mat);
+    job.written.push_back(r.mat);
+    const std::filesystem::path p(r.mat);
+    job.written.push_back((p.parent_path() / (p.stem().string() + ".m")).string());
   }
   if (journal.is_open()) {
     journal.close();
@@ -1100,6 +1121,183 @@ void study_write_sweep_csv(const SweepJob& job, const std::string& path) {
     text += '\n';
   }
   write_file_atomically(path, text);
+}
+
+namespace {
+
+struct MatVarFree {
+  void operator()(matvar_t* v) const { Mat_VarFree(v); }
+};
+using MatVar = std::unique_ptr<matvar_t, MatVarFree>;
+
+MatVar mat_checked(matvar_t* v, const char* name) {
+  if (!v) throw std::runtime_error(std::string("cannot create MAT variable ") + (name ? name : "(cell)"));
+  return MatVar(v);
+}
+
+// column-major data of dims
+MatVar mat_doubles(const char* name, std::vector<size_t> dims, std::vector<double> data) {
+  return mat_checked(Mat_VarCreate(name, MAT_C_DOUBLE, MAT_T_DOUBLE, static_cast<int>(dims.size()), dims.data(), data.data(), 0),
+                     name);
+}
+
+MatVar mat_char(const char* name, const std::string& s) {
+  std::u16string u;
+  for (unsigned char ch : s) u.push_back(static_cast<char16_t>(ch < 128 ? ch : '?'));
+  size_t dims[2] = {u.empty() ? 0u : 1u, u.size()};
+  return mat_checked(Mat_VarCreate(name, MAT_C_CHAR, MAT_T_UINT16, 2, dims, u.data(), 0), name);
+}
+
+MatVar mat_cellstr(const char* name, const std::vector<std::string>& list) {
+  size_t dims[2] = {list.size(), 1};
+  MatVar cell = mat_checked(Mat_VarCreate(name, MAT_C_CELL, MAT_T_CELL, 2, dims, nullptr, 0), name);
+  for (std::size_t i = 0; i < list.size(); ++i) Mat_VarSetCell(cell.get(), static_cast<int>(i), mat_char(nullptr, list[i]).release());
+  return cell;
+}
+
+// rows x cols x n, page k = variant k's matrix (NaN when it failed)
+MatVar mat_stack(const char* name, const std::vector<SweepVariant>& vs, Eigen::MatrixXd SweepVariant::*field, Eigen::Index rows,
+                 Eigen::Index cols) {
+  std::vector<double> data(vs.size() * static_cast<std::size_t>(rows * cols), kNaN);
+  for (std::size_t k = 0; k < vs.size(); ++k) {
+    const Eigen::MatrixXd& M = vs[k].*field;
+    if (vs[k].status == SweepStatus::Ok && M.rows() == rows && M.cols() == cols)
+      std::copy(M.data(), M.data() + M.size(), data.begin() + static_cast<std::ptrdiff_t>(k * static_cast<std::size_t>(rows * cols)));
+  }
+  return mat_doubles(name, {static_cast<size_t>(rows), static_cast<size_t>(cols), vs.size()}, std::move(data));
+}
+
+// nx x n, column k = variant k's poles (real or imaginary parts)
+MatVar mat_poles(const char* name, const std::vector<SweepVariant>& vs, Eigen::VectorXcd SweepVariant::*field, Eigen::Index nx,
+                 bool imag) {
+  std::vector<double> data(vs.size() * static_cast<std::size_t>(nx), kNaN);
+  for (std::size_t k = 0; k < vs.size(); ++k) {
+    const Eigen::VectorXcd& p = vs[k].*field;
+    if (vs[k].status != SweepStatus::Ok || p.size() != nx) continue;
+    for (Eigen::Index j = 0; j < nx; ++j) data[k * static_cast<std::size_t>(nx) + static_cast<std::size_t>(j)] = imag ? p[j].imag() : p[j].real();
+  }
+  return mat_doubles(name, {static_cast<size_t>(nx), vs.size()}, std::move(data));
+}
+
+std::string m_quoted(const std::string& s) {
+  std::string out = "'";
+  for (char ch : s) {
+    if (ch == '\n' || ch == '\r') ch = ' ';
+    out += ch == '\'' ? std::string("''") : std::string(1, ch);
+  }
+  return out + "'";
+}
+
+std::string sweep_script(const SweepJob& job, const std::string& name) {
+  std::ostringstream m;
+  m << "% " << name << ".m - a parameter study (codyna sweep), exported by codyna " << CODYNA_VERSION << "\n"
+    << "%\n% Model: " << job.model_name << "  (" << job.model_file << ")\n"
+    << "% " << job.variants.size() << " variants of the fields in `fields` (values(k,:) is variant k's), "
+    << (job.plan.random ? "joint random samples" : "a full grid") << "; " << job.operating_point << " point, " << job.method
+    << " Jacobians.\n"
+    << "% Variant k: A(:,:,k), B(:,:,k), C(:,:,k), D(:,:,k) (continuous; NaN when status(k) is not 0: see reason{k}),\n"
+    << "% open_poles(:,k) = eig(A(:,:,k))";
+  if (job.closed_loop)
+    m << ", closed_poles(:,k) = eig(A(:,:,k) - B(:,:,k) * K" << (job.redesigned ? "(:,:,k)" : "") << ")";
+  m << ".\n% sys: the completed variants ok = find(status == 0) as one ss array (MATLAB) or a cell array of ss\n"
+    << "% (Octave's ss has no array dimension), when ss() exists.\n\n"
+    << "codyna_here = fileparts(mfilename('fullpath'));\n"
+    << "load(fullfile(codyna_here, '" << name << ".mat'));\n"
+    << "if exist('OCTAVE_VERSION', 'builtin')\n  try\n    pkg load control\n  catch\n  end\nend\n"
+    << "open_poles = open_poles_real + 1i * open_poles_imag;\n";
+  if (job.closed_loop) m << "closed_poles = closed_poles_real + 1i * closed_poles_imag;\n";
+  m << "ok = find(status == 0);\n"
+    << "if exist('ss') >= 2\n"
+    << "  if exist('OCTAVE_VERSION', 'builtin')\n"
+    << "    sys = cell(numel(ok), 1);\n"
+    << "    for codyna_k = 1:numel(ok)\n"
+    << "      j = ok(codyna_k);\n"
+    << "      sys{codyna_k} = ss(A(:,:,j), B(:,:,j), C(:,:,j), D(:,:,j), 'StateName', state_names, 'InputName', input_names, "
+       "'OutputName', output_names);\n"
+    << "    end\n"
+    << "    clear codyna_k j\n"
+    << "  else\n"
+    << "    sys = ss(A(:,:,ok), B(:,:,ok), C(:,:,ok), D(:,:,ok), 'StateName', state_names, 'InputName', input_names, "
+       "'OutputName', output_names);\n"
+    << "  end\n"
+    << "end\n"
+    << "fprintf('%s: %d variants of model %s (%d completed), %d states, %d inputs, %d outputs.\\n', ...\n"
+    << "        " << m_quoted(name) << ", numel(status), " << m_quoted(job.model_name)
+    << ", numel(ok), size(A, 1), size(B, 2), size(C, 1));\n"
+    << "clear codyna_here\n";
+  return m.str();
+}
+
+}  // namespace
+
+void study_write_sweep_mat(const SweepJob& job, const std::string& mat_path) {
+  const std::filesystem::path p(mat_path);
+  const std::string name = p.stem().string();
+  if (p.extension() != ".mat") throw std::invalid_argument(mat_path + ": expected DIR/NAME.mat");
+  if (study_matlab_identifier(name) != name)
+    throw std::invalid_argument(mat_path + ": '" + name + "' is not a MATLAB identifier (try " + study_matlab_identifier(name) + ".mat)");
+  const std::string m_path = (p.parent_path() / (name + ".m")).string();
+  study_guard_output(mat_path, OutputKind::PlantMat, {job.model_file});
+  study_guard_output(m_path, OutputKind::PlantScript, {job.model_file});
+  const auto& vs = job.variants;
+  const std::size_t n = vs.size(), nv = job.plan.vary.size();
+  const Eigen::Index nx = static_cast<Eigen::Index>(job.state_names.size()), nu = static_cast<Eigen::Index>(job.input_names.size()),
+                     ny = static_cast<Eigen::Index>(job.output_names.size());
+  AtomicFile mat(mat_path), script(m_path);
+  {
+    const std::string header = "MATLAB 5.0 MAT-file, codyna sweep " + name + ", codyna " + CODYNA_VERSION;
+    mat_t* f = Mat_CreateVer(mat.temp_path().c_str(), header.c_str(), MAT_FT_MAT5);
+    if (!f) throw std::runtime_error(mat_path + ": cannot create " + mat.temp_path());
+    std::vector<MatVar> vars;
+    vars.push_back(mat_stack("A", vs, &SweepVariant::A, nx, nx));
+    vars.push_back(mat_stack("B", vs, &SweepVariant::B, nx, nu));
+    vars.push_back(mat_stack("C", vs, &SweepVariant::C, ny, nx));
+    vars.push_back(mat_stack("D", vs, &SweepVariant::D, ny, nu));
+    std::vector<double> values(n * nv, kNaN), status(n), omr(n, kNaN), cmr(n, kNaN), stable(n);
+    std::vector<std::string> fields, reasons;
+    for (std::size_t k = 0; k < nv; ++k) fields.push_back(job.plan.vary[k].field);
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::size_t k = 0; k < nv && k < vs[i].values.size(); ++k) values[k * n + i] = vs[i].values[k];  // column-major
+      status[i] = static_cast<double>(static_cast<int>(vs[i].status));
+      reasons.push_back(vs[i].reason);
+      if (vs[i].status == SweepStatus::Ok) {
+        omr[i] = vs[i].open_max_real;
+        cmr[i] = vs[i].closed_max_real;
+      }
+      stable[i] = vs[i].stable ? 1 : 0;
+    }
+    vars.push_back(mat_doubles("values", {n, nv}, values));
+    vars.push_back(mat_cellstr("fields", fields));
+    vars.push_back(mat_doubles("status", {n, 1}, status));
+    vars.push_back(mat_cellstr("reason", reasons));
+    vars.push_back(mat_poles("open_poles_real", vs, &SweepVariant::open_poles, nx, false));
+    vars.push_back(mat_poles("open_poles_imag", vs, &SweepVariant::open_poles, nx, true));
+    vars.push_back(mat_doubles("open_max_real", {n, 1}, omr));
+    vars.push_back(mat_doubles("stable", {n, 1}, stable));
+    if (job.closed_loop) {
+      if (job.redesigned) vars.push_back(mat_stack("K", vs, &SweepVariant::K, nu, nx));
+      else vars.push_back(mat_doubles("K", {static_cast<size_t>(nu), static_cast<size_t>(nx)},
+                                      std::vector<double>(job.K.data(), job.K.data() + job.K.size())));
+      vars.push_back(mat_poles("closed_poles_real", vs, &SweepVariant::closed_poles, nx, false));
+      vars.push_back(mat_poles("closed_poles_imag", vs, &SweepVariant::closed_poles, nx, true));
+      vars.push_back(mat_doubles("closed_max_real", {n, 1}, cmr));
+    }
+    vars.push_back(mat_cellstr("state_names", job.state_names));
+    vars.push_back(mat_cellstr("input_names", job.input_names));
+    vars.push_back(mat_cellstr("output_names", job.output_names));
+    bool ok = true;
+    for (const MatVar& v : vars) ok = ok && Mat_VarWrite(f, v.get(), MAT_COMPRESSION_NONE) == 0;
+    ok = Mat_Close(f) == 0 && ok;
+    if (!ok) throw std::runtime_error(mat_path + ": cannot write " + mat.temp_path());
+  }
+  {
+    std::ofstream out(script.temp_path(), std::ios::binary | std::ios::trunc);
+    out << sweep_script(job, name);
+    out.close();
+    if (!out) throw std::runtime_error(m_path + ": cannot write " + script.temp_path());
+  }
+  mat.commit();
+  script.commit();
 }
 
 std::string study_sweep_summary(const SweepJob& job) {

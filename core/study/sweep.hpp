@@ -46,6 +46,7 @@ struct SweepRequest {
   int threads = 0;                          // 0: std::thread::hardware_concurrency()
   std::string redesign;                     // "" (K fixed) or "lqr" (designed again per variant)
   std::string out, csv;                     // HDF5 and CSV results; "" = not written
+  std::string mat;                          // DIR/NAME.mat + DIR/NAME.m for MATLAB/Octave; "" = not written
   // also a nonlinear closed-loop run per variant (the file's solver settings and initial state),
   // with the same controller as the linear figures: the nominal K as a state feedback about the
   // variant's own operating point, or the LQR designed again with redesign = "lqr"
@@ -148,6 +149,11 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell = {}, 
 // Writes the HDF5 results / the CSV (each atomically; see docs/parameter-studies.md).
 void study_write_sweep_hdf5(const SweepJob& job, const std::string& path);
 void study_write_sweep_csv(const SweepJob& job, const std::string& path);
+// DIR/NAME.mat (MAT v5: the A, B, C, D stacks as nx x nx x n arrays, values, status, reason, poles,
+// K, names) and DIR/NAME.m, which loads it and builds `sys` over the completed variants `ok`
+// (MATLAB: one ss array; Octave, whose ss has no array dimension: a cell array of ss). NAME must
+// be a MATLAB identifier.
+void study_write_sweep_mat(const SweepJob& job, const std::string& mat_path);
 
 // The summary `codyna sweep` prints.
 std::string study_sweep_summary(const SweepJob& job);
