@@ -398,6 +398,27 @@ TEST(ExportMjcf, EveryJointEffectAndActuatorThatMaps) {
     EXPECT_EQ(mm->body_jntnum[tip], 2);
     EXPECT_EQ(mm->ntendon, 2);
     compare_tree("random tree " + std::to_string(seed) + " with every mapped effect and actuator", s, 6, 20 + seed);
+    // the initial state as MuJoCo's keyframe, in its joints' order (merged frames included):
+    // turned balls, a moving start and nominal inputs
+    ModelSpec s0 = s;
+    std::mt19937 rng(seed);
+    for (JointSpec& j : s0.joints) {
+      const int nv = joint_nv(j.type);
+      if (j.type == JointType::Spherical) {
+        const Eigen::Quaterniond qr(random_rotation(rng));
+        j.q0 = Eigen::Vector4d(qr.w(), qr.x(), qr.y(), qr.z());
+      }
+      j.v0 = Eigen::VectorXd::Random(nv);
+    }
+    for (ActuatorSpec& a : s0.actuators) a.u0 = 0.25;
+    const Model m0 = compile(s0);
+    MjModelPtr mk = export_and_load(s0, "everything with an initial state");
+    ASSERT_TRUE(mk);
+    ASSERT_EQ(mk->nkey, 1);
+    const peer::Mapped mp = peer::map_state(m0, mk.get(), m0.q0, m0.v0);
+    EXPECT_LE((Eigen::Map<const Eigen::VectorXd>(mk->key_qpos, mk->nq) - mp.qpos).cwiseAbs().maxCoeff(), 1e-15);
+    EXPECT_LE((Eigen::Map<const Eigen::VectorXd>(mk->key_qvel, mk->nv) - mp.qvel).cwiseAbs().maxCoeff(), 1e-14);
+    for (int k = 0; k < mk->nu; ++k) EXPECT_EQ(mk->key_ctrl[k], 0.25);
   }
 }
 
