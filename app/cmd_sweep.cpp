@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 
 #include "commands.hpp"
@@ -15,7 +16,7 @@ namespace codyna::cli {
 namespace {
 
 struct SweepArgs {
-  std::string model, out, csv, mat, redesign;
+  std::string model, out, csv, mat, redesign, shard;
   std::vector<std::string> vary;
   long long samples = 0;
   std::uint64_t seed = 0;
@@ -36,6 +37,30 @@ void run(const SweepArgs& a) {
   r.csv = a.csv;
   r.mat = a.mat;
   r.simulate = a.simulate;
+  if (!a.shard.empty()) {
+    // K/N, or "slurm": SLURM_ARRAY_TASK_ID (from SLURM_ARRAY_TASK_MIN) of SLURM_ARRAY_TASK_COUNT
+    long long k = -1, n = 0;
+    if (a.shard == "slurm") {
+      const char* id = std::getenv("SLURM_ARRAY_TASK_ID");
+      const char* count = std::getenv("SLURM_ARRAY_TASK_COUNT");
+      const char* min = std::getenv("SLURM_ARRAY_TASK_MIN");
+      if (!id || !count) throw std::invalid_argument("--shard slurm: SLURM_ARRAY_TASK_ID and SLURM_ARRAY_TASK_COUNT are not set (not in a Slurm job array)");
+      k = std::atoll(id) - (min ? std::atoll(min) : 0);
+      n = std::atoll(count);
+    } else {
+      const auto slash = a.shard.find('/');
+      char* end = nullptr;
+      if (slash != std::string::npos) {
+        k = std::strtoll(a.shard.c_str(), &end, 10);
+        if (end != a.shard.c_str() + slash) k = -1;
+        n = std::strtoll(a.shard.c_str() + slash + 1, &end, 10);
+        if (*end != '\0') n = 0;
+      }
+      if (k < 0 || n < 1 || k >= n) throw std::invalid_argument("--shard " + a.shard + ": expected K/N with 0 <= K < N, or slurm");
+    }
+    r.shard_index = k;
+    r.shard_count = n;
+  }
   r.resume = !a.restart;
   SweepProgress progress;
   const bool bar = !a.quiet && isatty(STDERR_FILENO);
@@ -84,9 +109,30 @@ void add_sweep(CLI::App& app) {
   cmd->add_option("--mat", a->mat, "DIR/NAME.mat + DIR/NAME.m: the stacks for MATLAB/Octave, NAME.m builds the ss array over the variants");
   cmd->add_flag("--simulate", a->simulate, "also run every variant's nonlinear closed loop (the file's solver settings): status, peak |u|, final error");
   cmd->add_flag("--restart", a->restart, "ignore the journal of an interrupted run (OUT.partial) and run every variant again");
+  cmd->add_option("--shard", a->shard, "K/N: run only the variants i with i % N = K and write them to --out (a shard; slurm: from SLURM_ARRAY_TASK_ID/COUNT); codyna sweep-merge joins the shards");
   cmd->add_flag("--quiet", a->quiet, "no progress line");
   a->cmd = cmd;
   cmd->callback([a] { set_exit_code(run_guarded([&] { run(*a); })); });
+
+  auto m = std::make_shared<SweepArgs>();
+  auto shards = std::make_shared<std::vector<std::string>>();
+  auto* merge = app.add_subcommand("sweep-merge", "Join the shards of a codyna sweep --shard K/N into the results the whole study writes");
+  merge->add_option("shards", *shards, "the shards' files")->required();
+  merge->add_option("--out", m->out, "results (HDF5)")->required();
+  merge->add_option("--csv", m->csv, "the per-variant figures as CSV");
+  merge->add_option("--mat", m->mat, "DIR/NAME.mat + DIR/NAME.m for MATLAB/Octave");
+  merge->callback([m, shards] {
+    set_exit_code(run_guarded([&] {
+      SweepRequest outputs;
+      outputs.out = m->out;
+      outputs.csv = m->csv;
+      outputs.mat = m->mat;
+      outputs.threads = 1;
+      const SweepJob job = study_sweep_merge(*shards, outputs, print_message);
+      std::cout << study_sweep_summary(job);
+      for (const std::string& f : job.written) std::cout << "wrote " << f << "\n";
+    }));
+  });
 }
 
 }  // namespace codyna::cli

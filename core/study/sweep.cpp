@@ -16,6 +16,7 @@
 #include <iomanip>
 #include <iterator>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <numeric>
 #include <sstream>
@@ -478,6 +479,20 @@ std::string journal_head(const SweepRequest& r, const std::string& model_bytes, 
   return std::string("codyna sweep journal 1 ") + key + " " + std::to_string(count) + "\n";
 }
 
+// the second line: the request itself, so that sweep-merge needs only the shards
+std::string journal_request(const SweepRequest& r) {
+  nlohmann::json j = {{"model", r.model}, {"vary", r.vary}, {"redesign", r.redesign}, {"simulate", r.simulate}};
+  j["samples"] = r.samples ? nlohmann::json(*r.samples) : nlohmann::json();
+  j["seed"] = r.seed ? nlohmann::json(std::to_string(*r.seed)) : nlohmann::json();
+  return "request " + j.dump() + "\n";
+}
+
+bool is_journal(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string first;
+  return !(in && std::getline(in, first) && !first.empty() && first.rfind("codyna sweep journal ", 0) != 0);
+}
+
 }  // namespace
 
 std::string study_sweep_journal_path(const std::string& out) { return out + ".partial"; }
@@ -577,8 +592,23 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
   if (r.redesign != "" && r.redesign != "lqr")
     throw std::invalid_argument(opt("redesign") + " " + r.redesign + ": expected lqr");
   if (r.threads < 0) throw std::invalid_argument(opt("threads") + ": expected 1 or more (0: every core)");
+  const bool shard = r.shard_count > 0;
+  if (shard) {
+    if (r.shard_index < 0 || r.shard_index >= r.shard_count)
+      throw std::invalid_argument(opt("shard") + " " + std::to_string(r.shard_index) + "/" + std::to_string(r.shard_count) +
+                                  ": expected K/N with 0 <= K < N");
+    if (r.out.empty()) throw std::invalid_argument(opt("shard") + ": give " + opt("out") + " (the shard's file)");
+    if (!r.csv.empty() || !r.mat.empty())
+      throw std::invalid_argument(opt("shard") + ": a shard writes its variants only (" + opt("out") +
+                                  "); codyna sweep-merge writes the results, CSV and MAT files");
+    if (study_same_file(r.out, r.model))
+      throw std::invalid_argument(r.out + ": this is the input file " + r.model + "; choose another name");
+    if (!is_journal(r.out))
+      throw std::invalid_argument(r.out + ": exists and is not a shard of codyna sweep; codyna never replaces a file it "
+                                  "did not write: remove it or choose another name");
+  }
   // the outputs, before any work
-  if (!r.out.empty()) study_guard_output(r.out, OutputKind::ResultsHdf5, {r.model});
+  if (!r.out.empty() && !shard) study_guard_output(r.out, OutputKind::ResultsHdf5, {r.model});
   if (!r.csv.empty()) {
     guard_csv(r.csv, r.model);
     if (!r.out.empty() && (r.csv == r.out || study_same_file(r.csv, r.out)))
@@ -687,9 +717,11 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
   // the journal: the variants an interrupted run of this very study finished
   std::vector<char> have(static_cast<std::size_t>(n), 0);
   std::ofstream journal;
-  const std::string journal_path = r.out.empty() ? std::string() : study_sweep_journal_path(r.out);
+  job.shard_index = shard ? r.shard_index : 0;
+  job.shard_count = shard ? r.shard_count : 0;
+  const std::string journal_path = r.out.empty() ? std::string() : shard ? r.out : study_sweep_journal_path(r.out);
   if (!journal_path.empty()) {
-    const std::string head = journal_head(r, model_bytes, n);
+    const std::string head = journal_head(r, model_bytes, n), request_line = journal_request(r);
     std::error_code ec;
     if (r.resume && std::filesystem::exists(journal_path, ec)) {
       std::ifstream in(journal_path, std::ios::binary);
@@ -697,13 +729,14 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
       if (!std::getline(in, line) || line + "\n" != head)
         throw std::invalid_argument(journal_path + ": the journal of another study (other model file contents or options) "
                                     "is in the way: remove it to start afresh");
-      std::string kept = head;
+      std::string kept = head + request_line;
       while (std::getline(in, line)) {
         if (in.eof()) break;  // a last line without its newline was cut by the interruption
+        if (line.rfind("request ", 0) == 0) continue;
         try {
           const nlohmann::json j = nlohmann::json::parse(line);
           const long long i = j.at("i").get<long long>();
-          if (i < 0 || i >= n || have[static_cast<std::size_t>(i)]) continue;
+          if (i < 0 || i >= n || have[static_cast<std::size_t>(i)] || !job.in_shard(i)) continue;
           SweepVariant v = journal_variant(j);
           if (v.values != job.plan.values(i)) continue;
           job.variants[static_cast<std::size_t>(i)] = std::move(v);
@@ -720,12 +753,10 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
         note("resuming: " + std::to_string(job.resumed) + " of " + std::to_string(n) + " variants were done (" +
              journal_path + ")");
     } else {
-      std::ifstream in(journal_path, std::ios::binary);
-      std::string first;
-      if (in && std::getline(in, first) && !first.empty() && first.rfind("codyna sweep journal ", 0) != 0)
+      if (!is_journal(journal_path))
         throw std::invalid_argument(journal_path + ": exists and is not the journal of a codyna sweep; codyna never "
                                     "replaces a file it did not write: remove it or choose another --out");
-      write_file_atomically(journal_path, head);
+      write_file_atomically(journal_path, head + request_line);
     }
     journal.open(journal_path, std::ios::binary | std::ios::app);
     if (!journal) throw std::runtime_error(journal_path + ": cannot append to the journal");
@@ -738,7 +769,7 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
       if (progress.cancel && progress.cancel->load()) return;
       const long long i = next.fetch_add(1);
       if (i >= n) return;
-      if (have[static_cast<std::size_t>(i)]) continue;
+      if (have[static_cast<std::size_t>(i)] || !job.in_shard(i)) continue;
       SweepVariant& v = job.variants[static_cast<std::size_t>(i)];
       try {
         run_variant(c, i, v);
@@ -762,12 +793,15 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
     for (std::thread& t : pool) t.join();
   }
   if (fatal) std::rethrow_exception(fatal);
-  if (done.load() < n) throw StudyCancelled("the sweep was cancelled after " + std::to_string(done.load()) + " of " +
-                                            std::to_string(n) + " variants");
+  long long expected = n;
+  if (shard) expected = r.shard_index < n ? (n - r.shard_index + r.shard_count - 1) / r.shard_count : 0;
+  if (done.load() < expected) throw StudyCancelled("the sweep was cancelled after " + std::to_string(done.load()) + " of " +
+                                            std::to_string(expected) + " variants");
 
   // the summary: the worst case is the completed variant with the largest max real part (first on ties)
   double worst = -std::numeric_limits<double>::infinity();
   for (long long i = 0; i < n; ++i) {
+    if (!job.in_shard(i)) continue;
     const SweepVariant& v = job.variants[static_cast<std::size_t>(i)];
     if (v.status != SweepStatus::Ok) {
       ++job.failed;
@@ -786,6 +820,12 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
     }
   }
 
+  if (shard) {  // the shard's journal is its result
+    journal.close();
+    if (!journal) throw std::runtime_error(r.out + ": cannot finish the shard's file");
+    job.written.push_back(r.out);
+    return job;
+  }
   if (!r.out.empty()) {
     study_write_sweep_hdf5(job, r.out);
     job.written.push_back(r.out);
@@ -806,6 +846,76 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
     std::filesystem::remove(journal_path, ec);
   }
   return job;
+}
+
+SweepJob study_sweep_merge(const std::vector<std::string>& shards, const SweepRequest& outputs, const StudyMessages& tell) {
+  if (shards.empty()) throw std::invalid_argument("sweep-merge: give the shards' files");
+  if (outputs.out.empty()) throw std::invalid_argument(option_name(outputs.style, "out") + ": the merged results (HDF5)");
+  std::string head, request;
+  std::map<long long, std::string> lines;
+  for (const std::string& path : shards) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw std::invalid_argument(path + ": cannot read this shard");
+    std::string h, q, line;
+    if (!std::getline(in, h) || h.rfind("codyna sweep journal ", 0) != 0 || !std::getline(in, q) || q.rfind("request ", 0) != 0)
+      throw std::invalid_argument(path + ": not a shard written by codyna sweep --shard");
+    if (head.empty()) {
+      head = h;
+      request = q;
+    } else if (h != head) {
+      throw std::invalid_argument(path + ": a shard of another study than " + shards.front() +
+                                  " (other model file contents or options)");
+    }
+    while (std::getline(in, line)) {
+      if (in.eof()) break;
+      try {
+        lines.emplace(nlohmann::json::parse(line).at("i").get<long long>(), line);
+      } catch (const std::exception&) {
+      }
+    }
+  }
+  const long long n = std::stoll(head.substr(head.rfind(' ') + 1));
+  if (static_cast<long long>(lines.size()) != n) {
+    std::string missing;
+    long long count = 0;
+    for (long long i = 0; i < n; ++i)
+      if (!lines.count(i) && count++ < 8) missing += (missing.empty() ? "" : ", ") + std::to_string(i);
+    throw std::invalid_argument("sweep-merge: variants " + missing + (count > 8 ? ", ..." : "") + " (" + std::to_string(count) +
+                                " of " + std::to_string(n) + ") are in none of the shards given: run (or resume) their shards first");
+  }
+  const nlohmann::json q = nlohmann::json::parse(request.substr(8));
+  SweepRequest r = outputs;
+  r.model = q.at("model").get<std::string>();
+  r.vary = q.at("vary").get<std::vector<std::string>>();
+  r.redesign = q.at("redesign").get<std::string>();
+  r.simulate = q.at("simulate").get<bool>();
+  r.samples.reset();
+  r.seed.reset();
+  if (!q.at("samples").is_null()) r.samples = q.at("samples").get<long long>();
+  if (!q.at("seed").is_null()) r.seed = std::stoull(q.at("seed").get<std::string>());
+  r.resume = true;
+  r.shard_index = 0;
+  r.shard_count = 0;
+  // the joined journal: the whole study resumes from it with nothing left to run
+  const std::string journal_path = study_sweep_journal_path(r.out);
+  study_guard_output(r.out, OutputKind::ResultsHdf5, {r.model});
+  if (!is_journal(journal_path))
+    throw std::invalid_argument(journal_path + ": exists and is not the journal of a codyna sweep: remove it");
+  std::string text = head + "\n" + request + "\n";
+  for (const auto& [i, line] : lines) text += line + "\n";
+  write_file_atomically(journal_path, text);
+  try {
+    const StudyMessages quiet = [&](const StudyMessage& m) {
+      if (tell && m.text.rfind("resuming: ", 0) != 0) tell(m);
+    };
+    SweepJob job = study_sweep_job(r, quiet);
+    if (job.resumed != n) throw std::runtime_error("sweep-merge: " + std::to_string(n - job.resumed) + " variants were run again");
+    return job;
+  } catch (...) {
+    std::error_code ec;
+    std::filesystem::remove(journal_path, ec);
+    throw;
+  }
 }
 
 // ------------------------------------------------------------------ HDF5
@@ -1304,6 +1414,14 @@ std::string study_sweep_summary(const SweepJob& job) {
   std::ostringstream os;
   const long long n = static_cast<long long>(job.variants.size());
   const std::size_t fields = job.plan.vary.size();
+  if (job.shard_count > 0) {
+    long long mine = 0;
+    for (long long i = 0; i < n; ++i) mine += job.in_shard(i) ? 1 : 0;
+    os << "shard            " << job.shard_index << "/" << job.shard_count << ": " << mine << " of the " << n
+       << " variants (i % " << job.shard_count << " = " << job.shard_index << "), " << job.failed
+       << " failed; codyna sweep-merge joins the shards\n";
+    return os.str();
+  }
   os << "sweep            " << job.model_name << ": " << n << " variants, "
      << (job.plan.random ? "joint random samples (seed " + std::to_string(job.plan.seed) + ")" : std::string("a full grid"))
      << " of " << fields << (fields == 1 ? " field" : " fields") << "\n";

@@ -57,6 +57,10 @@ struct SweepRequest {
   // uninterrupted run. The journal is removed once the results are written; a journal of another
   // study (other file contents or options) is refused. resume = false starts afresh.
   bool resume = true;
+  // A shard (Slurm job arrays): shard_count > 0 runs only the variants i with
+  // i % shard_count == shard_index and writes them, as a journal, to `out` (no HDF5 there);
+  // study_sweep_merge joins the shards into the file the whole study would have written.
+  long long shard_index = 0, shard_count = 0;
 };
 
 // OUT.partial: where the journal of a study writing `out` is kept
@@ -129,6 +133,8 @@ struct SweepJob {
   std::vector<std::string> notes, warnings;
   std::vector<std::string> written;
   long long resumed = 0;                      // variants read back from the journal
+  long long shard_index = 0, shard_count = 0;  // a shard's (shard_count 0: the whole study)
+  bool in_shard(long long i) const { return shard_count == 0 || i % shard_count == shard_index; }
   // summary
   long long failed = 0, stable = 0;
   long long worst = -1;                       // the completed variant with the largest max real part
@@ -145,6 +151,12 @@ struct SweepProgress {
 // must work), every variant on `threads` workers, and the files (each output checked against the
 // model file before any work, written through a temporary file renamed into place).
 SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell = {}, const SweepProgress& progress = {});
+
+// `codyna sweep-merge`: the shards' journals (every variant in one of them, all of the same study:
+// the same model file bytes and options) joined and written to outputs.out / csv / mat exactly as
+// the whole study run at once writes them (the nominal model is compiled again, no variant is).
+SweepJob study_sweep_merge(const std::vector<std::string>& shards, const SweepRequest& outputs,
+                           const StudyMessages& tell = {});
 
 // Writes the HDF5 results / the CSV (each atomically; see docs/parameter-studies.md).
 void study_write_sweep_hdf5(const SweepJob& job, const std::string& path);

@@ -8,6 +8,7 @@
 #   * a variant that fails (mass -1) is recorded with status 1 and its reason, the others complete,
 #     exit code 0;
 #   * a study interrupted by SIGINT and started again writes the uninterrupted file, byte for byte;
+#   * two --shard runs (one from SLURM_ARRAY_TASK_ID/COUNT) joined by sweep-merge: the single run's bytes;
 #   * bad --vary, a missing --seed, and --out over the model exit 1 naming the option, writing nothing.
 # Usage: sweep.sh CODYNA SOURCE_DIR WORK_DIR
 set -euo pipefail
@@ -110,6 +111,19 @@ cmp -s cut.h5 whole.h5 || fail "the resumed cut.h5 differs from the uninterrupte
 cmp -s cut.csv whole.csv || fail "the resumed cut.csv differs"
 [ ! -e cut.h5.partial ] || fail "the journal was left behind"
 echo "interrupted after $done_before of 800 variants, resumed: the same bytes"
+
+# two shards (one through Slurm's variables) merged: the single run's bytes
+"$codyna" "${study[@]:0:8}" --threads 2 --out whole2.h5 --csv whole2.csv > /dev/null
+"$codyna" "${study[@]:0:8}" --shard 0/2 --out s0.sweep > /dev/null
+SLURM_ARRAY_TASK_ID=1 SLURM_ARRAY_TASK_COUNT=2 "$codyna" "${study[@]:0:8}" --shard slurm --out s1.sweep > s1.txt
+grep -q "shard            1/2: 400 of the 800 variants" s1.txt || fail "shard summary: $(cat s1.txt)"
+"$codyna" sweep-merge s1.sweep s0.sweep --out merged.h5 --csv merged.csv > merged.txt || fail "sweep-merge failed"
+cmp -s merged.h5 whole2.h5 || fail "the merged shards differ from the single run"
+cmp -s merged.csv whole2.csv || fail "the merged CSV differs from the single run's"
+rc=0; "$codyna" sweep-merge s0.sweep --out half.h5 > /dev/null 2> half.err || rc=$?
+[ $rc -eq 1 ] && grep -q "variants 1, 3, 5" half.err || fail "a missing shard: exit $rc, $(cat half.err)"
+[ ! -e half.h5 ] || fail "a refused merge wrote half.h5"
+echo "two shards merged: the same bytes as one run"
 
 refused() {  # refused OUTPUT_WORDS -- ARGS...
   local words="$1"; shift

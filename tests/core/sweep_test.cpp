@@ -298,6 +298,59 @@ TEST(Sweep, AnInterruptedStudyResumesToTheSameFile) {
   EXPECT_NE(notes.back().find("resuming: "), std::string::npos) << notes.back();
 }
 
+TEST(Sweep, ShardsMergeIntoTheWholeStudysFile) {
+  TempDir dir;
+  SweepRequest r;
+  r.model = kModel;
+  r.vary = {"/bodies/1/mass=normal(10,3)", "/bodies/0/mass=uniform(10,30)"};
+  r.samples = 101;
+  r.seed = 4;
+  r.threads = 2;
+  r.out = dir.file("whole.h5");
+  r.csv = dir.file("whole.csv");
+  study_sweep_job(r);
+  std::vector<std::string> shards;
+  for (long long k = 0; k < 3; ++k) {
+    SweepRequest s = r;
+    s.csv = "";
+    s.out = dir.file("shard" + std::to_string(k) + ".sweep");
+    s.shard_index = k;
+    s.shard_count = 3;
+    s.threads = 1;
+    const SweepJob part = study_sweep_job(s);
+    EXPECT_EQ(part.shard_count, 3);
+    shards.push_back(s.out);
+  }
+  EXPECT_FALSE(fs::exists(r.out + "x"));
+  SweepRequest outputs;
+  outputs.out = dir.file("merged.h5");
+  outputs.csv = dir.file("merged.csv");
+  // a shard missing: refused, naming the variants
+  try {
+    study_sweep_merge({shards[0], shards[2]}, outputs);
+    ADD_FAILURE() << "merged without shard 1";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("variants 1, 4, 7"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(outputs.out));
+  const SweepJob merged = study_sweep_merge({shards[2], shards[0], shards[1]}, outputs);
+  EXPECT_EQ(merged.resumed, 101);
+  EXPECT_EQ(slurp(outputs.out), slurp(r.out));
+  EXPECT_EQ(slurp(outputs.csv), slurp(r.csv));
+  EXPECT_FALSE(fs::exists(study_sweep_journal_path(outputs.out)));
+  // a shard of another study is refused
+  SweepRequest other = r;
+  other.seed = 5;
+  other.csv = "";
+  other.out = dir.file("other.sweep");
+  other.shard_index = 1;
+  other.shard_count = 3;
+  study_sweep_job(other);
+  outputs.out = dir.file("mixed.h5");
+  outputs.csv = "";
+  EXPECT_THROW(study_sweep_merge({shards[0], other.out, shards[2]}, outputs), std::invalid_argument);
+}
+
 void expect_refused(const std::vector<std::string>& vary, const std::vector<std::string>& words,
                     std::optional<long long> samples = {}, std::optional<std::uint64_t> seed = {}) {
   SweepRequest r;
