@@ -49,7 +49,7 @@ int main(int argc, char** argv) {
     else
       std::cerr << "codyna: error: " << e.what() << "\n";
     if (app.get_subcommands().empty())
-      std::cerr << "commands: info, linearize, simulate, import, export-mjcf, sweep (codyna COMMAND --help for each)\n";
+      std::cerr << "commands: info, linearize, simulate, import, export-mjcf, sweep, sweep-merge (codyna COMMAND --help for each)\n";
     else
       std::cerr << "see codyna " << app.get_subcommands().front()->get_name() << " --help\n";
     return 1;
