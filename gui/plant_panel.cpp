@@ -79,11 +79,18 @@ QVariant PlantListModel::data(const QModelIndex& index, int role) const {
           for (const auto& d : a.drives) driven << qs(d);
           return QStringLiteral("mix of %1").arg(driven.join(", "));
         }
-        return QStringLiteral("%1 on %2").arg(to_string(a.type), qs(a.type == ActuatorType::JointForce  ? a.joint
+        return QStringLiteral("%1 on %2").arg(to_string(a.type), qs(a.type == ActuatorType::JointForce || a.type == ActuatorType::Motion ? a.joint
                                                                    : a.type == ActuatorType::LineForce ? a.body_a + " - " + a.body_b
                                                                                                        : a.body));
-      case 2: return qs(a.unit.empty() ? (a.type == ActuatorType::JointForce ? "N | N m" : a.type == ActuatorType::BodyTorque ? "N m" : "N") : a.unit);
-      case 3: return a.u0;
+      case 2:
+        return qs(a.unit.empty() ? (a.type == ActuatorType::JointForce ? "N | N m"
+                                    : a.type == ActuatorType::Motion   ? "m | rad"
+                                    : a.type == ActuatorType::BodyTorque ? "N m"
+                                                                         : "N")
+                                 : a.unit);
+      case 3:
+        if (a.type == ActuatorType::Motion) return QStringLiteral("q0 of %1").arg(qs(a.joint));  // its nominal value
+        return a.u0;
       case 4: return limit_text(a.min);
       case 5: return limit_text(a.max);
     }

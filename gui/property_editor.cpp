@@ -378,7 +378,8 @@ bool PropertyEditor::applyText(const QString& field, const QString& text, QStrin
           } else if (key == "drives") {  // a mix: the first other actuator, weight 1
             json names = json::array();
             for (const auto& a : spec.actuators)
-              if (a.name != element_name(spec, id_->kind, id_->index) && a.type != ActuatorType::Mix) {
+              if (a.name != element_name(spec, id_->kind, id_->index) && a.type != ActuatorType::Mix &&
+                  a.type != ActuatorType::Motion) {
                 names.push_back(a.name);
                 break;
               }

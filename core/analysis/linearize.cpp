@@ -1,7 +1,10 @@
 #include "analysis/linearize.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include "dynamics/kinematics.hpp"
 #include "model/errors.hpp"
@@ -22,7 +25,7 @@ namespace {
 Eigen::VectorXd stacked(const PlantFunction& f, const Eigen::VectorXd& xu) {
   const int nx = f.nx();
   Eigen::VectorXd xd, y;
-  f.eval<double>(xu.head(nx), xu.tail(f.nu()), xd, y);
+  f.eval<double>(xu.head(nx), xu.tail(xu.size() - nx), xd, y);
   Eigen::VectorXd r(xd.size() + y.size());
   r << xd, y;
   return r;
@@ -30,7 +33,7 @@ Eigen::VectorXd stacked(const PlantFunction& f, const Eigen::VectorXd& xu) {
 }  // namespace
 
 Eigen::MatrixXd plant_jacobian_autodiff(const PlantFunction& f, const Eigen::VectorXd& x, const Eigen::VectorXd& u) {
-  const int nx = f.nx(), nu = f.nu(), ny = f.ny(), n = nx + nu;
+  const int nx = f.nx(), nu = static_cast<int>(u.size()), ny = f.ny(), n = nx + nu;
   Eigen::MatrixXd J(nx + ny, n);
   const ADVec xa = ad_seed(x, n, 0), ua = ad_seed(u, n, nx);
   ADVec xd, y;
@@ -44,7 +47,7 @@ Eigen::MatrixXd plant_jacobian_autodiff(const PlantFunction& f, const Eigen::Vec
 
 Eigen::MatrixXd plant_jacobian(const PlantFunction& f, const Eigen::VectorXd& x, const Eigen::VectorXd& u,
                                JacobianMethod method) {
-  Eigen::MatrixXd J(f.nx() + f.ny(), f.nx() + f.nu());
+  Eigen::MatrixXd J(f.nx() + f.ny(), f.nx() + u.size());
   if (method == JacobianMethod::Exact) {
     if (f.analytic_jacobian(x, u, J)) return J;
     return plant_jacobian_autodiff(f, x, u);
@@ -56,7 +59,7 @@ Eigen::MatrixXd plant_jacobian(const PlantFunction& f, const Eigen::VectorXd& x,
 
 Eigen::MatrixXd plant_jacobian_fd_full(const PlantFunction& f, const Eigen::VectorXd& x, const Eigen::VectorXd& u,
                                        bool central) {
-  const int nx = f.nx(), nu = f.nu(), ny = f.ny(), n = nx + nu;
+  const int nx = f.nx(), nu = static_cast<int>(u.size()), ny = f.ny(), n = nx + nu;
   Eigen::VectorXd xu(n);
   xu << x, u;
   Eigen::MatrixXd J(nx + ny, n);
@@ -103,6 +106,50 @@ void refuse_coincident_spring_dampers(const Model& model, const Eigen::VectorXd&
 
 }  // namespace
 
+namespace {
+
+// The realization of motion inputs. With their rates and accelerations the plant is
+//   x' = A x + B0 u + B1 u' + B2 u'',   y = C x + D0 u + D1 u' + D2 u''
+// (B1, B2 only in the velocity rows). The change of state  xi = x - B2 u' - F u,  F = A B2 + B1,
+// removes the derivatives:  xi' = A xi + (B0 + A F) u,  y = C xi + (D0 + C F) u  + (C B2 + D1) u'
+// + D2 u'': a proper model of the same transfer function exactly when C B2 + D1 = 0 and D2 = 0
+// (an output that responds to an input's rate or acceleration has an improper transfer function:
+// refused, naming it). xi equals x whenever the motion inputs are at their operating values.
+void realize_motion_inputs(const Model& model, const PlantFunction& f, const Eigen::MatrixXd& J, LinearSystem& s,
+                           Linearization& out) {
+  const int nx = f.nx(), nu = f.nu(), ny = f.ny(), nm = f.nm();
+  Eigen::MatrixXd B1 = Eigen::MatrixXd::Zero(nx, nu), B2 = B1, D1 = Eigen::MatrixXd::Zero(ny, nu), D2 = D1;
+  for (int j = 0; j < nm; ++j) {
+    const int c = f.motion_inputs()[static_cast<std::size_t>(j)];
+    B1.col(c) = J.block(0, nx + nu + j, nx, 1);
+    B2.col(c) = J.block(0, nx + nu + nm + j, nx, 1);
+    D1.col(c) = J.block(nx, nx + nu + j, ny, 1);
+    D2.col(c) = J.block(nx, nx + nu + nm + j, ny, 1);
+  }
+  const Eigen::MatrixXd F = s.A * B2 + B1;
+  const Eigen::MatrixXd rate_gain = s.C * B2 + D1;
+  const double scale = std::max({1.0, s.C.cwiseAbs().maxCoeff(), D1.cwiseAbs().maxCoeff()}) *
+                       std::max({1.0, B2.cwiseAbs().maxCoeff()});
+  for (int i = 0; i < ny; ++i)
+    for (int j = 0; j < nm; ++j) {
+      const int c = f.motion_inputs()[static_cast<std::size_t>(j)];
+      const std::string& yn = model.sensors[static_cast<std::size_t>(model.plant_outputs[i])].name;
+      const std::string& un = model.actuators[static_cast<std::size_t>(model.plant_inputs[c])].name;
+      if (std::abs(D2(i, c)) > 1e-12 * scale || std::abs(rate_gain(i, c)) > 1e-12 * scale)
+        throw std::invalid_argument("linearize: the output \"" + yn + "\" responds to the " +
+                                    (std::abs(D2(i, c)) > 1e-12 * scale ? "acceleration" : "rate") +
+                                    " of the motion input \"" + un +
+                                    "\": its transfer function from it is improper (no state-space model); choose "
+                                    "outputs of positions the motion does not drive (docs/model-format.md, motion)");
+    }
+  s.B += s.A * F;
+  s.D += s.C * F;
+  out.motion_shift = F;
+  out.motion_rate_shift = B2;
+}
+
+}  // namespace
+
 Linearization linearize(const Model& model, const OperatingPoint& op, const LinearizeOptions& options) {
   refuse_coincident_spring_dampers(model, op.q);
   Linearization out;
@@ -115,17 +162,23 @@ Linearization linearize(const Model& model, const OperatingPoint& op, const Line
   Eigen::VectorXd u(nu);
   for (int k = 0; k < nu; ++k) u[k] = op.u[model.plant_inputs[k]];
 
-  const Eigen::MatrixXd J = plant_jacobian(f, x, u, options.method);
+  // motion inputs enter with their rates and accelerations too: the Jacobian is taken over
+  // [u; u'; u''] of the motion inputs (zero at the operating point)
+  const int nm = f.nm();
+  Eigen::VectorXd ue = Eigen::VectorXd::Zero(nu + 2 * nm);
+  ue.head(nu) = u;
+  const Eigen::MatrixXd J = plant_jacobian(f, x, ue, options.method);
   if (options.method != JacobianMethod::Exact) {
-    const Eigen::MatrixXd Je = plant_jacobian(f, x, u, JacobianMethod::Exact);
+    const Eigen::MatrixXd Je = plant_jacobian(f, x, ue, JacobianMethod::Exact);
     const double scale = std::max(Je.cwiseAbs().maxCoeff(), 1e-300);
     out.fd_error = (J - Je).cwiseAbs().maxCoeff() / scale;
   }
   LinearSystem& s = out.system;
   s.A = J.topLeftCorner(nx, nx);
-  s.B = J.topRightCorner(nx, nu);
+  s.B = J.block(0, nx, nx, nu);
   s.C = J.bottomLeftCorner(ny, nx);
-  s.D = J.bottomRightCorner(ny, nu);
+  s.D = J.block(nx, nx, ny, nu);
+  if (nm > 0) realize_motion_inputs(model, f, J, s, out);
   Eigen::VectorXd xd, y;
   f.eval<double>(x, u, xd, y);
   s.x0 = f.state_offset(op.v);

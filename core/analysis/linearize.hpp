@@ -36,6 +36,9 @@ struct Linearization {
   LinearSystem system;
   CoordinatePartition partition;
   double fd_error = 0.0;  // finite differences: max |J_fd - J_exact| / max |J_exact|; 0 for exact
+  // motion inputs among Plant/In: the state is xi = x - motion_rate_shift u' - motion_shift u
+  // (deviations; see linearize.cpp), which keeps the model proper; both empty without them
+  Eigen::MatrixXd motion_shift, motion_rate_shift;  // [nx x nu]
 };
 
 Linearization linearize(const Model& model, const OperatingPoint& op, const LinearizeOptions& options = {});

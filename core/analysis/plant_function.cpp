@@ -59,14 +59,22 @@ MatXT<S> columns_t(const MatXT<S>& J, const std::vector<int>& cols) {
 CoordinatePartition partition_coordinates(const Model& m, const Eigen::VectorXd& q,
                                           const std::vector<std::string>& preferred) {
   CoordinatePartition p;
+  for (int k : m.motions) p.driven.push_back(m.actuators[static_cast<std::size_t>(k)].iv);
+  const auto is_driven = [&](int i) { return std::find(p.driven.begin(), p.driven.end(), i) != p.driven.end(); };
+  for (const std::string& name : preferred) {
+    const auto it = std::find(m.v_names.begin(), m.v_names.end(), name);
+    if (it != m.v_names.end() && is_driven(static_cast<int>(it - m.v_names.begin())))
+      throw std::invalid_argument("independent coordinates: \"" + name + "\" is driven by a motion input (not a state)");
+  }
   const std::vector<int> rows = independent_rows(m, q);
   if (rows.empty()) {
-    for (int i = 0; i < m.nv; ++i) p.independent.push_back(i);
+    for (int i = 0; i < m.nv; ++i)
+      if (!is_driven(i)) p.independent.push_back(i);
     for (const std::string& name : preferred)
       if (std::find(m.v_names.begin(), m.v_names.end(), name) == m.v_names.end())
         throw std::invalid_argument("independent coordinates: unknown coordinate \"" + name + "\"");
-    if (!preferred.empty() && static_cast<int>(preferred.size()) != m.nv)
-      throw std::invalid_argument("independent coordinates: a tree model has all " + std::to_string(m.nv) +
+    if (!preferred.empty() && static_cast<int>(preferred.size()) != m.dof())
+      throw std::invalid_argument("independent coordinates: a tree model has all " + std::to_string(m.dof()) +
                                   " coordinates independent");
     return p;
   }
@@ -97,7 +105,8 @@ CoordinatePartition partition_coordinates(const Model& m, const Eigen::VectorXd&
       // kept when conditioned to 1e-3, or to a tenth of the unbiased choice (never below 1e-6)
       if (pref != dep && conditioning(pref) >= std::max(1e-6, std::min(1e-3, 0.1 * conditioning(dep)))) dep = pref;
     }
-    for (int i = 0; i < m.nv; ++i) (dep.count(i) ? p.dependent : p.independent).push_back(i);
+    for (int i = 0; i < m.nv; ++i)
+      if (!is_driven(i)) (dep.count(i) ? p.dependent : p.independent).push_back(i);
   } else {
     std::set<int> ind;
     for (const std::string& name : preferred) {
@@ -109,7 +118,8 @@ CoordinatePartition partition_coordinates(const Model& m, const Eigen::VectorXd&
     if (static_cast<int>(ind.size()) != m.dof())
       throw std::invalid_argument("independent coordinates: the model has " + std::to_string(m.dof()) +
                                   " degrees of freedom, " + std::to_string(ind.size()) + " distinct coordinates given");
-    for (int i = 0; i < m.nv; ++i) (ind.count(i) ? p.independent : p.dependent).push_back(i);
+    for (int i = 0; i < m.nv; ++i)
+      if (!is_driven(i)) (ind.count(i) ? p.independent : p.dependent).push_back(i);
   }
   const Eigen::MatrixXd Jd = columns(J, p.dependent);
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(Jd);
@@ -128,6 +138,10 @@ CoordinatePartition partition_holding(const Model& m, const Eigen::VectorXd& q, 
     if (it == m.v_names.end())
       throw std::invalid_argument("held coordinates: unknown coordinate \"" + name + "\"");
     held_v.push_back(static_cast<int>(it - m.v_names.begin()));
+    for (int k : m.motions)
+      if (m.actuators[static_cast<std::size_t>(k)].iv == held_v.back())
+        throw std::invalid_argument("held coordinates: \"" + name + "\" is driven by the motion input \"" +
+                                    m.actuators[static_cast<std::size_t>(k)].name + "\" (set that input instead)");
   }
   if (held_v.empty() || !preferred.empty()) {
     CoordinatePartition p = partition_coordinates(m, q, preferred);
@@ -151,8 +165,11 @@ CoordinatePartition partition_holding(const Model& m, const Eigen::VectorXd& q, 
       throw std::invalid_argument("held coordinates: the loops leave no freedom to hold \"" +
                                   m.v_names[static_cast<std::size_t>(i)] + "\" with the others held too");
   std::vector<std::string> names;
-  for (int i = 0; i < m.nv; ++i)
-    if (!dep.count(i)) names.push_back(m.v_names[static_cast<std::size_t>(i)]);
+  for (int i = 0; i < m.nv; ++i) {
+    bool driven = false;
+    for (int k : m.motions) driven = driven || m.actuators[static_cast<std::size_t>(k)].iv == i;
+    if (!dep.count(i) && !driven) names.push_back(m.v_names[static_cast<std::size_t>(i)]);
+  }
   try {
     return partition_coordinates(m, q, names);
   } catch (const std::invalid_argument&) {
@@ -166,6 +183,9 @@ PlantFunction::PlantFunction(const Model& model, const Eigen::VectorXd& q_ref, c
     : model_(model), q_ref_(q_ref), u_all_(u_all), part_(std::move(partition)), rows_(independent_rows(model, q_ref)) {
   if (rows_.size() != part_.dependent.size())
     throw std::invalid_argument("coordinate partition does not match the constraints at the reference configuration");
+  for (std::size_t k = 0; k < model.plant_inputs.size(); ++k)
+    if (model.actuators[static_cast<std::size_t>(model.plant_inputs[k])].type == ActuatorType::Motion)
+      motion_inputs_.push_back(static_cast<int>(k));
 }
 
 Eigen::VectorXd PlantFunction::solve_dependent(const Eigen::VectorXd& z) const {
@@ -216,7 +236,7 @@ double fd_step(bool central, double xk) {
 bool PlantFunction::fd_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& u, bool central,
                                 Eigen::MatrixXd& J) const {
   const Model& m = model_;
-  if (m.nc != 0 || !part_.dependent.empty()) return false;
+  if (m.nc != 0 || !part_.dependent.empty() || !m.motions.empty()) return false;
   const int n = nz(), nx_p = 2 * n, nu_p = nu(), ny_p = ny(), rows = nx_p + ny_p;
   if (J.rows() != rows || J.cols() != nx_p + nu_p) J.resize(rows, nx_p + nu_p);
   Eigen::VectorXd &xs = ws_.fd_x, &us = ws_.fd_u, &xd = ws_.fd_xd, &y = ws_.fd_y;
@@ -273,9 +293,11 @@ bool PlantFunction::fd_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd&
 template <class S>
 void PlantFunction::eval(const VecXT<S>& x, const VecXT<S>& u, VecXT<S>& xdot, VecXT<S>& y) const {
   if constexpr (std::is_same_v<S, double>) {
-    if (part_.dependent.empty() && model_.nc == 0) eval_tree(x, u, xdot, y);
-    else eval_closed(x, u, xdot, y);
-    return;
+    if (model_.motions.empty()) {
+      if (part_.dependent.empty() && model_.nc == 0) eval_tree(x, u, xdot, y);
+      else eval_closed(x, u, xdot, y);
+      return;
+    }
   }
   const Model& m = model_;
   const int n = nz(), nd = static_cast<int>(part_.dependent.size());
@@ -288,6 +310,30 @@ void PlantFunction::eval(const VecXT<S>& x, const VecXT<S>& u, VecXT<S>& xdot, V
   }
   DataT<S> d(m);
   const VecXT<S> zero_v = VecXT<S>::Zero(m.nv);
+  // motion inputs: their coordinates at u (a Plant/In's value, or the nominal), u', u''
+  if (!m.motions.empty()) {
+    const int nu_p = nu(), nmi = nm();
+    if (u.size() != nu_p && u.size() != nu_p + 2 * nmi)
+      throw std::invalid_argument("plant function: expected " + std::to_string(nu_p) + " or " +
+                                  std::to_string(nu_p + 2 * nmi) + " inputs");
+    for (std::size_t i = 0; i < m.motions.size(); ++i) {
+      const int k = m.motions[i];
+      const ActuatorModel& a = m.actuators[static_cast<std::size_t>(k)];
+      S value = S(u_all_[k]), rate = S(0.0), acc = S(0.0);
+      for (int j = 0; j < nmi; ++j) {
+        const int pos = motion_inputs_[static_cast<std::size_t>(j)];
+        if (m.plant_inputs[static_cast<std::size_t>(pos)] != k) continue;
+        value = u[pos];
+        if (u.size() > nu_p) {
+          rate = u[nu_p + j];
+          acc = u[nu_p + nmi + j];
+        }
+      }
+      dq[a.iv] = value - S(q_ref_[a.iq]);
+      v[a.iv] = rate;
+      d.motion_acc[static_cast<Eigen::Index>(i)] = acc;
+    }
+  }
   if (nd > 0) {
     // dependent positions: converged Newton in double, then one Newton step in S,
     // which carries the exact derivative (implicit function theorem) since phi ~ 0
@@ -341,6 +387,7 @@ PlantFunction::Workspace::~Workspace() = default;
 
 bool PlantFunction::analytic_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::MatrixXd& J) const {
   const Model& m = model_;
+  if (!m.motions.empty()) return false;  // motion inputs: forward-mode automatic differentiation
   if (m.nc != 0) return closed_loop_jacobian(x, u, J);
   if (!part_.dependent.empty()) return false;
   const int n = nz(), nu_p = nu(), ny_p = ny();

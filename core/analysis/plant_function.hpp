@@ -28,6 +28,7 @@ class TreeDerivatives;
 struct CoordinatePartition {
   std::vector<int> independent;  // v indices, size DOF
   std::vector<int> dependent;    // v indices, size = independent constraint rows
+  std::vector<int> driven;       // v indices of the motion inputs' coordinates (Model::motions order)
 };
 
 // Chooses independent coordinates at q: the dependent ones are the pivot
@@ -59,6 +60,11 @@ class PlantFunction {
   int nz() const { return static_cast<int>(part_.independent.size()); }
   int nx() const { return 2 * nz(); }
   int nu() const { return static_cast<int>(model_.plant_inputs.size()); }
+  // the Plant/In inputs that are motion inputs (positions in plant_inputs). eval takes u of size
+  // nu(), or nu() + 2 nm(): then u's tail holds their rates u' and then their accelerations u''
+  // (otherwise 0); the other motion actuators stay at their nominal value, at rest
+  int nm() const { return static_cast<int>(motion_inputs_.size()); }
+  const std::vector<int>& motion_inputs() const { return motion_inputs_; }
   int ny() const { return static_cast<int>(model_.plant_outputs.size()); }
 
   template <class S>
@@ -106,6 +112,7 @@ class PlantFunction {
   Eigen::VectorXd q_ref_, u_all_;
   CoordinatePartition part_;
   std::vector<int> rows_;  // constraint rows independent at q_ref
+  std::vector<int> motion_inputs_;
 
   // workspace of analytic_jacobian, made on first use; a copy starts without one
   // eval<double> on a tree, into the workspace (no heap after the first call)

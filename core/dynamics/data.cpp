@@ -46,7 +46,7 @@ ModelConstants::ModelConstants(const Model& model) {
   dense_mass_matrix = pairs == static_cast<long>(model.nv) * (model.nv + 1) / 2;
   body_force_sources = !model.springs.empty() || !model.body_forces.empty() || !model.bushings.empty();
   for (const ActuatorModel& a : model.actuators)
-    if (a.type != ActuatorType::JointForce) body_force_sources = true;
+    if (a.type != ActuatorType::JointForce && a.type != ActuatorType::Motion) body_force_sources = true;
 }
 
 template <class S>
@@ -78,6 +78,8 @@ DataT<S>::DataT(const Model& model) : constants(model) {
   Q = VecXT<S>::Zero(model.nv);
   qdd = VecXT<S>::Zero(model.nv);
   lambda = VecXT<S>::Zero(model.nc);
+  motion_acc = VecXT<S>::Zero(static_cast<Eigen::Index>(model.motions.size()));
+  motion_force = VecXT<S>::Zero(static_cast<Eigen::Index>(model.motions.size()));
   phi = VecXT<S>::Zero(model.nc);
   Jc = MatXT<S>::Zero(model.nc, model.nv);
   gamma = VecXT<S>::Zero(model.nc);

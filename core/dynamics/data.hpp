@@ -60,6 +60,10 @@ struct DataT {
   std::vector<Vec6T<S>> fext;    // [nbodies] external body forces, body coordinates (effects workspace)
   VecXT<S> qdd;                  // [nv] forward dynamics output
   VecXT<S> lambda;               // [nc] constraint multipliers (M qdd = Q - nle - J^T lambda); 0 on redundant rows
+  // motion inputs (Model::motions): the prescribed accelerations u'' forward_dynamics imposes on their
+  // coordinates (the caller sets q, v there), and the generalized force each then applies
+  // (M qdd + nle - Q on its coordinate: the reaction a motion actuator must supply)
+  VecXT<S> motion_acc, motion_force;  // [motions]
 
   // articulated-body workspace (aba)
   std::vector<Mat6T<S>> IA;      // [nbodies] articulated inertia, body coordinates

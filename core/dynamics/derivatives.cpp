@@ -574,7 +574,7 @@ void TreeDerivatives::applied_force_derivatives(const Eigen::VectorXd& q, const 
   };
   for (int k = 0; k < m_.nu(); ++k) {
     const ActuatorModel& act = m_.actuators[k];
-    if (act.type == ActuatorType::Mix) continue;  // acts through the actuators it drives
+    if (act.type == ActuatorType::Mix || act.type == ActuatorType::Motion) continue;  // no force of its own
     double uk_in = u[k];  // the input with the mixes' shares
     for (const auto& [mix, weight] : act.driven_by) uk_in += weight * u[mix];
     if (act.type == ActuatorType::JointForce) {

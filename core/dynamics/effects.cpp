@@ -102,6 +102,7 @@ const VecXT<S>& applied_forces(const Model& model, DataT<S>& d, const VecXT<S>& 
     ++count.actuators;
     const ActuatorModel& a = model.actuators[k];
     if (a.type == ActuatorType::Mix) continue;  // acts through the actuators it drives
+    if (a.type == ActuatorType::Motion) continue;  // prescribes its coordinate (forward_dynamics)
     S input = u[k];
     for (const auto& [mix, weight] : a.driven_by) input = input + S(weight) * u[mix];
     const S value = S(a.gain) * input;

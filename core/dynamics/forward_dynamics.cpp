@@ -107,6 +107,70 @@ const Eigen::VectorXd& closed_loop_dynamics(const Model& model, Data& d, const E
   for (int k = 0; k < na; ++k) d.lambda[w.rows[k]] = w.lam[k];
   return d.qdd;
 }
+
+// Motion inputs: their coordinates d follow prescribed accelerations a (data.motion_acc; q and v
+// there are the caller's), so only the free coordinates f are unknown:
+//   M_ff qdd_f = (Q - nle - M_:d a)_f - J_f^T lambda,   J_f qdd_f + gamma = -stab
+// (a motion never drives a coordinate of a loop: J_d = 0, checked by prepare_model). The
+// generalized force each motion supplies is (M qdd + nle - Q)_d.
+template <class S>
+const VecXT<S>& prescribed_dynamics(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>& v,
+                                    const VecXT<S>& Q, const Baumgarte& stab) {
+  const int nv = model.nv, nm = static_cast<int>(model.motions.size());
+  crba<S>(model, d, q);
+  nonlinear_effects<S>(model, d, q, v);
+  std::vector<int> dr(nm), fr;
+  for (int k = 0; k < nm; ++k) dr[k] = model.actuators[model.motions[k]].iv;
+  for (int i = 0; i < nv; ++i)
+    if (std::find(dr.begin(), dr.end(), i) == dr.end()) fr.push_back(i);
+  const int nf = static_cast<int>(fr.size());
+  VecXT<S> rhs = Q - d.nle;
+  for (int k = 0; k < nm; ++k) rhs -= d.M.col(dr[k]) * d.motion_acc[k];
+  std::vector<int> rows;
+  if (model.nc > 0) {
+    constraint_terms<S>(model, d, q, v);
+    Eigen::MatrixXd Jv(model.nc, nv);
+    for (int r = 0; r < model.nc; ++r)
+      for (int c = 0; c < nv; ++c) Jv(r, c) = ad_value(d.Jc(r, c));
+    rows = partition_rows(Jv, 1e-9, static_cast<int>(model.active_rows.size())).independent;
+  }
+  const int na = static_cast<int>(rows.size());
+  MatXT<S> Mff(nf, nf), B(nf, 1 + na);
+  for (int i = 0; i < nf; ++i) {
+    for (int j = 0; j < nf; ++j) Mff(i, j) = d.M(fr[i], fr[j]);
+    B(i, 0) = rhs[fr[i]];
+    for (int k = 0; k < na; ++k) B(i, 1 + k) = d.Jc(rows[k], fr[i]);
+  }
+  d.qdd.setZero(nv);
+  d.lambda.setZero(model.nc);
+  if (nf > 0) {
+    const MatXT<S> X = cholesky_solve<S>(Mff, B);
+    VecXT<S> qf = X.col(0);
+    if (na > 0) {
+      VecXT<S> crhs(na);
+      for (int k = 0; k < na; ++k) crhs[k] = d.gamma[rows[k]];
+      if (stab.alpha != 0.0 || stab.beta != 0.0)
+        for (int k = 0; k < na; ++k) {
+          S Jvel = S(0.0);
+          for (int c = 0; c < nv; ++c) Jvel += d.Jc(rows[k], c) * v[c];
+          crhs[k] += S(2.0 * stab.alpha) * Jvel + S(stab.beta * stab.beta) * d.phi[rows[k]];
+        }
+      const MatXT<S> Jt = B.rightCols(na);
+      const MatXT<S> A = Jt.transpose() * X.rightCols(na);
+      const VecXT<S> lam = cholesky_solve<S>(A, MatXT<S>(Jt.transpose() * X.col(0) + crhs)).col(0);
+      qf -= X.rightCols(na) * lam;
+      for (int k = 0; k < na; ++k) d.lambda[rows[k]] = lam[k];
+    }
+    for (int i = 0; i < nf; ++i) d.qdd[fr[i]] = qf[i];
+  }
+  for (int k = 0; k < nm; ++k) d.qdd[dr[k]] = d.motion_acc[k];
+  for (int k = 0; k < nm; ++k) {
+    S f = d.nle[dr[k]] - Q[dr[k]];
+    for (int c = 0; c < nv; ++c) f += d.M(dr[k], c) * d.qdd[c];
+    d.motion_force[k] = f;
+  }
+  return d.qdd;
+}
 }  // namespace
 
 template <class S>
@@ -114,6 +178,7 @@ const VecXT<S>& forward_dynamics(const Model& model, DataT<S>& d, const VecXT<S>
                                  const VecXT<S>& u, const Baumgarte& stab) {
   forward_kinematics<S>(model, d, q, v);
   const VecXT<S>& Q = applied_forces<S>(model, d, q, v, u);  // data.Q: nothing below writes it
+  if (!model.motions.empty()) return prescribed_dynamics<S>(model, d, q, v, Q, stab);
   if (model.nc == 0) {
     d.lambda.setZero(model.nc);
     return aba_after_kinematics<S>(model, d, v, Q);
@@ -159,5 +224,21 @@ template const VecXT<double>& forward_dynamics<double>(const Model&, DataT<doubl
 template const VecXT<ADScalar>& forward_dynamics<ADScalar>(const Model&, DataT<ADScalar>&, const VecXT<ADScalar>&,
                                                            const VecXT<ADScalar>&, const VecXT<ADScalar>&,
                                                            const Baumgarte&);
+
+Eigen::VectorXd prescribed_velocity_jump(const Model& model, Data& d, const Eigen::VectorXd& q,
+                                         const Eigen::VectorXd& jump) {
+  const int nv = model.nv, nm = static_cast<int>(model.motions.size());
+  if (jump.size() != nm) throw std::invalid_argument("prescribed_velocity_jump: one rate jump per motion input");
+  // the balance of prescribed_dynamics with no forces, no velocity terms and the jumps as accelerations
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(nv);
+  forward_kinematics<double>(model, d, q, zero);
+  d.motion_acc = jump;
+  // prescribed_dynamics subtracts nle (at rest: gravity alone); Q = nle cancels it, and gamma = 0
+  nonlinear_effects<double>(model, d, q, zero);
+  const Eigen::VectorXd Q = d.nle;
+  const Eigen::VectorXd dv = prescribed_dynamics<double>(model, d, q, zero, Q, Baumgarte{});
+  d.motion_acc.setZero();
+  return dv;
+}
 
 }  // namespace codyna

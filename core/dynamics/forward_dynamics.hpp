@@ -20,4 +20,11 @@ template <class S>
 const VecXT<S>& forward_dynamics(const Model& model, DataT<S>& data, const VecXT<S>& q, const VecXT<S>& v,
                                  const VecXT<S>& u, const Baumgarte& stab = {});
 
+// Motion inputs whose rates jump by `jump` (one per Model::motions entry: a ramp starting, a
+// table's knot) move the other coordinates impulsively: their velocity change dv_f follows from
+// the impulse balance on the free coordinates, M_ff dv_f = -M_fd jump - J_f^T Lambda with
+// J_f dv_f = 0 on the loops' independent rows at q. Returns dv (nv; jump on the driven coordinates).
+Eigen::VectorXd prescribed_velocity_jump(const Model& model, Data& data, const Eigen::VectorXd& q,
+                                         const Eigen::VectorXd& jump);
+
 }  // namespace codyna

@@ -87,6 +87,22 @@ class Preparer {
     const RowPartition rows = partition_rows(d.Jc);
     m_.active_rows = rows.independent;
     m_.redundant_rows = rows.redundant;
+    // a motion input holds a coordinate no loop may move (loops on prescribed coordinates are not
+    // solved yet): its column of the loops' Jacobian must vanish
+    for (int k : m_.motions) {
+      const ActuatorModel& a = m_.actuators[k];
+      for (std::size_t c = 0; c < m_.constraints.size(); ++c) {
+        const ConstraintModel& cm = m_.constraints[c];
+        if (d.Jc.block(cm.row, a.iv, cm.nrows, 1).cwiseAbs().maxCoeff() == 0.0) continue;
+        std::size_t spec_k = 0;
+        for (std::size_t i = 0; i < m_.spec.actuators.size(); ++i)
+          if (m_.spec.actuators[i].name == a.name) spec_k = i;
+        fail(at("actuators", spec_k) + "/joint",
+             "the motion input " + quoted(a.name) + " drives " + quoted(m_.v_names[a.iv]) + ", which the loop closure " +
+                 quoted(cm.name) + " moves; a motion input on a coordinate of a loop is not supported yet (drive a "
+                 "coordinate outside the loops, or use a joint_force)");
+      }
+    }
   }
 
   // The tree's mass matrix is positive definite exactly when every joint's articulated
@@ -103,7 +119,11 @@ class Preparer {
       const JointModel& j = m_.joints[i];
       const Mat6T<double> Xi = d.liMi[i].inverse().motion_matrix();
       Mat6T<double> Ia = IA[i];
-      if (j.nv > 0) {
+      // a coordinate a motion input drives moves as prescribed: its joint passes the whole
+      // articulated inertia on, like a fixed joint (its body may be massless, the road under a tire)
+      bool driven = false;
+      for (int k : m_.motions) driven = driven || (j.nv == 1 && m_.actuators[k].iv == j.idx_v);
+      if (j.nv > 0 && !driven) {
         const Mat6xT<double>& S = d.Sb[i];
         const Eigen::MatrixXd U = IA[i] * S;
         Eigen::MatrixXd D = S.transpose() * U;

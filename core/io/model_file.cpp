@@ -852,6 +852,7 @@ const Schema<ActuatorSpec>& schema<ActuatorSpec>() {
           case ActuatorType::BodyTorque: return element_keys({"body", "direction", "frame"}, tail);
           case ActuatorType::LineForce: return element_keys(point_pair_and({}), tail);
           case ActuatorType::Mix: return element_keys({"drives", "weights"}, {"u0", "min", "max", "unit"});
+          case ActuatorType::Motion: return element_keys({"joint", "dof"}, {"min", "max", "unit"});
         }
         return element_keys({}, tail);
       }};

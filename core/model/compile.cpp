@@ -536,6 +536,23 @@ class Compiler {
         check_dof(jb, s.dof, p + "/dof");
         a.iv = m_.joints[jb].idx_v + s.dof;
         a.unit = is_angular(m_.joints[jb].type, s.dof) ? "N m" : "N";
+      } else if (s.type == ActuatorType::Motion) {
+        const int jb = joint(s.joint, p + "/joint");
+        const JointModel& j = m_.joints[jb];
+        if (j.type != JointType::Revolute && j.type != JointType::Prismatic)
+          fail(p + "/joint", "a motion input drives a scalar coordinate (a revolute or prismatic joint); " +
+                                 quoted(j.name) + " is " + to_string(j.type));
+        check_dof(jb, s.dof, p + "/dof");
+        a.iv = j.idx_v;
+        a.iq = j.idx_q;
+        for (int other : m_.motions)
+          if (m_.actuators[other].iv == a.iv)
+            fail(p + "/joint", quoted(j.name) + " is already driven by the motion input " + quoted(m_.actuators[other].name));
+        if (s.gain != 1.0) fail(p + "/gain", "a motion input has no gain (the coordinate is u itself)");
+        if (s.u0 != 0.0)
+          fail(p + "/u0", "a motion input's nominal value is its joint's q0; set /joints q0 of " + quoted(j.name) + " instead");
+        a.unit = j.type == JointType::Revolute ? "rad" : "m";
+        m_.motions.push_back(static_cast<int>(k));
       } else if (s.type == ActuatorType::Mix) {
         a.unit = "";  // its drives are resolved once every actuator is known (below)
       } else if (s.type == ActuatorType::LineForce) {
@@ -583,6 +600,8 @@ class Compiler {
           fail(pi, "unknown actuator " + quoted(s.drives[i]) + " (actuators: " + join_names(all) + ")");
         }
         if (m_.actuators[j].type == ActuatorType::Mix) fail(pi, quoted(s.drives[i]) + " is a mix (a mix drives actuators, not mixes)");
+        if (m_.actuators[j].type == ActuatorType::Motion)
+          fail(pi, quoted(s.drives[i]) + " is a motion input (a mix drives forces and torques)");
         if (!seen.insert(j).second) fail(pi, quoted(s.drives[i]) + " is listed twice");
         const double w = s.weights[static_cast<Eigen::Index>(i)];
         if (!std::isfinite(w)) fail(p + "/weights/" + std::to_string(i), "expected a finite weight");
@@ -694,6 +713,18 @@ class Compiler {
     }
     m_.q0 = q;
     m_.v0 = v;
+    // a motion input's nominal value is its coordinate's q0; the coordinate is at rest there
+    for (int k : m_.motions) {
+      ActuatorModel& a = m_.actuators[static_cast<std::size_t>(k)];
+      a.u0 = q[a.iq];
+      if (v[a.iv] != 0.0) {
+        for (int i = 1; i < m_.nbodies; ++i)
+          if (m_.joints[i].idx_v == a.iv)
+            fail(at("joints", m_.joints[i].spec_index) + "/v0",
+                 "the coordinate is driven by the motion input " + quoted(a.name) +
+                     ", which starts at rest (its rate u' is 0 at the nominal); expected 0");
+      }
+    }
     // a coupler without an offset holds the joints as their q0 write them
     for (ConstraintModel& c : m_.constraints) {
       if (c.type != ConstraintType::Coupler || c.offset_given) continue;

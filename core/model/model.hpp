@@ -76,7 +76,8 @@ struct BushingModel {
 struct ActuatorModel {
   std::string name;
   ActuatorType type = ActuatorType::JointForce;
-  int iv = 0;                      // joint_force: velocity index it drives
+  int iv = 0;                      // joint_force, motion: velocity index it drives
+  int iq = 0;                      // motion: the coordinate's index in q
   int body = 0;                    // body_force
   Eigen::Vector3d point = Eigen::Vector3d::Zero(), direction = Eigen::Vector3d::UnitX();  // direction unit
   bool in_world = true;
@@ -152,6 +153,9 @@ struct Model {
   std::vector<ActuatorModel> actuators;  // [nu_all]
   std::vector<SensorModel> sensors;      // [ny_all]
   std::vector<int> plant_inputs;         // indices into actuators
+  // the motion actuators (indices into actuators): each holds its coordinate at u, u', u''
+  // (prescribed, out of the state: dof() does not count it); never a coordinate of a loop
+  std::vector<int> motions;
   std::vector<int> plant_outputs;        // indices into sensors
 
   Eigen::VectorXd q0, v0;                // assembled initial state
@@ -174,7 +178,7 @@ struct Model {
 
   int nu() const { return static_cast<int>(actuators.size()); }
   int ny() const { return static_cast<int>(sensors.size()); }
-  int dof() const { return nv - static_cast<int>(active_rows.size()); }
+  int dof() const { return nv - static_cast<int>(active_rows.size()) - static_cast<int>(motions.size()); }
   Eigen::VectorXd u_nominal() const;     // u0 of every actuator
   int find_body(const std::string& name) const;  // -1 if absent
   int find_actuator(const std::string& name) const;

@@ -44,12 +44,13 @@ constexpr std::array<std::pair<EffectType, const char*>, 7> kEffects{{
     {EffectType::BodyForce, "body_force"},
     {EffectType::Bushing, "bushing"},
 }};
-constexpr std::array<std::pair<ActuatorType, const char*>, 5> kActuators{{
+constexpr std::array<std::pair<ActuatorType, const char*>, 6> kActuators{{
     {ActuatorType::JointForce, "joint_force"},
     {ActuatorType::BodyForce, "body_force"},
     {ActuatorType::BodyTorque, "body_torque"},
     {ActuatorType::LineForce, "line_force"},
     {ActuatorType::Mix, "mix"},
+    {ActuatorType::Motion, "motion"},
 }};
 constexpr std::array<std::pair<SensorType, const char*>, 7> kSensors{{
     {SensorType::JointPosition, "joint_position"},

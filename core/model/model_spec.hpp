@@ -147,6 +147,9 @@ enum class ActuatorType {
                // apart for u > 0 (a hydraulic cylinder, an active suspension strut): -F on a, +F on b
   Mix,         // one input driving several actuators: each of `drives` adds weight * u to its own input
                // (a rotor's thrust and reaction torque, a differential drive, a collective); acts through them
+  Motion,      // a motion input: the joint coordinate (joint, dof) follows u (rad or m), its rate u' and its
+               // acceleration u'' (a beam angle, a shaker table, the road under a tire on a prismatic joint);
+               // the coordinate leaves the state, and its nominal value is the joint's q0
 };
 
 struct ActuatorSpec {

@@ -73,6 +73,13 @@ ClosedLoopSystem::ClosedLoopSystem(const Model& model, const Controller* control
     : model_(model), controller_(controller), plant_(plant), x_ref_(x_ref), u_nominal_(u_nominal), stab_(stab),
       data_(model) {
   if (controller_ && controller_->sample_time() == 0) continuous_states_ = controller_->nxc();
+  // a controller's output has no rate or acceleration to give a motion input
+  for (int k : model.plant_inputs)
+    if (controller_ && model.actuators[static_cast<std::size_t>(k)].type == ActuatorType::Motion)
+      throw std::invalid_argument("simulate: the controller drives the motion input \"" +
+                                  model.actuators[static_cast<std::size_t>(k)].name +
+                                  "\", whose rate and acceleration it does not give: not simulated yet (linearize takes "
+                                  "it; simulate with it outside Plant/In, moved by a disturbance signal)");
   if (controller_ && controller_->needs_state() && !plant_)
     throw std::invalid_argument("state feedback needs the plant's linearization (its state order)");
 }
@@ -129,14 +136,48 @@ Eigen::VectorXd ClosedLoopSystem::inputs(double t, const Eigen::VectorXd& q, con
   return saturate(u);
 }
 
+Eigen::VectorXd ClosedLoopSystem::motion_rates(double t) const {
+  const int nm = static_cast<int>(model_.motions.size());
+  Eigen::VectorXd r = Eigen::VectorXd::Zero(nm);
+  if (!disturbance_rate_) return r;
+  const Eigen::VectorXd all = disturbance_rate_(t);
+  for (int i = 0; i < nm; ++i) r[i] = all[model_.motions[static_cast<std::size_t>(i)]];
+  return r;
+}
+
+void ClosedLoopSystem::apply_motions(double t, Eigen::VectorXd& q, Eigen::VectorXd& v, Eigen::VectorXd* acc) {
+  const int nm = static_cast<int>(model_.motions.size());
+  if (nm == 0) return;
+  // u0 plus the disturbance, or a held Plant/In value (no controller drives a motion input)
+  Eigen::VectorXd value = u_nominal_;
+  if (disturbance_) value += disturbance_(t);
+  if (held_)
+    for (std::size_t k = 0; k < model_.plant_inputs.size(); ++k) value[model_.plant_inputs[k]] = (*held_)[k];
+  value = saturate(value);
+  const Eigen::VectorXd rate = motion_rates(t);
+  const Eigen::VectorXd all_acc = disturbance_acceleration_ ? disturbance_acceleration_(t) : Eigen::VectorXd();
+  if (data_.motion_acc.size() != nm) data_.motion_acc.setZero(nm);
+  for (int i = 0; i < nm; ++i) {
+    const int k = model_.motions[static_cast<std::size_t>(i)];
+    const ActuatorModel& a = model_.actuators[static_cast<std::size_t>(k)];
+    const bool held_at_limit = value[k] <= a.min || value[k] >= a.max;  // saturated: the coordinate stops there
+    q[a.iq] = value[k];
+    v[a.iv] = held_at_limit ? 0.0 : rate[i];
+    data_.motion_acc[i] = held_at_limit || all_acc.size() == 0 ? 0.0 : all_acc[k];
+  }
+  if (acc) *acc = data_.motion_acc;
+}
+
 void ClosedLoopSystem::rhs(double t, const Eigen::VectorXd& y, Eigen::VectorXd& ydot) {
   ++evaluations_;
   const int nq = model_.nq, nv = model_.nv, nx = nxc();
-  const Eigen::VectorXd q = y.head(nq), v = y.segment(nq, nv), xc = y.tail(nx);
+  Eigen::VectorXd q = y.head(nq), v = y.segment(nq, nv);
+  const Eigen::VectorXd xc = y.tail(nx);
+  apply_motions(t, q, v);
   const Eigen::VectorXd u = inputs(t, q, v, xc);
   ydot.resize(ode_size());
   ydot.head(nq) = qdot<double>(model_, q, v);
-  if (model_.nc == 0) ydot.segment(nq, nv) = forward_dynamics<double>(model_, data_, q, v, u, stab_);
+  if (model_.nc == 0 || !model_.motions.empty()) ydot.segment(nq, nv) = forward_dynamics<double>(model_, data_, q, v, u, stab_);
   else ydot.segment(nq, nv) = loop_accelerations(model_, data_, stab_, q, v, u);
   if (nx) ydot.tail(nx) = controller_rates(t, q, v, xc, u);
 }
@@ -270,7 +311,7 @@ Eigen::Matrix<double, 3, 4> rotation_tangent(const Eigen::Vector4d& p) {
 }  // namespace
 
 bool ClosedLoopSystem::exact_dae_jacobian() const {
-  return nxc() == 0 && (!controller_ || controller_->sample_time() > 0);
+  return nxc() == 0 && (!controller_ || controller_->sample_time() > 0) && model_.motions.empty();
 }
 
 bool ClosedLoopSystem::exact_ode_jacobian() const {

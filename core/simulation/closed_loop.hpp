@@ -48,6 +48,17 @@ class ClosedLoopSystem {
   // d(t) added to the actuators' nominal values (one entry per actuator, Model::actuators;
   // the Plant/In entries are replaced by the controller's output anyway)
   void set_disturbance(std::function<Eigen::VectorXd(double)> d) { disturbance_ = std::move(d); }
+  // motion inputs moved by the disturbance: its rate and acceleration (SimulationOptions)
+  void set_disturbance_rates(std::function<Eigen::VectorXd(double)> rate, std::function<Eigen::VectorXd(double)> acc) {
+    disturbance_rate_ = std::move(rate);
+    disturbance_acceleration_ = std::move(acc);
+  }
+  // Motion inputs (Model::motions): their coordinates in q, v set to the prescribed u(t), u'(t)
+  // (u0 plus the disturbance, or the held Plant/In value at rest), their accelerations u''(t)
+  // into the Data rhs() uses, and into `acc` when given. Nothing without motion inputs.
+  void apply_motions(double t, Eigen::VectorXd& q, Eigen::VectorXd& v, Eigen::VectorXd* acc = nullptr);
+  // the motions' rates at t (Model::motions order; 0 where no disturbance moves them)
+  Eigen::VectorXd motion_rates(double t) const;
 
   ControllerInput measure(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v) const;
   // every actuator's value at a state (controller output on Plant/In, saturated)
@@ -92,7 +103,7 @@ class ClosedLoopSystem {
   const PlantFunction* plant_;
   Eigen::VectorXd x_ref_, u_nominal_;
   std::optional<Eigen::VectorXd> held_;
-  std::function<Eigen::VectorXd(double)> reference_, disturbance_;
+  std::function<Eigen::VectorXd(double)> reference_, disturbance_, disturbance_rate_, disturbance_acceleration_;
   // the controller's state equation, told the Plant/In values applied (after saturation) in u
   Eigen::VectorXd controller_rates(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
                                    const Eigen::VectorXd& xc, const Eigen::VectorXd& u) const;

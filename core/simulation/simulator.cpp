@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "dynamics/assembly.hpp"
+#include "dynamics/forward_dynamics.hpp"
 #include "dynamics/energy.hpp"
 #include "dynamics/kinematics.hpp"
 #include "dynamics/sensors.hpp"
@@ -37,7 +38,8 @@ struct Recorder {
 std::vector<Eigen::VectorXd> linear_run(const Model& model, const Controller* ctrl, const LinearPlant& plant,
                                         const std::vector<double>& times, const Eigen::VectorXd& dx0,
                                         const std::function<Eigen::VectorXd(double)>& reference,
-                                        const std::function<Eigen::VectorXd(double)>& disturbance, double rtol,
+                                        const std::function<Eigen::VectorXd(double)>& disturbance,
+                                        const std::function<Eigen::VectorXd(double)>& disturbance_rate, double rtol,
                                         double atol, std::string& failure) {
   double now = times.front();  // the time the stages below are evaluated at (for the reference)
   const LinearSystem& s = plant.lin.system;
@@ -54,6 +56,18 @@ std::vector<Eigen::VectorXd> linear_run(const Model& model, const Controller* ct
     for (int k = 0; k < nd; ++k) d[k] = all[plant.disturbance_actuators[k]];
     return d;
   };
+  // disturbed motion inputs: the controller sees the mechanism's state x = xi + Fw w + Fw_rate w'
+  const bool shifted = nd > 0 && plant.Fw.cols() == nd;
+  auto shift = [&]() {
+    Eigen::VectorXd x = plant.Fw * dw();
+    if (disturbance_rate && plant.Fw_rate.cols() == nd) {
+      const Eigen::VectorXd all = disturbance_rate(now);
+      Eigen::VectorXd r(nd);
+      for (int k = 0; k < nd; ++k) r[k] = all[plant.disturbance_actuators[k]];
+      x += plant.Fw_rate * r;
+    }
+    return x;
+  };
   auto measure = [&](const Eigen::VectorXd& dx, const Eigen::VectorXd& du) {
     ControllerInput in;
     in.t = now;
@@ -63,7 +77,7 @@ std::vector<Eigen::VectorXd> linear_run(const Model& model, const Controller* ct
     Eigen::VectorXd rate = Eigen::VectorXd::Zero(nx);  // constant-velocity rate, as for the nonlinear plant
     rate.head(nz) = dx.tail(nz) + s.xdot0.head(nz);
     in.ydot = s.C * rate;
-    in.x = dx;
+    in.x = shifted ? Eigen::VectorXd(dx + shift()) : dx;
     return in;
   };
   auto input = [&](const Eigen::VectorXd& dx, const Eigen::VectorXd& xc) -> Eigen::VectorXd {
@@ -91,6 +105,7 @@ std::vector<Eigen::VectorXd> linear_run(const Model& model, const Controller* ct
   };
   Eigen::VectorXd z = Eigen::VectorXd::Zero(nx + nc);
   z.head(nx) = dx0;
+  if (shifted) z.head(nx) -= shift();
   std::vector<Eigen::VectorXd> out;
   double t = times.front(), next_sample = t;
   const double Ts = discrete ? ctrl->sample_time() : 0;
@@ -192,6 +207,7 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
   ClosedLoopSystem sys(model, controller, pf ? &*pf : nullptr, x_ref, u_nominal, o.stabilization);
   if (o.reference) sys.set_reference(o.reference);
   if (o.disturbance) sys.set_disturbance(o.disturbance);
+  if (o.disturbance_rate) sys.set_disturbance_rates(o.disturbance_rate, o.disturbance_acceleration);
 
   // initial state, on the constraint manifold
   Eigen::VectorXd q0 = o.q0.size() ? o.q0 : model.q0, v0 = o.v0.size() ? o.v0 : model.v0;
@@ -201,6 +217,18 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
     if (!a.converged) throw std::invalid_argument("simulate: the initial state cannot be assembled onto the loop closures");
     q0 = a.q;
     v0 = a.v;
+  }
+  sys.apply_motions(o.t0, q0, v0);  // the driven coordinates where their motions start
+  if (!model.motions.empty()) {
+    // a motion that starts moving at t0 (a ramp from 0, a table's first segment) jolts the others
+    // from the state given, as at any later jump of its rate
+    const Eigen::VectorXd jump = sys.motion_rates(o.t0) - sys.motion_rates(o.t0 - 1e-9 * std::max(1.0, std::abs(o.t0)));
+    if (jump.cwiseAbs().maxCoeff() > 0) {
+      Data dj(model);
+      Eigen::VectorXd dv = prescribed_velocity_jump(model, dj, q0, jump);
+      for (int k : model.motions) dv[model.actuators[static_cast<std::size_t>(k)].iv] = 0;  // set by apply_motions
+      v0 += dv;
+    }
   }
   Eigen::VectorXd y(sys.ode_size());
   y << q0, v0, Eigen::VectorXd::Zero(sys.nxc());
@@ -224,6 +252,9 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
     settings.method = choice.method;
     r.stats.integrator_choice = choice.reason;
   }
+  if (!model.motions.empty() && settings.method == "ida")
+    throw std::invalid_argument("simulate: the DAE integrator (ida) does not take motion inputs yet; choose an ODE "
+                                "integrator (cvode-bdf, cvode-adams, arkode, rk4) or auto");
   r.stats.integrator = settings.method;
   r.stats.rtol = o.integrator.rtol;
   r.stats.atol = o.integrator.atol;
@@ -234,7 +265,8 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
   Recorder rec;
   Data d(model);
   auto record = [&](double t) {
-    const Eigen::VectorXd q = y.head(model.nq), v = y.segment(model.nq, model.nv);
+    Eigen::VectorXd q = y.head(model.nq), v = y.segment(model.nq, model.nv);
+    sys.apply_motions(t, q, v);  // exactly where they are driven (the state integrates their rates)
     const Eigen::VectorXd xc = discrete ? xcd : Eigen::VectorXd(y.tail(sys.nxc()));
     const Eigen::VectorXd u = sys.inputs(t, q, v, y.tail(sys.nxc()));
     forward_kinematics<double>(model, d, q, v);
@@ -263,6 +295,7 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
   // (docs/work-precision.md), so the threshold follows atol when that is tighter
   const double projection_tolerance = std::min(o.projection_tolerance, 0.1 * o.integrator.atol);
   long out_index = 1;
+  std::size_t jump_index = 0;
   double t = o.t0;
   while (t < o.t_end - eps) {
     if (cb.cancel && cb.cancel->load()) {
@@ -271,7 +304,10 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
     }
     const double next_out = std::min(o.t0 + out_index * o.output_step, o.t_end);
     const double next_sample = discrete ? o.t0 + sample_index * Ts : o.t_end;
-    const double target = std::min({next_out, next_sample, o.t_end});
+    // a motion input's rate jumps (a ramp starts, a table's knot): stop there for its impulse
+    while (jump_index < o.rate_jumps.size() && o.rate_jumps[jump_index] <= t + eps) ++jump_index;
+    const double next_jump = jump_index < o.rate_jumps.size() ? o.rate_jumps[jump_index] : o.t_end;
+    const double target = std::min({next_out, next_sample, next_jump, o.t_end});
     try {
       integrator->advance(target);
     } catch (const IntegratorFailure& f) {
@@ -296,6 +332,17 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
       break;
     }
     bool restart = false;
+    if (jump_index < o.rate_jumps.size() && t >= o.rate_jumps[jump_index] - eps) {
+      // the other coordinates take the impulse of the motions' rate jumps (and the integrator restarts)
+      const double tj = o.rate_jumps[jump_index];
+      const Eigen::VectorXd jump = sys.motion_rates(tj) - sys.motion_rates(tj - 1e-9 * std::max(1.0, std::abs(tj)));
+      if (jump.size() && jump.cwiseAbs().maxCoeff() > 0) {
+        Eigen::VectorXd q = y.head(model.nq);
+        y.segment(model.nq, model.nv) += prescribed_velocity_jump(model, d, q, jump);
+        restart = true;
+      }
+      ++jump_index;
+    }
     if (model.nc && !integrator->projects() && sys.project(y, projection_tolerance)) {
       ++r.stats.projections;
       restart = true;
@@ -352,13 +399,13 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
     // a rerun at 100 times looser tolerances bounds the error of the looser one (reported beside it)
     r.linear_rtol = std::clamp(1e-3 * o.integrator.rtol, 1e-13, 1e-10);
     r.linear_atol = std::clamp(1e-3 * o.integrator.atol, 1e-15, 1e-12);
-    const auto lin = linear_run(model, controller, *plant, rec.t, dx0, o.reference, o.disturbance, r.linear_rtol,
-                                r.linear_atol, r.linear_failure);
+    const auto lin = linear_run(model, controller, *plant, rec.t, dx0, o.reference, o.disturbance,
+                                o.disturbance_rate, r.linear_rtol, r.linear_atol, r.linear_failure);
     r.y_linear = Recorder::stack(lin, r.y.cols());
     if (r.linear_failure.empty()) {
       std::string loose_failure;
       const auto check = linear_run(model, controller, *plant, rec.t, dx0, o.reference, o.disturbance,
-                                    100 * r.linear_rtol, 100 * r.linear_atol, loose_failure);
+                                    o.disturbance_rate, 100 * r.linear_rtol, 100 * r.linear_atol, loose_failure);
       if (loose_failure.empty() && r.y_linear.size() > 0)
         r.linear_error_estimate = (Recorder::stack(check, r.y.cols()) - r.y_linear).cwiseAbs().maxCoeff();
     }

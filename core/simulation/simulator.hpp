@@ -37,6 +37,11 @@ struct SimulationOptions {
   // for those not disturbed); the linear comparison adds LinearPlant::Bw/Dw times the entries of
   // LinearPlant::disturbance_actuators; empty: none
   std::function<Eigen::VectorXd(double)> disturbance;
+  // motion inputs (Model::motions) moved by a disturbance: its rate and acceleration (one entry per
+  // actuator, like `disturbance`; right-continuous), and the times where a rate jumps (a ramp's
+  // start, a table's knots), where the run stops and applies the impulse (prescribed_velocity_jump)
+  std::function<Eigen::VectorXd(double)> disturbance_rate, disturbance_acceleration;
+  std::vector<double> rate_jumps;
 };
 
 // What a sample callback gets: copies, safe to hand to another thread.
@@ -59,6 +64,9 @@ struct LinearPlant {
   // same linearization, in the order of disturbance_actuators (indices into Model::actuators)
   std::vector<int> disturbance_actuators;
   Eigen::MatrixXd Bw, Dw;  // nx x nd, ny x nd
+  // disturbed motion inputs: the linear state is xi = x - Fw_rate w' - Fw w (Linearization::motion_shift);
+  // the controller sees x. Empty or zero without them
+  Eigen::MatrixXd Fw, Fw_rate;  // nx x nd
 };
 
 SimulationResult simulate(const Model& model, const Controller* controller, const LinearPlant* plant,

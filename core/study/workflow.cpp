@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <numbers>
 #include <filesystem>
 #include <sstream>
 #include <stdexcept>
@@ -144,6 +145,36 @@ SignalSpec resolved(const Model& m, const SignalSpec& s, const std::string& fiel
   return r;
 }
 
+// A signal's rate and acceleration (right-continuous: a ramp's rate is its slope from `time` on),
+// and the times where its rate jumps: what a motion input driven by it needs
+double signal_rate(const SignalSpec& s, double t) {
+  if (s.type == "table" || s.type == "file") {
+    const auto& p = s.points;
+    for (std::size_t k = 1; k < p.size(); ++k)
+      if (t >= p[k - 1].first && t < p[k].first) return (p[k].second - p[k - 1].second) / (p[k].first - p[k - 1].first);
+    return 0.0;
+  }
+  if (t < s.time) return 0.0;
+  const double w = 2 * std::numbers::pi * s.frequency;
+  if (s.type == "ramp") return s.slope;
+  if (s.type == "sine") return s.amplitude * w * std::cos(w * (t - s.time) + s.phase);
+  return 0.0;
+}
+double signal_acceleration(const SignalSpec& s, double t) {
+  if (s.type != "sine" || t < s.time) return 0.0;
+  const double w = 2 * std::numbers::pi * s.frequency;
+  return -s.amplitude * w * w * std::sin(w * (t - s.time) + s.phase);
+}
+std::vector<double> signal_rate_jumps(const SignalSpec& s) {
+  if (s.type == "table" || s.type == "file") {
+    std::vector<double> t;
+    for (const auto& p : s.points) t.push_back(p.first);
+    return t;
+  }
+  if (s.type == "ramp" || s.type == "sine") return {s.time};
+  return {};
+}
+
 // d(t) on actuators that are not Plant/In: in the nonlinear run, and through their own B and D
 // columns (the plant linearized with them as extra inputs) in the linear comparison
 void attach_disturbances(const Model& m, StudySimulation& out) {
@@ -167,6 +198,16 @@ void attach_disturbances(const Model& m, StudySimulation& out) {
       fail(m, field + "/actuator", "a second disturbance on \"" + d.actuator + "\"");
     actuators.push_back(i);
     signals.emplace_back(i, resolved(m, d, field));
+    if (m.actuators[static_cast<std::size_t>(i)].type == ActuatorType::Motion) {
+      // a motion input moves its coordinate: no jump in position (an infinite rate)
+      const SignalSpec& sig = signals.back().second;
+      if (sig.type == "step")
+        fail(m, field + "/type", "a step on the motion input \"" + d.actuator + "\" would move its coordinate at once; " +
+                                     "use a ramp or a table");
+      if (sig.type == "sine" && std::abs(sig.amplitude * std::sin(sig.phase)) > 1e-12)
+        fail(m, field + "/phase", "a sine on the motion input \"" + d.actuator + "\" must start at 0 (phase 0 or pi), " +
+                                      "or its coordinate would jump");
+    }
   }
   const int nu = m.nu();
   out.options.disturbance = [nu, signals](double t) {
@@ -174,6 +215,25 @@ void attach_disturbances(const Model& m, StudySimulation& out) {
     for (const auto& [i, sig] : signals) d[i] += signal_value(sig, t, 0.0);
     return d;
   };
+  bool moves = false;
+  for (const auto& [i, sig] : signals) {
+    if (m.actuators[static_cast<std::size_t>(i)].type != ActuatorType::Motion) continue;
+    moves = true;
+    for (double t : signal_rate_jumps(sig)) out.options.rate_jumps.push_back(t);
+  }
+  if (moves) {
+    std::sort(out.options.rate_jumps.begin(), out.options.rate_jumps.end());
+    out.options.disturbance_rate = [nu, signals](double t) {
+      Eigen::VectorXd d = Eigen::VectorXd::Zero(nu);
+      for (const auto& [i, sig] : signals) d[i] += signal_rate(sig, t);
+      return d;
+    };
+    out.options.disturbance_acceleration = [nu, signals](double t) {
+      Eigen::VectorXd d = Eigen::VectorXd::Zero(nu);
+      for (const auto& [i, sig] : signals) d[i] += signal_acceleration(sig, t);
+      return d;
+    };
+  }
   if (!out.plant) return;
   // the same linearization with the disturbed actuators as extra inputs: their B and D columns
   Model wide = m;
@@ -186,6 +246,10 @@ void attach_disturbances(const Model& m, StudySimulation& out) {
   plant->disturbance_actuators = actuators;
   plant->Bw = l.system.B.rightCols(nd);
   plant->Dw = l.system.D.rightCols(nd);
+  if (l.motion_shift.size()) {
+    plant->Fw = l.motion_shift.rightCols(nd);
+    plant->Fw_rate = l.motion_rate_shift.rightCols(nd);
+  }
   out.plant = plant;
 }
 

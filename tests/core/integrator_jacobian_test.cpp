@@ -31,7 +31,10 @@ Eigen::MatrixXd fd_ode(ClosedLoopSystem& s, const Eigen::VectorXd& y) {
   Eigen::MatrixXd J(n, n);
   Eigen::VectorXd fp, fm;
   for (int j = 0; j < n; ++j) {
-    const double h = 1e-4 * std::max(1.0, std::abs(y[j]));
+    // the accelerations are quadratic in v (velocity products, gamma, linear dampers), where
+    // central differences are exact at any step: a long step there keeps the round-off of an
+    // ill-conditioned loop (Andrews' squeezer: an error growing as 1/h, 2e-5 at 1e-4) small
+    const double h = (j >= s.nq() && j < s.nq() + s.nv() ? 1e-2 : 1e-4) * std::max(1.0, std::abs(y[j]));
     Eigen::VectorXd yp = y, ym = y;
     yp[j] += h, ym[j] -= h;
     s.rhs(0.0, yp, fp);
@@ -135,15 +138,20 @@ void check_model(const Model& m, const std::string& name, std::mt19937& rng, boo
 }
 
 TEST(IntegratorJacobian, ExactAgreesWithCentralDifferencesOnEveryExample) {
-  std::mt19937 rng(11);
   int loops = 0, quaternions = 0;
   for (const auto& entry : std::filesystem::directory_iterator(CODYNA_EXAMPLES_DIR)) {
     if (entry.path().extension() != ".json") continue;
     const std::string name = entry.path().filename().string();
     const Model m = test::load_example(name);
+    // motion inputs: no exact integrator Jacobian (difference quotients; motion_test.cpp runs them)
+    if (!m.motions.empty()) continue;
     loops += m.nc > 0;
     quaternions += m.nq > m.nv;
-    check_model(m, name, rng, true, 3);
+    // each example's states from its own name, so that adding an example changes no other's
+    std::uint32_t seed = 2166136261u;
+    for (char c : name) seed = (seed ^ static_cast<unsigned char>(c)) * 16777619u;
+    std::mt19937 own(seed);
+    check_model(m, name, own, true, 3);
   }
   EXPECT_GE(loops, 4);
   EXPECT_GE(quaternions, 1);

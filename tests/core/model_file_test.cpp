@@ -815,7 +815,7 @@ TEST(ModelFileErrors, UnknownTypeInEveryList) {
       {"/constraints/0/type"_json_pointer,
        "unknown constraint type \"bogus\" (expected one of: ball, revolute, planar_revolute, coupler)"},
       {"/effects/0/type"_json_pointer, "unknown effect type \"bogus\" (expected one of: gravity, spring_damper,"},
-      {"/actuators/0/type"_json_pointer, "unknown actuator type \"bogus\" (expected one of: joint_force, body_force, body_torque, line_force, mix)"},
+      {"/actuators/0/type"_json_pointer, "unknown actuator type \"bogus\" (expected one of: joint_force, body_force, body_torque, line_force, mix, motion)"},
       {"/sensors/0/type"_json_pointer, "unknown sensor type \"bogus\" (expected one of: joint_position,"},
   };
   for (const auto& c : cases) {

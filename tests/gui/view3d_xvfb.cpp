@@ -36,7 +36,9 @@ Eigen::VectorXd perturbed(const codyna::Model& m, double amount) {
       const Eigen::Quaterniond q0(q[j.idx_q], q[j.idx_q + 1], q[j.idx_q + 2], q[j.idx_q + 3]);
       const Eigen::Quaterniond qn = q0 * r;
       q.segment<4>(j.idx_q) << qn.w(), qn.x(), qn.y(), qn.z();
-    } else if (j.type != codyna::JointType::Free) {
+    } else if (j.type == codyna::JointType::Free) {
+      q[j.idx_q] += amount;  // its position (x); the quaternion follows at idx_q + 3
+    } else {
       for (int k = 0; k < j.nq; ++k) q[j.idx_q + k] += amount;
     }
   }
