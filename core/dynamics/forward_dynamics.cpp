@@ -124,8 +124,14 @@ const VecXT<S>& prescribed_dynamics(const Model& model, DataT<S>& d, const VecXT
   for (int i = 0; i < nv; ++i)
     if (std::find(dr.begin(), dr.end(), i) == dr.end()) fr.push_back(i);
   const int nf = static_cast<int>(fr.size());
+  // (every product is evaluated into an S before it is summed: an autodiff sum of unevaluated
+  // products does not reconcile a constant's empty derivatives with the others')
   VecXT<S> rhs = Q - d.nle;
-  for (int k = 0; k < nm; ++k) rhs -= d.M.col(dr[k]) * d.motion_acc[k];
+  for (int k = 0; k < nm; ++k)
+    for (int i = 0; i < nv; ++i) {
+      const S p = d.M(i, dr[k]) * d.motion_acc[k];
+      rhs[i] = rhs[i] - p;
+    }
   std::vector<int> rows;
   if (model.nc > 0) {
     constraint_terms<S>(model, d, q, v);
@@ -152,8 +158,13 @@ const VecXT<S>& prescribed_dynamics(const Model& model, DataT<S>& d, const VecXT
       if (stab.alpha != 0.0 || stab.beta != 0.0)
         for (int k = 0; k < na; ++k) {
           S Jvel = S(0.0);
-          for (int c = 0; c < nv; ++c) Jvel += d.Jc(rows[k], c) * v[c];
-          crhs[k] += S(2.0 * stab.alpha) * Jvel + S(stab.beta * stab.beta) * d.phi[rows[k]];
+          for (int c = 0; c < nv; ++c) {
+            const S p = d.Jc(rows[k], c) * v[c];
+            Jvel = Jvel + p;
+          }
+          const S a = S(2.0 * stab.alpha) * Jvel, b = S(stab.beta * stab.beta) * d.phi[rows[k]];
+          crhs[k] = crhs[k] + a;
+          crhs[k] = crhs[k] + b;
         }
       const MatXT<S> Jt = B.rightCols(na);
       const MatXT<S> A = Jt.transpose() * X.rightCols(na);
@@ -166,7 +177,10 @@ const VecXT<S>& prescribed_dynamics(const Model& model, DataT<S>& d, const VecXT
   for (int k = 0; k < nm; ++k) d.qdd[dr[k]] = d.motion_acc[k];
   for (int k = 0; k < nm; ++k) {
     S f = d.nle[dr[k]] - Q[dr[k]];
-    for (int c = 0; c < nv; ++c) f += d.M(dr[k], c) * d.qdd[c];
+    for (int c = 0; c < nv; ++c) {
+      const S p = d.M(dr[k], c) * d.qdd[c];
+      f = f + p;
+    }
     d.motion_force[k] = f;
   }
   return d.qdd;
