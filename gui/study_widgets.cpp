@@ -102,7 +102,11 @@ NameValueTable::NameValueTable(const QString& nameHeader, const QString& valueHe
     emit edited(false);
   });
   connect(remove_, &QPushButton::clicked, this, [this] {
-    if (removeSelectedRow(table_)) emit edited(false);
+    // the row's editors lose focus as they go and may report a last edit: not while half removed
+    syncing_ = true;
+    const bool removed = removeSelectedRow(table_);
+    syncing_ = false;
+    if (removed) emit edited(false);
   });
 }
 
@@ -145,7 +149,8 @@ void NameValueTable::setPairs(const std::vector<std::pair<std::string, double>>&
 
 std::vector<std::pair<std::string, double>> NameValueTable::pairs() const {
   std::vector<std::pair<std::string, double>> v;
-  for (int r = 0; r < table_->rowCount(); ++r) v.emplace_back(ss(nameCombo(r)->currentText()), valueSpin(r)->value());
+  for (int r = 0; r < table_->rowCount(); ++r)
+    if (nameCombo(r) && valueSpin(r)) v.emplace_back(ss(nameCombo(r)->currentText()), valueSpin(r)->value());
   return v;
 }
 
@@ -188,7 +193,11 @@ SignalTable::SignalTable(const QString& targetHeader, QWidget* parent) : QWidget
     emit edited(false);
   });
   connect(remove_, &QPushButton::clicked, this, [this] {
-    if (removeSelectedRow(table_)) emit edited(false);
+    // the row's editors lose focus as they go and may report a last edit: not while half removed
+    syncing_ = true;
+    const bool removed = removeSelectedRow(table_);
+    syncing_ = false;
+    if (removed) emit edited(false);
   });
 }
 
@@ -289,6 +298,9 @@ void SignalTable::setSignals(const std::vector<SignalSpec>& v) {
 bool SignalTable::readSignals(std::vector<SignalSpec>* out, QString* error) const {
   out->clear();
   for (int r = 0; r < table_->rowCount(); ++r) {
+    if (!targetCombo(r) || !typeCombo(r) || !spin(r, Value) || !spin(r, Time) || !spin(r, Frequency) || !spin(r, Phase) ||
+        !dataEdit(r))
+      continue;  // a row being built or removed
     SignalSpec s;
     s.output = ss(targetCombo(r)->currentText());
     s.type = ss(typeCombo(r)->currentText());
