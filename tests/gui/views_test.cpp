@@ -343,6 +343,45 @@ class ViewsTest : public QObject {
   }
 
 
+  // A person types a value into a row, then clicks Remove while the typing has the focus: the
+  // row's spin box reports its last edit as it goes (the monkey found the handler reading the
+  // half-removed row under ASan); the other row and the study stay whole.
+  void removingTheRowBeingTypedIntoKeepsTheOthers() {
+    Document doc;
+    QVERIFY(doc.load(kCart));  // two coordinates: two rows can be held
+    LinearizeView view(&doc);
+    view.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&view));
+    view.activateWindow();
+    QVERIFY(QTest::qWaitForWindowActive(&view));  // focus is real: leaving the spin box commits its text
+    NameValueTable* set = view.setTable();
+    QTest::mouseClick(set->addButton(), Qt::LeftButton);
+    QTest::mouseClick(set->addButton(), Qt::LeftButton);
+    QCOMPARE(set->table()->rowCount(), 2);
+    const QString kept = set->nameCombo(0)->currentText(), removed = set->nameCombo(1)->currentText();
+    QVERIFY(kept != removed);
+    QDoubleSpinBox* spin = set->valueSpin(1);
+    set->table()->setCurrentCell(1, 1);
+    spin->setFocus();
+    QTRY_VERIFY(spin->hasFocus());
+    spin->selectAll();
+    QTest::keyClicks(spin, "0.7");  // typed, not yet committed: it commits as the focus leaves
+    QVERIFY2(spin->text().contains("0.7"), qPrintable(spin->text()));
+    QCOMPARE(doc.spec().analysis.set.size(), std::size_t(2));
+    QTest::mouseClick(set->removeButton(), Qt::LeftButton);
+    QCOMPARE(set->table()->rowCount(), 1);
+    QCOMPARE(set->nameCombo(0)->currentText(), kept);
+    const auto& held = doc.spec().analysis.set;
+    QCOMPARE(held.size(), std::size_t(1));
+    QCOMPARE(QString::fromStdString(held[0].first), kept);
+    // and the remaining row still takes a typed value with Enter
+    set->valueSpin(0)->setFocus();
+    set->valueSpin(0)->selectAll();
+    QTest::keyClicks(set->valueSpin(0), "1.25");
+    QTest::keyClick(set->valueSpin(0), Qt::Key_Return);
+    QCOMPARE(doc.spec().analysis.set[0].second, 1.25);
+  }
+
   // The four-bar's crank held at 1.3 rad, its torque solved: the widgets write the study,
   // and Linearize gives what the core computes headless for the same study.
   void steadyStateSearchEqualsTheCore() {
