@@ -628,10 +628,11 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
     study_guard_output(r.mat, OutputKind::PlantMat, {r.model});
     study_guard_output((p.parent_path() / (p.stem().string() + ".m")).string(), OutputKind::PlantScript, {r.model});
   }
-  const ModelSpec nominal_spec = study_read_model(r.model);  // errors name the file and the field
+  // errors name the file and the field
+  const ModelSpec nominal_spec = r.model_text.empty() ? study_read_model(r.model) : study_parse_model_text(r.model_text, r.model);
   for (const std::string& n : nominal_spec.notes) note(n);
-  std::string model_bytes;
-  {
+  std::string model_bytes = r.model_text;
+  if (model_bytes.empty()) {
     std::ifstream in(r.model, std::ios::binary);
     model_bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }

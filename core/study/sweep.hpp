@@ -40,6 +40,9 @@ namespace codyna {
 struct SweepRequest {
   OptionStyle style = OptionStyle::Flag;
   std::string model;                        // the model file
+  // the model file's text, used instead of reading `model` when not empty (a front end's unsaved
+  // document); `model` still names it in messages and is where relative paths start
+  std::string model_text;
   std::vector<std::string> vary;            // FIELD=SPEC, in order
   std::optional<long long> samples;         // random studies: the number of variants
   std::optional<std::uint64_t> seed;        // random studies
