@@ -387,8 +387,7 @@ PlantFunction::Workspace::~Workspace() = default;
 
 bool PlantFunction::analytic_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::MatrixXd& J) const {
   const Model& m = model_;
-  if (!m.motions.empty()) return false;  // motion inputs: forward-mode automatic differentiation
-  if (m.nc != 0) return closed_loop_jacobian(x, u, J);
+  if (m.nc != 0 || !m.motions.empty()) return closed_loop_jacobian(x, u, J);
   if (!part_.dependent.empty()) return false;
   const int n = nz(), nu_p = nu(), ny_p = ny();
   for (int k = 0; k < n; ++k)
@@ -439,11 +438,13 @@ void PlantFunction::loop_workspace() const {
   W.vd.resize(nd);
   W.Ja.resize(nd, nv);
   W.Jd.resize(nd, nd);
-  W.Jz.resize(nd, n);
-  W.G.resize(nv, n);
-  W.H.resize(nv, n);
-  W.P.resize(nd, n);
-  W.DQ.resize(nv, n);
+  // columns: the independent coordinates, then the motion inputs' coordinates (closed_loop_jacobian)
+  const int np = n + nm();
+  W.Jz.resize(nd, np);
+  W.G.resize(nv, np);
+  W.H.resize(nv, np);
+  W.P.resize(nd, np);
+  W.DQ.resize(nv, np);
 }
 
 // Jd (the plant's rows, the dependent columns) of the constraint terms in the workspace's Data, factored
@@ -516,33 +517,59 @@ bool PlantFunction::closed_loop_jacobian(const Eigen::VectorXd& x, const Eigen::
                                          Eigen::MatrixXd& J) const {
   const Model& m = model_;
   const int n = nz(), nu_p = nu(), ny_p = ny(), nd = static_cast<int>(part_.dependent.size());
+  // motion inputs (Plant/In): their coordinates' values are inputs like the independent positions,
+  // their rates like the velocities; with u = [u; u'; u''] the Jacobian has their rate and
+  // acceleration columns too. A motion outside Plant/In stays at its nominal value, at rest.
+  const int nmi = nm(), np = n + nmi;
+  const bool rates = !m.motions.empty() && u.size() == nu_p + 2 * nmi && nmi > 0;
+  if (u.size() != nu_p && !rates) return false;
   for (int k = 0; k < n; ++k)
     if (x[k] != 0.0) return false;
+  // differentiated where the motions' coordinates are the reference configuration's
+  for (int k : m.motions) {
+    double value = u_all_[k];
+    for (int j = 0; j < nmi; ++j)
+      if (m.plant_inputs[motion_inputs_[j]] == k) value = u[motion_inputs_[j]];
+    if (value != q_ref_[m.actuators[static_cast<std::size_t>(k)].iq]) return false;
+  }
   const auto& ind = part_.independent;
   const auto& dep = part_.dependent;
+  // the velocity index of column c of [z, motion inputs]
+  auto column = [&](int c) {
+    return c < n ? ind[c] : m.actuators[static_cast<std::size_t>(m.plant_inputs[motion_inputs_[c - n]])].iv;
+  };
   Workspace& W = ws_;
   loop_workspace();
   if (!W.td) W.td = std::make_unique<TreeDerivatives>(m);
   Data& d = *W.data;
   TreeDerivatives& td = *W.td;
-  // the velocity map G at q_ref: v_ind = w, Jd v_dep = -Jz w
-  constraint_terms<double>(m, d, q_ref_, W.zero);
-  for (int k = 0; k < nd; ++k)
-    for (int c = 0; c < n; ++c) W.Jz(k, c) = d.Jc(rows_[k], ind[c]);
+  // the velocity map G at q_ref: v = G [w; u'], Jd v_dep = -Jz [w; u']
   W.G.setZero();
-  for (int k = 0; k < n; ++k) W.G(ind[k], k) = 1.0;
+  for (int c = 0; c < np; ++c) W.G(column(c), c) = 1.0;
   if (nd > 0) {  // (Eigen's LU must not see an empty matrix)
+    constraint_terms<double>(m, d, q_ref_, W.zero);
+    for (int k = 0; k < nd; ++k)
+      for (int c = 0; c < np; ++c) W.Jz(k, c) = d.Jc(rows_[k], column(c));
     factor_dependent();
     W.P.noalias() = W.lu.solve(W.Jz);
     for (int k = 0; k < nd; ++k) W.G.row(dep[k]) = -W.P.row(k);
   }
-  W.v.noalias() = W.G * x.tail(n);
+  W.v.noalias() = W.G.leftCols(n) * x.tail(n);
+  if (rates)
+    for (int j = 0; j < nmi; ++j) W.v += W.G.col(n + j) * u[nu_p + j];
   W.u_all = u_all_;
   for (int k = 0; k < nu_p; ++k) W.u_all[m.plant_inputs[k]] = u[k];
+  for (std::size_t i = 0; i < m.motions.size(); ++i) {
+    double acc = 0.0;
+    if (rates)
+      for (int j = 0; j < nmi; ++j)
+        if (m.plant_inputs[motion_inputs_[j]] == m.motions[i]) acc = u[nu_p + nmi + j];
+    d.motion_acc[static_cast<Eigen::Index>(i)] = acc;
+  }
   // the constrained accelerations and multipliers, then their derivatives
   forward_dynamics<double>(m, d, q_ref_, W.v, W.u_all);
   td.compute_constrained(q_ref_, W.v, W.u_all, d.qdd, d.lambda, d.loop.rows, m.plant_outputs);
-  // H = dv/dz: Jd dv_dep/dz = -(d(Jc v)/dq) G on the plant's rows
+  // H = dv/d[z, u] at fixed [w, u']: Jd dv_dep = -(d(Jc v)/dq) G on the plant's rows
   W.H.setZero();
   if (nd > 0) {
     for (int k = 0; k < nd; ++k) W.Ja.row(k) = td.dphid_dq.row(rows_[k]);
@@ -550,8 +577,13 @@ bool PlantFunction::closed_loop_jacobian(const Eigen::VectorXd& x, const Eigen::
     W.P.noalias() = W.lu.solve(W.Jz);
     for (int k = 0; k < nd; ++k) W.H.row(dep[k]) = -W.P.row(k);
   }
-  if (J.rows() != 2 * n + ny_p || J.cols() != 2 * n + nu_p) J.resize(2 * n + ny_p, 2 * n + nu_p);
+  const int ncols = 2 * n + nu_p + (rates ? 2 * nmi : 0);
+  if (J.rows() != 2 * n + ny_p || J.cols() != ncols) J.resize(2 * n + ny_p, ncols);
   J.setZero();
+  // the column of motion input j's value, rate and acceleration
+  auto value_col = [&](int j) { return 2 * n + motion_inputs_[j]; };
+  auto rate_col = [&](int j) { return 2 * n + nu_p + j; };
+  auto acc_col = [&](int j) { return 2 * n + nu_p + nmi + j; };
   // position rows: d(rate)/d(dq) G + H (d(rate)/dv = I at dq = 0), and d/dw = G = I on the independent rows
   W.DQ = W.H;
   for (int b = 1; b < m.nbodies; ++b) {
@@ -564,22 +596,40 @@ bool PlantFunction::closed_loop_jacobian(const Eigen::VectorXd& x, const Eigen::
           skew<double>(Eigen::Vector3d(W.v.segment<3>(j.idx_v + 3))) * W.G.middleRows<3>(j.idx_v);
   }
   for (int k = 0; k < n; ++k) {
-    J.row(k).head(n) = W.DQ.row(ind[k]);
+    J.row(k).head(n) = W.DQ.row(ind[k]).head(n);
     J(k, n + k) = 1.0;
+    for (int j = 0; j < nmi; ++j) J(k, value_col(j)) = W.DQ(ind[k], n + j);
   }
   // accelerations: dqdd/dz = dqdd_dq G + dqdd_dv H, dqdd/dw = dqdd_dv G
-  W.DQ.noalias() = td.dqdd_dq * W.G;
-  W.DQ.noalias() += td.dqdd_dv * W.H;
-  for (int k = 0; k < n; ++k) J.row(n + k).head(n) = W.DQ.row(ind[k]);
-  W.DQ.noalias() = td.dqdd_dv * W.G;
-  for (int k = 0; k < n; ++k) J.row(n + k).segment(n, n) = W.DQ.row(ind[k]);
   for (int k = 0; k < nu_p; ++k)
     for (int r = 0; r < n; ++r) J(n + r, 2 * n + k) = td.dqdd_du(ind[r], m.plant_inputs[k]);
+  W.DQ.noalias() = td.dqdd_dq * W.G;
+  W.DQ.noalias() += td.dqdd_dv * W.H;
+  for (int k = 0; k < n; ++k) {
+    J.row(n + k).head(n) = W.DQ.row(ind[k]).head(n);
+    for (int j = 0; j < nmi; ++j) J(n + k, value_col(j)) = W.DQ(ind[k], n + j);
+  }
+  W.DQ.noalias() = td.dqdd_dv * W.G;
+  for (int k = 0; k < n; ++k) {
+    J.row(n + k).segment(n, n) = W.DQ.row(ind[k]).head(n);
+    if (rates)
+      for (int j = 0; j < nmi; ++j) J(n + k, rate_col(j)) = W.DQ(ind[k], n + j);
+  }
+  if (rates)
+    for (std::size_t i = 0; i < m.motions.size(); ++i)
+      for (int j = 0; j < nmi; ++j)
+        if (m.plant_inputs[motion_inputs_[j]] == m.motions[i])
+          for (int k = 0; k < n; ++k) J(n + k, acc_col(j)) = td.dqdd_dacc(ind[k], static_cast<Eigen::Index>(i));
   // sensors
   if (ny_p > 0) {
-    J.block(2 * n, 0, ny_p, n).noalias() = td.dy_dq * W.G;
-    J.block(2 * n, 0, ny_p, n).noalias() += td.dy_dv * W.H;
-    J.block(2 * n, n, ny_p, n).noalias() = td.dy_dv * W.G;
+    J.block(2 * n, 0, ny_p, n).noalias() = td.dy_dq * W.G.leftCols(n);
+    J.block(2 * n, 0, ny_p, n).noalias() += td.dy_dv * W.H.leftCols(n);
+    J.block(2 * n, n, ny_p, n).noalias() = td.dy_dv * W.G.leftCols(n);
+    for (int j = 0; j < nmi; ++j) {
+      J.block(2 * n, value_col(j), ny_p, 1).noalias() = td.dy_dq * W.G.col(n + j);
+      J.block(2 * n, value_col(j), ny_p, 1).noalias() += td.dy_dv * W.H.col(n + j);
+      if (rates) J.block(2 * n, rate_col(j), ny_p, 1).noalias() = td.dy_dv * W.G.col(n + j);
+    }
   }
   return true;
 }

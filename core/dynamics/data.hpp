@@ -97,6 +97,11 @@ struct DataT {
     std::vector<int> rows;                           // [na] independent rows at this q
     Eigen::MatrixXd J, B, L, X, A, LA;               // [na x nv], [nv x 1+na], [nv x nv], [nv x 1+na], [na x na] x 2
     Eigen::VectorXd rhs, Jvel, lam;                  // [na]
+    // motion inputs (prescribed_dynamics in double): the free and the driven coordinates, M on the
+    // free ones, the right-hand side Q - nle - M_:d a_d
+    std::vector<int> free, driven;
+    Eigen::MatrixXd Mff;                             // [nf x nf]
+    Eigen::VectorXd f;                               // [nv]
   } loop;                        // used with S = double only
 };
 

@@ -202,6 +202,17 @@ TreeDerivatives::TreeDerivatives(const Model& model) : m_(model), d_(model), llt
   dqdd_du.setZero(nv, model.nu());
   M.setZero(nv, nv);
   rhs_.setZero(nv, 2 * nv + model.nu());
+  const int nm = static_cast<int>(model.motions.size());
+  dqdd_dacc.setZero(nv, nm);
+  for (int k : model.motions) driven_.push_back(model.actuators[static_cast<std::size_t>(k)].iv);
+  for (int i = 0; i < nv; ++i)
+    if (std::find(driven_.begin(), driven_.end(), i) == driven_.end()) free_.push_back(i);
+  if (nm > 0) {
+    const int nf = static_cast<int>(free_.size());
+    Mff_.setZero(nf, nf);
+    Rf_.setZero(nf, 2 * nv + model.nu() + nm);
+    llt_ff_ = Eigen::LLT<Eigen::MatrixXd>(nf);
+  }
   Minv_.setZero(nv, nv);
   scratch_.setZero(nv);
   Jc.setZero(model.nc, nv);
@@ -944,10 +955,15 @@ void TreeDerivatives::compute_constrained(const Eigen::VectorXd& q, const Eigen:
   applied_force_derivatives(q, v, u_all);
   constraint_derivatives(lambda, a);
   mass_matrix();
+  qdd = a;
+  if (!m_.motions.empty()) {
+    solve_prescribed(rows);
+    sensor_derivatives(q, v, outputs);
+    return;
+  }
   llt_.compute(M);
   if (llt_.info() != Eigen::Success)
     throw std::runtime_error("the mass matrix is not positive definite at this configuration");
-  qdd = a;
   // M da + Jr^T dlambda = dQ - dtau,  Jr da = -dc
   rhs_.leftCols(nv) = dQ_dq - dtau_dq;
   rhs_.middleCols(nv, nv) = dQ_dv - dtau_dv;
@@ -979,6 +995,71 @@ void TreeDerivatives::compute_constrained(const Eigen::VectorXd& q, const Eigen:
   dqdd_dv = rhs_.middleCols(nv, nv);
   dqdd_du = rhs_.rightCols(nu);
   sensor_derivatives(q, v, outputs);
+}
+
+// Motion inputs: the driven coordinates d hold their accelerations, so the balance is kept on the
+// free coordinates f only (with the loops' kept rows r; a motion never drives a loop's coordinate,
+// Jc_rd = 0):
+//   M_ff da_f + Jr_f^T dlambda = (dQ - dtau)_f - M_fd da_d,   Jr_f da_f = -dc,
+// where dtau and dc are taken at the whole a (the driven accelerations included), da_d = 0 for the
+// q, v and u columns and da_d = e_k for motion k's acceleration. The same Schur complement as
+// the loops without motion, on M_ff, which stays positive definite with massless driven bodies.
+void TreeDerivatives::solve_prescribed(const std::vector<int>& rows) {
+  const int nv = m_.nv, nu = m_.nu(), na = static_cast<int>(rows.size());
+  const int nm = static_cast<int>(driven_.size()), nf = static_cast<int>(free_.size());
+  for (int i = 0; i < nf; ++i)
+    for (int j = 0; j < nf; ++j) Mff_(i, j) = M(free_[i], free_[j]);
+  if (nf > 0) {
+    llt_ff_.compute(Mff_);
+    if (llt_ff_.info() != Eigen::Success)
+      throw std::runtime_error("the mass matrix of the coordinates no motion drives is not positive definite "
+                               "at this configuration");
+  }
+  for (int i = 0; i < nf; ++i) {
+    const int r = free_[i];
+    Rf_.row(i).head(nv) = dQ_dq.row(r) - dtau_dq.row(r);
+    Rf_.row(i).segment(nv, nv) = dQ_dv.row(r) - dtau_dv.row(r);
+    Rf_.row(i).segment(2 * nv, nu) = dQ_du.row(r);
+    for (int k = 0; k < nm; ++k) Rf_(i, 2 * nv + nu + k) = -M(r, driven_[k]);
+  }
+  if (nf > 0) {
+    for (Eigen::Index c0 = 0; c0 < Rf_.cols(); c0 += 48) {
+      auto panel = Rf_.middleCols(c0, std::min<Eigen::Index>(48, Rf_.cols() - c0));
+      llt_ff_.solveInPlace(panel);
+    }
+    if (na > 0) {
+      if (Jr_.rows() != na || Jr_.cols() != nf) Jr_.resize(na, nf);
+      for (int k = 0; k < na; ++k)
+        for (int i = 0; i < nf; ++i) Jr_(k, i) = Jc(rows[k], free_[i]);
+      Y_ = Jr_.transpose();
+      llt_ff_.solveInPlace(Y_);
+      if (Sc_.rows() != na) Sc_.resize(na, na);
+      Sc_.noalias() = Jr_ * Y_;
+      llt_schur_.compute(Sc_);
+      if (llt_schur_.info() != Eigen::Success)
+        throw std::runtime_error("the loop closures' Schur complement is singular at this configuration");
+      if (T_.rows() != na || T_.cols() != Rf_.cols()) T_.resize(na, Rf_.cols());
+      T_.noalias() = Jr_ * Rf_;
+      for (int k = 0; k < na; ++k) {
+        T_.row(k).head(nv) += dc_dq.row(rows[k]);
+        T_.row(k).segment(nv, nv) += dc_dv.row(rows[k]);
+      }
+      llt_schur_.solveInPlace(T_);
+      Rf_.noalias() -= Y_ * T_;
+    }
+  }
+  dqdd_dq.setZero();
+  dqdd_dv.setZero();
+  dqdd_du.setZero();
+  dqdd_dacc.setZero();
+  for (int i = 0; i < nf; ++i) {
+    const int r = free_[i];
+    dqdd_dq.row(r) = Rf_.row(i).head(nv);
+    dqdd_dv.row(r) = Rf_.row(i).segment(nv, nv);
+    dqdd_du.row(r) = Rf_.row(i).segment(2 * nv, nu);
+    dqdd_dacc.row(r) = Rf_.row(i).tail(nm);
+  }
+  for (int k = 0; k < nm; ++k) dqdd_dacc(driven_[k], k) = 1.0;
 }
 
 }  // namespace codyna

@@ -68,7 +68,13 @@ class TreeDerivatives {
   // Closed loops: everything at (q, v, u_all) for joint accelerations a and
   // multipliers lambda [nc] that satisfy M a + nle = Q - Jc^T lambda and
   // Jc a + gamma = 0 on `rows` (independent constraint rows at q, as
-  // forward_dynamics chose them; lambda is zero on the others). Fills
+  // forward_dynamics chose them; lambda is zero on the others). Motion inputs
+  // (any model, loops or not): their coordinates' rows of that balance carry
+  // the motions' reactions instead, and their accelerations are held, so each
+  // enters the derivative system as one more row e_d da = d(acceleration)
+  // (a rheonomic constraint with a constant Jacobian; its multiplier is the
+  // reaction), solved on the free coordinates only (a motion's bodies may be
+  // massless, M singular). Fills
   // dqdd_dq, dqdd_dv, dqdd_du (the constrained accelerations' derivatives),
   // Jc, dc_dq, dc_dv, dphid_dq, tau/dtau (at a), Q/dQ (including -Jc^T lambda)
   // and the sensors. No heap after the first call with the same sizes.
@@ -90,6 +96,9 @@ class TreeDerivatives {
   Eigen::VectorXd qdd;                      // [nv]
   Eigen::MatrixXd dqdd_dq, dqdd_dv;         // [nv x nv]
   Eigen::MatrixXd dqdd_du;                  // [nv x nu_all]
+  // motion inputs (Model::motions, compute_constrained): derivatives with respect to each motion's
+  // prescribed acceleration; its coordinate's value and rate are the columns of dqdd_dq and dqdd_dv
+  Eigen::MatrixXd dqdd_dacc;                // [nv x motions]
   Eigen::VectorXd y;                        // [outputs]
   Eigen::MatrixXd dy_dq, dy_dv;             // [outputs x nv]
   // parts (also set by compute())
@@ -147,6 +156,12 @@ class TreeDerivatives {
   // closed loops: kept rows of Jc, M^-1 Jr^T, the Schur complement and its right-hand sides
   Eigen::MatrixXd Jr_, Y_, Sc_, T_;
   Eigen::LLT<Eigen::MatrixXd> llt_schur_;
+  // motion inputs: the free and the driven coordinates, M on the free ones, the right-hand sides
+  // [q, v, u_all, accelerations] on the free rows
+  std::vector<int> free_, driven_;
+  Eigen::MatrixXd Mff_, Rf_;
+  Eigen::LLT<Eigen::MatrixXd> llt_ff_;
+  void solve_prescribed(const std::vector<int>& rows);
 };
 
 }  // namespace codyna

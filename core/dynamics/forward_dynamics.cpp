@@ -108,6 +108,79 @@ const Eigen::VectorXd& closed_loop_dynamics(const Model& model, Data& d, const E
   return d.qdd;
 }
 
+// prescribed_dynamics (below) in double, in data's workspace: the same equations, no heap after the
+// first call; forward_kinematics(q, v) and applied_forces have run. The independent loop rows are
+// kept in d.loop.rows, as closed_loop_dynamics keeps them.
+const Eigen::VectorXd& prescribed_dynamics_double(const Model& model, Data& d, const Eigen::VectorXd& q,
+                                                  const Eigen::VectorXd& v, const Eigen::VectorXd& Q,
+                                                  const Baumgarte& stab) {
+  const int nv = model.nv, nm = static_cast<int>(model.motions.size());
+  crba_after_kinematics<double>(model, d);
+  nonlinear_effects<double>(model, d, q, v);
+  Data::LoopSolve& w = d.loop;
+  if (static_cast<int>(w.driven.size()) != nm || static_cast<int>(w.free.size()) + nm != nv) {
+    w.driven.clear();
+    w.free.clear();
+    for (int k = 0; k < nm; ++k) w.driven.push_back(model.actuators[static_cast<std::size_t>(model.motions[k])].iv);
+    for (int i = 0; i < nv; ++i)
+      if (std::find(w.driven.begin(), w.driven.end(), i) == w.driven.end()) w.free.push_back(i);
+  }
+  const int nf = static_cast<int>(w.free.size());
+  resize_if(w.f, nv, 1);
+  w.f = Q - d.nle;
+  for (int k = 0; k < nm; ++k) w.f.noalias() -= d.M.col(w.driven[k]) * d.motion_acc[k];
+  w.rows.clear();
+  if (model.nc > 0) {
+    constraint_terms<double>(model, d, q, v);
+    w.qr.compute(d.Jc.transpose());
+    const int rank = static_cast<int>(model.active_rows.size());
+    const auto& perm = w.qr.colsPermutation().indices();
+    for (int k = 0; k < rank; ++k) w.rows.push_back(perm[k]);
+    std::sort(w.rows.begin(), w.rows.end());
+  }
+  const int na = static_cast<int>(w.rows.size());
+  resize_if(w.Mff, nf, nf);
+  resize_if(w.X, nf, 1 + na);
+  resize_if(w.J, na, nf);
+  resize_if(w.rhs, na, 1);
+  for (int i = 0; i < nf; ++i) {
+    for (int j = 0; j < nf; ++j) w.Mff(i, j) = d.M(w.free[i], w.free[j]);
+    w.X(i, 0) = w.f[w.free[i]];
+  }
+  for (int k = 0; k < na; ++k) {
+    for (int i = 0; i < nf; ++i) w.J(k, i) = d.Jc(w.rows[k], w.free[i]);
+    w.rhs[k] = d.gamma[w.rows[k]];
+  }
+  d.qdd.setZero(nv);
+  d.lambda.setZero(model.nc);
+  if (nf > 0) {
+    if (stab.alpha != 0.0 || stab.beta != 0.0)
+      for (int k = 0; k < na; ++k) {
+        double Jvel = 0.0;
+        for (int c = 0; c < nv; ++c) Jvel += d.Jc(w.rows[k], c) * v[c];
+        w.rhs[k] += 2.0 * stab.alpha * Jvel + stab.beta * stab.beta * d.phi[w.rows[k]];
+      }
+    w.X.rightCols(na) = w.J.transpose();
+    cholesky_factor_into(w.Mff, w.L);
+    cholesky_solve_in_place(w.L, w.X);
+    if (na > 0) {
+      resize_if(w.A, na, na);
+      w.A.noalias() = w.J * w.X.rightCols(na);
+      resize_if(w.lam, na, 1);
+      w.lam.noalias() = w.J * w.X.col(0);
+      w.lam += w.rhs;
+      cholesky_factor_into(w.A, w.LA);
+      cholesky_solve_in_place(w.LA, w.lam);
+      w.X.col(0).noalias() -= w.X.rightCols(na) * w.lam;
+      for (int k = 0; k < na; ++k) d.lambda[w.rows[k]] = w.lam[k];
+    }
+    for (int i = 0; i < nf; ++i) d.qdd[w.free[i]] = w.X(i, 0);
+  }
+  for (int k = 0; k < nm; ++k) d.qdd[w.driven[k]] = d.motion_acc[k];
+  for (int k = 0; k < nm; ++k) d.motion_force[k] = d.nle[w.driven[k]] - Q[w.driven[k]] + d.M.row(w.driven[k]).dot(d.qdd);
+  return d.qdd;
+}
+
 // Motion inputs: their coordinates d follow prescribed accelerations a (data.motion_acc; q and v
 // there are the caller's), so only the free coordinates f are unknown:
 //   M_ff qdd_f = (Q - nle - M_:d a)_f - J_f^T lambda,   J_f qdd_f + gamma = -stab
@@ -192,7 +265,10 @@ const VecXT<S>& forward_dynamics(const Model& model, DataT<S>& d, const VecXT<S>
                                  const VecXT<S>& u, const Baumgarte& stab) {
   forward_kinematics<S>(model, d, q, v);
   const VecXT<S>& Q = applied_forces<S>(model, d, q, v, u);  // data.Q: nothing below writes it
-  if (!model.motions.empty()) return prescribed_dynamics<S>(model, d, q, v, Q, stab);
+  if (!model.motions.empty()) {
+    if constexpr (std::is_same_v<S, double>) return prescribed_dynamics_double(model, d, q, v, Q, stab);
+    return prescribed_dynamics<S>(model, d, q, v, Q, stab);
+  }
   if (model.nc == 0) {
     d.lambda.setZero(model.nc);
     return aba_after_kinematics<S>(model, d, v, Q);

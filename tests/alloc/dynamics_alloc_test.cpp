@@ -159,6 +159,40 @@ TEST(NoAllocation, ForwardDynamicsAndPlantOnEveryClosedLoopExample) {
   EXPECT_GE(loops, 3);
 }
 
+// motion inputs (bus suspension: a tree with a massless driven road; ball and beam: a coupler's
+// loop row and the driven beam): the free coordinates' balance, the loops' Schur complement and
+// the motions' reactions, in Data's loop workspace
+TEST(NoAllocation, ForwardDynamicsWithMotionInputs) {
+  int motions = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(CODYNA_EXAMPLES_DIR)) {
+    if (entry.path().extension() != ".json") continue;
+    const std::string name = entry.path().filename().string();
+    const Model m = load(name);
+    if (m.motions.empty()) continue;
+    ++motions;
+    Data d(m);
+    const Eigen::VectorXd u = m.u_nominal();
+    Eigen::VectorXd v = m.v0;
+    for (int k = 0; k < m.nv; ++k) v[k] += 0.1 + 0.01 * k;
+    for (Eigen::Index k = 0; k < d.motion_acc.size(); ++k) d.motion_acc[k] = 0.3 - 0.2 * static_cast<double>(k);
+    forward_dynamics<double>(m, d, m.q0, v, u);  // warm-up, without and with stabilization
+    forward_dynamics<double>(m, d, m.q0, v, u, Baumgarte{2.0, 3.0});
+    long n = 0;
+    {
+      Count c;
+      forward_dynamics<double>(m, d, m.q0, v, u);
+      forward_dynamics<double>(m, d, m.q0, v, u, Baumgarte{2.0, 3.0});
+      n = c.n();
+    }
+    EXPECT_EQ(n, 0) << name << ": forward_dynamics";
+    // the driven coordinates follow their accelerations; the reactions are M qdd + nle - Q there
+    for (std::size_t k = 0; k < m.motions.size(); ++k)
+      EXPECT_EQ(d.qdd[m.actuators[static_cast<std::size_t>(m.motions[k])].iv], d.motion_acc[static_cast<Eigen::Index>(k)])
+          << name;
+  }
+  EXPECT_GE(motions, 2);
+}
+
 // rotor inertia (armature) on every joint with coordinates: one value on odd joints, one per
 // coordinate on even ones
 ModelSpec with_armature(ModelSpec s) {

@@ -154,6 +154,65 @@ TEST(Motion, ExactJacobianOverRatesAndAccelerationsAgreesWithCentralDifferences)
   }
 }
 
+// The analytic Jacobian (tree derivatives with one held-acceleration row per motion, solved on the
+// free coordinates; the loops' velocity maps extended over the motions' coordinates) against
+// automatic differentiation of the same dynamics and central differences, at the reference
+// configuration with random velocities, force inputs, motion rates and accelerations. The models:
+// the bus (a tree; the road body massless), the ball and beam (a coupler: a loop row), the shaker
+// pendulum, and the ball and beam with its beam angle outside Plant/In (a motion held at rest).
+TEST(Motion, AnalyticJacobianAgreesWithAutodiffAndCentralDifferences) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> U(-1, 1);
+  std::vector<std::pair<std::string, Model>> models;
+  for (const char* file : {"ball_beam.json", "bus_suspension.json"}) models.emplace_back(file, test::load_example(file));
+  models.emplace_back("shaker", study_model(parse(shaker(R"(["angle", "tip_x"])"))));
+  for (const auto& [name, m] : models) {
+    const CoordinatePartition p = partition_coordinates(m, m.q0);
+    const PlantFunction f(m, m.q0, m.u_nominal(), p);
+    ASSERT_GT(f.nm(), 0) << name;
+    for (int trial = 0; trial < 3; ++trial) {
+      Eigen::VectorXd x = Eigen::VectorXd::Zero(f.nx()), u(f.nu() + 2 * f.nm());
+      for (int k = f.nz(); k < x.size(); ++k) x[k] = 0.4 * U(rng);
+      for (int k = 0; k < u.size(); ++k) u[k] = 0.3 * U(rng);
+      for (int j = 0; j < f.nm(); ++j) u[f.motion_inputs()[j]] = m.u_nominal()[m.plant_inputs[f.motion_inputs()[j]]];
+      Eigen::MatrixXd analytic;
+      ASSERT_TRUE(f.analytic_jacobian(x, u, analytic)) << name;
+      const Eigen::MatrixXd ad = plant_jacobian_autodiff(f, x, u);
+      const Eigen::MatrixXd fd = plant_jacobian_fd_full(f, x, u, true);
+      ASSERT_EQ(analytic.rows(), ad.rows());
+      ASSERT_EQ(analytic.cols(), ad.cols());
+      const double scale = std::max(1.0, ad.cwiseAbs().maxCoeff());
+      EXPECT_LT((analytic - ad).cwiseAbs().maxCoeff() / scale, 1e-12) << name << " trial " << trial << "\n"
+                                                                       << analytic << "\n\n" << ad;
+      EXPECT_LT((analytic - fd).cwiseAbs().maxCoeff() / scale, 1e-8) << name << " trial " << trial;
+      // the motions' value, rate and acceleration columns are not all zero: the test can fail
+      EXPECT_GT(analytic.rightCols(2 * f.nm()).cwiseAbs().maxCoeff(), 1e-3) << name;
+      for (int j = 0; j < f.nm(); ++j)
+        EXPECT_GT(analytic.col(f.nx() + f.motion_inputs()[j]).cwiseAbs().maxCoeff(), 1e-3) << name;
+      // without the rate and acceleration columns (the motions at rest): the first columns of the
+      // Jacobian taken with zero rates and accelerations
+      Eigen::MatrixXd plain, at_rest;
+      Eigen::VectorXd u_rest = u;
+      u_rest.tail(2 * f.nm()).setZero();
+      ASSERT_TRUE(f.analytic_jacobian(x, u.head(f.nu()), plain)) << name;
+      ASSERT_TRUE(f.analytic_jacobian(x, u_rest, at_rest)) << name;
+      EXPECT_EQ(plain, at_rest.leftCols(f.nx() + f.nu())) << name;
+    }
+  }
+  // a motion outside Plant/In: held at its nominal value, at rest
+  ModelSpec spec = load_model_spec(test::example_path("ball_beam.json"));
+  ASSERT_EQ(spec.plant.inputs.size(), 1u);
+  spec.plant.inputs.clear();
+  const Model m = study_model(spec);
+  const PlantFunction f(m, m.q0, m.u_nominal(), partition_coordinates(m, m.q0));
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(f.nx()), u(0);
+  for (int k = f.nz(); k < x.size(); ++k) x[k] = 0.25 + 0.1 * k;
+  Eigen::MatrixXd analytic;
+  ASSERT_TRUE(f.analytic_jacobian(x, u, analytic));
+  const Eigen::MatrixXd ad = plant_jacobian_autodiff(f, x, u);
+  EXPECT_LT((analytic - ad).cwiseAbs().maxCoeff() / std::max(1.0, ad.cwiseAbs().maxCoeff()), 1e-12);
+}
+
 TEST(Motion, BadMotionInputsAreRefusedAtTheField) {
   const auto error_path = [](const std::string& text) {
     try {
