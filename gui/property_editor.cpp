@@ -35,7 +35,7 @@ QStringList type_names(ElementKind k) {
     case ElementKind::Constraint: return {"ball", "revolute", "planar_revolute", "coupler"};
     case ElementKind::Effect:
       return {"gravity", "spring_damper", "joint_spring_damper", "joint_friction", "joint_damper", "body_force", "bushing"};
-    case ElementKind::Actuator: return {"joint_force", "body_force", "body_torque", "line_force", "mix"};
+    case ElementKind::Actuator: return {"joint_force", "body_force", "body_torque", "line_force", "mix", "motion"};
     case ElementKind::Sensor:
       return {"joint_position", "joint_velocity", "point_position", "point_velocity", "body_angle", "distance", "distance_rate"};
     default: return {};

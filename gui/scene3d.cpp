@@ -380,10 +380,12 @@ void Scene::build(const Model* model) {
     it.prim = Prim::Cylinder;
     it.body = s.body_a, it.body_b = s.body_b;
     it.point_a = s.point_a, it.point_b = s.point_b;
+    it.span = Span::Whole;
     it.thickness = 0.004 * L;
     it.color = {0.30f, 0.30f, 0.32f, 1.0f};
     items_.push_back(it);
   }
+  addElements(oMi);
 
   // joint axes (on the parent's joint frame F; a universal's second axis on the child's M)
   const Eigen::Vector4f revolute_color{0.95f, 0.80f, 0.10f, 1.0f}, slide_color{0.85f, 0.20f, 0.75f, 1.0f};
@@ -503,11 +505,163 @@ void Scene::addDefaultLook(int i) {
   }
 }
 
+Eigen::Affine3d spanTransform(const Item& it, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const Eigen::Vector3d d = b - a;
+  const double len = d.norm();
+  const Eigen::Vector3d u = len > 0 ? Eigen::Vector3d(d / len) : Eigen::Vector3d::Zero();
+  switch (it.span) {
+    case Span::Barrel: {
+      const double l = std::min(std::max(it.span_a, len - it.span_b), len);
+      return segment(a, a + l * u, it.thickness);
+    }
+    case Span::Rod: return segment(b - std::min(it.span_b, len) * u, b, it.thickness);
+    case Span::Dash: return segment(a + it.span_a * d, a + it.span_b * d, it.thickness);
+    default: return segment(a, b, it.thickness);
+  }
+}
+
+// the elements that act between bodies or on joints, drawn as they act (docs/gui.md, "3-D view")
+void Scene::addElements(const std::vector<SE3>& oMi) {
+  const Model& m = *model_;
+  const double L = length_;
+  auto twoPoint = [&](ItemKind kind, const std::string& name, int body_a, const Eigen::Vector3d& pa, int body_b,
+                      const Eigen::Vector3d& pb, Span span, double radius, const Eigen::Vector4f& color) {
+    Item it;
+    it.kind = kind;
+    it.prim = Prim::Cylinder;
+    it.element = name;
+    it.body = body_a, it.body_b = body_b;
+    it.point_a = pa, it.point_b = pb;
+    it.span = span;
+    it.thickness = radius;
+    it.color = color;
+    items_.push_back(it);
+    return &items_.back();
+  };
+  auto local = [&](ItemKind kind, const std::string& name, int body, Prim prim, const Eigen::Affine3d& T,
+                   const Eigen::Vector4f& color) {
+    Item it;
+    it.kind = kind;
+    it.prim = prim;
+    it.element = name;
+    it.body = body;
+    it.local = T;
+    it.color = color;
+    items_.push_back(it);
+    return &items_.back();
+  };
+  // a flat disc of radius r about unit axis a at p
+  auto disc = [](const Eigen::Vector3d& p, const Eigen::Vector3d& a, double r, double h) {
+    Eigen::Affine3d T = Eigen::Affine3d::Identity();
+    T.translation() = p;
+    T.linear() = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), a).toRotationMatrix() *
+                 Eigen::Vector3d(r, r, h).asDiagonal();
+    return T;
+  };
+  // the body whose joint owns velocity index iv (0 if none)
+  auto jointOf = [&](int iv) {
+    for (int i = 1; i < m.nbodies; ++i)
+      if (iv >= m.joints[i].idx_v && iv < m.joints[i].idx_v + m.joints[i].nv) return i;
+    return 0;
+  };
+
+  // two-point actuators: a barrel (dark orange) on body_a's point and a rod (light steel) from body_b's,
+  // each 0.6 of the length at q0, so that they slide in each other as the length changes
+  for (const ActuatorModel& a : m.actuators) {
+    if (a.type != ActuatorType::LineForce) continue;
+    const double d0 = (oMi[a.body_b].act_point(a.point_b) - oMi[a.body].act_point(a.point)).norm();
+    const double l0 = d0 > 1e-9 ? 0.6 * d0 : 0.1 * L;
+    Item* barrel = twoPoint(ItemKind::LineForce, a.name, a.body, a.point, a.body_b, a.point_b, Span::Barrel, 0.014 * L,
+                            {0.85f, 0.40f, 0.12f, 1.0f});
+    barrel->span_a = l0, barrel->span_b = l0;
+    Item* rod = twoPoint(ItemKind::LineForce, a.name, a.body, a.point, a.body_b, a.point_b, Span::Rod, 0.007 * L,
+                         {0.82f, 0.84f, 0.88f, 1.0f});
+    rod->span_a = l0, rod->span_b = l0;
+  }
+
+  // bushings: an amber block at each frame (turned with it), the line between the origins when apart
+  for (const BushingModel& b : m.bushings) {
+    const double s = 0.035 * L;
+    const Eigen::Vector4f amber{0.95f, 0.62f, 0.08f, 1.0f};
+    local(ItemKind::Bushing, b.name, b.body_a, Prim::Box, toAffine(b.X_a) * Eigen::Scaling(s), amber);
+    local(ItemKind::Bushing, b.name, b.body_b, Prim::Box, toAffine(b.X_b) * Eigen::Scaling(0.7 * s),
+          {0.20f, 0.20f, 0.22f, 1.0f});
+    twoPoint(ItemKind::Bushing, b.name, b.body_a, b.X_a.p, b.body_b, b.X_b.p, Span::Whole, 0.006 * L, amber);
+  }
+
+  // couplers: teal dashes from each coupled joint's frame F to the next one's, a dot on each
+  for (const ConstraintModel& c : m.constraints) {
+    if (c.type != ConstraintType::Coupler) continue;
+    const Eigen::Vector4f teal{0.05f, 0.65f, 0.60f, 1.0f};
+    int prev = 0;
+    for (int k = 0; k < c.ncoupled; ++k) {
+      const int j = jointOf(c.iv[k]);
+      if (j == 0) continue;
+      const JointModel& J = m.joints[j];
+      local(ItemKind::Coupler, c.name, J.parent, Prim::Sphere,
+            Eigen::Translation3d(J.X_PF.p) * Eigen::Scaling(0.015 * L), teal);
+      if (prev > 0) {
+        const JointModel& P = m.joints[prev];
+        constexpr int kDashes = 7;  // dash, gap, ..., dash: 2 kDashes - 1 equal parts
+        for (int d = 0; d < kDashes; ++d) {
+          Item* it = twoPoint(ItemKind::Coupler, c.name, P.parent, P.X_PF.p, J.parent, J.X_PF.p, Span::Dash,
+                              0.004 * L, teal);
+          it->span_a = 2.0 * d / (2 * kDashes - 1), it->span_b = (2.0 * d + 1) / (2 * kDashes - 1);
+        }
+      }
+      prev = j;
+    }
+  }
+
+  // motion inputs: a crimson arrow along the driven joint's axis from its frame F, and a disc around it
+  for (const int k : m.motions) {
+    const ActuatorModel& a = m.actuators[static_cast<size_t>(k)];
+    const int j = jointOf(a.iv);
+    if (j == 0) continue;
+    const JointModel& J = m.joints[j];
+    const Eigen::Vector3d axis = J.X_PF.R * J.axis;
+    const Eigen::Vector4f crimson{0.85f, 0.08f, 0.30f, 1.0f};
+    const double len = 0.3 * L;
+    local(ItemKind::Motion, a.name, J.parent, Prim::Arrow, arrowAt(J.X_PF.p + 0.5 * len * axis, axis, len, 0.6 * len),
+          crimson);
+    local(ItemKind::Motion, a.name, J.parent, Prim::Cylinder, disc(J.X_PF.p, axis, 0.05 * L, 0.006 * L), crimson);
+  }
+
+  // actuators driven by a mix, coloured by the (first) mix: a body force as an arrow from its point
+  // along its direction, a body torque as an arrow along its axis through the centre of mass and a disc
+  std::vector<int> mix_rank(m.actuators.size(), -1);
+  int nmix = 0;
+  for (size_t k = 0; k < m.actuators.size(); ++k)
+    if (m.actuators[k].type == ActuatorType::Mix) mix_rank[k] = nmix++;
+  const std::array<Eigen::Vector4f, 4> mix_colors = {{
+      {0.90f, 0.20f, 0.15f, 1.0f}, {0.15f, 0.45f, 0.90f, 1.0f}, {0.10f, 0.70f, 0.25f, 1.0f}, {0.70f, 0.30f, 0.80f, 1.0f}}};
+  for (const ActuatorModel& a : m.actuators) {
+    if (a.driven_by.empty()) continue;
+    if (a.type != ActuatorType::BodyForce && a.type != ActuatorType::BodyTorque) continue;
+    Eigen::Vector4f color{0.35f, 0.35f, 0.40f, 1.0f};  // driven by several mixes: neutral
+    if (a.driven_by.size() == 1 && mix_rank[static_cast<size_t>(a.driven_by[0].first)] >= 0) color = mix_colors[static_cast<size_t>(mix_rank[static_cast<size_t>(a.driven_by[0].first)]) % 4];
+    const Eigen::Vector3d p = a.type == ActuatorType::BodyForce ? a.point : m.com[a.body];
+    const double len = (a.type == ActuatorType::BodyForce ? 0.25 : 0.2) * L;
+    Item* it = local(ItemKind::Actuator, a.name, a.body, Prim::Arrow,
+                     arrowAt(p + 0.5 * len * a.direction, a.direction, len, 0.6 * len), color);
+    it->world_axes = a.in_world;
+    if (a.type == ActuatorType::BodyTorque) {
+      Item* d = local(ItemKind::Actuator, a.name, a.body, Prim::Cylinder, disc(p, a.direction, 0.06 * L, 0.005 * L),
+                      color);
+      d->world_axes = a.in_world;
+    }
+  }
+}
+
 void Scene::update(const std::vector<SE3>& oMi) {
   for (Item& it : items_) {
-    if (it.kind == ItemKind::Spring) {
-      const Eigen::Vector3d a = oMi[it.body].act_point(it.point_a), b = oMi[it.body_b].act_point(it.point_b);
-      it.world = segment(a, b, it.thickness);
+    if (it.span != Span::None) {
+      it.world = spanTransform(it, oMi[it.body].act_point(it.point_a), oMi[it.body_b].act_point(it.point_b));
+      continue;
+    }
+    if (it.world_axes) {
+      it.world = it.local;
+      it.world.translation() = oMi[it.body].act_point(it.local.translation());
       continue;
     }
     it.world = toAffine(oMi[it.body]) * it.local;
@@ -517,7 +671,9 @@ void Scene::update(const std::vector<SE3>& oMi) {
 Eigen::AlignedBox3d Scene::bounds() const {
   Eigen::AlignedBox3d box;
   for (const Item& it : items_) {
-    if (it.kind != ItemKind::Shape && it.kind != ItemKind::Anchor && it.kind != ItemKind::Spring) continue;
+    if (it.kind != ItemKind::Shape && it.kind != ItemKind::Anchor && it.kind != ItemKind::Spring &&
+        it.kind != ItemKind::LineForce && it.kind != ItemKind::Bushing)
+      continue;
     for (const auto& c : corners(it.prim, it.world)) box.extend(c);
   }
   if (box.isEmpty()) {
@@ -534,6 +690,10 @@ Eigen::AlignedBox3d Scene::viewBounds(bool overlays) const {
     for (const Item& it : items_)
       if (it.kind == ItemKind::Axis || it.kind == ItemKind::Frame)
         for (const auto& c : corners(it.prim, it.world)) box.extend(c);
+  // the elements' arrows and links (motion inputs, mixed actuators, couplers) always show
+  for (const Item& it : items_)
+    if (it.kind == ItemKind::Motion || it.kind == ItemKind::Actuator || it.kind == ItemKind::Coupler)
+      for (const auto& c : corners(it.prim, it.world)) box.extend(c);
   const double h = grid_center_.dot(up_);
   Eigen::AlignedBox3d out = box;
   for (int k = 0; k < 8; ++k) {

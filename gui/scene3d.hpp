@@ -46,6 +46,21 @@ enum class ItemKind {
   Frame,    // body frame triad (overlay)
   Spring,   // spring-damper between two bodies
   Com,      // centre of mass marker (overlay, shown on request)
+  // the elements of docs/model-format.md drawn as they act (`element` names them):
+  LineForce,  // two-point actuator: a barrel on body_a's point, a rod on body_b's (two tones)
+  Bushing,    // a block at each of its two frames, and the line between their origins when apart
+  Coupler,    // dashes between the coupled joints' frames F, and a dot on each
+  Motion,     // a joint driven by a motion input: an arrow along its axis and a disc around it
+  Actuator,   // an actuator driven by a mix: a force arrow from its point, a torque arrow and disc
+};
+
+// how a two-point item spans the line from point_a (on `body`) to point_b (on body_b)
+enum class Span {
+  None,    // not a two-point item: world = pose of `body` * local
+  Whole,   // the whole line
+  Barrel,  // from a towards b: span_a long, or longer so that it meets the rod; at most the line
+  Rod,     // from b towards a: span_b long, at most the line
+  Dash,    // the fractions [span_a, span_b] of the line
 };
 
 struct Item {
@@ -55,11 +70,20 @@ struct Item {
   Eigen::Affine3d local = Eigen::Affine3d::Identity();  // unit primitive -> body frame
   Eigen::Affine3d world = Eigen::Affine3d::Identity();  // unit primitive -> world (update())
   Eigen::Vector4f color{0.7f, 0.7f, 0.75f, 1.0f};
-  // springs only: end points on body (a = `body`) and body_b
+  // two-point items (span != None: springs, struts, links): end points on body (a = `body`) and body_b
+  Span span = Span::None;
   int body_b = 0;
   Eigen::Vector3d point_a = Eigen::Vector3d::Zero(), point_b = Eigen::Vector3d::Zero();
-  double thickness = 0.0;
+  double thickness = 0.0;     // radius of the cylinder drawn along the line
+  double span_a = 0.0, span_b = 0.0;
+  // an arrow whose direction stays in world axes (an actuator with "frame": "world"): world =
+  // translation to the pose of `body` * local's origin, then local's linear part unturned
+  bool world_axes = false;
+  std::string element;        // the model element it draws (LineForce .. Actuator), for tests and tips
 };
+
+// the cylinder of a two-point item from world points a to b (Scene::update uses it)
+Eigen::Affine3d spanTransform(const Item& it, const Eigen::Vector3d& a, const Eigen::Vector3d& b);
 
 struct Ray {
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();
@@ -99,6 +123,7 @@ class Scene {
 
  private:
   void addDefaultLook(int body);
+  void addElements(const std::vector<SE3>& oMi);
   void placeGrid(const std::vector<SE3>& oMi);
 
   const Model* model_ = nullptr;

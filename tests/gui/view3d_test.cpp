@@ -48,6 +48,30 @@ Eigen::VectorXd perturbed(const codyna::Model& m, double amount) {
 
 std::string bodyName(const codyna::Model& m, int i) { return m.body_names[static_cast<size_t>(i)]; }
 
+// the items of one element, in the order the scene made them
+std::vector<codyna::gui::Item> itemsOf(const Scene& scene, ItemKind kind, const std::string& element) {
+  std::vector<codyna::gui::Item> out;
+  for (const auto& it : scene.items())
+    if (it.kind == kind && it.element == element) out.push_back(it);
+  return out;
+}
+
+// a unit cylinder or arrow (z in [-0.5, 0.5]) under T: its two end points, where z = -0.5 and z = +0.5
+Eigen::Vector3d tail(const Eigen::Affine3d& T) { return T * Eigen::Vector3d(0, 0, -0.5); }
+Eigen::Vector3d tip(const Eigen::Affine3d& T) { return T * Eigen::Vector3d(0, 0, 0.5); }
+
+bool near(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double tol = 1e-12) { return (a - b).norm() <= tol; }
+
+QString str(const Eigen::Vector3d& v) { return QString("(%1, %2, %3)").arg(v.x(), 0, 'g', 17).arg(v.y(), 0, 'g', 17).arg(v.z(), 0, 'g', 17); }
+
+#define EXPECT_NEAR3(a, b) QVERIFY2(near((a), (b)), qPrintable(QString(#a " = %1, expected %2").arg(str(a), str(b))))
+
+void place(Scene& scene, const codyna::Model& m, const Eigen::VectorXd& q) {
+  codyna::Data d(m);
+  codyna::forward_kinematics(m, d, q);
+  scene.update(d.oMi);
+}
+
 }  // namespace
 
 class View3DTest : public QObject {
@@ -368,6 +392,186 @@ class View3DTest : public QObject {
       QVERIFY(view.bodyScreenPos(name, &q));
       QVERIFY2(!view.pickBody(q.toPoint()).isEmpty(), name);
     }
+  }
+
+  // The bus suspension's strut U (a line_force from the wheel's centre to the body's) is a barrel on
+  // the wheel and a rod on the body: their outer ends are the attachment points, which the prismatic
+  // joints X1, X2 place at (0, 1.5 + X1, 0) and (0, 0.5 + X2, 0) (closed form, not the scene's own
+  // kinematics); the two overlap as the strut is pulled or pushed. The road's motion input W draws a
+  // crimson arrow along +y from road_height's frame at (0, -0.2, 0), with a disc around it.
+  void lineForceAndMotionOnTheBus() {
+    auto m = loadExample("bus_suspension.json");
+    Scene scene;
+    scene.build(m.get());
+    const int x1 = m->joints[static_cast<size_t>(m->find_joint("X1"))].idx_q;
+    const int x2 = m->joints[static_cast<size_t>(m->find_joint("X2"))].idx_q;
+    const int road = m->joints[static_cast<size_t>(m->find_joint("road_height"))].idx_q;
+    for (const auto& [d1, d2] : {std::pair{0.0, 0.0}, {0.31, -0.12}, {-0.27, 0.22}, {0.9, -0.4}}) {
+      Eigen::VectorXd q = m->q0;
+      q[x1] = d1, q[x2] = d2, q[road] = 0.05;
+      place(scene, *m, q);
+      const Eigen::Vector3d a(0, 0.5 + d2, 0), b(0, 1.5 + d1, 0);
+      const auto strut = itemsOf(scene, ItemKind::LineForce, "U");
+      QCOMPARE(strut.size(), size_t(2));
+      const auto& barrel = strut[0];
+      const auto& rod = strut[1];
+      QCOMPARE(barrel.span, codyna::gui::Span::Barrel);
+      QCOMPARE(rod.span, codyna::gui::Span::Rod);
+      EXPECT_NEAR3(tail(barrel.world), a);
+      EXPECT_NEAR3(tip(rod.world), b);
+      // along the line from a to b, barrel and rod meeting or overlapping, neither past the other end
+      const Eigen::Vector3d u = (b - a).normalized();
+      EXPECT_NEAR3(Eigen::Vector3d((tip(barrel.world) - a).normalized()), u);
+      EXPECT_NEAR3(Eigen::Vector3d((b - tail(rod.world)).normalized()), u);
+      const double lb = (tip(barrel.world) - a).norm(), lr = (b - tail(rod.world)).norm(), len = (b - a).norm();
+      QVERIFY(lb + lr >= len - 1e-12 && lb <= len + 1e-12 && lr <= len + 1e-12);
+      QVERIFY(barrel.world.linear().col(0).norm() > rod.world.linear().col(0).norm());  // the thicker barrel
+      QVERIFY((barrel.color - rod.color).head<3>().norm() > 0.3);                       // two tones
+
+      const auto w = itemsOf(scene, ItemKind::Motion, "W");
+      QCOMPARE(w.size(), size_t(2));
+      QCOMPARE(w[0].prim, Prim::Arrow);
+      EXPECT_NEAR3(tail(w[0].world), Eigen::Vector3d(0, -0.2, 0));
+      EXPECT_NEAR3(Eigen::Vector3d((tip(w[0].world) - tail(w[0].world)).normalized()), Eigen::Vector3d(0, 1, 0));
+      QCOMPARE(w[1].prim, Prim::Cylinder);
+      EXPECT_NEAR3(Eigen::Vector3d(w[1].world.translation()), Eigen::Vector3d(0, -0.2, 0));
+    }
+    // only the motion input and the line force are marked; the frame of the view holds them
+    int marks = 0;
+    for (const auto& it : scene.items())
+      marks += it.kind == ItemKind::Motion || it.kind == ItemKind::LineForce || it.kind == ItemKind::Coupler ||
+               it.kind == ItemKind::Actuator || it.kind == ItemKind::Bushing;
+    QCOMPARE(marks, 4);
+  }
+
+  // The quadrotor's mixes rotor1..rotor4 show the actuators they drive: thrust1..thrust4 as arrows
+  // from the rotor's point (+-0.2, 0, 0), (0, +-0.2, 0) along body z, one colour per rotor, and the
+  // yaw torque they share as an arrow along body z through the centre of mass (neutral: four mixes
+  // drive it). Placed by the free joint at a turned pose: p + R * point, R * z (closed form).
+  void mixedActuatorsOnTheQuadrotor() {
+    auto m = loadExample("quadrotor.json");
+    Scene scene;
+    scene.build(m.get());
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
+    const Eigen::Quaterniond qr(R);
+    const Eigen::Vector3d p(0.3, -0.2, 1.4);
+    Eigen::VectorXd q = m->q0;
+    q.head<3>() = p;
+    q.segment<4>(3) << qr.w(), qr.x(), qr.y(), qr.z();
+    QVERIFY(std::abs(m->q0[3] - 1) < 1e-15);  // q0: level, at (0, 0, 1)
+    for (int turned = 0; turned < 2; ++turned) {
+      const Eigen::VectorXd config = turned ? q : m->q0;
+      place(scene, *m, config);
+      const Eigen::Matrix3d Rc = turned ? R : Eigen::Matrix3d::Identity();
+      const Eigen::Vector3d pc = turned ? p : Eigen::Vector3d(0, 0, 1);
+      const Eigen::Vector3d points[4] = {{0.2, 0, 0}, {0, 0.2, 0}, {-0.2, 0, 0}, {0, -0.2, 0}};
+      std::vector<Eigen::Vector4f> colors;
+      for (int k = 0; k < 4; ++k) {
+        const auto arrow = itemsOf(scene, ItemKind::Actuator, "thrust" + std::to_string(k + 1));
+        QCOMPARE(arrow.size(), size_t(1));
+        QCOMPARE(arrow[0].prim, Prim::Arrow);
+        EXPECT_NEAR3(tail(arrow[0].world), Eigen::Vector3d(pc + Rc * points[k]));
+        EXPECT_NEAR3(Eigen::Vector3d((tip(arrow[0].world) - tail(arrow[0].world)).normalized()), Eigen::Vector3d(Rc.col(2)));
+        for (const auto& c : colors) QVERIFY((c - arrow[0].color).norm() > 0.3);  // one colour per rotor
+        colors.push_back(arrow[0].color);
+      }
+      const auto yaw = itemsOf(scene, ItemKind::Actuator, "yaw_torque");
+      QCOMPARE(yaw.size(), size_t(2));  // arrow and disc
+      EXPECT_NEAR3(tail(yaw[0].world), pc);
+      EXPECT_NEAR3(Eigen::Vector3d((tip(yaw[0].world) - tail(yaw[0].world)).normalized()), Eigen::Vector3d(Rc.col(2)));
+      EXPECT_NEAR3(Eigen::Vector3d(yaw[1].world.translation()), pc);
+      // the mixes themselves draw nothing: they act through these
+      for (int k = 1; k <= 4; ++k) {
+        for (const auto& it : scene.items()) QVERIFY(it.element != "rotor" + std::to_string(k));
+      }
+    }
+  }
+
+  // The ball and beam: the motion input alpha marks the beam's pivot (an arrow along z from the origin),
+  // and the rolling coupler links the frames of its joints r (on the beam at the pivot) and spin (on
+  // the carriage, at r along the turned beam: (r cos alpha, r sin alpha, 0)) with dashes and a dot on
+  // each. The geared pendulum's gear links motor's frame (0, 0, -0.05) to theta's (0, 0, 0).
+  void couplersAndMotionOnBallBeamAndGear() {
+    auto m = loadExample("ball_beam.json");
+    Scene scene;
+    scene.build(m.get());
+    const int ia = m->joints[static_cast<size_t>(m->find_joint("beam_pivot"))].idx_q;
+    const int ir = m->joints[static_cast<size_t>(m->find_joint("r"))].idx_q;
+    for (const auto& [alpha, r] : {std::pair{0.0, 0.5}, {0.2, 0.37}, {-0.35, 0.81}}) {
+      Eigen::VectorXd q = m->q0;
+      q[ia] = alpha, q[ir] = r;
+      place(scene, *m, q);
+      const auto mo = itemsOf(scene, ItemKind::Motion, "alpha");
+      QCOMPARE(mo.size(), size_t(2));
+      EXPECT_NEAR3(tail(mo[0].world), Eigen::Vector3d::Zero());
+      EXPECT_NEAR3(Eigen::Vector3d((tip(mo[0].world) - tail(mo[0].world)).normalized()), Eigen::Vector3d::UnitZ());
+      const auto c = itemsOf(scene, ItemKind::Coupler, "rolling");
+      const Eigen::Vector3d a = Eigen::Vector3d::Zero(), b(r * std::cos(alpha), r * std::sin(alpha), 0);
+      QCOMPARE(c.size(), size_t(2 + 7));  // two dots, seven dashes
+      QCOMPARE(c[0].prim, Prim::Sphere);
+      EXPECT_NEAR3(Eigen::Vector3d(c[0].world.translation()), a);
+      EXPECT_NEAR3(Eigen::Vector3d(c[1].world.translation()), b);
+      EXPECT_NEAR3(tail(c[2].world), a);
+      EXPECT_NEAR3(tip(c.back().world), b);
+      for (size_t k = 2; k < c.size(); ++k) {  // dashes on the line, gaps between them
+        const Eigen::Vector3d s = tail(c[k].world), e = tip(c[k].world);
+        QVERIFY(std::abs((s - a).cross(b - a).norm()) < 1e-12 && std::abs((e - a).cross(b - a).norm()) < 1e-12);
+        if (k > 2) QVERIFY((s - a).norm() > (tip(c[k - 1].world) - a).norm() + 1e-3 * r);
+      }
+    }
+
+    auto g = loadExample("geared_pendulum.json");
+    scene.build(g.get());
+    const int it = g->joints[static_cast<size_t>(g->find_joint("theta"))].idx_q;
+    const int im = g->joints[static_cast<size_t>(g->find_joint("motor"))].idx_q;
+    Eigen::VectorXd q = g->q0;
+    q[it] = 0.3, q[im] = 15.0;
+    place(scene, *g, q);
+    const auto c = itemsOf(scene, ItemKind::Coupler, "gear");
+    QCOMPARE(c.size(), size_t(9));
+    EXPECT_NEAR3(Eigen::Vector3d(c[0].world.translation()), Eigen::Vector3d(0, 0, -0.05));
+    EXPECT_NEAR3(Eigen::Vector3d(c[1].world.translation()), Eigen::Vector3d::Zero());
+    EXPECT_NEAR3(tail(c[2].world), Eigen::Vector3d(0, 0, -0.05));
+    EXPECT_NEAR3(tip(c.back().world), Eigen::Vector3d::Zero());
+    QVERIFY(itemsOf(scene, ItemKind::Motion, "tau_m").empty());  // a joint force is no motion input
+  }
+
+  // A bushing between the ground (its frame at (0, 0, 1.2), turned) and the quadrotor's frame (at
+  // its origin): a block on each frame, turned with it, and the line between the origins when apart.
+  void bushingBlocks() {
+    const std::string path = QDir(CODYNA_EXAMPLES_DIR).filePath("quadrotor.json").toStdString();
+    codyna::ModelSpec spec = codyna::load_model_spec(path);
+    codyna::EffectSpec b;
+    b.name = "mount";
+    b.type = codyna::EffectType::Bushing;
+    b.body_a = "ground";
+    b.body_b = "frame";
+    b.frame_a.position = {0, 0, 1.2};
+    const Eigen::Matrix3d Ra = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    b.frame_a.rotation = Ra;
+    b.translational_stiffness = {100, 100, 100};
+    spec.effects.push_back(b);
+    auto m = std::make_shared<const codyna::Model>(codyna::compile(spec, path));
+    Scene scene;
+    scene.build(m.get());
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(-0.5, Eigen::Vector3d(0.3, 1, 0.2).normalized()).toRotationMatrix();
+    const Eigen::Quaterniond qr(R);
+    const Eigen::Vector3d p(0.1, 0.25, 0.9);
+    Eigen::VectorXd q = m->q0;
+    q.head<3>() = p;
+    q.segment<4>(3) << qr.w(), qr.x(), qr.y(), qr.z();
+    place(scene, *m, q);
+    const auto items = itemsOf(scene, ItemKind::Bushing, "mount");
+    QCOMPARE(items.size(), size_t(3));
+    QCOMPARE(items[0].prim, Prim::Box);
+    EXPECT_NEAR3(Eigen::Vector3d(items[0].world.translation()), Eigen::Vector3d(0, 0, 1.2));
+    const Eigen::Matrix3d La = items[0].world.linear(), Lb = items[1].world.linear();
+    const double sa = La.col(0).norm(), sb = Lb.col(0).norm();
+    QVERIFY(((La / sa) - Ra).cwiseAbs().maxCoeff() < 1e-12);
+    EXPECT_NEAR3(Eigen::Vector3d(items[1].world.translation()), p);
+    QVERIFY(((Lb / sb) - R).cwiseAbs().maxCoeff() < 1e-12);
+    EXPECT_NEAR3(tail(items[2].world), Eigen::Vector3d(0, 0, 1.2));
+    EXPECT_NEAR3(tip(items[2].world), p);
   }
 
   // an edited model (same file and name) keeps the camera; another model is framed anew
