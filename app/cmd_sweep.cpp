@@ -10,6 +10,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "study/sweep.hpp"
+#include "sweep_mpi.hpp"
 
 namespace codyna::cli {
 
@@ -25,7 +26,17 @@ struct SweepArgs {
   const CLI::App* cmd = nullptr;
 };
 
-void run(const SweepArgs& a) {
+// returns the exit code under mpirun (built with MPI), -1 when run here as one process
+int run(const SweepArgs& a) {
+  const int processes = launched_processes();
+  if (processes > 1 && !built_with_mpi())
+    throw std::invalid_argument("started as one of " + std::to_string(processes) +
+                                " processes by an MPI launcher (OMPI_COMM_WORLD_SIZE or PMI_SIZE), but this codyna was built "
+                                "without MPI: each process would run the whole study and write the same files. Run it "
+                                "without mpirun, build codyna with OpenMPI (Debian: libopenmpi-dev), or split the study with "
+                                "--shard K/N and codyna sweep-merge");
+  if (processes > 1 && !a.shard.empty())
+    throw std::invalid_argument("--shard " + a.shard + ": under mpirun the ranks share the variants already; give one or the other");
   SweepRequest r;
   r.model = a.model;
   r.vary = a.vary;
@@ -84,17 +95,26 @@ void run(const SweepArgs& a) {
     bar_open = false;
     print_message(m);
   };
-  const SweepJob job = study_sweep_job(r, tell, progress);
-  if (bar_open) std::fprintf(stderr, "\n");
-  std::cout << study_sweep_summary(job);
-  for (const std::string& f : job.written) std::cout << "wrote " << f << "\n";
+  const auto print = [&](const SweepJob& job) {
+    if (bar_open) std::fprintf(stderr, "\n");
+    bar_open = false;
+    std::cout << study_sweep_summary(job);
+    for (const std::string& f : job.written) std::cout << "wrote " << f << "\n";
+  };
+  if (processes > 1) {
+    const int code = sweep_over_mpi(r, tell, progress, print);
+    if (bar_open) std::fprintf(stderr, "\n");
+    return code;
+  }
+  print(study_sweep_job(r, tell, progress));
+  return -1;
 }
 
 }  // namespace
 
 void add_sweep(CLI::App& app) {
   auto a = std::make_shared<SweepArgs>();
-  auto* cmd = app.add_subcommand("sweep", "Parameter study: linearize (and close the loop of) every variant of a model over a grid or random samples");
+  auto* cmd = app.add_subcommand("sweep", "Parameter study: linearize (and close the loop of) every variant of a model over a grid or random samples; one machine's threads, MPI ranks (mpirun) or Slurm shards");
   cmd->add_option("model", a->model, "model file (JSON)")->required();
   cmd->add_option("--vary", a->vary,
                   "FIELD=SPEC (repeatable): FIELD a JSON pointer into the model file (/bodies/1/mass), SPEC a:b:n, "
@@ -107,12 +127,21 @@ void add_sweep(CLI::App& app) {
   cmd->add_option("--out", a->out, "results (HDF5)")->required();
   cmd->add_option("--csv", a->csv, "the per-variant figures as CSV");
   cmd->add_option("--mat", a->mat, "DIR/NAME.mat + DIR/NAME.m: the stacks for MATLAB/Octave, NAME.m builds the ss array over the variants");
-  cmd->add_flag("--simulate", a->simulate, "also run every variant's nonlinear closed loop (the file's solver settings): status, peak |u|, final error");
+  cmd->add_flag("--simulate", a->simulate, "also run every variant's nonlinear closed loop (the file's solver settings): status, peak |u|, final error, overshoot, settling time, time at an input limit");
   cmd->add_flag("--restart", a->restart, "ignore the journal of an interrupted run (OUT.partial) and run every variant again");
   cmd->add_option("--shard", a->shard, "K/N: run only the variants i with i % N = K and write them to --out (a shard; slurm: from SLURM_ARRAY_TASK_ID/COUNT); codyna sweep-merge joins the shards");
   cmd->add_flag("--quiet", a->quiet, "no progress line");
   a->cmd = cmd;
-  cmd->callback([a] { set_exit_code(run_guarded([&] { run(*a); })); });
+  cmd->footer(
+      "MPI: mpirun -np N codyna sweep ... shares the variants among N ranks (variant i on rank i % N, one thread each "
+      "unless --threads); rank 0 writes the one result file, the single-process run's bit for bit "
+      "(docs/parameter-studies.md)." +
+      std::string(built_with_mpi() ? "" : " This codyna was built without MPI: under mpirun it refuses to run."));
+  cmd->callback([a] {
+    int mpi = -1;
+    const int code = run_guarded([&] { mpi = run(*a); });
+    set_exit_code(code == 0 && mpi >= 0 ? mpi : code);
+  });
 
   auto m = std::make_shared<SweepArgs>();
   auto shards = std::make_shared<std::vector<std::string>>();
@@ -123,6 +152,10 @@ void add_sweep(CLI::App& app) {
   merge->add_option("--mat", m->mat, "DIR/NAME.mat + DIR/NAME.m for MATLAB/Octave");
   merge->callback([m, shards] {
     set_exit_code(run_guarded([&] {
+      if (launched_processes() > 1)
+        throw std::invalid_argument("sweep-merge: started as one of " + std::to_string(launched_processes()) +
+                                    " processes by an MPI launcher; they would all write the same files: run it once, "
+                                    "without mpirun");
       SweepRequest outputs;
       outputs.out = m->out;
       outputs.csv = m->csv;

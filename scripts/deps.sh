@@ -16,6 +16,7 @@ PKGS=(
   octave octave-control liboctave-dev python3 python3-scipy python3-h5py python3-numpy
   python3-matplotlib  # scripts/plot_work_precision.py (work-precision plots, Agg backend)
   pybind11-dev python3-dev python3-pytest  # the Python module (python/) and its pytest suite
+  openmpi-bin libopenmpi-dev  # mpirun -np N codyna sweep (app/sweep_mpi.cpp, tests/cli/sweep_mpi.sh); the build works without
   # the GUI (codyna-gui) and its tests: Qt 6 widgets, OpenGL, Charts, SVG export,
   # and a virtual X server with Mesa's software OpenGL for the rendering tests
   qt6-base-dev qt6-base-dev-tools libqt6opengl6-dev qt6-charts-dev qt6-svg-dev

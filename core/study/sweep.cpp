@@ -231,6 +231,41 @@ struct Context {
   Eigen::MatrixXd K;
 };
 
+// Per column of e (samples x outputs, y - target at times t): the overshoot in % of the
+// excursion E = max |e| past the target, on the side opposite to the excursion, and the time e
+// enters the band |e| <= 0.02 E for good (e linear between samples), NaN when the last sample is
+// outside it; E = 0: 0 % at t[0]. docs/parameter-studies.md, "Figures of merit".
+void response_figures(const std::vector<double>& t, const Eigen::MatrixXd& e, Eigen::VectorXd& overshoot,
+                      Eigen::VectorXd& settling) {
+  const Eigen::Index N = e.rows();
+  for (Eigen::Index j = 0; j < e.cols(); ++j) {
+    const auto col = e.col(j);
+    if (N == 0 || !col.allFinite()) continue;
+    Eigen::Index peak = 0;
+    const double E = col.cwiseAbs().maxCoeff(&peak);
+    if (E == 0) {
+      overshoot[j] = 0;
+      settling[j] = t[0];
+      continue;
+    }
+    const double s = col[peak] > 0 ? 1.0 : -1.0;
+    overshoot[j] = 100.0 * std::max(0.0, (-s * col).maxCoeff()) / E;
+    const double band = 0.02 * E;
+    Eigen::Index k = N - 1;
+    if (std::abs(col[k]) > band) continue;
+    while (k > 0 && std::abs(col[k - 1]) <= band) --k;
+    if (k == 0) {
+      settling[j] = t[0];
+      continue;
+    }
+    // e(k-1) is outside the band, e(k) inside: where the line between them meets it
+    const double a = col[k - 1], b = col[k], edge = a > 0 ? band : -band;
+    const double f = (a - edge) / (a - b);
+    const std::size_t i = static_cast<std::size_t>(k);
+    settling[j] = t[i - 1] + f * (t[i] - t[i - 1]);
+  }
+}
+
 // The variant's nonlinear closed-loop run with the sweep's controller.
 void simulate_variant(const Context& c, nlohmann::json j, SweepVariant& v) {
   try {
@@ -253,17 +288,38 @@ void simulate_variant(const Context& c, nlohmann::json j, SweepVariant& v) {
     v.sim_t_end = r.t.empty() ? 0.0 : r.t.back();
     v.peak_input = sj.max_abs_input;
     v.final_error = 0;
-    if (!r.t.empty() && r.y.cols() > 0) {
+    const Eigen::Index ny = r.y.cols();
+    v.overshoot = v.settling_time = Eigen::VectorXd::Constant(ny, std::numeric_limits<double>::quiet_NaN());
+    if (!r.t.empty() && ny > 0) {
       const Eigen::Index last = r.y.rows() - 1;
-      Eigen::VectorXd target = sj.setup.plant ? sj.setup.plant->lin.system.y0 : Eigen::VectorXd::Zero(r.y.cols());
-      if (r.y_reference.cols() == r.y.cols() && r.y_reference.rows() == r.y.rows()) target = r.y_reference.row(last).transpose();
-      if (target.size() == r.y.cols()) v.final_error = (r.y.row(last).transpose() - target).cwiseAbs().maxCoeff();
-      else v.final_error = std::numeric_limits<double>::quiet_NaN();
+      Eigen::VectorXd target = sj.setup.plant ? sj.setup.plant->lin.system.y0 : Eigen::VectorXd::Zero(ny);
+      if (r.y_reference.cols() == ny && r.y_reference.rows() == r.y.rows()) target = r.y_reference.row(last).transpose();
+      if (target.size() == ny) {
+        v.final_error = (r.y.row(last).transpose() - target).cwiseAbs().maxCoeff();
+        if (r.completed) response_figures(r.t, r.y.rowwise() - target.transpose(), v.overshoot, v.settling_time);
+      } else {
+        v.final_error = std::numeric_limits<double>::quiet_NaN();
+      }
+    }
+    // seconds at a limit per Plant/In: 0 never, NaN for an input without limits
+    const Model& m = sj.model;
+    v.saturation_time = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(m.plant_inputs.size()),
+                                                  std::numeric_limits<double>::quiet_NaN());
+    for (std::size_t k = 0; k < m.plant_inputs.size(); ++k) {
+      const ActuatorModel& a = m.actuators[static_cast<std::size_t>(m.plant_inputs[k])];
+      if (!std::isfinite(a.min) && !std::isfinite(a.max)) continue;
+      double at = 0;
+      for (const Saturation& sat : sj.saturation)
+        if (sat.actuator == a.name) at += sat.at_max + sat.at_min;
+      v.saturation_time[static_cast<Eigen::Index>(k)] = at;
     }
   } catch (const std::exception& e) {
     v.sim_status = 2;
     v.sim_reason = e.what();
     v.peak_input.resize(0);
+    v.overshoot.resize(0);
+    v.settling_time.resize(0);
+    v.saturation_time.resize(0);
   }
 }
 
@@ -373,8 +429,16 @@ std::uint64_t hash_text(std::uint64_t h, const std::string& text) {
   return splitmix64(h ^ text.size());
 }
 
+// NaN as its bits ("nan:7ff8000000000000"): its sign and payload (0/0 gives -nan on x86) come
+// back as they were, so a merged file keeps the single run's bytes
 std::string hex(double x) {
   char buf[64];
+  if (std::isnan(x)) {
+    std::uint64_t bits = 0;
+    std::memcpy(&bits, &x, sizeof bits);
+    std::snprintf(buf, sizeof buf, "nan:%016llx", static_cast<unsigned long long>(bits));
+    return buf;
+  }
   const auto res = std::to_chars(buf, buf + sizeof buf, x, std::chars_format::hex);
   return std::string(buf, res.ptr);
 }
@@ -382,6 +446,13 @@ std::string hex(double x) {
 double unhex(const nlohmann::json& j) {
   const std::string t = j.get<std::string>();
   double x = 0;
+  if (t.size() == 20 && t.rfind("nan:", 0) == 0) {
+    std::uint64_t bits = 0;
+    const auto [ptr, ec] = std::from_chars(t.data() + 4, t.data() + t.size(), bits, 16);
+    if (ec != std::errc() || ptr != t.data() + t.size()) throw std::runtime_error("not a number: " + t);
+    std::memcpy(&x, &bits, sizeof x);
+    return x;
+  }
   const char* first = t.data();
   const auto [ptr, ec] = std::from_chars(first, t.data() + t.size(), x, std::chars_format::hex);
   if (ec != std::errc() || ptr != t.data() + t.size()) throw std::runtime_error("not a number: " + t);
@@ -435,7 +506,10 @@ std::string journal_line(long long i, const SweepVariant& v) {
                             {"sim_reason", v.sim_reason},
                             {"sim_t_end", hex(v.sim_t_end)},
                             {"final_error", hex(v.final_error)},
-                            {"peak_input", encode(Eigen::MatrixXd(v.peak_input))}};
+                            {"peak_input", encode(Eigen::MatrixXd(v.peak_input))},
+                            {"overshoot", encode(Eigen::MatrixXd(v.overshoot))},
+                            {"settling_time", encode(Eigen::MatrixXd(v.settling_time))},
+                            {"saturation_time", encode(Eigen::MatrixXd(v.saturation_time))}};
   return j.dump() + "\n";
 }
 
@@ -460,8 +534,14 @@ SweepVariant journal_variant(const nlohmann::json& j) {
   v.sim_reason = j.at("sim_reason").get<std::string>();
   v.sim_t_end = unhex(j.at("sim_t_end"));
   v.final_error = unhex(j.at("final_error"));
-  const Eigen::MatrixXd peak = decode_matrix(j.at("peak_input"));
-  v.peak_input = peak.size() ? Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(peak.data(), peak.size())) : Eigen::VectorXd();
+  const auto vector = [&](const char* key) {
+    const Eigen::MatrixXd m = decode_matrix(j.at(key));
+    return m.size() ? Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(m.data(), m.size())) : Eigen::VectorXd();
+  };
+  v.peak_input = vector("peak_input");
+  v.overshoot = vector("overshoot");
+  v.settling_time = vector("settling_time");
+  v.saturation_time = vector("saturation_time");
   return v;
 }
 
@@ -593,10 +673,13 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
     throw std::invalid_argument(opt("redesign") + " " + r.redesign + ": expected lqr");
   if (r.threads < 0) throw std::invalid_argument(opt("threads") + ": expected 1 or more (0: every core)");
   const bool shard = r.shard_count > 0;
+  const bool memory = shard && r.journal_in_memory;  // an MPI rank's slice: the whole study's outputs checked below
   if (shard) {
     if (r.shard_index < 0 || r.shard_index >= r.shard_count)
       throw std::invalid_argument(opt("shard") + " " + std::to_string(r.shard_index) + "/" + std::to_string(r.shard_count) +
                                   ": expected K/N with 0 <= K < N");
+  }
+  if (shard && !memory) {
     if (r.out.empty()) throw std::invalid_argument(opt("shard") + ": give " + opt("out") + " (the shard's file)");
     if (!r.csv.empty() || !r.mat.empty())
       throw std::invalid_argument(opt("shard") + ": a shard writes its variants only (" + opt("out") +
@@ -608,7 +691,7 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
                                   "did not write: remove it or choose another name");
   }
   // the outputs, before any work
-  if (!r.out.empty() && !shard) study_guard_output(r.out, OutputKind::ResultsHdf5, {r.model});
+  if (!r.out.empty() && (!shard || memory)) study_guard_output(r.out, OutputKind::ResultsHdf5, {r.model});
   if (!r.csv.empty()) {
     guard_csv(r.csv, r.model);
     if (!r.out.empty() && (r.csv == r.out || study_same_file(r.csv, r.out)))
@@ -720,7 +803,8 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
   std::ofstream journal;
   job.shard_index = shard ? r.shard_index : 0;
   job.shard_count = shard ? r.shard_count : 0;
-  const std::string journal_path = r.out.empty() ? std::string() : shard ? r.out : study_sweep_journal_path(r.out);
+  const std::string journal_path = r.out.empty() || memory ? std::string() : shard ? r.out : study_sweep_journal_path(r.out);
+  if (memory) job.journal = journal_head(r, model_bytes, n) + journal_request(r);
   if (!journal_path.empty()) {
     const std::string head = journal_head(r, model_bytes, n), request_line = journal_request(r);
     std::error_code ec;
@@ -783,6 +867,7 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
       const long long d = done.fetch_add(1) + 1;
       const std::lock_guard<std::mutex> lock(report);
       if (journal.is_open()) journal << journal_line(i, v) << std::flush;
+      if (memory) job.journal += journal_line(i, v);
       if (progress.done) progress.done(d, n);
     }
   };
@@ -821,6 +906,7 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
     }
   }
 
+  if (memory) return job;  // the journal in job.journal is the slice's result
   if (shard) {  // the shard's journal is its result
     journal.close();
     if (!journal) throw std::runtime_error(r.out + ": cannot finish the shard's file");
@@ -851,12 +937,24 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
 
 SweepJob study_sweep_merge(const std::vector<std::string>& shards, const SweepRequest& outputs, const StudyMessages& tell) {
   if (shards.empty()) throw std::invalid_argument("sweep-merge: give the shards' files");
-  if (outputs.out.empty()) throw std::invalid_argument(option_name(outputs.style, "out") + ": the merged results (HDF5)");
-  std::string head, request;
-  std::map<long long, std::string> lines;
+  std::vector<std::string> texts;
   for (const std::string& path : shards) {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw std::invalid_argument(path + ": cannot read this shard");
+    texts.emplace_back(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  return study_sweep_merge_journals(texts, shards, outputs, tell);
+}
+
+SweepJob study_sweep_merge_journals(const std::vector<std::string>& journals, const std::vector<std::string>& names,
+                                    const SweepRequest& outputs, const StudyMessages& tell) {
+  if (journals.empty() || journals.size() != names.size()) throw std::invalid_argument("sweep-merge: give the shards' files");
+  if (outputs.out.empty()) throw std::invalid_argument(option_name(outputs.style, "out") + ": the merged results (HDF5)");
+  std::string head, request;
+  std::map<long long, std::string> lines;
+  for (std::size_t s = 0; s < journals.size(); ++s) {
+    const std::string& path = names[s];
+    std::istringstream in(journals[s]);
     std::string h, q, line;
     if (!std::getline(in, h) || h.rfind("codyna sweep journal ", 0) != 0 || !std::getline(in, q) || q.rfind("request ", 0) != 0)
       throw std::invalid_argument(path + ": not a shard written by codyna sweep --shard");
@@ -864,7 +962,7 @@ SweepJob study_sweep_merge(const std::vector<std::string>& shards, const SweepRe
       head = h;
       request = q;
     } else if (h != head) {
-      throw std::invalid_argument(path + ": a shard of another study than " + shards.front() +
+      throw std::invalid_argument(path + ": a shard of another study than " + names.front() +
                                   " (other model file contents or options)");
     }
     while (std::getline(in, line)) {
@@ -1035,6 +1133,16 @@ std::vector<double> stack(const std::vector<SweepVariant>& vs, Eigen::MatrixXd S
   return out;
 }
 
+// variants x size, row i = variant i's vector (NaN when it has none of that size)
+std::vector<double> rows(const std::vector<SweepVariant>& vs, Eigen::VectorXd SweepVariant::*field, Eigen::Index size) {
+  std::vector<double> out(vs.size() * static_cast<std::size_t>(size), kNaN);
+  for (std::size_t i = 0; i < vs.size(); ++i) {
+    const Eigen::VectorXd& x = vs[i].*field;
+    if (x.size() == size) std::copy(x.data(), x.data() + size, out.begin() + static_cast<std::ptrdiff_t>(i * static_cast<std::size_t>(size)));
+  }
+  return out;
+}
+
 void write_poles(hid_t file, const std::string& group, const std::vector<SweepVariant>& vs,
                  Eigen::VectorXcd SweepVariant::*field, double SweepVariant::*maxr, Eigen::Index n) {
   std::vector<double> re(vs.size() * static_cast<std::size_t>(n), kNaN), im = re, mr(vs.size(), kNaN);
@@ -1120,7 +1228,7 @@ void write_contents(hid_t file, const SweepJob& job) {
     create_group(file, "/simulation");
     std::vector<int> st;
     std::vector<std::string> why;
-    std::vector<double> reached(n, kNaN), err(n, kNaN), peak(n * static_cast<std::size_t>(nu), kNaN);
+    std::vector<double> reached(n, kNaN), err(n, kNaN);
     for (std::size_t i = 0; i < n; ++i) {
       const SweepVariant& v = vs[i];
       st.push_back(v.sim_status);
@@ -1129,14 +1237,16 @@ void write_contents(hid_t file, const SweepJob& job) {
         reached[i] = v.sim_t_end;
         err[i] = v.final_error;
       }
-      if (v.peak_input.size() == nu)
-        for (Eigen::Index k = 0; k < nu; ++k) peak[i * static_cast<std::size_t>(nu) + static_cast<std::size_t>(k)] = v.peak_input[k];
     }
     write_ints(file, "/simulation/status", st);
     write_strings(file, "/simulation/reason", why);
     write_doubles(file, "/simulation/t_reached", {n}, reached);
-    write_doubles(file, "/simulation/peak_input", {n, static_cast<hsize_t>(nu)}, peak);
+    write_doubles(file, "/simulation/peak_input", {n, static_cast<hsize_t>(nu)}, rows(vs, &SweepVariant::peak_input, nu));
     write_doubles(file, "/simulation/final_error", {n}, err);
+    write_doubles(file, "/simulation/overshoot", {n, static_cast<hsize_t>(ny)}, rows(vs, &SweepVariant::overshoot, ny));
+    write_doubles(file, "/simulation/settling_time", {n, static_cast<hsize_t>(ny)}, rows(vs, &SweepVariant::settling_time, ny));
+    write_doubles(file, "/simulation/saturation_time", {n, static_cast<hsize_t>(nu)},
+                  rows(vs, &SweepVariant::saturation_time, nu));
     write_attribute(file, "/simulation", "status_codes",
                     std::string("-1 not run (the variant failed), 0 reached t_end, 1 the run failed, 2 it could not be set up"));
   }
@@ -1204,7 +1314,15 @@ void study_write_sweep_csv(const SweepJob& job, const std::string& path) {
   text += ",open_loop_max_real";
   if (job.closed_loop) text += ",closed_loop_max_real";
   text += ",stable,uncontrollable";
-  if (job.simulated) text += ",sim_status,peak_input,final_error";
+  if (job.simulated) {
+    text += ",sim_status,peak_input,final_error";
+    for (const auto& [label, names] : {std::pair{"overshoot:", &job.output_names}, {"settling_time:", &job.output_names},
+                                       {"saturation_time:", &job.input_names}})
+      for (const std::string& name : *names) {
+        text += ',';
+        append_csv_field(text, label + name);
+      }
+  }
   text += ",reason\n";
   for (std::size_t i = 0; i < job.variants.size(); ++i) {
     const SweepVariant& v = job.variants[i];
@@ -1226,6 +1344,15 @@ void study_write_sweep_csv(const SweepJob& job, const std::string& path) {
       append_number(text, v.peak_input.size() ? v.peak_input.maxCoeff() : kNaN);
       text += ',';
       append_number(text, v.sim_status == 0 || v.sim_status == 1 ? v.final_error : kNaN);
+      const auto each = [&](const Eigen::VectorXd& x, std::size_t size) {
+        for (std::size_t k = 0; k < size; ++k) {
+          text += ',';
+          append_number(text, x.size() == static_cast<Eigen::Index>(size) ? x[static_cast<Eigen::Index>(k)] : kNaN);
+        }
+      };
+      each(v.overshoot, job.output_names.size());
+      each(v.settling_time, job.output_names.size());
+      each(v.saturation_time, job.input_names.size());
     }
     text += ',';
     append_csv_field(text, v.reason.empty() ? v.sim_reason : v.reason);
@@ -1393,6 +1520,28 @@ void study_write_sweep_mat(const SweepJob& job, const std::string& mat_path) {
       vars.push_back(mat_poles("closed_poles_imag", vs, &SweepVariant::closed_poles, nx, true));
       vars.push_back(mat_doubles("closed_max_real", {n, 1}, cmr));
     }
+    if (job.simulated) {  // n x size, row k = variant k's (NaN where it has none)
+      const auto columns = [&](const char* name, Eigen::VectorXd SweepVariant::*field, Eigen::Index size) {
+        std::vector<double> data(n * static_cast<std::size_t>(size), kNaN);
+        for (std::size_t i = 0; i < n; ++i) {
+          const Eigen::VectorXd& x = vs[i].*field;
+          if (x.size() == size)
+            for (Eigen::Index k = 0; k < size; ++k) data[static_cast<std::size_t>(k) * n + i] = x[k];
+        }
+        return mat_doubles(name, {n, static_cast<size_t>(size)}, std::move(data));
+      };
+      std::vector<double> sim_status(n), final_error(n, kNaN);
+      for (std::size_t i = 0; i < n; ++i) {
+        sim_status[i] = vs[i].sim_status;
+        if (vs[i].sim_status == 0 || vs[i].sim_status == 1) final_error[i] = vs[i].final_error;
+      }
+      vars.push_back(mat_doubles("sim_status", {n, 1}, sim_status));
+      vars.push_back(mat_doubles("final_error", {n, 1}, final_error));
+      vars.push_back(columns("peak_input", &SweepVariant::peak_input, nu));
+      vars.push_back(columns("overshoot", &SweepVariant::overshoot, ny));
+      vars.push_back(columns("settling_time", &SweepVariant::settling_time, ny));
+      vars.push_back(columns("saturation_time", &SweepVariant::saturation_time, nu));
+    }
     vars.push_back(mat_cellstr("state_names", job.state_names));
     vars.push_back(mat_cellstr("input_names", job.input_names));
     vars.push_back(mat_cellstr("output_names", job.output_names));
@@ -1465,6 +1614,31 @@ std::string study_sweep_summary(const SweepJob& job) {
     if (far >= 0)
       os << "largest error    variant " << far << ": final error " << fmt(job.variants[static_cast<std::size_t>(far)].final_error)
          << " (the largest |y - y0| over Plant/Out at t_end)\n";
+    // the largest of a figure over the variants' entries, and whose it is
+    const auto largest = [&](Eigen::VectorXd SweepVariant::*field, const std::vector<std::string>& names, const char* label,
+                             const char* unit) {
+      long long at = -1;
+      Eigen::Index which = 0;
+      double best = 0;
+      for (long long i = 0; i < n; ++i) {
+        const Eigen::VectorXd& x = job.variants[static_cast<std::size_t>(i)].*field;
+        for (Eigen::Index k = 0; k < x.size() && k < static_cast<Eigen::Index>(names.size()); ++k)
+          if (std::isfinite(x[k]) && (at < 0 || x[k] > best)) {
+            at = i;
+            which = k;
+            best = x[k];
+          }
+      }
+      if (at >= 0)
+        os << label << fmt(best) << unit << " (" << names[static_cast<std::size_t>(which)] << "), variant " << at << "\n";
+    };
+    largest(&SweepVariant::overshoot, job.output_names, "overshoot        largest ", " %");
+    largest(&SweepVariant::settling_time, job.output_names, "settling time    longest ", " s (2 % band)");
+    largest(&SweepVariant::saturation_time, job.input_names, "at a limit       longest ", " s");
+    long long unsettled = 0;
+    for (const SweepVariant& v : job.variants)
+      if (v.sim_status == 0 && v.settling_time.size() && !v.settling_time.allFinite()) ++unsettled;
+    if (unsettled) os << "not settled      " << unsettled << " runs end outside the 2 % band of an output\n";
     long long shown = 0;
     for (long long i = 0; i < n && shown < 5; ++i) {
       const SweepVariant& v = job.variants[static_cast<std::size_t>(i)];

@@ -64,6 +64,10 @@ struct SweepRequest {
   // i % shard_count == shard_index and writes them, as a journal, to `out` (no HDF5 there);
   // study_sweep_merge joins the shards into the file the whole study would have written.
   long long shard_index = 0, shard_count = 0;
+  // with a shard: its journal is kept in SweepJob::journal and no file is written (an MPI rank's
+  // slice; `out`, `csv` and `mat` are then the whole study's, checked but not written, and
+  // study_sweep_merge_journals joins the slices)
+  bool journal_in_memory = false;
 };
 
 // OUT.partial: where the journal of a study writing `out` is kept
@@ -119,6 +123,12 @@ struct SweepVariant {
   std::string sim_reason;
   double sim_t_end = 0, final_error = 0;
   Eigen::VectorXd peak_input;
+  // simulate, per Plant/Out (docs/parameter-studies.md, "Figures of merit"): e(t) = y(t) - target,
+  // E = max |e| over the run; overshoot = 100 max(0, max(-s e)) / E in % (s the sign of e where
+  // |e| = E), settling time = when |e| enters the band 0.02 E for good (linear between samples;
+  // NaN when the last sample is outside it); per Plant/In: the seconds spent at a limit (min or
+  // max, summed over the output intervals, as simulate's saturation report counts them)
+  Eigen::VectorXd overshoot, settling_time, saturation_time;
 };
 
 struct SweepJob {
@@ -137,6 +147,7 @@ struct SweepJob {
   std::vector<std::string> written;
   long long resumed = 0;                      // variants read back from the journal
   long long shard_index = 0, shard_count = 0;  // a shard's (shard_count 0: the whole study)
+  std::string journal;                        // a shard's journal, with journal_in_memory
   bool in_shard(long long i) const { return shard_count == 0 || i % shard_count == shard_index; }
   // summary
   long long failed = 0, stable = 0;
@@ -160,6 +171,11 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell = {}, 
 // the whole study run at once writes them (the nominal model is compiled again, no variant is).
 SweepJob study_sweep_merge(const std::vector<std::string>& shards, const SweepRequest& outputs,
                            const StudyMessages& tell = {});
+
+// The same from journals in memory (SweepJob::journal of shards run with journal_in_memory: the
+// MPI ranks'); names[k] names journals[k] in errors ("rank 1").
+SweepJob study_sweep_merge_journals(const std::vector<std::string>& journals, const std::vector<std::string>& names,
+                                    const SweepRequest& outputs, const StudyMessages& tell = {});
 
 // Writes the HDF5 results / the CSV (each atomically; see docs/parameter-studies.md).
 void study_write_sweep_hdf5(const SweepJob& job, const std::string& path);

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <complex>
 #include <filesystem>
 #include <fstream>
@@ -349,6 +350,54 @@ TEST(Sweep, ShardsMergeIntoTheWholeStudysFile) {
   outputs.out = dir.file("mixed.h5");
   outputs.csv = "";
   EXPECT_THROW(study_sweep_merge({shards[0], other.out, shards[2]}, outputs), std::invalid_argument);
+}
+
+// MPI's path without MPI: three slices with their journals in memory (no file written, the whole
+// study's outputs named), joined by study_sweep_merge_journals into the single run's bytes
+TEST(Sweep, JournalsInMemoryMergeIntoTheWholeStudysFile) {
+  TempDir dir;
+  SweepRequest r;
+  r.model = kModel;
+  r.vary = {"/bodies/1/mass=5:15:7"};
+  r.simulate = true;
+  r.threads = 1;
+  r.out = dir.file("whole.h5");
+  r.csv = dir.file("whole.csv");
+  study_sweep_job(r);
+  SweepRequest slice = r;
+  slice.out = dir.file("merged.h5");
+  slice.csv = dir.file("merged.csv");
+  slice.journal_in_memory = true;
+  slice.shard_count = 3;
+  std::vector<std::string> journals;
+  for (long long k = 0; k < 3; ++k) {
+    slice.shard_index = k;
+    const SweepJob part = study_sweep_job(slice);
+    EXPECT_TRUE(part.written.empty());
+    journals.push_back(part.journal);
+  }
+  EXPECT_FALSE(fs::exists(slice.out));
+  EXPECT_FALSE(fs::exists(study_sweep_journal_path(slice.out)));
+  // 7 variants: 3 + 2 + 2 lines after the journal's two
+  EXPECT_EQ(std::count(journals[1].begin(), journals[1].end(), '\n'), 4);
+  try {
+    study_sweep_merge_journals({journals[0], journals[2]}, {"rank 0", "rank 2"}, slice);
+    ADD_FAILURE() << "merged without rank 1";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("variants 1, 4"), std::string::npos) << e.what();
+  }
+  const SweepJob merged = study_sweep_merge_journals({journals[2], journals[0], journals[1]}, {"rank 2", "rank 0", "rank 1"}, slice);
+  EXPECT_EQ(merged.resumed, 7);
+  EXPECT_EQ(slurp(slice.out), slurp(r.out));
+  EXPECT_EQ(slurp(slice.csv), slurp(r.csv));
+  ASSERT_EQ(merged.variants[3].overshoot.size(), 2);  // the figures went through the journal
+  EXPECT_TRUE(std::isfinite(merged.variants[3].overshoot[0]));
+  EXPECT_NEAR(merged.variants[3].settling_time[0], 4.713, 1e-3);  // h settles within the file's 5 s
+  EXPECT_TRUE(std::isnan(merged.variants[3].settling_time[1]));     // theta does not: NaN, kept bit for bit
+  EXPECT_EQ(merged.variants[3].saturation_time.size(), 1);  // the cart's force has no limits: NaN
+  EXPECT_TRUE(std::isnan(merged.variants[3].saturation_time[0]));
+  // a journal in memory that is not one is named
+  EXPECT_THROW(study_sweep_merge_journals({journals[0], "garbage\n"}, {"rank 0", "rank 1"}, slice), std::invalid_argument);
 }
 
 void expect_refused(const std::vector<std::string>& vary, const std::vector<std::string>& words,

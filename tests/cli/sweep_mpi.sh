@@ -1,0 +1,97 @@
+#!/usr/bin/env bash
+# codyna sweep under mpirun (OpenMPI; docs/parameter-studies.md, "MPI"), read back with h5py:
+#   * the cart-pendulum's rod mass over 11 values with --simulate, on 2 and 3 ranks (11 = 4+4+3,
+#     uneven), and a Monte Carlo of 200 samples on 2 and 3 ranks (67+67+66): every dataset and
+#     attribute equal to the single-process run's, variable by variable, and the HDF5, CSV and MAT
+#     files equal byte for byte;
+#   * a study every rank refuses (a bad --vary) exits 1 with the error said once, no hang;
+#   * --shard under mpirun is refused, and so is sweep-merge (N processes would write one file).
+# A codyna built without MPI: started as one of 2 MPI processes (OMPI_COMM_WORLD_SIZE=2) it must
+# refuse, writing nothing; then the test is skipped (exit 77), saying so.
+# Environment: as root, OpenMPI needs OMPI_ALLOW_RUN_AS_ROOT(_CONFIRM); in containers its shared
+# memory transport's single-copy mechanism (CMA) may be forbidden: btl_vader_single_copy_mechanism
+# none. Under AddressSanitizer, OpenMPI's own allocations live until exit and are reported from
+# unloaded plugins (no names to suppress): the mpirun runs alone have detect_leaks=0; the
+# single-process runs of the same binary are still leak-checked.
+# Usage: sweep_mpi.sh CODYNA SOURCE_DIR WORK_DIR
+set -euo pipefail
+codyna="$1"; src="$2"; work="$3"
+rm -rf "$work"; mkdir -p "$work"; cd "$work"
+fail() { echo "FAIL: $*"; exit 1; }
+PY=/usr/bin/python3
+model="$src/examples/cart_pendulum.json"
+
+if ! "$codyna" sweep --help | tr '\n' ' ' | grep -q "mpirun -np N codyna sweep"; then
+  fail "codyna sweep --help does not mention MPI"
+fi
+if "$codyna" sweep --help | tr '\n' ' ' | grep -q "built without MPI"; then
+  rc=0
+  OMPI_COMM_WORLD_SIZE=2 "$codyna" sweep "$model" --vary /bodies/1/mass=5:15:3 --out no.h5 > /dev/null 2> no.err || rc=$?
+  [ $rc -eq 1 ] && grep -q "built without MPI" no.err || fail "without MPI, under a launcher of 2: exit $rc, $(cat no.err)"
+  [ ! -e no.h5 ] || fail "a refused run wrote no.h5"
+  echo "SKIP: this codyna was built without MPI (it refuses to run under mpirun, checked); nothing more to test"
+  exit 77
+fi
+command -v mpirun > /dev/null || fail "codyna was built with MPI but mpirun is not installed (Debian: openmpi-bin)"
+
+if [ "$(id -u)" -eq 0 ]; then export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1; fi
+export OMPI_MCA_btl_vader_single_copy_mechanism=none
+mpi() {  # mpi NP ARGS...
+  local np="$1"; shift
+  ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" timeout 120 mpirun --oversubscribe -np "$np" "$codyna" "$@"
+}
+
+grid=(sweep "$model" --vary /bodies/1/mass=5:15:11 --simulate --quiet)
+mc=(sweep "$model" --vary '/bodies/1/mass=normal(10,2)' --vary '/bodies/0/mass=uniform(15,25)' --samples 200 --seed 2026 --quiet)
+"$codyna" "${grid[@]}" --threads 1 --out grid1.h5 --csv grid1.csv --mat grid1/g.mat > grid1.txt
+"$codyna" "${mc[@]}" --threads 1 --out mc1.h5 --csv mc1.csv > mc1.txt
+for np in 2 3; do
+  mpi $np "${grid[@]}" --out grid$np.h5 --csv grid$np.csv --mat grid$np/g.mat > grid$np.txt 2> grid$np.err ||
+    fail "mpirun -np $np, the grid: $(cat grid$np.err)"
+  mpi $np "${mc[@]}" --out mc$np.h5 --csv mc$np.csv > mc$np.txt 2> mc$np.err || fail "mpirun -np $np, the Monte Carlo: $(cat mc$np.err)"
+  sed "s/grid$np/grid1/g" grid$np.txt | cmp -s - grid1.txt || fail "-np $np: the printed summary differs: $(cat grid$np.txt)"
+  [ ! -e grid$np.h5.partial ] || fail "-np $np left a journal"
+done
+
+"$PY" - <<'PY'
+import h5py, numpy as np
+def items(path):
+    out = {}
+    def visit(name, obj):
+        for k, v in obj.attrs.items(): out[name + "@" + k] = v
+        if isinstance(obj, h5py.Dataset): out[name] = obj[()]
+    f = h5py.File(path, "r")
+    for k, v in f.attrs.items(): out["@" + k] = v
+    f.visititems(visit)
+    return out
+for study, n in (("grid", 11), ("mc", 200)):
+    one = items(study + "1.h5")
+    for np_ in (2, 3):
+        other = items("%s%d.h5" % (study, np_))
+        assert one.keys() == other.keys(), (study, np_, one.keys() ^ other.keys())
+        for k in one:
+            x, y = np.asarray(one[k]), np.asarray(other[k])
+            assert x.shape == y.shape and x.dtype == y.dtype, (study, np_, k)
+            assert x.tobytes() == y.tobytes(), (study, np_, k)   # bit for bit, NaN included
+    assert one["@variants"] == n and (one["status/code"] == 0).all()
+    if study == "grid":
+        assert (one["simulation/status"] == 0).all() and one["simulation/overshoot"].shape == (11, 2)
+    print("%s: %d variables equal bit for bit on 1, 2 and 3 ranks" % (study, len(one)))
+PY
+for np in 2 3; do
+  for f in grid$np.h5 grid$np.csv grid$np/g.mat grid$np/g.m mc$np.h5 mc$np.csv; do
+    cmp -s "$f" "${f/$np/1}" || fail "$f differs from the single-process ${f/$np/1}"
+  done
+done
+echo "mpirun -np 2 and 3: the single-process files, byte for byte"
+
+# every rank refuses: said once, exit 1, nothing written
+rc=0; mpi 2 sweep "$model" --vary /bodies/1/mass=1..3 --out bad.h5 > bad.txt 2> bad.err || rc=$?
+[ $rc -ne 0 ] || fail "a bad --vary under mpirun exited 0"
+[ "$(grep -c "codyna: error: --vary /bodies/1/mass=1..3: expected a:b:n" bad.err)" -eq 1 ] || fail "the error, once: $(cat bad.err)"
+[ ! -e bad.h5 ] || fail "a refused study wrote bad.h5"
+rc=0; mpi 2 sweep "$model" --vary /bodies/1/mass=5:15:3 --shard 0/2 --out s.sweep > /dev/null 2> shard.err || rc=$?
+[ $rc -ne 0 ] && grep -q "under mpirun the ranks share the variants already" shard.err || fail "--shard under mpirun: $(cat shard.err)"
+rc=0; mpi 2 sweep-merge whatever.sweep --out m.h5 > /dev/null 2> merge.err || rc=$?
+[ $rc -ne 0 ] && grep -q "sweep-merge: started as one of 2 processes by an MPI launcher" merge.err || fail "sweep-merge under mpirun: $(cat merge.err)"
+echo "sweep mpi: ok"
