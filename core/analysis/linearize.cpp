@@ -1,12 +1,19 @@
 #include "analysis/linearize.hpp"
 
 #include <algorithm>
+#include <memory>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
+#include "analysis/linearizer.hpp"
+#include "dynamics/derivatives.hpp"
+#include "dynamics/forward_dynamics.hpp"
+#include "dynamics/joint.hpp"
 #include "dynamics/kinematics.hpp"
+#include "dynamics/sensors.hpp"
 #include "model/errors.hpp"
 #include "spatial/autodiff.hpp"
 
@@ -85,9 +92,8 @@ namespace {
 // c (n . v) n and, with a rest length, its elastic force k (0 - L0) n have no limit, and so no
 // derivative (exact and finite differences would each report their own number). Refused with
 // the element and the way out; a rest length 0 spring without damping is smooth (k dp) and fine.
-void refuse_coincident_spring_dampers(const Model& model, const Eigen::VectorXd& q) {
+void refuse_coincident_spring_dampers(const Model& model, const Eigen::VectorXd& q, Data& d) {
   if (model.springs.empty()) return;
-  Data d(model);
   forward_kinematics<double>(model, d, q);
   for (const SpringDamperModel& s : model.springs) {
     const double L = (point_position<double>(d, s.body_b, s.point_b) - point_position<double>(d, s.body_a, s.point_a)).norm();
@@ -102,6 +108,12 @@ void refuse_coincident_spring_dampers(const Model& model, const Eigen::VectorXd&
                          " has no direction and no derivative; offset the points, or use rest_length 0 without damping "
                          "(then the force k (x_b - x_a) is smooth), or linearize elsewhere");
   }
+}
+
+void refuse_coincident_spring_dampers(const Model& model, const Eigen::VectorXd& q) {
+  if (model.springs.empty()) return;
+  Data d(model);
+  refuse_coincident_spring_dampers(model, q, d);
 }
 
 }  // namespace
@@ -150,7 +162,11 @@ void realize_motion_inputs(const Model& model, const PlantFunction& f, const Eig
 
 }  // namespace
 
-Linearization linearize(const Model& model, const OperatingPoint& op, const LinearizeOptions& options) {
+namespace {
+
+// closed loops, motion inputs, finite differences, chosen independent coordinates: a plant
+// function made for this operating point
+Linearization linearize_general(const Model& model, const OperatingPoint& op, const LinearizeOptions& options) {
   refuse_coincident_spring_dampers(model, op.q);
   Linearization out;
   out.partition = partition_coordinates(model, op.q, options.independent);
@@ -202,6 +218,146 @@ Linearization linearize(const Model& model, const OperatingPoint& op, const Line
   s.time = op.t;
   s.codyna_version = CODYNA_VERSION;
   return out;
+}
+
+}  // namespace
+
+// The fast path (a tree without motion inputs, exact, automatic partition) computes what the
+// general path computes, with the same operations in the same order, so that every number is
+// the same bit for bit: the plant function's analytic_jacobian at x = [0; v] (A, B, C, D from
+// TreeDerivatives::compute at (q, v, u)), its eval_tree there (x0dot, y0: integrate_into of a zero
+// deviation, forward_dynamics, tangent_rate_into, sensor_value), and state_offset (x0).
+struct Linearizer::Impl {
+  const Model& m;
+  const bool tree;  // no loop closures, no motion inputs: every coordinate independent, in order
+  bool ready = false;
+  CoordinatePartition partition;
+  std::vector<std::string> state_names, state_units, input_names, input_units, output_names, output_units;
+  std::vector<int> offset_q;  // [nv] the q index that x0's position entry k carries; -1: a rotation/translation tangent (0)
+  std::unique_ptr<TreeDerivatives> td;
+  std::unique_ptr<Data> data;
+  Eigen::VectorXd dq, q, rate;
+
+  explicit Impl(const Model& model) : m(model), tree(model.nc == 0 && model.motions.empty()) {}
+
+  // what depends on the model only, made at the first call
+  void prepare(const OperatingPoint& op) {
+    partition = partition_coordinates(m, op.q);  // a tree: every coordinate, in order
+    const PlantFunction f(m, op.q, op.u, partition);
+    state_names = f.state_names();
+    state_units = f.state_units();
+    for (int k : m.plant_inputs) {
+      input_names.push_back(m.actuators[k].name);
+      input_units.push_back(m.actuators[k].unit);
+    }
+    for (int k : m.plant_outputs) {
+      output_names.push_back(m.sensors[k].name);
+      output_units.push_back(m.sensors[k].unit);
+    }
+    offset_q.assign(static_cast<std::size_t>(m.nv), -1);
+    for (int b = 1; b < m.nbodies; ++b) {
+      const JointModel& j = m.joints[b];
+      if (j.type == JointType::Spherical || j.type == JointType::Free) continue;
+      for (int c = 0; c < j.nv; ++c) offset_q[static_cast<std::size_t>(j.idx_v + c)] = j.idx_q + c;
+    }
+    td = std::make_unique<TreeDerivatives>(m);
+    data = std::make_unique<Data>(m);
+    dq = Eigen::VectorXd::Zero(m.nv);
+    q.resize(m.nq);
+    rate.resize(m.nv);
+    ready = true;
+  }
+
+  void linearize_tree(const OperatingPoint& op, Linearization& out) {
+    if (!ready) prepare(op);
+    refuse_coincident_spring_dampers(m, op.q, *data);
+    const int n = m.nv, nu = static_cast<int>(m.plant_inputs.size()), ny = static_cast<int>(m.plant_outputs.size());
+    if (op.q.size() != m.nq || op.v.size() != n || op.u.size() != m.nu())
+      throw std::invalid_argument("linearize: the operating point has " + std::to_string(op.q.size()) + " positions, " +
+                                  std::to_string(op.v.size()) + " velocities and " + std::to_string(op.u.size()) +
+                                  " actuator values where the model has " + std::to_string(m.nq) + ", " +
+                                  std::to_string(n) + " and " + std::to_string(m.nu()));
+    LinearSystem& s = out.system;
+    // the exact Jacobian (PlantFunction::analytic_jacobian)
+    TreeDerivatives& d = *td;
+    d.compute(op.q, op.v, op.u, m.plant_outputs);
+    s.A.resize(2 * n, 2 * n);
+    s.A.topLeftCorner(n, n).setZero();
+    s.A.topRightCorner(n, n).setIdentity();
+    for (int b = 1; b < m.nbodies; ++b) {
+      const JointModel& j = m.joints[b];
+      if (j.type != JointType::Spherical && j.type != JointType::Free) continue;
+      const Eigen::Vector3d w = op.v.segment<3>(j.idx_v);
+      s.A.block<3, 3>(j.idx_v, j.idx_v) = -0.5 * skew<double>(w);
+      if (j.type == JointType::Free)
+        s.A.block<3, 3>(j.idx_v + 3, j.idx_v) = -skew<double>(Eigen::Vector3d(op.v.segment<3>(j.idx_v + 3)));
+    }
+    s.A.block(n, 0, n, n) = d.dqdd_dq;
+    s.A.block(n, n, n, n) = d.dqdd_dv;
+    s.B.resize(2 * n, nu);
+    s.B.topRows(n).setZero();
+    for (int k = 0; k < nu; ++k) s.B.block(n, k, n, 1) = d.dqdd_du.col(m.plant_inputs[k]);
+    s.C.resize(ny, 2 * n);
+    s.C.leftCols(n) = d.dy_dq;
+    s.C.rightCols(n) = d.dy_dv;
+    s.D.setZero(ny, nu);
+    // x0dot and y0 (PlantFunction::eval_tree at x = [0; v])
+    Data& fd = *data;
+    integrate_into<double>(m, op.q, dq, q);
+    const Eigen::VectorXd& qdd = forward_dynamics<double>(m, fd, q, op.v, op.u);
+    tangent_rate_into<double>(m, dq, op.v, rate);
+    s.xdot0.resize(2 * n);
+    s.xdot0.head(n) = rate;
+    s.xdot0.tail(n) = qdd;
+    s.y0.resize(ny);
+    for (int k = 0; k < ny; ++k) s.y0[k] = sensor_value<double>(m, fd, m.sensors[m.plant_outputs[k]], q, op.v);
+    // x0 (PlantFunction::state_offset), u0
+    s.x0.setZero(2 * n);
+    for (int k = 0; k < n; ++k) {
+      if (offset_q[static_cast<std::size_t>(k)] >= 0) s.x0[k] = op.q[offset_q[static_cast<std::size_t>(k)]];
+      s.x0[n + k] = op.v[k];
+    }
+    s.u0.resize(nu);
+    for (int k = 0; k < nu; ++k) s.u0[k] = op.u[m.plant_inputs[k]];
+    s.Ts = 0.0;
+    // (written into the same Linearization point after point, they are already these: compared
+    // first, which costs less than copying them again)
+    for (auto [to, from] : {std::pair{&s.state_names, &state_names}, {&s.state_units, &state_units},
+                            {&s.input_names, &input_names}, {&s.input_units, &input_units},
+                            {&s.output_names, &output_names}, {&s.output_units, &output_units}})
+      if (*to != *from) *to = *from;
+    s.model_name = m.name;
+    s.model_file = m.source_file;
+    s.operating_point = op.kind;
+    s.method = to_string(JacobianMethod::Exact);
+    s.time = op.t;
+    s.codyna_version = CODYNA_VERSION;
+    s.study.clear();
+    out.partition = partition;
+    out.fd_error = 0.0;
+    out.motion_shift.resize(0, 0);
+    out.motion_rate_shift.resize(0, 0);
+  }
+};
+
+Linearizer::Linearizer(const Model& model) : impl_(std::make_unique<Impl>(model)) {}
+Linearizer::~Linearizer() = default;
+
+void Linearizer::linearize(const OperatingPoint& op, const LinearizeOptions& options, Linearization& out) {
+  if (impl_->tree && options.method == JacobianMethod::Exact && options.independent.empty())
+    impl_->linearize_tree(op, out);
+  else
+    out = linearize_general(impl_->m, op, options);
+}
+
+Linearization Linearizer::linearize(const OperatingPoint& op, const LinearizeOptions& options) {
+  Linearization out;
+  linearize(op, options, out);
+  return out;
+}
+
+Linearization linearize(const Model& model, const OperatingPoint& op, const LinearizeOptions& options) {
+  return Linearizer(model).linearize(op, options);
 }
 
 }  // namespace codyna

@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 
+#include "analysis/linearizer.hpp"
 #include "analysis/operating_point.hpp"
 
 namespace codyna {
@@ -10,11 +11,12 @@ std::vector<Linearization> linearize_along(const Model& model, const SimulationR
                                            int stride) {
   if (stride < 1) throw std::invalid_argument("linearize_along: stride must be >= 1");
   std::vector<Linearization> out;
+  Linearizer linearizer(model);  // the workspaces and names, made once for every point
   for (int k = 0; k < r.samples(); k += stride) {
     const OperatingPoint op = snapshot_point(model, r.t[k], r.q.row(k).transpose(), r.v.row(k).transpose(),
                                              r.u.row(k).transpose());
     try {
-      out.push_back(linearize(model, op, options));
+      out.push_back(linearizer.linearize(op, options));
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument("linearization at t = " + std::to_string(r.t[k]) + " s: " + e.what());
     }

@@ -1,0 +1,308 @@
+// linearize() end to end against the exact Jacobian alone, side by side in one
+// run (issue 22), and the throughput of a parameter study on 1 and 2 threads.
+//
+//   Jacobian/<n>   PlantFunction::analytic_jacobian on a plant made once (its
+//                  workspace warm, J preallocated): the exact [A B; C D] alone
+//   Linearize/<n>  linearize(model, op): the partition, the plant function, the
+//                  exact Jacobian, xdot0 and y0, names, units, x0 (everything a
+//                  LinearSystem holds), the operating point given; one call
+//                  alone (its workspaces made and freed in the call)
+//   Linearizer/<n> the same numbers through a Linearizer kept from call to call
+//                  (analysis/linearizer.hpp), written into the same
+//                  Linearization: what a study or a trajectory pays per point
+// The models are those of bench/derivatives_bench.cpp: 3-D hinge chains of n
+// links (varied axes, full inertias, a motor per joint, gravity; n = 7, 30) and
+// the 28-DOF ball-joint tree (n = 0), at their initial point with moving
+// velocities; Loop*/<example> the same for closed-loop examples (at rest,
+// where the general path runs). The ratios Linearize / Jacobian and
+// Linearizer / Jacobian are printed at the end for every model (medians when
+// --benchmark_repetitions is given).
+//
+//   Sweep/threads:<t>/variants:<n>  study_sweep_job over the cart-pendulum's
+//                  rod mass on a grid of n variants (each variant read,
+//                  compiled, linearized at the model's equilibrium, its poles
+//                  and the closed loop with the model's LQR fixed), wall-clock
+//                  time; the counter variants_per_s is the throughput. n = 200
+//                  on 1 and 2 threads, and n = 1 (the study's fixed, serial
+//                  cost): the summary estimates from them the speed-up on 16
+//                  threads (Amdahl's law; docs/performance.md).
+//
+//   build/bin/codyna_bench_linearize --benchmark_repetitions=5 --benchmark_enable_random_interleaving=true
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <map>
+#include <random>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "analysis/linearize.hpp"
+#include "analysis/linearizer.hpp"
+#include "analysis/operating_point.hpp"
+#include "dynamics/prepare.hpp"
+#include "io/model_file.hpp"
+#include "study/sweep.hpp"
+
+namespace {
+
+using namespace codyna;
+
+Eigen::Matrix3d rotation(std::mt19937& rng) {
+  std::normal_distribution<double> g;
+  return Eigen::Quaterniond(g(rng), g(rng), g(rng), g(rng)).normalized().toRotationMatrix();
+}
+
+// as bench/derivatives_bench.cpp: n = 0 is the 28-DOF ball-joint tree
+ModelSpec bench_model(int n) {
+  std::mt19937 rng(7 + n);
+  std::uniform_real_distribution<double> u(0.1, 1.0);
+  ModelSpec s;
+  s.name = n ? "chain" + std::to_string(n) : "ball_tree";
+  const int nb = n ? n : 10;
+  for (int i = 0; i < nb; ++i) {
+    BodySpec b;
+    b.name = "b" + std::to_string(i);
+    b.mass = 0.5 + u(rng);
+    b.com = Eigen::Vector3d(0.3 * u(rng), 0.1 * u(rng), 0.05 * u(rng));
+    const Eigen::Matrix3d R = rotation(rng);
+    const double a = 0.02 + 0.02 * u(rng), c = 0.02 + 0.02 * u(rng);
+    b.inertia = R * Eigen::Vector3d(a, c, 0.5 * (a + c)).asDiagonal() * R.transpose();
+    s.bodies.push_back(b);
+    JointSpec j;
+    j.name = "j" + std::to_string(i);
+    j.child = b.name;
+    if (n) {
+      j.type = JointType::Revolute;
+      j.parent = i ? "b" + std::to_string(i - 1) : std::string(kGroundName);
+      j.axis = i % 3 == 0 ? Eigen::Vector3d::UnitZ() : (i % 3 == 1 ? Eigen::Vector3d::UnitY() : Eigen::Vector3d::UnitX());
+    } else {
+      j.type = i == 0 ? JointType::Revolute : JointType::Spherical;
+      j.parent = i == 0 ? std::string(kGroundName) : "b" + std::to_string(i <= 3 ? 0 : i - 3);
+    }
+    j.parent_frame.position = i ? Eigen::Vector3d(0.4, 0.05 * (i % 2), 0.0) : Eigen::Vector3d::Zero();
+    s.joints.push_back(j);
+    if (j.type == JointType::Revolute) {
+      ActuatorSpec a;
+      a.name = "m" + std::to_string(i);
+      a.joint = j.name;
+      s.actuators.push_back(a);
+      s.plant.inputs.push_back(a.name);
+    } else {
+      for (int k = 0; k < 3; ++k) {
+        ActuatorSpec a;
+        a.name = "m" + std::to_string(i) + "_" + std::to_string(k);
+        a.joint = j.name;
+        a.dof = k;
+        s.actuators.push_back(a);
+        s.plant.inputs.push_back(a.name);
+      }
+    }
+  }
+  EffectSpec g;
+  g.name = "gravity";
+  g.type = EffectType::Gravity;
+  s.effects.push_back(g);
+  return s;
+}
+
+// the model at its initial point with moving velocities and nonzero inputs (so
+// that no term of the Jacobian vanishes), and the plant's x, u there exactly as
+// linearize() forms them
+struct Fixture {
+  Model m;
+  OperatingPoint op;
+  Eigen::VectorXd x, u;
+  explicit Fixture(Model model) : m(std::move(model)), op(initial_point(m)) {
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> r(-1, 1);
+    if (m.nc == 0)  // closed loops keep their assembled velocities (Jc v = 0)
+      for (Eigen::Index k = 0; k < op.v.size(); ++k) op.v[k] = 0.5 * r(rng);
+    for (int k : m.plant_inputs) op.u[k] = r(rng);
+  }
+  PlantFunction plant() const { return PlantFunction(m, op.q, op.u, partition_coordinates(m, op.q)); }
+  void state_of(const PlantFunction& f) {
+    x = Eigen::VectorXd::Zero(f.nx());
+    for (int k = 0; k < f.nz(); ++k) x[f.nz() + k] = op.v[f.partition().independent[k]];
+    u.resize(f.nu());
+    for (int k = 0; k < f.nu(); ++k) u[k] = op.u[m.plant_inputs[k]];
+  }
+};
+
+Model chain(int n) { return compile(bench_model(n)); }
+Model example(const std::string& name) {
+  const std::string path = std::string(CODYNA_SOURCE_DIR) + "/examples/" + name + ".json";
+  return compile(load_model_spec(path), path);
+}
+
+void jacobian(benchmark::State& state, Fixture& fx) {
+  const PlantFunction f = fx.plant();
+  fx.state_of(f);
+  Eigen::MatrixXd J;
+  if (!f.analytic_jacobian(fx.x, fx.u, J)) {
+    state.SkipWithError("no analytic Jacobian");
+    return;
+  }
+  for (auto _ : state) {
+    f.analytic_jacobian(fx.x, fx.u, J);
+    benchmark::DoNotOptimize(J.data());
+  }
+  state.counters["nv"] = fx.m.nv;
+}
+
+void linearized(benchmark::State& state, Fixture& fx) {
+  for (auto _ : state) {
+    const Linearization l = linearize(fx.m, fx.op);
+    benchmark::DoNotOptimize(l.system.A.data());
+  }
+  state.counters["nv"] = fx.m.nv;
+}
+
+void linearized_reusing(benchmark::State& state, Fixture& fx) {
+  Linearizer lz(fx.m);
+  Linearization l;
+  for (auto _ : state) {
+    lz.linearize(fx.op, {}, l);
+    benchmark::DoNotOptimize(l.system.A.data());
+  }
+  state.counters["nv"] = fx.m.nv;
+}
+
+const int kChains[] = {7, 30, 0};
+const char* const kLoops[] = {"four_bar", "bricard"};
+
+int register_all() {
+  for (int n : kChains) {
+    const std::string tag = std::to_string(n);
+    benchmark::RegisterBenchmark(("Jacobian/" + tag).c_str(), [n](benchmark::State& st) {
+      Fixture fx(chain(n));
+      jacobian(st, fx);
+    })->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("Linearize/" + tag).c_str(), [n](benchmark::State& st) {
+      Fixture fx(chain(n));
+      linearized(st, fx);
+    })->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("Linearizer/" + tag).c_str(), [n](benchmark::State& st) {
+      Fixture fx(chain(n));
+      linearized_reusing(st, fx);
+    })->Unit(benchmark::kMicrosecond);
+  }
+  for (const char* name : kLoops) {
+    const std::string n = name;
+    benchmark::RegisterBenchmark(("LoopJacobian/" + n).c_str(), [n](benchmark::State& st) {
+      Fixture fx(example(n));
+      jacobian(st, fx);
+    })->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("LoopLinearize/" + n).c_str(), [n](benchmark::State& st) {
+      Fixture fx(example(n));
+      linearized(st, fx);
+    })->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("LoopLinearizer/" + n).c_str(), [n](benchmark::State& st) {
+      Fixture fx(example(n));
+      linearized_reusing(st, fx);
+    })->Unit(benchmark::kMicrosecond);
+  }
+  return 0;
+}
+const int registered = register_all();
+
+constexpr int kVariants = 200;
+
+// args: threads, variants (1 variant: the study's fixed cost, serial, plus one variant)
+void Sweep(benchmark::State& state) {
+  const int variants = static_cast<int>(state.range(1));
+  SweepRequest r;
+  r.model = std::string(CODYNA_SOURCE_DIR) + "/examples/cart_pendulum.json";
+  r.vary = {variants > 1 ? "/bodies/1/mass=5:15:" + std::to_string(variants) : std::string("/bodies/1/mass=[10]")};
+  r.threads = static_cast<int>(state.range(0));
+  r.resume = false;
+  long long ok = 0;
+  for (auto _ : state) {
+    const SweepJob job = study_sweep_job(r);
+    ok = static_cast<long long>(job.variants.size()) - job.failed;
+    benchmark::DoNotOptimize(job.variants.data());
+  }
+  if (ok != variants) state.SkipWithError("variants failed");
+  state.counters["variants_per_s"] =
+      benchmark::Counter(static_cast<double>(variants), benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(Sweep)
+    ->ArgNames({"threads", "variants"})
+    ->Args({1, kVariants})
+    ->Args({2, kVariants})
+    ->Args({1, 1})
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0);
+
+// the ratio table: Linearize / Jacobian per model, from the median (or the mean
+// of one run) of each; and the sweep's speed-up on 2 threads
+class RatioReporter : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override {
+    for (const Run& r : runs) {
+      const std::string name = r.run_name.str();
+      const bool aggregate = r.run_type == Run::RT_Aggregate;
+      if (aggregate && r.aggregate_name != "median") continue;
+      if (aggregate) have_median_.insert(name);
+      if (!aggregate && have_median_.count(name)) continue;
+      double t = r.GetAdjustedCPUTime();
+      if (name.rfind("Sweep", 0) == 0) t = r.GetAdjustedRealTime();
+      times_[name] = aggregate || !times_.count(name) ? t : std::min(times_[name], t);
+    }
+    ConsoleReporter::ReportRuns(runs);
+  }
+  void Finalize() override {
+    ConsoleReporter::Finalize();
+    std::printf("\n%-12s %12s %14s %8s %15s %8s\n", "model", "Jacobian us", "linearize us", "ratio",
+                "Linearizer us", "ratio");
+    for (const auto& [name, t] : times_) {
+      for (const std::string loop : {"", "Loop"}) {
+        const std::string p = loop + "Jacobian/";
+        if (name.rfind(p, 0) != 0) continue;
+        const std::string model = name.substr(p.size());
+        const auto other = [&](const std::string& what) {
+          const auto it = times_.find(loop + what + "/" + model);
+          return it == times_.end() ? 0.0 : it->second;
+        };
+        const double once = other("Linearize"), reused = other("Linearizer");
+        std::printf("%-12s %12.3f %14.3f %8.3f %15.3f %8.3f\n", (model == "0" ? std::string("tree28") : model).c_str(),
+                    t, once, once / t, reused, reused / t);
+      }
+    }
+    const auto sweep = [&](const std::string& args) {
+      for (const auto& [name, t] : times_)
+        if (name.rfind("Sweep/" + args + "/", 0) == 0) return t;
+      return 0.0;
+    };
+    const std::string all = "variants:" + std::to_string(kVariants);
+    const double s1 = sweep("threads:1/" + all), s2 = sweep("threads:2/" + all), one = sweep("threads:1/variants:1");
+    if (s1 > 0 && s2 > 0)
+      std::printf("\nsweep of %d variants: 1 thread %.1f ms (%.0f variants/s), 2 threads %.1f ms (%.0f variants/s), "
+                  "speed-up %.2f\n",
+                  kVariants, s1, 1e3 * kVariants / s1, s2, 1e3 * kVariants / s2, s1 / s2);
+    if (s1 > 0 && one > 0) {
+      // Amdahl: a serial part (the nominal model, the plan, the results) and variants that share nothing
+      const double variant = (s1 - one) / (kVariants - 1), serial = std::max(0.0, one - variant);
+      std::printf("a study of 1 variant %.2f ms: serial part %.2f ms, %.3f ms per variant; expected speed-up of %d "
+                  "variants on 16 threads (no other limit): %.1f\n",
+                  one, serial, variant, kVariants, s1 / (serial + kVariants * variant / 16));
+    }
+  }
+
+ private:
+  std::map<std::string, double> times_;
+  std::set<std::string> have_median_;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  RatioReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  benchmark::Shutdown();
+  return 0;
+}
