@@ -4,7 +4,9 @@
 #     uneven), and a Monte Carlo of 200 samples on 2 and 3 ranks (67+67+66): every dataset and
 #     attribute equal to the single-process run's, variable by variable, and the HDF5, CSV and MAT
 #     files equal byte for byte;
-#   * a study every rank refuses (a bad --vary) exits 1 with the error said once, no hang;
+#   * a study every rank refuses (a bad --vary) exits 1 with the error said once, no hang; one
+#     rank failing alone (mpirun's MPMD form gives it another --vary) is named by rank 0, exit 1,
+#     nothing written; ranks given different studies (another seed) are refused when joined;
 #   * --shard under mpirun is refused, and so is sweep-merge (N processes would write one file).
 # A codyna built without MPI: started as one of 2 MPI processes (OMPI_COMM_WORLD_SIZE=2) it must
 # refuse, writing nothing; then the test is skipped (exit 77), saying so.
@@ -74,6 +76,21 @@ rc=0; mpi 2 sweep "$model" --vary /bodies/1/mass=1..3 --out bad.h5 > bad.txt 2> 
 [ $rc -ne 0 ] || fail "a bad --vary under mpirun exited 0"
 [ "$(grep -c "codyna: error: --vary /bodies/1/mass=1..3: expected a:b:n" bad.err)" -eq 1 ] || fail "the error, once: $(cat bad.err)"
 [ ! -e bad.h5 ] || fail "a refused study wrote bad.h5"
+# one rank fails on its own (mpirun's MPMD form: rank 1 is given a field the model lacks): rank 0,
+# done with its slice, is not left waiting; it names rank 1's error, writes nothing, exit 1
+rc=0
+ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" timeout 120 mpirun --oversubscribe -np 1 "$codyna" "${mc[@]}" \
+  --out part.h5 : -np 1 "$codyna" sweep "$model" --vary /bodies/9/mass=1:2:3 --out part.h5 > part.txt 2> part.err || rc=$?
+[ $rc -eq 1 ] || fail "a rank that failed: exit $rc, $(cat part.err)"
+grep -q "codyna: error: rank 1 of 2: --vary /bodies/9/mass=1:2:3: the model file .* has no field /bodies/9/mass" part.err &&
+  grep -q "codyna: error: 1 of 2 ranks failed; no results written" part.err || fail "a rank that failed: $(cat part.err)"
+[ ! -e part.h5 ] && [ ! -e part.h5.partial ] || fail "a study with a failed rank wrote part.h5"
+# ranks given different studies (another seed on rank 1): refused when joined, naming the ranks
+rc=0
+ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" timeout 120 mpirun --oversubscribe -np 1 "$codyna" "${mc[@]}" \
+  --out mixed.h5 : -np 1 "$codyna" "${mc[@]/2026/2027}" --out mixed.h5 > mixed.txt 2> mixed.err || rc=$?
+[ $rc -eq 1 ] && grep -q "codyna: error: rank 1: a shard of another study than rank 0" mixed.err || fail "mixed studies: exit $rc, $(cat mixed.err)"
+[ ! -e mixed.h5 ] && [ ! -e mixed.h5.partial ] || fail "mixed studies wrote mixed.h5"
 rc=0; mpi 2 sweep "$model" --vary /bodies/1/mass=5:15:3 --shard 0/2 --out s.sweep > /dev/null 2> shard.err || rc=$?
 [ $rc -ne 0 ] && grep -q "under mpirun the ranks share the variants already" shard.err || fail "--shard under mpirun: $(cat shard.err)"
 rc=0; mpi 2 sweep-merge whatever.sweep --out m.h5 > /dev/null 2> merge.err || rc=$?
