@@ -38,6 +38,7 @@
 
 #include "gui/autosave.hpp"
 #include "gui/control_view.hpp"
+#include "gui/sweep_view.hpp"
 #include "gui/linearize_view.hpp"
 #include "gui/plant_panel.hpp"
 #include "gui/property_editor.hpp"
@@ -101,6 +102,9 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
   tabs_->setTabToolTip(0, tr("Operating point, A, B, C, D, modes; export for MATLAB and GNU Octave"));
   tabs_->setTabToolTip(1, tr("The controller on the nonlinear mechanism: run, plots, results"));
   tabs_->setTabToolTip(2, tr("The linear plant and closed loop: gain K, closed-loop poles, Bode and step responses"));
+  sweep_view_ = new SweepView(doc_, this);
+  tabs_->addTab(sweep_view_, tr("Sweep"));
+  tabs_->setTabToolTip(3, tr("A parameter study: the closed-loop poles and figures of every variant of the model"));
   auto* centre = new QSplitter(Qt::Vertical, this);
   centre->setObjectName("centreSplitter");
   centre->addWidget(top);
@@ -214,6 +218,11 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
           [this](int index, const Eigen::VectorXcd& shape, std::complex<double>) { animateMode(index, shape); });
   connect(sim_view_, &SimulateView::message, this, [this](const QString& m) { message(m); });
   connect(control_view_, &ControlView::message, this, [this](const QString& m) { message(m); });
+  connect(sweep_view_, &SweepView::message, this, [this](const QString& m) { message(m); });
+  connect(props_, &PropertyEditor::varyRequested, this, [this](const QString& pointer) {
+    sweep_view_->addField(pointer);
+    tabs_->setCurrentWidget(sweep_view_);
+  });
   connect(sim_view_, &SimulateView::runFinished, this, &MainWindow::onResult);
   connect(sim_view_, &SimulateView::runStarted, this, [this] { animateMode(-1, {}); });
 

@@ -37,6 +37,7 @@ class PlantPanel;
 class LinearizeView;
 class SimulateView;
 class ControlView;
+class SweepView;
 class Autosave;
 
 class MainWindow : public QMainWindow {
@@ -55,6 +56,7 @@ class MainWindow : public QMainWindow {
   LinearizeView* linearizeView() { return lin_view_; }
   SimulateView* simulateView() { return sim_view_; }
   ControlView* controlView() { return control_view_; }
+  SweepView* sweepView() { return sweep_view_; }
   QTabWidget* analysisTabs() { return tabs_; }
   QPlainTextEdit* messages() { return messages_; }
   QSlider* playbackSlider() { return slider_; }
@@ -139,6 +141,7 @@ class MainWindow : public QMainWindow {
   LinearizeView* lin_view_;
   SimulateView* sim_view_;
   ControlView* control_view_ = nullptr;
+  SweepView* sweep_view_ = nullptr;
   Autosave* autosave_ = nullptr;
   QTabWidget* tabs_;
   QPlainTextEdit* messages_;

@@ -7,6 +7,7 @@
 #include <QLabel>
 #include <QHBoxLayout>
 #include <QLineEdit>
+#include <QMenu>
 #include <QPushButton>
 #include <QLocale>
 #include <QRegularExpression>
@@ -37,7 +38,7 @@ QStringList type_names(ElementKind k) {
       return {"gravity", "spring_damper", "joint_spring_damper", "joint_friction", "joint_damper", "body_force", "bushing"};
     case ElementKind::Actuator: return {"joint_force", "body_force", "body_torque", "line_force", "mix", "motion"};
     case ElementKind::Sensor:
-      return {"joint_position", "joint_velocity", "point_position", "point_velocity", "body_angle", "distance", "distance_rate"};
+      return {"joint_position", "joint_velocity", "point_position", "point_velocity", "body_angle", "distance", "distance_rate", "motion_force"};
     default: return {};
   }
 }
@@ -541,6 +542,30 @@ void PropertyEditor::rebuild() {
       auto* e = new QLineEdit(text);
       if (v.is_null()) e->setPlaceholderText(tr("none"));
       e->setProperty("value", e->text());
+      // a number, or a vector's entries, can be varied in a parameter study (the Sweep view)
+      if (!is_rotation_key(key) && (v.is_number() || (is_number_array(v) && !v.empty()))) {
+        const QString pointer = QStringLiteral("/%1/%2/%3").arg(section_of(kind)).arg(index).arg(key);
+        const int entries = v.is_number() ? 0 : static_cast<int>(v.size());
+        e->setContextMenuPolicy(Qt::CustomContextMenu);
+        connect(e, &QLineEdit::customContextMenuRequested, this, [this, e, pointer, entries](const QPoint& at) {
+          QMenu* menu = e->createStandardContextMenu();
+          menu->setAttribute(Qt::WA_DeleteOnClose);
+          menu->addSeparator();
+          if (entries == 0) {
+            QAction* a = menu->addAction(tr("Vary in sweep"));
+            a->setObjectName("varyInSweep");
+            connect(a, &QAction::triggered, this, [this, pointer] { emit varyRequested(pointer); });
+          } else {
+            for (int k = 0; k < entries; ++k) {
+              QAction* a = menu->addAction(tr("Vary in sweep: entry %1").arg(k));
+              a->setObjectName(QStringLiteral("varyInSweep:%1").arg(k));
+              const QString p = pointer + "/" + QString::number(k);
+              connect(a, &QAction::triggered, this, [this, p] { emit varyRequested(p); });
+            }
+          }
+          menu->popup(e->mapToGlobal(at));
+        });
+      }
       connect(e, &QLineEdit::editingFinished, this, [this, e, key] {
         if (isCurrent(key, e) && e->text() != e->property("value").toString()) applyText(key, e->text());
       });

@@ -39,6 +39,9 @@ class PropertyEditor : public QWidget {
 
  signals:
   void message(const QString& text);
+  // the context menu's "Vary in sweep" on a numeric field: its JSON pointer in the model file
+  // (/bodies/1/mass; an entry of a vector: /bodies/0/com/1)
+  void varyRequested(const QString& pointer);
 
  private:
   void rebuild();
