@@ -102,7 +102,7 @@ QVariant PlantListModel::data(const QModelIndex& index, int role) const {
       case 0: return on ? QStringLiteral("y%1  %2").arg(index.row() + 1).arg(name) : name;
       case 1: return qs(to_string(x.type));
       case 2: return qs(x.unit);
-      case 3: return qs(!x.joint.empty() && (x.type == SensorType::JointPosition || x.type == SensorType::JointVelocity) ? x.joint
+      case 3: return qs(!x.joint.empty() && (x.type == SensorType::JointPosition || x.type == SensorType::JointVelocity || x.type == SensorType::MotionForce) ? x.joint
                         : x.type == SensorType::Distance || x.type == SensorType::DistanceRate ? x.body_a + " - " + x.body_b
                                                                                            : x.body);
     }

@@ -525,6 +525,9 @@ bool PlantFunction::closed_loop_jacobian(const Eigen::VectorXd& x, const Eigen::
   if (u.size() != nu_p && !rates) return false;
   for (int k = 0; k < n; ++k)
     if (x[k] != 0.0) return false;
+  // a motion's reaction as an output reads the accelerations: automatic differentiation
+  for (int k : m.plant_outputs)
+    if (m.sensors[static_cast<std::size_t>(k)].type == SensorType::MotionForce) return false;
   // differentiated where the motions' coordinates are the reference configuration's
   for (int k : m.motions) {
     double value = u_all_[k];

@@ -42,6 +42,12 @@ S sensor_value(const Model& model, const DataT<S>& d, const SensorModel& s, cons
       const Vec3T<S> dv = point_velocity<S>(d, s.body_b, s.point_b) - point_velocity<S>(d, s.body_a, s.point_a);
       return S(dp.dot(dv)) / L;
     }
+    case SensorType::MotionForce:
+      // kept by forward_dynamics on this data (at the same q, v and inputs)
+      for (std::size_t k = 0; k < model.motions.size(); ++k)
+        if (model.actuators[static_cast<std::size_t>(model.motions[k])].iv == s.iv)
+          return k < static_cast<std::size_t>(d.motion_force.size()) ? d.motion_force[static_cast<Eigen::Index>(k)] : S(0);
+      return S(0);
   }
   return S(0);
 }

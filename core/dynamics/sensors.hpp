@@ -1,5 +1,6 @@
 // Sensor outputs: one scalar per sensor (see SensorType). Needs
-// forward_kinematics(q, v) on data. sensor_outputs evaluates only the sensors
+// forward_kinematics(q, v) on data; motion_force reads the reaction that
+// forward_dynamics (which runs the kinematics too) kept on data. sensor_outputs evaluates only the sensors
 // listed in `which` (indices into Model::sensors), so outputs nobody asked
 // for are never computed.
 #pragma once

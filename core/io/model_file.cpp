@@ -876,7 +876,8 @@ const Schema<SensorSpec>& schema<SensorSpec>() {
       [](const SensorSpec& s) {
         switch (s.type) {
           case SensorType::JointPosition:
-          case SensorType::JointVelocity: return element_keys({"joint", "dof"}, {"unit"});
+          case SensorType::JointVelocity:
+          case SensorType::MotionForce: return element_keys({"joint", "dof"}, {"unit"});
           case SensorType::PointPosition:
           case SensorType::PointVelocity: return element_keys({"body", "point", "component", "frame"}, {"unit"});
           case SensorType::BodyAngle: return element_keys({"body", "axis"}, {"unit"});

@@ -631,6 +631,30 @@ class Compiler {
           o.unit = s.type == SensorType::JointPosition ? (ang ? "rad" : "m") : (ang ? "rad/s" : "m/s");
           break;
         }
+        case SensorType::MotionForce: {
+          // the coordinate must be driven by a motion input (built before the sensors)
+          const int jb = joint(s.joint, p + "/joint");
+          check_dof(jb, s.dof, p + "/dof");
+          const JointModel& j = m_.joints[jb];
+          o.iv = j.idx_v + s.dof;
+          o.iq = j.idx_q + s.dof;
+          bool driven = false;
+          std::vector<std::string> driven_joints;
+          for (const ActuatorModel& a : m_.actuators)
+            if (a.type == ActuatorType::Motion) {
+              driven = driven || a.iv == o.iv;
+              for (const JointModel& jm : m_.joints)
+                if (jm.nv > 0 && a.iv >= jm.idx_v && a.iv < jm.idx_v + jm.nv)
+                  driven_joints.push_back(jm.name + " (by " + quoted(a.name) + ")");
+            }
+          if (!driven)
+            fail(p + "/joint", "motion_force reads the reaction of a motion input; no motion drives " + quoted(j.name) +
+                                   (j.nv > 1 ? " dof " + std::to_string(s.dof) : std::string()) + " (" +
+                                   (driven_joints.empty() ? std::string("the model has no motion input")
+                                                          : "driven: " + join_names(driven_joints)) + ")");
+          o.unit = is_angular(j.type, s.dof) ? "N m" : "N";
+          break;
+        }
         case SensorType::PointPosition:
         case SensorType::PointVelocity:
           o.body = body(s.body, p + "/body");

@@ -52,7 +52,7 @@ constexpr std::array<std::pair<ActuatorType, const char*>, 6> kActuators{{
     {ActuatorType::Mix, "mix"},
     {ActuatorType::Motion, "motion"},
 }};
-constexpr std::array<std::pair<SensorType, const char*>, 7> kSensors{{
+constexpr std::array<std::pair<SensorType, const char*>, 8> kSensors{{
     {SensorType::JointPosition, "joint_position"},
     {SensorType::JointVelocity, "joint_velocity"},
     {SensorType::PointPosition, "point_position"},
@@ -60,6 +60,7 @@ constexpr std::array<std::pair<SensorType, const char*>, 7> kSensors{{
     {SensorType::BodyAngle, "body_angle"},
     {SensorType::Distance, "distance"},
     {SensorType::DistanceRate, "distance_rate"},
+    {SensorType::MotionForce, "motion_force"},
 }};
 constexpr std::array<std::pair<ShapeType, const char*>, 3> kShapes{{
     {ShapeType::Box, "box"},

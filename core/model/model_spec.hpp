@@ -180,6 +180,8 @@ enum class SensorType {
   BodyAngle,       // rotation of body about `axis` (world axes), measured from its zero-configuration orientation
   Distance,        // |p_b - p_a| between body_a/point_a and body_b/point_b
   DistanceRate,    // its rate d|p_b - p_a|/dt = n . (v_b - v_a) (0 where the points coincide)
+  MotionForce,     // joint, dof driven by a motion input: the generalized force (N, N m) the motion supplies
+                   // to hold the coordinate on its course, (M qdd + nle - Q) there; needs the accelerations
 };
 
 struct SensorSpec {

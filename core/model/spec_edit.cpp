@@ -98,7 +98,7 @@ void for_each_joint_ref(ModelSpec& s, F&& f) {
   for (auto& a : s.actuators)
     if (a.type == ActuatorType::JointForce) f(a.joint, "actuator " + a.name + ": joint");
   for (auto& x : s.sensors)
-    if (x.type == SensorType::JointPosition || x.type == SensorType::JointVelocity) f(x.joint, "sensor " + x.name + ": joint");
+    if (x.type == SensorType::JointPosition || x.type == SensorType::JointVelocity || x.type == SensorType::MotionForce) f(x.joint, "sensor " + x.name + ": joint");
 }
 
 }  // namespace

@@ -194,6 +194,13 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
                                 "nothing moves, nothing to simulate");
   if (controller && controller->needs_state() && !plant)
     throw std::invalid_argument("simulate: state feedback needs the linearized plant it was designed on");
+  if (controller && !controller->needs_state())
+    for (int k : model.plant_outputs)
+      if (model.sensors[static_cast<std::size_t>(k)].type == SensorType::MotionForce)
+        throw std::invalid_argument("simulate: the controller measures \"" + model.sensors[static_cast<std::size_t>(k)].name +
+                                    "\", a motion input's reaction force, which depends on the inputs the controller "
+                                    "computes (an algebraic loop); feed back positions or velocities, or use state "
+                                    "feedback (the reaction is then recorded as an output)");
   const auto wall0 = std::chrono::steady_clock::now();
 
   std::optional<PlantFunction> pf;
@@ -264,11 +271,18 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
 
   Recorder rec;
   Data d(model);
+  bool reactions = false;  // a motion's reaction among the outputs: the accelerations at each sample
+  for (int k : model.plant_outputs) reactions = reactions || model.sensors[static_cast<std::size_t>(k)].type == SensorType::MotionForce;
+  Eigen::VectorXd motion_acc;
   auto record = [&](double t) {
     Eigen::VectorXd q = y.head(model.nq), v = y.segment(model.nq, model.nv);
-    sys.apply_motions(t, q, v);  // exactly where they are driven (the state integrates their rates)
+    sys.apply_motions(t, q, v, &motion_acc);  // exactly where they are driven (the state integrates their rates)
     const Eigen::VectorXd xc = discrete ? xcd : Eigen::VectorXd(y.tail(sys.nxc()));
     const Eigen::VectorXd u = sys.inputs(t, q, v, y.tail(sys.nxc()));
+    if (reactions) {
+      d.motion_acc = motion_acc;
+      forward_dynamics<double>(model, d, q, v, u);
+    }
     forward_kinematics<double>(model, d, q, v);
     const Eigen::VectorXd out = sensor_outputs<double>(model, d, model.plant_outputs, q, v);
     const auto [pv, vv] = sys.violation(q, v);

@@ -213,6 +213,98 @@ TEST(Motion, AnalyticJacobianAgreesWithAutodiffAndCentralDifferences) {
   EXPECT_LT((analytic - ad).cwiseAbs().maxCoeff() / std::max(1.0, ad.cwiseAbs().maxCoeff()), 1e-12);
 }
 
+// The shaker with its table's reaction as a sensor, the table moved by a disturbance signal (or
+// held), a motor on the rod as the Plant/In
+std::string shaker_with_reaction(const std::string& inputs, const std::string& outputs, const std::string& extra) {
+  std::string t = shaker(outputs);
+  const auto put = [&](const std::string& from, const std::string& to) {
+    const auto at = t.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    t.replace(at, from.size(), to);
+  };
+  put(R"({"name": "table", "type": "motion", "joint": "x"})",
+      R"({"name": "table", "type": "motion", "joint": "x"}, {"name": "motor", "type": "joint_force", "joint": "theta"})");
+  put(R"({"name": "rate", "type": "joint_velocity", "joint": "theta"},)",
+      R"({"name": "rate", "type": "joint_velocity", "joint": "theta"}, {"name": "force", "type": "motion_force", "joint": "x"},)");
+  put(R"("inputs": ["table"])", R"("inputs": )" + inputs);
+  put(R"("analysis": {"operating_point": "initial"})", R"("analysis": {"operating_point": "initial")" + extra + "}");
+  return t;
+}
+
+// The reaction a motion input supplies (sensor motion_force): the table is massless, so it is the
+// horizontal force that accelerates the rod's centre, F = m (x'' + c (theta'' cos - theta'^2 sin)),
+// with the rod's own equation about the moving pivot, I theta'' = -m c (g sin theta + x'' cos theta).
+// In a run with the table shaken by a sine, sample by sample; linearized with the table held, the
+// proper model F = m c theta'' (a feedthrough from the motor); with the table as Plant/In refused
+// (F responds to its acceleration: improper); on a coordinate no motion drives, refused at the field.
+TEST(Motion, TheReactionOfAMotionIsASensor) {
+  const double m = 0.8, l = 0.6, c = l / 2, g = 9.81, I = m * l * l / 3, A = 0.05, w = 2 * std::numbers::pi * 0.7;
+  const Model run = study_model(parse(shaker_with_reaction(
+      "[]", R"(["angle", "rate", "force"])",
+      R"(, "controller": "none", "disturbances": [{"actuator": "table", "type": "sine", "amplitude": 0.05, "frequency": 0.7}])")));
+  ModelSpec spec = run.spec;
+  spec.solver.rtol = 1e-11;
+  spec.solver.atol = 1e-13;
+  spec.solver.t_end = 2.0;
+  spec.solver.output_step = 0.02;
+  const Model tight = study_model(spec);
+  const SimulationResult r = study_simulate(tight, study_simulation(tight));
+  ASSERT_TRUE(r.completed) << r.failure;
+  double worst = 0, largest = 0;
+  for (int i = 0; i < r.samples(); ++i) {
+    const double t = r.t[i], th = r.y(i, 0), thd = r.y(i, 1);
+    const double xdd = -A * w * w * std::sin(w * t);
+    const double thdd = -(m * c / I) * (g * std::sin(th) + xdd * std::cos(th));
+    const double F = m * (xdd + c * (thdd * std::cos(th) - thd * thd * std::sin(th)));
+    worst = std::max(worst, std::abs(r.y(i, 2) - F));
+    largest = std::max(largest, std::abs(F));
+  }
+  EXPECT_GT(largest, 0.3);  // the table was shaken hard enough to need a force
+  EXPECT_LT(worst, 1e-9 * largest) << "largest " << largest;
+
+  // held table, the motor as Plant/In: F = m c theta'' = (m c / I) (tau - m g c theta)
+  const LinearSystem s =
+      study_linearize(study_model(parse(shaker_with_reaction(R"(["motor"])", R"(["angle", "force"])", "")))).system;
+  ASSERT_EQ(s.nx(), 2);
+  EXPECT_NEAR(s.C(1, 0), -(m * c / I) * m * g * c, 1e-12);
+  EXPECT_NEAR(s.C(1, 1), 0.0, 1e-12);
+  EXPECT_NEAR(s.D(1, 0), m * c / I, 1e-12);
+  EXPECT_NEAR(s.A(1, 0), -m * g * c / I, 1e-12);
+  // the table as Plant/In: the reaction responds to its acceleration
+  try {
+    study_linearize(study_model(parse(shaker_with_reaction(R"(["table"])", R"(["force"])", ""))));
+    FAIL() << "expected a refusal";
+  } catch (const std::exception& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("\"force\""), std::string::npos) << what;
+    EXPECT_NE(what.find("acceleration"), std::string::npos) << what;
+  }
+  // a controller that measures the reaction: an algebraic loop, refused naming it
+  try {
+    std::string text = shaker_with_reaction(R"(["motor"])", R"(["force"])", "");
+    text.replace(text.find(R"("plant":)"), 8, R"("controller": {"type": "pid", "kp": [[0.1]]}, "plant":)");
+    const Model pid = study_model(parse(text));
+    study_simulate(pid, study_simulation(pid));
+    FAIL() << "expected a refusal";
+  } catch (const std::exception& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("\"force\""), std::string::npos) << what;
+    EXPECT_NE(what.find("algebraic loop"), std::string::npos) << what;
+  }
+  // on a coordinate no motion drives
+  std::string bad = shaker_with_reaction("[]", R"(["angle"])", "");
+  const std::string from = R"("type": "motion_force", "joint": "x")";
+  bad.replace(bad.find(from), from.size(), R"("type": "motion_force", "joint": "theta")");
+  try {
+    parse(bad);
+    study_model(parse(bad));
+    FAIL() << "expected a refusal";
+  } catch (const ModelError& e) {
+    EXPECT_EQ(e.path().rfind("/sensors/2/joint", 0), 0u) << e.what();
+    EXPECT_NE(std::string(e.what()).find("x (by \"table\")"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Motion, BadMotionInputsAreRefusedAtTheField) {
   const auto error_path = [](const std::string& text) {
     try {
