@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "io/atomic_file.hpp"
+#include "io/hdf5_handle.hpp"
 
 namespace codyna {
 namespace {
@@ -142,62 +143,9 @@ void require_consistent(const R& r, const std::string& path) {
 
 // ------------------------------------------------------------------ HDF5 plumbing
 
-// A failure inside the file; the public functions prefix the path.
-class FileError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
-// The most specific message on HDF5's error stack.
-std::string hdf5_reason() {
-  std::string reason;
-  H5Ewalk2(
-      H5E_DEFAULT, H5E_WALK_UPWARD,
-      [](unsigned n, const H5E_error2_t* e, void* out) -> herr_t {
-        if (n == 0 && e->desc) *static_cast<std::string*>(out) = e->desc;
-        return 0;
-      },
-      &reason);
-  // a failed system call: HDF5's text carries a time stamp, the file descriptor, buffer
-  // addresses, ... and the one thing a user needs, the system's message
-  const std::string key = "error message = '";
-  if (const auto a = reason.find(key); a != std::string::npos)
-    if (const auto b = reason.find('\'', a + key.size()); b != std::string::npos)
-      return reason.substr(a + key.size(), b - a - key.size());
-  return reason.empty() ? "HDF5 error" : reason;
-}
-
-[[noreturn]] void fail(const std::string& what) { throw FileError(what + ": " + hdf5_reason()); }
-
-void check(herr_t rc, const std::string& what) {
-  if (rc < 0) fail(what);
-}
-
-// HDF5 prints its error stack to stderr by default; here failures become exceptions instead.
-
-// An HDF5 identifier closed on destruction; a negative id (a failed call) throws.
-class Handle {
- public:
-  using Close = herr_t (*)(hid_t);
-  Handle(hid_t id, Close close, const std::string& what) : id_(id), close_(close) {
-    if (id_ < 0) fail(what);
-  }
-  Handle(Handle&& other) noexcept : id_(std::exchange(other.id_, -1)), close_(other.close_) {}
-  Handle(const Handle&) = delete;
-  Handle& operator=(const Handle&) = delete;
-  Handle& operator=(Handle&&) = delete;
-  ~Handle() {
-    if (id_ >= 0) close_(id_);
-  }
-  operator hid_t() const { return id_; }
-
-  // Close now and report a failure (closing a file flushes it).
-  void close(const std::string& what) { check(close_(std::exchange(id_, -1)), what); }
-
- private:
-  hid_t id_;
-  Close close_;
-};
+using FileError = Hdf5Error;
+using Handle = Hdf5Handle;
+void check(herr_t rc, const std::string& what) { hdf5_check(rc, what); }
 
 template <class T>
 struct H5Type;

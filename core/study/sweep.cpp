@@ -25,6 +25,7 @@
 #include <utility>
 
 #include "io/atomic_file.hpp"
+#include "io/hdf5_handle.hpp"
 #include "io/hdf5_quiet.hpp"
 #include "model/errors.hpp"
 #include "study/files.hpp"
@@ -1021,35 +1022,9 @@ SweepJob study_sweep_merge_journals(const std::vector<std::string>& journals, co
 
 namespace {
 
-class FileError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
-[[noreturn]] void fail(const std::string& what) { throw FileError(what); }
-void check(herr_t rc, const std::string& what) {
-  if (rc < 0) fail(what);
-}
-
-class Handle {
- public:
-  using Close = herr_t (*)(hid_t);
-  Handle(hid_t id, Close close, const std::string& what) : id_(id), close_(close) {
-    if (id_ < 0) fail(what);
-  }
-  Handle(Handle&& other) noexcept : id_(std::exchange(other.id_, -1)), close_(other.close_) {}
-  Handle(const Handle&) = delete;
-  Handle& operator=(const Handle&) = delete;
-  ~Handle() {
-    if (id_ >= 0) close_(id_);
-  }
-  operator hid_t() const { return id_; }
-  void close(const std::string& what) { check(close_(std::exchange(id_, -1)), what); }
-
- private:
-  hid_t id_;
-  Close close_;
-};
+using FileError = Hdf5Error;
+using Handle = Hdf5Handle;
+void check(herr_t rc, const std::string& what) { hdf5_check(rc, what); }
 
 // no modification times in the object headers: the same study gives the same bytes
 Handle untimed(hid_t cls, const std::string& what) {
