@@ -166,6 +166,9 @@ void SweepView::buildUi() {
   fields_->horizontalHeader()->setSectionResizeMode(1, QHeaderView::Stretch);
   fields_->verticalHeader()->setVisible(false);
   fields_->setSelectionBehavior(QAbstractItemView::SelectRows);
+  // no delayed edit on a click into a selected cell: a double click, F2 or typing opens the editor
+  fields_->setEditTriggers(QAbstractItemView::DoubleClicked | QAbstractItemView::EditKeyPressed |
+                           QAbstractItemView::AnyKeyPressed);
   fields_->setToolTip(tr("Field: a JSON pointer into the model file (/bodies/1/mass, /joints/0/q0/0).\n"
                          "Values: a:b:n (n values from a to b), [v1,v2,...], normal(mu,sigma) or uniform(a,b).\n"
                          "Several grids make the full grid; several distributions joint random samples."));

@@ -1,0 +1,256 @@
+// The Sweep view (issue 22), offscreen, driven as a person drives it: the rod's mass picked
+// into the study from the property editor's context menu, its values typed into the table, Run
+// clicked. What it draws is checked against core's study_sweep_job run directly on the model file
+// with the same request: every variant's plotted poles equal the core's closed-loop poles to 1e-12,
+// the colours follow the mass (viridis: lighter as the mass grows), the figure of merit is the
+// core's largest closed-loop real part. A variant made to fail (a mass of -1) is listed with the
+// core's reason; a spec the core refuses is reported naming the field; Cancel stops a long study
+// and closing the window while one runs does not crash.
+#include <QAction>
+#include <QApplication>
+#include <QContextMenuEvent>
+#include <QElapsedTimer>
+#include <QLabel>
+#include <QLineEdit>
+#include <QMenu>
+#include <QProgressBar>
+#include <QPushButton>
+#include <QTabWidget>
+#include <QTableWidget>
+#include <QTemporaryDir>
+#include <QTest>
+#include <cmath>
+
+#include "drive.hpp"
+#include "gui/main_window.hpp"
+#include "gui/property_editor.hpp"
+#include "gui/sweep_view.hpp"
+#include "study/sweep.hpp"
+
+using namespace codyna;
+using namespace codyna::gui;
+
+namespace {
+const QString kCart = QStringLiteral(CODYNA_EXAMPLES_DIR "/cart_pendulum.json");
+
+double luminance(const QColor& c) { return 0.2126 * c.redF() + 0.7152 * c.greenF() + 0.0722 * c.blueF(); }
+}  // namespace
+
+class SweepViewTest : public QObject {
+  Q_OBJECT
+ private:
+  std::unique_ptr<MainWindow> w;
+
+  SweepView* view() { return w->sweepView(); }
+
+  // right-click on the rod's mass in the property editor, "Vary in sweep" clicked in the menu
+  bool pickRodMass() {
+    w->selectElement(ElementId{ElementKind::Body, 1});
+    auto* mass = qobject_cast<QLineEdit*>(w->propertyEditor()->editorFor("mass"));
+    if (!mass) return false;
+    const QPoint at(mass->width() / 2, mass->height() / 2);
+    QTest::mouseClick(mass, Qt::RightButton, {}, at);
+    if (!QTest::qWaitFor([] { return qobject_cast<QMenu*>(QApplication::activePopupWidget()) != nullptr; }, 500)) {
+      // a platform that opens context menus on the release only: the event the press would give
+      QContextMenuEvent e(QContextMenuEvent::Mouse, at, mass->mapToGlobal(at));
+      QApplication::sendEvent(mass, &e);
+    }
+    if (!QTest::qWaitFor([] { return qobject_cast<QMenu*>(QApplication::activePopupWidget()) != nullptr; }, 2000)) return false;
+    auto* menu = qobject_cast<QMenu*>(QApplication::activePopupWidget());
+    QAction* vary = menu->findChild<QAction*>("varyInSweep");
+    if (!vary || !vary->isEnabled()) return false;
+    QTest::qWait(QApplication::doubleClickInterval() + 50);
+    const QPoint p = menu->actionGeometry(vary).center();
+    QTest::mouseMove(menu, p);
+    QTest::mouseClick(menu, Qt::LeftButton, {}, p);
+    return QTest::qWaitFor([menu] { return !menu->isVisible(); }, 2000);
+  }
+
+  // the values of row `row` typed in: a click on the cell, its editor opened, Ctrl+A, the text, Enter
+  void typeSpec(int row, const QString& text) {
+    QTableWidget* t = view()->fieldTable();
+    w->activateWindow();
+    QVERIFY(QTest::qWaitForWindowActive(w.get()));  // focus is real: the editor keeps it while typed into
+    const QModelIndex cell = t->model()->index(row, 1);
+    QTest::mouseClick(t->viewport(), Qt::LeftButton, {}, t->visualRect(cell).center());
+    QCOMPARE(t->currentIndex(), cell);
+    // the cell's editor opened as F2 or a double click opens it (the editor a person then types into)
+    const QList<QLineEdit*> before = t->viewport()->findChildren<QLineEdit*>();
+    t->editItem(t->item(row, 1));
+    QLineEdit* editor = nullptr;
+    for (QLineEdit* e : t->viewport()->findChildren<QLineEdit*>())
+      if (!before.contains(e) && e->isVisible()) editor = e;
+    QVERIFY2(editor, "the cell's editor is open");
+    QTest::keyClick(editor, Qt::Key_A, Qt::ControlModifier);
+    QTest::keyClicks(editor, text);
+    QTest::keyClick(editor, Qt::Key_Return);
+    QTRY_VERIFY(!t->indexWidget(cell));  // the delegate commits and closes the editor from the event loop
+    QCOMPARE(t->item(row, 1)->text(), text);
+  }
+
+  bool runAndWait(int ms = 120000) {
+    QTest::mouseClick(view()->runButton(), Qt::LeftButton);
+    return QTest::qWaitFor([this] { return !view()->isRunning(); }, ms);
+  }
+
+ private slots:
+  void init() {
+    w = drive::window("sweep_view_test");
+    QVERIFY(w);
+    QVERIFY(w->openFile(kCart));
+    w->analysisTabs()->setCurrentWidget(view());
+  }
+  void cleanup() { drive::close(w); }
+
+  void rodMassPolesEqualTheCore() {
+    QVERIFY(pickRodMass());
+    QCOMPARE(w->analysisTabs()->currentWidget(), static_cast<QWidget*>(view()));
+    QTableWidget* t = view()->fieldTable();
+    QCOMPARE(t->rowCount(), 1);
+    QCOMPARE(t->item(0, 0)->text(), QStringLiteral("/bodies/1/mass"));
+    QCOMPARE(t->item(0, 1)->text(), QStringLiteral("5:15:11"));  // the first grid: half to 1.5 times 10 kg
+    typeSpec(0, "5:15:11");
+    QVERIFY(runAndWait());
+    const SweepJob* shown = view()->result();
+    QVERIFY2(shown, qPrintable(view()->statusLabel()->text()));
+
+    SweepRequest r;
+    r.model = kCart.toStdString();
+    r.vary = {"/bodies/1/mass=5:15:11"};
+    r.threads = 1;
+    const SweepJob direct = study_sweep_job(r);
+    QVERIFY(direct.closed_loop);
+    QCOMPARE(shown->variants.size(), std::size_t(11));
+    QCOMPARE(direct.variants.size(), std::size_t(11));
+    double worst = 0;
+    for (int i = 0; i < 11; ++i) {
+      const SweepVariant& v = direct.variants[i];
+      QCOMPARE(int(v.status), int(SweepStatus::Ok));
+      QCOMPARE(v.values[0], 5.0 + i);
+      const QList<QPointF> drawn = view()->plottedPoles(i);
+      QCOMPARE(drawn.size(), int(v.closed_poles.size()));
+      QCOMPARE(drawn.size(), 4);
+      for (int k = 0; k < drawn.size(); ++k) {
+        worst = std::max(worst, std::abs(drawn[k].x() - v.closed_poles[k].real()));
+        worst = std::max(worst, std::abs(drawn[k].y() - v.closed_poles[k].imag()));
+      }
+    }
+    QVERIFY2(worst <= 1e-12, qPrintable(QString("largest difference %1").arg(worst)));
+    // the colours follow the mass: distinct, and lighter as the mass grows (viridis)
+    for (int i = 1; i < 11; ++i) {
+      QVERIFY(view()->variantColour(i).isValid());
+      QVERIFY2(luminance(view()->variantColour(i)) > luminance(view()->variantColour(i - 1)) + 0.01,
+               qPrintable(QString("variant %1 %2 against %3").arg(i).arg(view()->variantColour(i).name(), view()->variantColour(i - 1).name())));
+    }
+    QCOMPARE(view()->variantColour(0), ColourBar::colourAt(0.0));
+    QCOMPARE(view()->variantColour(10), ColourBar::colourAt(1.0));
+    QCOMPARE(view()->colourBar()->low(), 5.0);
+    QCOMPARE(view()->colourBar()->high(), 15.0);
+    // the figure of merit: (mass, largest closed-loop real part), the core's numbers
+    const QList<QPointF> fig = view()->figurePoints();
+    QCOMPARE(fig.size(), 11);
+    for (int i = 0; i < 11; ++i) {
+      QCOMPARE(fig[i].x(), 5.0 + i);
+      QVERIFY(std::abs(fig[i].y() - direct.variants[i].closed_max_real) <= 1e-12);
+      QVERIFY(fig[i].y() < 0);
+    }
+    QCOMPARE(view()->failedTable()->rowCount(), 0);
+    QCOMPARE(view()->progressBar()->value(), 11);
+    QVERIFY(view()->statusLabel()->text().startsWith("11 of 11 variants completed, 0 failed; 11 stable"));
+
+    // saved through the core's writers, guarded: never over the model file
+    QTemporaryDir dir;
+    QString error;
+    QVERIFY(view()->saveResults(dir.filePath("rod.csv"), &error));
+    QFile csv(dir.filePath("rod.csv"));
+    QVERIFY(csv.open(QIODevice::ReadOnly));
+    QVERIFY(csv.readLine().startsWith("variant,status,/bodies/1/mass,"));
+    QVERIFY(view()->saveResults(dir.filePath("rod.h5"), &error));
+    QVERIFY(view()->saveResults(dir.filePath("rod.mat"), &error));
+    QVERIFY(QFile::exists(dir.filePath("rod.m")));
+    QVERIFY(!view()->saveResults(kCart, &error));
+    QVERIFY(!view()->saveResults(dir.filePath("rod.txt"), &error));
+    QVERIFY(error.contains(".h5"));
+  }
+
+  void failedVariantIsListed() {
+    QVERIFY(pickRodMass());
+    typeSpec(0, "[-1,10]");
+    QVERIFY(runAndWait());
+    QVERIFY(view()->result());
+    SweepRequest r;
+    r.model = kCart.toStdString();
+    r.vary = {"/bodies/1/mass=[-1,10]"};
+    r.threads = 1;
+    const SweepJob direct = study_sweep_job(r);
+    QCOMPARE(direct.failed, 1LL);
+    QTableWidget* failed = view()->failedTable();
+    QCOMPARE(failed->rowCount(), 1);
+    QCOMPARE(failed->item(0, 0)->text(), QStringLiteral("0"));
+    QCOMPARE(failed->item(0, 1)->text(), QStringLiteral("/bodies/1/mass = -1"));
+    QCOMPARE(failed->item(0, 2)->text(), QString::fromStdString(to_string(direct.variants[0].status)));
+    QCOMPARE(failed->item(0, 3)->text(), QString::fromStdString(direct.variants[0].reason));
+    QVERIFY(failed->item(0, 3)->text().contains("mass"));
+    QCOMPARE(view()->resultTabs()->tabText(2), QStringLiteral("Failed (1)"));
+    // the other variant is drawn, the failed one is not
+    QCOMPARE(view()->plottedPoles(0).size(), 0);
+    QCOMPARE(view()->plottedPoles(1).size(), 4);
+  }
+
+  void badSpecNamesTheField() {
+    QVERIFY(pickRodMass());
+    typeSpec(0, "5:15:abc");
+    QTest::mouseClick(view()->runButton(), Qt::LeftButton);
+    QVERIFY(!view()->isRunning());
+    QVERIFY2(view()->statusLabel()->text().contains("/bodies/1/mass"), qPrintable(view()->statusLabel()->text()));
+    // a field that is not in the file
+    QTest::mouseClick(view()->addRowButton(), Qt::LeftButton);
+    QTableWidget* t = view()->fieldTable();
+    QCOMPARE(t->rowCount(), 2);
+    typeSpec(0, "5:15:3");
+    t->item(1, 0)->setText("/bodies/7/mass");
+    QTest::mouseClick(view()->runButton(), Qt::LeftButton);
+    QVERIFY(!view()->isRunning());
+    QVERIFY2(view()->statusLabel()->text().contains("/bodies/7/mass"), qPrintable(view()->statusLabel()->text()));
+    QVERIFY(!view()->result());
+  }
+
+  void cancelStopsALongStudy() {
+    QVERIFY(pickRodMass());
+    typeSpec(0, "5:15:50000");
+    QTest::mouseClick(view()->runButton(), Qt::LeftButton);
+    QVERIFY(view()->isRunning());
+    QVERIFY(!view()->runButton()->isEnabled());
+    QVERIFY(QTest::qWaitFor([this] { return view()->progressBar()->value() > 0; }, 60000));
+    QTest::mouseClick(view()->cancelButton(), Qt::LeftButton);
+    QElapsedTimer t;
+    t.start();
+    QVERIFY(QTest::qWaitFor([this] { return !view()->isRunning(); }, 60000));
+    qInfo("stopped %lld ms after Cancel", qlonglong(t.elapsed()));
+    QVERIFY2(view()->statusLabel()->text().contains("cancelled"), qPrintable(view()->statusLabel()->text()));
+    QVERIFY(view()->progressBar()->value() < 50000);
+    QVERIFY(!view()->result());
+    QVERIFY(view()->runButton()->isEnabled());
+    // and a study runs again after it
+    typeSpec(0, "9:11:3");
+    QVERIFY(runAndWait());
+    QVERIFY(view()->result());
+    QCOMPARE(view()->result()->variants.size(), std::size_t(3));
+  }
+
+  void closingWhileRunning() {
+    QVERIFY(pickRodMass());
+    typeSpec(0, "5:15:50000");
+    QTest::mouseClick(view()->runButton(), Qt::LeftButton);
+    QVERIFY(view()->isRunning());
+    QTest::qWait(200);
+    QElapsedTimer t;
+    t.start();
+    drive::close(w);  // the window goes with the study running
+    qInfo("the window closed in %lld ms", qlonglong(t.elapsed()));
+    QVERIFY(!w);
+  }
+};
+
+QTEST_MAIN(SweepViewTest)
+#include "sweep_view_test.moc"
