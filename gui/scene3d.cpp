@@ -589,23 +589,23 @@ void Scene::addElements(const std::vector<SE3>& oMi) {
     twoPoint(ItemKind::Bushing, b.name, b.body_a, b.X_a.p, b.body_b, b.X_b.p, Span::Whole, 0.006 * L, amber);
   }
 
-  // couplers: teal dashes from each coupled joint's frame F to the next one's, a dot on each
+  // couplers: violet dashes from each coupled joint's frame F to the next one's, a dot on each
   for (const ConstraintModel& c : m.constraints) {
     if (c.type != ConstraintType::Coupler) continue;
-    const Eigen::Vector4f teal{0.05f, 0.65f, 0.60f, 1.0f};
+    const Eigen::Vector4f violet{0.40f, 0.25f, 0.90f, 1.0f};
     int prev = 0;
     for (int k = 0; k < c.ncoupled; ++k) {
       const int j = jointOf(c.iv[k]);
       if (j == 0) continue;
       const JointModel& J = m.joints[j];
       local(ItemKind::Coupler, c.name, J.parent, Prim::Sphere,
-            Eigen::Translation3d(J.X_PF.p) * Eigen::Scaling(0.015 * L), teal);
+            Eigen::Translation3d(J.X_PF.p) * Eigen::Scaling(0.015 * L), violet);
       if (prev > 0) {
         const JointModel& P = m.joints[prev];
         constexpr int kDashes = 7;  // dash, gap, ..., dash: 2 kDashes - 1 equal parts
         for (int d = 0; d < kDashes; ++d) {
           Item* it = twoPoint(ItemKind::Coupler, c.name, P.parent, P.X_PF.p, J.parent, J.X_PF.p, Span::Dash,
-                              0.004 * L, teal);
+                              0.004 * L, violet);
           it->span_a = 2.0 * d / (2 * kDashes - 1), it->span_b = (2.0 * d + 1) / (2 * kDashes - 1);
         }
       }
@@ -613,18 +613,19 @@ void Scene::addElements(const std::vector<SE3>& oMi) {
     }
   }
 
-  // motion inputs: a crimson arrow along the driven joint's axis from its frame F, and a disc around it
+  // motion inputs: a cyan arrow (thicker than a joint axis) along the driven joint's axis from its
+  // frame F, and a disc around it
   for (const int k : m.motions) {
     const ActuatorModel& a = m.actuators[static_cast<size_t>(k)];
     const int j = jointOf(a.iv);
     if (j == 0) continue;
     const JointModel& J = m.joints[j];
     const Eigen::Vector3d axis = J.X_PF.R * J.axis;
-    const Eigen::Vector4f crimson{0.85f, 0.08f, 0.30f, 1.0f};
+    const Eigen::Vector4f cyan{0.0f, 0.78f, 0.92f, 1.0f};
     const double len = 0.3 * L;
-    local(ItemKind::Motion, a.name, J.parent, Prim::Arrow, arrowAt(J.X_PF.p + 0.5 * len * axis, axis, len, 0.6 * len),
-          crimson);
-    local(ItemKind::Motion, a.name, J.parent, Prim::Cylinder, disc(J.X_PF.p, axis, 0.05 * L, 0.006 * L), crimson);
+    local(ItemKind::Motion, a.name, J.parent, Prim::Arrow, arrowAt(J.X_PF.p + 0.5 * len * axis, axis, len, 1.3 * len),
+          cyan);
+    local(ItemKind::Motion, a.name, J.parent, Prim::Cylinder, disc(J.X_PF.p, axis, 0.05 * L, 0.006 * L), cyan);
   }
 
   // actuators driven by a mix, coloured by the (first) mix: a body force as an arrow from its point
@@ -686,14 +687,12 @@ Eigen::AlignedBox3d Scene::bounds() const {
 Eigen::AlignedBox3d Scene::viewBounds(bool overlays) const {
   Eigen::AlignedBox3d box = bounds();
   if (!model_) return box;
+  // overlays: frames, joint axes and the elements' marks (motion inputs, mixed actuators, couplers)
   if (overlays)
     for (const Item& it : items_)
-      if (it.kind == ItemKind::Axis || it.kind == ItemKind::Frame)
+      if (it.kind == ItemKind::Axis || it.kind == ItemKind::Frame || it.kind == ItemKind::Motion ||
+          it.kind == ItemKind::Actuator || it.kind == ItemKind::Coupler)
         for (const auto& c : corners(it.prim, it.world)) box.extend(c);
-  // the elements' arrows and links (motion inputs, mixed actuators, couplers) always show
-  for (const Item& it : items_)
-    if (it.kind == ItemKind::Motion || it.kind == ItemKind::Actuator || it.kind == ItemKind::Coupler)
-      for (const auto& c : corners(it.prim, it.world)) box.extend(c);
   const double h = grid_center_.dot(up_);
   Eigen::AlignedBox3d out = box;
   for (int k = 0; k < 8; ++k) {

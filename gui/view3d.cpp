@@ -227,11 +227,11 @@ class GLCanvas : public QOpenGLWidget, protected QOpenGLExtraFunctions {
       for (const Item& it : scene.items()) {
         // overlays: frames and joint axes, centres of mass; drawn over the bodies (faint where hidden)
         // and the elements' marks (couplers, motion inputs, mixed actuators), which sit in bodies too
-        const bool frame = it.kind == ItemKind::Axis || it.kind == ItemKind::Frame;
-        const bool overlay = frame || it.kind == ItemKind::Com || it.kind == ItemKind::Coupler ||
-                             it.kind == ItemKind::Motion || it.kind == ItemKind::Actuator;
+        // and are shown and hidden with the frames (View > Show frames)
+        const bool overlay = it.kind == ItemKind::Axis || it.kind == ItemKind::Frame || it.kind == ItemKind::Com ||
+                             it.kind == ItemKind::Coupler || it.kind == ItemKind::Motion || it.kind == ItemKind::Actuator;
         if (overlay != overlays) continue;
-        if (it.kind == ItemKind::Com ? !owner_->show_com_ : frame && !owner_->show_frames_) continue;
+        if (it.kind == ItemKind::Com ? !owner_->show_com_ : overlay && !owner_->show_frames_) continue;
         const Eigen::Matrix4f MV = V * it.world.matrix().cast<float>();
         const Eigen::Matrix3f A = MV.topLeftCorner<3, 3>();
         if (std::abs(A.determinant()) < 1e-30f) continue;  // degenerate (zero-length spring)
@@ -282,7 +282,7 @@ class GLCanvas : public QOpenGLWidget, protected QOpenGLExtraFunctions {
       glStencilMask(0xFF);
       glDisable(GL_STENCIL_TEST);
     }
-    {
+    if (owner_->show_frames_ || owner_->show_com_) {
       // frames and axes often sit inside bodies: show their hidden parts faintly first
       glDepthFunc(GL_GREATER);
       glDepthMask(GL_FALSE);

@@ -398,7 +398,7 @@ class View3DTest : public QObject {
   // the wheel and a rod on the body: their outer ends are the attachment points, which the prismatic
   // joints X1, X2 place at (0, 1.5 + X1, 0) and (0, 0.5 + X2, 0) (closed form, not the scene's own
   // kinematics); the two overlap as the strut is pulled or pushed. The road's motion input W draws a
-  // crimson arrow along +y from road_height's frame at (0, -0.2, 0), with a disc around it.
+  // cyan arrow along +y from road_height's frame at (0, -0.2, 0), with a disc around it.
   void lineForceAndMotionOnTheBus() {
     auto m = loadExample("bus_suspension.json");
     Scene scene;
