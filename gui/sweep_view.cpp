@@ -630,11 +630,11 @@ void SweepView::drawPoles() {
     l->attachAxis(ay);
   }
   const SweepVary& first = job_->plan.vary.front();
-  pole_chart_->setTitle(tr("%1 poles of %2 variants (%3), coloured by %4; black rings: nominal")
+  pole_chart_->setTitle(tr("%1 poles of %2 variants, %3 (rings: nominal)")
                             .arg(closed ? tr("Closed-loop") : tr("Open-loop"))
                             .arg(job_->variants.size() - job_->failed)
-                            .arg(closed ? (job_->redesigned ? tr("LQR redesigned") : tr("K fixed")) : tr("no state feedback"))
-                            .arg(qs(first.field)));
+                            .arg(closed ? (job_->redesigned ? tr("LQR redesigned") : tr("K fixed")) : tr("no state feedback")));
+  pole_chart_->setToolTip(tr("Coloured by %1 (the colour bar)").arg(qs(first.field)));
   if (std::isfinite(lo)) colour_bar_->setRange(qs(first.field), lo, hi);
 }
 

@@ -12,6 +12,7 @@
 #include <QListWidget>
 #include <QPushButton>
 #include <QScreen>
+#include <QLabel>
 #include <QSplitter>
 #include <QTableWidget>
 #include <QSet>
@@ -32,6 +33,8 @@
 #include "gui/study_widgets.hpp"
 #include "gui/control_view.hpp"
 #include "gui/property_editor.hpp"
+#include "gui/chart_view.hpp"
+#include "gui/sweep_view.hpp"
 #include "gui/view3d.hpp"
 #include "simulation/result.hpp"
 
@@ -316,6 +319,31 @@ class MainWindowXvfb : public QObject {
     QVERIFY(cv->isStale());
     QTest::qWait(200);
     save(screenOf(&w), "control_stale.png");
+    w.document()->undoStack()->setClean();
+  }
+
+  // the Sweep view of issue 22: the rod mass from 5 to 15 kg, K fixed; the pole map coloured by it
+  void sweepView() {
+    MainWindow w;
+    w.resize(1600, 1000);
+    w.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&w));
+    QVERIFY(w.openFile(QStringLiteral(CODYNA_EXAMPLES_DIR "/cart_pendulum.json")));
+    SweepView* sv = w.sweepView();
+    w.analysisTabs()->setCurrentWidget(sv);
+    w.findChild<QSplitter*>("centreSplitter")->setSizes({300, 640});
+    w.selectElement(ElementId{ElementKind::Body, 1});
+    sv->addField("/bodies/1/mass", "5:15:11");
+    QVERIFY(sv->run());
+    QVERIFY(waitFor([sv] { return !sv->isRunning(); }));
+    QVERIFY2(sv->result(), qPrintable(sv->statusLabel()->text()));
+    QTest::qWait(300);
+    const Stats ps = stats(screenOfChild(&w, sv->poleChartView()));
+    QVERIFY2(ps.foreground > 0.005, "the pole map shows poles");
+    save(screenOf(&w), "sweep_view.png");
+    sv->resultTabs()->setCurrentIndex(1);
+    QTest::qWait(300);
+    save(screenOfChild(&w, sv), "sweep_figure.png");
     w.document()->undoStack()->setClean();
   }
 };
