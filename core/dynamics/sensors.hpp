@@ -20,6 +20,22 @@ template <class D>
 double scalar_value(const Eigen::AutoDiffScalar<D>& x) {
   return x.value();
 }
+// atan2(y, x) keeping the derivatives' own type: Eigen's atan2 of AutoDiffScalars returns
+// dynamic-size derivatives (a heap allocation in the fixed-size differentiation of
+// TreeDerivatives); d atan2 = (x dy - y dx) / (x^2 + y^2). A constant's derivatives may be
+// empty (dynamic sizes): then only the other's count.
+inline double atan2_keep(double y, double x) { return std::atan2(y, x); }
+template <class D>
+Eigen::AutoDiffScalar<D> atan2_keep(const Eigen::AutoDiffScalar<D>& y, const Eigen::AutoDiffScalar<D>& x) {
+  using Der = typename Eigen::AutoDiffScalar<D>::DerType;
+  const double yv = y.value(), xv = x.value(), r2 = xv * xv + yv * yv;
+  const double wy = r2 > 0 ? xv / r2 : 0.0, wx = r2 > 0 ? -yv / r2 : 0.0;
+  Der der;
+  if (y.derivatives().size() == 0) der = wx * x.derivatives();
+  else if (x.derivatives().size() == 0) der = wy * y.derivatives();
+  else der = wy * y.derivatives() + wx * x.derivatives();
+  return Eigen::AutoDiffScalar<D>(std::atan2(yv, xv), der);
+}
 }  // namespace detail
 
 // How far the rotation R (a body's orientation relative to a reference one)
@@ -41,7 +57,7 @@ S rotation_about_axis(const M3& R, const Eigen::Vector3d& a) {
     const S sa = sx * a[0] + sy * a[1] + sz * a[2];
     if (detail::scalar_value(s2) < 1e-16) return sa * (1.0 + s2 / 6.0);  // theta / sin(theta) = 1 + theta^2 / 6 + ...
     const S sn = sqrt(s2);
-    return atan2(sn, c) / sn * sa;
+    return detail::atan2_keep(sn, c) / sn * sa;
   }
   // Near pi sin(theta) vanishes: the axis from the symmetric part
   // (R + R^T) / 2 - cos(theta) I = (1 - cos(theta)) n n^T, its sign from sin(theta) n.
@@ -54,7 +70,7 @@ S rotation_about_axis(const M3& R, const Eigen::Vector3d& a) {
   for (int i = 0; i < 3; ++i) n[i] = (i == k ? bkk : S(S(R(i, k) + R(k, i)) * 0.5)) / scale;
   const S along = n[0] * sx + n[1] * sy + n[2] * sz;
   const double sign = detail::scalar_value(along) < 0 ? -1.0 : 1.0;
-  const S theta = detail::scalar_value(s2) > 0 ? S(atan2(sqrt(s2), c)) : S(c * 0.0 + 3.14159265358979323846);
+  const S theta = detail::scalar_value(s2) > 0 ? S(detail::atan2_keep(S(sqrt(s2)), c)) : S(c * 0.0 + 3.14159265358979323846);
   return theta * (n[0] * a[0] + n[1] * a[1] + n[2] * a[2]) * sign;
 }
 

@@ -72,6 +72,30 @@ TEST(NoAllocation, ExactJacobianWithArmature) {
   }
 }
 
+// issue 19's elements where no example has them: a bushing (off the centre of mass, turned, both
+// of its frames on moving bodies) and a line_force driven through a mix, on a two-body tree
+const char* kBushingAndMix = R"({"name": "elements",
+  "bodies": [{"name": "a", "mass": 2, "com": [0.1, 0, 0], "inertia": [0.1, 0.2, 0.3]},
+             {"name": "b", "mass": 3, "com": [0, 0.2, 0], "inertia": [0.2, 0.1, 0.3]}],
+  "joints": [{"name": "ja", "type": "revolute", "parent": "ground", "child": "a", "axis": [0, 0, 1], "q0": 0.3},
+             {"name": "jb", "type": "free", "parent": "a", "child": "b", "q0": [0.1, 0.2, 0.05, 0.98, 0.1, 0.1, 0.1]}],
+  "effects": [{"name": "gravity", "type": "gravity"},
+              {"name": "mount", "type": "bushing", "body_a": "a", "frame_a": {"position": [0.2, 0, 0]},
+               "body_b": "b", "frame_b": {"position": [0, 0.1, 0], "rotation": {"axis": [0, 0, 1], "angle": 0.4}},
+               "translational_stiffness": [400, 900, 1600], "translational_damping": [2, 3, 4],
+               "rotational_stiffness": [30, 50, 70], "rotational_damping": [0.3, 0.5, 0.7]}],
+  "actuators": [{"name": "strut", "type": "line_force", "body_a": "ground", "point_a": [0, 1, 0],
+                 "body_b": "b", "point_b": [0.1, 0, 0]},
+                {"name": "motor", "type": "joint_force", "joint": "ja"},
+                {"name": "both", "type": "mix", "drives": ["strut", "motor"], "weights": [1, 0.2]}],
+  "sensors": [{"name": "gap", "type": "distance", "body_a": "ground", "point_a": [0, 1, 0], "body_b": "b", "point_b": [0.1, 0, 0]},
+              {"name": "gap_rate", "type": "distance_rate", "body_a": "ground", "point_a": [0, 1, 0], "body_b": "b", "point_b": [0.1, 0, 0]}],
+  "plant": {"inputs": ["both", "strut"], "outputs": ["gap", "gap_rate"]}})";
+
+TEST(NoAllocation, ExactJacobianWithBushingLineForceAndMix) {
+  const Model m = compile(parse_model_spec_text(kBushingAndMix, "elements.json"));
+  expect_no_allocation(m, "bushing, line_force and mix");
+}
 // a long chain: blocked factorizations and solves stay on the stack too
 TEST(NoAllocation, ExactJacobianNinetyLinkChain) {
   ModelSpec s;
