@@ -15,6 +15,9 @@
 #include <QMenu>
 #include <QProgressBar>
 #include <QPushButton>
+#include <QSpinBox>
+#include <QCheckBox>
+#include <QComboBox>
 #include <QTabWidget>
 #include <QTableWidget>
 #include <QTemporaryDir>
@@ -101,6 +104,49 @@ class SweepViewTest : public QObject {
     w->analysisTabs()->setCurrentWidget(view());
   }
   void cleanup() { drive::close(w); }
+
+  // the choices below the table driven as a person drives them: a wheel over the unfocused drop-down
+  // and spin boxes changes nothing; the controller picked from the open list with the mouse, the
+  // simulate box clicked, the figure picked from its list with the keys; the run then equals the
+  // core's study with the same choices (LQR redesigned per variant, peak |input| of each run)
+  void choicesDrivenAsAPersonDrivesThem() {
+    QVERIFY(pickRodMass());
+    typeSpec(0, "8:12:3");
+    drive::wheelOver(view()->redesignCombo(), -2);
+    drive::wheelOver(view()->samplesSpin(), 3);
+    drive::wheelOver(view()->threadsSpin(), 2);
+    QCOMPARE(view()->redesignCombo()->currentIndex(), 0);
+    QCOMPARE(view()->samplesSpin()->value(), 100);
+    QCOMPARE(view()->threadsSpin()->value(), 0);
+    QVERIFY(drive::pickWithMouse(view()->redesignCombo(), "LQR redesigned per variant"));
+    QCOMPARE(view()->redesignCombo()->currentData().toString(), QStringLiteral("lqr"));
+    QTest::mouseClick(view()->simulateCheck(), Qt::LeftButton, {}, QPoint(8, view()->simulateCheck()->height() / 2));
+    QVERIFY(view()->simulateCheck()->isChecked());
+    QVERIFY(runAndWait());
+    const SweepJob* shown = view()->result();
+    QVERIFY2(shown, qPrintable(view()->statusLabel()->text()));
+    QVERIFY(shown->redesigned);
+    QVERIFY(shown->simulated);
+    QVERIFY(drive::pickWithKeys(view()->figureCombo(), "peak |input| (nonlinear run)"));
+    SweepRequest r;
+    r.model = kCart.toStdString();
+    r.vary = {"/bodies/1/mass=8:12:3"};
+    r.threads = 1;
+    r.redesign = "lqr";
+    r.simulate = true;
+    const SweepJob direct = study_sweep_job(r);
+    QCOMPARE(direct.variants.size(), std::size_t(3));
+    const QList<QPointF> points = view()->figurePoints();
+    QCOMPARE(points.size(), 3);
+    for (int i = 0; i < 3; ++i) {
+      const SweepVariant& v = direct.variants[static_cast<std::size_t>(i)];
+      QCOMPARE(v.sim_status, 0);
+      QCOMPARE(points[i].x(), v.values[0]);
+      QVERIFY2(std::abs(points[i].y() - v.peak_input.cwiseAbs().maxCoeff()) <= 1e-12 * std::max(1.0, points[i].y()),
+               qPrintable(QString("variant %1: drawn %2, core %3").arg(i).arg(points[i].y()).arg(v.peak_input.cwiseAbs().maxCoeff())));
+      QVERIFY(v.peak_input.cwiseAbs().maxCoeff() > 0);
+    }
+  }
 
   void rodMassPolesEqualTheCore() {
     QVERIFY(pickRodMass());
