@@ -57,6 +57,22 @@ void resize_if(M& m, Eigen::Index r, Eigen::Index c) {
   if (m.rows() != r || m.cols() != c) m.resize(r, c);
 }
 
+// M a + J^T lam = f, J a + rhs = 0 in the loop workspace: w.X holds [f, J^T] (M's size x 1 + na),
+// w.J and w.rhs the kept rows. One factorization of M gives [M^-1 f, M^-1 J^T], the Schur
+// complement J M^-1 J^T the multipliers (w.lam), and w.X.col(0) becomes a; no heap once sized
+void schur_solve(const Eigen::MatrixXd& M, Data::LoopSolve& w, int na) {
+  cholesky_factor_into(M, w.L);
+  cholesky_solve_in_place(w.L, w.X);
+  resize_if(w.A, na, na);
+  w.A.noalias() = w.J * w.X.rightCols(na);
+  resize_if(w.lam, na, 1);
+  w.lam.noalias() = w.J * w.X.col(0);
+  w.lam += w.rhs;
+  cholesky_factor_into(w.A, w.LA);
+  cholesky_solve_in_place(w.LA, w.lam);
+  w.X.col(0).noalias() -= w.X.rightCols(na) * w.lam;
+}
+
 // the closed-loop branch of forward_dynamics in double, in data's workspace
 // (the same steps and the same arithmetic as the generic branch below, no heap
 // after the first call); forward_kinematics(q, v) and applied_forces have run
@@ -88,21 +104,11 @@ const Eigen::VectorXd& closed_loop_dynamics(const Model& model, Data& d, const E
     for (int k = 0; k < na; ++k)
       w.rhs[k] += 2.0 * stab.alpha * w.Jvel[k] + stab.beta * stab.beta * d.phi[w.rows[k]];
   }
-  // [qdd_free, M^-1 J^T] in one factorization
   resize_if(w.X, nv, 1 + na);
   w.X.col(0) = Q - d.nle;
   w.X.rightCols(na) = w.J.transpose();
-  cholesky_factor_into(d.M, w.L);
-  cholesky_solve_in_place(w.L, w.X);
-  resize_if(w.A, na, na);
-  w.A.noalias() = w.J * w.X.rightCols(na);
-  resize_if(w.lam, na, 1);
-  w.lam.noalias() = w.J * w.X.col(0);
-  w.lam += w.rhs;
-  cholesky_factor_into(w.A, w.LA);
-  cholesky_solve_in_place(w.LA, w.lam);
+  schur_solve(d.M, w, na);
   d.qdd = w.X.col(0);
-  d.qdd.noalias() -= w.X.rightCols(na) * w.lam;
   d.lambda.setZero(model.nc);
   for (int k = 0; k < na; ++k) d.lambda[w.rows[k]] = w.lam[k];
   return d.qdd;
@@ -161,19 +167,8 @@ const Eigen::VectorXd& prescribed_dynamics_double(const Model& model, Data& d, c
         w.rhs[k] += 2.0 * stab.alpha * Jvel + stab.beta * stab.beta * d.phi[w.rows[k]];
       }
     w.X.rightCols(na) = w.J.transpose();
-    cholesky_factor_into(w.Mff, w.L);
-    cholesky_solve_in_place(w.L, w.X);
-    if (na > 0) {
-      resize_if(w.A, na, na);
-      w.A.noalias() = w.J * w.X.rightCols(na);
-      resize_if(w.lam, na, 1);
-      w.lam.noalias() = w.J * w.X.col(0);
-      w.lam += w.rhs;
-      cholesky_factor_into(w.A, w.LA);
-      cholesky_solve_in_place(w.LA, w.lam);
-      w.X.col(0).noalias() -= w.X.rightCols(na) * w.lam;
-      for (int k = 0; k < na; ++k) d.lambda[w.rows[k]] = w.lam[k];
-    }
+    schur_solve(w.Mff, w, na);
+    for (int k = 0; k < na; ++k) d.lambda[w.rows[k]] = w.lam[k];
     for (int i = 0; i < nf; ++i) d.qdd[w.free[i]] = w.X(i, 0);
   }
   for (int k = 0; k < nm; ++k) d.qdd[w.driven[k]] = d.motion_acc[k];
