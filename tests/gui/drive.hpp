@@ -6,7 +6,11 @@
 
 #include <QAbstractItemView>
 #include <QApplication>
+#include <QAction>
 #include <QComboBox>
+#include <QMainWindow>
+#include <QMenu>
+#include <QMenuBar>
 #include <QMessageBox>
 #include <QTest>
 #include <QUndoStack>
@@ -58,6 +62,19 @@ inline bool pickWithKeys(QComboBox* c, const QString& text) {
     QTest::keyClick(v, v->currentIndex().row() < row ? Qt::Key_Down : Qt::Key_Up);
   QTest::keyClick(v, Qt::Key_Return);
   return QTest::qWaitFor([v] { return !v->isVisible(); }, 2000);
+}
+
+// the window's Edit > Add > "Add KIND" action (nullptr when there is none)
+inline QAction* addAction(QMainWindow* w, const QString& kind) {
+  for (QAction* top : w->menuBar()->actions()) {
+    if (top->text() != "&Edit" || !top->menu()) continue;
+    for (QAction* a : top->menu()->actions()) {
+      if (!a->menu()) continue;
+      for (QAction* b : a->menu()->actions())
+        if (b->text() == "Add " + kind) return b;
+    }
+  }
+  return nullptr;
 }
 
 // a wheel notch over the middle of `w` (delivered as Qt delivers one: to the widget under the mouse)

@@ -90,15 +90,7 @@ class ElementsEditingTest : public QObject {
 
   // Edit > Add > Add KIND, from the window's menu
   void add(const QString& kind) {
-    QAction* found = nullptr;
-    for (QAction* top : w->menuBar()->actions()) {
-      if (top->text() != "&Edit" || !top->menu()) continue;
-      for (QAction* a : top->menu()->actions()) {
-        if (!a->menu()) continue;
-        for (QAction* b : a->menu()->actions())
-          if (b->text() == "Add " + kind) found = b;
-      }
-    }
+    QAction* found = drive::addAction(w.get(), kind);
     QVERIFY2(found, qPrintable(kind));
     found->trigger();
     QVERIFY(props()->element());
