@@ -223,10 +223,11 @@ Linearization linearize_general(const Model& model, const OperatingPoint& op, co
 }  // namespace
 
 // The fast path (a tree without motion inputs, exact, automatic partition) computes what the
-// general path computes, with the same operations in the same order, so that every number is
-// the same bit for bit: the plant function's analytic_jacobian at x = [0; v] (A, B, C, D from
-// TreeDerivatives::compute at (q, v, u)), its eval_tree there (x0dot, y0: integrate_into of a zero
-// deviation, forward_dynamics, tangent_rate_into, sensor_value), and state_offset (x0).
+// general path computes: A, B, C, D with the same operations in the same order, so bit for bit
+// (the plant function's analytic_jacobian at x = [0; v]: TreeDerivatives::compute at (q, v, u)),
+// x0 as state_offset does; x0dot's accelerations and y0 are those TreeDerivatives computed on
+// the way (CRBA and a Cholesky solve; the general path evaluates ABA), equal to round-off, which
+// spares a forward-dynamics evaluation per point (a quarter of the Jacobian's cost at 7 DOF).
 struct Linearizer::Impl {
   const Model& m;
   const bool tree;  // no loop closures, no motion inputs: every coordinate independent, in order
@@ -236,16 +237,15 @@ struct Linearizer::Impl {
   std::vector<int> offset_q;  // [nv] the q index that x0's position entry k carries; -1: a rotation/translation tangent (0)
   std::unique_ptr<TreeDerivatives> td;
   std::unique_ptr<Data> data;
-  Eigen::VectorXd dq, q, rate;
+  Eigen::VectorXd dq, rate;
 
   explicit Impl(const Model& model) : m(model), tree(model.nc == 0 && model.motions.empty()) {}
 
   // what depends on the model only, made at the first call
   void prepare(const OperatingPoint& op) {
     partition = partition_coordinates(m, op.q);  // a tree: every coordinate, in order
-    const PlantFunction f(m, op.q, op.u, partition);
-    state_names = f.state_names();
-    state_units = f.state_units();
+    state_names = plant_state_names(m, partition.independent);
+    state_units = plant_state_units(m, partition.independent);
     for (int k : m.plant_inputs) {
       input_names.push_back(m.actuators[k].name);
       input_units.push_back(m.actuators[k].unit);
@@ -261,16 +261,15 @@ struct Linearizer::Impl {
       for (int c = 0; c < j.nv; ++c) offset_q[static_cast<std::size_t>(j.idx_v + c)] = j.idx_q + c;
     }
     td = std::make_unique<TreeDerivatives>(m);
-    data = std::make_unique<Data>(m);
+    if (!m.springs.empty()) data = std::make_unique<Data>(m);  // for refuse_coincident_spring_dampers
     dq = Eigen::VectorXd::Zero(m.nv);
-    q.resize(m.nq);
     rate.resize(m.nv);
     ready = true;
   }
 
   void linearize_tree(const OperatingPoint& op, Linearization& out) {
     if (!ready) prepare(op);
-    refuse_coincident_spring_dampers(m, op.q, *data);
+    if (data) refuse_coincident_spring_dampers(m, op.q, *data);
     const int n = m.nv, nu = static_cast<int>(m.plant_inputs.size()), ny = static_cast<int>(m.plant_outputs.size());
     if (op.q.size() != m.nq || op.v.size() != n || op.u.size() != m.nu())
       throw std::invalid_argument("linearize: the operating point has " + std::to_string(op.q.size()) + " positions, " +
@@ -301,16 +300,14 @@ struct Linearizer::Impl {
     s.C.leftCols(n) = d.dy_dq;
     s.C.rightCols(n) = d.dy_dv;
     s.D.setZero(ny, nu);
-    // x0dot and y0 (PlantFunction::eval_tree at x = [0; v])
-    Data& fd = *data;
-    integrate_into<double>(m, op.q, dq, q);
-    const Eigen::VectorXd& qdd = forward_dynamics<double>(m, fd, q, op.v, op.u);
+    // x0dot and y0: the accelerations and sensor values the Jacobian was taken at (its
+    // qdd, by CRBA and a Cholesky solve, agrees with ABA's to round-off), and the
+    // positions' rate at a zero deviation
     tangent_rate_into<double>(m, dq, op.v, rate);
     s.xdot0.resize(2 * n);
     s.xdot0.head(n) = rate;
-    s.xdot0.tail(n) = qdd;
-    s.y0.resize(ny);
-    for (int k = 0; k < ny; ++k) s.y0[k] = sensor_value<double>(m, fd, m.sensors[m.plant_outputs[k]], q, op.v);
+    s.xdot0.tail(n) = d.qdd;
+    s.y0 = d.y;
     // x0 (PlantFunction::state_offset), u0
     s.x0.setZero(2 * n);
     for (int k = 0; k < n; ++k) {

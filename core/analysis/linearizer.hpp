@@ -7,10 +7,11 @@
 //
 // On trees without motion inputs, with the exact method and the automatic
 // partition (every coordinate independent), it keeps the analytic derivatives'
-// workspace (TreeDerivatives), one Data for x0dot and y0, the partition, the
-// state, input and output names and units, and where each x0 entry comes
-// from; a call is then the exact Jacobian, one forward-dynamics evaluation at
-// the operating point and copies, with no heap allocation when writing into a
+// workspace (TreeDerivatives), the partition, the state, input and output
+// names and units, and where each x0 entry comes from; a call is then the
+// exact Jacobian (x0dot and y0 are its own accelerations and sensor values,
+// equal to a forward-dynamics evaluation's to round-off) and copies, with no
+// heap allocation when writing into a
 // Linearization of the same sizes. Other cases (closed loops, motion inputs,
 // finite differences, chosen independent coordinates) take linearize()'s
 // general path. linearize(model, op, options) is Linearizer(model).linearize(op,

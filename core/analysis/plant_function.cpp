@@ -681,27 +681,27 @@ const JointModel& joint_of(const Model& m, int i, int& k) {
 }
 }  // namespace
 
-std::vector<std::string> PlantFunction::state_names() const {
+std::vector<std::string> plant_state_names(const Model& model, const std::vector<int>& independent) {
   // Model::v_names and rate_names: for a ball or free joint the position states are the
   // rotation vector (and displacement) of the deviation, in the joint's frame at the operating point
-  std::vector<std::string> pos, vel;
-  for (int i : part_.independent) {
-    pos.push_back(model_.v_names[static_cast<std::size_t>(i)]);
-    vel.push_back(model_.rate_names[static_cast<std::size_t>(i)]);
-  }
-  pos.insert(pos.end(), vel.begin(), vel.end());
-  return pos;
+  std::vector<std::string> names;
+  names.reserve(2 * independent.size());
+  for (int i : independent) names.push_back(model.v_names[static_cast<std::size_t>(i)]);
+  for (int i : independent) names.push_back(model.rate_names[static_cast<std::size_t>(i)]);
+  return names;
 }
 
-std::vector<std::string> PlantFunction::state_units() const {
-  std::vector<std::string> pos, vel;
-  for (int i : part_.independent) {
-    pos.push_back(model_.v_units[i]);
-    vel.push_back(model_.v_units[i] + "/s");
-  }
-  pos.insert(pos.end(), vel.begin(), vel.end());
-  return pos;
+std::vector<std::string> plant_state_units(const Model& model, const std::vector<int>& independent) {
+  std::vector<std::string> units;
+  units.reserve(2 * independent.size());
+  for (int i : independent) units.push_back(model.v_units[static_cast<std::size_t>(i)]);
+  for (int i : independent) units.push_back(model.v_units[static_cast<std::size_t>(i)] + "/s");
+  return units;
 }
+
+std::vector<std::string> PlantFunction::state_names() const { return plant_state_names(model_, part_.independent); }
+
+std::vector<std::string> PlantFunction::state_units() const { return plant_state_units(model_, part_.independent); }
 
 Eigen::VectorXd PlantFunction::state_offset(const Eigen::VectorXd& v_ref) const {
   const int n = nz();

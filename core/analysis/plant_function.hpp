@@ -150,4 +150,9 @@ class PlantFunction {
   mutable Workspace ws_;
 };
 
+// The state names and units of a plant whose independent coordinates are `independent`
+// (PlantFunction::state_names and state_units, without making a plant function)
+std::vector<std::string> plant_state_names(const Model& model, const std::vector<int>& independent);
+std::vector<std::string> plant_state_units(const Model& model, const std::vector<int>& independent);
+
 }  // namespace codyna
