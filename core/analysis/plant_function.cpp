@@ -78,7 +78,10 @@ CoordinatePartition partition_coordinates(const Model& m, const Eigen::VectorXd&
                                   " coordinates independent");
     return p;
   }
-  const Eigen::MatrixXd J = active_jacobian(m, q, rows);
+  // a motion input's coordinate is neither independent nor dependent: its column takes no part
+  // in the choice (a zero column is pivoted last)
+  Eigen::MatrixXd J = active_jacobian(m, q, rows);
+  for (int i : p.driven) J.col(i).setZero();
   if (preferred.empty()) {
     // the dependent coordinates: the pivots of a column-pivoted QR. The coordinates a joint_force
     // actuator drives (a five-bar's cranks) are kept independent when that choice is well
@@ -156,6 +159,7 @@ CoordinatePartition partition_holding(const Model& m, const Eigen::VectorXd& q, 
   // dependent coordinates among the others: the held columns are left out of the pivoting
   Eigen::MatrixXd J = active_jacobian(m, q, rows);
   for (int i : held_v) J.col(i).setZero();
+  for (int k : m.motions) J.col(m.actuators[static_cast<std::size_t>(k)].iv).setZero();
   Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(J);
   const auto& perm = qr.colsPermutation().indices();
   std::set<int> dep;
@@ -339,7 +343,28 @@ void PlantFunction::eval(const VecXT<S>& x, const VecXT<S>& u, VecXT<S>& xdot, V
     // which carries the exact derivative (implicit function theorem) since phi ~ 0
     Eigen::VectorXd zv(n);
     for (int k = 0; k < n; ++k) zv[k] = ad_value(x[k]);
-    const Eigen::VectorXd dd = solve_dependent(zv);
+    Eigen::VectorXd dd = solve_dependent(zv);
+    if (!m.motions.empty()) {
+      // motion inputs on the loops' coordinates: Newton again from there with them at their values
+      Eigen::VectorXd dqv = Eigen::VectorXd::Zero(m.nv);
+      for (int i = 0; i < m.nv; ++i) dqv[i] = ad_value(dq[i]);
+      for (int k = 0; k < nd; ++k) dqv[dep[k]] = dd[k];
+      Data dv(m);
+      const Eigen::VectorXd zero = Eigen::VectorXd::Zero(m.nv);
+      for (int it = 0; it < 50; ++it) {
+        constraint_terms<double>(m, dv, integrate<double>(m, q_ref_, dqv), zero);
+        Eigen::VectorXd ph(nd);
+        Eigen::MatrixXd Jdd(nd, nd);
+        for (int k = 0; k < nd; ++k) {
+          ph[k] = dv.phi[rows_[k]];
+          for (int c = 0; c < nd; ++c) Jdd(k, c) = dv.Jc(rows_[k], dep[c]);
+        }
+        if (ph.lpNorm<Eigen::Infinity>() < 1e-14) break;
+        const Eigen::VectorXd st = Jdd.partialPivLu().solve(ph);
+        for (int k = 0; k < nd; ++k) dqv[dep[k]] -= st[k];
+      }
+      for (int k = 0; k < nd; ++k) dd[k] = dqv[dep[k]];
+    }
     for (int k = 0; k < nd; ++k) dq[dep[k]] = S(dd[k]);
     constraint_terms<S>(m, d, integrate<S>(m, q_ref_.cast<S>(), dq), zero_v);
     MatXT<S> Ja(nd, m.nv);
@@ -359,7 +384,16 @@ void PlantFunction::eval(const VecXT<S>& x, const VecXT<S>& u, VecXT<S>& xdot, V
     const MatXT<S> Jd = columns_t<S>(Ja, dep), Jz = columns_t<S>(Ja, ind);
     VecXT<S> w(n);
     for (int k = 0; k < n; ++k) w[k] = x[n + k];
-    const VecXT<S> vd = -lu_solve<S>(Jd, MatXT<S>(Jz * w)).col(0);
+    VecXT<S> Jw = Jz * w;
+    // the motion inputs' rates on the loops' driven columns: Jd v_dep = -Jz w - J_driven u'
+    for (int k : m.motions) {
+      const int i = m.actuators[static_cast<std::size_t>(k)].iv;
+      for (int r = 0; r < nd; ++r) {
+        const S p = Ja(r, i) * v[i];
+        Jw[r] = Jw[r] + p;
+      }
+    }
+    const VecXT<S> vd = -lu_solve<S>(Jd, MatXT<S>(Jw)).col(0);
     for (int k = 0; k < nd; ++k) v[dep[k]] = vd[k];
   }
   const VecXT<S> q = integrate<S>(m, q_ref_.cast<S>(), dq);

@@ -32,13 +32,20 @@ AssemblyResult assemble(const Model& model, const Eigen::VectorXd& q_guess, cons
   }
   Data d(model);
   const Eigen::VectorXd zero_v = Eigen::VectorXd::Zero(model.nv);
+  // a motion input's coordinate is where its motion puts it, and so is its rate: the loops close
+  // on the other coordinates
+  std::vector<int> locked_q = opt.locked_positions, locked_v = opt.locked_velocities;
+  for (int k : model.motions) {
+    locked_q.push_back(model.actuators[static_cast<std::size_t>(k)].iv);
+    locked_v.push_back(model.actuators[static_cast<std::size_t>(k)].iv);
+  }
   auto residual = [&](const Eigen::VectorXd& q) { return Eigen::VectorXd(constraint_residual<double>(model, d, q)); };
   Eigen::VectorXd phi = residual(r.q);
   for (r.iterations = 0; r.iterations < opt.max_iterations; ++r.iterations) {
     if (phi.lpNorm<Eigen::Infinity>() <= opt.tolerance) break;
     constraint_terms<double>(model, d, r.q, zero_v);
     Eigen::MatrixXd J = d.Jc;
-    for (int k : opt.locked_positions) J.col(k).setZero();  // a zero column gets a zero step (minimum norm)
+    for (int k : locked_q) J.col(k).setZero();  // a zero column gets a zero step (minimum norm)
     const Eigen::VectorXd step = -min_norm_solve(J, phi);
     double t = 1.0;
     bool improved = false;
@@ -61,7 +68,7 @@ AssemblyResult assemble(const Model& model, const Eigen::VectorXd& q_guess, cons
   constraint_terms<double>(model, d, r.q, zero_v);
   const Eigen::MatrixXd J = d.Jc;
   Eigen::MatrixXd J_free = J;
-  for (int k : opt.locked_velocities) J_free.col(k).setZero();
+  for (int k : locked_v) J_free.col(k).setZero();
   r.v = r.v - min_norm_solve(J_free, J * r.v);
   r.velocity_residual = (J * r.v).lpNorm<Eigen::Infinity>();
   r.converged = r.position_residual <= std::max(opt.tolerance, 1e-10) && r.velocity_residual <= 1e-8 * (1.0 + r.v.norm());

@@ -15,7 +15,8 @@ struct AssemblyOptions {
   double tolerance = 1e-12;    // on max |phi| (and max |Jc v|)
   int max_iterations = 100;
   // coordinates the user set (Adams' locked initial conditions): tangent indices whose
-  // position stays exactly as guessed, and velocity indices whose rate does; the others move
+  // position stays exactly as guessed, and velocity indices whose rate does; the others move.
+  // The coordinates of motion inputs (Model::motions) are always held, position and rate
   std::vector<int> locked_positions, locked_velocities;
 };
 

@@ -998,9 +998,9 @@ void TreeDerivatives::compute_constrained(const Eigen::VectorXd& q, const Eigen:
 }
 
 // Motion inputs: the driven coordinates d hold their accelerations, so the balance is kept on the
-// free coordinates f only (with the loops' kept rows r; a motion never drives a loop's coordinate,
-// Jc_rd = 0):
-//   M_ff da_f + Jr_f^T dlambda = (dQ - dtau)_f - M_fd da_d,   Jr_f da_f = -dc,
+// free coordinates f only (with the loops' kept rows r; Jr_d, the driven coordinates' columns, is
+// not zero where a motion drives a loop's coordinate, a four-bar's crank):
+//   M_ff da_f + Jr_f^T dlambda = (dQ - dtau)_f - M_fd da_d,   Jr_f da_f = -dc - Jr_d da_d,
 // where dtau and dc are taken at the whole a (the driven accelerations included), da_d = 0 for the
 // q, v and u columns and da_d = e_k for motion k's acceleration. The same Schur complement as
 // the loops without motion, on M_ff, which stays positive definite with massless driven bodies.
@@ -1043,6 +1043,7 @@ void TreeDerivatives::solve_prescribed(const std::vector<int>& rows) {
       for (int k = 0; k < na; ++k) {
         T_.row(k).head(nv) += dc_dq.row(rows[k]);
         T_.row(k).segment(nv, nv) += dc_dv.row(rows[k]);
+        for (int j = 0; j < nm; ++j) T_(k, 2 * nv + nu + j) += Jc(rows[k], driven_[j]);
       }
       llt_schur_.solveInPlace(T_);
       Rf_.noalias() -= Y_ * T_;

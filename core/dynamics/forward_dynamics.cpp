@@ -156,6 +156,8 @@ const Eigen::VectorXd& prescribed_dynamics_double(const Model& model, Data& d, c
   for (int k = 0; k < na; ++k) {
     for (int i = 0; i < nf; ++i) w.J(k, i) = d.Jc(w.rows[k], w.free[i]);
     w.rhs[k] = d.gamma[w.rows[k]];
+    // a driven coordinate of a loop: J_f a_f = -J_d a_d - gamma
+    for (int j = 0; j < nm; ++j) w.rhs[k] += d.Jc(w.rows[k], w.driven[j]) * d.motion_acc[j];
   }
   d.qdd.setZero(nv);
   d.lambda.setZero(model.nc);
@@ -172,15 +174,19 @@ const Eigen::VectorXd& prescribed_dynamics_double(const Model& model, Data& d, c
     for (int i = 0; i < nf; ++i) d.qdd[w.free[i]] = w.X(i, 0);
   }
   for (int k = 0; k < nm; ++k) d.qdd[w.driven[k]] = d.motion_acc[k];
-  for (int k = 0; k < nm; ++k) d.motion_force[k] = d.nle[w.driven[k]] - Q[w.driven[k]] + d.M.row(w.driven[k]).dot(d.qdd);
+  for (int k = 0; k < nm; ++k) {
+    d.motion_force[k] = d.nle[w.driven[k]] - Q[w.driven[k]] + d.M.row(w.driven[k]).dot(d.qdd);
+    for (int r = 0; r < na; ++r) d.motion_force[k] += d.Jc(w.rows[r], w.driven[k]) * d.lambda[w.rows[r]];  // the loops' share
+  }
   return d.qdd;
 }
 
 // Motion inputs: their coordinates d follow prescribed accelerations a (data.motion_acc; q and v
 // there are the caller's), so only the free coordinates f are unknown:
-//   M_ff qdd_f = (Q - nle - M_:d a)_f - J_f^T lambda,   J_f qdd_f + gamma = -stab
-// (a motion never drives a coordinate of a loop: J_d = 0, checked by prepare_model). The
-// generalized force each motion supplies is (M qdd + nle - Q)_d.
+//   M_ff qdd_f = (Q - nle - M_:d a)_f - J_f^T lambda,   J_f qdd_f + J_d a + gamma = -stab
+// (J_d: the loops' columns of the driven coordinates, a crank driven in a four-bar; prepare_model
+// checks that the loops keep the rank of Jc on the free columns, so the rows independent in Jc
+// are independent in J_f). The generalized force each motion supplies is (M qdd + nle - Q + Jc^T lambda)_d.
 template <class S>
 const VecXT<S>& prescribed_dynamics(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>& v,
                                     const VecXT<S>& Q, const Baumgarte& stab) {
@@ -222,7 +228,13 @@ const VecXT<S>& prescribed_dynamics(const Model& model, DataT<S>& d, const VecXT
     VecXT<S> qf = X.col(0);
     if (na > 0) {
       VecXT<S> crhs(na);
-      for (int k = 0; k < na; ++k) crhs[k] = d.gamma[rows[k]];
+      for (int k = 0; k < na; ++k) {
+        crhs[k] = d.gamma[rows[k]];
+        for (int j = 0; j < nm; ++j) {
+          const S p = d.Jc(rows[k], dr[j]) * d.motion_acc[j];
+          crhs[k] = crhs[k] + p;
+        }
+      }
       if (stab.alpha != 0.0 || stab.beta != 0.0)
         for (int k = 0; k < na; ++k) {
           S Jvel = S(0.0);
@@ -247,6 +259,10 @@ const VecXT<S>& prescribed_dynamics(const Model& model, DataT<S>& d, const VecXT
     S f = d.nle[dr[k]] - Q[dr[k]];
     for (int c = 0; c < nv; ++c) {
       const S p = d.M(dr[k], c) * d.qdd[c];
+      f = f + p;
+    }
+    for (int r : rows) {  // the loops' share, J_d^T lambda
+      const S p = d.Jc(r, dr[k]) * d.lambda[r];
       f = f + p;
     }
     d.motion_force[k] = f;

@@ -23,7 +23,8 @@ const VecXT<S>& forward_dynamics(const Model& model, DataT<S>& data, const VecXT
 // Motion inputs whose rates jump by `jump` (one per Model::motions entry: a ramp starting, a
 // table's knot) move the other coordinates impulsively: their velocity change dv_f follows from
 // the impulse balance on the free coordinates, M_ff dv_f = -M_fd jump - J_f^T Lambda with
-// J_f dv_f = 0 on the loops' independent rows at q. Returns dv (nv; jump on the driven coordinates).
+// J_f dv_f = -J_d jump on the loops' independent rows at q (J_d: the driven coordinates' columns).
+// Returns dv (nv; jump on the driven coordinates).
 Eigen::VectorXd prescribed_velocity_jump(const Model& model, Data& data, const Eigen::VectorXd& q,
                                          const Eigen::VectorXd& jump);
 

@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
+#include <Eigen/SVD>
 #include <cmath>
 #include <sstream>
 
@@ -57,11 +58,18 @@ class Preparer {
     const Eigen::VectorXd q = m_.q0, v = m_.v0;
     const AssemblyResult r = assemble(m_, q, v);
     if (r.position_residual > 1e-9) {
-      int k = 0;
-      while (k + 1 < static_cast<int>(m_.constraints.size()) && m_.constraints[k + 1].row <= r.worst_row) ++k;
-      fail(at("constraints", k), "the loop cannot be assembled from the joints' q0: residual " + fmt(r.position_residual) +
-                                     " on " + m_.row_names[r.worst_row] + " after " + std::to_string(r.iterations) +
-                                     " iterations (check the constraint points and the joints' q0)");
+      // the motion inputs' coordinates stay at their q0 (assemble holds them): say so
+      std::string held;
+      for (int k : m_.motions) {
+        const ActuatorModel& a = m_.actuators[static_cast<std::size_t>(k)];
+        held += (held.empty() ? "" : ", ") + quoted(m_.v_names[a.iv]) + " = " + fmt(q[a.iq]) + " (motion input " +
+                quoted(a.name) + ")";
+      }
+      fail(at("constraints", constraint_of_row(r.worst_row)),
+           "the loop cannot be assembled from the joints' q0: residual " + fmt(r.position_residual) + " on " +
+               m_.row_names[r.worst_row] + " after " + std::to_string(r.iterations) + " iterations" +
+               (held.empty() ? "" : " with " + held + " held where the motion puts it") +
+               " (check the constraint points and the joints' q0)");
     }
     m_.q0 = r.q;
     m_.v0 = r.v;
@@ -87,22 +95,59 @@ class Preparer {
     const RowPartition rows = partition_rows(d.Jc);
     m_.active_rows = rows.independent;
     m_.redundant_rows = rows.redundant;
-    // a motion input holds a coordinate no loop may move (loops on prescribed coordinates are not
-    // solved yet): its column of the loops' Jacobian must vanish
-    for (int k : m_.motions) {
-      const ActuatorModel& a = m_.actuators[k];
-      for (std::size_t c = 0; c < m_.constraints.size(); ++c) {
-        const ConstraintModel& cm = m_.constraints[c];
-        if (d.Jc.block(cm.row, a.iv, cm.nrows, 1).cwiseAbs().maxCoeff() == 0.0) continue;
-        std::size_t spec_k = 0;
-        for (std::size_t i = 0; i < m_.spec.actuators.size(); ++i)
-          if (m_.spec.actuators[i].name == a.name) spec_k = i;
-        fail(at("actuators", spec_k) + "/joint",
-             "the motion input " + quoted(a.name) + " drives " + quoted(m_.v_names[a.iv]) + ", which the loop closure " +
-                 quoted(cm.name) + " moves; a motion input on a coordinate of a loop is not supported yet (drive a "
-                 "coordinate outside the loops, or use a joint_force)");
+    check_driven_loops(d.Jc, static_cast<int>(rows.independent.size()));
+  }
+
+  // index into spec.actuators of the motion input k (an index into Model::actuators)
+  std::size_t spec_actuator(int k) const {
+    for (std::size_t i = 0; i < m_.spec.actuators.size(); ++i)
+      if (m_.spec.actuators[i].name == m_.actuators[static_cast<std::size_t>(k)].name) return i;
+    return 0;
+  }
+
+  // the constraint a row belongs to
+  std::size_t constraint_of_row(int row) const {
+    std::size_t c = 0;
+    while (c + 1 < m_.constraints.size() && m_.constraints[c + 1].row <= row) ++c;
+    return c;
+  }
+
+  // Motion inputs on the loops' coordinates (a four-bar's crank): the loops must close on the free
+  // coordinates whatever the driven ones do, i.e. the free columns J_f keep the rank of Jc at q0.
+  // A combination y of rows with y^T J_f = 0 but y^T J_d != 0 fixes the driven coordinates from the
+  // others: the motion over-drives the loop (two motions on a one-DOF loop, a motion on a rigid one).
+  void check_driven_loops(const Eigen::MatrixXd& Jc, int rank) {
+    if (m_.motions.empty() || rank == 0) return;
+    Eigen::MatrixXd Jf = Jc;
+    for (int k : m_.motions) Jf.col(m_.actuators[static_cast<std::size_t>(k)].iv).setZero();
+    const double largest = Eigen::JacobiSVD<Eigen::MatrixXd>(Jc).singularValues()[0];
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(Jf.transpose(), Eigen::ComputeFullV);  // Jf^T = U S V^T
+    const Eigen::VectorXd& s = svd.singularValues();
+    int rank_f = 0;
+    while (rank_f < s.size() && s[rank_f] > 1e-9 * largest) ++rank_f;
+    if (rank_f >= rank) return;
+    // the row combination (a column of V past J_f's rank) that sees the driven coordinates most
+    double worst = -1.0;
+    int motion = m_.motions.front(), row = 0;
+    for (int c = rank_f; c < svd.matrixV().cols(); ++c) {
+      const Eigen::VectorXd y = svd.matrixV().col(c);
+      for (int k : m_.motions) {
+        const double g = std::abs(y.dot(Jc.col(m_.actuators[static_cast<std::size_t>(k)].iv)));
+        if (g > worst) {
+          worst = g;
+          motion = k;
+          y.cwiseAbs().maxCoeff(&row);
+        }
       }
     }
+    const ActuatorModel& a = m_.actuators[static_cast<std::size_t>(motion)];
+    const ConstraintModel& cm = m_.constraints[constraint_of_row(row)];
+    fail(at("actuators", spec_actuator(motion)) + "/joint",
+         "the motion input " + quoted(a.name) + " drives " + quoted(m_.v_names[a.iv]) + ", which the loop closure " +
+             quoted(cm.name) + " fixes from the other coordinates at q0" +
+             (m_.motions.size() > 1 ? " and the other motion inputs" : "") + ": on the coordinates no motion drives the closure rows have rank " +
+             std::to_string(rank_f) + ", not " + std::to_string(rank) + " (the motion over-drives or locks the loop; drive a coordinate the loop leaves free, drive fewer, or "
+             "use a joint_force)");
   }
 
   // The tree's mass matrix is positive definite exactly when every joint's articulated

@@ -5,6 +5,7 @@
 #include <Eigen/QR>
 #include <Eigen/SVD>
 #include <algorithm>
+#include <cmath>
 
 #include "dynamics/assembly.hpp"
 #include "dynamics/constraints.hpp"
@@ -257,15 +258,26 @@ void ClosedLoopSystem::project_tangent(const Eigen::VectorXd& y, Eigen::VectorXd
   constraint_terms<double>(model_, data_, y.head(model_.nq), Eigen::VectorXd::Zero(model_.nv));
   Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod;
   cod.setThreshold(1e-9);
-  cod.compute(data_.Jc);
-  auto remove_normal = [&](auto&& block) { block -= cod.solve(data_.Jc * Eigen::VectorXd(block)); };
+  // a motion input's coordinate and rate have no error (they are set), and its column takes no part
+  Eigen::MatrixXd& J = data_.Jc;
+  for (int k : model_.motions) {
+    const ActuatorModel& a = model_.actuators[static_cast<std::size_t>(k)];
+    J.col(a.iv).setZero();
+    e[a.iq] = 0.0;
+    e[model_.nq + a.iv] = 0.0;
+  }
+  cod.compute(J);
+  auto remove_normal = [&](auto&& block) { block -= cod.solve(J * Eigen::VectorXd(block)); };
   remove_normal(e.segment(model_.nq, model_.nv));
   if (model_.nq == model_.nv) remove_normal(e.head(model_.nq));
 }
 
-bool ClosedLoopSystem::project(Eigen::VectorXd& y, double tol) {
+bool ClosedLoopSystem::project(Eigen::VectorXd& y, double tol, double t) {
   if (model_.nc == 0) return false;
-  const Eigen::VectorXd q = y.head(model_.nq), v = y.segment(model_.nq, model_.nv);
+  Eigen::VectorXd q = y.head(model_.nq), v = y.segment(model_.nq, model_.nv);
+  // the driven coordinates where their motions are (assemble holds them and closes the loops on the
+  // others); apply_motions' accelerations are set again by the next rhs
+  if (!model_.motions.empty() && !std::isnan(t)) apply_motions(t, q, v);
   const auto [p, w] = violation(q, v);
   if (p <= tol && w <= tol * std::max(1.0, v.norm())) return false;
   AssemblyOptions opt;

@@ -11,6 +11,8 @@
 // Not thread-safe: one ClosedLoopSystem per simulation (it owns a Data).
 #pragma once
 
+#include <limits>
+
 #include <Eigen/Core>
 #include <functional>
 #include <memory>
@@ -71,8 +73,10 @@ class ClosedLoopSystem {
   // the DAE form's constraint rows (chosen in consistent()) have become ill-conditioned
   // at q compared with the best choice: the integrator should be reset
   bool rows_degraded(const Eigen::VectorXd& q);
-  // back onto phi = 0, Jc v = 0 if the violation exceeds tol; returns whether it moved
-  bool project(Eigen::VectorXd& y, double tol);
+  // back onto phi = 0, Jc v = 0 if the violation exceeds tol; returns whether it moved. The motion
+  // inputs' coordinates are held: at their prescribed u(t), u'(t) when t is given (not NaN), else
+  // where y has them
+  bool project(Eigen::VectorXd& y, double tol, double t = std::numeric_limits<double>::quiet_NaN());
   // removes from a state-space vector e (ODE layout, e.g. an error estimate) its components
   // normal to the constraint manifold at y: Jc e_v = 0 and, where q is additive, Jc e_q = 0
   void project_tangent(const Eigen::VectorXd& y, Eigen::VectorXd& e);

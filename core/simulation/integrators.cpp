@@ -181,12 +181,12 @@ class Cvode final : public SundialsBase {
   Eigen::MatrixXd jac_;  // workspace of the exact Jacobian
   // CVProjFn: the correction that brings ycur back onto phi = 0, Jc v = 0, and the error
   // estimate projected onto the constraints' tangent space (CVODE's default expects both)
-  static int project(double, N_Vector ycur, N_Vector corr, double, N_Vector err, void* self) {
+  static int project(double t, N_Vector ycur, N_Vector corr, double, N_Vector err, void* self) {
     auto* me = static_cast<Cvode*>(static_cast<SundialsBase*>(self));
     return me->guarded([&] {
       Eigen::VectorXd y = view(ycur);
       const Eigen::VectorXd y0 = y;
-      if (me->sys_.project(y, 0.0)) ++me->projections_;
+      if (me->sys_.project(y, 0.0, t)) ++me->projections_;
       view(corr) = y - y0;
       if (err) {
         Eigen::VectorXd e = view(err);
@@ -240,11 +240,11 @@ class Erk final : public SundialsBase {
  private:
   // after every accepted step, back onto phi = 0, Jc v = 0 (a one-step method starts the next
   // step from the projected state, so this costs no accuracy)
-  static int project(double, N_Vector y, void* self) {
+  static int project(double t, N_Vector y, void* self) {
     auto* me = static_cast<Erk*>(static_cast<SundialsBase*>(self));
     return me->guarded([&] {
       Eigen::VectorXd x = view(y);
-      if (me->sys_.project(x, 0.0)) ++me->projections_, view(y) = x;
+      if (me->sys_.project(x, 0.0, t)) ++me->projections_, view(y) = x;
     });
   }
 };

@@ -219,24 +219,28 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
   // initial state, on the constraint manifold
   Eigen::VectorXd q0 = o.q0.size() ? o.q0 : model.q0, v0 = o.v0.size() ? o.v0 : model.v0;
   if (q0.size() != model.nq || v0.size() != model.nv) throw std::invalid_argument("simulate: initial state has the wrong size");
+  // a motion that starts moving at t0 (a ramp from 0, a table's first segment) jolts the others
+  // from the state given, as at any later jump of its rate
+  const Eigen::VectorXd jump0 =
+      model.motions.empty() ? Eigen::VectorXd()
+                            : Eigen::VectorXd(sys.motion_rates(o.t0) -
+                                              sys.motion_rates(o.t0 - 1e-9 * std::max(1.0, std::abs(o.t0))));
+  // the driven coordinates where their motions start, their rates those just before t0; the
+  // loops close on the others (assemble holds the driven ones)
+  sys.apply_motions(o.t0, q0, v0);
+  for (std::size_t i = 0; i < model.motions.size(); ++i)
+    v0[model.actuators[static_cast<std::size_t>(model.motions[i])].iv] -= jump0[static_cast<Eigen::Index>(i)];
   if (model.nc) {
     const AssemblyResult a = assemble(model, q0, v0);
     if (!a.converged) throw std::invalid_argument("simulate: the initial state cannot be assembled onto the loop closures");
     q0 = a.q;
     v0 = a.v;
   }
-  sys.apply_motions(o.t0, q0, v0);  // the driven coordinates where their motions start
-  if (!model.motions.empty()) {
-    // a motion that starts moving at t0 (a ramp from 0, a table's first segment) jolts the others
-    // from the state given, as at any later jump of its rate
-    const Eigen::VectorXd jump = sys.motion_rates(o.t0) - sys.motion_rates(o.t0 - 1e-9 * std::max(1.0, std::abs(o.t0)));
-    if (jump.cwiseAbs().maxCoeff() > 0) {
-      Data dj(model);
-      Eigen::VectorXd dv = prescribed_velocity_jump(model, dj, q0, jump);
-      for (int k : model.motions) dv[model.actuators[static_cast<std::size_t>(k)].iv] = 0;  // set by apply_motions
-      v0 += dv;
-    }
+  if (jump0.size() && jump0.cwiseAbs().maxCoeff() > 0) {
+    Data dj(model);
+    v0 += prescribed_velocity_jump(model, dj, q0, jump0);  // jump0 on the driven coordinates
   }
+  sys.apply_motions(o.t0, q0, v0);
   Eigen::VectorXd y(sys.ode_size());
   y << q0, v0, Eigen::VectorXd::Zero(sys.nxc());
 
@@ -357,7 +361,7 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
       }
       ++jump_index;
     }
-    if (model.nc && !integrator->projects() && sys.project(y, projection_tolerance)) {
+    if (model.nc && !integrator->projects() && sys.project(y, projection_tolerance, t)) {
       ++r.stats.projections;
       restart = true;
     }

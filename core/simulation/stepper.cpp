@@ -68,7 +68,7 @@ const Eigen::VectorXd& Stepper::step(const Eigen::VectorXd& u, double dt) {
   integrator_->advance(t_ + dt);
   t_ += dt;
   y_ = integrator_->state();
-  if (model_.nc && !integrator_->projects() && sys_.project(y_, projection_tolerance_)) ++extra_.projections;
+  if (model_.nc && !integrator_->projects() && sys_.project(y_, projection_tolerance_, t_)) ++extra_.projections;
   measure();
   return out_;
 }

@@ -328,9 +328,13 @@ TEST(Motion, BadMotionInputsAreRefusedAtTheField) {
   EXPECT_EQ(error_path(with(motion, motion + R"(, {"name": "again", "type": "motion", "joint": "x"})")).rfind("/actuators/1/joint", 0), 0u);
   EXPECT_EQ(error_path(with(motion, motion + R"(, {"name": "m", "type": "mix", "drives": ["table"], "weights": [1]})")).rfind("/actuators/1/drives/0", 0), 0u);
   EXPECT_EQ(error_path(with(R"("q0": 0.1})", R"("q0": 0.1, "v0": 0.5})")).rfind("/joints/0/v0", 0), 0u);
-  // a coordinate of a loop: the table coupled to the rod's angle
+  // a loop over-driven: the table coupled to the rod's angle, and both driven (a motion on a
+  // loop's coordinate is fine while the loop leaves the others free: tests/core/motion_loop_test.cpp)
   const std::string looped = with(R"("effects")", R"("constraints": [{"name": "link", "type": "coupler", "joint_a": "x", "ratio_a": 1, "joint_b": "theta", "ratio_b": 0.5}], "effects")");
-  const std::string err = error_path(looped);
+  EXPECT_EQ(error_path(looped), "no error");
+  std::string overdriven = with(motion, motion + R"(, {"name": "rod", "type": "motion", "joint": "theta"})");
+  overdriven.replace(overdriven.find(R"("effects")"), 9, R"("constraints": [{"name": "link", "type": "coupler", "joint_a": "x", "ratio_a": 1, "joint_b": "theta", "ratio_b": 0.5}], "effects")");
+  const std::string err = error_path(overdriven);
   EXPECT_EQ(err.rfind("/actuators/0/joint", 0), 0u) << err;
   EXPECT_NE(err.find("\"link\""), std::string::npos) << err;
 }
