@@ -1306,6 +1306,24 @@ ModelSpec parse_model_spec(const nlohmann::json& j, const std::string& file_labe
   return spec;
 }
 
+bool parse_model_element(ModelSpec& spec, const std::string& section, std::size_t index, const nlohmann::json& element,
+                         const std::string& file_label) {
+  const Node n(element, "/" + section + "/" + std::to_string(index), file_label);
+  const auto read = [&](auto& list) {
+    using T = typename std::decay_t<decltype(list)>::value_type;
+    if (index >= list.size()) return false;
+    list[index] = read_struct<T>(n);
+    return true;
+  };
+  if (section == "bodies") return read(spec.bodies);
+  if (section == "joints") return read(spec.joints);
+  if (section == "constraints") return read(spec.constraints);
+  if (section == "effects") return read(spec.effects);
+  if (section == "actuators") return read(spec.actuators);
+  if (section == "sensors") return read(spec.sensors);
+  return false;
+}
+
 ModelSpec parse_model_spec_text(const std::string& text, const std::string& file_label) {
   json j;
   // the path of the value being read, so that a JSON error inside a field (a number that

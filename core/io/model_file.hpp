@@ -23,6 +23,14 @@ ModelSpec load_model_spec(const std::string& path);
 // Parses a JSON document; `file_label` names it in error messages.
 ModelSpec parse_model_spec(const nlohmann::json& j, const std::string& file_label);
 
+// Reads one element of a model file's arrays ("bodies", "joints", "constraints", "effects",
+// "actuators", "sensors") from its JSON into spec.<section>[index], as parse_model_spec reads
+// it (errors name /section/index/...). A parameter study varies a number of one element: the
+// rest of the nominal spec is kept, not read again. Returns false, changing nothing, for a
+// section that is not one of these arrays or an index outside it.
+bool parse_model_element(ModelSpec& spec, const std::string& section, std::size_t index, const nlohmann::json& element,
+                         const std::string& file_label);
+
 // Parses JSON text; malformed JSON gives a ModelError with line and column.
 ModelSpec parse_model_spec_text(const std::string& text, const std::string& file_label);
 

@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <chrono>
 #include <cmath>
@@ -27,6 +28,7 @@
 #include "io/atomic_file.hpp"
 #include "io/hdf5_handle.hpp"
 #include "io/hdf5_quiet.hpp"
+#include "io/model_file.hpp"
 #include "model/errors.hpp"
 #include "study/files.hpp"
 #include "study/tools.hpp"
@@ -218,11 +220,23 @@ std::string joined(const std::vector<std::string>& v) {
   return s;
 }
 
+// The varied fields of one element of the model file's arrays (/bodies/1/mass, /bodies/1/com/0):
+// a variant reads that element again into a copy of the nominal spec (io/model_file.hpp,
+// parse_model_element), the rest of the file is not read again.
+struct ElementEdit {
+  std::string section;
+  std::size_t index = 0;
+  std::vector<std::pair<nlohmann::json::json_pointer, std::size_t>> fields;  // below the element; which value
+};
+
 struct Context {
   const SweepRequest* request;
   const SweepPlan* plan;
   const nlohmann::json* file;
+  const ModelSpec* nominal = nullptr;
   std::vector<nlohmann::json::json_pointer> pointers;
+  std::vector<ElementEdit> edits;
+  bool whole_file = false;  // a varied field outside the element arrays: each variant's file is read whole
   LinearizeRequest linearize;
   int nx = 0, nu = 0, ny = 0;
   std::vector<std::string> state_names;
@@ -324,14 +338,55 @@ void simulate_variant(const Context& c, nlohmann::json j, SweepVariant& v) {
   }
 }
 
+// the variant's model file, the varied fields set
+nlohmann::json variant_file(const Context& c, const SweepVariant& v) {
+  nlohmann::json j = *c.file;
+  for (std::size_t k = 0; k < c.pointers.size(); ++k) j[c.pointers[k]] = v.values[k];
+  return j;
+}
+
+// the variant's spec: what reading variant_file gives, by reading only the edited elements again
+ModelSpec variant_spec(const Context& c, const SweepVariant& v) {
+  if (c.whole_file) return study_parse_model(variant_file(c, v), c.request->model);
+  ModelSpec spec = *c.nominal;
+  for (const ElementEdit& e : c.edits) {
+    nlohmann::json element = (*c.file)[e.section][e.index];
+    for (const auto& [pointer, k] : e.fields) element[pointer] = v.values[k];
+    parse_model_element(spec, e.section, e.index, element, c.request->model);
+  }
+  return spec;
+}
+
+// which element each varied field belongs to (Context::edits), or whole_file
+void plan_edits(Context& c, const std::vector<SweepVary>& vary) {
+  static const char* const sections[] = {"bodies", "joints", "constraints", "effects", "actuators", "sensors"};
+  for (std::size_t k = 0; k < vary.size(); ++k) {
+    const std::string& f = vary[k].field;  // "/section/index/rest..."
+    const std::size_t a = f.find('/', 1), b = a == std::string::npos ? a : f.find('/', a + 1);
+    const std::string section = f.substr(1, a == std::string::npos ? std::string::npos : a - 1);
+    const std::string index = a == std::string::npos ? "" : f.substr(a + 1, b == std::string::npos ? b : b - a - 1);
+    const bool known = std::find_if(std::begin(sections), std::end(sections),
+                                    [&](const char* s) { return section == s; }) != std::end(sections);
+    const bool digits = !index.empty() && index.size() < 9 && std::all_of(index.begin(), index.end(), ::isdigit) &&
+                        (index == "0" || index[0] != '0');
+    if (!known || !digits || b == std::string::npos || !c.file->contains(section) || !(*c.file)[section].is_array() ||
+        std::stoul(index) >= (*c.file)[section].size() || !(*c.file)[section][std::stoul(index)].is_object()) {
+      c.whole_file = true;
+      return;
+    }
+    const std::size_t i = std::stoul(index);
+    auto it = std::find_if(c.edits.begin(), c.edits.end(), [&](const ElementEdit& e) { return e.section == section && e.index == i; });
+    if (it == c.edits.end()) it = c.edits.insert(c.edits.end(), ElementEdit{section, i, {}});
+    it->fields.emplace_back(nlohmann::json::json_pointer(f.substr(b)), k);
+  }
+}
+
 void run_variant(const Context& c, long long i, SweepVariant& v) {
   v.values = c.plan->values(i);
   try {
-    nlohmann::json j = *c.file;
-    for (std::size_t k = 0; k < c.pointers.size(); ++k) j[c.pointers[k]] = v.values[k];
-    const ModelSpec spec = study_parse_model(j, c.request->model);
+    const ModelSpec spec = variant_spec(c, v);
     const auto simulate_after = [&] {
-      if (c.simulate) simulate_variant(c, std::move(j), v);
+      if (c.simulate) simulate_variant(c, variant_file(c, v), v);
     };
     const LinearizeJob lj = study_linearize_job(c.linearize, spec);
     const LinearSystem& sys = lj.linearization.lin.system;  // continuous
@@ -730,7 +785,9 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
   c.request = &r;
   c.plan = &job.plan;
   c.file = &file;
+  c.nominal = &nominal_spec;
   for (const SweepVary& v : job.plan.vary) c.pointers.emplace_back(v.field);
+  plan_edits(c, job.plan.vary);
   c.linearize.style = r.style;
   c.linearize.model = r.model;
   const LinearizeJob nominal = study_linearize_job(c.linearize, nominal_spec);

@@ -1092,3 +1092,53 @@ TEST(ModelFileErrors, OverflowingNumberNamesItsField) {
   EXPECT_EQ(path_of(R"({"name": "p", "bodies": [{"name": "b", "mass": 1, "com": [0, 1, )" + std::string(400, '9') +
                     "]}], \"joints\": []}").substr(0, 16), "/bodies/0/com/2:");
 }
+
+namespace codyna {
+namespace {
+
+// parse_model_element reads one element as parse_model_spec reads the whole file: on every
+// example, each element of each array read again from its (edited) JSON into a copy of the
+// file's spec gives the spec of the edited file read whole; a bad value names its field.
+TEST(ModelFile, OneElementReadAgainEqualsTheWholeFileRead) {
+  int checked = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(CODYNA_EXAMPLES_DIR)) {
+    if (entry.path().extension() != ".json") continue;
+    const std::string path = entry.path().string();
+    std::ifstream in(path);
+    const nlohmann::json file = nlohmann::json::parse(in);
+    const ModelSpec spec = parse_model_spec(file, path);
+    for (const char* section : {"bodies", "joints", "constraints", "effects", "actuators", "sensors"}) {
+      if (!file.contains(section)) continue;
+      for (std::size_t i = 0; i < file[section].size(); ++i) {
+        nlohmann::json edited = file;
+        nlohmann::json& e = edited[section][i];
+        if (e.contains("mass")) e["mass"] = e["mass"].get<double>() * 1.5;   // a number changed, when there is one
+        if (e.contains("gain")) e["gain"] = e["gain"].get<double>() * 0.5;
+        ModelSpec copy = spec;
+        ASSERT_TRUE(parse_model_element(copy, section, i, e, path)) << path << " " << section << " " << i;
+        EXPECT_EQ(to_json(copy), to_json(parse_model_spec(edited, path))) << path << " /" << section << "/" << i;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 100);
+  const std::string cart = std::string(CODYNA_EXAMPLES_DIR) + "/cart_pendulum.json";
+  std::ifstream in(cart);
+  const nlohmann::json file = nlohmann::json::parse(in);
+  ModelSpec spec = parse_model_spec(file, cart);
+  nlohmann::json rod = file["bodies"][1];
+  rod["mass"] = "heavy";
+  try {
+    parse_model_element(spec, "bodies", 1, rod, cart);
+    ADD_FAILURE() << "a mass of \"heavy\" was read";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("/bodies/1/mass"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(cart), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(spec.bodies[1].mass, 10.0) << "nothing changed by a refused element";
+  EXPECT_FALSE(parse_model_element(spec, "solver", 0, rod, cart));
+  EXPECT_FALSE(parse_model_element(spec, "bodies", 7, rod, cart));
+}
+
+}  // namespace
+}  // namespace codyna

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -119,6 +120,40 @@ TEST(Sweep, FixedLqrClosedLoopPolesAreEigOfEachVariantsOwnLinearization) {
   EXPECT_EQ(job.failed, 0);
   EXPECT_EQ(job.stable, 11);
   EXPECT_EQ(job.worst, 0);  // the lightest rod is the least damped closed loop
+}
+
+// A variant reads again only the elements whose fields vary (parse_model_element into a copy of
+// the nominal spec); a field outside the element arrays makes each variant read its whole file.
+// Both give every variant's A, B, C, D, poles and figures bit for bit as the variant's own file
+// read whole and linearized does.
+TEST(Sweep, ElementsReadAgainEqualTheVariantsWholeFile) {
+  for (const bool outside : {false, true}) {
+    SweepRequest r;
+    r.model = kModel;
+    r.vary = {"/bodies/1/mass=8:12:3", "/bodies/1/com/1=[0.9,1.1]", "/effects/0/g/1=[-9.7,-9.81]"};
+    if (outside) r.vary.push_back("/solver/rtol=[1e-9]");
+    r.threads = 1;
+    const SweepJob job = study_sweep_job(r);
+    ASSERT_EQ(job.variants.size(), 12u);
+    for (long long i = 0; i < 12; ++i) {
+      const SweepVariant& v = job.variants[static_cast<std::size_t>(i)];
+      ASSERT_EQ(v.status, SweepStatus::Ok) << v.reason;
+      nlohmann::json j = model_json();
+      j["bodies"][1]["mass"] = v.values[0];
+      j["bodies"][1]["com"][1] = v.values[1];
+      j["effects"][0]["g"][1] = v.values[2];
+      if (outside) j["solver"]["rtol"] = v.values[3];
+      LinearizeRequest lr;
+      lr.model = kModel;
+      const LinearSystem own = study_linearize_job(lr, study_parse_model(j, kModel)).linearization.lin.system;
+      for (auto [a, b] : {std::pair{&v.A, &own.A}, {&v.B, &own.B}, {&v.C, &own.C}, {&v.D, &own.D}}) {
+        ASSERT_EQ(a->rows(), b->rows());
+        ASSERT_EQ(a->cols(), b->cols());
+        EXPECT_EQ(std::memcmp(a->data(), b->data(), sizeof(double) * static_cast<std::size_t>(a->size())), 0)
+            << "variant " << i << (outside ? " (whole files)" : " (elements)");
+      }
+    }
+  }
 }
 
 TEST(Sweep, RedesignedLqrIsDesignedOnEachVariant) {
