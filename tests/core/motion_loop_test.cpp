@@ -266,6 +266,23 @@ TEST(MotionLoop, TheCrankAsAPlantInputLinearizesAsTheClosedForm) {
   EXPECT_NEAR(y[1], G.x, 1e-12);
 }
 
+// the example's own study: the crank held (a motion outside Plant/In, at rest), the follower
+// pushed; the drive torque as an output, at rest tau = m_r g p_y' + x_theta (F - k s)
+TEST(MotionLoop, TheDriveTorqueLinearizesAsTheVirtualWorkAtRest) {
+  const LinearSystem s = study_linearize(study_model(example())).system;
+  ASSERT_EQ(s.nx(), 2);
+  ASSERT_EQ(s.output_names.size(), 3u);
+  EXPECT_EQ(s.output_names[2], "drive_torque");
+  const Geometry G = geometry(0.5);
+  EXPECT_NEAR(s.A(1, 0), -k / m2, 1e-10);
+  EXPECT_NEAR(s.B(1, 0), 1 / m2, 1e-12);
+  EXPECT_NEAR(s.C(2, 0), -k * G.x1, 1e-10);
+  EXPECT_NEAR(s.C(2, 1), 0.0, 1e-12);
+  EXPECT_NEAR(s.D(2, 0), G.x1, 1e-12);
+  EXPECT_NEAR(s.y0[2], drive_torque(0.5, 0, 0, 0), 1e-12);
+  EXPECT_NEAR(s.y0[0], G.x, 1e-13);
+}
+
 std::string error_of(const ModelSpec& spec) {
   try {
     study_model(spec);
