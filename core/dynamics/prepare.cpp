@@ -58,6 +58,12 @@ class Preparer {
     const Eigen::VectorXd q = m_.q0, v = m_.v0;
     const AssemblyResult r = assemble(m_, q, v);
     if (r.position_residual > 1e-9) {
+      // motions that over-drive a loop cannot close it anywhere: say that first
+      if (!m_.motions.empty()) {
+        Data d(m_);
+        constraint_terms<double>(m_, d, r.q, r.v);
+        check_driven_loops(d.Jc, static_cast<int>(partition_rows(d.Jc).independent.size()));
+      }
       // the motion inputs' coordinates stay at their q0 (assemble holds them): say so
       std::string held;
       for (int k : m_.motions) {

@@ -306,6 +306,13 @@ TEST(MotionLoop, MotionsThatOverDriveOrCannotCloseTheLoopAreRefusedNamingIt) {
   EXPECT_EQ(err.rfind("/actuators/", 0), 0u) << err;
   EXPECT_NE(err.find("\"wrist_pin\""), std::string::npos) << err;
   EXPECT_NE(err.find("over-drives"), std::string::npos) << err;
+  // ... and where the two motions' q0 do not close the loop: the same reason, not the residual
+  for (JointSpec& j : spec.joints)
+    if (j.name == "slide") j.q0 = Eigen::VectorXd::Constant(1, 0.39);
+  err = error_of(spec);
+  EXPECT_EQ(err.rfind("/actuators/", 0), 0u) << err;
+  EXPECT_NE(err.find("\"wrist_pin\""), std::string::npos) << err;
+  EXPECT_NE(err.find("over-drives"), std::string::npos) << err;
   // the slider driven alone, held where the rod cannot reach (x > r + l)
   spec = example();
   spec.actuators[0].joint = "slide";
