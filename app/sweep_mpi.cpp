@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
 #include <stdexcept>
 #include <string>
@@ -77,6 +78,36 @@ int failure(std::string& what) {
   }
 }
 
+// rank k of N appends its variants to OUT.partial.<k>of<N> (resumed from it when the study is
+// started again on N ranks)
+std::string rank_journal(const std::string& out, int rank, int size) {
+  return study_sweep_journal_path(out) + "." + std::to_string(rank) + "of" + std::to_string(size);
+}
+
+// the ranks' journals next to `out` (OUT.partial.<k>of<M>): rank k and M of each
+struct RankJournal {
+  std::filesystem::path path;
+  int rank = 0, size = 0;
+};
+std::vector<RankJournal> rank_journals(const std::string& out) {
+  std::vector<RankJournal> found;
+  const std::filesystem::path base(study_sweep_journal_path(out));
+  const std::filesystem::path dir = base.parent_path().empty() ? std::filesystem::path(".") : base.parent_path();
+  const std::string prefix = base.filename().string() + ".";
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.rfind(prefix, 0) != 0) continue;
+    const std::string tail = name.substr(prefix.size());  // <k>of<M>
+    const std::size_t of = tail.find("of");
+    if (of == std::string::npos || of == 0 || of + 2 >= tail.size() ||
+        tail.find_first_not_of("0123456789") != of || tail.find_first_not_of("0123456789", of + 2) != std::string::npos)
+      continue;
+    found.push_back({e.path(), std::stoi(tail.substr(0, of)), std::stoi(tail.substr(of + 2))});
+  }
+  return found;
+}
+
 }  // namespace
 
 int sweep_over_mpi(const SweepRequest& r, const StudyMessages& tell, const SweepProgress& progress,
@@ -96,6 +127,16 @@ int sweep_over_mpi(const SweepRequest& r, const StudyMessages& tell, const Sweep
     mine.shard_count = size;
     mine.journal_in_memory = true;
     if (mine.threads == 0) mine.threads = 1;  // one process per core: mpirun binds each rank to one
+    if (!r.out.empty()) {
+      // an interrupted study on another number of ranks: its journals hold the variants done
+      if (r.resume)
+        for (const RankJournal& j : rank_journals(r.out))
+          if (j.size != size)
+            throw std::invalid_argument(j.path.string() + ": the journal of rank " + std::to_string(j.rank) + " of an interrupted run on " +
+                                        std::to_string(j.size) + " ranks: start it again with mpirun -np " + std::to_string(j.size) +
+                                        " to resume it, or give --restart to run every variant again on " + std::to_string(size));
+      mine.journal_file = rank_journal(r.out, rank, size);
+    }
     SweepProgress scaled;
     scaled.cancel = progress.cancel;
     if (rank == 0 && progress.done)  // rank 0's share of the slices, scaled to the whole study
@@ -134,6 +175,11 @@ int sweep_over_mpi(const SweepRequest& r, const StudyMessages& tell, const Sweep
       SweepRequest outputs = r;
       outputs.threads = 1;
       result = run_guarded([&] { print(study_sweep_merge_journals(journals, names, outputs, tell)); });
+      if (result == 0 && !r.out.empty())  // the results are written: the ranks' journals (any run's) have served
+        for (const RankJournal& j : rank_journals(r.out)) {
+          std::error_code ec;
+          std::filesystem::remove(j.path, ec);
+        }
     }
   }
   MPI_Bcast(&result, 1, MPI_INT, 0, MPI_COMM_WORLD);

@@ -861,7 +861,8 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
   std::ofstream journal;
   job.shard_index = shard ? r.shard_index : 0;
   job.shard_count = shard ? r.shard_count : 0;
-  const std::string journal_path = r.out.empty() || memory ? std::string() : shard ? r.out : study_sweep_journal_path(r.out);
+  const std::string journal_path =
+      memory ? r.journal_file : r.out.empty() ? std::string() : shard ? r.out : study_sweep_journal_path(r.out);
   if (memory) job.journal = journal_head(r, model_bytes, n) + journal_request(r);
   if (!journal_path.empty()) {
     const std::string head = journal_head(r, model_bytes, n), request_line = journal_request(r);
@@ -886,15 +887,21 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
           have[static_cast<std::size_t>(i)] = 1;
           ++job.resumed;
           kept += line + "\n";
+          if (memory) job.journal += line + "\n";
         } catch (const std::exception&) {
           // a damaged line: that variant runs again
         }
       }
       in.close();
       write_file_atomically(journal_path, kept);  // without the damaged lines, then appended to
-      if (job.resumed > 0)
+      if (job.resumed > 0 && !shard)
         note("resuming: " + std::to_string(job.resumed) + " of " + std::to_string(n) + " variants were done (" +
              journal_path + ")");
+      if (job.resumed > 0 && shard) {
+        const long long slice = r.shard_index < n ? (n - r.shard_index + r.shard_count - 1) / r.shard_count : 0;
+        note("resuming: " + std::to_string(job.resumed) + " of the " + std::to_string(slice) + " variants of slice " +
+             std::to_string(r.shard_index) + "/" + std::to_string(r.shard_count) + " were done (" + journal_path + ")");
+      }
     } else {
       if (!is_journal(journal_path))
         throw std::invalid_argument(journal_path + ": exists and is not the journal of a codyna sweep; codyna never "

@@ -68,6 +68,11 @@ struct SweepRequest {
   // slice; `out`, `csv` and `mat` are then the whole study's, checked but not written, and
   // study_sweep_merge_journals joins the slices)
   bool journal_in_memory = false;
+  // with journal_in_memory: the slice's journal is also appended to this file as variants finish
+  // (and resumed from it with `resume`), so that an interrupted MPI study started again skips
+  // the variants its ranks had done; the file is left for the caller to remove once the whole
+  // study's results are written. Empty: in memory only.
+  std::string journal_file;
 };
 
 // OUT.partial: where the journal of a study writing `out` is kept

@@ -7,7 +7,9 @@
 #   * a study every rank refuses (a bad --vary) exits 1 with the error said once, no hang; one
 #     rank failing alone (mpirun's MPMD form gives it another --vary) is named by rank 0, exit 1,
 #     nothing written; ranks given different studies (another seed) are refused when joined;
-#   * --shard under mpirun is refused, and so is sweep-merge (N processes would write one file).
+#   * --shard under mpirun is refused, and so is sweep-merge (N processes would write one file);
+#   * a study interrupted under mpirun resumes from its ranks' journals (OUT.partial.<k>of<N>) when
+#     started again on N ranks, to the uninterrupted run's bytes; on other N it is refused.
 # A codyna built without MPI: started as one of 2 MPI processes (OMPI_COMM_WORLD_SIZE=2) it must
 # refuse, writing nothing; then the test is skipped (exit 77), saying so.
 # Environment: as root, OpenMPI needs OMPI_ALLOW_RUN_AS_ROOT(_CONFIRM); in containers its shared
@@ -95,4 +97,34 @@ rc=0; mpi 2 sweep "$model" --vary /bodies/1/mass=5:15:3 --shard 0/2 --out s.swee
 [ $rc -ne 0 ] && grep -q "under mpirun the ranks share the variants already" shard.err || fail "--shard under mpirun: $(cat shard.err)"
 rc=0; mpi 2 sweep-merge whatever.sweep --out m.h5 > /dev/null 2> merge.err || rc=$?
 [ $rc -ne 0 ] && grep -q "sweep-merge: started as one of 2 processes by an MPI launcher" merge.err || fail "sweep-merge under mpirun: $(cat merge.err)"
+# interrupted under mpirun (its ranks killed, as a job killed at its time limit or a node lost), then
+# started again: on another number of ranks it is refused, naming a rank's journal; on as many
+# ranks it resumes and writes the uninterrupted run's bytes, leaving no journal behind
+study=(sweep "$model" --vary /bodies/1/mass=5:15:80 --vary '/solver/t_end=[20]' --simulate --quiet)  # about 1 s on 2 ranks
+"$codyna" "${study[@]}" --threads 1 --out whole.h5 --csv whole.csv > /dev/null
+ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" timeout 120 mpirun --oversubscribe -np 2 "$codyna" "${study[@]}" \
+  --out cut.h5 --csv cut.csv > cut1.txt 2>&1 &
+pid=$!
+lines() { [ -f "$1" ] && wc -l < "$1" || echo 0; }
+for _ in $(seq 3000); do
+  [ "$(lines cut.h5.partial.0of2)" -ge 8 ] && [ "$(lines cut.h5.partial.1of2)" -ge 8 ] && break
+  sleep 0.01
+done
+pkill -KILL -f "^$codyna sweep .*--out cut.h5" || true  # the ranks (their command lines start with codyna), not mpirun
+rc=0; wait $pid || rc=$?
+[ $rc -ne 0 ] || fail "the MPI study finished before it was interrupted (make it longer)"
+[ ! -e cut.h5 ] || fail "an interrupted MPI study left cut.h5"
+done0=$(( $(lines cut.h5.partial.0of2) - 2 )); done1=$(( $(lines cut.h5.partial.1of2) - 2 ))
+[ $done0 -ge 6 ] && [ $done1 -ge 6 ] || fail "the ranks' journals hold $done0 and $done1 variants"
+rc=0; mpi 3 "${study[@]}" --out cut.h5 --csv cut.csv > cut3.txt 2> cut3.err || rc=$?
+[ $rc -eq 1 ] && grep -q "cut.h5.partial.[01]of2: the journal of rank [01] of an interrupted run on 2 ranks: start it again with mpirun -np 2" cut3.err ||
+  fail "resumed on 3 ranks: exit $rc, $(cat cut3.err)"
+[ ! -e cut.h5 ] || fail "a refused resume wrote cut.h5"
+mpi 2 "${study[@]}" --out cut.h5 --csv cut.csv > cut2.txt 2> cut2.err || fail "the MPI restart failed: $(cat cut2.err)"
+grep -q "codyna: note: resuming: [0-9]* of the 40 variants of slice 0/2 were done (cut.h5.partial.0of2)" cut2.err ||
+  fail "no resume note: $(cat cut2.err)"
+cmp -s cut.h5 whole.h5 || fail "the resumed cut.h5 differs from the uninterrupted single-process whole.h5"
+cmp -s cut.csv whole.csv || fail "the resumed cut.csv differs"
+ls cut.h5.partial* > /dev/null 2>&1 && fail "journals left behind: $(ls cut.h5.partial*)"
+echo "mpirun -np 2 interrupted after $done0 + $done1 of 80 variants, refused on 3 ranks, resumed on 2: the same bytes"
 echo "sweep mpi: ok"
