@@ -321,11 +321,11 @@ LinearizeJob study_linearize_job(const LinearizeRequest& a, const ModelSpec& fil
   // anything is written, so that a search that fails leaves no export behind
   if (m.spec.analysis.closed_loop.enabled) job.closed_loop = study_closed_loop(m);
   job.method = to_string(method_of(m.spec.analysis.method, opt));
-  job.modes = modal_analysis(job.linearization.system);
+  if (a.modes) job.modes = modal_analysis(job.linearization.system);
   // what the inputs cannot move and the outputs cannot see, named (continuous plant)
   const LinearSystem& c = job.linearization.lin.system;
   job.uncontrollable = uncontrollable_modes(c.A, c.B, c.state_names);
-  job.unobservable = unobservable_modes(c.A, c.C, c.state_names);
+  if (a.modes) job.unobservable = unobservable_modes(c.A, c.C, c.state_names);
   if (a.out.empty()) return job;
   const ExportPaths p = study_export(m, job.linearization.system, a.out);
   job.written = {p.mat_file, p.m_file};

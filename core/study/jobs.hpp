@@ -63,6 +63,9 @@ struct LinearizeRequest {
   std::optional<double> discrete, trajectory, trajectory_step;
   bool closed_loop = false, lqr = false, lqr_controllable_part = false;
   std::optional<std::vector<double>> q_weights, r_weights;
+  // false: no modal analysis and no unobservable modes (LinearizeJob::modes and unobservable
+  // left empty), the rest as always: what each variant of a parameter study needs
+  bool modes = true;
 };
 
 struct LinearizeJob {

@@ -790,6 +790,7 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
   plan_edits(c, job.plan.vary);
   c.linearize.style = r.style;
   c.linearize.model = r.model;
+  c.linearize.modes = false;  // a variant records its poles and uncontrollable modes only
   const LinearizeJob nominal = study_linearize_job(c.linearize, nominal_spec);
   const Model& m = nominal.model;
   const StudySpec& s = m.spec.analysis;
