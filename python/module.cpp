@@ -2,7 +2,7 @@
 //
 // It binds core's study/ layer and the model/ types it hands back, and nothing below them:
 // each Python call is one study call. What this file does is conversion only: Python keywords
-// into a LinearizeRequest / SimulateRequest (OptionStyle::Keyword, so the core's messages name
+// into a LinearizeRequest / SimulateRequest / SweepRequest (OptionStyle::Keyword, so the core's messages name
 // the keywords), Eigen matrices into numpy arrays, names into lists, C++ exceptions into
 // Python ones. It decides nothing, computes nothing and reads or writes no file itself.
 //
@@ -16,10 +16,14 @@
 
 #include <atomic>
 #include <chrono>
+#include <climits>
+#include <condition_variable>
 #include <cstdio>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "model/errors.hpp"
@@ -27,6 +31,7 @@
 #include "model/model_spec.hpp"
 #include "study/files.hpp"
 #include "study/jobs.hpp"
+#include "study/sweep.hpp"
 #include "study/tools.hpp"
 #include "study/workflow.hpp"
 
@@ -140,6 +145,69 @@ class Keywords {
     for (const auto& item : iterable(*o, key, "a dict {name: value} or \"NAME=VALUE\" strings")) v.push_back(text_of(item, key));
     return v;
   }
+  // a whole number (int or a numpy integer; a float or a bool is a TypeError) within [lo, hi]
+  std::optional<long long> whole(const std::string& key, long long lo = LLONG_MIN, long long hi = LLONG_MAX) {
+    const auto o = take(key);
+    if (!o) return std::nullopt;
+    const py::int_ i = int_of(*o, key);
+    int overflow = 0;
+    const long long x = PyLong_AsLongLongAndOverflow(i.ptr(), &overflow);
+    if (overflow != 0 || x < lo || x > hi)
+      throw py::value_error(key + ": expected a whole number from " + std::to_string(lo) + " to " + std::to_string(hi) +
+                            ", got " + py::repr(i).cast<std::string>());
+    return x;
+  }
+  // an unsigned 64-bit whole number (a seed)
+  std::optional<std::uint64_t> whole_u64(const std::string& key) {
+    const auto o = take(key);
+    if (!o) return std::nullopt;
+    const py::int_ i = int_of(*o, key);
+    const bool negative = PyObject_RichCompareBool(i.ptr(), py::int_(0).ptr(), Py_LT) == 1;
+    const unsigned long long x = negative ? 0 : PyLong_AsUnsignedLongLong(i.ptr());
+    if (negative || (x == static_cast<unsigned long long>(-1) && PyErr_Occurred())) {
+      PyErr_Clear();
+      throw py::value_error(key + ": expected a whole number from 0 to " + std::to_string(UINT64_MAX) + ", got " +
+                            py::repr(i).cast<std::string>());
+    }
+    return static_cast<std::uint64_t>(x);
+  }
+  // FIELD=SPEC texts: "FIELD=SPEC" strings (one, or a list), or a dict {field: spec} whose spec
+  // is a SPEC text ("5:15:11", "normal(10,3)"), a sequence of numbers (the list [v1,v2,...],
+  // each written with 17 significant digits) or one number (a list of one)
+  std::vector<std::string> field_specs(const std::string& key) {
+    const auto o = take(key);
+    if (!o) return {};
+    if (py::isinstance<py::str>(*o)) return {o->cast<std::string>()};
+    std::vector<std::string> v;
+    if (py::isinstance<py::dict>(*o)) {
+      for (const auto& kv : o->cast<py::dict>()) {
+        const std::string field = text_of(kv.first, key);
+        if (py::isinstance<py::str>(kv.second)) {
+          v.push_back(field + "=" + kv.second.cast<std::string>());
+          continue;
+        }
+        std::vector<double> values;
+        if (py::hasattr(kv.second, "__iter__")) {
+          for (const auto& item : iterable(py::reinterpret_borrow<py::object>(kv.second), key + "[" + field + "]",
+                                           "a SPEC str, a sequence of numbers or a number"))
+            values.push_back(number_of(item, key + "[" + field + "]"));
+        } else {
+          values.push_back(number_of(kv.second, key + "[" + field + "]"));
+        }
+        std::string list = field + "=[";
+        for (std::size_t i = 0; i < values.size(); ++i) {
+          char value[64];
+          std::snprintf(value, sizeof value, "%.17g", values[i]);
+          if (i) list += ',';
+          list += value;
+        }
+        v.push_back(list + "]");
+      }
+      return v;
+    }
+    for (const auto& item : iterable(*o, key, "a dict {field: spec} or \"FIELD=SPEC\" strings")) v.push_back(text_of(item, key));
+    return v;
+  }
   // signals: a "NAME=VALUE[@TIME]" string or a dict (the model file's object, as JSON text),
   // one or a list of them
   std::optional<std::vector<std::string>> signals(const std::string& key, const std::string& alias = "") {
@@ -171,6 +239,13 @@ class Keywords {
         !py::hasattr(o, "__float__"))
       type_error(function_ + "(): " + key + ": expected a number, got " + type_name(o));
     return py::float_(py::reinterpret_borrow<py::object>(o)).cast<double>();
+  }
+  py::int_ int_of(const py::handle& o, const std::string& key) const {
+    if (py::isinstance<py::bool_>(o) || !py::hasattr(o, "__index__"))
+      type_error(function_ + "(): " + key + ": expected a whole number (int), got " + type_name(o));
+    PyObject* i = PyNumber_Index(o.ptr());
+    if (!i) throw py::error_already_set();
+    return py::reinterpret_steal<py::int_>(i);
   }
   std::string signal_of(const py::handle& o, const std::string& key) const {
     if (py::isinstance<py::dict>(o)) return py::str(py::module_::import("json").attr("dumps")(o));
@@ -272,6 +347,7 @@ py::array_t<double> stacked_vector(const std::vector<LinearSystem>& systems, Get
 struct Study {
   std::shared_ptr<const ModelSpec> spec;
   std::string file;  // the request's `model`: messages, relative paths, outputs that must not replace it
+  std::string text;  // from_json: the text (a sweep's variants are edits of it); "": the file's
 };
 
 struct LinearizationResult {
@@ -294,6 +370,10 @@ struct ClosedLoopResult {
 struct SimulationRun {
   SimulateRequest request;
   SimulateJob job;
+};
+
+struct SweepResult {
+  std::shared_ptr<const SweepJob> job;
 };
 
 // Ctrl+C during a run: the progress callback (called after every recorded sample, without the
@@ -340,6 +420,7 @@ Study study_from_json(const std::string& text, const py::object& base_dir_object
   Study s;
   s.spec = std::make_shared<const ModelSpec>(study_parse_model_text(text, label));
   s.file = label;
+  s.text = text;
   return s;
 }
 
@@ -492,6 +573,164 @@ void save_simulation(const SimulationRun& run, const py::object& path_object, co
   study_write_results(run.job.result, path, csv);
 }
 
+SweepRequest sweep_request(const Study& s, Keywords& k) {
+  SweepRequest r;
+  r.style = OptionStyle::Keyword;
+  r.model = s.file;
+  r.model_text = s.text;
+  r.vary = k.field_specs("vary");
+  r.samples = k.whole("samples");
+  r.seed = k.whole_u64("seed");
+  if (const auto t = k.whole("threads", INT_MIN, INT_MAX)) r.threads = static_cast<int>(*t);
+  r.redesign = k.text("redesign").value_or("");
+  r.simulate = k.flag("simulate");
+  r.out = k.path("out").value_or("");
+  r.csv = k.path("csv").value_or("");
+  r.mat = k.path("mat").value_or("");
+  // the command's --restart, or its opposite resume=False
+  const auto truth = [&](const std::optional<py::object>& o, const char* key) -> std::optional<bool> {
+    if (!o) return std::nullopt;
+    if (py::isinstance<py::str>(*o) || py::isinstance<py::bytes>(*o))
+      type_error(std::string("sweep(): ") + key + ": expected True or False, got " + type_name(*o));
+    return py::bool_(*o).cast<bool>();
+  };
+  const std::optional<bool> restart = truth(k.take("restart"), "restart"), resume = truth(k.take("resume"), "resume");
+  if (restart && resume && *restart == *resume)
+    throw py::value_error(std::string("restart=") + (*restart ? "True" : "False") + " and resume=" + (*resume ? "True" : "False") +
+                          " contradict each other: give one");
+  r.resume = restart ? !*restart : resume.value_or(true);
+  return r;
+}
+
+// The sweep runs on a thread of its own (its pool's workers below it) while the calling thread
+// waits without the GIL, waking every 50 ms to let Python run its signal handlers (Ctrl+C) and to
+// call the progress callback, so that both work whatever thread finishes a variant and the
+// workers never take the GIL. A handler or a callback that raised cancels the study (no new
+// variant is taken; with `out`, the journal keeps those done) and its exception is raised.
+std::unique_ptr<SweepResult> do_sweep(const Study& s, const py::dict& options) {
+  Keywords k(options, "sweep");
+  const std::optional<py::object> callback = k.take("progress");
+  if (callback && !PyCallable_Check(callback->ptr()))
+    type_error("sweep(): progress: expected a callable progress(done, total), got " + type_name(*callback));
+  const SweepRequest r = sweep_request(s, k);
+  k.finish();
+
+  std::atomic<bool> cancel{false};
+  std::atomic<long long> done{-1}, total{0};
+  SweepProgress progress;
+  progress.cancel = &cancel;
+  progress.done = [&](long long d, long long n) {
+    total = n;
+    done = d;
+  };
+  std::mutex mutex;
+  std::condition_variable finished_cv;
+  bool finished = false;
+  auto job = std::make_shared<SweepJob>();
+  std::exception_ptr failure;
+  std::optional<py::error_already_set> raised;
+  {
+    py::gil_scoped_release release;
+    std::thread study([&] {
+      try {
+        *job = study_sweep_job(r, {}, progress);
+      } catch (...) {
+        failure = std::current_exception();
+      }
+      const std::lock_guard<std::mutex> lock(mutex);
+      finished = true;
+      finished_cv.notify_all();
+    });
+    long long reported = -1;
+    for (bool end = false; !end;) {
+      {
+        std::unique_lock<std::mutex> lock(mutex);
+        end = finished_cv.wait_for(lock, std::chrono::milliseconds(50), [&] { return finished; });
+      }
+      if (cancel) continue;
+      py::gil_scoped_acquire gil;
+      if (PyErr_CheckSignals() != 0) {
+        raised.emplace();  // fetches (and clears) the handler's exception
+        cancel = true;
+        continue;
+      }
+      const long long d = done;
+      if (callback && d > reported) {
+        reported = d;
+        try {
+          (*callback)(d, total.load());
+        } catch (py::error_already_set& e) {
+          raised.emplace(std::move(e));
+          cancel = true;
+        }
+      }
+    }
+    study.join();
+  }
+  if (raised) throw *raised;
+  if (failure) std::rethrow_exception(failure);
+  auto result = std::make_unique<SweepResult>();
+  result->job = std::move(job);
+  return result;
+}
+
+// ---------------------------------------------------------------------------------------------
+// A sweep's per-variant arrays, laid out as the HDF5 file's datasets (study_write_sweep_hdf5): the
+// variants first, NaN where a variant has no such value (it failed, or was not simulated)
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+bool variant_ok(const SweepVariant& v) { return v.status == SweepStatus::Ok; }
+
+// (n, rows, cols): variant i's matrix when it completed with these sizes
+py::array_t<double> variant_stack(const SweepJob& j, Eigen::MatrixXd SweepVariant::*field, Eigen::Index rows, Eigen::Index cols) {
+  py::array_t<double> a({static_cast<py::ssize_t>(j.variants.size()), static_cast<py::ssize_t>(rows), static_cast<py::ssize_t>(cols)});
+  auto out = a.mutable_unchecked<3>();
+  for (std::size_t i = 0; i < j.variants.size(); ++i) {
+    const SweepVariant& v = j.variants[i];
+    const Eigen::MatrixXd& M = v.*field;
+    const bool have = variant_ok(v) && M.rows() == rows && M.cols() == cols;
+    for (Eigen::Index r = 0; r < rows; ++r)
+      for (Eigen::Index c = 0; c < cols; ++c) out(static_cast<py::ssize_t>(i), r, c) = have ? M(r, c) : kNaN;
+  }
+  return a;
+}
+
+// (n, size): variant i's vector when it has this size
+py::array_t<double> variant_rows(const SweepJob& j, Eigen::VectorXd SweepVariant::*field, Eigen::Index size) {
+  py::array_t<double> a({static_cast<py::ssize_t>(j.variants.size()), static_cast<py::ssize_t>(size)});
+  auto out = a.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < j.variants.size(); ++i) {
+    const Eigen::VectorXd& x = j.variants[i].*field;
+    for (Eigen::Index k = 0; k < size; ++k) out(static_cast<py::ssize_t>(i), k) = x.size() == size ? x[k] : kNaN;
+  }
+  return a;
+}
+
+// (n, nx) complex: variant i's poles when it completed
+py::array_t<std::complex<double>> variant_poles(const SweepJob& j, Eigen::VectorXcd SweepVariant::*field) {
+  const Eigen::Index nx = static_cast<Eigen::Index>(j.state_names.size());
+  py::array_t<std::complex<double>> a({static_cast<py::ssize_t>(j.variants.size()), static_cast<py::ssize_t>(nx)});
+  auto out = a.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < j.variants.size(); ++i) {
+    const SweepVariant& v = j.variants[i];
+    const Eigen::VectorXcd& p = v.*field;
+    const bool have = variant_ok(v) && p.size() == nx;
+    for (Eigen::Index k = 0; k < nx; ++k) out(static_cast<py::ssize_t>(i), k) = have ? p[k] : std::complex<double>(kNaN, kNaN);
+  }
+  return a;
+}
+
+// (n): one number per variant, from `get` (NaN where it has none)
+template <class T, class Get>
+py::array_t<T> per_variant(const SweepJob& j, Get get) {
+  py::array_t<T> a(static_cast<py::ssize_t>(j.variants.size()));
+  for (std::size_t i = 0; i < j.variants.size(); ++i) a.mutable_at(static_cast<py::ssize_t>(i)) = get(j.variants[i]);
+  return a;
+}
+
+py::object index_or_none(long long i) { return i < 0 ? py::object(py::none()) : py::object(py::int_(i)); }
+
 py::tuple do_lqr(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& Q, const Eigen::MatrixXd& R,
               bool discrete) {
   LqrResult r;
@@ -561,6 +800,9 @@ PYBIND11_MODULE(_codyna, m) {
         "study_linearize_job with the keywords given (a dict); codyna.Study.linearize documents them.");
   m.def("_simulate", &do_simulate, "study"_a, "options"_a,
         "study_simulate_job with the keywords given (a dict); codyna.Study.simulate documents them.");
+
+  m.def("_sweep", &do_sweep, "study"_a, "options"_a,
+        "study_sweep_job with the keywords given (a dict); codyna.Study.sweep documents them.");
 
   py::class_<ClosedLoopResult>(m, "ClosedLoop",
                                "The linear closed loop of the study's plant and controller (linearize(closed_loop=True)).\n"
@@ -844,7 +1086,167 @@ PYBIND11_MODULE(_codyna, m) {
            "is given; path may be None for CSV only), each atomically, refusing to replace the model,\n"
            "the controller file or a file codyna did not write.");
 
-  for (const char* name : {"ClosedLoop", "Linearization", "Simulation"}) m.attr(name).attr("__module__") = "codyna";
+  py::class_<SweepResult>(m, "Sweep",
+                          "What Study.sweep returns: the parameter study `codyna sweep` runs (docs/parameter-studies.md).\n"
+                          "Per-variant arrays have the variants first, laid out as the HDF5 file's datasets, with NaN\n"
+                          "where a variant has no value (it failed, or was not simulated).")
+      .def("__len__", [](const SweepResult& s) { return s.job->variants.size(); }, "the number of variants")
+      .def_property_readonly("model_file", [](const SweepResult& s) { return s.job->model_file; }, "the model file (or the label of a JSON text)")
+      .def_property_readonly("model_name", [](const SweepResult& s) { return s.job->model_name; }, "the model's name")
+      .def_property_readonly("design", [](const SweepResult& s) { return std::string(s.job->plan.random ? "random" : "grid"); },
+                             "\"grid\" (a full grid, the last field varying fastest) or \"random\" (joint random samples)")
+      .def_property_readonly("seed", [](const SweepResult& s) -> py::object {
+        if (!s.job->plan.random) return py::none();
+        return py::int_(s.job->plan.seed);
+      }, "a random study's seed, else None")
+      .def_property_readonly("fields", [](const SweepResult& s) {
+        std::vector<std::string> f;
+        for (const SweepVary& v : s.job->plan.vary) f.push_back(v.field);
+        return f;
+      }, "the varied fields (JSON pointers into the model file), values' columns")
+      .def_property_readonly("specs", [](const SweepResult& s) {
+        std::vector<std::string> f;
+        for (const SweepVary& v : s.job->plan.vary) f.push_back(v.spec);
+        return f;
+      }, "the SPECs as given, one per field")
+      .def_property_readonly("nominal", [](const SweepResult& s) {
+        std::vector<double> f;
+        for (const SweepVary& v : s.job->plan.vary) f.push_back(v.nominal);
+        return vector_of(f);
+      }, "the model file's values of the fields")
+      .def_property_readonly("values", [](const SweepResult& s) {
+        const SweepJob& j = *s.job;
+        const std::size_t m = j.plan.vary.size();
+        py::array_t<double> a({static_cast<py::ssize_t>(j.variants.size()), static_cast<py::ssize_t>(m)});
+        auto out = a.mutable_unchecked<2>();
+        for (std::size_t i = 0; i < j.variants.size(); ++i)
+          for (std::size_t k = 0; k < m; ++k)
+            out(static_cast<py::ssize_t>(i), static_cast<py::ssize_t>(k)) = k < j.variants[i].values.size() ? j.variants[i].values[k] : kNaN;
+        return a;
+      }, "each variant's values of the fields (n x k)")
+      .def_property_readonly("status", [](const SweepResult& s) {
+        return per_variant<int>(*s.job, [](const SweepVariant& v) { return static_cast<int>(v.status); });
+      }, "status codes (n): 0 ok, 1 model error, 2 not converged, 3 refused, 4 failed, 5 sizes differ")
+      .def_property_readonly("status_text", [](const SweepResult& s) {
+        std::vector<std::string> t;
+        for (const SweepVariant& v : s.job->variants) t.push_back(to_string(v.status));
+        return t;
+      }, "the status codes' names (\"ok\", \"model error\", ...)")
+      .def_property_readonly("reasons", [](const SweepResult& s) {
+        std::vector<std::string> t;
+        for (const SweepVariant& v : s.job->variants) t.push_back(v.reason);
+        return t;
+      }, "why each variant failed (\"\" when ok)")
+      .def_property_readonly("state_names", [](const SweepResult& s) { return s.job->state_names; }, "names of the states (A's rows)")
+      .def_property_readonly("input_names", [](const SweepResult& s) { return s.job->input_names; }, "Plant/In names (B's columns)")
+      .def_property_readonly("output_names", [](const SweepResult& s) { return s.job->output_names; }, "Plant/Out names (C's rows)")
+      .def_property_readonly("A", [](const SweepResult& s) {
+        const auto nx = static_cast<Eigen::Index>(s.job->state_names.size());
+        return variant_stack(*s.job, &SweepVariant::A, nx, nx);
+      }, "each variant's continuous A (n x nx x nx)")
+      .def_property_readonly("B", [](const SweepResult& s) {
+        return variant_stack(*s.job, &SweepVariant::B, static_cast<Eigen::Index>(s.job->state_names.size()),
+                             static_cast<Eigen::Index>(s.job->input_names.size()));
+      }, "each variant's B (n x nx x nu)")
+      .def_property_readonly("C", [](const SweepResult& s) {
+        return variant_stack(*s.job, &SweepVariant::C, static_cast<Eigen::Index>(s.job->output_names.size()),
+                             static_cast<Eigen::Index>(s.job->state_names.size()));
+      }, "each variant's C (n x ny x nx)")
+      .def_property_readonly("D", [](const SweepResult& s) {
+        return variant_stack(*s.job, &SweepVariant::D, static_cast<Eigen::Index>(s.job->output_names.size()),
+                             static_cast<Eigen::Index>(s.job->input_names.size()));
+      }, "each variant's D (n x ny x nu)")
+      .def_property_readonly("open_poles", [](const SweepResult& s) { return variant_poles(*s.job, &SweepVariant::open_poles); },
+                             "eig(A) of each variant (n x nx complex), sorted by real part, then imaginary part")
+      .def_property_readonly("open_max_real", [](const SweepResult& s) {
+        return per_variant<double>(*s.job, [](const SweepVariant& v) { return variant_ok(v) ? v.open_max_real : kNaN; });
+      }, "the largest real part of eig(A) (n)")
+      .def_property_readonly("uncontrollable", [](const SweepResult& s) {
+        return per_variant<int>(*s.job, [](const SweepVariant& v) { return variant_ok(v) ? v.uncontrollable : -1; });
+      }, "the number of modes the inputs cannot move (n; -1: the variant failed)")
+      .def_property_readonly("uncontrollable_text", [](const SweepResult& s) {
+        std::vector<std::string> t;
+        for (const SweepVariant& v : s.job->variants) t.push_back(v.uncontrollable_text);
+        return t;
+      }, "those modes described (as codyna linearize prints them), per variant")
+      .def_property_readonly("stable", [](const SweepResult& s) {
+        return per_variant<bool>(*s.job, [](const SweepVariant& v) { return v.stable; });
+      }, "the closed loop is asymptotically stable (without a closed loop: the open loop) (n)")
+      .def_property_readonly("closed_loop", [](const SweepResult& s) { return s.job->closed_loop; }, "a state feedback closes the loop")
+      .def_property_readonly("controller", [](const SweepResult& s) { return s.job->controller; }, "what the closed loop is")
+      .def_property_readonly("redesigned", [](const SweepResult& s) { return s.job->redesigned; }, "K designed again for every variant (redesign=\"lqr\")")
+      .def_property_readonly("K", [](const SweepResult& s) -> py::object {
+        const SweepJob& j = *s.job;
+        if (!j.closed_loop) return py::none();
+        if (j.redesigned)
+          return variant_stack(j, &SweepVariant::K, static_cast<Eigen::Index>(j.input_names.size()),
+                               static_cast<Eigen::Index>(j.state_names.size()));
+        return py::cast(j.K);
+      }, "the gain: nu x nx (the nominal model's, fixed), n x nu x nx when redesigned; None without a closed loop")
+      .def_property_readonly("closed_poles", [](const SweepResult& s) -> py::object {
+        if (!s.job->closed_loop) return py::none();
+        return variant_poles(*s.job, &SweepVariant::closed_poles);
+      }, "eig(A - B K) of each variant (n x nx complex, sorted as open_poles); None without a closed loop")
+      .def_property_readonly("closed_max_real", [](const SweepResult& s) -> py::object {
+        if (!s.job->closed_loop) return py::none();
+        return per_variant<double>(*s.job, [](const SweepVariant& v) { return variant_ok(v) ? v.closed_max_real : kNaN; });
+      }, "the largest real part of eig(A - B K) (n); None without a closed loop")
+      .def_property_readonly("nominal_open_poles", [](const SweepResult& s) { return s.job->nominal_open_poles; }, "eig(A) of the nominal model")
+      .def_property_readonly("nominal_closed_poles", [](const SweepResult& s) -> py::object {
+        if (!s.job->closed_loop) return py::none();
+        return py::cast(s.job->nominal_closed_poles);
+      }, "eig(A - B K) of the nominal model; None without a closed loop")
+      .def_property_readonly("operating_point", [](const SweepResult& s) { return s.job->operating_point; }, "the study's operating point (equilibrium, ...)")
+      .def_property_readonly("method", [](const SweepResult& s) { return s.job->method; }, "the Jacobians' method")
+      .def_property_readonly("simulated", [](const SweepResult& s) { return s.job->simulated; }, "simulate=True: every variant was also run")
+      .def_property_readonly("sim_status", [](const SweepResult& s) -> py::object {
+        if (!s.job->simulated) return py::none();
+        return per_variant<int>(*s.job, [](const SweepVariant& v) { return v.sim_status; });
+      }, "simulate: -1 not run (the variant failed), 0 reached t_end, 1 the run failed, 2 it could not be set up")
+      .def_property_readonly("sim_reason", [](const SweepResult& s) -> py::object {
+        if (!s.job->simulated) return py::none();
+        std::vector<std::string> t;
+        for (const SweepVariant& v : s.job->variants) t.push_back(v.sim_reason);
+        return py::cast(t);
+      }, "simulate: why a run failed (\"\" otherwise)")
+      .def_property_readonly("t_reached", [](const SweepResult& s) -> py::object {
+        if (!s.job->simulated) return py::none();
+        return per_variant<double>(*s.job, [](const SweepVariant& v) { return v.sim_status == 0 || v.sim_status == 1 ? v.sim_t_end : kNaN; });
+      }, "simulate: the time each run reached (n)")
+      .def_property_readonly("final_error", [](const SweepResult& s) -> py::object {
+        if (!s.job->simulated) return py::none();
+        return per_variant<double>(*s.job, [](const SweepVariant& v) { return v.sim_status == 0 || v.sim_status == 1 ? v.final_error : kNaN; });
+      }, "simulate: the largest |y - target| over Plant/Out at the last sample (n)")
+      .def_property_readonly("peak_input", [](const SweepResult& s) -> py::object {
+        if (!s.job->simulated) return py::none();
+        return variant_rows(*s.job, &SweepVariant::peak_input, static_cast<Eigen::Index>(s.job->input_names.size()));
+      }, "simulate: the largest |u| of each Plant/In (n x nu)")
+      .def_property_readonly("overshoot", [](const SweepResult& s) -> py::object {
+        if (!s.job->simulated) return py::none();
+        return variant_rows(*s.job, &SweepVariant::overshoot, static_cast<Eigen::Index>(s.job->output_names.size()));
+      }, "simulate: the overshoot of each Plant/Out, % (n x ny)")
+      .def_property_readonly("settling_time", [](const SweepResult& s) -> py::object {
+        if (!s.job->simulated) return py::none();
+        return variant_rows(*s.job, &SweepVariant::settling_time, static_cast<Eigen::Index>(s.job->output_names.size()));
+      }, "simulate: the 2 % settling time of each Plant/Out, s (n x ny; NaN: not settled)")
+      .def_property_readonly("saturation_time", [](const SweepResult& s) -> py::object {
+        if (!s.job->simulated) return py::none();
+        return variant_rows(*s.job, &SweepVariant::saturation_time, static_cast<Eigen::Index>(s.job->input_names.size()));
+      }, "simulate: the seconds each Plant/In spent at a limit (n x nu; NaN: no limits)")
+      .def_property_readonly("failed", [](const SweepResult& s) { return s.job->failed; }, "the number of variants that failed")
+      .def_property_readonly("stable_count", [](const SweepResult& s) { return s.job->stable; }, "the number of stable completed variants")
+      .def_property_readonly("sim_completed", [](const SweepResult& s) { return s.job->sim_completed; }, "simulate: the runs that reached t_end")
+      .def_property_readonly("worst", [](const SweepResult& s) { return index_or_none(s.job->worst); },
+                             "the completed variant with the largest max real part (closed loop, else open), None if none completed")
+      .def_property_readonly("largest_input", [](const SweepResult& s) { return index_or_none(s.job->largest_input); },
+                             "simulate: the run with the largest peak |u|, else None")
+      .def_property_readonly("summary", [](const SweepResult& s) { return study_sweep_summary(*s.job); }, "the summary codyna sweep prints")
+      .def_property_readonly("resumed", [](const SweepResult& s) { return s.job->resumed; }, "variants read back from the journal of an interrupted run")
+      .def_property_readonly("written", [](const SweepResult& s) { return py::tuple(py::cast(s.job->written)); }, "the files written (out, csv, mat and its .m)")
+      .def_property_readonly("notes", [](const SweepResult& s) { return s.job->notes; }, "notes for the user (what codyna sweep prints as notes)")
+      .def_property_readonly("warnings", [](const SweepResult& s) { return s.job->warnings; }, "warnings for the user");
+
+  for (const char* name : {"ClosedLoop", "Linearization", "Simulation", "Sweep"}) m.attr(name).attr("__module__") = "codyna";
 
   m.def("lqr", &do_lqr, "A"_a, "B"_a, "Q"_a, "R"_a, "discrete"_a = false,
         "lqr(A, B, Q, R, discrete=False) -> (K, X, poles)\n\n"

@@ -11,11 +11,13 @@ command line's, bit for bit. docs/python.md has a tour.
     run = study.simulate(lqr=True, t_end=2, compare_linear=True)
     run.t, run.y, run.y_linear
     run.save("run.h5")
+    sweep = study.sweep(vary={"/bodies/1/mass": "5:15:11"})   # codyna sweep
+    sweep.values, sweep.closed_poles, sweep.stable, sweep.summary
 
 Errors: a bad model or a bad choice in it raises ModelError (a ValueError) whose message names
 the file and the field, as the command line prints it; a bad keyword value raises ValueError
 (naming the keyword) or TypeError; an equilibrium or trim that does not converge raises
-ConvergenceError (a RuntimeError). Ctrl+C interrupts a simulation (KeyboardInterrupt).
+ConvergenceError (a RuntimeError). Ctrl+C interrupts a simulation or a sweep (KeyboardInterrupt).
 """
 
 from ._codyna import (  # noqa: F401  (the public names)
@@ -24,6 +26,7 @@ from ._codyna import (  # noqa: F401  (the public names)
     Linearization,
     ModelError,
     Simulation,
+    Sweep,
     __version__,
     lqr,
     place,
@@ -35,6 +38,7 @@ __all__ = [
     "Linearization",
     "ClosedLoop",
     "Simulation",
+    "Sweep",
     "ModelError",
     "ConvergenceError",
     "lqr",
@@ -53,7 +57,7 @@ class Study:
 
     Study(path) reads and checks the file (ModelError names the file and the field);
     Study.from_json(text, base_dir=".") does the same for a JSON text. The keywords of
-    linearize() and simulate() override the file's choices for that one call, as the command
+    linearize(), simulate() and sweep() override the file's choices for that one call, as the command
     line's flags do; the file is not changed.
     """
 
@@ -251,3 +255,64 @@ class Study:
             warnings.warn("codyna: the run failed: %s (the samples up to it are kept)" % run.failure,
                           RuntimeWarning, stacklevel=2)
         return run
+
+    def sweep(
+        self,
+        vary=None,
+        *,
+        samples=None,
+        seed=None,
+        threads=None,
+        redesign=None,
+        simulate=None,
+        out=None,
+        csv=None,
+        mat=None,
+        restart=None,
+        resume=None,
+        progress=None,
+    ):
+        """A parameter study, as `codyna sweep` runs it (docs/parameter-studies.md).
+
+        Every variant is the model file with some numbers replaced, linearized (and its loop
+        closed) by the file's "analysis" choices. The variants are edits of the file's text (of
+        the JSON text for a Study.from_json), read again by the core as the command reads it.
+        Returns a Sweep: fields, values (n x k), status, status_text, reasons, A, B, C, D (n x
+        nx x nx ...; NaN for a failed variant, as the HDF5 file), open_poles, open_max_real,
+        closed_poles, closed_max_real (complex / float, None without a closed loop), stable,
+        uncontrollable, K (nu x nx fixed, n x nu x nx redesigned), with simulate=True the
+        figures of merit (sim_status, t_reached, peak_input, final_error, overshoot,
+        settling_time, saturation_time), the names, summary (the printed summary), worst, and
+        written (the files written).
+
+        The keywords are the flags of `codyna sweep` (dashes become underscores):
+
+        vary        FIELD=SPEC: "FIELD=SPEC" strings (one, or a list), or a dict {field: spec}
+                    whose spec is a SPEC str ("5:15:11", "[1,2]", "normal(10,3)",
+                    "uniform(a,b)"), a sequence of numbers (the values listed) or a number.
+                    FIELD is a JSON pointer into the model file (/bodies/1/mass)
+        samples     random studies: the number of variants
+        seed        random studies: the seed (variant i depends only on the specs, the seed, i)
+        threads     worker threads (default: every core)
+        redesign    "lqr": design the study's LQR again for every variant (default: the
+                    nominal model's K, fixed)
+        simulate    True: also run every variant's nonlinear closed loop
+        out, csv    HDF5 results and the per-variant CSV (str or os.PathLike), written by
+                    the core as the command writes them; with out, an interrupted study
+                    started again resumes from its journal OUT.partial
+        mat         DIR/NAME.mat (+ NAME.m) for MATLAB/Octave
+        restart     True: ignore the journal of an interrupted run (resume=False says the same)
+        progress    a callable progress(done, total), called on this thread (at most every
+                    50 ms, and once at the end) as variants finish; an exception it raises
+                    stops the study and is raised
+
+        A variant that fails is recorded (status, reasons) and never stops the study. The
+        sweep releases the GIL; Ctrl+C stops it (no new variant is started; with out, the
+        journal keeps those done) and raises KeyboardInterrupt.
+
+        Raises ModelError (a bad nominal model), ValueError (a bad keyword value, naming the
+        keyword: vary and the field, samples, seed ...), ConvergenceError (the nominal
+        operating point does not converge), TypeError (an unknown keyword or a wrong type).
+        """
+        options = _given(locals())
+        return _codyna._sweep(self._study, options)

@@ -14,6 +14,14 @@ the command line's output bit for bit (np.array_equal, never allclose):
   * codyna.lqr agrees with scipy.linalg.solve_continuous_are (K = R^-1 B' X, 1e-9 relative),
     codyna.place puts eig(A - B K) at the poles;
   * Ctrl+C (SIGINT) stops a long simulation within a second, as KeyboardInterrupt;
+  * Study.sweep: the rod mass over 11 values with the LQR fixed: each variant's A, B, C, D equal
+    its own Study.from_json(edited JSON).linearize() bit for bit, its closed-loop poles
+    eig(A - B K) to 1e-10, K scipy's design on the nominal model; a Monte Carlo (seed 7, run
+    with --simulate) equals the CLI's HDF5 file dataset by dataset and itself on 1 and 2
+    threads, and the files it writes are the CLI's bytes; failed variants (status, reason, NaN
+    rows); bad keywords (ValueError naming vary and the field, TypeError); the progress
+    callback on the calling thread; a study stopped by its callback resumes from its journal
+    into the uninterrupted run's bytes; SIGINT stops a sweep on 2 threads within a second;
   * examples/python/cart_pendulum_lqr.py runs and writes its PNG.
 
 Environment (set by CTest): PYTHONPATH=build/python, CODYNA_BIN (the codyna command),
@@ -456,3 +464,254 @@ def test_example_script_writes_its_png(tmp_path):
     assert p.returncode == 0, p.stdout + p.stderr
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 20000
     assert "K =" in p.stdout and "closed-loop poles" in p.stdout and "max |y - y_lin|" in p.stdout, p.stdout
+
+
+# ---------------------------------------------------------------------------- sweep
+
+ROD_MASS = "/bodies/1/mass"
+
+
+def sorted_poles(p):
+    p = np.asarray(p)
+    return p[np.lexsort((p.imag, p.real))]
+
+
+def cart_with(**masses):
+    """The cart-pendulum's JSON text with body masses replaced (index -> kg)."""
+    model = json.load(open(CART))
+    for index, mass in masses.items():
+        model["bodies"][int(index[1:])]["mass"] = mass
+    return json.dumps(model)
+
+
+def test_sweep_rod_mass_fixed_lqr_against_each_variants_own_linearization():
+    study = codyna.Study(CART)
+    sweep = study.sweep(vary={ROD_MASS: "5:15:11"})
+    assert isinstance(sweep, codyna.Sweep) and len(sweep) == 11
+    assert sweep.fields == [ROD_MASS] and sweep.specs == ["5:15:11"] and sweep.design == "grid" and sweep.seed is None
+    assert np.array_equal(sweep.values[:, 0], np.linspace(5, 15, 11)) and sweep.nominal.tolist() == [10.0]
+    assert sweep.status.tolist() == [0] * 11 and sweep.reasons == [""] * 11 and sweep.failed == 0
+    assert sweep.closed_loop and not sweep.redesigned and not sweep.simulated
+    assert sweep.state_names == ["cart_slider", "rod_pivot", "cart_slider_dot", "rod_pivot_dot"]
+    assert sweep.input_names == ["force"] and sweep.output_names == ["h", "theta"]
+    assert sweep.A.shape == (11, 4, 4) and sweep.B.shape == (11, 4, 1) and sweep.C.shape == (11, 2, 4)
+    assert sweep.D.shape == (11, 2, 1) and sweep.closed_poles.shape == (11, 4) and sweep.closed_poles.dtype == complex
+    # K: the model file's LQR (Q = diag(10, 100, 1, 1), R = 0.01) designed once, on the nominal model, by scipy
+    nominal = study.linearize()
+    X = scipy.linalg.solve_continuous_are(nominal.A, nominal.B, np.diag([10.0, 100.0, 1.0, 1.0]), np.array([[0.01]]))
+    K = np.linalg.solve([[0.01]], nominal.B.T @ X)
+    assert sweep.K.shape == (1, 4) and np.abs(sweep.K - K).max() <= 1e-9 * np.abs(K).max()
+    base = os.path.join(SOURCE_DIR, "examples")
+    for i, mass in enumerate(sweep.values[:, 0]):
+        # the variant's own model: the JSON edited here, linearized by Study.linearize
+        lin = codyna.Study.from_json(cart_with(b1=mass), base_dir=base).linearize()
+        assert np.array_equal(sweep.A[i], lin.A) and np.array_equal(sweep.B[i], lin.B), i
+        assert np.array_equal(sweep.C[i], lin.C) and np.array_equal(sweep.D[i], lin.D), i
+        expected = sorted_poles(np.linalg.eigvals(lin.A - lin.B @ sweep.K))
+        assert np.abs(sweep.closed_poles[i] - expected).max() < 1e-10, (i, sweep.closed_poles[i], expected)
+        assert np.abs(sweep.open_poles[i] - sorted_poles(np.linalg.eigvals(lin.A))).max() < 1e-10, i
+        assert sweep.closed_max_real[i] == sweep.closed_poles[i].real.max() and sweep.open_max_real[i] == sweep.open_poles[i].real.max()
+        if i == 0:  # K is the nominal one: a gain designed on the 5 kg variant would put the poles elsewhere
+            Xi = scipy.linalg.solve_continuous_are(lin.A, lin.B, np.diag([10.0, 100.0, 1.0, 1.0]), np.array([[0.01]]))
+            redesigned = sorted_poles(np.linalg.eigvals(lin.A - lin.B @ (100.0 * lin.B.T @ Xi)))
+            assert np.abs(sweep.closed_poles[0] - redesigned).max() > 1e-3
+    assert sweep.stable.dtype == bool and sweep.stable.all() and sweep.stable_count == 11
+    # the summary's worst case: the 5 kg rod, max Re = -0.6175065646 (docs/parameter-studies.md)
+    assert sweep.worst == 0 and abs(sweep.closed_max_real[0] - (-0.6175065646)) < 1e-10
+    assert int(np.argmax(sweep.closed_max_real)) == sweep.worst
+    assert "worst case       variant 0: /bodies/1/mass = 5, max Re(closed-loop pole) = -0.6175065646" in sweep.summary
+    assert sweep.written == () and sweep.sim_status is None and sweep.overshoot is None
+
+
+# dataset -> Sweep attribute (every dataset of the file is one of these)
+SWEEP_DATASETS = {
+    "parameters/values": "values", "parameters/fields": "fields", "parameters/specs": "specs",
+    "parameters/nominal": "nominal", "status/code": "status", "status/reason": "reasons",
+    "names/states": "state_names", "names/inputs": "input_names", "names/outputs": "output_names",
+    "linear/A": "A", "linear/B": "B", "linear/C": "C", "linear/D": "D",
+    "open_loop/max_real": "open_max_real", "open_loop/uncontrollable": "uncontrollable",
+    "open_loop/stable": "stable", "closed_loop/K": "K", "closed_loop/max_real": "closed_max_real",
+    "closed_loop/stable": "stable", "simulation/status": "sim_status", "simulation/reason": "sim_reason",
+    "simulation/t_reached": "t_reached", "simulation/peak_input": "peak_input",
+    "simulation/final_error": "final_error", "simulation/overshoot": "overshoot",
+    "simulation/settling_time": "settling_time", "simulation/saturation_time": "saturation_time",
+}
+
+
+def check_sweep_against_h5(sweep, path):
+    """Every dataset and root attribute of a codyna sweep HDF5 file against the Sweep, exactly."""
+    checked = set()
+    with h5py.File(path, "r") as f:
+        datasets = {}
+        f.visititems(lambda name, obj: datasets.__setitem__(name, obj[()]) if isinstance(obj, h5py.Dataset) else None)
+        for group in ("open_loop", "closed_loop"):
+            if group + "/poles_real" in datasets:
+                poles = datasets.pop(group + "/poles_real") + 1j * datasets.pop(group + "/poles_imag")
+                got = getattr(sweep, group.replace("_loop", "") + "_poles")
+                assert got.shape == poles.shape and np.array_equal(got, poles, equal_nan=True), group
+                checked.add(group + "/poles")
+        for name, data in datasets.items():
+            assert name in SWEEP_DATASETS, "a dataset the test does not know: " + name
+            got = getattr(sweep, SWEEP_DATASETS[name])
+            if data.dtype.kind in "OS":
+                assert list(got) == [x.decode() for x in data], name
+            else:
+                got = np.asarray(got)
+                assert got.shape == data.shape and np.array_equal(got, data, equal_nan=True), name
+            checked.add(name)
+        attrs = dict(f.attrs)
+        for key in ("design", "operating_point", "method", "controller", "model_name", "model_file"):
+            value = attrs[key].decode() if isinstance(attrs[key], bytes) else str(attrs[key])
+            assert value == str(getattr(sweep, key)), key
+        assert attrs["variants"] == len(sweep)
+        assert attrs.get("seed") == sweep.seed
+        gain = attrs["gain"].decode() if isinstance(attrs["gain"], bytes) else str(attrs["gain"])
+        assert gain == ("none" if not sweep.closed_loop else "redesigned" if sweep.redesigned else "fixed")
+    return checked
+
+
+def test_sweep_monte_carlo_equals_the_cli_and_itself(tmp_path):
+    vary = ["/bodies/1/mass=normal(10,3)", "/bodies/0/mass=uniform(10,30)"]
+    stdout, _ = cli("sweep", CART, *sum((["--vary", v] for v in vary), []), "--samples", 100, "--seed", 7, "--simulate",
+                    "--out", tmp_path / "cli.h5", "--csv", tmp_path / "cli.csv", "--quiet")
+    study = codyna.Study(CART)
+    a = study.sweep(vary, samples=100, seed=7, simulate=True, threads=1, out=tmp_path / "py.h5", csv=str(tmp_path / "py.csv"))
+    b = study.sweep(vary={f: s for f, s in (v.split("=", 1) for v in vary)}, samples=100, seed=7, simulate=True, threads=2)
+    assert a.design == "random" and a.seed == 7 and len(a) == 100 and a.simulated
+    assert a.written == (str(tmp_path / "py.h5"), str(tmp_path / "py.csv"))
+    # the command line's file, dataset by dataset: every one checked
+    checked = check_sweep_against_h5(a, tmp_path / "cli.h5")
+    # parameters 4, status 2, names 3, linear 4, open_loop 3 (poles, max_real, uncontrollable),
+    # closed_loop 4 (K, poles, max_real, stable), simulation 8
+    assert len(checked) == 28, sorted(checked)
+    # the same study twice (1 and 2 threads): the same numbers
+    for key in ("values", "status", "A", "B", "C", "D", "open_poles", "closed_poles", "stable", "peak_input",
+                "final_error", "overshoot", "settling_time", "saturation_time", "t_reached", "sim_status"):
+        assert np.array_equal(getattr(a, key), getattr(b, key), equal_nan=True), key
+    assert a.summary == b.summary
+    # what the command prints, and the files the module's call wrote: the command's bytes
+    assert stdout.startswith(a.summary), stdout
+    assert (tmp_path / "py.h5").read_bytes() == (tmp_path / "cli.h5").read_bytes()
+    assert (tmp_path / "py.csv").read_text() == (tmp_path / "cli.csv").read_text()
+    assert a.peak_input.shape == (100, 1) and a.overshoot.shape == (100, 2) and a.saturation_time.shape == (100, 1)
+    assert a.largest_input is not None and a.peak_input[a.largest_input, 0] == np.nanmax(a.peak_input)
+
+
+def test_sweep_failed_variants_are_recorded():
+    study = codyna.Study(CART)
+    nominal = study.linearize()
+    sweep = study.sweep(vary={ROD_MASS: [0, -1, 10]}, redesign="lqr")
+    assert sweep.specs == ["[0,-1,10]"] and sweep.redesigned
+    # a massless rod: nothing can move its angle, so no LQR; a negative mass: the model is refused
+    assert sweep.status.tolist() == [3, 1, 0]
+    assert sweep.status_text == ["refused", "model error", "ok"]
+    assert "lqr: the plant is not stabilizable" in sweep.reasons[0], sweep.reasons[0]
+    assert sweep.reasons[1] == CART + ": /bodies/1/mass: expected a non-negative mass (kg), got number -1.0"
+    assert sweep.reasons[2] == "" and sweep.failed == 2 and sweep.worst == 2
+    for i in (0, 1):
+        assert np.isnan(sweep.A[i]).all() and np.isnan(sweep.K[i]).all() and np.isnan(sweep.closed_poles[i].real).all()
+        assert np.isnan(sweep.closed_max_real[i]) and sweep.uncontrollable[i] == -1 and not sweep.stable[i]
+    assert np.array_equal(sweep.A[2], nominal.A) and np.array_equal(sweep.B[2], nominal.B)
+    # the 10 kg variant's LQR designed again is the nominal one (the fixed K of the study without redesign)
+    fixed = study.sweep(vary={ROD_MASS: [0, 10]})
+    assert np.abs(sweep.K[2] - fixed.K).max() <= 1e-12 * np.abs(fixed.K).max()
+    # without redesign the massless rod completes: unstable, one mode the force cannot move
+    assert fixed.status.tolist() == [0, 0] and fixed.uncontrollable.tolist() == [1, 0]
+    assert fixed.stable.tolist() == [False, True] and fixed.worst == 0
+    assert "failed           variant 0 (refused): " + sweep.reasons[0] + "\n" in sweep.summary
+    assert "                 variant 1 (model error): " + sweep.reasons[1] + "\n" in sweep.summary
+
+
+def test_sweep_bad_keywords():
+    study = codyna.Study(CART)
+    with pytest.raises(ValueError, match="^vary /bodies/1/masse=1:2:3: .*has no field /bodies/1/masse"):
+        study.sweep(vary="/bodies/1/masse=1:2:3")
+    with pytest.raises(ValueError, match="^vary /bodies/1/name=.*/bodies/1/name"):
+        study.sweep(vary={"/bodies/1/name": [1, 2]})
+    with pytest.raises(ValueError, match="^vary: give at least one FIELD=SPEC"):
+        study.sweep()
+    with pytest.raises(ValueError, match="^vary: a grid .* cannot be mixed"):
+        study.sweep(vary={ROD_MASS: "normal(10,3)", "/bodies/0/mass": "10:30:3"}, samples=5, seed=1)
+    with pytest.raises(ValueError, match="^seed: a random study"):
+        study.sweep(vary={ROD_MASS: "normal(10,3)"}, samples=5)
+    with pytest.raises(ValueError, match="^samples: a grid study"):
+        study.sweep(vary={ROD_MASS: "5:15:3"}, samples=5)
+    with pytest.raises(ValueError, match="^redesign lqrr: expected lqr"):
+        study.sweep(vary={ROD_MASS: "5:15:3"}, redesign="lqrr")
+    with pytest.raises(ValueError, match="^seed: expected a whole number from 0"):
+        study.sweep(vary={ROD_MASS: "normal(10,3)"}, samples=5, seed=-1)
+    with pytest.raises(ValueError, match="contradict"):
+        study.sweep(vary={ROD_MASS: "5:15:3"}, restart=True, resume=True)
+    with pytest.raises(TypeError, match="unexpected keyword argument 'samlpes'"):
+        study.sweep(vary={ROD_MASS: "5:15:3"}, samlpes=5)
+    with pytest.raises(TypeError, match="samples: expected a whole number"):
+        study.sweep(vary={ROD_MASS: "normal(10,3)"}, samples=5.0, seed=1)
+    with pytest.raises(TypeError, match=r"vary\[/bodies/1/mass\]: expected a number, got str"):
+        study.sweep(vary={ROD_MASS: ["5", "6"]})
+    with pytest.raises(TypeError, match="progress: expected a callable"):
+        study.sweep(vary={ROD_MASS: "5:15:3"}, progress=3)
+    # an output that would replace the model
+    with pytest.raises(ValueError, match="cart_pendulum.json"):
+        study.sweep(vary={ROD_MASS: "5:15:3"}, out=CART)
+
+
+def test_sweep_progress_on_the_calling_thread():
+    import threading
+    calls = []
+    sweep = codyna.Study(CART).sweep(vary={ROD_MASS: "5:15:11"}, threads=2,
+                                     progress=lambda done, total: calls.append((done, total, threading.get_ident())))
+    assert calls and calls[-1][:2] == (11, 11) and len(sweep) == 11
+    assert all(c[2] == threading.get_ident() for c in calls)
+    assert [c[0] for c in calls] == sorted(c[0] for c in calls)
+
+
+def test_sweep_stopped_by_its_callback_resumes_from_the_journal(tmp_path):
+    study = codyna.Study(CART)
+    options = dict(vary={ROD_MASS: "normal(10,3)"}, samples=200, seed=3, simulate=True, threads=1)
+
+    def stop(done, total):
+        raise RuntimeError("stop at %d of %d" % (done, total))
+
+    with pytest.raises(RuntimeError, match="^stop at"):
+        study.sweep(out=tmp_path / "a.h5", progress=stop, **options)
+    journal = tmp_path / "a.h5.partial"
+    assert not (tmp_path / "a.h5").exists() and journal.exists()
+    kept = len(journal.read_text().splitlines()) - 2  # the head and request lines, then a line per variant
+    assert 0 < kept < 200, kept
+    resumed = study.sweep(out=tmp_path / "a.h5", **options)
+    assert resumed.resumed == kept and not journal.exists()
+    assert any(n.startswith("resuming: %d of 200 variants were done" % kept) for n in resumed.notes), resumed.notes
+    whole = study.sweep(out=tmp_path / "b.h5", **options)
+    assert whole.resumed == 0
+    assert (tmp_path / "a.h5").read_bytes() == (tmp_path / "b.h5").read_bytes()
+
+
+def test_ctrl_c_interrupts_a_sweep(tmp_path):
+    # 20000 simulated variants on 2 worker threads (about 40 s), interrupted after a second
+    child = r"""
+import sys, time, codyna
+study = codyna.Study(sys.argv[1])
+print("start", flush=True)
+t0 = time.monotonic()
+try:
+    study.sweep(vary={"/bodies/1/mass": "normal(10,3)"}, samples=20000, seed=1, simulate=True, threads=2, out=sys.argv[2])
+    print("completed")
+except KeyboardInterrupt:
+    print("interrupted after %.3f s" % (time.monotonic() - t0), flush=True)
+"""
+    out = tmp_path / "mc.h5"
+    p = subprocess.Popen([sys.executable, "-c", child, CART, str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                         text=True, env=CHILD_ENV)
+    assert p.stdout.readline().strip() == "start"
+    time.sleep(1.0)
+    sent = time.monotonic()
+    p.send_signal(signal.SIGINT)
+    stdout, err = p.communicate(timeout=60)
+    waited = time.monotonic() - sent
+    assert p.returncode == 0, err
+    assert stdout.startswith("interrupted after"), stdout + err
+    assert float(stdout.split()[2]) < 8, stdout
+    assert waited < 5.0, waited
+    # the variants done are in the journal, the results file is not written
+    done = len((tmp_path / "mc.h5.partial").read_text().splitlines()) - 2
+    assert 0 < done < 20000 and not out.exists(), done
