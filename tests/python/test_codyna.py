@@ -18,7 +18,8 @@ the command line's output bit for bit (np.array_equal, never allclose):
     its own Study.from_json(edited JSON).linearize() bit for bit, its closed-loop poles
     eig(A - B K) to 1e-10, K scipy's design on the nominal model; a Monte Carlo (seed 7, run
     with --simulate) equals the CLI's HDF5 file dataset by dataset and itself on 1 and 2
-    threads, and the files it writes are the CLI's bytes; failed variants (status, reason, NaN
+    threads, and the files it writes (HDF5, CSV, MAT and .m) are the CLI's bytes; the grid from
+    Study.from_json with the values as a numpy array gives the same arrays; failed variants (status, reason, NaN
     rows); bad keywords (ValueError naming vary and the field, TypeError); the progress
     callback on the calling thread; a study stopped by its callback resumes from its journal
     into the uninterrupted run's bytes; SIGINT stops a sweep on 2 threads within a second;
@@ -521,6 +522,11 @@ def test_sweep_rod_mass_fixed_lqr_against_each_variants_own_linearization():
     assert int(np.argmax(sweep.closed_max_real)) == sweep.worst
     assert "worst case       variant 0: /bodies/1/mass = 5, max Re(closed-loop pole) = -0.6175065646" in sweep.summary
     assert sweep.written == () and sweep.sim_status is None and sweep.overshoot is None
+    # the same study from the JSON text, and with the values given as a numpy array
+    text = codyna.Study.from_json(open(CART).read(), base_dir=base).sweep(vary={ROD_MASS: np.linspace(5, 15, 11)})
+    assert text.model_file == os.path.join(base, "<json>") and text.specs[0].startswith("[5,6,7,")
+    for key in ("values", "A", "B", "C", "D", "open_poles", "closed_poles", "K"):
+        assert np.array_equal(getattr(text, key), getattr(sweep, key)), key
 
 
 # dataset -> Sweep attribute (every dataset of the file is one of these)
@@ -573,12 +579,13 @@ def check_sweep_against_h5(sweep, path):
 def test_sweep_monte_carlo_equals_the_cli_and_itself(tmp_path):
     vary = ["/bodies/1/mass=normal(10,3)", "/bodies/0/mass=uniform(10,30)"]
     stdout, _ = cli("sweep", CART, *sum((["--vary", v] for v in vary), []), "--samples", 100, "--seed", 7, "--simulate",
-                    "--out", tmp_path / "cli.h5", "--csv", tmp_path / "cli.csv", "--quiet")
+                    "--out", tmp_path / "cli.h5", "--csv", tmp_path / "cli.csv", "--mat", tmp_path / "cli" / "mc.mat", "--quiet")
     study = codyna.Study(CART)
-    a = study.sweep(vary, samples=100, seed=7, simulate=True, threads=1, out=tmp_path / "py.h5", csv=str(tmp_path / "py.csv"))
+    a = study.sweep(vary, samples=100, seed=7, simulate=True, threads=1, out=tmp_path / "py.h5", csv=str(tmp_path / "py.csv"),
+                    mat=tmp_path / "py" / "mc.mat")
     b = study.sweep(vary={f: s for f, s in (v.split("=", 1) for v in vary)}, samples=100, seed=7, simulate=True, threads=2)
     assert a.design == "random" and a.seed == 7 and len(a) == 100 and a.simulated
-    assert a.written == (str(tmp_path / "py.h5"), str(tmp_path / "py.csv"))
+    assert a.written == tuple(str(tmp_path / f) for f in ("py.h5", "py.csv", "py/mc.mat", "py/mc.m"))
     # the command line's file, dataset by dataset: every one checked
     checked = check_sweep_against_h5(a, tmp_path / "cli.h5")
     # parameters 4, status 2, names 3, linear 4, open_loop 3 (poles, max_real, uncontrollable),
@@ -593,6 +600,8 @@ def test_sweep_monte_carlo_equals_the_cli_and_itself(tmp_path):
     assert stdout.startswith(a.summary), stdout
     assert (tmp_path / "py.h5").read_bytes() == (tmp_path / "cli.h5").read_bytes()
     assert (tmp_path / "py.csv").read_text() == (tmp_path / "cli.csv").read_text()
+    for f in ("mc.mat", "mc.m"):
+        assert (tmp_path / "py" / f).read_bytes() == (tmp_path / "cli" / f).read_bytes(), f
     assert a.peak_input.shape == (100, 1) and a.overshoot.shape == (100, 2) and a.saturation_time.shape == (100, 1)
     assert a.largest_input is not None and a.peak_input[a.largest_input, 0] == np.nanmax(a.peak_input)
 
