@@ -700,13 +700,17 @@ def test_ctrl_c_interrupts_a_sweep(tmp_path):
     child = r"""
 import sys, time, codyna
 study = codyna.Study(sys.argv[1])
-print("start", flush=True)
-t0 = time.monotonic()
+started = []
+def progress(done, total):  # "start" once variants are done (and in the journal)
+    if not started:
+        started.append(time.monotonic())
+        print("start", flush=True)
 try:
-    study.sweep(vary={"/bodies/1/mass": "normal(10,3)"}, samples=20000, seed=1, simulate=True, threads=2, out=sys.argv[2])
+    study.sweep(vary={"/bodies/1/mass": "normal(10,3)"}, samples=20000, seed=1, simulate=True, threads=2, out=sys.argv[2],
+                progress=progress)
     print("completed")
 except KeyboardInterrupt:
-    print("interrupted after %.3f s" % (time.monotonic() - t0), flush=True)
+    print("interrupted after %.3f s" % (time.monotonic() - started[0]), flush=True)
 """
     out = tmp_path / "mc.h5"
     p = subprocess.Popen([sys.executable, "-c", child, CART, str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
