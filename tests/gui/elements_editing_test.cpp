@@ -12,8 +12,10 @@
 //   - motion (the cart pendulum's cart driven, a shaker under an inverted pendulum):
 //     its type and joint picked; A, B, D of the realization without derivatives,
 //     theta/x = -(3/(2l)) s^2 / (s^2 - 3g/(2l)).
-// Bad values typed (a negative stiffness, an unknown joint or body, a motion input on a
-// coupled joint, a weight missing) are refused naming the field, and nothing crashes.
+// Bad values typed (a negative stiffness, an unknown joint or body, a second motion input on
+// a driven joint, a weight missing) are refused naming the field, and nothing crashes; the ball
+// and beam's motion moved onto the coupled coordinate r is accepted (a motion on a loop's
+// coordinate: the beam left free).
 #include <QAbstractItemView>
 #include <QAction>
 #include <QApplication>
@@ -306,17 +308,25 @@ class ElementsEditingTest : public QObject {
     QVERIFY2(near(s->D(y, 0), b), qPrintable(QString("D = %1").arg(s->D(y, 0), 0, 'g', 17)));
     QVERIFY(near(s->D(h, 0), 1) && near(s->C(h, th), 0));
 
-    // the ball and beam: its motion input moved to the rolling ball's coordinate r, which a
-    // coupler holds: refused, naming the joint field
+    // the ball and beam: its motion input moved to the rolling ball's coordinate r, which the
+    // rolling coupler ties to the spin (a motion on a loop's coordinate): the beam turns freely,
+    // one degree of freedom; a second motion on r is refused, naming the joint field
     QVERIFY(w->openFile(QStringLiteral(CODYNA_EXAMPLES_DIR "/ball_beam.json")));
     click(ElementKind::Actuator, "alpha");
     QCOMPARE(combo("joint")->currentText(), QString("beam_pivot"));
+    choose("joint", "r");
+    QVERIFY2(w->document()->model(), qPrintable(w->document()->errorText()));
+    QCOMPARE(w->document()->model()->dof(), 1);
+    add("actuator");
+    type("name", "alpha2");
+    choose("type", "motion");
     QVERIFY(drive::pickWithMouse(combo("joint"), "r"));
     QCOMPARE(props()->markedField(), QString("joint"));
     QVERIFY2(props()->errorText().startsWith("joint:"), qPrintable(props()->errorText()));
     QVERIFY(!w->document()->model());
-    choose("joint", "beam_pivot");
+    choose("joint", "beam_pivot");  // both driven: the spin follows r, nothing left free
     QVERIFY2(w->document()->model(), qPrintable(w->document()->errorText()));
+    QCOMPARE(w->document()->model()->dof(), 0);
   }
 };
 
