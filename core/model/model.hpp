@@ -154,7 +154,8 @@ struct Model {
   std::vector<SensorModel> sensors;      // [ny_all]
   std::vector<int> plant_inputs;         // indices into actuators
   // the motion actuators (indices into actuators): each holds its coordinate at u, u', u''
-  // (prescribed, out of the state: dof() does not count it); never a coordinate of a loop
+  // (prescribed, out of the state: dof() does not count it); on a loop's coordinate the loop
+  // closes on the free coordinates (prepare_model refuses motions that lock or over-drive it)
   std::vector<int> motions;
   std::vector<int> plant_outputs;        // indices into sensors
 
