@@ -379,6 +379,24 @@ def test_compare_linear_equals_cli(tmp_path):
     assert gap["max_abs"]["theta"] == np.abs(run.y[:, 0] - run.y_linear[:, 0]).max()
 
 
+def interrupt_a_second_in(child, *args):
+    """Runs the Python code `child` with `args`; once it prints "start", waits a second and sends
+    SIGINT: it must print "interrupted after T s" with T under 8 s (it stopped about a second in,
+    not after its whole run; margins for a loaded machine) within 5 s of the signal, exit 0."""
+    p = subprocess.Popen([sys.executable, "-c", child, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         env=CHILD_ENV)
+    assert p.stdout.readline().strip() == "start"
+    time.sleep(1.0)
+    sent = time.monotonic()
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate(timeout=60)
+    waited = time.monotonic() - sent
+    assert p.returncode == 0, err
+    assert out.startswith("interrupted after"), out + err
+    assert float(out.split()[2]) < 8, out
+    assert waited < 5.0, waited
+
+
 def test_ctrl_c_interrupts_a_simulation():
     # a run of hours (the double pendulum, open loop, 20000 s), interrupted after a second
     child = r"""
@@ -392,20 +410,8 @@ try:
 except KeyboardInterrupt:
     print("interrupted after %.3f s" % (time.monotonic() - t0), flush=True)
 """
-    model = os.path.join(SOURCE_DIR, "examples", "double_pendulum.json")
-    p = subprocess.Popen([sys.executable, "-c", child, model], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                         env=CHILD_ENV)
-    assert p.stdout.readline().strip() == "start"
-    time.sleep(1.0)
-    sent = time.monotonic()
-    p.send_signal(signal.SIGINT)
-    out, err = p.communicate(timeout=60)
-    waited = time.monotonic() - sent
-    assert p.returncode == 0, err
-    assert out.startswith("interrupted after"), out + err
-    # stopped about a second in, not after the whole run (about 25 s alone; margins for a loaded machine)
-    assert float(out.split()[2]) < 8, out
-    assert waited < 5.0, waited
+    # stopped about a second in, not after the whole run (about 25 s alone)
+    interrupt_a_second_in(child, os.path.join(SOURCE_DIR, "examples", "double_pendulum.json"))
 
 
 def test_a_simulation_releases_the_gil():
@@ -713,18 +719,7 @@ except KeyboardInterrupt:
     print("interrupted after %.3f s" % (time.monotonic() - started[0]), flush=True)
 """
     out = tmp_path / "mc.h5"
-    p = subprocess.Popen([sys.executable, "-c", child, CART, str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                         text=True, env=CHILD_ENV)
-    assert p.stdout.readline().strip() == "start"
-    time.sleep(1.0)
-    sent = time.monotonic()
-    p.send_signal(signal.SIGINT)
-    stdout, err = p.communicate(timeout=60)
-    waited = time.monotonic() - sent
-    assert p.returncode == 0, err
-    assert stdout.startswith("interrupted after"), stdout + err
-    assert float(stdout.split()[2]) < 8, stdout
-    assert waited < 5.0, waited
+    interrupt_a_second_in(child, CART, str(out))
     # the variants done are in the journal, the results file is not written
     done = len((tmp_path / "mc.h5.partial").read_text().splitlines()) - 2
     assert 0 < done < 20000 and not out.exists(), done
