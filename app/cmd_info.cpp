@@ -12,7 +12,11 @@ int g_exit = 0;
 void print_info(const Model& m) {
   std::cout << "model        " << m.name << "\n";
   if (!m.source_file.empty()) std::cout << "file         " << m.source_file << "\n";
-  std::cout << "DOF          " << m.dof() << "\n"
+  std::cout << "DOF          " << m.dof();
+  if (m.active_velocity_rows > 0)
+    std::cout << " coordinates, " << m.rate_dof() << " rates (rolling: " << m.active_velocity_rows
+              << " non-holonomic equations remove rates, not coordinates)";
+  std::cout << "\n"
             << "nq, nv       " << m.nq << ", " << m.nv << "\n"
             << "bodies       " << m.nbodies - 1 << "\n";
   for (int i = 1; i < m.nbodies; ++i) {
@@ -25,7 +29,10 @@ void print_info(const Model& m) {
   std::cout << "\nrates        ";
   for (int k = 0; k < m.nv; ++k) std::cout << (k ? ", " : "") << m.rate_names[k] << " [" << m.v_units[k] << "/s]";
   std::cout << "\nconstraints  " << m.constraints.size() << " (" << m.nc << " equations, "
-            << m.active_rows.size() << " independent)\n";
+            << m.active_rows.size() << " independent"
+            << (m.velocity_rows.empty() ? std::string()
+                                         : ", " + std::to_string(m.velocity_rows.size()) + " on the velocities only")
+            << ")\n";
   for (const ConstraintModel& c : m.constraints)
     std::cout << "  " << std::left << std::setw(14) << c.name << " " << to_string(c.type) << " " << m.body_names[c.body_a]
               << " - " << m.body_names[c.body_b] << "\n";

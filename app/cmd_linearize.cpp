@@ -100,6 +100,13 @@ void print(const LinearizeJob& job) {
       std::cout << (k ? ", " : "") << m.v_names[lin.partition.independent[k]];
     std::cout << "\n";
   }
+  if (!lin.partition.rate_dependent.empty()) {
+    // rolling: these coordinates are states, their rates follow from the others'
+    std::cout << "rates not states ";
+    for (std::size_t k = 0; k < lin.partition.rate_dependent.size(); ++k)
+      std::cout << (k ? ", " : "") << m.rate_names[lin.partition.rate_dependent[k]];
+    std::cout << " (they follow from the rolling conditions)\n";
+  }
   std::cout << "\n";
   std::cout << "x0\n" << name_values(sys.state_names, sys.x0) << "u0\n" << name_values(sys.input_names, sys.u0)
             << "y0\n" << name_values(sys.output_names, sys.y0) << "xdot0\n" << name_values(sys.state_names, sys.xdot0) << "\n";

@@ -575,7 +575,7 @@ void SimulateView::refreshFromDocument() {
     tracking_time_->setValue(st.tracking_time);
     tracking_time_->setEnabled(st.anti_windup == "back_calculation");
   }
-  const int dof2 = doc_->model() ? 2 * doc_->model()->dof() : -1;
+  const int dof2 = doc_->model() ? doc_->model()->dof() + doc_->model()->rate_dof() : -1;
   const int nu = static_cast<int>(spec.plant.inputs.size());
   lqr_hint_->setText(dof2 >= 0 ? tr("Q: %1 weights in state order (positions, then velocities); R: %2 weights, one per "
                                     "Plant/In. Empty = identity.")

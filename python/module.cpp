@@ -451,8 +451,8 @@ py::dict model_info(const Study& s) {
     actuators.append(py::dict("name"_a = a.name, "type"_a = to_string(a.type), "unit"_a = a.unit, "gain"_a = a.gain,
                               "u0"_a = a.u0, "min"_a = a.min, "max"_a = a.max));
   for (const SensorModel& y : m.sensors) sensors.append(py::dict("name"_a = y.name, "type"_a = to_string(y.type), "unit"_a = y.unit));
-  return py::dict("name"_a = m.name, "file"_a = m.source_file, "dof"_a = m.dof(), "nq"_a = m.nq, "nv"_a = m.nv,
-                  "bodies"_a = bodies, "joints"_a = joints, "coordinates"_a = m.v_names, "units"_a = m.v_units,
+  return py::dict("name"_a = m.name, "file"_a = m.source_file, "dof"_a = m.dof(), "rate_dof"_a = m.rate_dof(),
+                  "nq"_a = m.nq, "nv"_a = m.nv, "bodies"_a = bodies, "joints"_a = joints, "coordinates"_a = m.v_names, "units"_a = m.v_units,
                   "rates"_a = m.rate_names, "q_names"_a = m.q_names, "constraints"_a = constraints,
                   "constraint_equations"_a = m.nc, "independent_equations"_a = m.active_rows.size(),
                   "redundant_equations"_a = redundant, "assembly_residual"_a = m.assembly_residual,

@@ -29,7 +29,7 @@ void expect_size(const char* what, const Eigen::MatrixXd& M, Eigen::Index rows, 
 ClosedLoopLinear close_loop(const LinearSystem& plant_in, const LinearLaw& law, const DisturbanceInputs& w_in,
                             const std::vector<std::string>& xc_names, const std::string& description) {
   if (plant_in.Ts > 0) throw std::invalid_argument("closed loop: the plant must be continuous (it is discretized here when the controller is sampled)");
-  const int nx = plant_in.nx(), nu = plant_in.nu(), ny = plant_in.ny(), nz = nx / 2;
+  const int nx = plant_in.nx(), nu = plant_in.nu(), ny = plant_in.ny(), nz = plant_in.npositions();
   const int nd = static_cast<int>(w_in.Bw.cols());
   const int nxc = static_cast<int>(law.Ak.rows());
   expect_size("Ak", law.Ak, nxc, nxc);
@@ -63,7 +63,9 @@ ClosedLoopLinear close_loop(const LinearSystem& plant_in, const LinearLaw& law, 
 
   // ydot = Cv dx: the z-columns of C applied to the velocity states w
   Eigen::MatrixXd Cv = Eigen::MatrixXd::Zero(ny, nx);
-  if (nz > 0) Cv.rightCols(nz) = plant_in.C.leftCols(nz);
+  if (nz > 0 && 2 * nz == nx) Cv.rightCols(nz) = plant_in.C.leftCols(nz);
+  // rolling: fewer rates than positions, zdot = A_zw w
+  else if (nz > 0) Cv.rightCols(nx - nz).noalias() = plant_in.C.leftCols(nz) * plant_in.A.topRightCorner(nz, nx - nz);
   // the controller's direct dependence on dx: Dx + Dv Cv (and Bx + Bv Cv)
   const Eigen::MatrixXd Dx = law.Dx + law.Dv * Cv, Bx = law.Bx + law.Bv * Cv;
 

@@ -15,6 +15,10 @@ struct LinearSystem {
   Eigen::MatrixXd A, B, C, D;
   Eigen::VectorXd x0, u0, y0, xdot0;
   double Ts = 0.0;
+  // the position states z, first in x = [z; w]: nx / 2, or fewer velocities w with rolling's
+  // non-holonomic rows (-1: not known, nx / 2). zdot = A_zw w about the operating point
+  int positions = -1;
+  int npositions() const { return positions >= 0 ? positions : nx() / 2; }
   std::vector<std::string> state_names, input_names, output_names;
   std::vector<std::string> state_units, input_units, output_units;
 

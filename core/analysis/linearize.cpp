@@ -174,7 +174,7 @@ Linearization linearize_general(const Model& model, const OperatingPoint& op, co
   const int nx = f.nx(), nu = f.nu(), ny = f.ny();
   // state at the operating point: zero deviation, independent velocities
   Eigen::VectorXd x = Eigen::VectorXd::Zero(nx);
-  for (int k = 0; k < f.nz(); ++k) x[f.nz() + k] = op.v[out.partition.independent[k]];
+  for (int k = 0; k < f.nw(); ++k) x[f.nz() + k] = op.v[f.rates()[static_cast<std::size_t>(k)]];
   Eigen::VectorXd u(nu);
   for (int k = 0; k < nu; ++k) u[k] = op.u[model.plant_inputs[k]];
 
@@ -198,6 +198,7 @@ Linearization linearize_general(const Model& model, const OperatingPoint& op, co
   Eigen::VectorXd xd, y;
   f.eval<double>(x, u, xd, y);
   s.x0 = f.state_offset(op.v);
+  s.positions = f.nz();
   s.u0 = u;
   s.y0 = y;
   s.xdot0 = xd;

@@ -42,7 +42,7 @@ Eigen::VectorXd rest_accelerations(const PlantFunction& f, const Eigen::VectorXd
   Eigen::VectorXd x = Eigen::VectorXd::Zero(f.nx()), xd, y;
   x.head(f.nz()) = z;
   f.eval<double>(x, u, xd, y);
-  return xd.tail(f.nz());
+  return xd.tail(f.nw());
 }
 
 Eigen::VectorXd plant_u(const Model& m, const Eigen::VectorXd& u_all) {
@@ -91,8 +91,7 @@ void require_steady_state(const Model& model, const OperatingPoint& op, const st
   const Eigen::VectorXd r = rest_accelerations(f, Eigen::VectorXd::Zero(f.nz()), plant_u(model, op.u));
   std::vector<std::string> in_names, coords;
   for (int k : model.plant_inputs) in_names.push_back(model.actuators[k].name);
-  const CoordinatePartition part = partition_coordinates(model, op.q, independent);
-  for (int i : part.independent) coords.push_back(model.v_names[static_cast<std::size_t>(i)]);
+  for (int i : f.rates()) coords.push_back(model.v_names[static_cast<std::size_t>(i)]);
   std::ostringstream os;
   os << op.kind << ": not converged: the residual accelerations are " << op.residual << " after " << op.iterations
      << " iterations (tolerance " << tolerance;
@@ -146,10 +145,10 @@ OperatingPoint steady_state(const Model& model, const OperatingPoint& start, con
     Eigen::VectorXd x = Eigen::VectorXd::Zero(f.nx()), xd, y;
     x.head(f.nz()) = z;
     f.eval<double>(x, uu, xd, y);
-    Eigen::VectorXd r(f.nz() + static_cast<Eigen::Index>(target_y.size()));
-    r.head(f.nz()) = xd.tail(f.nz());
+    Eigen::VectorXd r(f.nw() + static_cast<Eigen::Index>(target_y.size()));
+    r.head(f.nw()) = xd.tail(f.nw());
     for (std::size_t i = 0; i < target_y.size(); ++i)
-      r[f.nz() + static_cast<Eigen::Index>(i)] = y[target_y[i]] - target[static_cast<Eigen::Index>(i)];
+      r[f.nw() + static_cast<Eigen::Index>(i)] = y[target_y[i]] - target[static_cast<Eigen::Index>(i)];
     return r;
   };
   double accel_left = 0.0, output_left = 0.0;
@@ -161,20 +160,20 @@ OperatingPoint steady_state(const Model& model, const OperatingPoint& start, con
       const CoordinatePartition part = partition_holding(model, op.q, spec.held, independent);
       for (std::size_t k = 0; k < model.plant_inputs.size(); ++k) op.u[model.plant_inputs[k]] = u[static_cast<Eigen::Index>(k)];
       const PlantFunction f(model, op.q, op.u, part);
-      const int n = f.nz();
+      const int n = f.nz(), na = f.nw();  // positions, and accelerations (fewer with rolling)
       std::vector<int> free_z;  // unknown positions in z
       for (int k = 0; k < n; ++k)
         if (index_of(spec.held, model.v_names[static_cast<std::size_t>(part.independent[static_cast<std::size_t>(k)])]) < 0)
           free_z.push_back(k);
       const Eigen::VectorXd z0 = Eigen::VectorXd::Zero(n);
       const Eigen::VectorXd r = residual(f, z0, u);
-      accel_left = n ? r.head(n).lpNorm<Eigen::Infinity>() : 0.0;
+      accel_left = na ? r.head(na).lpNorm<Eigen::Infinity>() : 0.0;
       free_coords.clear();
       for (int k : free_z) free_coords.push_back(model.v_names[static_cast<std::size_t>(part.independent[static_cast<std::size_t>(k)])]);
-      if (n) {
+      if (na) {
         Eigen::Index i = 0;
-        r.head(n).cwiseAbs().maxCoeff(&i);
-        worst = model.v_names[static_cast<std::size_t>(part.independent[static_cast<std::size_t>(i)])];
+        r.head(na).cwiseAbs().maxCoeff(&i);
+        worst = model.v_names[static_cast<std::size_t>(f.rates()[static_cast<std::size_t>(i)])];
       }
       output_left = target_y.empty() ? 0.0 : r.tail(static_cast<Eigen::Index>(target_y.size())).lpNorm<Eigen::Infinity>();
       if (accel_left < 1e-11 && output_left < 1e-11 * (1.0 + (target.size() ? target.lpNorm<Eigen::Infinity>() : 0.0)))
@@ -184,7 +183,7 @@ OperatingPoint steady_state(const Model& model, const OperatingPoint& start, con
       if (nf == 0) break;
       Eigen::MatrixXd G(m, nf);
       for (Eigen::Index i = 0; i < m; ++i) {
-        const Eigen::Index row = i < n ? n + i : f.nx() + target_y[static_cast<std::size_t>(i - n)];
+        const Eigen::Index row = i < na ? n + i : f.nx() + target_y[static_cast<std::size_t>(i - na)];
         Eigen::Index c = 0;
         for (int k : free_z) G(i, c++) = J(row, k);
         for (int k : free_u) G(i, c++) = J(row, f.nx() + k);
@@ -266,7 +265,7 @@ OperatingPoint static_equilibrium(const Model& model, const OperatingPoint& star
     op.residual = r.size() ? r.lpNorm<Eigen::Infinity>() : 0.0;
     if (op.residual < 1e-11) break;
     const Eigen::MatrixXd J = plant_jacobian(f, Eigen::VectorXd::Zero(f.nx()), u, JacobianMethod::Exact);
-    const Eigen::MatrixXd K = J.block(n, 0, n, n);  // d(qdd)/dz
+    const Eigen::MatrixXd K = J.block(n, 0, f.nw(), n);  // d(qdd)/dz
     const Eigen::VectorXd dz = -Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(K).solve(r);
     double t = 1.0;
     bool moved = false;
@@ -307,7 +306,7 @@ OperatingPoint trim(const Model& model, const OperatingPoint& start, const std::
     op.residual = r.size() ? r.lpNorm<Eigen::Infinity>() : 0.0;
     if (op.residual < 1e-12) break;
     const Eigen::MatrixXd J = plant_jacobian(f, Eigen::VectorXd::Zero(f.nx()), u, JacobianMethod::Exact);
-    const Eigen::MatrixXd Bq = J.block(n, f.nx(), n, f.nu());  // d(qdd)/du
+    const Eigen::MatrixXd Bq = J.block(n, f.nx(), f.nw(), f.nu());  // d(qdd)/du
     u -= Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(Bq).solve(r);
   }
   for (std::size_t k = 0; k < model.plant_inputs.size(); ++k) op.u[model.plant_inputs[k]] = u[k];

@@ -25,12 +25,48 @@ namespace codyna {
 
 namespace {
 
-// the constraint rows that are independent at q (redundancy can move between rows)
+// the constraint rows on q that are independent at q (redundancy can move between rows); rolling's
+// no-slip rows, on the velocities only, are not among them (velocity_rows_at)
 std::vector<int> independent_rows(const Model& m, const Eigen::VectorXd& q) {
   if (m.nc == 0) return {};
+  const int rank = static_cast<int>(m.active_rows.size()) - m.active_velocity_rows;
+  if (rank == 0) return {};
   Data d(m);
   constraint_terms<double>(m, d, q, Eigen::VectorXd::Zero(m.nv));
-  return partition_rows(d.Jc, 1e-9, static_cast<int>(m.active_rows.size())).independent;
+  for (int r : m.velocity_rows) d.Jc.row(r).setZero();
+  return partition_rows(d.Jc, 1e-9, rank).independent;
+}
+
+int row_rank(const Eigen::MatrixXd& A) {
+  if (A.rows() == 0) return 0;
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A.transpose());
+  qr.setThreshold(1e-9);
+  return static_cast<int>(qr.rank());
+}
+
+// the non-holonomic rows independent of the holonomic rows `held` at q (as prepare_model chose them
+// at q0: in order, each kept when it adds to the rank)
+std::vector<int> velocity_rows_at(const Model& m, const Eigen::VectorXd& q, const std::vector<int>& held) {
+  std::vector<int> out;
+  if (m.active_velocity_rows == 0) return out;
+  Data d(m);
+  constraint_terms<double>(m, d, q, Eigen::VectorXd::Zero(m.nv));
+  Eigen::MatrixXd J(static_cast<Eigen::Index>(held.size()), m.nv);
+  for (std::size_t k = 0; k < held.size(); ++k) J.row(static_cast<Eigen::Index>(k)) = d.Jc.row(held[k]);
+  for (int r : m.velocity_rows) {
+    if (static_cast<int>(out.size()) == m.active_velocity_rows) break;
+    Eigen::MatrixXd Jn(J.rows() + 1, m.nv);
+    Jn << J, d.Jc.row(r);
+    if (row_rank(Jn) == Jn.rows()) {
+      J = Jn;
+      out.push_back(r);
+    }
+  }
+  if (static_cast<int>(out.size()) != m.active_velocity_rows)
+    throw std::invalid_argument("the rolling conditions lose rank at this configuration (" +
+                                std::to_string(out.size()) + " of " + std::to_string(m.active_velocity_rows) +
+                                " independent): no state-space model here");
+  return out;
 }
 
 Eigen::MatrixXd active_jacobian(const Model& m, const Eigen::VectorXd& q, const std::vector<int>& rows) {
@@ -38,6 +74,35 @@ Eigen::MatrixXd active_jacobian(const Model& m, const Eigen::VectorXd& q, const 
   constraint_terms<double>(m, d, q, Eigen::VectorXd::Zero(m.nv));
   Eigen::MatrixXd J(rows.size(), m.nv);
   for (std::size_t k = 0; k < rows.size(); ++k) J.row(k) = d.Jc.row(rows[k]);
+  return J;
+}
+
+// a dependent coordinate on a ball or free joint (a tangent coordinate)
+bool tangent_dependent(const Model& m, const std::vector<int>& dep) {
+  for (int b = 1; b < m.nbodies; ++b) {
+    const JointModel& j = m.joints[b];
+    if (j.type != JointType::Spherical && j.type != JointType::Free) continue;
+    for (int i : dep)
+      if (i >= j.idx_v && i < j.idx_v + j.nv) return true;
+  }
+  return false;
+}
+
+// d phi(q_ref (+) dq) / d(dq[dep]) on `rows`, by automatic differentiation
+Eigen::MatrixXd phi_by_dependent(const Model& m, const Eigen::VectorXd& q_ref, const Eigen::VectorXd& dq,
+                                 const std::vector<int>& rows, const std::vector<int>& dep) {
+  const int nd = static_cast<int>(dep.size());
+  ADVec dqa(m.nv);
+  for (int i = 0; i < m.nv; ++i) dqa[i] = ADScalar(dq[i], Eigen::VectorXd::Zero(nd));
+  for (int c = 0; c < nd; ++c) dqa[dep[static_cast<std::size_t>(c)]].derivatives()[c] = 1.0;
+  DataT<ADScalar> d(m);
+  const ADVec q = integrate<ADScalar>(m, q_ref.cast<ADScalar>(), dqa);
+  const ADVec& phi = constraint_residual<ADScalar>(m, d, q);
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows.size()), nd);
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    const ADScalar& p = phi[rows[k]];
+    if (p.derivatives().size() == nd) J.row(static_cast<Eigen::Index>(k)) = p.derivatives().transpose();
+  }
   return J;
 }
 
@@ -56,8 +121,63 @@ MatXT<S> columns_t(const MatXT<S>& J, const std::vector<int>& cols) {
 
 }  // namespace
 
+std::vector<int> CoordinatePartition::rates() const {
+  std::vector<int> r;
+  for (int i : independent)
+    if (std::find(rate_dependent.begin(), rate_dependent.end(), i) == rate_dependent.end()) r.push_back(i);
+  return r;
+}
+
+namespace {
+
+CoordinatePartition partition_positions(const Model& m, const Eigen::VectorXd& q,
+                                        const std::vector<std::string>& preferred);
+
+// Rolling's no-slip rows fix some of the independent coordinates' rates from the others': with
+// the holonomic rows Jh (v_dep = -Jh_d^-1 Jh_i v_ind), the rolling rows on the independent rates are
+// E = Jn_i - Jn_d Jh_d^-1 Jh_i, and its pivots (column-pivoted QR) are the rates that follow.
+void choose_rate_dependent(const Model& m, const Eigen::VectorXd& q, CoordinatePartition& p) {
+  p.rate_dependent.clear();
+  if (m.active_velocity_rows == 0) return;
+  const std::vector<int> held = independent_rows(m, q), rolling = velocity_rows_at(m, q, held);
+  Data d(m);
+  constraint_terms<double>(m, d, q, Eigen::VectorXd::Zero(m.nv));
+  const auto block = [&](const std::vector<int>& rows, const std::vector<int>& cols) {
+    Eigen::MatrixXd B(rows.size(), cols.size());
+    for (std::size_t r = 0; r < rows.size(); ++r)
+      for (std::size_t c = 0; c < cols.size(); ++c) B(r, c) = d.Jc(rows[r], cols[c]);
+    return B;
+  };
+  Eigen::MatrixXd E = block(rolling, p.independent);
+  if (!p.dependent.empty())
+    E -= block(rolling, p.dependent) * block(held, p.dependent).partialPivLu().solve(block(held, p.independent));
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(E);
+  const auto& perm = qr.colsPermutation().indices();
+  std::vector<int> cols;
+  for (Eigen::Index k = 0; k < E.rows(); ++k) cols.push_back(static_cast<int>(perm[k]));
+  std::sort(cols.begin(), cols.end());
+  Eigen::MatrixXd Ed(E.rows(), static_cast<Eigen::Index>(cols.size()));
+  for (std::size_t c = 0; c < cols.size(); ++c) Ed.col(static_cast<Eigen::Index>(c)) = E.col(cols[c]);
+  const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(Ed).singularValues();
+  if (sv.size() && sv[sv.size() - 1] < 1e-8 * std::max(1.0, sv[0]))
+    throw std::invalid_argument("the rolling conditions fix no rate of the independent coordinates at this "
+                                "configuration (their Jacobian is singular there)");
+  for (int c : cols) p.rate_dependent.push_back(p.independent[static_cast<std::size_t>(c)]);
+}
+
+}  // namespace
+
 CoordinatePartition partition_coordinates(const Model& m, const Eigen::VectorXd& q,
                                           const std::vector<std::string>& preferred) {
+  CoordinatePartition p = partition_positions(m, q, preferred);
+  choose_rate_dependent(m, q, p);
+  return p;
+}
+
+namespace {
+
+CoordinatePartition partition_positions(const Model& m, const Eigen::VectorXd& q,
+                                        const std::vector<std::string>& preferred) {
   CoordinatePartition p;
   for (int k : m.motions) p.driven.push_back(m.actuators[static_cast<std::size_t>(k)].iv);
   const auto is_driven = [&](int i) { return std::find(p.driven.begin(), p.driven.end(), i) != p.driven.end(); };
@@ -133,6 +253,8 @@ CoordinatePartition partition_coordinates(const Model& m, const Eigen::VectorXd&
   return p;
 }
 
+}  // namespace
+
 CoordinatePartition partition_holding(const Model& m, const Eigen::VectorXd& q, const std::vector<std::string>& held,
                                       const std::vector<std::string>& preferred) {
   std::vector<int> held_v;
@@ -187,6 +309,17 @@ PlantFunction::PlantFunction(const Model& model, const Eigen::VectorXd& q_ref, c
     : model_(model), q_ref_(q_ref), u_all_(u_all), part_(std::move(partition)), rows_(independent_rows(model, q_ref)) {
   if (rows_.size() != part_.dependent.size())
     throw std::invalid_argument("coordinate partition does not match the constraints at the reference configuration");
+  rates_ = part_.rates();
+  vrows_ = rows_;
+  vdep_ = part_.dependent;
+  if (!part_.rate_dependent.empty() || model.active_velocity_rows > 0) {
+    const std::vector<int> rolling = velocity_rows_at(model, q_ref, rows_);
+    if (rolling.size() != part_.rate_dependent.size())
+      throw std::invalid_argument("coordinate partition does not match the rolling conditions at the reference "
+                                  "configuration");
+    vrows_.insert(vrows_.end(), rolling.begin(), rolling.end());
+    vdep_.insert(vdep_.end(), part_.rate_dependent.begin(), part_.rate_dependent.end());
+  }
   for (std::size_t k = 0; k < model.plant_inputs.size(); ++k)
     if (model.actuators[static_cast<std::size_t>(model.plant_inputs[k])].type == ActuatorType::Motion)
       motion_inputs_.push_back(static_cast<int>(k));
@@ -297,21 +430,19 @@ bool PlantFunction::fd_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd&
 template <class S>
 void PlantFunction::eval(const VecXT<S>& x, const VecXT<S>& u, VecXT<S>& xdot, VecXT<S>& y) const {
   if constexpr (std::is_same_v<S, double>) {
-    if (model_.motions.empty()) {
+    if (model_.motions.empty() && part_.rate_dependent.empty()) {
       if (part_.dependent.empty() && model_.nc == 0) eval_tree(x, u, xdot, y);
       else eval_closed(x, u, xdot, y);
       return;
     }
   }
   const Model& m = model_;
-  const int n = nz(), nd = static_cast<int>(part_.dependent.size());
+  const int n = nz(), nw_ = nw(), nd = static_cast<int>(part_.dependent.size());
   const auto& ind = part_.independent;
   const auto& dep = part_.dependent;
   VecXT<S> dq = VecXT<S>::Zero(m.nv), v = VecXT<S>::Zero(m.nv);
-  for (int k = 0; k < n; ++k) {
-    dq[ind[k]] = x[k];
-    v[ind[k]] = x[n + k];
-  }
+  for (int k = 0; k < n; ++k) dq[ind[k]] = x[k];
+  for (int k = 0; k < nw_; ++k) v[rates_[k]] = x[n + k];
   DataT<S> d(m);
   const VecXT<S> zero_v = VecXT<S>::Zero(m.nv);
   // motion inputs: their coordinates at u (a Plant/In's value, or the nominal), u', u''
@@ -376,36 +507,47 @@ void PlantFunction::eval(const VecXT<S>& x, const VecXT<S>& u, VecXT<S>& xdot, V
     MatXT<double> Jd_value(nd, nd);
     for (int r = 0; r < nd; ++r)
       for (int c = 0; c < nd; ++c) Jd_value(r, c) = ad_value(Ja(r, dep[c]));
+    // The step carries the exact derivative only with d phi / d(dq_dep) itself. Jc is that where
+    // the dependent coordinates add (revolute, prismatic) or at dq = 0; a ball's or free joint's
+    // tangent coordinates away from the reference turn with their rotation: differentiate there
+    if (tangent_dependent(m, dep)) {
+      Eigen::VectorXd dqv(m.nv);
+      for (int i = 0; i < m.nv; ++i) dqv[i] = ad_value(dq[i]);
+      if (dqv.cwiseAbs().maxCoeff() > 0) Jd_value = phi_by_dependent(m, q_ref_, dqv, rows_, dep);
+    }
     const VecXT<S> step = lu_solve<S>(Jd_value.cast<S>(), MatXT<S>(phi)).col(0);
     for (int k = 0; k < nd; ++k) dq[dep[k]] -= step[k];
-    // dependent velocities from Jc v = 0
+  }
+  const int nvd = static_cast<int>(vdep_.size());
+  if (nvd > 0) {
+    // dependent velocities from Jc v = 0 (the holonomic rows, and rolling's no-slip rows for the
+    // rates they fix)
     constraint_terms<S>(m, d, integrate<S>(m, q_ref_.cast<S>(), dq), zero_v);
-    for (int k = 0; k < nd; ++k) Ja.row(k) = d.Jc.row(rows_[k]);
-    const MatXT<S> Jd = columns_t<S>(Ja, dep), Jz = columns_t<S>(Ja, ind);
-    VecXT<S> w(n);
-    for (int k = 0; k < n; ++k) w[k] = x[n + k];
+    MatXT<S> Ja(nvd, m.nv);
+    for (int k = 0; k < nvd; ++k) Ja.row(k) = d.Jc.row(vrows_[k]);
+    const MatXT<S> Jd = columns_t<S>(Ja, vdep_), Jz = columns_t<S>(Ja, rates_);
+    VecXT<S> w(nw_);
+    for (int k = 0; k < nw_; ++k) w[k] = x[n + k];
     VecXT<S> Jw = Jz * w;
     // the motion inputs' rates on the loops' driven columns: Jd v_dep = -Jz w - J_driven u'
     for (int k : m.motions) {
       const int i = m.actuators[static_cast<std::size_t>(k)].iv;
-      for (int r = 0; r < nd; ++r) {
+      for (int r = 0; r < nvd; ++r) {
         const S p = Ja(r, i) * v[i];
         Jw[r] = Jw[r] + p;
       }
     }
     const VecXT<S> vd = -lu_solve<S>(Jd, MatXT<S>(Jw)).col(0);
-    for (int k = 0; k < nd; ++k) v[dep[k]] = vd[k];
+    for (int k = 0; k < nvd; ++k) v[vdep_[k]] = vd[k];
   }
   const VecXT<S> q = integrate<S>(m, q_ref_.cast<S>(), dq);
   VecXT<S> u_all = u_all_.cast<S>();
   for (int k = 0; k < nu(); ++k) u_all[m.plant_inputs[k]] = u[k];
   const VecXT<S> qdd = forward_dynamics<S>(m, d, q, v, u_all);
   const VecXT<S> rate = tangent_rate<S>(m, dq, v);
-  xdot.resize(2 * n);
-  for (int k = 0; k < n; ++k) {
-    xdot[k] = rate[ind[k]];
-    xdot[n + k] = qdd[ind[k]];
-  }
+  xdot.resize(n + nw_);
+  for (int k = 0; k < n; ++k) xdot[k] = rate[ind[k]];
+  for (int k = 0; k < nw_; ++k) xdot[n + k] = qdd[rates_[k]];
   forward_kinematics<S>(m, d, q, v);
   y = sensor_outputs<S>(m, d, m.plant_outputs, q, v);
 }
@@ -421,6 +563,8 @@ PlantFunction::Workspace::~Workspace() = default;
 
 bool PlantFunction::analytic_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::MatrixXd& J) const {
   const Model& m = model_;
+  // rolling's no-slip rows have no analytic derivatives yet: automatic differentiation
+  if (!m.velocity_rows.empty()) return false;
   if (m.nc != 0 || !m.motions.empty()) return closed_loop_jacobian(x, u, J);
   if (!part_.dependent.empty()) return false;
   const int n = nz(), nu_p = nu(), ny_p = ny();
@@ -682,22 +826,20 @@ void PlantFunction::state_to_qv(const Eigen::VectorXd& x, Eigen::VectorXd& q, Ei
   }
   q = integrate<double>(model_, q_ref_, dq);
   v = Eigen::VectorXd::Zero(model_.nv);
-  for (int k = 0; k < n; ++k) v[part_.independent[k]] = x[n + k];
-  if (!part_.dependent.empty()) {
-    const Eigen::MatrixXd J = active_jacobian(model_, q, rows_);
-    const Eigen::VectorXd vd = -columns(J, part_.dependent).partialPivLu().solve(columns(J, part_.independent) * x.tail(n));
-    for (std::size_t k = 0; k < part_.dependent.size(); ++k) v[part_.dependent[k]] = vd[k];
+  for (int k = 0; k < nw(); ++k) v[rates_[static_cast<std::size_t>(k)]] = x[n + k];
+  if (!vdep_.empty()) {
+    const Eigen::MatrixXd J = active_jacobian(model_, q, vrows_);
+    const Eigen::VectorXd vd = -columns(J, vdep_).partialPivLu().solve(columns(J, rates_) * x.tail(nw()));
+    for (std::size_t k = 0; k < vdep_.size(); ++k) v[vdep_[k]] = vd[static_cast<Eigen::Index>(k)];
   }
 }
 
 Eigen::VectorXd PlantFunction::qv_to_state(const Eigen::VectorXd& q, const Eigen::VectorXd& v) const {
   const Eigen::VectorXd dq = difference(model_, q_ref_, q);
   const int n = nz();
-  Eigen::VectorXd x(2 * n);
-  for (int k = 0; k < n; ++k) {
-    x[k] = dq[part_.independent[k]];
-    x[n + k] = v[part_.independent[k]];
-  }
+  Eigen::VectorXd x(n + nw());
+  for (int k = 0; k < n; ++k) x[k] = dq[part_.independent[k]];
+  for (int k = 0; k < nw(); ++k) x[n + k] = v[rates_[static_cast<std::size_t>(k)]];
   return x;
 }
 
@@ -715,31 +857,45 @@ const JointModel& joint_of(const Model& m, int i, int& k) {
 }
 }  // namespace
 
-std::vector<std::string> plant_state_names(const Model& model, const std::vector<int>& independent) {
+std::vector<std::string> plant_state_names(const Model& model, const std::vector<int>& independent,
+                                           const std::vector<int>& rates) {
   // Model::v_names and rate_names: for a ball or free joint the position states are the
   // rotation vector (and displacement) of the deviation, in the joint's frame at the operating point
   std::vector<std::string> names;
-  names.reserve(2 * independent.size());
+  names.reserve(independent.size() + rates.size());
   for (int i : independent) names.push_back(model.v_names[static_cast<std::size_t>(i)]);
-  for (int i : independent) names.push_back(model.rate_names[static_cast<std::size_t>(i)]);
+  for (int i : rates) names.push_back(model.rate_names[static_cast<std::size_t>(i)]);
   return names;
 }
 
-std::vector<std::string> plant_state_units(const Model& model, const std::vector<int>& independent) {
+std::vector<std::string> plant_state_units(const Model& model, const std::vector<int>& independent,
+                                           const std::vector<int>& rates) {
   std::vector<std::string> units;
-  units.reserve(2 * independent.size());
+  units.reserve(independent.size() + rates.size());
   for (int i : independent) units.push_back(model.v_units[static_cast<std::size_t>(i)]);
-  for (int i : independent) units.push_back(model.v_units[static_cast<std::size_t>(i)] + "/s");
+  for (int i : rates) units.push_back(model.v_units[static_cast<std::size_t>(i)] + "/s");
   return units;
 }
 
-std::vector<std::string> PlantFunction::state_names() const { return plant_state_names(model_, part_.independent); }
+std::vector<std::string> plant_state_names(const Model& model, const std::vector<int>& independent) {
+  return plant_state_names(model, independent, independent);
+}
 
-std::vector<std::string> PlantFunction::state_units() const { return plant_state_units(model_, part_.independent); }
+std::vector<std::string> plant_state_units(const Model& model, const std::vector<int>& independent) {
+  return plant_state_units(model, independent, independent);
+}
+
+std::vector<std::string> PlantFunction::state_names() const {
+  return plant_state_names(model_, part_.independent, rates_);
+}
+
+std::vector<std::string> PlantFunction::state_units() const {
+  return plant_state_units(model_, part_.independent, rates_);
+}
 
 Eigen::VectorXd PlantFunction::state_offset(const Eigen::VectorXd& v_ref) const {
   const int n = nz();
-  Eigen::VectorXd x0 = Eigen::VectorXd::Zero(2 * n);
+  Eigen::VectorXd x0 = Eigen::VectorXd::Zero(n + nw());
   for (int k = 0; k < n; ++k) {
     const int i = part_.independent[k];
     int c = 0;
@@ -747,8 +903,8 @@ Eigen::VectorXd PlantFunction::state_offset(const Eigen::VectorXd& v_ref) const 
     // additive coordinates carry their absolute value; rotation/translation tangents of
     // spherical and free joints are deviations from the reference pose (offset 0)
     if (j.type != JointType::Spherical && j.type != JointType::Free) x0[k] = q_ref_[j.idx_q + c];
-    x0[n + k] = v_ref[i];
   }
+  for (int k = 0; k < nw(); ++k) x0[n + k] = v_ref[rates_[static_cast<std::size_t>(k)]];
   return x0;
 }
 

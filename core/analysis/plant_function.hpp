@@ -1,7 +1,8 @@
 // The plant as a first-order system in minimal coordinates about a base
 // configuration q_ref:
 //   x = [z; w]   z: tangent deviation of the independent coordinates from q_ref
-//                w: the independent velocities
+//                w: the independent velocities (as many as z, fewer with rolling's
+//                   non-holonomic rows: then some of z's rates follow from w)
 //   xdot = f(x, u),  y = h(x, u)       u: values of the Plant/In actuators
 // For a tree every coordinate is independent. For closed loops the
 // independent coordinates come from coordinate partitioning of the constraint
@@ -29,6 +30,11 @@ struct CoordinatePartition {
   std::vector<int> independent;  // v indices, size DOF
   std::vector<int> dependent;    // v indices, size = independent constraint rows
   std::vector<int> driven;       // v indices of the motion inputs' coordinates (Model::motions order)
+  // non-holonomic rows (rolling): the independent coordinates whose rates follow from the others'
+  // (a subset of `independent`); the state's velocities are the rates of the rest (rates())
+  std::vector<int> rate_dependent;
+  // the independent coordinates whose rates are states, in `independent`'s order
+  std::vector<int> rates() const;
 };
 
 // Chooses independent coordinates at q: the dependent ones are the pivot
@@ -58,7 +64,11 @@ class PlantFunction {
                 CoordinatePartition partition);
 
   int nz() const { return static_cast<int>(part_.independent.size()); }
-  int nx() const { return 2 * nz(); }
+  // the independent velocities: nz() less the active non-holonomic rows (rolling); nz() otherwise
+  int nw() const { return static_cast<int>(rates_.size()); }
+  int nx() const { return nz() + nw(); }
+  // velocity indices of the state's velocities w (CoordinatePartition::rates())
+  const std::vector<int>& rates() const { return rates_; }
   int nu() const { return static_cast<int>(model_.plant_inputs.size()); }
   // the Plant/In inputs that are motion inputs (positions in plant_inputs). eval takes u of size
   // nu(), or nu() + 2 nm(): then u's tail holds their rates u' and then their accelerations u''
@@ -111,7 +121,10 @@ class PlantFunction {
   const Model& model_;
   Eigen::VectorXd q_ref_, u_all_;
   CoordinatePartition part_;
-  std::vector<int> rows_;  // constraint rows independent at q_ref
+  std::vector<int> rows_;  // constraint rows on q independent at q_ref (the holonomic ones)
+  // the velocities' rows (rows_, then the active non-holonomic rows), the state's rates, and the
+  // velocities solved from them (dependent, then rate_dependent)
+  std::vector<int> vrows_, rates_, vdep_;
   std::vector<int> motion_inputs_;
 
   // workspace of analytic_jacobian, made on first use; a copy starts without one
@@ -154,5 +167,10 @@ class PlantFunction {
 // (PlantFunction::state_names and state_units, without making a plant function)
 std::vector<std::string> plant_state_names(const Model& model, const std::vector<int>& independent);
 std::vector<std::string> plant_state_units(const Model& model, const std::vector<int>& independent);
+// with non-holonomic rows: the positions' coordinates `independent`, the velocities' `rates`
+std::vector<std::string> plant_state_names(const Model& model, const std::vector<int>& independent,
+                                           const std::vector<int>& rates);
+std::vector<std::string> plant_state_units(const Model& model, const std::vector<int>& independent,
+                                           const std::vector<int>& rates);
 
 }  // namespace codyna

@@ -46,6 +46,7 @@ AssemblyResult assemble(const Model& model, const Eigen::VectorXd& q_guess, cons
     constraint_terms<double>(model, d, r.q, zero_v);
     Eigen::MatrixXd J = d.Jc;
     for (int k : locked_q) J.col(k).setZero();  // a zero column gets a zero step (minimum norm)
+    for (int r : model.velocity_rows) J.row(r).setZero();  // no condition on q (phi is 0 there)
     const Eigen::VectorXd step = -min_norm_solve(J, phi);
     double t = 1.0;
     bool improved = false;

@@ -146,6 +146,75 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool with_vel
           ++r;
         }
         break;
+      case ConstraintType::RollingBall: {
+        // the plane's normal n and directions t1, t2 on body_a; the ball's centre c = p_b, the contact
+        // point P = c - R n. Height: n . (c - p_a) - R (on q). No slip: t . (v_b(P) - v_a(P)) with
+        // v_b(P) - v_a(P) = w = -dp' + R n x w_b + (P - p_a) x w_a, dp = p_a - c (on v only: phi 0)
+        const S R = ad_coherent(S(c.radius), nd);
+        const Attached<S> n = attached<S>(d, c.body_a, c.axis_a, nd);
+        Vec3T<S> ndp = n.x.cross(dpc);
+        coh(ndp);
+        const S h = dot3<S>(n.x, dpc, nd);
+        d.phi[r] = -h - R;
+        if (with_velocity) {
+          d.Jc.row(r).noalias() = -(ndp.transpose() * Jwa);
+          d.Jc.row(r).noalias() -= n.x.transpose() * Jp;
+          const S g1 = dot3<S>(n.xdd, dpc, nd), g2 = dot3<S>(n.xd, dpd, nd), g3 = dot3<S>(n.x, dpdd, nd);
+          const S g2x2 = ad_coherent(S(S(2) * g2), nd);
+          const S g12 = g1 + g2x2;
+          d.gamma[r] = -(g12 + g3);
+        }
+        ++r;
+        Vec3T<S> Rn = n.x * R, Rnd = n.xd * R;
+        coh(Rn);
+        coh(Rnd);
+        Vec3T<S> Pa = -dpc - Rn;  // P - p_a
+        coh(Pa);
+        for (const Eigen::Vector3d* perp : {&c.perp_a1, &c.perp_a2}) {
+          d.phi[r] = ad_coherent(S(0), nd);
+          if (with_velocity) {
+            const Attached<S> t = attached<S>(d, c.body_a, *perp, nd);
+            Vec3T<S> tn = t.x.cross(Rn), tP = t.x.cross(Pa);
+            coh(tn);
+            coh(tP);
+            d.Jc.row(r).noalias() = -(t.x.transpose() * Jp);
+            d.Jc.row(r).noalias() += tn.transpose() * Jwb;
+            d.Jc.row(r).noalias() += tP.transpose() * Jwa;
+            // d/dt at qdd = 0: t' . w + t . w', with P' - p_a' = -dp' - R n'
+            Vec3T<S> wa = angular_velocity<S>(d, c.body_a), wb = angular_velocity<S>(d, c.body_b);
+            Vec3T<S> aa = angular_acceleration<S>(d, c.body_a), ab = angular_acceleration<S>(d, c.body_b);
+            coh(wa);
+            coh(wb);
+            coh(aa);
+            coh(ab);
+            Vec3T<S> Pad = -dpd - Rnd;
+            coh(Pad);
+            Vec3T<S> w = Rn.cross(wb);
+            coh(w);
+            Vec3T<S> wP = Pa.cross(wa);
+            coh(wP);
+            w = w + wP - dpd;
+            coh(w);
+            Vec3T<S> wd1 = Rnd.cross(wb), wd2 = Rn.cross(ab), wd3 = Pad.cross(wa), wd4 = Pa.cross(aa);
+            coh(wd1);
+            coh(wd2);
+            coh(wd3);
+            coh(wd4);
+            Vec3T<S> wd = wd1 + wd2;
+            coh(wd);
+            wd = wd + wd3;
+            coh(wd);
+            wd = wd + wd4;
+            coh(wd);
+            wd = wd - dpdd;
+            coh(wd);
+            const S s1 = dot3<S>(t.xd, w, nd), s2 = dot3<S>(t.x, wd, nd);
+            d.gamma[r] = s1 + s2;
+          }
+          ++r;
+        }
+        break;
+      }
       case ConstraintType::Coupler: break;  // coupler_row
     }
   }

@@ -818,6 +818,8 @@ void TreeDerivatives::constraint_derivatives(const Eigen::VectorXd& lambda, cons
   Vec6 w;
   Eigen::Matrix<double, 6, 24> dw;
   for (const ConstraintModel& cm : m_.constraints) {
+    if (cm.type == ConstraintType::RollingBall)
+      throw std::logic_error("TreeDerivatives: rolling_ball has no analytic derivatives (callers use autodiff)");
     if (cm.type == ConstraintType::Coupler) {
       // sum_k ratio_k q_k = offset: Jc is the ratios, c = Jc a, and the reaction -Jc^T lambda acts on
       // the coordinates themselves; nothing here depends on q or v
@@ -936,7 +938,8 @@ void TreeDerivatives::constraint_derivatives(const Eigen::VectorXd& lambda, cons
         }
         break;
       }
-      case ConstraintType::Coupler: break;  // above
+      case ConstraintType::Coupler:
+      case ConstraintType::RollingBall: break;  // above
     }
   }
 }

@@ -2,7 +2,9 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
+#include <Eigen/QR>
 #include <Eigen/SVD>
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -101,7 +103,51 @@ class Preparer {
     const RowPartition rows = partition_rows(d.Jc);
     m_.active_rows = rows.independent;
     m_.redundant_rows = rows.redundant;
+    if (!m_.velocity_rows.empty()) velocity_row_partition(d.Jc, static_cast<int>(rows.independent.size()));
     check_driven_loops(d.Jc, static_cast<int>(rows.independent.size()));
+  }
+
+  // With non-holonomic rows the active rows are the independent holonomic ones (which fix the
+  // coordinates), then the velocity rows independent of them: a velocity row never stands in for a
+  // position row, so that the positions' partition and the rates' stay apart.
+  void velocity_row_partition(const Eigen::MatrixXd& Jc, int rank) {
+    Eigen::MatrixXd Jh = Jc;
+    for (int r : m_.velocity_rows) Jh.row(r).setZero();
+    const RowPartition held = partition_rows(Jh);
+    std::vector<int> active;
+    for (int r : held.independent)
+      if (!m_.is_velocity_row(r)) active.push_back(r);
+    Eigen::MatrixXd J(0, Jc.cols());
+    const auto rank_of = [](const Eigen::MatrixXd& A) {
+      if (A.rows() == 0) return 0;
+      Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A.transpose());
+      qr.setThreshold(1e-9);
+      return static_cast<int>(qr.rank());
+    };
+    for (int r : active) {
+      J.conservativeResize(J.rows() + 1, Eigen::NoChange);
+      J.row(J.rows() - 1) = Jc.row(r);
+    }
+    int nvel = 0;
+    for (int r : m_.velocity_rows) {
+      Eigen::MatrixXd Jn(J.rows() + 1, Jc.cols());
+      Jn << J, Jc.row(r);
+      if (rank_of(Jn) == Jn.rows()) {
+        J = Jn;
+        active.push_back(r);
+        ++nvel;
+      }
+    }
+    std::sort(active.begin(), active.end());
+    if (static_cast<int>(active.size()) != rank)
+      fail(at("constraints", constraint_of_row(m_.velocity_rows.front())),
+           "the rolling conditions and the loops leave " + std::to_string(active.size()) +
+               " independent rows where their Jacobian has rank " + std::to_string(rank) + " (expected them to agree)");
+    m_.active_rows = active;
+    m_.active_velocity_rows = nvel;
+    m_.redundant_rows.clear();
+    for (int r = 0; r < m_.nc; ++r)
+      if (!std::binary_search(active.begin(), active.end(), r)) m_.redundant_rows.push_back(r);
   }
 
   // index into spec.actuators of the motion input k (an index into Model::actuators)

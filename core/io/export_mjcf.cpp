@@ -399,6 +399,11 @@ class Exporter {
         ++ncoupler_;
         continue;
       }
+      if (c.type == ConstraintType::RollingBall) {
+        refuse("rolling_ball " + c.name + ": MuJoCo models rolling by contact and friction, not as an exact "
+               "no-slip condition");
+        continue;
+      }
       if (c.type != ConstraintType::Ball) {
         // planar_revolute, revolute: a connect is the same where the loop is planar about the axis
         const Eigen::Vector3d n = d0.oMi[c.body_a].R * c.axis_a;

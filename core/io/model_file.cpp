@@ -768,7 +768,8 @@ const Schema<ConstraintSpec>& schema<ConstraintSpec>() {
            field("ratio_b", &ConstraintSpec::ratio_b, read_number, Need::Required),
            field("ratio_c", &ConstraintSpec::ratio_c, read_number,
                  [](double r) { return r == 0 ? ojson() : ojson(r); }),
-           field("offset", &ConstraintSpec::offset, [](const Node& n) { return std::optional<double>(read_number(n)); })},
+           field("offset", &ConstraintSpec::offset, [](const Node& n) { return std::optional<double>(read_number(n)); }),
+           field("radius", &ConstraintSpec::radius, read_number, Need::Required)},
       }),
       "constraint",
       [](const ConstraintSpec& c) {
@@ -778,6 +779,7 @@ const Schema<ConstraintSpec>& schema<ConstraintSpec>() {
           case ConstraintType::PlanarRevolute: return element_keys(point_pair_and({"axis_a"}));
           case ConstraintType::Coupler:
             return element_keys({"joint_a", "ratio_a", "joint_b", "ratio_b", "joint_c", "ratio_c", "offset"});
+          case ConstraintType::RollingBall: return element_keys(point_pair_and({"axis_a", "radius"}));
         }
         return element_keys({});
       }};

@@ -360,7 +360,15 @@ class Compiler {
       c.perp_b2 = axis_b.cross(c.perp_b1);
       c.row = row;
       std::vector<std::string> rows;
-      if (c.type == ConstraintType::PlanarRevolute) rows = {"u", "v"};
+      if (c.type == ConstraintType::RollingBall) {
+        if (!std::isfinite(cs.radius) || cs.radius <= 0)
+          fail(p + "/radius", "expected a positive radius (m), got " + fmt(cs.radius));
+        c.radius = cs.radius;
+        // height on q; no slip along the plane's two directions, on v only
+        rows = {"height", "slip_u", "slip_v"};
+        m_.velocity_rows.push_back(row + 1);
+        m_.velocity_rows.push_back(row + 2);
+      } else if (c.type == ConstraintType::PlanarRevolute) rows = {"u", "v"};
       else rows = {"x", "y", "z"};
       if (c.type == ConstraintType::Revolute) rows.insert(rows.end(), {"axis1", "axis2"});
       c.nrows = static_cast<int>(rows.size());

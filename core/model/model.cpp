@@ -1,5 +1,7 @@
 #include "model/model.hpp"
 
+#include <algorithm>
+
 namespace codyna {
 
 namespace {
@@ -15,6 +17,10 @@ Eigen::VectorXd Model::u_nominal() const {
   Eigen::VectorXd u(nu());
   for (int k = 0; k < nu(); ++k) u[k] = actuators[k].u0;
   return u;
+}
+
+bool Model::is_velocity_row(int row) const {
+  return std::binary_search(velocity_rows.begin(), velocity_rows.end(), row);
 }
 
 int Model::find_body(const std::string& n) const {

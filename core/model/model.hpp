@@ -43,6 +43,9 @@ struct ConstraintModel {
   double ratio[3] = {0, 0, 0};
   double offset = 0;
   bool offset_given = false;
+  // rolling_ball: the ball's radius (point_b is its centre, axis_a the plane's normal, perp_a1 and
+  // perp_a2 the plane's directions of no slip); its first row is on q, the other two on v only
+  double radius = 0;
 };
 
 struct SpringDamperModel {
@@ -140,6 +143,11 @@ struct Model {
   std::vector<std::string> row_names;    // [nc]
   std::vector<int> active_rows;          // independent rows, used in dynamics
   std::vector<int> redundant_rows;       // rows dependent on the others (named in row_names)
+  // non-holonomic rows (rolling without slip): conditions on the velocities only, with no phi(q)
+  // (Data::phi is 0 there); assembly, the position projections and the dependent positions use
+  // the other rows. The active ones are counted apart: they remove rates, not coordinates.
+  std::vector<int> velocity_rows;        // sorted
+  int active_velocity_rows = 0;          // of active_rows
 
   // effects: only these are evaluated
   bool has_gravity = false;
@@ -163,10 +171,6 @@ struct Model {
   double assembly_residual = 0.0;        // max |phi(q0)|, |J v0| after assembly
   // what assembly changed in the joints' q0 and v0 to close the loops, by more than 1e-6 (m, rad,
   // m/s, rad/s): a coordinate (Model::v_names; `from`, `to` its values for a scalar joint, NaN for
-  // rotor inertia per velocity index, added to the mass matrix's diagonal by every algorithm
-  // (crba, aba, rnea, energy, derivatives); empty when no joint has any (JointSpec::armature)
-  Eigen::VectorXd armature;              // [nv] or empty
-
   // a ball's or free joint's rotation, whose `by` is the tangent step) or a rate (rate_names)
   struct AssemblyMove {
     std::string name;
@@ -174,12 +178,22 @@ struct Model {
   };
   std::vector<AssemblyMove> assembly_moves;
 
+  // rotor inertia per velocity index, added to the mass matrix's diagonal by every algorithm
+  // (crba, aba, rnea, energy, derivatives); empty when no joint has any (JointSpec::armature)
+  Eigen::VectorXd armature;              // [nv] or empty
+
   ModelSpec spec;                        // the spec it was compiled from
   std::string source_file;               // where the spec was read, if from a file
 
   int nu() const { return static_cast<int>(actuators.size()); }
   int ny() const { return static_cast<int>(sensors.size()); }
-  int dof() const { return nv - static_cast<int>(active_rows.size()) - static_cast<int>(motions.size()); }
+  // the coordinates left free by the holonomic loops and the motions (the plant's positions z)
+  int dof() const {
+    return nv - (static_cast<int>(active_rows.size()) - active_velocity_rows) - static_cast<int>(motions.size());
+  }
+  // the independent rates (the plant's velocities w): dof() less the active non-holonomic rows
+  int rate_dof() const { return dof() - active_velocity_rows; }
+  bool is_velocity_row(int row) const;
   Eigen::VectorXd u_nominal() const;     // u0 of every actuator
   int find_body(const std::string& name) const;  // -1 if absent
   int find_actuator(const std::string& name) const;

@@ -81,7 +81,11 @@ struct JointSpec {
 //   revolute         ball + axis_a (on body_a) stays parallel to axis_b (on body_b) (5)
 //   planar_revolute  the two points coincide in the plane normal to axis_a (2);
 //                    for planar mechanisms, whose loops would be redundant in 3-D
-enum class ConstraintType { Ball, Revolute, PlanarRevolute, Coupler };
+//   rolling_ball     a ball of `radius` centred at point_b on body_b rolls without slipping on the
+//                    plane through point_a normal to axis_a (on body_a, the ball on the side axis_a
+//                    points to): the centre's height (1 equation on q) and no slip at the contact
+//                    (2 on the velocities only: non-holonomic)
+enum class ConstraintType { Ball, Revolute, PlanarRevolute, Coupler, RollingBall };
 
 struct ConstraintSpec {
   std::string name;
@@ -98,6 +102,7 @@ struct ConstraintSpec {
   std::string joint_a, joint_b, joint_c;
   double ratio_a = 1, ratio_b = -1, ratio_c = 0;
   std::optional<double> offset;
+  double radius = 0;  // rolling_ball, m
 };
 
 // Force elements. Only those listed in a model are ever evaluated.

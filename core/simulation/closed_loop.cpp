@@ -269,7 +269,14 @@ void ClosedLoopSystem::project_tangent(const Eigen::VectorXd& y, Eigen::VectorXd
   cod.compute(J);
   auto remove_normal = [&](auto&& block) { block -= cod.solve(J * Eigen::VectorXd(block)); };
   remove_normal(e.segment(model_.nq, model_.nv));
-  if (model_.nq == model_.nv) remove_normal(e.head(model_.nq));
+  if (model_.nq == model_.nv) {
+    // the positions' normal: the rows on q only (rolling's no-slip rows do not restrict them)
+    if (!model_.velocity_rows.empty()) {
+      for (int r : model_.velocity_rows) J.row(r).setZero();
+      cod.compute(J);
+    }
+    remove_normal(e.head(model_.nq));
+  }
 }
 
 bool ClosedLoopSystem::project(Eigen::VectorXd& y, double tol, double t) {
@@ -323,7 +330,9 @@ Eigen::Matrix<double, 3, 4> rotation_tangent(const Eigen::Vector4d& p) {
 }  // namespace
 
 bool ClosedLoopSystem::exact_dae_jacobian() const {
-  return nxc() == 0 && (!controller_ || controller_->sample_time() > 0) && model_.motions.empty();
+  // (rolling's no-slip rows have no analytic derivatives yet: SUNDIALS' difference quotients)
+  return nxc() == 0 && (!controller_ || controller_->sample_time() > 0) && model_.motions.empty() &&
+         model_.velocity_rows.empty();
 }
 
 bool ClosedLoopSystem::exact_ode_jacobian() const {

@@ -43,7 +43,7 @@ std::vector<Eigen::VectorXd> linear_run(const Model& model, const Controller* ct
                                         double atol, std::string& failure) {
   double now = times.front();  // the time the stages below are evaluated at (for the reference)
   const LinearSystem& s = plant.lin.system;
-  const int nx = s.nx(), nz = nx / 2;
+  const int nx = s.nx(), nz = s.npositions();
   const bool discrete = ctrl && ctrl->sample_time() > 0;
   const int nxc = ctrl ? ctrl->nxc() : 0;
   Eigen::VectorXd held = s.u0, xcd = Eigen::VectorXd::Zero(discrete ? nxc : 0);
@@ -75,7 +75,8 @@ std::vector<Eigen::VectorXd> linear_run(const Model& model, const Controller* ct
     in.y = s.y0 + s.C * dx + s.D * du;
     if (nd) in.y += plant.Dw * dw();
     Eigen::VectorXd rate = Eigen::VectorXd::Zero(nx);  // constant-velocity rate, as for the nonlinear plant
-    rate.head(nz) = dx.tail(nz) + s.xdot0.head(nz);
+    if (2 * nz == nx) rate.head(nz) = dx.tail(nz) + s.xdot0.head(nz);
+    else rate.head(nz) = s.A.topRightCorner(nz, nx - nz) * dx.tail(nx - nz) + s.xdot0.head(nz);  // rolling
     in.ydot = s.C * rate;
     in.x = shifted ? Eigen::VectorXd(dx + shift()) : dx;
     return in;
@@ -208,7 +209,7 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
   if (plant) {
     pf.emplace(model, plant->op.q, plant->op.u, plant->lin.partition);
     x_ref = Eigen::VectorXd::Zero(pf->nx());
-    for (int k = 0; k < pf->nz(); ++k) x_ref[pf->nz() + k] = plant->op.v[plant->lin.partition.independent[k]];
+    for (int k = 0; k < pf->nw(); ++k) x_ref[pf->nz() + k] = plant->op.v[pf->rates()[static_cast<std::size_t>(k)]];
   }
   const Eigen::VectorXd u_nominal = plant ? plant->op.u : model.u_nominal();
   ClosedLoopSystem sys(model, controller, pf ? &*pf : nullptr, x_ref, u_nominal, o.stabilization);
