@@ -33,7 +33,7 @@ const QStringList kBodyRefs{"parent", "child", "body", "body_a", "body_b", "fram
 QStringList type_names(ElementKind k) {
   switch (k) {
     case ElementKind::Joint: return {"revolute", "prismatic", "fixed", "spherical", "universal", "cylindrical", "planar", "free"};
-    case ElementKind::Constraint: return {"ball", "revolute", "planar_revolute", "coupler"};
+    case ElementKind::Constraint: return {"ball", "revolute", "planar_revolute", "coupler", "rolling_ball"};
     case ElementKind::Effect:
       return {"gravity", "spring_damper", "joint_spring_damper", "joint_friction", "joint_damper", "body_force", "bushing"};
     case ElementKind::Actuator: return {"joint_force", "body_force", "body_torque", "line_force", "mix", "motion"};
@@ -194,7 +194,20 @@ json shown_element(const ModelSpec& spec, ElementKind k, int index) {
 
 }  // namespace
 
-QString PropertyEditor::fieldHelp(ElementKind kind, const QString& key, const QString& unit) {
+QString PropertyEditor::fieldHelp(ElementKind kind, const QString& key, const QString& unit, const QString& type) {
+  // a rolling ball's fields mean what they are for it: a plane on body_a, a ball on body_b
+  if (kind == ElementKind::Constraint && type == QLatin1String("rolling_ball")) {
+    static const std::map<QString, QString> rolling{
+        {"body_a", "The body that carries the plane the ball rolls on"},
+        {"point_a", "A point of the plane, on the first body, in its frame"},
+        {"axis_a", "Normal of the plane, on the first body, in its frame (the ball is on the side it points to)"},
+        {"body_b", "The ball's body"},
+        {"point_b", "Centre of the ball, on the second body, in its frame"},
+    };
+    if (key == QLatin1String("radius")) return QStringLiteral("Radius of the rolling ball (m, > 0)");
+    const auto r = rolling.find(key);
+    if (r != rolling.end()) return unit.isEmpty() ? r->second : QStringLiteral("%1 [%2]").arg(r->second, unit);
+  }
   static const std::map<QString, QString> meaning{
       {"name", "The element's name; references to it follow a rename"},
       {"type", "The element's type; fields the new type does not take are dropped"},
@@ -259,7 +272,6 @@ QString PropertyEditor::fieldHelp(ElementKind kind, const QString& key, const QS
   const auto it = meaning.find(key.section('/', -1));
   QString text = it == meaning.end() ? QString(key).replace('/', '.') : it->second;
   if (!unit.isEmpty()) text += QStringLiteral(" [%1]").arg(unit);
-  (void)kind;
   return text;
 }
 
@@ -355,7 +367,7 @@ bool PropertyEditor::applyText(const QString& field, const QString& text, QStrin
     // keep only what the new type accepts: drop the fields the reader calls unknown, and
     // initial values sized for the old type (a joint's q0, v0); give the fields the new type
     // requires and the old one lacked a first value (a coupler's joints: the model's first two;
-    // its ratios 1 and -1), which the user then picks
+    // its ratios 1 and -1; a rolling ball's radius 0.05 m), which the user then picks
     for (int tries = 0; tries < 40; ++tries) {
       try {
         study_parse_model(j, ss(doc_->filePath()));
@@ -387,6 +399,8 @@ bool PropertyEditor::applyText(const QString& field, const QString& text, QStrin
             element[key] = names;
           } else if (key == "weights") {
             element[key] = json::array({1.0});
+          } else if (key == "radius") {  // a rolling ball: 5 cm
+            element[key] = 0.05;
           } else {
             break;
           }
@@ -576,7 +590,7 @@ void PropertyEditor::rebuild() {
     const QString unit = is_rotation_key(key) ? tr("deg, roll pitch yaw") : unitOf(key);
     QString label = key;
     label.replace('/', '.');
-    editor->setProperty("help", fieldHelp(kind, key, unit));
+    editor->setProperty("help", fieldHelp(kind, key, unit, j.contains("type") && j["type"].is_string() ? qs(j["type"].get<std::string>()) : QString()));
     editor->setToolTip(editor->property("help").toString());
     form_->addRow(unit.isEmpty() ? label : QStringLiteral("%1 [%2]").arg(label, unit), editor);
   };

@@ -34,8 +34,9 @@ class PropertyEditor : public QWidget {
   bool applyText(const QString& field, const QString& text, QString* error = nullptr);
 
   static QString unitOf(const QString& key);
-  // the tooltip of a field: what it means, with its unit
-  static QString fieldHelp(ElementKind kind, const QString& key, const QString& unit);
+  // the tooltip of a field: what it means, with its unit (`type`: the element's type, where a
+  // field means something of its own for it: a rolling_ball's axis_a is its plane's normal)
+  static QString fieldHelp(ElementKind kind, const QString& key, const QString& unit, const QString& type = QString());
 
  signals:
   void message(const QString& text);

@@ -365,6 +365,7 @@ void Scene::build(const Model* model) {
     if (m.parent[i] == 0) anchor(m.joints[i].X_PF.p, m.joints[i].X_PF.R, anchorSize(i, m.joints[i].X_CM.p));
   for (const ConstraintModel& c : m.constraints) {
     if (c.type == ConstraintType::Coupler) continue;  // couples coordinates, at no point
+    if (c.type == ConstraintType::RollingBall) continue;  // point_a is a point of a plane: drawn as its contact
     if (c.body_a == 0) anchor(c.point_a, Eigen::Matrix3d::Identity(), anchorSize(c.body_b, c.point_b));
     if (c.body_b == 0) anchor(c.point_b, Eigen::Matrix3d::Identity(), anchorSize(c.body_a, c.point_a));
   }
@@ -454,8 +455,14 @@ void Scene::addDefaultLook(int i) {
   std::vector<Eigen::Vector3d> ends;  // link ends other than the inboard joint
   for (int c = i + 1; c < m.nbodies; ++c)
     if (m.parent[c] == i) ends.push_back(m.joints[c].X_PF.p);
+  // a rolling ball on this body (point_b its centre): the ball itself, not a pin at its centre
+  std::vector<const ConstraintModel*> rolling;
   for (const ConstraintModel& c : m.constraints) {
     if (c.type == ConstraintType::Coupler) continue;
+    if (c.type == ConstraintType::RollingBall) {
+      if (c.body_b == i) rolling.push_back(&c);
+      continue;  // point_a is a point of the plane, not a link's end
+    }
     if (c.body_a == i) ends.push_back(c.point_a);
     if (c.body_b == i) ends.push_back(c.point_b);
   }
@@ -503,6 +510,8 @@ void Scene::addDefaultLook(int i) {
     knob.linear() *= 1.6 * r_link;
     add(Prim::Sphere, knob, pin);
   }
+  for (const ConstraintModel* c : rolling)
+    add(Prim::Sphere, Eigen::Translation3d(c->point_b) * Eigen::Scaling(c->radius), color);
 }
 
 Eigen::Affine3d spanTransform(const Item& it, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
@@ -613,6 +622,28 @@ void Scene::addElements(const std::vector<SE3>& oMi) {
     }
   }
 
+  // rolling balls: a thin green disc of the plane (turned with body_a) at the contact, the ball's
+  // centre less its radius along the plane's normal, and a dark dot at the contact; placed by update()
+  for (const ConstraintModel& c : m.constraints) {
+    if (c.type != ConstraintType::RollingBall) continue;
+    const double r = c.radius;
+    const Eigen::Matrix3d Rn = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), c.axis_a).toRotationMatrix();
+    const double patch = std::clamp(3.0 * r, 0.02 * L, 0.2 * L), h = std::min(0.004 * L, 0.2 * patch);
+    const double dot_r = std::clamp(0.3 * r, 0.004 * L, 0.02 * L);
+    for (const bool dot : {false, true}) {
+      const Eigen::Vector3d scale = dot ? Eigen::Vector3d::Constant(dot_r) : Eigen::Vector3d(patch, patch, h);
+      Eigen::Affine3d T = Eigen::Affine3d::Identity();
+      T.linear() = Rn * scale.asDiagonal();
+      Item* it = local(ItemKind::Contact, c.name, c.body_a, dot ? Prim::Sphere : Prim::Cylinder, T,
+                       dot ? Eigen::Vector4f(0.12f, 0.12f, 0.14f, 1.0f) : Eigen::Vector4f(0.25f, 0.72f, 0.45f, 1.0f));
+      it->span = Span::Contact;
+      it->body_b = c.body_b;
+      it->point_b = c.point_b;
+      it->normal = c.axis_a;
+      it->depth = r;
+    }
+  }
+
   // motion inputs: a cyan arrow (thicker than a joint axis) along the driven joint's axis from its
   // frame F, and a disc around it
   for (const int k : m.motions) {
@@ -656,6 +687,14 @@ void Scene::addElements(const std::vector<SE3>& oMi) {
 
 void Scene::update(const std::vector<SE3>& oMi) {
   for (Item& it : items_) {
+    if (it.span == Span::Contact) {
+      const SE3& A = oMi[it.body];
+      Eigen::Affine3d X = Eigen::Affine3d::Identity();
+      X.linear() = A.R;
+      X.translation() = oMi[it.body_b].act_point(it.point_b) - it.depth * (A.R * it.normal);
+      it.world = X * it.local;
+      continue;
+    }
     if (it.span != Span::None) {
       it.world = spanTransform(it, oMi[it.body].act_point(it.point_a), oMi[it.body_b].act_point(it.point_b));
       continue;

@@ -52,6 +52,7 @@ enum class ItemKind {
   Coupler,    // dashes between the coupled joints' frames F, and a dot on each
   Motion,     // a joint driven by a motion input: an arrow along its axis and a disc around it
   Actuator,   // an actuator driven by a mix: a force arrow from its point, a torque arrow and disc
+  Contact,    // a rolling_ball: a thin disc of the plane under the ball at the contact, a dot on it
 };
 
 // how a two-point item spans the line from point_a (on `body`) to point_b (on body_b)
@@ -61,6 +62,10 @@ enum class Span {
   Barrel,  // from a towards b: span_a long, or longer so that it meets the rod; at most the line
   Rod,     // from b towards a: span_b long, at most the line
   Dash,    // the fractions [span_a, span_b] of the line
+  // not a line: the contact of a ball (centre point_b on body_b) with a plane of `body` whose
+  // normal is `normal` (body frame): world = translation to the contact (the centre less `depth`
+  // along the normal as turned now) * the body's rotation * local (local's z: the normal)
+  Contact,
 };
 
 struct Item {
@@ -76,6 +81,8 @@ struct Item {
   Eigen::Vector3d point_a = Eigen::Vector3d::Zero(), point_b = Eigen::Vector3d::Zero();
   double thickness = 0.0;     // radius of the cylinder drawn along the line
   double span_a = 0.0, span_b = 0.0;
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // Span::Contact: the plane's normal, `body` frame (unit)
+  double depth = 0.0;                                 // Span::Contact: the ball's radius
   // an arrow whose direction stays in world axes (an actuator with "frame": "world"): world =
   // translation to the pose of `body` * local's origin, then local's linear part unturned
   bool world_axes = false;

