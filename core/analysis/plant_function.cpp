@@ -563,8 +563,6 @@ PlantFunction::Workspace::~Workspace() = default;
 
 bool PlantFunction::analytic_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::MatrixXd& J) const {
   const Model& m = model_;
-  // rolling's no-slip rows have no analytic derivatives yet: automatic differentiation
-  if (!m.velocity_rows.empty()) return false;
   if (m.nc != 0 || !m.motions.empty()) return closed_loop_jacobian(x, u, J);
   if (!part_.dependent.empty()) return false;
   const int n = nz(), nu_p = nu(), ny_p = ny();
@@ -735,9 +733,41 @@ bool PlantFunction::closed_loop_jacobian(const Eigen::VectorXd& x, const Eigen::
     W.P.noalias() = W.lu.solve(W.Jz);
     for (int k = 0; k < nd; ++k) W.G.row(dep[k]) = -W.P.row(k);
   }
-  W.v.noalias() = W.G.leftCols(n) * x.tail(n);
+  // G maps [z; u] to the coordinates' deviations and [w; u'] to the velocities. With rolling the
+  // velocities have their own map Gv on [w; u'] (the rates of rates_ and the motions', the others
+  // from all the velocity rows: holonomic and no-slip)
+  const bool rolling = !part_.rate_dependent.empty();
+  const int nw_ = nw(), npw = nw_ + nmi, nvd = static_cast<int>(vdep_.size());
+  auto wcolumn = [&](int c) {
+    return c < nw_ ? rates_[static_cast<std::size_t>(c)]
+                   : m.actuators[static_cast<std::size_t>(m.plant_inputs[motion_inputs_[c - nw_]])].iv;
+  };
+  if (rolling) {
+    if (W.Gv.rows() != m.nv || W.Gv.cols() != npw) {
+      W.Gv.resize(m.nv, npw);
+      W.Jvd.resize(nvd, nvd);
+      W.Jzv.resize(nvd, npw);
+      W.Pv.resize(nvd, npw);
+      W.Jav.resize(nvd, m.nv);
+      W.Ph.resize(nvd, np);
+      W.Phx.resize(nvd, np);
+      W.DQv.resize(m.nv, npw);
+    }
+    constraint_terms<double>(m, d, q_ref_, W.zero);
+    W.Gv.setZero();
+    for (int c = 0; c < npw; ++c) W.Gv(wcolumn(c), c) = 1.0;
+    for (int k = 0; k < nvd; ++k) {
+      for (int c = 0; c < nvd; ++c) W.Jvd(k, c) = d.Jc(vrows_[k], vdep_[c]);
+      for (int c = 0; c < npw; ++c) W.Jzv(k, c) = d.Jc(vrows_[k], wcolumn(c));
+    }
+    W.luv.compute(W.Jvd);
+    W.Pv.noalias() = W.luv.solve(W.Jzv);
+    for (int k = 0; k < nvd; ++k) W.Gv.row(vdep_[k]) = -W.Pv.row(k);
+  }
+  const Eigen::MatrixXd& Gv = rolling ? W.Gv : W.G;
+  W.v.noalias() = Gv.leftCols(nw_) * x.tail(nw_);
   if (rates)
-    for (int j = 0; j < nmi; ++j) W.v += W.G.col(n + j) * u[nu_p + j];
+    for (int j = 0; j < nmi; ++j) W.v += Gv.col(nw_ + j) * u[nu_p + j];
   W.u_all = u_all_;
   for (int k = 0; k < nu_p; ++k) W.u_all[m.plant_inputs[k]] = u[k];
   for (std::size_t i = 0; i < m.motions.size(); ++i) {
@@ -750,22 +780,30 @@ bool PlantFunction::closed_loop_jacobian(const Eigen::VectorXd& x, const Eigen::
   // the constrained accelerations and multipliers, then their derivatives
   forward_dynamics<double>(m, d, q_ref_, W.v, W.u_all);
   td.compute_constrained(q_ref_, W.v, W.u_all, d.qdd, d.lambda, d.loop.rows, m.plant_outputs);
-  // H = dv/d[z, u] at fixed [w, u']: Jd dv_dep = -(d(Jc v)/dq) G on the plant's rows
+  // H = dv/d[z, u] at fixed [w, u']: Jd dv_dep = -(d(Jc v)/dq) G on the plant's rows (with rolling:
+  // on the velocity rows, for the velocities' dependent columns)
   W.H.setZero();
-  if (nd > 0) {
+  if (rolling) {
+    for (int k = 0; k < nvd; ++k) W.Jav.row(k) = td.dphid_dq.row(vrows_[k]);
+    W.Ph.noalias() = W.Jav * W.G;
+    W.Phx.noalias() = W.luv.solve(W.Ph);
+    for (int k = 0; k < nvd; ++k) W.H.row(vdep_[k]) = -W.Phx.row(k);
+  } else if (nd > 0) {
     for (int k = 0; k < nd; ++k) W.Ja.row(k) = td.dphid_dq.row(rows_[k]);
     W.Jz.noalias() = W.Ja * W.G;
     W.P.noalias() = W.lu.solve(W.Jz);
     for (int k = 0; k < nd; ++k) W.H.row(dep[k]) = -W.P.row(k);
   }
-  const int ncols = 2 * n + nu_p + (rates ? 2 * nmi : 0);
-  if (J.rows() != 2 * n + ny_p || J.cols() != ncols) J.resize(2 * n + ny_p, ncols);
+  const int nxr = n + nw_;  // the state's size (2 n without rolling)
+  const int ncols = nxr + nu_p + (rates ? 2 * nmi : 0);
+  if (J.rows() != nxr + ny_p || J.cols() != ncols) J.resize(nxr + ny_p, ncols);
   J.setZero();
   // the column of motion input j's value, rate and acceleration
-  auto value_col = [&](int j) { return 2 * n + motion_inputs_[j]; };
-  auto rate_col = [&](int j) { return 2 * n + nu_p + j; };
-  auto acc_col = [&](int j) { return 2 * n + nu_p + nmi + j; };
-  // position rows: d(rate)/d(dq) G + H (d(rate)/dv = I at dq = 0), and d/dw = G = I on the independent rows
+  auto value_col = [&](int j) { return nxr + motion_inputs_[j]; };
+  auto rate_col = [&](int j) { return nxr + nu_p + j; };
+  auto acc_col = [&](int j) { return nxr + nu_p + nmi + j; };
+  // position rows: d(rate)/d(dq) G + H (d(rate)/dv = I at dq = 0), and d/dw = Gv (I on the
+  // independent rows without rolling)
   W.DQ = W.H;
   for (int b = 1; b < m.nbodies; ++b) {
     const JointModel& j = m.joints[b];
@@ -778,38 +816,45 @@ bool PlantFunction::closed_loop_jacobian(const Eigen::VectorXd& x, const Eigen::
   }
   for (int k = 0; k < n; ++k) {
     J.row(k).head(n) = W.DQ.row(ind[k]).head(n);
-    J(k, n + k) = 1.0;
+    if (rolling) {
+      J.row(k).segment(n, nw_) = W.Gv.row(ind[k]).head(nw_);
+      if (rates)
+        for (int j = 0; j < nmi; ++j) J(k, rate_col(j)) = W.Gv(ind[k], nw_ + j);
+    } else {
+      J(k, n + k) = 1.0;
+    }
     for (int j = 0; j < nmi; ++j) J(k, value_col(j)) = W.DQ(ind[k], n + j);
   }
-  // accelerations: dqdd/dz = dqdd_dq G + dqdd_dv H, dqdd/dw = dqdd_dv G
+  // accelerations of the state's rates: dqdd/dz = dqdd_dq G + dqdd_dv H, dqdd/dw = dqdd_dv Gv
   for (int k = 0; k < nu_p; ++k)
-    for (int r = 0; r < n; ++r) J(n + r, 2 * n + k) = td.dqdd_du(ind[r], m.plant_inputs[k]);
+    for (int r = 0; r < nw_; ++r) J(n + r, nxr + k) = td.dqdd_du(rates_[r], m.plant_inputs[k]);
   W.DQ.noalias() = td.dqdd_dq * W.G;
   W.DQ.noalias() += td.dqdd_dv * W.H;
-  for (int k = 0; k < n; ++k) {
-    J.row(n + k).head(n) = W.DQ.row(ind[k]).head(n);
-    for (int j = 0; j < nmi; ++j) J(n + k, value_col(j)) = W.DQ(ind[k], n + j);
+  for (int k = 0; k < nw_; ++k) {
+    J.row(n + k).head(n) = W.DQ.row(rates_[k]).head(n);
+    for (int j = 0; j < nmi; ++j) J(n + k, value_col(j)) = W.DQ(rates_[k], n + j);
   }
-  W.DQ.noalias() = td.dqdd_dv * W.G;
-  for (int k = 0; k < n; ++k) {
-    J.row(n + k).segment(n, n) = W.DQ.row(ind[k]).head(n);
+  Eigen::MatrixXd& DW = rolling ? W.DQv : W.DQ;
+  DW.noalias() = td.dqdd_dv * Gv;
+  for (int k = 0; k < nw_; ++k) {
+    J.row(n + k).segment(n, nw_) = DW.row(rates_[k]).head(nw_);
     if (rates)
-      for (int j = 0; j < nmi; ++j) J(n + k, rate_col(j)) = W.DQ(ind[k], n + j);
+      for (int j = 0; j < nmi; ++j) J(n + k, rate_col(j)) = DW(rates_[k], nw_ + j);
   }
   if (rates)
     for (std::size_t i = 0; i < m.motions.size(); ++i)
       for (int j = 0; j < nmi; ++j)
         if (m.plant_inputs[motion_inputs_[j]] == m.motions[i])
-          for (int k = 0; k < n; ++k) J(n + k, acc_col(j)) = td.dqdd_dacc(ind[k], static_cast<Eigen::Index>(i));
+          for (int k = 0; k < nw_; ++k) J(n + k, acc_col(j)) = td.dqdd_dacc(rates_[k], static_cast<Eigen::Index>(i));
   // sensors
   if (ny_p > 0) {
-    J.block(2 * n, 0, ny_p, n).noalias() = td.dy_dq * W.G.leftCols(n);
-    J.block(2 * n, 0, ny_p, n).noalias() += td.dy_dv * W.H.leftCols(n);
-    J.block(2 * n, n, ny_p, n).noalias() = td.dy_dv * W.G.leftCols(n);
+    J.block(nxr, 0, ny_p, n).noalias() = td.dy_dq * W.G.leftCols(n);
+    J.block(nxr, 0, ny_p, n).noalias() += td.dy_dv * W.H.leftCols(n);
+    J.block(nxr, n, ny_p, nw_).noalias() = td.dy_dv * Gv.leftCols(nw_);
     for (int j = 0; j < nmi; ++j) {
-      J.block(2 * n, value_col(j), ny_p, 1).noalias() = td.dy_dq * W.G.col(n + j);
-      J.block(2 * n, value_col(j), ny_p, 1).noalias() += td.dy_dv * W.H.col(n + j);
-      if (rates) J.block(2 * n, rate_col(j), ny_p, 1).noalias() = td.dy_dv * W.G.col(n + j);
+      J.block(nxr, value_col(j), ny_p, 1).noalias() = td.dy_dq * W.G.col(n + j);
+      J.block(nxr, value_col(j), ny_p, 1).noalias() += td.dy_dv * W.H.col(n + j);
+      if (rates) J.block(nxr, rate_col(j), ny_p, 1).noalias() = td.dy_dv * Gv.col(nw_ + j);
     }
   }
   return true;

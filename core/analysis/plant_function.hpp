@@ -155,6 +155,10 @@ class PlantFunction {
     Eigen::VectorXd zero, phi, step, vd;      // closed loops: [nv], [nd] x 3
     Eigen::PartialPivLU<Eigen::MatrixXd> lu;  // of Jd
     Eigen::VectorXd fd_x, fd_u, fd_xd, fd_y, fd_p, fd_m, fd_0;  // fd_jacobian
+    // rolling (closed_loop_jacobian): the velocity map Gv = dv/d[w; u'] apart from the positions' G,
+    // the velocity rows' dependent columns Jvd (factored in luv), their products
+    Eigen::MatrixXd Gv, Jvd, Jzv, Pv, Jav, Ph, Phx, DQv;
+    Eigen::PartialPivLU<Eigen::MatrixXd> luv;
     Workspace();
     Workspace(const Workspace&);
     Workspace& operator=(const Workspace&);  // the copy makes its own

@@ -152,13 +152,14 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool with_vel
         // v_b(P) - v_a(P) = w = -dp' + R n x w_b + (P - p_a) x w_a, dp = p_a - c (on v only: phi 0)
         const S R = ad_coherent(S(c.radius), nd);
         const Attached<S> n = attached<S>(d, c.body_a, c.axis_a, nd);
-        Vec3T<S> ndp = n.x.cross(dpc);
-        coh(ndp);
+        Vec3T<S> ndp = dpc.cross(n.x), mn = -n.x;  // -(n x dp), -n: products of small negated factors
+        coh(ndp);                                   // (no heap: a negated product would be a temporary)
+        coh(mn);
         const S h = dot3<S>(n.x, dpc, nd);
         d.phi[r] = -h - R;
         if (with_velocity) {
-          d.Jc.row(r).noalias() = -(ndp.transpose() * Jwa);
-          d.Jc.row(r).noalias() -= n.x.transpose() * Jp;
+          d.Jc.row(r).noalias() = ndp.transpose() * Jwa;
+          d.Jc.row(r).noalias() += mn.transpose() * Jp;
           const S g1 = dot3<S>(n.xdd, dpc, nd), g2 = dot3<S>(n.xd, dpd, nd), g3 = dot3<S>(n.x, dpdd, nd);
           const S g2x2 = ad_coherent(S(S(2) * g2), nd);
           const S g12 = g1 + g2x2;
@@ -174,10 +175,11 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool with_vel
           d.phi[r] = ad_coherent(S(0), nd);
           if (with_velocity) {
             const Attached<S> t = attached<S>(d, c.body_a, *perp, nd);
-            Vec3T<S> tn = t.x.cross(Rn), tP = t.x.cross(Pa);
+            Vec3T<S> tn = t.x.cross(Rn), tP = t.x.cross(Pa), mt = -t.x;
             coh(tn);
             coh(tP);
-            d.Jc.row(r).noalias() = -(t.x.transpose() * Jp);
+            coh(mt);
+            d.Jc.row(r).noalias() = mt.transpose() * Jp;
             d.Jc.row(r).noalias() += tn.transpose() * Jwb;
             d.Jc.row(r).noalias() += tP.transpose() * Jwa;
             // d/dt at qdd = 0: t' . w + t . w', with P' - p_a' = -dp' - R n'

@@ -818,8 +818,6 @@ void TreeDerivatives::constraint_derivatives(const Eigen::VectorXd& lambda, cons
   Vec6 w;
   Eigen::Matrix<double, 6, 24> dw;
   for (const ConstraintModel& cm : m_.constraints) {
-    if (cm.type == ConstraintType::RollingBall)
-      throw std::logic_error("TreeDerivatives: rolling_ball has no analytic derivatives (callers use autodiff)");
     if (cm.type == ConstraintType::Coupler) {
       // sum_k ratio_k q_k = offset: Jc is the ratios, c = Jc a, and the reaction -Jc^T lambda acts on
       // the coordinates themselves; nothing here depends on q or v
@@ -938,8 +936,112 @@ void TreeDerivatives::constraint_derivatives(const Eigen::VectorXd& lambda, cons
         }
         break;
       }
-      case ConstraintType::Coupler:
-      case ConstraintType::RollingBall: break;  // above
+      case ConstraintType::RollingBall: {
+        const double R = cm.radius;
+        const LocalKin n = kin(ba, cm.axis_a, true);
+        // height: phi = n . (c - p_a) - R = -(n . dp) - R with dp = p_a - c: the planar_revolute
+        // row along n, negated (its reaction with l = +lambda)
+        {
+          const Vec3 dp = xa.x - xb.x, dpd = xa.xd - xb.xd, dpdd = xa.xdd - xb.xdd;
+          gp.setZero();
+          add_grad(gp, 0, -dp, n.Dxd);
+          add_grad(gp, 0, -dpd, n.Dx);
+          add_grad(gp, 0, -n.xd, xa.Dx);
+          add_grad(gp, 0, -n.x, xa.Dxd);
+          add_grad(gp, 1, n.xd, xb.Dx);
+          add_grad(gp, 1, n.x, xb.Dxd);
+          gc.setZero();
+          add_grad(gc, 0, -dp, n.Dxdd);
+          add_grad(gc, 0, -2.0 * dpd, n.Dxd);
+          add_grad(gc, 0, -dpdd, n.Dx);
+          add_grad(gc, 0, -n.xdd, xa.Dx);
+          add_grad(gc, 0, -2.0 * n.xd, xa.Dxd);
+          add_grad(gc, 0, -n.x, xa.Dxdd);
+          add_grad(gc, 1, n.xdd, xb.Dx);
+          add_grad(gc, 1, 2.0 * n.xd, xb.Dxd);
+          add_grad(gc, 1, n.x, xb.Dxdd);
+          row_out(r, -(n.xdd.dot(dp) + 2.0 * n.xd.dot(dpd) + n.x.dot(dpdd)), ba, bb);
+          const double l = lambda[r];
+          const Eigen::Matrix<double, 3, 6> de = n.Dx.leftCols<6>(), dxb = xb.Dx.leftCols<6>();
+          const Mat3 ex = skew<double>(n.x), xbx = skew<double>(xb.x);
+          dw.setZero();
+          w << l * xb.x.cross(n.x), l * n.x;
+          dw.block<3, 6>(0, 0).noalias() = l * xbx * de;
+          dw.block<3, 6>(0, 12).noalias() = -l * ex * dxb;
+          dw.block<3, 6>(3, 0) = l * de;
+          add_body_wrench(ba, w, dw, ba, bb);
+          w = -w;
+          dw = -dw;
+          add_body_wrench(bb, w, dw, ba, bb);
+          ++r;
+        }
+        // no slip along t: g = t . u, u = (V_b - V_a).tail + (w_b - w_a) x P, P = c - R n (spatial
+        // velocities at the world origin); c = dg/dt = t' . u + t . u', with
+        // u' = (A_b - A_a).tail + (al_b - al_a) x P + (w_b - w_a) x P',  P' = c' - R n'
+        const Vec6 Va = ba > 0 ? V_[ba] : Vec6::Zero(), Vb = bb > 0 ? V_[bb] : Vec6::Zero();
+        const Vec6 Aa = ba > 0 ? Vec6(A_[ba] - A0) : Vec6::Zero(), Ab = bb > 0 ? Vec6(A_[bb] - A0) : Vec6::Zero();
+        const Vec3 Om = Vb.head<3>() - Va.head<3>(), La = Ab.head<3>() - Aa.head<3>();
+        const Vec3 P = xb.x - R * n.x, Pd = xb.xd - R * n.xd;
+        const Vec3 u = Vb.tail<3>() - Va.tail<3>() + Om.cross(P);
+        const Vec3 ud = Ab.tail<3>() - Aa.tail<3>() + La.cross(P) + Om.cross(Pd);
+        for (const Eigen::Vector3d* perp : {&cm.perp_a1, &cm.perp_a2}) {
+          const LocalKin t = kin(ba, *perp, true);
+          // g's gradient: through t, through P (n on a, c on b), and the velocities
+          gp.setZero();
+          add_grad(gp, 0, u, t.Dx);
+          const Vec3 tO = t.x.cross(Om);
+          add_grad(gp, 0, -R * tO, n.Dx);
+          add_grad(gp, 1, tO, xb.Dx);
+          const Vec3 Pt = P.cross(t.x);
+          gp.segment<3>(18 + 6) += Pt;
+          gp.segment<3>(18 + 9) += t.x;
+          gp.segment<3>(6) -= Pt;
+          gp.segment<3>(9) -= t.x;
+          // c's gradient: t' . u (t' on a; u as above with t' for t), then t . u'
+          gc.setZero();
+          add_grad(gc, 0, u, t.Dxd);
+          const Vec3 tdO = t.xd.cross(Om), Ptd = P.cross(t.xd);
+          add_grad(gc, 0, -R * tdO, n.Dx);
+          add_grad(gc, 1, tdO, xb.Dx);
+          gc.segment<3>(18 + 6) += Ptd;
+          gc.segment<3>(18 + 9) += t.xd;
+          gc.segment<3>(6) -= Ptd;
+          gc.segment<3>(9) -= t.xd;
+          add_grad(gc, 0, ud, t.Dx);
+          // t . (A_b - A_a).tail and t . ((al_b - al_a) x P) = (al_b - al_a) . (P x t)
+          gc.segment<3>(18 + 12) += Pt;
+          gc.segment<3>(18 + 15) += t.x;
+          gc.segment<3>(12) -= Pt;
+          gc.segment<3>(15) -= t.x;
+          const Vec3 tL = t.x.cross(La);
+          add_grad(gc, 0, -R * tL, n.Dx);
+          add_grad(gc, 1, tL, xb.Dx);
+          // t . (Om x P') = Om . (P' x t) = P' . (t x Om), P' = c' - R n'
+          const Vec3 Pdt = Pd.cross(t.x);
+          gc.segment<3>(18 + 6) += Pdt;
+          gc.segment<3>(6) -= Pdt;
+          add_grad(gc, 1, tO, xb.Dxd);
+          add_grad(gc, 0, -R * tO, n.Dxd);
+          row_out(r, t.xd.dot(u) + t.x.dot(ud), ba, bb);
+          // the reaction -lambda Jc_r^T: on b the wrench -lambda [P x t; t], on a its opposite
+          const double l = lambda[r];
+          const Eigen::Matrix<double, 3, 6> dt = t.Dx.leftCols<6>(), dn = n.Dx.leftCols<6>(), dc = xb.Dx.leftCols<6>();
+          const Mat3 tx = skew<double>(t.x), Px = skew<double>(P);
+          dw.setZero();
+          w << -l * Pt, -l * t.x;
+          // d(P x t) = -[t]x dP + [P]x dt, dP = dc - R dn
+          dw.block<3, 6>(0, 0).noalias() = -l * (R * tx * dn + Px * dt);
+          dw.block<3, 6>(0, 12).noalias() = l * tx * dc;
+          dw.block<3, 6>(3, 0) = -l * dt;
+          add_body_wrench(bb, w, dw, ba, bb);
+          w = -w;
+          dw = -dw;
+          add_body_wrench(ba, w, dw, ba, bb);
+          ++r;
+        }
+        break;
+      }
+      case ConstraintType::Coupler: break;  // above
     }
   }
 }

@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <stdexcept>
+#include <type_traits>
 
 namespace codyna {
 
@@ -63,7 +64,13 @@ Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic> lu_solve(
     }
     for (Eigen::Index i = k + 1; i < n; ++i) {
       const S f = A(i, k) / A(k, k);
-      if (f == S(0)) continue;
+      // skipped only when it is zero with its derivatives: an autodiff entry whose value is 0
+      // where it varies (a sin at 0) still carries them
+      if constexpr (std::is_arithmetic_v<S>) {
+        if (f == S(0)) continue;
+      } else {
+        if (f.value() == 0.0 && (f.derivatives().size() == 0 || f.derivatives().isZero(0))) continue;
+      }
       for (Eigen::Index j = k + 1; j < n; ++j) A(i, j) -= f * A(k, j);
       for (Eigen::Index c = 0; c < X.cols(); ++c) X(i, c) -= f * X(k, c);
     }

@@ -23,6 +23,8 @@
 #include "dynamics/constraints.hpp"
 #include "dynamics/joint.hpp"
 #include "model/errors.hpp"
+#include "spatial/autodiff.hpp"
+#include "spatial/linalg.hpp"
 #include "study/files.hpp"
 #include "study/workflow.hpp"
 #include "test_util.hpp"
@@ -271,6 +273,65 @@ TEST(Rolling, ThePlantJacobianAgreesWithCentralDifferences) {
     const double worst = (Ja - Jf).cwiseAbs().maxCoeff(&ir, &ic);
     EXPECT_LT(worst, 1e-9 * scale) << trial << " at (" << ir << ", " << ic << "): " << Ja(ir, ic) << " vs " << Jf(ir, ic);
   }
+}
+
+// the analytic Jacobian (TreeDerivatives through the rolling rows: their accelerations' and
+// reactions' derivatives, the velocity map with the no-slip rows) against automatic
+// differentiation at the operating point's positions, with random rates, motion rates and
+// accelerations: the ball and plate (a tilted, moving plane), the turntable (a motion outside
+// Plant/In) and a free ball on a fixed incline (the plane on the ground)
+TEST(Rolling, TheAnalyticJacobianEqualsAutomaticDifferentiation) {
+  ModelSpec incline = turntable(0.0);
+  incline.actuators.clear();
+  incline.analysis.disturbances.clear();
+  incline.joints.erase(incline.joints.begin());
+  incline.bodies.erase(incline.bodies.begin());
+  incline.constraints.at(0).body_a = "ground";
+  incline.constraints.at(0).axis_a = Eigen::Vector3d(0.3, 0.2, 1).normalized();
+  incline.plant.inputs = {};
+  int checked = 0;
+  for (const ModelSpec& spec : {plate(), turntable(2.0), incline}) {
+    const Model mod = study_model(spec);
+    const CoordinatePartition p = partition_coordinates(mod, mod.q0);
+    const PlantFunction f(mod, mod.q0, mod.u_nominal(), p);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> U(-1.0, 1.0);
+    for (int trial = 0; trial < 3; ++trial) {
+      Eigen::VectorXd x = Eigen::VectorXd::Zero(f.nx()), u(f.nu() + 2 * f.nm());
+      for (int i = f.nz(); i < f.nx(); ++i) x[i] = 2.0 * U(rng);
+      for (int i = 0; i < f.nu(); ++i) u[i] = mod.u_nominal()[mod.plant_inputs[static_cast<std::size_t>(i)]];
+      for (int i = f.nu(); i < u.size(); ++i) u[i] = U(rng);
+      Eigen::MatrixXd Ja;
+      ASSERT_TRUE(f.analytic_jacobian(x, u, Ja)) << spec.name;
+      const Eigen::MatrixXd Jd = plant_jacobian_autodiff(f, x, u);
+      ASSERT_EQ(Ja.rows(), Jd.rows());
+      ASSERT_EQ(Ja.cols(), Jd.cols());
+      const double scale = Jd.cwiseAbs().maxCoeff();
+      Eigen::Index ir = 0, ic = 0;
+      const double worst = (Ja - Jd).cwiseAbs().maxCoeff(&ir, &ic);
+      EXPECT_LT(worst, 1e-12 * scale) << spec.name << " trial " << trial << " at (" << ir << ", " << ic
+                                      << "): " << Ja(ir, ic) << " vs " << Jd(ir, ic);
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 9);
+}
+
+// lu_solve in autodiff: an entry whose value is 0 where it varies keeps its derivative. A(p) =
+// [[1, 0], [sin p, 1]], b = [1, 1]: x2 = 1 - sin p, dx2/dp = -1 at p = 0 (the elimination step
+// used to be skipped on the value alone, which lost it: found by the turntable's Jacobian above,
+// where -sin(rz) of the ball's rotation is such an entry at the reference)
+TEST(Rolling, AutodiffLuSolveKeepsTheDerivativeOfAnEntryZeroWhereItVaries) {
+  const ADScalar p(0.0, Eigen::VectorXd::Unit(1, 0));
+  const ADScalar one(1.0, Eigen::VectorXd::Zero(1)), zero(0.0, Eigen::VectorXd::Zero(1));
+  MatXT<ADScalar> A(2, 2), b(2, 1);
+  A << one, zero, sin(p), one;
+  b << one, one;
+  const MatXT<ADScalar> x = lu_solve<ADScalar>(A, b);
+  EXPECT_EQ(x(1, 0).value(), 1.0);
+  ASSERT_EQ(x(1, 0).derivatives().size(), 1);
+  EXPECT_EQ(x(1, 0).derivatives()[0], -1.0);
+  EXPECT_EQ(x(0, 0).derivatives()[0], 0.0);
 }
 
 TEST(Rolling, ANonPositiveRadiusIsRefusedNamingTheField) {
