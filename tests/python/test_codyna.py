@@ -240,7 +240,13 @@ def test_model_info():
     assert len(info["coordinates"]) == 2 and len(info["rates"]) == 2
     assert info["controller"] == "lqr"
     four_bar = codyna.Study(os.path.join(SOURCE_DIR, "examples", "four_bar.json")).model_info()
-    assert four_bar["constraints"] and four_bar["dof"] == 1
+    assert four_bar["constraints"] and four_bar["dof"] == 1 and four_bar["rate_dof"] == 1
+    # rolling (non-holonomic): 5 coordinates, 3 rates, and a plant of 5 + 3 states
+    plate = codyna.Study(os.path.join(SOURCE_DIR, "examples", "ball_plate.json"))
+    info = plate.model_info()
+    assert info["dof"] == 5 and info["rate_dof"] == 3 and info["constraint_equations"] == 3
+    lin = plate.linearize()
+    assert lin.A.shape == (8, 8) and lin.B.shape == (8, 2)
 
 
 # ---------------------------------------------------------------------------- errors
