@@ -817,6 +817,46 @@ void TreeDerivatives::constraint_derivatives(const Eigen::VectorXd& lambda, cons
   // a reaction wrench w on `body` with dw/d(pose) of body_a (columns 0..5) and body_b (12..17)
   Vec6 w;
   Eigen::Matrix<double, 6, 24> dw;
+  // row r = sign e . (x_a - x_b), e a vector of body_a (planar_revolute's rows, sign 1; rolling's
+  // height, -1): phidot = sign (ed . dp + e . dpd), c = sign (edd . dp + 2 ed . dpd + e . dpdd)
+  // with their gradients, and the reaction -lambda Jc_r^T
+  auto along_row = [&](int r, const LocalKin& e, const LocalKin& xa, const LocalKin& xb, double sign, int ba, int bb) {
+    const Vec3 dp = sign * (xa.x - xb.x), dpd = sign * (xa.xd - xb.xd), dpdd = sign * (xa.xdd - xb.xdd);
+    const Vec3 ex = sign * e.x, exd = sign * e.xd, exdd = sign * e.xdd;
+    gp.setZero();
+    add_grad(gp, 0, dp, e.Dxd);
+    add_grad(gp, 0, dpd, e.Dx);
+    add_grad(gp, 0, exd, xa.Dx);
+    add_grad(gp, 0, ex, xa.Dxd);
+    add_grad(gp, 1, -exd, xb.Dx);
+    add_grad(gp, 1, -ex, xb.Dxd);
+    gc.setZero();
+    add_grad(gc, 0, dp, e.Dxdd);
+    add_grad(gc, 0, 2.0 * dpd, e.Dxd);
+    add_grad(gc, 0, dpdd, e.Dx);
+    add_grad(gc, 0, exdd, xa.Dx);
+    add_grad(gc, 0, 2.0 * exd, xa.Dxd);
+    add_grad(gc, 0, ex, xa.Dxdd);
+    add_grad(gc, 1, -exdd, xb.Dx);
+    add_grad(gc, 1, -2.0 * exd, xb.Dxd);
+    add_grad(gc, 1, -ex, xb.Dxdd);
+    row_out(r, e.xdd.dot(dp) + 2.0 * e.xd.dot(dpd) + e.x.dot(dpdd), ba, bb);
+    // phidot = sign (w_a . (e x dp) + e . (velocity of x_a - velocity of x_b)): with l = -sign lambda,
+    // body_a: [l (x_b x e); l e],  body_b: [-l (x_b x e); -l e]
+    const double l = -sign * lambda[r];
+    const Eigen::Matrix<double, 3, 6> de = e.Dx.leftCols<6>();  // d e / d pose_a
+    const Eigen::Matrix<double, 3, 6> dxb = xb.Dx.leftCols<6>();
+    const Mat3 exs = skew<double>(e.x), xbx = skew<double>(xb.x);
+    dw.setZero();
+    w << l * xb.x.cross(e.x), l * e.x;
+    dw.block<3, 6>(0, 0).noalias() = l * xbx * de;
+    dw.block<3, 6>(0, 12).noalias() = -l * exs * dxb;
+    dw.block<3, 6>(3, 0) = l * de;
+    add_body_wrench(ba, w, dw, ba, bb);
+    w = -w;
+    dw = -dw;
+    add_body_wrench(bb, w, dw, ba, bb);
+  };
   for (const ConstraintModel& cm : m_.constraints) {
     if (cm.type == ConstraintType::Coupler) {
       // sum_k ratio_k q_k = offset: Jc is the ratios, c = Jc a, and the reaction -Jc^T lambda acts on
@@ -894,87 +934,15 @@ void TreeDerivatives::constraint_derivatives(const Eigen::VectorXd& lambda, cons
         }
         break;
       }
-      case ConstraintType::PlanarRevolute: {
-        const Vec3 dp = xa.x - xb.x, dpd = xa.xd - xb.xd, dpdd = xa.xdd - xb.xdd;
-        for (const Eigen::Vector3d* perp : {&cm.perp_a1, &cm.perp_a2}) {
-          const LocalKin e = kin(ba, *perp, true);
-          // phidot = ed . dp + e . dpd;  c = edd . dp + 2 ed . dpd + e . dpdd
-          gp.setZero();
-          add_grad(gp, 0, dp, e.Dxd);
-          add_grad(gp, 0, dpd, e.Dx);
-          add_grad(gp, 0, e.xd, xa.Dx);
-          add_grad(gp, 0, e.x, xa.Dxd);
-          add_grad(gp, 1, -e.xd, xb.Dx);
-          add_grad(gp, 1, -e.x, xb.Dxd);
-          gc.setZero();
-          add_grad(gc, 0, dp, e.Dxdd);
-          add_grad(gc, 0, 2.0 * dpd, e.Dxd);
-          add_grad(gc, 0, dpdd, e.Dx);
-          add_grad(gc, 0, e.xdd, xa.Dx);
-          add_grad(gc, 0, 2.0 * e.xd, xa.Dxd);
-          add_grad(gc, 0, e.x, xa.Dxdd);
-          add_grad(gc, 1, -e.xdd, xb.Dx);
-          add_grad(gc, 1, -2.0 * e.xd, xb.Dxd);
-          add_grad(gc, 1, -e.x, xb.Dxdd);
-          row_out(r, e.xdd.dot(dp) + 2.0 * e.xd.dot(dpd) + e.x.dot(dpdd), ba, bb);
-          // phidot = w_a . (e x dp) + e . (velocity of x_a - velocity of x_b): with l = -lambda,
-          // body_a: [l (x_b x e); l e],  body_b: [-l (x_b x e); -l e]
-          const double l = -lambda[r];
-          const Eigen::Matrix<double, 3, 6> de = e.Dx.leftCols<6>();  // d e / d pose_a
-          const Eigen::Matrix<double, 3, 6> dxb = xb.Dx.leftCols<6>();
-          const Mat3 ex = skew<double>(e.x), xbx = skew<double>(xb.x);
-          dw.setZero();
-          w << l * xb.x.cross(e.x), l * e.x;
-          dw.block<3, 6>(0, 0).noalias() = l * xbx * de;
-          dw.block<3, 6>(0, 12).noalias() = -l * ex * dxb;
-          dw.block<3, 6>(3, 0) = l * de;
-          add_body_wrench(ba, w, dw, ba, bb);
-          w = -w;
-          dw = -dw;
-          add_body_wrench(bb, w, dw, ba, bb);
-          ++r;
-        }
+      case ConstraintType::PlanarRevolute:
+        for (const Eigen::Vector3d* perp : {&cm.perp_a1, &cm.perp_a2}) along_row(r++, kin(ba, *perp, true), xa, xb, 1.0, ba, bb);
         break;
-      }
       case ConstraintType::RollingBall: {
         const double R = cm.radius;
         const LocalKin n = kin(ba, cm.axis_a, true);
-        // height: phi = n . (c - p_a) - R = -(n . dp) - R with dp = p_a - c: the planar_revolute
-        // row along n, negated (its reaction with l = +lambda)
-        {
-          const Vec3 dp = xa.x - xb.x, dpd = xa.xd - xb.xd, dpdd = xa.xdd - xb.xdd;
-          gp.setZero();
-          add_grad(gp, 0, -dp, n.Dxd);
-          add_grad(gp, 0, -dpd, n.Dx);
-          add_grad(gp, 0, -n.xd, xa.Dx);
-          add_grad(gp, 0, -n.x, xa.Dxd);
-          add_grad(gp, 1, n.xd, xb.Dx);
-          add_grad(gp, 1, n.x, xb.Dxd);
-          gc.setZero();
-          add_grad(gc, 0, -dp, n.Dxdd);
-          add_grad(gc, 0, -2.0 * dpd, n.Dxd);
-          add_grad(gc, 0, -dpdd, n.Dx);
-          add_grad(gc, 0, -n.xdd, xa.Dx);
-          add_grad(gc, 0, -2.0 * n.xd, xa.Dxd);
-          add_grad(gc, 0, -n.x, xa.Dxdd);
-          add_grad(gc, 1, n.xdd, xb.Dx);
-          add_grad(gc, 1, 2.0 * n.xd, xb.Dxd);
-          add_grad(gc, 1, n.x, xb.Dxdd);
-          row_out(r, -(n.xdd.dot(dp) + 2.0 * n.xd.dot(dpd) + n.x.dot(dpdd)), ba, bb);
-          const double l = lambda[r];
-          const Eigen::Matrix<double, 3, 6> de = n.Dx.leftCols<6>(), dxb = xb.Dx.leftCols<6>();
-          const Mat3 ex = skew<double>(n.x), xbx = skew<double>(xb.x);
-          dw.setZero();
-          w << l * xb.x.cross(n.x), l * n.x;
-          dw.block<3, 6>(0, 0).noalias() = l * xbx * de;
-          dw.block<3, 6>(0, 12).noalias() = -l * ex * dxb;
-          dw.block<3, 6>(3, 0) = l * de;
-          add_body_wrench(ba, w, dw, ba, bb);
-          w = -w;
-          dw = -dw;
-          add_body_wrench(bb, w, dw, ba, bb);
-          ++r;
-        }
+        // height: phi = n . (c - p_a) - R = -(n . (p_a - c)) - R: the planar_revolute row along n,
+        // negated
+        along_row(r++, n, xa, xb, -1.0, ba, bb);
         // no slip along t: g = t . u, u = (V_b - V_a).tail + (w_b - w_a) x P, P = c - R n (spatial
         // velocities at the world origin); c = dg/dt = t' . u + t . u', with
         // u' = (A_b - A_a).tail + (al_b - al_a) x P + (w_b - w_a) x P',  P' = c' - R n'

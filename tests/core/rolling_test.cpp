@@ -190,17 +190,23 @@ TEST(Rolling, ABallOnATurntableCirclesAtTwoSeventhsOfItsRate) {
   EXPECT_LT(worst_slip, 1e-9);
 }
 
-// a ball rolling and spinning on a fixed incline (the plane on the ground): no work is done by the
-// contact, so the energy is constant
-TEST(Rolling, ABallRollingOnAFixedInclineKeepsItsEnergy) {
+// the turntable's ball on a fixed plane through the origin with this normal (the ground's)
+ModelSpec incline(const Eigen::Vector3d& normal) {
   ModelSpec spec = turntable(0.0);
   spec.actuators.clear();
   spec.analysis.disturbances.clear();
   spec.joints.erase(spec.joints.begin());
   spec.bodies.erase(spec.bodies.begin());
-  ConstraintSpec& c = spec.constraints.at(0);
-  c.body_a = "ground";
-  c.axis_a = Eigen::Vector3d(0.3, 0, 1).normalized();
+  spec.constraints.at(0).body_a = "ground";
+  spec.constraints.at(0).axis_a = normal.normalized();
+  return spec;
+}
+
+// a ball rolling and spinning on a fixed incline (the plane on the ground): no work is done by the
+// contact, so the energy is constant
+TEST(Rolling, ABallRollingOnAFixedInclineKeepsItsEnergy) {
+  ModelSpec spec = incline(Eigen::Vector3d(0.3, 0, 1));
+  const ConstraintSpec& c = spec.constraints.at(0);
   // on the plane, rolling along y and spinning about the normal: v = w x (R n)
   const Eigen::Vector3d n = c.axis_a, w(-5.0, 2.0, 3.0);
   const Eigen::Vector3d v = w.cross(R * n);
@@ -281,16 +287,8 @@ TEST(Rolling, ThePlantJacobianAgreesWithCentralDifferences) {
 // accelerations: the ball and plate (a tilted, moving plane), the turntable (a motion outside
 // Plant/In) and a free ball on a fixed incline (the plane on the ground)
 TEST(Rolling, TheAnalyticJacobianEqualsAutomaticDifferentiation) {
-  ModelSpec incline = turntable(0.0);
-  incline.actuators.clear();
-  incline.analysis.disturbances.clear();
-  incline.joints.erase(incline.joints.begin());
-  incline.bodies.erase(incline.bodies.begin());
-  incline.constraints.at(0).body_a = "ground";
-  incline.constraints.at(0).axis_a = Eigen::Vector3d(0.3, 0.2, 1).normalized();
-  incline.plant.inputs = {};
   int checked = 0;
-  for (const ModelSpec& spec : {plate(), turntable(2.0), incline}) {
+  for (const ModelSpec& spec : {plate(), turntable(2.0), incline(Eigen::Vector3d(0.3, 0.2, 1))}) {
     const Model mod = study_model(spec);
     const CoordinatePartition p = partition_coordinates(mod, mod.q0);
     const PlantFunction f(mod, mod.q0, mod.u_nominal(), p);
