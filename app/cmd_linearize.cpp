@@ -10,6 +10,10 @@
 namespace codyna::cli {
 
 namespace {
+// with rolling: the rates apart from the coordinates
+std::string rates_said(const Model& m) {
+  return m.active_velocity_rows > 0 ? ", " + std::to_string(m.rate_dof()) + " rates" : std::string();
+}
 
 struct LinearizeArgs {
   std::string model, out, op = "equilibrium", method = "exact", mat_version = "5", name, controller;
@@ -50,7 +54,7 @@ LinearizeRequest request_of(const LinearizeArgs& a) {
 
 void print_trajectory(const LinearizeJob& job) {
   const Model& m = job.model;
-  std::cout << "model            " << m.name << " (" << m.dof() << " DOF)\n"
+  std::cout << "model            " << m.name << " (" << m.dof() << " DOF" << rates_said(m) << ")\n"
             << "trajectory       " << job.systems.size() << " points, t = 0 .. " << job.times.back() << " s, "
             << job.trajectory_controller << "\n"
             << "method           " << job.method << "\n"
@@ -87,7 +91,7 @@ void print(const LinearizeJob& job) {
   const OperatingPoint& op = job.linearization.op;
   const Linearization& lin = job.linearization.lin;
   const LinearSystem& sys = job.linearization.system;
-  std::cout << "model            " << m.name << " (" << m.dof() << " DOF)\n"
+  std::cout << "model            " << m.name << " (" << m.dof() << " DOF" << rates_said(m) << ")\n"
             << "operating point  " << op.kind;
   if (op.kind == "equilibrium" || op.kind == "trim")
     std::cout << " (residual " << op.residual << ", " << op.iterations << " iterations)";
