@@ -315,6 +315,76 @@ TEST(Rolling, TheAnalyticJacobianEqualsAutomaticDifferentiation) {
   EXPECT_EQ(checked, 9);
 }
 
+// A ball on the floor pushed at its centre by two horizontal forces: (m + J/R^2) x'' = F on each
+// axis, exactly, whatever the ball's orientation. A PD on the measured X, Y (their rates through
+// the plant's C and A_zw: 5 coordinates, 3 rates) brings it back to the origin, and the nonlinear
+// closed loop equals the linear one to the integrator's tolerance. (An LQR on the full state would
+// not: the linearization conserves X - R ry and Y + R rx, the ball's position tied to its
+// orientation, as linearizations of rolling do; docs/model-format.md.)
+TEST(Rolling, APdOnAPushedBallMatchesItsLinearClosedLoop) {
+  const std::string text = R"({
+  "codyna_model": 1, "name": "pushed_ball",
+  "bodies": [{"name": "ball", "mass": 0.111, "com": [0, 0, 0], "inertia": [9.99e-6, 9.99e-6, 9.99e-6]}],
+  "joints": [{"name": "ball", "type": "free", "parent": "ground", "child": "ball", "q0": {"position": [0, 0, 0.015]}}],
+  "constraints": [{"name": "floor", "type": "rolling_ball", "body_a": "ground", "body_b": "ball", "radius": 0.015}],
+  "effects": [{"name": "gravity", "type": "gravity", "g": [0, 0, -9.8]}],
+  "actuators": [
+    {"name": "push_x", "type": "body_force", "body": "ball", "direction": [1, 0, 0], "unit": "N"},
+    {"name": "push_y", "type": "body_force", "body": "ball", "direction": [0, 1, 0], "unit": "N"}
+  ],
+  "sensors": [
+    {"name": "X", "type": "point_position", "body": "ball", "component": 0, "unit": "m"},
+    {"name": "Y", "type": "point_position", "body": "ball", "component": 1, "unit": "m"}
+  ],
+  "plant": {"inputs": ["push_x", "push_y"], "outputs": ["X", "Y"]},
+  "controller": {"type": "pid", "kp": [[1, 0], [0, 1]], "kd": [[0.8, 0], [0, 0.8]], "setpoint": [0, 0],
+                 "operating_point": "initial"},
+  "analysis": {"operating_point": "initial", "controller": "model", "compare_linear": true,
+               "initial": {"ball.x": 0.1, "ball.y": -0.05}},
+  "solver": {"rtol": 1e-11, "atol": 1e-13, "t_end": 5.0, "output_step": 0.01}
+})";
+  const Model mod = study_model(study_parse_model_text(text, "pushed_ball"));
+  EXPECT_EQ(mod.dof(), 5);
+  EXPECT_EQ(mod.rate_dof(), 3);
+  const StudySimulation setup = study_simulation(mod);
+  ASSERT_TRUE(setup.plant);
+  const LinearSystem& s = setup.plant->lin.system;
+  ASSERT_EQ(s.nx(), 8);
+  ASSERT_EQ(s.positions, 5);
+  // each axis: x/F = 1 / ((m + J/R^2) s^2)
+  for (double w : {0.5, 3.0, 20.0}) {
+    const cd z(0, w);
+    const Eigen::MatrixXcd M = z * Eigen::MatrixXcd::Identity(8, 8) - s.A.cast<cd>();
+    const Eigen::MatrixXcd G = s.C.cast<cd>() * M.partialPivLu().solve(s.B.cast<cd>()) + s.D.cast<cd>();
+    const cd e = 1.0 / (mass_eff * z * z);
+    EXPECT_LT(std::abs(G(0, 0) - e), 1e-10 * std::abs(e)) << w;
+    EXPECT_LT(std::abs(G(1, 1) - e), 1e-10 * std::abs(e)) << w;
+    EXPECT_LT(std::abs(G(0, 1)) + std::abs(G(1, 0)), 1e-12 * std::abs(e)) << w;
+  }
+  // the linear closed loop (the PD's rate term through C and A_zw): m_eff s^2 + kd s + kp on each
+  // axis (twice), the rest at 0
+  const StudyClosedLoop cl = study_closed_loop(mod);
+  const Eigen::VectorXcd poles = Eigen::EigenSolver<Eigen::MatrixXd>(cl.loop.system.A).eigenvalues();
+  const cd disc = std::sqrt(cd(0.8 * 0.8 - 4 * mass_eff * 1.0, 0));
+  const cd s1 = (-0.8 + disc) / (2 * mass_eff), s2 = (-0.8 - disc) / (2 * mass_eff);  // -2.14, -3.01
+  int found = 0;
+  for (Eigen::Index k = 0; k < poles.size(); ++k)
+    if (std::abs(poles[k] - s1) < 1e-9 || std::abs(poles[k] - s2) < 1e-9) ++found;
+  EXPECT_EQ(found, 4) << poles.transpose();
+  const SimulationResult r = study_simulate(mod, setup);
+  ASSERT_TRUE(r.completed) << r.failure;
+  ASSERT_EQ(r.y_linear.rows(), r.samples());
+  const int ix = column(r.output_names, "X"), iy = column(r.output_names, "Y");
+  EXPECT_NEAR(r.y(0, ix), 0.1, 1e-12);
+  EXPECT_NEAR(r.y(0, iy), -0.05, 1e-12);
+  double worst = 0;
+  for (int i = 0; i < r.samples(); ++i)
+    worst = std::max({worst, std::abs(r.y(i, ix) - r.y_linear(i, ix)), std::abs(r.y(i, iy) - r.y_linear(i, iy))});
+  EXPECT_LT(worst, 1e-8);
+  // back within 0.1 mm of the origin after 5 s (the slowest decay e^{-2.14 t})
+  EXPECT_LT(std::hypot(r.y(r.samples() - 1, ix), r.y(r.samples() - 1, iy)), 1e-4);
+}
+
 // lu_solve in autodiff: an entry whose value is 0 where it varies keeps its derivative. A(p) =
 // [[1, 0], [sin p, 1]], b = [1, 1]: x2 = 1 - sin p, dx2/dp = -1 at p = 0 (the elimination step
 // used to be skipped on the value alone, which lost it: found by the turntable's Jacobian above,
