@@ -196,8 +196,14 @@ Eigen::VectorXd ClosedLoopSystem::controller_rates(double t, const Eigen::Vector
 void ClosedLoopSystem::residual(double t, const Eigen::VectorXd& Y, const Eigen::VectorXd& Yp, Eigen::VectorXd& F) {
   ++evaluations_;
   const int nq = model_.nq, nv = model_.nv, nx = nxc(), n = na();
-  const Eigen::VectorXd q = Y.head(nq), v = Y.segment(nq, nv), xc = Y.segment(nq + nv, nx);
-  const Eigen::VectorXd vp = Yp.segment(nq, nv);
+  Eigen::VectorXd q = Y.head(nq), v = Y.segment(nq, nv);
+  const Eigen::VectorXd xc = Y.segment(nq + nv, nx);
+  Eigen::VectorXd vp = Yp.segment(nq, nv);
+  // motion inputs: their coordinates, rates and accelerations are the signal's (as in rhs); their
+  // balance, which holds their unknown reaction, is replaced below by v_d' = u''
+  apply_motions(t, q, v);
+  for (std::size_t i = 0; i < model_.motions.size(); ++i)
+    vp[model_.actuators[static_cast<std::size_t>(model_.motions[i])].iv] = data_.motion_acc[static_cast<Eigen::Index>(i)];
   const Eigen::VectorXd u = inputs(t, q, v, xc);
   F.resize(dae_size());
   F.head(nq) = Yp.head(nq) - qdot<double>(model_, q, v);
@@ -217,10 +223,22 @@ void ClosedLoopSystem::residual(double t, const Eigen::VectorXd& Y, const Eigen:
     }
   }
   F.segment(nq, nv) = dyn;
+  for (std::size_t i = 0; i < model_.motions.size(); ++i) {
+    const int iv = model_.actuators[static_cast<std::size_t>(model_.motions[i])].iv;
+    F[nq + iv] = Yp[nq + iv] - vp[iv];
+  }
   if (nx) F.segment(nq + nv, nx) = Yp.segment(nq + nv, nx) - controller_rates(t, q, v, xc, u);
 }
 
-void ClosedLoopSystem::consistent(double t, const Eigen::VectorXd& y, Eigen::VectorXd& Y, Eigen::VectorXd& Yp) {
+void ClosedLoopSystem::consistent(double t, const Eigen::VectorXd& y_in, Eigen::VectorXd& Y, Eigen::VectorXd& Yp) {
+  // the motion inputs' coordinates and rates where their signals are
+  Eigen::VectorXd y = y_in;
+  if (!model_.motions.empty()) {
+    Eigen::VectorXd q = y.head(model_.nq), v = y.segment(model_.nq, model_.nv);
+    apply_motions(t, q, v);
+    y.head(model_.nq) = q;
+    y.segment(model_.nq, model_.nv) = v;
+  }
   Eigen::VectorXd yd;
   rhs(t, y, yd);
   Y.resize(dae_size());

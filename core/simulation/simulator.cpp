@@ -264,9 +264,6 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
     settings.method = choice.method;
     r.stats.integrator_choice = choice.reason;
   }
-  if (!model.motions.empty() && settings.method == "ida")
-    throw std::invalid_argument("simulate: the DAE integrator (ida) does not take motion inputs yet; choose an ODE "
-                                "integrator (cvode-bdf, cvode-adams, arkode, rk4) or auto");
   r.stats.integrator = settings.method;
   r.stats.rtol = o.integrator.rtol;
   r.stats.atol = o.integrator.atol;
