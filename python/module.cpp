@@ -208,6 +208,41 @@ class Keywords {
     for (const auto& item : iterable(*o, key, "a dict {field: spec} or \"FIELD=SPEC\" strings")) v.push_back(text_of(item, key));
     return v;
   }
+  // a sweep's shard: (K, N) (a tuple or list of two whole numbers) or the command's "K/N" text,
+  // with N >= 1 and 0 <= K < N (K counts from 0, as codyna sweep --shard K/N)
+  std::optional<std::pair<long long, long long>> shard(const std::string& key) {
+    const auto o = take(key);
+    if (!o) return std::nullopt;
+    const auto refuse = [&]() -> std::pair<long long, long long> {
+      throw py::value_error(key + ": expected (K, N) or \"K/N\" with N >= 1 and 0 <= K < N (K counts from 0, as codyna "
+                            "sweep --shard K/N), got " + py::repr(*o).cast<std::string>());
+    };
+    long long k = -1, n = 0;
+    if (py::isinstance<py::str>(*o)) {
+      const std::string t = o->cast<std::string>();
+      const std::size_t slash = t.find('/');
+      const auto whole = [](const std::string& x, long long& v) {
+        if (x.empty() || x.size() > 18 || x.find_first_not_of("0123456789") != std::string::npos) return false;
+        v = std::stoll(x);
+        return true;
+      };
+      if (slash == std::string::npos || !whole(t.substr(0, slash), k) || !whole(t.substr(slash + 1), n)) refuse();
+    } else {
+      if (py::isinstance<py::dict>(*o) || py::isinstance<py::bytes>(*o) || !py::isinstance<py::sequence>(*o))
+        type_error(function_ + "(): " + key + ": expected a tuple (K, N) or a \"K/N\" str, got " + type_name(*o));
+      const py::sequence seq = o->cast<py::sequence>();
+      if (seq.size() != 2) refuse();
+      const auto whole = [&](const py::handle& x) {
+        int overflow = 0;
+        const long long v = PyLong_AsLongLongAndOverflow(int_of(x, key).ptr(), &overflow);
+        return overflow != 0 ? -1 : v;
+      };
+      k = whole(seq[0]);
+      n = whole(seq[1]);
+    }
+    if (n < 1 || k < 0 || k >= n) refuse();
+    return std::make_pair(k, n);
+  }
   // signals: a "NAME=VALUE[@TIME]" string or a dict (the model file's object, as JSON text),
   // one or a list of them
   std::optional<std::vector<std::string>> signals(const std::string& key, const std::string& alias = "") {
@@ -374,7 +409,35 @@ struct SimulationRun {
 
 struct SweepResult {
   std::shared_ptr<const SweepJob> job;
+  // a shard's: the study's variant numbers of job->variants (the shard's only); empty: 0 .. n-1
+  std::vector<long long> indices;
+  std::string summary;  // study_sweep_summary of the job as the core returned it
 };
+
+// What a study call returned, for Python. A shard's job holds every variant of the study, those
+// of the other shards never run (status Failed, no reason): the result keeps the shard's own
+// only, in the study's order, with their numbers in `indices`, and worst / largest_input made
+// positions in them.
+std::unique_ptr<SweepResult> sweep_result(SweepJob&& job) {
+  auto result = std::make_unique<SweepResult>();
+  result->summary = study_sweep_summary(job);
+  if (job.shard_count > 0) {
+    std::vector<SweepVariant> mine;
+    long long worst = -1, largest = -1;
+    for (long long i = 0; i < static_cast<long long>(job.variants.size()); ++i) {
+      if (!job.in_shard(i)) continue;
+      if (i == job.worst) worst = static_cast<long long>(mine.size());
+      if (i == job.largest_input) largest = static_cast<long long>(mine.size());
+      result->indices.push_back(i);
+      mine.push_back(std::move(job.variants[static_cast<std::size_t>(i)]));
+    }
+    job.variants = std::move(mine);
+    job.worst = worst;
+    job.largest_input = largest;
+  }
+  result->job = std::make_shared<const SweepJob>(std::move(job));
+  return result;
+}
 
 // Ctrl+C during a run: the progress callback (called after every recorded sample, without the
 // GIL) takes the GIL every 50 ms to let Python run its signal handlers; a handler that raised
@@ -599,6 +662,14 @@ SweepRequest sweep_request(const Study& s, Keywords& k) {
     throw py::value_error(std::string("restart=") + (*restart ? "True" : "False") + " and resume=" + (*resume ? "True" : "False") +
                           " contradict each other: give one");
   r.resume = restart ? !*restart : resume.value_or(true);
+  if (const auto shard = k.shard("shard")) {
+    // sweep_merge reads the model again from the path the shard names: a JSON text has none
+    if (!s.text.empty())
+      throw py::value_error("shard: a Study.from_json has no model file for sweep_merge to read again (its shards would "
+                            "name " + s.file + "): write the JSON to a file and shard codyna.Study(path)");
+    r.shard_index = shard->first;
+    r.shard_count = shard->second;
+  }
   return r;
 }
 
@@ -669,9 +740,40 @@ std::unique_ptr<SweepResult> do_sweep(const Study& s, const py::dict& options) {
   }
   if (raised) throw *raised;
   if (failure) std::rethrow_exception(failure);
-  auto result = std::make_unique<SweepResult>();
-  result->job = std::move(job);
-  return result;
+  return sweep_result(std::move(*job));
+}
+
+// `codyna sweep-merge SHARD... --out --csv --mat`: the shards' journals joined into the whole
+// study's files (the same core call; the nominal model is compiled again, no variant is run)
+std::unique_ptr<SweepResult> do_sweep_merge(const py::object& shards, const py::dict& options) {
+  Keywords k(options, "sweep_merge");
+  SweepRequest outputs;
+  outputs.style = OptionStyle::Keyword;
+  outputs.out = k.path("out").value_or("");
+  outputs.csv = k.path("csv").value_or("");
+  outputs.mat = k.path("mat").value_or("");
+  outputs.threads = 1;
+  k.finish();
+  const auto fspath = py::module_::import("os").attr("fspath");
+  const auto path_of = [&](const py::handle& o) -> std::string {
+    if (py::isinstance<py::str>(o) || (py::hasattr(o, "__fspath__") && !py::isinstance<py::bytes>(o)))
+      return py::str(fspath(o)).cast<std::string>();
+    type_error("sweep_merge(): shards: expected a list of paths (str or os.PathLike), got " + type_name(o));
+  };
+  std::vector<std::string> paths;
+  if (py::isinstance<py::str>(shards) || py::hasattr(shards, "__fspath__")) {
+    paths.push_back(path_of(shards));  // one shard (a study of N = 1)
+  } else {
+    if (py::isinstance<py::dict>(shards) || py::isinstance<py::bytes>(shards) || !py::isinstance<py::iterable>(shards))
+      type_error("sweep_merge(): shards: expected a list of paths (str or os.PathLike), got " + type_name(shards));
+    for (const auto& item : shards.cast<py::iterable>()) paths.push_back(path_of(item));
+  }
+  // the GIL stays held: no variant is run, and the HDF5 library is serial (h5py may be in this process)
+  SweepJob job = study_sweep_merge(paths, outputs);
+  // the merge resumes the whole study from the joined journal: not news to the caller (the command
+  // does not print it either)
+  std::erase_if(job.notes, [](const std::string& n) { return n.rfind("resuming: ", 0) == 0; });
+  return sweep_result(std::move(job));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -803,6 +905,8 @@ PYBIND11_MODULE(_codyna, m) {
 
   m.def("_sweep", &do_sweep, "study"_a, "options"_a,
         "study_sweep_job with the keywords given (a dict); codyna.Study.sweep documents them.");
+  m.def("_sweep_merge", &do_sweep_merge, "shards"_a, "options"_a,
+        "study_sweep_merge of the shards' files with out, csv, mat (a dict); codyna.sweep_merge documents them.");
 
   py::class_<ClosedLoopResult>(m, "ClosedLoop",
                                "The linear closed loop of the study's plant and controller (linearize(closed_loop=True)).\n"
@@ -1237,10 +1341,23 @@ PYBIND11_MODULE(_codyna, m) {
       .def_property_readonly("stable_count", [](const SweepResult& s) { return s.job->stable; }, "the number of stable completed variants")
       .def_property_readonly("sim_completed", [](const SweepResult& s) { return s.job->sim_completed; }, "simulate: the runs that reached t_end")
       .def_property_readonly("worst", [](const SweepResult& s) { return index_or_none(s.job->worst); },
-                             "the completed variant with the largest max real part (closed loop, else open), None if none completed")
+                             "the completed variant with the largest max real part (closed loop, else open), None if none completed\n"
+                             "(its row in the arrays; indices[worst] is its number in the whole study)")
       .def_property_readonly("largest_input", [](const SweepResult& s) { return index_or_none(s.job->largest_input); },
-                             "simulate: the run with the largest peak |u|, else None")
-      .def_property_readonly("summary", [](const SweepResult& s) { return study_sweep_summary(*s.job); }, "the summary codyna sweep prints")
+                             "simulate: the run with the largest peak |u| (its row in the arrays), else None")
+      .def_property_readonly("summary", [](const SweepResult& s) { return s.summary; },
+                             "the summary codyna sweep prints (a shard's: its one line)")
+      .def_property_readonly("shard", [](const SweepResult& s) -> py::object {
+        if (s.job->shard_count == 0) return py::none();
+        return py::make_tuple(s.job->shard_index, s.job->shard_count);
+      }, "a shard's (K, N), else None (the whole study, also when merged)")
+      .def_property_readonly("indices", [](const SweepResult& s) {
+        const std::size_t n = s.job->variants.size();
+        py::array_t<std::int64_t> a(static_cast<py::ssize_t>(n));
+        for (std::size_t i = 0; i < n; ++i)
+          a.mutable_at(static_cast<py::ssize_t>(i)) = s.indices.empty() ? static_cast<std::int64_t>(i) : s.indices[i];
+        return a;
+      }, "each variant's number in the whole study (n): a shard K/N holds the variants i % N == K; else 0 .. n-1")
       .def_property_readonly("resumed", [](const SweepResult& s) { return s.job->resumed; }, "variants read back from the journal of an interrupted run")
       .def_property_readonly("written", [](const SweepResult& s) { return py::tuple(py::cast(s.job->written)); }, "the files written (out, csv, mat and its .m)")
       .def_property_readonly("notes", [](const SweepResult& s) { return s.job->notes; }, "notes for the user (what codyna sweep prints as notes)")

@@ -13,6 +13,8 @@ command line's, bit for bit. docs/python.md has a tour.
     run.save("run.h5")
     sweep = study.sweep(vary={"/bodies/1/mass": "5:15:11"})   # codyna sweep
     sweep.values, sweep.closed_poles, sweep.stable, sweep.summary
+    study.sweep(vary=..., shard=(0, 2), out="s0.sweep")          # codyna sweep --shard 0/2
+    codyna.sweep_merge(["s0.sweep", "s1.sweep"], out="study.h5")  # codyna sweep-merge
 
 Errors: a bad model or a bad choice in it raises ModelError (a ValueError) whose message names
 the file and the field, as the command line prints it; a bad keyword value raises ValueError
@@ -43,6 +45,7 @@ __all__ = [
     "ConvergenceError",
     "lqr",
     "place",
+    "sweep_merge",
     "__version__",
 ]
 
@@ -270,6 +273,7 @@ class Study:
         mat=None,
         restart=None,
         resume=None,
+        shard=None,
         progress=None,
     ):
         """A parameter study, as `codyna sweep` runs it (docs/parameter-studies.md).
@@ -302,6 +306,12 @@ class Study:
                     started again resumes from its journal OUT.partial
         mat         DIR/NAME.mat (+ NAME.m) for MATLAB/Octave
         restart     True: ignore the journal of an interrupted run (resume=False says the same)
+        shard       (K, N) or "K/N" (as --shard K/N): run only the variants i with i % N == K
+                    (0 <= K < N, K counting from 0) and write them to out as a shard file (no
+                    csv or mat; resumed as a journal is); sweep_merge joins the shards. The
+                    Sweep returned holds the shard's variants only (indices: their numbers in
+                    the study; summary: the command's one line). Not for a Study.from_json
+                    (the merge reads the model file again)
         progress    a callable progress(done, total), called on this thread (at most every
                     50 ms, and once at the end) as variants finish; an exception it raises
                     stops the study and is raised
@@ -316,3 +326,22 @@ class Study:
         """
         options = _given(locals())
         return _codyna._sweep(self._study, options)
+
+
+def sweep_merge(shards, *, out, csv=None, mat=None):
+    """Joins the shards of Study.sweep(shard=(K, N)) (or of `codyna sweep --shard K/N`) into the
+    files the whole study run at once writes, byte for byte, as `codyna sweep-merge SHARD... --out
+    OUT [--csv CSV] [--mat DIR/NAME.mat]` does (the same core call).
+
+    shards      the shards' files: a list of str or os.PathLike (or one path)
+    out         the merged HDF5 results (required)
+    csv, mat    as in Study.sweep
+
+    The shards must be of one study (the same model file bytes and options) and hold every
+    variant between them; the model file is read again from the path the shards name (relative
+    paths from the current folder). Returns the whole study's Sweep (no variant is run again).
+    Raises ValueError with the command's message: a shard missing ("variants ... are in none of
+    the shards given"), a shard of another study, a file that is not a shard, an output that
+    would replace an input; TypeError for a wrong type.
+    """
+    return _codyna._sweep_merge(shards, _given(dict(out=out, csv=csv, mat=mat)))

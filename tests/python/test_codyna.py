@@ -729,3 +729,100 @@ except KeyboardInterrupt:
     # the variants done are in the journal, the results file is not written
     done = len((tmp_path / "mc.h5.partial").read_text().splitlines()) - 2
     assert 0 < done < 20000 and not out.exists(), done
+
+
+# ------------------------------------------------------------------------- shards (Slurm) and their merge
+
+SHARD_GRID = {ROD_MASS: "5:15:6"}
+
+
+def test_sweep_shards_merged_from_python_equal_the_whole_study_and_the_cli(tmp_path):
+    study = codyna.Study(CART)
+    whole = study.sweep(vary=SHARD_GRID, threads=1, out=tmp_path / "whole.h5", csv=tmp_path / "whole.csv")
+    s0 = study.sweep(vary=SHARD_GRID, shard=(0, 2), threads=1, out=tmp_path / "py0.sweep")
+    s1 = study.sweep(vary=SHARD_GRID, shard="1/2", threads=1, out=tmp_path / "py1.sweep")  # the command's spelling
+    # a shard's Sweep: its own variants only (i % 2 == K), the whole study's numbers bit for bit
+    assert len(whole) == 6 and whole.shard is None and whole.indices.tolist() == list(range(6))
+    assert s0.shard == (0, 2) and s1.shard == (1, 2)
+    for part, k in ((s0, 0), (s1, 1)):
+        assert len(part) == 3 and part.indices.tolist() == [k, k + 2, k + 4]
+        for key in ("values", "status", "A", "B", "C", "D", "open_poles", "closed_poles", "closed_max_real", "stable", "K"):
+            expected = getattr(whole, key) if key == "K" else getattr(whole, key)[k::2]
+            assert np.array_equal(getattr(part, key), expected), (k, key)
+        assert part.failed == 0 and part.stable_count == 3
+        assert part.written == (str(tmp_path / ("py%d.sweep" % k)),) and not (tmp_path / ("py%d.sweep.partial" % k)).exists()
+        assert part.summary == "shard            %d/2: 3 of the 6 variants (i %% 2 = %d), 0 failed; codyna sweep-merge joins the shards\n" % (k, k)
+    # worst: a row of the shard's arrays; its number in the study is indices[worst] (the 5 kg rod, variant 0)
+    assert whole.worst == 0 and s0.worst == 0 and s0.indices[s0.worst] == 0
+    assert s1.worst == 0 and s1.indices[s1.worst] == 1 and s1.closed_max_real[0] == s1.closed_max_real.max()
+    # the merge (shards in another order): the whole study's files byte for byte, its Sweep
+    merged = codyna.sweep_merge([tmp_path / "py1.sweep", str(tmp_path / "py0.sweep")], out=tmp_path / "merged.h5",
+                                csv=tmp_path / "merged.csv")
+    assert (tmp_path / "merged.h5").read_bytes() == (tmp_path / "whole.h5").read_bytes()
+    assert (tmp_path / "merged.csv").read_bytes() == (tmp_path / "whole.csv").read_bytes()
+    assert not (tmp_path / "merged.h5.partial").exists() and (tmp_path / "py0.sweep").exists()
+    assert isinstance(merged, codyna.Sweep) and len(merged) == 6 and merged.shard is None
+    assert merged.written == (str(tmp_path / "merged.h5"), str(tmp_path / "merged.csv"))
+    assert merged.summary == whole.summary and merged.worst == 0 and merged.notes == whole.notes
+    for key in ("values", "status", "A", "B", "C", "D", "open_poles", "closed_poles", "stable", "K", "indices"):
+        assert np.array_equal(getattr(merged, key), getattr(whole, key)), key
+    # the command line: its shards are the module's bytes, its merge the same file
+    for k in (0, 1):
+        stdout, _ = cli("sweep", CART, "--vary", ROD_MASS + "=5:15:6", "--shard", "%d/2" % k, "--threads", 1,
+                        "--out", tmp_path / ("cli%d.sweep" % k), "--quiet")
+        assert stdout.startswith(s0.summary if k == 0 else s1.summary), stdout
+        assert (tmp_path / ("cli%d.sweep" % k)).read_bytes() == (tmp_path / ("py%d.sweep" % k)).read_bytes(), k
+    cli("sweep-merge", tmp_path / "cli0.sweep", tmp_path / "cli1.sweep", "--out", tmp_path / "cli.h5")
+    assert (tmp_path / "cli.h5").read_bytes() == (tmp_path / "merged.h5").read_bytes()
+
+
+def test_sweep_merge_refusals_are_the_clis(tmp_path):
+    study = codyna.Study(CART)
+    study.sweep(vary=SHARD_GRID, shard=(0, 2), threads=1, out=tmp_path / "s0.sweep")
+    study.sweep(vary={ROD_MASS: "5:15:4"}, shard=(1, 2), threads=1, out=tmp_path / "other.sweep")  # another study
+
+    def refused(shards, out):
+        _, stderr = cli("sweep-merge", *shards, "--out", out, expect=1)
+        with pytest.raises(ValueError) as e:
+            codyna.sweep_merge(shards, out=out)
+        assert "codyna: error: " + str(e.value) + "\n" == stderr
+        assert not os.path.exists(out) and not os.path.exists(str(out) + ".partial")
+        return str(e.value)
+
+    # a shard missing: the variants no shard holds are named
+    assert refused([tmp_path / "s0.sweep"], tmp_path / "half.h5") == (
+        "sweep-merge: variants 1, 3, 5 (3 of 6) are in none of the shards given: run (or resume) their shards first")
+    assert refused([tmp_path / "s0.sweep", tmp_path / "other.sweep"], tmp_path / "mixed.h5") == (
+        str(tmp_path / "other.sweep") + ": a shard of another study than " + str(tmp_path / "s0.sweep") +
+        " (other model file contents or options)")
+    (tmp_path / "notes.txt").write_text("not a shard\n")
+    assert refused([tmp_path / "notes.txt"], tmp_path / "x.h5") == str(tmp_path / "notes.txt") + ": not a shard written by codyna sweep --shard"
+    with pytest.raises(TypeError, match="shards: expected a list of paths"):
+        codyna.sweep_merge([3], out=tmp_path / "x.h5")
+    with pytest.raises(TypeError, match="missing 1 required keyword-only argument: 'out'"):
+        codyna.sweep_merge([tmp_path / "s0.sweep"])
+
+
+@pytest.mark.parametrize("shard", [(2, 2), (-1, 2), (0, 0), (1, -3), "2/2", "1/0", "-1/2", "1 /2", "0/2/3", "a/b", (0, 1, 2), ()])
+def test_sweep_bad_shard_values(shard, tmp_path):
+    with pytest.raises(ValueError) as e:
+        codyna.Study(CART).sweep(vary=SHARD_GRID, shard=shard, out=tmp_path / "s.sweep")
+    assert str(e.value) == ('shard: expected (K, N) or "K/N" with N >= 1 and 0 <= K < N (K counts from 0, as codyna '
+                            "sweep --shard K/N), got " + repr(shard))
+    assert not (tmp_path / "s.sweep").exists()
+
+
+def test_sweep_shard_refusals(tmp_path):
+    study = codyna.Study(CART)
+    with pytest.raises(TypeError, match=r"^sweep\(\): shard: expected a whole number \(int\), got float$"):
+        study.sweep(vary=SHARD_GRID, shard=(0.0, 2), out=tmp_path / "s.sweep")
+    with pytest.raises(TypeError, match=r'^sweep\(\): shard: expected a tuple \(K, N\) or a "K/N" str, got int$'):
+        study.sweep(vary=SHARD_GRID, shard=1, out=tmp_path / "s.sweep")
+    # the core's refusals, as the command's (the keyword named as Python writes it)
+    with pytest.raises(ValueError, match=r"^shard: give out \(the shard's file\)$"):
+        study.sweep(vary=SHARD_GRID, shard=(0, 2))
+    with pytest.raises(ValueError, match="^shard: a shard writes its variants only"):
+        study.sweep(vary=SHARD_GRID, shard=(0, 2), out=tmp_path / "s.sweep", csv=tmp_path / "s.csv")
+    with pytest.raises(ValueError, match="^shard: a Study.from_json has no model file for sweep_merge"):
+        codyna.Study.from_json(open(CART).read()).sweep(vary=SHARD_GRID, shard=(0, 2), out=tmp_path / "s.sweep")
+    assert os.listdir(tmp_path) == []
