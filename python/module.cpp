@@ -691,7 +691,8 @@ std::unique_ptr<SweepResult> do_sweep(const Study& s, const py::dict& options) {
   SweepProgress progress;
   progress.cancel = &cancel;
   progress.done = [&](long long d, long long n) {
-    total = n;
+    // a shard counts its own variants (the core's total is the whole study's)
+    total = r.shard_count > 0 ? (r.shard_index < n ? (n - r.shard_index + r.shard_count - 1) / r.shard_count : 0) : n;
     done = d;
   };
   std::mutex mutex;

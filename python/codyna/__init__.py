@@ -310,7 +310,8 @@ class Study:
                     (0 <= K < N, K counting from 0) and write them to out as a shard file (no
                     csv or mat; resumed as a journal is); sweep_merge joins the shards. The
                     Sweep returned holds the shard's variants only (indices: their numbers in
-                    the study; summary: the command's one line). Not for a Study.from_json
+                    the study; summary: the command's one line; progress counts the
+                    shard's variants). Not for a Study.from_json
                     (the merge reads the model file again)
         progress    a callable progress(done, total), called on this thread (at most every
                     50 ms, and once at the end) as variants finish; an exception it raises

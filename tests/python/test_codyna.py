@@ -740,7 +740,10 @@ def test_sweep_shards_merged_from_python_equal_the_whole_study_and_the_cli(tmp_p
     study = codyna.Study(CART)
     whole = study.sweep(vary=SHARD_GRID, threads=1, out=tmp_path / "whole.h5", csv=tmp_path / "whole.csv")
     s0 = study.sweep(vary=SHARD_GRID, shard=(0, 2), threads=1, out=tmp_path / "py0.sweep")
-    s1 = study.sweep(vary=SHARD_GRID, shard="1/2", threads=1, out=tmp_path / "py1.sweep")  # the command's spelling
+    calls = []
+    s1 = study.sweep(vary=SHARD_GRID, shard="1/2", threads=1, out=tmp_path / "py1.sweep",  # the command's spelling
+                     progress=lambda done, total: calls.append((done, total)))
+    assert calls and calls[-1] == (3, 3) and all(total == 3 for _, total in calls), calls  # the shard's variants
     # a shard's Sweep: its own variants only (i % 2 == K), the whole study's numbers bit for bit
     assert len(whole) == 6 and whole.shard is None and whole.indices.tolist() == list(range(6))
     assert s0.shard == (0, 2) and s1.shard == (1, 2)
