@@ -8,16 +8,20 @@
 #include <QApplication>
 #include <QAction>
 #include <QComboBox>
+#include <QLineEdit>
 #include <QMainWindow>
 #include <QMenu>
 #include <QMenuBar>
 #include <QMessageBox>
 #include <QTest>
+#include <QTreeView>
 #include <QUndoStack>
 #include <QWheelEvent>
 #include <memory>
 
 #include "gui/main_window.hpp"
+#include "gui/model_tree.hpp"
+#include "gui/property_editor.hpp"
 
 namespace codyna::gui::drive {
 
@@ -75,6 +79,53 @@ inline QAction* addAction(QMainWindow* w, const QString& kind) {
     }
   }
   return nullptr;
+}
+
+// The element's row of the model tree clicked (its kind's node opened first), and the property
+// editor then showing it: "" when so, else what went wrong
+inline QString clickElement(MainWindow* w, ElementKind kind, int index) {
+  QTreeView* t = w->modelTree();
+  const QModelIndex i = w->treeModel()->indexOf({kind, index});
+  if (!i.isValid()) return QStringLiteral("no row for element %1").arg(index);
+  t->expand(i.parent());
+  t->scrollTo(i);
+  const QRect r = t->visualRect(i);
+  if (r.isEmpty()) return QStringLiteral("row %1 not shown").arg(index);
+  QTest::mouseClick(t->viewport(), Qt::LeftButton, {}, r.center());
+  const auto e = w->propertyEditor()->element();
+  if (!e || e->kind != kind || e->index != index) return QStringLiteral("the editor does not show element %1").arg(index);
+  return {};
+}
+
+// Edit > Add > "Add KIND" triggered from the window's menu, the new element in the editor: "" when so
+inline QString addElement(MainWindow* w, const QString& kind) {
+  QAction* found = addAction(w, kind);
+  if (!found) return "no action Add " + kind;
+  found->trigger();
+  return w->propertyEditor()->element() ? QString() : "nothing selected after Add " + kind;
+}
+
+// `text` typed into the field's line edit (an editable drop-down's too) and Enter pressed: "" when
+// there was one to type into
+inline QString typeInto(MainWindow* w, const QString& field, const QString& text) {
+  QWidget* ed = w->propertyEditor()->editorFor(field);
+  QLineEdit* e = qobject_cast<QLineEdit*>(ed);
+  if (auto* c = qobject_cast<QComboBox*>(ed)) e = c->lineEdit();
+  if (!e) return "no line edit for " + field;
+  e->setFocus();
+  e->selectAll();
+  QTest::keyClicks(e, text);
+  QTest::keyClick(e, Qt::Key_Return);
+  return {};
+}
+
+// typed and taken: nothing marked, no reason shown ("" when so)
+inline QString typeTaken(MainWindow* w, const QString& field, const QString& text) {
+  const QString why = typeInto(w, field, text);
+  if (!why.isEmpty()) return why;
+  const PropertyEditor* p = w->propertyEditor();
+  if (!p->markedField().isEmpty() || !p->errorText().isEmpty()) return field + " = " + text + " not taken: " + p->errorText();
+  return {};
 }
 
 // a wheel notch over the middle of `w` (delivered as Qt delivers one: to the widget under the mouse)

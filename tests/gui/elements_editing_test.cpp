@@ -77,44 +77,26 @@ class ElementsEditingTest : public QObject {
     if (kind == ElementKind::Effect) find(s.effects);
     if (kind == ElementKind::Joint) find(s.joints);
     QVERIFY2(index >= 0, name.c_str());
-    QTreeView* t = w->modelTree();
-    const QModelIndex i = w->treeModel()->indexOf({kind, index});
-    QVERIFY(i.isValid());
-    t->expand(i.parent());
-    t->scrollTo(i);
-    const QRect r = t->visualRect(i);
-    QVERIFY(!r.isEmpty());
-    QTest::mouseClick(t->viewport(), Qt::LeftButton, {}, r.center());
-    QVERIFY(props()->element());
-    QCOMPARE(props()->element()->kind, kind);
-    QCOMPARE(props()->element()->index, index);
+    const QString why = drive::clickElement(w.get(), kind, index);
+    QVERIFY2(why.isEmpty(), qPrintable(why));
   }
 
   // Edit > Add > Add KIND, from the window's menu
   void add(const QString& kind) {
-    QAction* found = drive::addAction(w.get(), kind);
-    QVERIFY2(found, qPrintable(kind));
-    found->trigger();
-    QVERIFY(props()->element());
+    const QString why = drive::addElement(w.get(), kind);
+    QVERIFY2(why.isEmpty(), qPrintable(why));
   }
 
   // types `text` into the field and presses Enter
   void typeInto(const QString& field, const QString& text) {
-    QWidget* ed = props()->editorFor(field);
-    QLineEdit* e = qobject_cast<QLineEdit*>(ed);
-    if (auto* c = qobject_cast<QComboBox*>(ed)) e = c->lineEdit();  // an editable drop-down: typed
-    QVERIFY2(e, qPrintable("no line edit for " + field));
-    e->setFocus();
-    e->selectAll();
-    QTest::keyClicks(e, text);
-    QTest::keyClick(e, Qt::Key_Return);
+    const QString why = drive::typeInto(w.get(), field, text);
+    QVERIFY2(why.isEmpty(), qPrintable(why));
   }
 
   // typed and taken: nothing marked, no reason shown
   void type(const QString& field, const QString& text) {
-    typeInto(field, text);
-    QVERIFY2(props()->markedField().isEmpty() && props()->errorText().isEmpty(),
-             qPrintable(field + " = " + text + " not taken: " + props()->errorText()));
+    const QString why = drive::typeTaken(w.get(), field, text);
+    QVERIFY2(why.isEmpty(), qPrintable(why));
   }
 
   // typed and refused: the field (or an entry of it: drives/1) is marked and the reason names

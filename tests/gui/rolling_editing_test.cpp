@@ -70,39 +70,20 @@ class RollingEditingTest : public QObject {
   }
 
   void click(ElementKind kind, int index) {
-    QTreeView* t = w->modelTree();
-    const QModelIndex i = w->treeModel()->indexOf({kind, index});
-    QVERIFY(i.isValid());
-    t->expand(i.parent());
-    t->scrollTo(i);
-    const QRect r = t->visualRect(i);
-    QVERIFY(!r.isEmpty());
-    QTest::mouseClick(t->viewport(), Qt::LeftButton, {}, r.center());
-    QVERIFY(props()->element());
-    QCOMPARE(props()->element()->kind, kind);
-    QCOMPARE(props()->element()->index, index);
+    const QString why = drive::clickElement(w.get(), kind, index);
+    QVERIFY2(why.isEmpty(), qPrintable(why));
   }
-
   void add(const QString& kind) {
-    QAction* found = drive::addAction(w.get(), kind);
-    QVERIFY2(found, qPrintable(kind));
-    found->trigger();
-    QVERIFY(props()->element());
+    const QString why = drive::addElement(w.get(), kind);
+    QVERIFY2(why.isEmpty(), qPrintable(why));
   }
-
   void typeInto(const QString& field, const QString& t) {
-    auto* e = qobject_cast<QLineEdit*>(props()->editorFor(field));
-    QVERIFY2(e, qPrintable("no line edit for " + field));
-    e->setFocus();
-    e->selectAll();
-    QTest::keyClicks(e, t);
-    QTest::keyClick(e, Qt::Key_Return);
+    const QString why = drive::typeInto(w.get(), field, t);
+    QVERIFY2(why.isEmpty(), qPrintable(why));
   }
-
   void type(const QString& field, const QString& t) {
-    typeInto(field, t);
-    QVERIFY2(props()->markedField().isEmpty() && props()->errorText().isEmpty(),
-             qPrintable(field + " = " + t + " not taken: " + props()->errorText()));
+    const QString why = drive::typeTaken(w.get(), field, t);
+    QVERIFY2(why.isEmpty(), qPrintable(why));
   }
 
   // a radius of 0: the model's error, at /constraints/K/radius, marked at the field; no model
