@@ -361,10 +361,8 @@ void Scene::build(const Model* model) {
         ball = std::max(ball, it.local.linear().col(0).norm());
     return std::clamp(std::max(2.4 * ball, 0.04 * L), 0.01 * L, 0.1 * L);
   };
-  // (a free joint holds nothing: a free-floating body, a ball on a plane, gets no block)
   for (int i = 1; i < m.nbodies; ++i)
-    if (m.parent[i] == 0 && m.joints[i].type != JointType::Free)
-      anchor(m.joints[i].X_PF.p, m.joints[i].X_PF.R, anchorSize(i, m.joints[i].X_CM.p));
+    if (m.parent[i] == 0) anchor(m.joints[i].X_PF.p, m.joints[i].X_PF.R, anchorSize(i, m.joints[i].X_CM.p));
   for (const ConstraintModel& c : m.constraints) {
     if (c.type == ConstraintType::Coupler) continue;  // couples coordinates, at no point
     if (c.type == ConstraintType::RollingBall) continue;  // point_a is a point of a plane: drawn as its contact
