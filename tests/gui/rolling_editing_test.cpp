@@ -116,6 +116,14 @@ class RollingEditingTest : public QObject {
     QVERIFY(w->openFile(QStringLiteral(CODYNA_EXAMPLES_DIR "/ball_plate.json")));
     click(ElementKind::Constraint, 0);
     QCOMPARE(combo("type")->currentText(), QString("rolling_ball"));
+    // a wheel turned over the unfocused type and body drop-downs (scrolling the panel) changes nothing
+    for (const char* f : {"type", "body_a"}) {
+      drive::wheelOver(combo(f), -2);
+      drive::wheelOver(combo(f), 3);
+    }
+    QCOMPARE(combo("type")->currentText(), QString("rolling_ball"));
+    QCOMPARE(w->document()->spec().constraints.at(0).type, ConstraintType::RollingBall);
+    QCOMPARE(w->document()->spec().constraints.at(0).body_a, std::string("plate"));
     QCOMPARE(combo("body_a")->currentText(), QString("plate"));
     QCOMPARE(combo("body_b")->currentText(), QString("ball"));
     QCOMPARE(text("radius"), QString("0.015"));
