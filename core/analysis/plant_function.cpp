@@ -37,31 +37,13 @@ std::vector<int> independent_rows(const Model& m, const Eigen::VectorXd& q) {
   return partition_rows(d.Jc, 1e-9, rank).independent;
 }
 
-int row_rank(const Eigen::MatrixXd& A) {
-  if (A.rows() == 0) return 0;
-  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A.transpose());
-  qr.setThreshold(1e-9);
-  return static_cast<int>(qr.rank());
-}
-
 // the non-holonomic rows independent of the holonomic rows `held` at q (as prepare_model chose them
 // at q0: in order, each kept when it adds to the rank)
 std::vector<int> velocity_rows_at(const Model& m, const Eigen::VectorXd& q, const std::vector<int>& held) {
-  std::vector<int> out;
-  if (m.active_velocity_rows == 0) return out;
+  if (m.active_velocity_rows == 0) return {};
   Data d(m);
   constraint_terms<double>(m, d, q, Eigen::VectorXd::Zero(m.nv));
-  Eigen::MatrixXd J(static_cast<Eigen::Index>(held.size()), m.nv);
-  for (std::size_t k = 0; k < held.size(); ++k) J.row(static_cast<Eigen::Index>(k)) = d.Jc.row(held[k]);
-  for (int r : m.velocity_rows) {
-    if (static_cast<int>(out.size()) == m.active_velocity_rows) break;
-    Eigen::MatrixXd Jn(J.rows() + 1, m.nv);
-    Jn << J, d.Jc.row(r);
-    if (row_rank(Jn) == Jn.rows()) {
-      J = Jn;
-      out.push_back(r);
-    }
-  }
+  const std::vector<int> out = rows_adding_rank(d.Jc, held, m.velocity_rows, m.active_velocity_rows);
   if (static_cast<int>(out.size()) != m.active_velocity_rows)
     throw std::invalid_argument("the rolling conditions lose rank at this configuration (" +
                                 std::to_string(out.size()) + " of " + std::to_string(m.active_velocity_rows) +

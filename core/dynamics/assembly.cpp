@@ -89,4 +89,22 @@ RowPartition partition_rows(const Eigen::MatrixXd& Jc, double relative_tolerance
   return p;
 }
 
+std::vector<int> rows_adding_rank(const Eigen::MatrixXd& Jc, const std::vector<int>& held,
+                                  const std::vector<int>& candidates, int max) {
+  std::vector<int> kept = held, out;
+  for (int r : candidates) {
+    if (max >= 0 && static_cast<int>(out.size()) == max) break;
+    Eigen::MatrixXd J(static_cast<Eigen::Index>(kept.size()) + 1, Jc.cols());
+    for (std::size_t k = 0; k < kept.size(); ++k) J.row(static_cast<Eigen::Index>(k)) = Jc.row(kept[k]);
+    J.row(J.rows() - 1) = Jc.row(r);
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(J.transpose());
+    qr.setThreshold(1e-9);
+    if (qr.rank() == J.rows()) {
+      kept.push_back(r);
+      out.push_back(r);
+    }
+  }
+  return out;
+}
+
 }  // namespace codyna

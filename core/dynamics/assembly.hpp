@@ -42,4 +42,10 @@ struct RowPartition {
 };
 RowPartition partition_rows(const Eigen::MatrixXd& Jc, double relative_tolerance = 1e-9, int rank = -1);
 
+// Of the rows `candidates` of Jc, in their order, those that add to the rank of the rows `held`
+// and of the candidates kept before them (column-pivoted QR, relative tolerance 1e-9), at most
+// `max` of them (-1: no limit): rolling's no-slip rows beside the holonomic ones
+std::vector<int> rows_adding_rank(const Eigen::MatrixXd& Jc, const std::vector<int>& held,
+                                  const std::vector<int>& candidates, int max = -1);
+
 }  // namespace codyna

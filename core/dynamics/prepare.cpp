@@ -2,7 +2,6 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
-#include <Eigen/QR>
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
@@ -117,27 +116,9 @@ class Preparer {
     std::vector<int> active;
     for (int r : held.independent)
       if (!m_.is_velocity_row(r)) active.push_back(r);
-    Eigen::MatrixXd J(0, Jc.cols());
-    const auto rank_of = [](const Eigen::MatrixXd& A) {
-      if (A.rows() == 0) return 0;
-      Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A.transpose());
-      qr.setThreshold(1e-9);
-      return static_cast<int>(qr.rank());
-    };
-    for (int r : active) {
-      J.conservativeResize(J.rows() + 1, Eigen::NoChange);
-      J.row(J.rows() - 1) = Jc.row(r);
-    }
-    int nvel = 0;
-    for (int r : m_.velocity_rows) {
-      Eigen::MatrixXd Jn(J.rows() + 1, Jc.cols());
-      Jn << J, Jc.row(r);
-      if (rank_of(Jn) == Jn.rows()) {
-        J = Jn;
-        active.push_back(r);
-        ++nvel;
-      }
-    }
+    const std::vector<int> rolling = rows_adding_rank(Jc, active, m_.velocity_rows);
+    const int nvel = static_cast<int>(rolling.size());
+    active.insert(active.end(), rolling.begin(), rolling.end());
     std::sort(active.begin(), active.end());
     if (static_cast<int>(active.size()) != rank)
       fail(at("constraints", constraint_of_row(m_.velocity_rows.front())),
