@@ -50,27 +50,9 @@ int run(const SweepArgs& a) {
   r.simulate = a.simulate;
   if (!a.shard.empty()) {
     // K/N, or "slurm": SLURM_ARRAY_TASK_ID (from SLURM_ARRAY_TASK_MIN) of SLURM_ARRAY_TASK_COUNT
-    long long k = -1, n = 0;
-    if (a.shard == "slurm") {
-      const char* id = std::getenv("SLURM_ARRAY_TASK_ID");
-      const char* count = std::getenv("SLURM_ARRAY_TASK_COUNT");
-      const char* min = std::getenv("SLURM_ARRAY_TASK_MIN");
-      if (!id || !count) throw std::invalid_argument("--shard slurm: SLURM_ARRAY_TASK_ID and SLURM_ARRAY_TASK_COUNT are not set (not in a Slurm job array)");
-      k = std::atoll(id) - (min ? std::atoll(min) : 0);
-      n = std::atoll(count);
-    } else {
-      const auto slash = a.shard.find('/');
-      char* end = nullptr;
-      if (slash != std::string::npos) {
-        k = std::strtoll(a.shard.c_str(), &end, 10);
-        if (end != a.shard.c_str() + slash) k = -1;
-        n = std::strtoll(a.shard.c_str() + slash + 1, &end, 10);
-        if (*end != '\0') n = 0;
-      }
-      if (k < 0 || n < 1 || k >= n) throw std::invalid_argument("--shard " + a.shard + ": expected K/N with 0 <= K < N, or slurm");
-    }
-    r.shard_index = k;
-    r.shard_count = n;
+    const SweepShard shard = study_parse_shard(a.shard, OptionStyle::Flag);
+    r.shard_index = shard.index;
+    r.shard_count = shard.count;
   }
   r.resume = !a.restart;
   SweepProgress progress;

@@ -208,40 +208,25 @@ class Keywords {
     for (const auto& item : iterable(*o, key, "a dict {field: spec} or \"FIELD=SPEC\" strings")) v.push_back(text_of(item, key));
     return v;
   }
-  // a sweep's shard: (K, N) (a tuple or list of two whole numbers) or the command's "K/N" text,
-  // with N >= 1 and 0 <= K < N (K counts from 0, as codyna sweep --shard K/N)
-  std::optional<std::pair<long long, long long>> shard(const std::string& key) {
+  // a sweep's shard: (K, N) (a tuple or list of two whole numbers), the command's "K/N" text or
+  // "slurm" (a Slurm job array task's), read and checked by the core's study_parse_shard /
+  // study_check_shard as codyna sweep --shard is (their std::invalid_argument: a ValueError)
+  std::optional<SweepShard> shard(const std::string& key) {
     const auto o = take(key);
     if (!o) return std::nullopt;
-    const auto refuse = [&]() -> std::pair<long long, long long> {
-      throw py::value_error(key + ": expected (K, N) or \"K/N\" with N >= 1 and 0 <= K < N (K counts from 0, as codyna "
-                            "sweep --shard K/N), got " + py::repr(*o).cast<std::string>());
+    if (py::isinstance<py::str>(*o)) return study_parse_shard(o->cast<std::string>(), OptionStyle::Keyword);
+    if (py::isinstance<py::dict>(*o) || py::isinstance<py::bytes>(*o) || !py::isinstance<py::sequence>(*o))
+      type_error(function_ + "(): " + key + ": expected a tuple (K, N), a \"K/N\" str or \"slurm\", got " + type_name(*o));
+    const std::string given = py::repr(*o).cast<std::string>();
+    const py::sequence seq = o->cast<py::sequence>();
+    if (seq.size() != 2) return study_check_shard(-1, 0, OptionStyle::Keyword, given);
+    const auto whole = [&](const py::handle& x) {
+      int overflow = 0;
+      const long long v = PyLong_AsLongLongAndOverflow(int_of(x, key).ptr(), &overflow);
+      return overflow != 0 ? -1 : v;
     };
-    long long k = -1, n = 0;
-    if (py::isinstance<py::str>(*o)) {
-      const std::string t = o->cast<std::string>();
-      const std::size_t slash = t.find('/');
-      const auto whole = [](const std::string& x, long long& v) {
-        if (x.empty() || x.size() > 18 || x.find_first_not_of("0123456789") != std::string::npos) return false;
-        v = std::stoll(x);
-        return true;
-      };
-      if (slash == std::string::npos || !whole(t.substr(0, slash), k) || !whole(t.substr(slash + 1), n)) refuse();
-    } else {
-      if (py::isinstance<py::dict>(*o) || py::isinstance<py::bytes>(*o) || !py::isinstance<py::sequence>(*o))
-        type_error(function_ + "(): " + key + ": expected a tuple (K, N) or a \"K/N\" str, got " + type_name(*o));
-      const py::sequence seq = o->cast<py::sequence>();
-      if (seq.size() != 2) refuse();
-      const auto whole = [&](const py::handle& x) {
-        int overflow = 0;
-        const long long v = PyLong_AsLongLongAndOverflow(int_of(x, key).ptr(), &overflow);
-        return overflow != 0 ? -1 : v;
-      };
-      k = whole(seq[0]);
-      n = whole(seq[1]);
-    }
-    if (n < 1 || k < 0 || k >= n) refuse();
-    return std::make_pair(k, n);
+    const long long k = whole(seq[0]), n = whole(seq[1]);
+    return study_check_shard(k, n, OptionStyle::Keyword, given);
   }
   // signals: a "NAME=VALUE[@TIME]" string or a dict (the model file's object, as JSON text),
   // one or a list of them
@@ -667,8 +652,8 @@ SweepRequest sweep_request(const Study& s, Keywords& k) {
     if (!s.text.empty())
       throw py::value_error("shard: a Study.from_json has no model file for sweep_merge to read again (its shards would "
                             "name " + s.file + "): write the JSON to a file and shard codyna.Study(path)");
-    r.shard_index = shard->first;
-    r.shard_count = shard->second;
+    r.shard_index = shard->index;
+    r.shard_count = shard->count;
   }
   return r;
 }

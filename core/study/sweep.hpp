@@ -171,6 +171,21 @@ struct SweepProgress {
 // model file before any work, written through a temporary file renamed into place).
 SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell = {}, const SweepProgress& progress = {});
 
+// A shard K of N (SweepRequest::shard_index, shard_count) as a front end is given it, read once
+// here for every front end (core/study/sweep_shard.cpp; issue 22): `codyna sweep --shard` and the
+// Python module's Study.sweep(shard=). Messages name the option in `style` (--shard, shard).
+struct SweepShard {
+  long long index = 0, count = 0;
+};
+// "K/N" (whole numbers, 0 <= K < N, K counting from 0) or "slurm": a Slurm job array task's,
+// K = SLURM_ARRAY_TASK_ID - SLURM_ARRAY_TASK_MIN (0 when unset), N = SLURM_ARRAY_TASK_COUNT.
+// Throws std::invalid_argument: not K/N; not in a job array (the variables missing, named); a
+// variable that is not a whole number; an array whose ID - MIN is not below COUNT (a step or gaps).
+SweepShard study_parse_shard(const std::string& text, OptionStyle style);
+// (K, N) checked: 0 <= K < N, else std::invalid_argument naming the option and `given` (as the
+// user wrote the value: "2/2", "(2, 2)").
+SweepShard study_check_shard(long long index, long long count, OptionStyle style, const std::string& given);
+
 // `codyna sweep-merge`: the shards' journals (every variant in one of them, all of the same study:
 // the same model file bytes and options) joined and written to outputs.out / csv / mat exactly as
 // the whole study run at once writes them (the nominal model is compiled again, no variant is).

@@ -810,16 +810,71 @@ def test_sweep_merge_refusals_are_the_clis(tmp_path):
 def test_sweep_bad_shard_values(shard, tmp_path):
     with pytest.raises(ValueError) as e:
         codyna.Study(CART).sweep(vary=SHARD_GRID, shard=shard, out=tmp_path / "s.sweep")
-    assert str(e.value) == ('shard: expected (K, N) or "K/N" with N >= 1 and 0 <= K < N (K counts from 0, as codyna '
-                            "sweep --shard K/N), got " + repr(shard))
+    assert str(e.value) == ('shard: expected (K, N), "K/N" or "slurm" with N >= 1 and 0 <= K < N (K counts from 0, as '
+                            "codyna sweep --shard K/N), got " + repr(shard))
     assert not (tmp_path / "s.sweep").exists()
+
+
+SLURM_VARIABLES = ("SLURM_ARRAY_TASK_ID", "SLURM_ARRAY_TASK_COUNT", "SLURM_ARRAY_TASK_MIN")
+
+
+def slurm_array(monkeypatch, task_id=None, count=None, first=None):
+    """Sets (None: removes) the Slurm job array's variables; monkeypatch restores os.environ after the test."""
+    for name, value in zip(SLURM_VARIABLES, (task_id, count, first)):
+        if value is None:
+            monkeypatch.delenv(name, raising=False)
+        else:
+            monkeypatch.setenv(name, value)
+
+
+def test_sweep_shard_slurm_is_the_array_tasks_shard(tmp_path, monkeypatch):
+    study = codyna.Study(CART)
+    by_hand = study.sweep(vary=SHARD_GRID, shard=(1, 2), threads=1, out=tmp_path / "hand.sweep")
+    # an array --array=0-1, task 1 (the command's --shard slurm: the same reader, core/study/sweep_shard.cpp)
+    slurm_array(monkeypatch, "1", "2", "0")
+    task = study.sweep(vary=SHARD_GRID, shard="slurm", threads=1, out=tmp_path / "slurm.sweep")
+    assert task.shard == (1, 2) and task.indices.tolist() == [1, 3, 5]
+    assert (tmp_path / "slurm.sweep").read_bytes() == (tmp_path / "hand.sweep").read_bytes()
+    assert np.array_equal(task.closed_poles, by_hand.closed_poles)
+    stdout, _ = cli("sweep", CART, "--vary", ROD_MASS + "=5:15:6", "--shard", "slurm", "--threads", 1,
+                    "--out", tmp_path / "cli.sweep", "--quiet")  # the child inherits the variables
+    assert stdout.startswith(by_hand.summary), stdout
+    assert (tmp_path / "cli.sweep").read_bytes() == (tmp_path / "hand.sweep").read_bytes()
+    # an array --array=1-2 counts its IDs from SLURM_ARRAY_TASK_MIN: task 2 is shard 1 of 2 too
+    slurm_array(monkeypatch, "2", "2", "1")
+    again = study.sweep(vary=SHARD_GRID, shard="slurm", threads=1, out=tmp_path / "from_one.sweep")
+    assert again.shard == (1, 2)
+    assert (tmp_path / "from_one.sweep").read_bytes() == (tmp_path / "hand.sweep").read_bytes()
+    # no MIN: IDs from 0
+    slurm_array(monkeypatch, "0", "2")
+    assert study.sweep(vary=SHARD_GRID, shard="slurm", threads=1, out=tmp_path / "zero.sweep").shard == (0, 2)
+
+
+@pytest.mark.parametrize("task_id, count, first, message", [
+    (None, None, None, "SLURM_ARRAY_TASK_ID and SLURM_ARRAY_TASK_COUNT are not set (not in a Slurm job array)"),
+    ("1", None, "0", "SLURM_ARRAY_TASK_COUNT is not set (not in a Slurm job array)"),
+    (None, "2", None, "SLURM_ARRAY_TASK_ID is not set (not in a Slurm job array)"),
+    ("one", "2", None, "SLURM_ARRAY_TASK_ID=one: expected a whole number (0 or more)"),
+    ("1", "2", "", "SLURM_ARRAY_TASK_MIN=: expected a whole number (0 or more)"),
+    ("12", "4", "0", "SLURM_ARRAY_TASK_ID=12 - SLURM_ARRAY_TASK_MIN=0 is not a shard of SLURM_ARRAY_TASK_COUNT=4: expected "
+                     "0 <= ID - MIN < COUNT (an array of consecutive tasks, e.g. --array=0-15, with no step or gaps)"),
+])
+def test_sweep_shard_slurm_refusals_name_the_variables(task_id, count, first, message, tmp_path, monkeypatch):
+    slurm_array(monkeypatch, task_id, count, first)
+    with pytest.raises(ValueError) as e:
+        codyna.Study(CART).sweep(vary=SHARD_GRID, shard="slurm", out=tmp_path / "s.sweep")
+    assert str(e.value) == "shard='slurm': " + message
+    # the command refuses the same, naming its option
+    _, stderr = cli("sweep", CART, "--vary", ROD_MASS + "=5:15:6", "--shard", "slurm", "--out", tmp_path / "s.sweep", expect=1)
+    assert stderr == "codyna: error: --shard slurm: " + message + "\n"
+    assert os.listdir(tmp_path) == []
 
 
 def test_sweep_shard_refusals(tmp_path):
     study = codyna.Study(CART)
     with pytest.raises(TypeError, match=r"^sweep\(\): shard: expected a whole number \(int\), got float$"):
         study.sweep(vary=SHARD_GRID, shard=(0.0, 2), out=tmp_path / "s.sweep")
-    with pytest.raises(TypeError, match=r'^sweep\(\): shard: expected a tuple \(K, N\) or a "K/N" str, got int$'):
+    with pytest.raises(TypeError, match=r'^sweep\(\): shard: expected a tuple \(K, N\), a "K/N" str or "slurm", got int$'):
         study.sweep(vary=SHARD_GRID, shard=1, out=tmp_path / "s.sweep")
     # the core's refusals, as the command's (the keyword named as Python writes it)
     with pytest.raises(ValueError, match=r"^shard: give out \(the shard's file\)$"):
