@@ -14,6 +14,7 @@ command line's, bit for bit. docs/python.md has a tour.
     sweep = study.sweep(vary={"/bodies/1/mass": "5:15:11"})   # codyna sweep
     sweep.values, sweep.closed_poles, sweep.stable, sweep.summary
     study.sweep(vary=..., shard=(0, 2), out="s0.sweep")          # codyna sweep --shard 0/2
+    study.sweep(vary=..., shard="slurm", out="s.sweep")          # codyna sweep --shard slurm
     codyna.sweep_merge(["s0.sweep", "s1.sweep"], out="study.h5")  # codyna sweep-merge
 
 Errors: a bad model or a bad choice in it raises ModelError (a ValueError) whose message names
@@ -308,7 +309,10 @@ class Study:
         restart     True: ignore the journal of an interrupted run (resume=False says the same)
         shard       (K, N) or "K/N" (as --shard K/N): run only the variants i with i % N == K
                     (0 <= K < N, K counting from 0) and write them to out as a shard file (no
-                    csv or mat; resumed as a journal is); sweep_merge joins the shards. The
+                    csv or mat; resumed as a journal is); sweep_merge joins the shards.
+                    "slurm" (as --shard slurm): a Slurm job array task's, K = SLURM_ARRAY_TASK_ID
+                    - SLURM_ARRAY_TASK_MIN, N = SLURM_ARRAY_TASK_COUNT (a ValueError outside an
+                    array or for values that are not such a shard). The
                     Sweep returned holds the shard's variants only (indices: their numbers in
                     the study; summary: the command's one line; progress counts the
                     shard's variants). Not for a Study.from_json
