@@ -3,6 +3,7 @@
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 
@@ -258,14 +259,21 @@ OperatingPoint static_equilibrium(const Model& model, const OperatingPoint& star
   op.t = start.t;
   op.v = Eigen::VectorXd::Zero(model.nv);
   const Eigen::VectorXd u = plant_u(model, op.u);
+  // one plant function per configuration; each takes the Data and derivative workspaces of the one
+  // before it (made once per search, not per step: the same numbers)
+  auto plant_at = [&](const Eigen::VectorXd& q, PlantFunction* from) {
+    auto p = std::make_unique<PlantFunction>(model, q, op.u, partition_coordinates(model, q, independent));
+    if (from) p->take_workspace(*from);
+    return p;
+  };
+  std::unique_ptr<PlantFunction> f = plant_at(op.q, nullptr);
   for (op.iterations = 0; op.iterations < 60; ++op.iterations) {
-    const PlantFunction f(model, op.q, op.u, partition_coordinates(model, op.q, independent));
-    const int n = f.nz();
-    const Eigen::VectorXd r = rest_accelerations(f, Eigen::VectorXd::Zero(n), u);
+    const int n = f->nz();
+    const Eigen::VectorXd r = rest_accelerations(*f, Eigen::VectorXd::Zero(n), u);
     op.residual = r.size() ? r.lpNorm<Eigen::Infinity>() : 0.0;
     if (op.residual < 1e-11) break;
-    const Eigen::MatrixXd J = plant_jacobian(f, Eigen::VectorXd::Zero(f.nx()), u, JacobianMethod::Exact);
-    const Eigen::MatrixXd K = J.block(n, 0, f.nw(), n);  // d(qdd)/dz
+    const Eigen::MatrixXd J = plant_jacobian(*f, Eigen::VectorXd::Zero(f->nx()), u, JacobianMethod::Exact);
+    const Eigen::MatrixXd K = J.block(n, 0, f->nw(), n);  // d(qdd)/dz
     const Eigen::VectorXd dz = -Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(K).solve(r);
     double t = 1.0;
     bool moved = false;
@@ -274,14 +282,18 @@ OperatingPoint static_equilibrium(const Model& model, const OperatingPoint& star
       // Bricard linkage's bifurcations), in this chart or in the next iteration's: a step whose
       // evaluation fails there is too long and is halved like one that does not lower the residual
       try {
-        const Eigen::VectorXd rn = rest_accelerations(f, t * dz, u);
+        const Eigen::VectorXd rn = rest_accelerations(*f, t * dz, u);
         if (!rn.allFinite() || !(rn.norm() < r.norm())) continue;
-        Eigen::VectorXd x = Eigen::VectorXd::Zero(f.nx()), v, q;
+        Eigen::VectorXd x = Eigen::VectorXd::Zero(f->nx()), v, q;
         x.head(n) = t * dz;
-        f.state_to_qv(x, q, v);
-        const PlantFunction next(model, q, op.u, partition_coordinates(model, q, independent));
-        if (!rest_accelerations(next, Eigen::VectorXd::Zero(next.nz()), u).allFinite()) continue;
+        f->state_to_qv(x, q, v);
+        std::unique_ptr<PlantFunction> next = plant_at(q, f.get());
+        if (!rest_accelerations(*next, Eigen::VectorXd::Zero(next->nz()), u).allFinite()) {
+          f->take_workspace(*next);
+          continue;
+        }
         op.q = q;
+        f = std::move(next);  // the next iteration's plant function (at op.q, its partition there)
         moved = true;
       } catch (const std::exception&) {  // singular constraints (runtime_error) or no chart there (invalid_argument)
         continue;

@@ -543,6 +543,17 @@ PlantFunction::Workspace& PlantFunction::Workspace::operator=(const Workspace&) 
 }
 PlantFunction::Workspace::~Workspace() = default;
 
+void PlantFunction::take_workspace(PlantFunction& other) {
+  if (&other == this || &other.model_ != &model_) return;
+  // only what depends on the model alone; the sizes that depend on the partition are made here
+  if (other.ws_.data) ws_.data = std::move(other.ws_.data);
+  if (other.ws_.td) {
+    ws_.td = std::move(other.ws_.td);
+    ws_.v.resize(model_.nv);
+    ws_.u_all.resize(model_.nu());
+  }
+}
+
 bool PlantFunction::analytic_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::MatrixXd& J) const {
   const Model& m = model_;
   if (m.nc != 0 || !m.motions.empty()) return closed_loop_jacobian(x, u, J);

@@ -115,6 +115,12 @@ class PlantFunction {
   const CoordinatePartition& partition() const { return part_; }
   const Eigen::VectorXd& u_all() const { return u_all_; }
 
+  // Takes the model's evaluation workspaces (its Data and TreeDerivatives, the costly part of a first
+  // evaluation) from another plant function of the same Model, which makes them again if it is used
+  // after. For a search that makes a plant function per step (static_equilibrium): the numbers are
+  // those of a plant function that made its own. Nothing is taken from a plant function of another Model.
+  void take_workspace(PlantFunction& other);
+
  private:
   Eigen::VectorXd solve_dependent(const Eigen::VectorXd& z) const;  // tangent deviation of dependent coords (newton_dependent)
 

@@ -43,6 +43,8 @@ std::vector<HiddenMode> hidden(const Eigen::MatrixXd& A, const Eigen::MatrixXd& 
     const Eigen::MatrixXcd shifted = (observability ? Eigen::MatrixXd(A.transpose()) : A).cast<std::complex<double>>() -
                                      lambda[k] * Eigen::MatrixXcd::Identity(n, n);
     P << shifted, (observability ? Eigen::MatrixXd(X.transpose()) : X).cast<std::complex<double>>();
+    // the singular values alone first: a mode well inside the tolerance (most) needs no U
+    if (Eigen::JacobiSVD<Eigen::MatrixXcd>(P).singularValues()[n - 1] / scale >= 100 * rel_tol) continue;
     const Eigen::JacobiSVD<Eigen::MatrixXcd> svd(P, Eigen::ComputeFullU);
     const Eigen::VectorXd sv = svd.singularValues();
     const double margin = sv[n - 1] / scale;

@@ -539,34 +539,102 @@ Eigen::VectorXcd decode_poles(const nlohmann::json& j) {
   return p;
 }
 
+// One journal line: the JSON object nlohmann::json would dump for these fields (keys in its sorted
+// order, numbers as hex() strings, no spaces), written straight into one string: a variant's line is
+// made on its worker thread, outside the lock, without a JSON tree per number (Sweep.JournalLines...)
+class JournalWriter {
+ public:
+  explicit JournalWriter(std::string& out) : s_(out) {}
+  void key(const char* k) {
+    s_ += first_ ? "{\"" : ",\"";
+    first_ = false;
+    s_ += k;
+    s_ += "\":";
+  }
+  void number(double x) {
+    s_ += '"';
+    char buf[64];
+    if (std::isnan(x)) {
+      s_ += hex(x);
+    } else {
+      const auto res = std::to_chars(buf, buf + sizeof buf, x, std::chars_format::hex);
+      s_.append(buf, res.ptr);
+    }
+    s_ += '"';
+  }
+  void integer(long long x) { s_ += std::to_string(x); }
+  void text(const std::string& t) { s_ += nlohmann::json(t).dump(); }
+  void boolean(bool b) { s_ += b ? "true" : "false"; }
+  // encode(): [rows, cols, ["hex", ...]]
+  void matrix(const double* data, Eigen::Index rows, Eigen::Index cols) {
+    s_ += '[';
+    integer(rows);
+    s_ += ',';
+    integer(cols);
+    s_ += ",[";
+    for (Eigen::Index k = 0; k < rows * cols; ++k) {
+      if (k) s_ += ',';
+      number(data[k]);
+    }
+    s_ += "]]";
+  }
+  void matrix(const Eigen::MatrixXd& m) { matrix(m.data(), m.rows(), m.cols()); }
+  void vector(const Eigen::VectorXd& v) { matrix(v.data(), v.size(), 1); }
+  void poles(const Eigen::VectorXcd& p) {  // encode(VectorXcd): the real parts, then the imaginary parts
+    s_ += '[';
+    integer(p.size());
+    s_ += ",2,[";
+    for (int part = 0; part < 2; ++part)
+      for (Eigen::Index k = 0; k < p.size(); ++k) {
+        if (part || k) s_ += ',';
+        number(part ? p[k].imag() : p[k].real());
+      }
+    s_ += "]]";
+  }
+  void end() { s_ += first_ ? "{}\n" : "}\n"; }
+
+ private:
+  std::string& s_;
+  bool first_ = true;
+};
+
 std::string journal_line(long long i, const SweepVariant& v) {
-  nlohmann::json values = nlohmann::json::array();
-  for (double x : v.values) values.push_back(hex(x));
-  const nlohmann::json j = {{"i", i},
-                            {"values", values},
-                            {"status", static_cast<int>(v.status)},
-                            {"reason", v.reason},
-                            {"A", encode(v.A)},
-                            {"B", encode(v.B)},
-                            {"C", encode(v.C)},
-                            {"D", encode(v.D)},
-                            {"K", encode(v.K)},
-                            {"open_poles", encode(v.open_poles)},
-                            {"closed_poles", encode(v.closed_poles)},
-                            {"open_max_real", hex(v.open_max_real)},
-                            {"closed_max_real", hex(v.closed_max_real)},
-                            {"stable", v.stable},
-                            {"uncontrollable", v.uncontrollable},
-                            {"uncontrollable_text", v.uncontrollable_text},
-                            {"sim_status", v.sim_status},
-                            {"sim_reason", v.sim_reason},
-                            {"sim_t_end", hex(v.sim_t_end)},
-                            {"final_error", hex(v.final_error)},
-                            {"peak_input", encode(Eigen::MatrixXd(v.peak_input))},
-                            {"overshoot", encode(Eigen::MatrixXd(v.overshoot))},
-                            {"settling_time", encode(Eigen::MatrixXd(v.settling_time))},
-                            {"saturation_time", encode(Eigen::MatrixXd(v.saturation_time))}};
-  return j.dump() + "\n";
+  std::string line;
+  line.reserve(256 + 24 * static_cast<std::size_t>(v.A.size() + v.B.size() + v.C.size() + v.D.size() + v.K.size() +
+                                                     2 * (v.open_poles.size() + v.closed_poles.size())));
+  JournalWriter w(line);
+  w.key("A"), w.matrix(v.A);
+  w.key("B"), w.matrix(v.B);
+  w.key("C"), w.matrix(v.C);
+  w.key("D"), w.matrix(v.D);
+  w.key("K"), w.matrix(v.K);
+  w.key("closed_max_real"), w.number(v.closed_max_real);
+  w.key("closed_poles"), w.poles(v.closed_poles);
+  w.key("final_error"), w.number(v.final_error);
+  w.key("i"), w.integer(i);
+  w.key("open_max_real"), w.number(v.open_max_real);
+  w.key("open_poles"), w.poles(v.open_poles);
+  w.key("overshoot"), w.vector(v.overshoot);
+  w.key("peak_input"), w.vector(v.peak_input);
+  w.key("reason"), w.text(v.reason);
+  w.key("saturation_time"), w.vector(v.saturation_time);
+  w.key("settling_time"), w.vector(v.settling_time);
+  w.key("sim_reason"), w.text(v.sim_reason);
+  w.key("sim_status"), w.integer(v.sim_status);
+  w.key("sim_t_end"), w.number(v.sim_t_end);
+  w.key("stable"), w.boolean(v.stable);
+  w.key("status"), w.integer(static_cast<int>(v.status));
+  w.key("uncontrollable"), w.integer(v.uncontrollable);
+  w.key("uncontrollable_text"), w.text(v.uncontrollable_text);
+  w.key("values");
+  line += '[';
+  for (std::size_t k = 0; k < v.values.size(); ++k) {
+    if (k) line += ',';
+    w.number(v.values[k]);
+  }
+  line += ']';
+  w.end();
+  return line;
 }
 
 SweepVariant journal_variant(const nlohmann::json& j) {
@@ -930,10 +998,11 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
         next.store(n);
         return;
       }
+      const std::string line = journal.is_open() || memory ? journal_line(i, v) : std::string();
       const long long d = done.fetch_add(1) + 1;
       const std::lock_guard<std::mutex> lock(report);
-      if (journal.is_open()) journal << journal_line(i, v) << std::flush;
-      if (memory) job.journal += journal_line(i, v);
+      if (journal.is_open()) journal << line << std::flush;
+      if (memory) job.journal += line;
       if (progress.done) progress.done(d, n);
     }
   };

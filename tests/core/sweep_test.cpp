@@ -14,6 +14,7 @@
 #include <fstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "study/files.hpp"
 #include "study/jobs.hpp"
@@ -433,6 +434,47 @@ TEST(Sweep, JournalsInMemoryMergeIntoTheWholeStudysFile) {
   EXPECT_TRUE(std::isnan(merged.variants[3].saturation_time[0]));
   // a journal in memory that is not one is named
   EXPECT_THROW(study_sweep_merge_journals({journals[0], "garbage\n"}, {"rank 0", "rank 1"}, slice), std::invalid_argument);
+}
+
+// the journal's lines are written without a JSON library; each must be the line nlohmann::json dumps
+// for the object it holds (sorted keys, no spaces, strings escaped), and read back bit for bit
+TEST(Sweep, JournalLinesAreWhatAJsonLibraryWrites) {
+  TempDir dir;
+  SweepRequest r;
+  r.model = kModel;
+  r.vary = {"/bodies/1/mass=[-1, 0, 12]"};  // -1: a failed variant with its reason; 0: an uncontrollable mode
+  r.simulate = true;
+  r.threads = 1;
+  r.out = dir.file("study.h5");
+  const SweepJob whole = study_sweep_job(r);
+  SweepRequest slice = r;
+  slice.out = dir.file("merged.h5");
+  slice.journal_in_memory = true;
+  slice.shard_count = 1;
+  slice.shard_index = 0;
+  const SweepJob part = study_sweep_job(slice);
+  std::istringstream lines(part.journal);
+  std::string line;
+  int variants = 0;
+  for (int k = 0; std::getline(lines, line); ++k) {
+    if (k < 2) continue;  // the journal's head and request
+    const nlohmann::json j = nlohmann::json::parse(line);
+    EXPECT_EQ(j.dump(), line);
+    ++variants;
+  }
+  EXPECT_EQ(variants, 3);
+  ASSERT_EQ(whole.variants.size(), 3u);
+  EXPECT_EQ(whole.variants[0].status, SweepStatus::ModelError);
+  EXPECT_NE(part.journal.find(nlohmann::json(whole.variants[0].reason).dump()), std::string::npos);
+  EXPECT_EQ(whole.variants[1].uncontrollable, 1);
+  const SweepJob merged = study_sweep_merge_journals({part.journal}, {"rank 0"}, slice);
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(merged.variants[k].reason, whole.variants[k].reason);
+    EXPECT_EQ(merged.variants[k].uncontrollable_text, whole.variants[k].uncontrollable_text);
+    EXPECT_EQ(merged.variants[k].A, whole.variants[k].A);
+    EXPECT_EQ(merged.variants[k].closed_poles, whole.variants[k].closed_poles);
+    EXPECT_EQ(merged.variants[k].overshoot.size(), whole.variants[k].overshoot.size());
+  }
 }
 
 void expect_refused(const std::vector<std::string>& vary, const std::vector<std::string>& words,
