@@ -1,5 +1,9 @@
 #include "dynamics/constraints.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
 #include <type_traits>
 
 #include "dynamics/kinematics.hpp"
@@ -59,6 +63,60 @@ void coupler_row(const ConstraintModel& c, DataT<S>& d, const VecXT<S>& q, bool 
   for (Eigen::Index j = 0; j < d.Jc.cols(); ++j) d.Jc(c.row, j) = ad_coherent(S(0), nd);
   for (int k = 0; k < c.ncoupled; ++k) d.Jc(c.row, c.iv[k]) = ad_coherent(S(c.ratio[k]), nd);
   d.gamma[c.row] = ad_coherent(S(0), nd);
+}
+
+// a disc lying flat on its plane: |n - (n . a) a| below this has no contact direction
+constexpr double kDiscFlat = 1e-6;
+
+// a contact row of rolling: e . (v_b(P) - v_a(P)) with e a vector of body_a and the contact point
+// P = c - Rd (c = p_b the centre, Rd = R n for a ball, R d for a disc; Rdd its rate):
+//   v_b(P) - v_a(P) = w = -dp' + Rd x w_b + (P - p_a) x w_a,  dp = p_a - c,
+// its Jc row and gamma = d/dt (e . w) at qdd = 0 = e' . w + e . w', with P' - p_a' = -dp' - Rd'
+template <class S>
+void contact_row(const Model& model, DataT<S>& d, const ConstraintModel& c, int r, const Attached<S>& t,
+                 const Vec3T<S>& Rn, const Vec3T<S>& Rnd, const Vec3T<S>& dpc, const Vec3T<S>& dpd,
+                 const Vec3T<S>& dpdd, Eigen::Index nd) {
+  (void)model;
+  auto coh = [nd](auto& m) { ad_make_coherent(m, nd); };
+  const MatXT<S>&Jp = d.Jp, &Jwa = d.Jwa, &Jwb = d.Jwb;
+  Vec3T<S> Pa = -dpc - Rn;  // P - p_a
+  coh(Pa);
+  Vec3T<S> tn = t.x.cross(Rn), tP = t.x.cross(Pa), mt = -t.x;
+  coh(tn);
+  coh(tP);
+  coh(mt);
+  d.Jc.row(r).noalias() = mt.transpose() * Jp;
+  d.Jc.row(r).noalias() += tn.transpose() * Jwb;
+  d.Jc.row(r).noalias() += tP.transpose() * Jwa;
+  Vec3T<S> wa = angular_velocity<S>(d, c.body_a), wb = angular_velocity<S>(d, c.body_b);
+  Vec3T<S> aa = angular_acceleration<S>(d, c.body_a), ab = angular_acceleration<S>(d, c.body_b);
+  coh(wa);
+  coh(wb);
+  coh(aa);
+  coh(ab);
+  Vec3T<S> Pad = -dpd - Rnd;
+  coh(Pad);
+  Vec3T<S> w = Rn.cross(wb);
+  coh(w);
+  Vec3T<S> wP = Pa.cross(wa);
+  coh(wP);
+  w = w + wP - dpd;
+  coh(w);
+  Vec3T<S> wd1 = Rnd.cross(wb), wd2 = Rn.cross(ab), wd3 = Pad.cross(wa), wd4 = Pa.cross(aa);
+  coh(wd1);
+  coh(wd2);
+  coh(wd3);
+  coh(wd4);
+  Vec3T<S> wd = wd1 + wd2;
+  coh(wd);
+  wd = wd + wd3;
+  coh(wd);
+  wd = wd + wd4;
+  coh(wd);
+  wd = wd - dpdd;
+  coh(wd);
+  const S s1 = dot3<S>(t.xd, w, nd), s2 = dot3<S>(t.x, wd, nd);
+  d.gamma[r] = s1 + s2;
 }
 
 template <class S>
@@ -169,50 +227,70 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool with_vel
         Vec3T<S> Rn = n.x * R, Rnd = n.xd * R;
         coh(Rn);
         coh(Rnd);
-        Vec3T<S> Pa = -dpc - Rn;  // P - p_a
-        coh(Pa);
         for (const Eigen::Vector3d* perp : {&c.perp_a1, &c.perp_a2}) {
           d.phi[r] = ad_coherent(S(0), nd);
-          if (with_velocity) {
-            const Attached<S> t = attached<S>(d, c.body_a, *perp, nd);
-            Vec3T<S> tn = t.x.cross(Rn), tP = t.x.cross(Pa), mt = -t.x;
-            coh(tn);
-            coh(tP);
-            coh(mt);
-            d.Jc.row(r).noalias() = mt.transpose() * Jp;
-            d.Jc.row(r).noalias() += tn.transpose() * Jwb;
-            d.Jc.row(r).noalias() += tP.transpose() * Jwa;
-            // d/dt at qdd = 0: t' . w + t . w', with P' - p_a' = -dp' - R n'
-            Vec3T<S> wa = angular_velocity<S>(d, c.body_a), wb = angular_velocity<S>(d, c.body_b);
-            Vec3T<S> aa = angular_acceleration<S>(d, c.body_a), ab = angular_acceleration<S>(d, c.body_b);
-            coh(wa);
-            coh(wb);
-            coh(aa);
-            coh(ab);
-            Vec3T<S> Pad = -dpd - Rnd;
-            coh(Pad);
-            Vec3T<S> w = Rn.cross(wb);
-            coh(w);
-            Vec3T<S> wP = Pa.cross(wa);
-            coh(wP);
-            w = w + wP - dpd;
-            coh(w);
-            Vec3T<S> wd1 = Rnd.cross(wb), wd2 = Rn.cross(ab), wd3 = Pad.cross(wa), wd4 = Pa.cross(aa);
-            coh(wd1);
-            coh(wd2);
-            coh(wd3);
-            coh(wd4);
-            Vec3T<S> wd = wd1 + wd2;
-            coh(wd);
-            wd = wd + wd3;
-            coh(wd);
-            wd = wd + wd4;
-            coh(wd);
-            wd = wd - dpdd;
-            coh(wd);
-            const S s1 = dot3<S>(t.xd, w, nd), s2 = dot3<S>(t.x, wd, nd);
-            d.gamma[r] = s1 + s2;
-          }
+          if (with_velocity)
+            contact_row<S>(model, d, c, r, attached<S>(d, c.body_a, *perp, nd), Rn, Rnd, dpc, dpd, dpdd, nd);
+          ++r;
+        }
+        break;
+      }
+      case ConstraintType::RollingDisc: {
+        // the plane's normal n (body_a), the axle a (body_b); k = n . a, s = |n - k a| = sqrt(1 - k^2),
+        // the contact direction d = (n - k a) / s (in the disc's plane, towards the plane's side:
+        // n . d = s > 0), the contact point P = c - R d. Height: n . (c - p_a) - R s (on q); its
+        // rate is n . (v_b(P) - v_a(P)) (the normal velocity at the contact), so that all three
+        // rows are e . (v_b(P) - v_a(P)) for e = n, t1, t2: the ball's slip rows with R n -> R d.
+        const S R = ad_coherent(S(c.radius), nd);
+        const Attached<S> n = attached<S>(d, c.body_a, c.axis_a, nd), a = attached<S>(d, c.body_b, c.axis_b, nd);
+        const S k = dot3<S>(n.x, a.x, nd);
+        const S kk = ad_coherent(S(k * k), nd);
+        const S one = ad_coherent(S(1), nd);
+        const S s2 = one - kk;
+        if (!(ad_value(s2) >= kDiscFlat * kDiscFlat))
+          throw std::domain_error("rolling_disc " + c.name + ": the disc lies flat on the plane (|n - (n.a) a| = " +
+                                  std::to_string(std::sqrt(std::max(0.0, ad_value(s2)))) +
+                                  "): its contact point is undefined there");
+        using std::sqrt;
+        const S sv = sqrt(s2);
+        Vec3T<S> ka = a.x * k;
+        coh(ka);
+        Vec3T<S> dir = n.x - ka;  // n - k a, then / s
+        coh(dir);
+        dir = dir / sv;
+        coh(dir);
+        const S h = dot3<S>(n.x, dpc, nd);
+        const S Rs = ad_coherent(S(R * sv), nd);
+        d.phi[r] = -h - Rs;  // n . (c - p_a) - R s
+        if (!with_velocity) {
+          d.phi[r + 1] = ad_coherent(S(0), nd);
+          d.phi[r + 2] = ad_coherent(S(0), nd);
+          break;
+        }
+        // k' = n' . a + n . a', u' = n' - k' a - k a', d' = (u' - d (d . u')) / s
+        const S k1 = dot3<S>(n.xd, a.x, nd), k2 = dot3<S>(n.x, a.xd, nd);
+        const S kd = k1 + k2;
+        Vec3T<S> kda = a.x * kd, kad = a.xd * k;
+        coh(kda);
+        coh(kad);
+        Vec3T<S> ud = n.xd - kda;
+        coh(ud);
+        ud = ud - kad;
+        coh(ud);
+        const S du = dot3<S>(dir, ud, nd);
+        Vec3T<S> ddu = dir * du;
+        coh(ddu);
+        Vec3T<S> dird = ud - ddu;
+        coh(dird);
+        dird = dird / sv;
+        coh(dird);
+        Vec3T<S> Rd = dir * R, Rdd = dird * R;
+        coh(Rd);
+        coh(Rdd);
+        contact_row<S>(model, d, c, r++, n, Rd, Rdd, dpc, dpd, dpdd, nd);
+        for (const Eigen::Vector3d* perp : {&c.perp_a1, &c.perp_a2}) {
+          d.phi[r] = ad_coherent(S(0), nd);
+          contact_row<S>(model, d, c, r, attached<S>(d, c.body_a, *perp, nd), Rd, Rdd, dpc, dpd, dpdd, nd);
           ++r;
         }
         break;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include "dynamics/kinematics.hpp"
 #include "dynamics/sensors.hpp"
@@ -136,6 +137,9 @@ void add_armature_force(const Model& m, const Eigen::VectorXd& a, Eigen::VectorX
 }
 
 using Grad36 = Eigen::Matrix<double, 36, 1>;
+// a rolling_disc lying flat on its plane: |n - (n . a) a| below this has no contact direction (as
+// in constraints.cpp)
+constexpr double kDiscFlat = 1e-6;
 // g += D^T f on the 18 variables of `slot`
 void add_grad(Grad36& g, int slot, const Vec3& f, const Eigen::Matrix<double, 3, 18>& D) {
   g.segment<18>(18 * slot).noalias() += D.transpose() * f;
@@ -857,6 +861,62 @@ void TreeDerivatives::constraint_derivatives(const Eigen::VectorXd& lambda, cons
     dw = -dw;
     add_body_wrench(bb, w, dw, ba, bb);
   };
+  // a contact row of rolling: g = e . u, e a vector of body_a, u = v_b(P) - v_a(P) =
+  // (V_b - V_a).tail + Om x P (spatial velocities at the world origin, Om = w_b - w_a) at the contact
+  // point P, whose gradients over both bodies' [pose, V, A] are DP (pose only) and DPd (of P');
+  // c = dg/dt = e' . u + e . u', u' = (A_b - A_a).tail + La x P + Om x P' (La = al_b - al_a); the
+  // reaction -lambda Jc_r^T: on b the wrench -lambda [P x e; e], on a its opposite
+  using Grad3 = Eigen::Matrix<double, 3, 36>;
+  auto contact_row = [&](int r, const LocalKin& e, const Vec3& P, const Vec3& Pd, const Grad3& DP, const Grad3& DPd,
+                         const Vec3& u, const Vec3& ud, const Vec3& Om, const Vec3& La, int ba, int bb) {
+    const Vec3 eO = e.x.cross(Om), Pe = P.cross(e.x);
+    gp.setZero();
+    add_grad(gp, 0, u, e.Dx);
+    gp.noalias() += DP.transpose() * eO;  // e . (Om x P) = P . (e x Om)
+    gp.segment<3>(18 + 6) += Pe;           // Om . (P x e) and e . v_b
+    gp.segment<3>(18 + 9) += e.x;
+    gp.segment<3>(6) -= Pe;
+    gp.segment<3>(9) -= e.x;
+    // e' . u
+    gc.setZero();
+    add_grad(gc, 0, u, e.Dxd);
+    const Vec3 edO = e.xd.cross(Om), Ped = P.cross(e.xd);
+    gc.noalias() += DP.transpose() * edO;
+    gc.segment<3>(18 + 6) += Ped;
+    gc.segment<3>(18 + 9) += e.xd;
+    gc.segment<3>(6) -= Ped;
+    gc.segment<3>(9) -= e.xd;
+    // e . u': through e, the accelerations, La x P, Om x P'
+    add_grad(gc, 0, ud, e.Dx);
+    gc.segment<3>(18 + 12) += Pe;
+    gc.segment<3>(18 + 15) += e.x;
+    gc.segment<3>(12) -= Pe;
+    gc.segment<3>(15) -= e.x;
+    const Vec3 eL = e.x.cross(La), Pde = Pd.cross(e.x);
+    gc.noalias() += DP.transpose() * eL;
+    gc.segment<3>(18 + 6) += Pde;
+    gc.segment<3>(6) -= Pde;
+    gc.noalias() += DPd.transpose() * eO;
+    row_out(r, e.xd.dot(u) + e.x.dot(ud), ba, bb);
+    const double l = lambda[r];
+    const Eigen::Matrix<double, 3, 6> de = e.Dx.leftCols<6>();
+    const Mat3 ex = skew<double>(e.x), Px = skew<double>(P);
+    dw.setZero();
+    w << -l * Pe, -l * e.x;
+    // d(P x e) = -[e]x dP + [P]x de
+    dw.block<3, 6>(0, 0).noalias() = l * (ex * DP.leftCols<6>() - Px * de);
+    dw.block<3, 6>(0, 12).noalias() = l * ex * DP.middleCols<6>(18);
+    dw.block<3, 6>(3, 0) = -l * de;
+    add_body_wrench(bb, w, dw, ba, bb);
+    w = -w;
+    dw = -dw;
+    add_body_wrench(ba, w, dw, ba, bb);
+  };
+  auto lift = [](int slot, const Eigen::Matrix<double, 3, 18>& D) {
+    Grad3 G = Grad3::Zero();
+    G.middleCols<18>(18 * slot) = D;
+    return G;
+  };
   for (const ConstraintModel& cm : m_.constraints) {
     if (cm.type == ConstraintType::Coupler) {
       // sum_k ratio_k q_k = offset: Jc is the ratios, c = Jc a, and the reaction -Jc^T lambda acts on
@@ -1007,6 +1067,50 @@ void TreeDerivatives::constraint_derivatives(const Eigen::VectorXd& lambda, cons
           add_body_wrench(ba, w, dw, ba, bb);
           ++r;
         }
+        break;
+      }
+      case ConstraintType::RollingDisc: {
+        // n on body_a, the axle a on body_b: k = n . a, m = n - k a, s = |m|, d = m / s, P = c - R d.
+        // Chain rule over both bodies' [pose, V, A] (Dx the gradient of x):
+        //   Dk = a^T Dn + n^T Da,  Dm = Dn - a Dk - k Da,  Dd = (I - d d^T) Dm / s
+        //   k' = n' . a + n . a',  m' = n' - k' a - k a',  s' = d . m',  d' = (m' - d s') / s
+        //   Dk' = a^T Dn' + n'^T Da + a'^T Dn + n^T Da',  Dm' = Dn' - a Dk' - k' Da - a' Dk - k Da'
+        //   Ds = d^T Dm,  Ds' = m'^T Dd + d^T Dm',  Dd' = (Dm' - Dd s' - d Ds' - d' Ds) / s
+        // and then the three rows e . (v_b(P) - v_a(P)), e = n (the height's rate), t1, t2
+        const double R = cm.radius;
+        const LocalKin n = kin(ba, cm.axis_a, true), ax = kin(bb, cm.axis_b, true);
+        const double k = n.x.dot(ax.x);
+        const Vec3 mv = n.x - k * ax.x;
+        const double s = mv.norm();
+        if (!(s >= kDiscFlat))
+          throw std::domain_error("rolling_disc " + cm.name + ": the disc lies flat on the plane (|n - (n.a) a| = " +
+                                  std::to_string(s) + "): its contact point is undefined there");
+        const Vec3 dv = mv / s;
+        const Grad3 Dn = lift(0, n.Dx), Dnd = lift(0, n.Dxd), Da = lift(1, ax.Dx), Dad = lift(1, ax.Dxd);
+        const Eigen::Matrix<double, 1, 36> Dk = ax.x.transpose() * Dn + n.x.transpose() * Da;
+        const Grad3 Dm = Dn - ax.x * Dk - k * Da;
+        const Mat3 proj = Mat3::Identity() - dv * dv.transpose();
+        const Grad3 Dd = proj * Dm / s;
+        const double kd = n.xd.dot(ax.x) + n.x.dot(ax.xd);
+        const Vec3 md = n.xd - kd * ax.x - k * ax.xd;
+        const double sd = dv.dot(md);
+        const Vec3 dvd = (md - sd * dv) / s;
+        const Eigen::Matrix<double, 1, 36> Dkd =
+            ax.x.transpose() * Dnd + n.xd.transpose() * Da + ax.xd.transpose() * Dn + n.x.transpose() * Dad;
+        const Grad3 Dmd = Dnd - ax.x * Dkd - kd * Da - ax.xd * Dk - k * Dad;
+        const Eigen::Matrix<double, 1, 36> Ds = dv.transpose() * Dm;
+        const Eigen::Matrix<double, 1, 36> Dsd = md.transpose() * Dd + dv.transpose() * Dmd;
+        const Grad3 Ddd = (Dmd - sd * Dd - dv * Dsd - dvd * Ds) / s;
+        const Vec3 P = xb.x - R * dv, Pd = xb.xd - R * dvd;
+        const Grad3 DP = lift(1, xb.Dx) - R * Dd, DPd = lift(1, xb.Dxd) - R * Ddd;
+        const Vec6 Va = ba > 0 ? V_[ba] : Vec6::Zero(), Vb = bb > 0 ? V_[bb] : Vec6::Zero();
+        const Vec6 Aa = ba > 0 ? Vec6(A_[ba] - A0) : Vec6::Zero(), Ab = bb > 0 ? Vec6(A_[bb] - A0) : Vec6::Zero();
+        const Vec3 Om = Vb.head<3>() - Va.head<3>(), La = Ab.head<3>() - Aa.head<3>();
+        const Vec3 u = Vb.tail<3>() - Va.tail<3>() + Om.cross(P);
+        const Vec3 ud = Ab.tail<3>() - Aa.tail<3>() + La.cross(P) + Om.cross(Pd);
+        contact_row(r++, n, P, Pd, DP, DPd, u, ud, Om, La, ba, bb);
+        for (const Eigen::Vector3d* perp : {&cm.perp_a1, &cm.perp_a2})
+          contact_row(r++, kin(ba, *perp, true), P, Pd, DP, DPd, u, ud, Om, La, ba, bb);
         break;
       }
       case ConstraintType::Coupler: break;  // above

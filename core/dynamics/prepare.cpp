@@ -57,6 +57,7 @@ class Preparer {
   void assemble_loops() {
     if (m_.nc == 0) return;
     const Eigen::VectorXd q = m_.q0, v = m_.v0;
+    check_discs_upright(q, "the joints' q0");
     const AssemblyResult r = assemble(m_, q, v);
     if (r.position_residual > 1e-9) {
       // motions that over-drive a loop cannot close it anywhere: say that first
@@ -78,6 +79,7 @@ class Preparer {
                (held.empty() ? "" : " with " + held + " held where the motion puts it") +
                " (check the constraint points and the joints' q0)");
     }
+    check_discs_upright(r.q, "the assembled q0");
     m_.q0 = r.q;
     m_.v0 = r.v;
     m_.assembly_residual = std::max(r.position_residual, r.velocity_residual);
@@ -104,6 +106,27 @@ class Preparer {
     m_.redundant_rows = rows.redundant;
     if (!m_.velocity_rows.empty()) velocity_row_partition(d.Jc, static_cast<int>(rows.independent.size()));
     check_driven_loops(d.Jc, static_cast<int>(rows.independent.size()));
+  }
+
+  // a rolling_disc lying flat on its plane (its axle along the normal) has no contact point: its
+  // rows are singular there (constraints.cpp refuses |n - (n.a) a| < 1e-6 when evaluated); say so
+  // at q0 with the constraint's path rather than fail inside the assembly
+  void check_discs_upright(const Eigen::VectorXd& q, const char* where) const {
+    bool any = false;
+    for (const ConstraintModel& c : m_.constraints) any = any || c.type == ConstraintType::RollingDisc;
+    if (!any) return;
+    Data d(m_);
+    forward_kinematics<double>(m_, d, q);
+    for (std::size_t k = 0; k < m_.constraints.size(); ++k) {
+      const ConstraintModel& c = m_.constraints[k];
+      if (c.type != ConstraintType::RollingDisc) continue;
+      const Eigen::Vector3d n = d.oMi[c.body_a].R * c.axis_a, a = d.oMi[c.body_b].R * c.axis_b;
+      const double s = (n - n.dot(a) * a).norm();
+      if (!(s >= 1e-3))
+        fail(at("constraints", k), std::string("the disc lies flat on the plane at ") + where +
+                                       " (its axle axis_b is along the plane's normal axis_a: |n - (n.a) a| = " +
+                                       fmt(s) + " < 1e-3, where its contact point is undefined; stand it up)");
+    }
   }
 
   // With non-holonomic rows the active rows are the independent holonomic ones (which fix the

@@ -399,9 +399,9 @@ class Exporter {
         ++ncoupler_;
         continue;
       }
-      if (c.type == ConstraintType::RollingBall) {
-        refuse("rolling_ball " + c.name + ": MuJoCo models rolling by contact and friction, not as an exact "
-               "no-slip condition");
+      if (c.type == ConstraintType::RollingBall || c.type == ConstraintType::RollingDisc) {
+        refuse(std::string(to_string(c.type)) + " " + c.name +
+               ": MuJoCo models rolling by contact and friction, not as an exact no-slip condition");
         continue;
       }
       if (c.type != ConstraintType::Ball) {

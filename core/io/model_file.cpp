@@ -780,6 +780,7 @@ const Schema<ConstraintSpec>& schema<ConstraintSpec>() {
           case ConstraintType::Coupler:
             return element_keys({"joint_a", "ratio_a", "joint_b", "ratio_b", "joint_c", "ratio_c", "offset"});
           case ConstraintType::RollingBall: return element_keys(point_pair_and({"axis_a", "radius"}));
+          case ConstraintType::RollingDisc: return element_keys(point_pair_and({"axis_a", "axis_b", "radius"}));
         }
         return element_keys({});
       }};

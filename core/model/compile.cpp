@@ -360,10 +360,11 @@ class Compiler {
       c.perp_b2 = axis_b.cross(c.perp_b1);
       c.row = row;
       std::vector<std::string> rows;
-      if (c.type == ConstraintType::RollingBall) {
+      if (c.type == ConstraintType::RollingBall || c.type == ConstraintType::RollingDisc) {
         if (!std::isfinite(cs.radius) || cs.radius <= 0)
           fail(p + "/radius", "expected a positive radius (m), got " + fmt(cs.radius));
         c.radius = cs.radius;
+        c.axis_b = axis_b;  // rolling_disc: the axle
         // height on q; no slip along the plane's two directions, on v only
         rows = {"height", "slip_u", "slip_v"};
         m_.velocity_rows.push_back(row + 1);

@@ -44,8 +44,10 @@ struct ConstraintModel {
   double offset = 0;
   bool offset_given = false;
   // rolling_ball: the ball's radius (point_b is its centre, axis_a the plane's normal, perp_a1 and
-  // perp_a2 the plane's directions of no slip); its first row is on q, the other two on v only
+  // perp_a2 the plane's directions of no slip); its first row is on q, the other two on v only.
+  // rolling_disc: the same, with the disc's axle axis_b (unit, body_b)
   double radius = 0;
+  Eigen::Vector3d axis_b = Eigen::Vector3d::UnitZ();
 };
 
 struct SpringDamperModel {

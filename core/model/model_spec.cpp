@@ -29,12 +29,13 @@ constexpr std::array<std::pair<JointType, const char*>, 8> kJoints{{
     {JointType::Planar, "planar"},
     {JointType::Free, "free"},
 }};
-constexpr std::array<std::pair<ConstraintType, const char*>, 5> kConstraints{{
+constexpr std::array<std::pair<ConstraintType, const char*>, 6> kConstraints{{
     {ConstraintType::Ball, "ball"},
     {ConstraintType::Revolute, "revolute"},
     {ConstraintType::PlanarRevolute, "planar_revolute"},
     {ConstraintType::Coupler, "coupler"},
     {ConstraintType::RollingBall, "rolling_ball"},
+    {ConstraintType::RollingDisc, "rolling_disc"},
 }};
 constexpr std::array<std::pair<EffectType, const char*>, 7> kEffects{{
     {EffectType::Gravity, "gravity"},

@@ -85,7 +85,12 @@ struct JointSpec {
 //                    plane through point_a normal to axis_a (on body_a, the ball on the side axis_a
 //                    points to): the centre's height (1 equation on q) and no slip at the contact
 //                    (2 on the velocities only: non-holonomic)
-enum class ConstraintType { Ball, Revolute, PlanarRevolute, Coupler, RollingBall };
+//   rolling_disc     a disc (wheel, coin) of `radius` centred at point_b on body_b, its axle axis_b
+//                    (on body_b), rolls without slipping on the same plane: the centre's height
+//                    n . (c - p_a) = radius sqrt(1 - (n . a)^2) (on q) and no slip at the contact
+//                    P = c - radius d, d the unit part of n normal to the axle (2 on v only);
+//                    singular where the disc lies flat on the plane (n . a = +-1)
+enum class ConstraintType { Ball, Revolute, PlanarRevolute, Coupler, RollingBall, RollingDisc };
 
 struct ConstraintSpec {
   std::string name;
@@ -102,7 +107,7 @@ struct ConstraintSpec {
   std::string joint_a, joint_b, joint_c;
   double ratio_a = 1, ratio_b = -1, ratio_c = 0;
   std::optional<double> offset;
-  double radius = 0;  // rolling_ball, m
+  double radius = 0;  // rolling_ball, rolling_disc, m
 };
 
 // Force elements. Only those listed in a model are ever evaluated.

@@ -203,7 +203,8 @@ void expect_plant_agrees(const Model& m, const OperatingPoint& op, const std::st
   const CoordinatePartition part = partition_coordinates(m, op.q);
   const PlantFunction f(m, op.q, op.u, part);
   Eigen::VectorXd x = Eigen::VectorXd::Zero(f.nx());
-  for (int k = 0; k < f.nz(); ++k) x[f.nz() + k] = op.v[part.independent[k]];
+  // the state's rates (as many as the coordinates, fewer with rolling's no-slip rows)
+  for (int k = 0; k < f.nw(); ++k) x[f.nz() + k] = op.v[f.rates()[static_cast<std::size_t>(k)]];
   Eigen::VectorXd u(f.nu());
   for (int k = 0; k < f.nu(); ++k) u[k] = op.u[m.plant_inputs[k]];
   Eigen::MatrixXd J;

@@ -813,7 +813,7 @@ TEST(ModelFileErrors, UnknownTypeInEveryList) {
       {"/bodies/0/shapes/0/type"_json_pointer, "unknown shape type \"bogus\" (expected one of: box, cylinder, sphere)"},
       {"/joints/0/type"_json_pointer, "unknown joint type \"bogus\""},
       {"/constraints/0/type"_json_pointer,
-       "unknown constraint type \"bogus\" (expected one of: ball, revolute, planar_revolute, coupler, rolling_ball)"},
+       "unknown constraint type \"bogus\" (expected one of: ball, revolute, planar_revolute, coupler, rolling_ball, rolling_disc)"},
       {"/effects/0/type"_json_pointer, "unknown effect type \"bogus\" (expected one of: gravity, spring_damper,"},
       {"/actuators/0/type"_json_pointer, "unknown actuator type \"bogus\" (expected one of: joint_force, body_force, body_torque, line_force, mix, motion)"},
       {"/sensors/0/type"_json_pointer, "unknown sensor type \"bogus\" (expected one of: joint_position,"},
