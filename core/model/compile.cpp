@@ -68,6 +68,21 @@ class Compiler {
     return std::move(m_);
   }
 
+  // compile_body_numbers
+  Model renumber(const Model& structure) {
+    const std::size_t nb = static_cast<std::size_t>(std::count_if(structure.body_spec_index.begin(),
+                                                                   structure.body_spec_index.end(),
+                                                                   [](int bs) { return bs >= 0; }));
+    if (spec_.bodies.size() != nb)
+      throw std::invalid_argument("compile_body_numbers: the spec has " + std::to_string(spec_.bodies.size()) +
+                                  " bodies, the structure " + std::to_string(nb));
+    m_ = structure;
+    m_.spec = spec_;
+    check_bodies();
+    for (int b = 1; b < m_.nbodies; ++b) set_body_numbers(b, spec_.bodies[static_cast<std::size_t>(m_.body_spec_index[b])]);
+    return std::move(m_);
+  }
+
  private:
   [[noreturn]] void fail(const std::string& path, const std::string& what) const { throw ModelError(file_, path, what); }
 
@@ -172,6 +187,14 @@ class Compiler {
   static Eigen::Vector3d unit(const Eigen::Vector3d& a, const std::string& path, const Compiler& c) {
     if (!a.allFinite() || a.norm() < 1e-12) c.fail(path, "expected a non-zero direction");
     return a.normalized();
+  }
+
+  // the numbers of model body b (compile_body_numbers sets them again)
+  void set_body_numbers(int b, const BodySpec& s) {
+    const auto i = static_cast<std::size_t>(b);
+    m_.mass[i] = s.mass;
+    m_.com[i] = s.com;
+    m_.inertia[i] = spatial_inertia(s.mass, s.com, s.inertia);
   }
 
   void build_tree() {
@@ -287,9 +310,10 @@ class Compiler {
       m_.body_names.push_back(b.name);
       m_.parent.push_back(j.parent);
       m_.joints.push_back(j);
-      m_.mass.push_back(b.mass);
-      m_.com.push_back(b.com);
-      m_.inertia.push_back(spatial_inertia(b.mass, b.com, b.inertia));
+      m_.mass.emplace_back();
+      m_.com.emplace_back();
+      m_.inertia.emplace_back();
+      set_body_numbers(index, b);
       m_.body_spec_index.push_back(bs);
     }
     m_.nq = iq;
@@ -776,5 +800,9 @@ class Compiler {
 }  // namespace
 
 Model compile_structure(const ModelSpec& spec, const std::string& file) { return Compiler(spec, file).run(); }
+
+Model compile_body_numbers(const Model& structure, const ModelSpec& spec, const std::string& file) {
+  return Compiler(spec, file).renumber(structure);
+}
 
 }  // namespace codyna

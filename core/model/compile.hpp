@@ -17,4 +17,11 @@ namespace codyna {
 
 Model compile_structure(const ModelSpec& spec, const std::string& file = "");
 
+// The model of `spec` from `structure`, compile_structure's model of a spec that differs from `spec`
+// only in the bodies' mass, com and inertia (a parameter study's variants): the bodies are checked
+// and their numbers set as compile_structure does, the rest is copied (its spec need not be kept:
+// the model gets `spec`). Member for member compile_structure(spec, file) (CompileTest.BodyNumbers*).
+// Throws std::invalid_argument if `spec` has another number of bodies.
+Model compile_body_numbers(const Model& structure, const ModelSpec& spec, const std::string& file = "");
+
 }  // namespace codyna

@@ -279,11 +279,14 @@ void trajectory_job(LinearizeJob& job, const LinearizeRequest& a) {
 
 }  // namespace
 
-LinearizeJob study_linearize_job(const LinearizeRequest& a, const ModelSpec& file_spec, const StudyMessages& tell) {
+namespace {
+LinearizeJob linearize_job(const LinearizeRequest& a, const ModelSpec& file_spec, const Model* structure,
+                           const StudyMessages& tell) {
   const Names opt{a.style};
   LinearizeJob job;
   const Teller say{tell, job.notes, job.warnings};
-  job.model = study_model(linearize_spec(a, file_spec), a.model);
+  job.model = structure ? study_model(linearize_spec(a, file_spec), a.model, *structure)
+                        : study_model(linearize_spec(a, file_spec), a.model);
   const Model& m = job.model;
   if (!m.assembly_moves.empty())
     say.note("closing the loops moved the joints' q0/v0: " + study_assembly_moves_text(m));
@@ -331,6 +334,20 @@ LinearizeJob study_linearize_job(const LinearizeRequest& a, const ModelSpec& fil
   job.written = {p.mat_file, p.m_file};
   if (job.closed_loop) job.closed_loop_written = study_export_closed_loop(m, *job.closed_loop, a.out);
   return job;
+}
+}  // namespace
+
+LinearizeJob study_linearize_job(const LinearizeRequest& a, const ModelSpec& spec, const StudyMessages& tell) {
+  return linearize_job(a, spec, nullptr, tell);
+}
+
+LinearizeJob study_linearize_job(const LinearizeRequest& a, const ModelSpec& spec, const Model& structure,
+                                 const StudyMessages& tell) {
+  return linearize_job(a, spec, &structure, tell);
+}
+
+Model study_linearize_structure(const LinearizeRequest& a, const ModelSpec& spec) {
+  return study_model_structure(linearize_spec(a, spec), a.model);
 }
 
 namespace {

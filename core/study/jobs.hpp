@@ -92,6 +92,12 @@ struct LinearizeJob {
 // controllability, the closed loop when asked, and (when r.out is given) the exports, each
 // checked before any work against replacing an input. `spec` is the model file as read.
 LinearizeJob study_linearize_job(const LinearizeRequest& r, const ModelSpec& spec, const StudyMessages& tell = {});
+// A parameter study's variant: `structure` is study_linearize_structure(r, nominal) of a nominal spec
+// that differs from `spec` only in the bodies' mass, com and inertia; the same job as above
+// (study_model's overload: the tree, names and indices are not made again)
+LinearizeJob study_linearize_job(const LinearizeRequest& r, const ModelSpec& spec, const Model& structure,
+                                 const StudyMessages& tell = {});
+Model study_linearize_structure(const LinearizeRequest& r, const ModelSpec& spec);
 
 struct SimulateRequest {
   OptionStyle style = OptionStyle::Flag;

@@ -19,6 +19,7 @@
 #include <limits>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
@@ -237,6 +238,9 @@ struct Context {
   std::vector<nlohmann::json::json_pointer> pointers;
   std::vector<ElementEdit> edits;
   bool whole_file = false;  // a varied field outside the element arrays: each variant's file is read whole
+  // the nominal model's tree, names and indices when the varied fields are bodies' mass, com and
+  // inertia alone (study_linearize_structure): a variant sets its bodies' numbers in a copy
+  const Model* structure = nullptr;
   LinearizeRequest linearize;
   int nx = 0, nu = 0, ny = 0;
   std::vector<std::string> state_names;
@@ -357,6 +361,21 @@ ModelSpec variant_spec(const Context& c, const SweepVariant& v) {
   return spec;
 }
 
+// whether every varied field is a body's mass, com or inertia (or a component of them): numbers
+// that leave the compiled model's tree, names and indices as they are (compile_body_numbers)
+bool body_numbers_only(const std::vector<SweepVary>& vary) {
+  for (const SweepVary& v : vary) {
+    const std::string& f = v.field;
+    if (f.rfind("/bodies/", 0) != 0) return false;
+    const std::size_t a = 8, b = f.find('/', a);
+    if (b == a || b == std::string::npos || !std::all_of(f.begin() + a, f.begin() + b, ::isdigit)) return false;
+    const std::size_t e = f.find('/', b + 1);
+    const std::string name = f.substr(b + 1, e == std::string::npos ? std::string::npos : e - b - 1);
+    if (name != "mass" && name != "com" && name != "inertia") return false;
+  }
+  return !vary.empty();
+}
+
 // which element each varied field belongs to (Context::edits), or whole_file
 void plan_edits(Context& c, const std::vector<SweepVary>& vary) {
   static const char* const sections[] = {"bodies", "joints", "constraints", "effects", "actuators", "sensors"};
@@ -388,7 +407,8 @@ void run_variant(const Context& c, long long i, SweepVariant& v) {
     const auto simulate_after = [&] {
       if (c.simulate) simulate_variant(c, variant_file(c, v), v);
     };
-    const LinearizeJob lj = study_linearize_job(c.linearize, spec);
+    const LinearizeJob lj =
+        c.structure ? study_linearize_job(c.linearize, spec, *c.structure) : study_linearize_job(c.linearize, spec);
     const LinearSystem& sys = lj.linearization.lin.system;  // continuous
     if (sys.nx() != c.nx || sys.nu() != c.nu || sys.ny() != c.ny) {
       v.status = SweepStatus::SizeDiffers;
@@ -861,6 +881,11 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
   c.linearize.modes = false;  // a variant records its poles and uncontrollable modes only
   const LinearizeJob nominal = study_linearize_job(c.linearize, nominal_spec);
   const Model& m = nominal.model;
+  std::optional<Model> structure;
+  if (!c.whole_file && body_numbers_only(job.plan.vary)) {
+    structure = study_linearize_structure(c.linearize, nominal_spec);
+    c.structure = &*structure;
+  }
   const StudySpec& s = m.spec.analysis;
   if (s.discrete != 0)
     throw std::invalid_argument(r.model + ": /analysis/discrete: a sweep linearizes in continuous time only (not built yet: "

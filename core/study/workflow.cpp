@@ -23,6 +23,7 @@
 #include "io/output_guard.hpp"
 #include "io/signal_file.hpp"
 #include "dynamics/prepare.hpp"
+#include "model/compile.hpp"
 #include "model/errors.hpp"
 #include "simulation/model_controller.hpp"
 
@@ -508,7 +509,9 @@ StudyInitialState set_coordinates(const Model& m, Eigen::VectorXd q, Eigen::Vect
 
 }  // namespace
 
-Model study_model(const ModelSpec& spec_in, const std::string& file) {
+namespace {
+// the spec study_model compiles: the controller file's study adopted, disabled effects left out
+ModelSpec study_compiled_spec(const ModelSpec& spec_in, const std::string& file) {
   ModelSpec spec = spec_in;
   adopt_controller_study(spec, file);
   const StudySpec& s = spec.analysis;
@@ -524,7 +527,11 @@ Model study_model(const ModelSpec& spec_in, const std::string& file) {
     }
     spec.effects.erase(it);
   }
-  Model m = compile(spec, file);
+  return spec;
+}
+
+// what study_model adds to the compiled model
+Model study_finish_model(Model m, const StudySpec& s) {
   m.spec.analysis = s;  // compile keeps the spec; the study travels with it
   if (!s.set.empty()) {
     // the held coordinates move the model's own state: the operating-point search starts there
@@ -533,6 +540,25 @@ Model study_model(const ModelSpec& spec_in, const std::string& file) {
     m.v0 = held.v;
   }
   if (!s.initial.empty()) study_initial_state(m);  // its names and values are checked before any work
+  return m;
+}
+}  // namespace
+
+Model study_model(const ModelSpec& spec_in, const std::string& file) {
+  const ModelSpec spec = study_compiled_spec(spec_in, file);
+  return study_finish_model(compile(spec, file), spec.analysis);
+}
+
+Model study_model(const ModelSpec& spec_in, const std::string& file, const Model& structure) {
+  const ModelSpec spec = study_compiled_spec(spec_in, file);
+  Model m = compile_body_numbers(structure, spec, file);
+  prepare_model(m);  // compile() is compile_structure then prepare_model
+  return study_finish_model(std::move(m), spec.analysis);
+}
+
+Model study_model_structure(const ModelSpec& spec_in, const std::string& file) {
+  Model m = compile_structure(study_compiled_spec(spec_in, file), file);
+  m.spec = ModelSpec{};
   return m;
 }
 

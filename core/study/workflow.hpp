@@ -38,6 +38,13 @@ namespace codyna {
 // see adopt_controller_study, which study_model applies first.
 Model study_model(const ModelSpec& spec, const std::string& file = "");
 
+// The same from `structure`, study_model_structure of a spec that differs from `spec` only in the
+// bodies' mass, com and inertia (a parameter study's variants reuse the nominal model's tree, names
+// and indices: model/compile.hpp's compile_body_numbers); the same model as study_model(spec, file).
+Model study_model(const ModelSpec& spec, const std::string& file, const Model& structure);
+// compile_structure of the spec as study_model compiles it, for the overload above (without its spec)
+Model study_model_structure(const ModelSpec& spec, const std::string& file = "");
+
 // When the study's controller is a .mat that holds codyna_study (what NAME.m's export
 // puts in the workspace; save it with K), that study's operating point, coordinates set,
 // independent coordinates and disabled effects replace the spec's, and a note says so

@@ -2,7 +2,14 @@
 // checking that the error names the file, the field path and what was expected.
 #include "dynamics/prepare.hpp"
 
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <random>
+
+#include "dynamics/data.hpp"
+#include "dynamics/forward_dynamics.hpp"
 #include "io/model_file.hpp"
+#include "model/compile.hpp"
 #include "test_util.hpp"
 
 namespace codyna {
@@ -60,6 +67,65 @@ TEST(Compile, AllExamplesCompile) {
                            "andrews_squeezer.json", "bricard.json", "heavy_top.json"}) {
     EXPECT_NO_THROW(test::load_example(name)) << name;
   }
+}
+
+// compile_body_numbers (a parameter study's variants) against compiling the variant from scratch:
+// every example, every body's mass, com and inertia changed, the same model bit for bit (numbers,
+// names, indices, spec, the assembled state, the forward dynamics), and the same error for a bad mass
+TEST(Compile, BodyNumbersOnTheStructureEqualCompilingAgain) {
+  std::mt19937 rng(7);
+  int examples = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(CODYNA_EXAMPLES_DIR)) {
+    if (entry.path().extension() != ".json") continue;
+    const std::string file = entry.path().string();
+    const ModelSpec nominal = load_model_spec(file);
+    Model structure = compile_structure(nominal, file);
+    structure.spec = ModelSpec{};
+    ModelSpec variant = nominal;
+    for (BodySpec& b : variant.bodies) {
+      b.mass *= 1.25;
+      b.com += Eigen::Vector3d(0.01, -0.02, 0.005);
+      b.inertia *= 1.1;
+    }
+    const Model a = compile(variant, file);
+    Model b = compile_body_numbers(structure, variant, file);
+    prepare_model(b);
+    SCOPED_TRACE(file);
+    EXPECT_EQ(a.mass, b.mass);
+    EXPECT_EQ(a.com, b.com);
+    EXPECT_EQ(a.inertia, b.inertia);
+    EXPECT_EQ(a.body_names, b.body_names);
+    EXPECT_EQ(a.v_names, b.v_names);
+    EXPECT_EQ(a.q0, b.q0);
+    EXPECT_EQ(a.v0, b.v0);
+    EXPECT_EQ(to_json(a.spec), to_json(b.spec));
+    Data da(a), db(b);
+    const Eigen::VectorXd u = Eigen::VectorXd::Random(a.nu());
+    const Eigen::VectorXd v = test::random_v(a, rng);
+    EXPECT_EQ(forward_dynamics<double>(a, da, a.q0, v, u), forward_dynamics<double>(b, db, b.q0, v, u));
+    // a bad mass: the error compile gives
+    variant.bodies.back().mass = -1;
+    std::string from_scratch, renumbered;
+    try {
+      compile(variant, file);
+    } catch (const ModelError& e) {
+      from_scratch = e.what();
+    }
+    try {
+      compile_body_numbers(structure, variant, file);
+    } catch (const ModelError& e) {
+      renumbered = e.what();
+    }
+    EXPECT_FALSE(from_scratch.empty());
+    EXPECT_EQ(from_scratch, renumbered);
+    ++examples;
+  }
+  EXPECT_GE(examples, 15);
+  // another number of bodies is not a variant of the structure
+  const Model structure = compile_structure(two_links());
+  ModelSpec one = two_links();
+  one.bodies.pop_back();
+  EXPECT_THROW(compile_body_numbers(structure, one), std::invalid_argument);
 }
 
 TEST(CompileErrors, NegativeMass) {
