@@ -33,7 +33,7 @@ const QStringList kBodyRefs{"parent", "child", "body", "body_a", "body_b", "fram
 QStringList type_names(ElementKind k) {
   switch (k) {
     case ElementKind::Joint: return {"revolute", "prismatic", "fixed", "spherical", "universal", "cylindrical", "planar", "free"};
-    case ElementKind::Constraint: return {"ball", "revolute", "planar_revolute", "coupler", "rolling_ball"};
+    case ElementKind::Constraint: return {"ball", "revolute", "planar_revolute", "coupler", "rolling_ball", "rolling_disc"};
     case ElementKind::Effect:
       return {"gravity", "spring_damper", "joint_spring_damper", "joint_friction", "joint_damper", "body_force", "bushing"};
     case ElementKind::Actuator: return {"joint_force", "body_force", "body_torque", "line_force", "mix", "motion"};
@@ -205,6 +205,21 @@ QString PropertyEditor::fieldHelp(ElementKind kind, const QString& key, const QS
         {"point_b", "Centre of the ball, on the second body, in its frame"},
     };
     if (key == QLatin1String("radius")) return QStringLiteral("Radius of the rolling ball (m, > 0)");
+    const auto r = rolling.find(key);
+    if (r != rolling.end()) return unit.isEmpty() ? r->second : QStringLiteral("%1 [%2]").arg(r->second, unit);
+  }
+  // a rolling disc's: a plane on body_a, a disc (a wheel, a coin) on body_b about its axle axis_b
+  if (kind == ElementKind::Constraint && type == QLatin1String("rolling_disc")) {
+    static const std::map<QString, QString> rolling{
+        {"body_a", "The body that carries the plane the disc rolls on"},
+        {"point_a", "A point of the plane, on the first body, in its frame"},
+        {"axis_a", "Normal of the plane, on the first body, in its frame (the disc is on the side it points to)"},
+        {"body_b", "The disc's body"},
+        {"point_b", "Centre of the disc, on the second body, in its frame"},
+        {"axis_b", "The disc's axle, on the second body, in its frame (not along the plane's normal: the disc "
+                   "would lie flat)"},
+    };
+    if (key == QLatin1String("radius")) return QStringLiteral("Radius of the rolling disc (m, > 0)");
     const auto r = rolling.find(key);
     if (r != rolling.end()) return unit.isEmpty() ? r->second : QStringLiteral("%1 [%2]").arg(r->second, unit);
   }
@@ -399,7 +414,7 @@ bool PropertyEditor::applyText(const QString& field, const QString& text, QStrin
             element[key] = names;
           } else if (key == "weights") {
             element[key] = json::array({1.0});
-          } else if (key == "radius") {  // a rolling ball: 5 cm
+          } else if (key == "radius") {  // a rolling ball or disc: 5 cm
             element[key] = 0.05;
           } else {
             break;
@@ -414,6 +429,22 @@ bool PropertyEditor::applyText(const QString& field, const QString& text, QStrin
         json& parent = j[json::json_pointer(p).parent_pointer()];
         if (!parent.is_object() || !parent.contains(last)) break;
         parent.erase(last);
+      }
+    }
+    // a rolling disc's axle (axis_b, z when not given, as is the plane's normal axis_a) must not be
+    // along the normal, where the disc lies flat: then a direction normal to it
+    json& element = j[json::json_pointer(ss(base))];
+    if (value == json("rolling_disc") && element.is_object()) {
+      auto vec = [&](const char* key) {
+        const json& a = element.contains(key) ? element[key] : json::array({0.0, 0.0, 1.0});
+        return a.is_array() && a.size() == 3 && a[0].is_number() && a[1].is_number() && a[2].is_number()
+                   ? Eigen::Vector3d(a[0].get<double>(), a[1].get<double>(), a[2].get<double>())
+                   : Eigen::Vector3d::Zero();
+      };
+      const Eigen::Vector3d n = vec("axis_a"), a = vec("axis_b");
+      if (n.norm() > 0 && a.normalized().cross(n.normalized()).norm() < 1e-3) {
+        const Eigen::Vector3d u = n.unitOrthogonal();
+        element["axis_b"] = json::array({u.x(), u.y(), u.z()});
       }
     }
   }

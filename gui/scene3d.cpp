@@ -365,7 +365,8 @@ void Scene::build(const Model* model) {
     if (m.parent[i] == 0) anchor(m.joints[i].X_PF.p, m.joints[i].X_PF.R, anchorSize(i, m.joints[i].X_CM.p));
   for (const ConstraintModel& c : m.constraints) {
     if (c.type == ConstraintType::Coupler) continue;  // couples coordinates, at no point
-    if (c.type == ConstraintType::RollingBall) continue;  // point_a is a point of a plane: drawn as its contact
+    if (c.type == ConstraintType::RollingBall || c.type == ConstraintType::RollingDisc)
+      continue;  // point_a is a point of a plane: drawn as its contact
     if (c.body_a == 0) anchor(c.point_a, Eigen::Matrix3d::Identity(), anchorSize(c.body_b, c.point_b));
     if (c.body_b == 0) anchor(c.point_b, Eigen::Matrix3d::Identity(), anchorSize(c.body_a, c.point_a));
   }
@@ -455,11 +456,12 @@ void Scene::addDefaultLook(int i) {
   std::vector<Eigen::Vector3d> ends;  // link ends other than the inboard joint
   for (int c = i + 1; c < m.nbodies; ++c)
     if (m.parent[c] == i) ends.push_back(m.joints[c].X_PF.p);
-  // a rolling ball on this body (point_b its centre): the ball itself, not a pin at its centre
+  // a rolling ball or disc on this body (point_b its centre): the ball or the disc itself, not a pin
+  // at its centre
   std::vector<const ConstraintModel*> rolling;
   for (const ConstraintModel& c : m.constraints) {
     if (c.type == ConstraintType::Coupler) continue;
-    if (c.type == ConstraintType::RollingBall) {
+    if (c.type == ConstraintType::RollingBall || c.type == ConstraintType::RollingDisc) {
       if (c.body_b == i) rolling.push_back(&c);
       continue;  // point_a is a point of the plane, not a link's end
     }
@@ -510,8 +512,15 @@ void Scene::addDefaultLook(int i) {
     knob.linear() *= 1.6 * r_link;
     add(Prim::Sphere, knob, pin);
   }
-  for (const ConstraintModel* c : rolling)
-    add(Prim::Sphere, Eigen::Translation3d(c->point_b) * Eigen::Scaling(c->radius), color);
+  for (const ConstraintModel* c : rolling) {
+    if (c->type == ConstraintType::RollingDisc) {  // a thin cylinder about the axle
+      Eigen::Affine3d T = Eigen::Affine3d::Identity();
+      T.translation() = c->point_b;
+      T.linear() = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), c->axis_b).toRotationMatrix() *
+                   Eigen::Vector3d(c->radius, c->radius, 0.1 * c->radius).asDiagonal();
+      add(Prim::Cylinder, T, color);
+    } else add(Prim::Sphere, Eigen::Translation3d(c->point_b) * Eigen::Scaling(c->radius), color);
+  }
 }
 
 Eigen::Affine3d spanTransform(const Item& it, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
@@ -622,10 +631,11 @@ void Scene::addElements(const std::vector<SE3>& oMi) {
     }
   }
 
-  // rolling balls: a thin green disc of the plane (turned with body_a) at the contact, the ball's
-  // centre less its radius along the plane's normal, and a dark dot at the contact; placed by update()
+  // rolling balls and discs: a thin green disc of the plane (turned with body_a) at the contact, the
+  // centre less the radius along the plane's normal (a disc: along its contact direction), and a
+  // dark dot at the contact; placed by update()
   for (const ConstraintModel& c : m.constraints) {
-    if (c.type != ConstraintType::RollingBall) continue;
+    if (c.type != ConstraintType::RollingBall && c.type != ConstraintType::RollingDisc) continue;
     const double r = c.radius;
     const Eigen::Matrix3d Rn = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), c.axis_a).toRotationMatrix();
     const double patch = std::clamp(3.0 * r, 0.02 * L, 0.2 * L), h = std::min(0.004 * L, 0.2 * patch);
@@ -641,6 +651,7 @@ void Scene::addElements(const std::vector<SE3>& oMi) {
       it->point_b = c.point_b;
       it->normal = c.axis_a;
       it->depth = r;
+      if (c.type == ConstraintType::RollingDisc) it->axle = c.axis_b;
     }
   }
 
@@ -691,7 +702,12 @@ void Scene::update(const std::vector<SE3>& oMi) {
       const SE3& A = oMi[it.body];
       Eigen::Affine3d X = Eigen::Affine3d::Identity();
       X.linear() = A.R;
-      X.translation() = oMi[it.body_b].act_point(it.point_b) - it.depth * (A.R * it.normal);
+      Eigen::Vector3d d = A.R * it.normal;
+      if (!it.axle.isZero()) {  // a disc: the normal's part normal to its axle (lying flat: the normal)
+        const Eigen::Vector3d a = oMi[it.body_b].R * it.axle, m = d - d.dot(a) * a;
+        if (m.norm() > 1e-9) d = m.normalized();
+      }
+      X.translation() = oMi[it.body_b].act_point(it.point_b) - it.depth * d;
       it.world = X * it.local;
       continue;
     }

@@ -64,7 +64,9 @@ enum class Span {
   Dash,    // the fractions [span_a, span_b] of the line
   // not a line: the contact of a ball (centre point_b on body_b) with a plane of `body` whose
   // normal is `normal` (body frame): world = translation to the contact (the centre less `depth`
-  // along the normal as turned now) * the body's rotation * local (local's z: the normal)
+  // along the normal as turned now) * the body's rotation * local (local's z: the normal); for a
+  // disc (`axle` not zero) the centre less `depth` along the contact direction d, the unit part of
+  // the normal n normal to the axle a as turned now: d = (n - (n.a) a) / |n - (n.a) a|
   Contact,
 };
 
@@ -82,7 +84,8 @@ struct Item {
   double thickness = 0.0;     // radius of the cylinder drawn along the line
   double span_a = 0.0, span_b = 0.0;
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // Span::Contact: the plane's normal, `body` frame (unit)
-  double depth = 0.0;                                 // Span::Contact: the ball's radius
+  double depth = 0.0;                                 // Span::Contact: the ball's or disc's radius
+  Eigen::Vector3d axle = Eigen::Vector3d::Zero();     // Span::Contact of a disc: its axle, body_b frame
   // an arrow whose direction stays in world axes (an actuator with "frame": "world"): world =
   // translation to the pose of `body` * local's origin, then local's linear part unturned
   bool world_axes = false;

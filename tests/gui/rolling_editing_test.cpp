@@ -11,7 +11,12 @@
 //   - the 3-D scene of ball_plate: the contact patch (a thin disc normal to the plate) and its dot
 //     at the ball's centre less R along the plate's normal: (0.1, 0.05, -0.015) level, and for the
 //     plate turned by Rx(a) Ry(b) with the ball on it at R (x, y, 0), the contact R (x, y, -0.015)
-//     (closed form), both to 1e-12; no line or pin between point_a and point_b.
+//     (closed form), both to 1e-12; no line or pin between point_a and point_b;
+//   - rolling_disc (a wheel): picked from the type list of a new constraint it gets radius 0.05 and
+//     an axle normal to the plane's normal z (the default z would lay it flat): it compiles with
+//     the disc's centre assembled to z = 0.05; the body is drawn as a disc about its axle; the
+//     contact of examples/rolling_disc.json leant by phi about x is at c - R d = (0, R sin(phi), 0)
+//     (d = (0, -sin(phi), cos(phi)), closed form, 1e-12); back to rolling_ball, axis_b goes.
 #include <QComboBox>
 #include <QDir>
 #include <QLineEdit>
@@ -217,6 +222,67 @@ class RollingEditingTest : public QObject {
     QVERIFY2(w->document()->model(), qPrintable(w->document()->errorText()));
     QVERIFY(!props()->editorFor("radius"));
     QCOMPARE(w->document()->model()->dof(), 3);
+  }
+
+  void newRollingDiscFromItsTypeList() {
+    QVERIFY(w->newModel());
+    add("body");
+    type("name", "wheel");
+    add("joint");
+    type("name", "float");
+    choose("type", "free");
+    add("constraint");
+    choose("type", "rolling_disc");
+    QVERIFY2(w->document()->model(), qPrintable(w->document()->errorText()));
+    QCOMPARE(combo("type")->currentText(), QString("rolling_disc"));
+    QCOMPARE(combo("body_b")->currentText(), QString("wheel"));
+    QCOMPARE(text("radius"), QString("0.05"));
+    QVERIFY2(props()->editorFor("axis_b")->toolTip().startsWith("The disc's axle"),
+             qPrintable(props()->editorFor("axis_b")->toolTip()));
+    {
+      const auto m = w->document()->model();
+      QCOMPARE(m->constraints.at(0).type, ConstraintType::RollingDisc);
+      QCOMPARE(m->constraints.at(0).axis_b.dot(Eigen::Vector3d::UnitZ()), 0.0);
+      QCOMPARE(m->dof(), 5);
+      QCOMPARE(m->rate_dof(), 3);
+      EXPECT_NEAR3(ballCentre(*m, "float"), Eigen::Vector3d(0, 0, 0.05));  // upright on z = 0
+      Scene scene;
+      scene.build(m.get());
+      int discs = 0;  // the body drawn as the disc: radius 0.05 about the axle, at the centre
+      for (const Item& it : scene.items())
+        if (it.kind == ItemKind::Shape && it.prim == Prim::Cylinder && it.local.translation().norm() < 1e-15 &&
+            (it.local.linear().col(2).normalized() - m->constraints.at(0).axis_b).norm() < 1e-12 &&
+            std::abs(it.local.linear().col(0).norm() - 0.05) < 1e-15)
+          ++discs;
+      QCOMPARE(discs, 1);
+      const auto contact = itemsOf(scene, ItemKind::Contact, m->constraints.at(0).name);
+      QCOMPARE(contact.size(), std::size_t(2));
+      EXPECT_NEAR3(Eigen::Vector3d(contact[0].world.translation()), Eigen::Vector3d::Zero());
+    }
+    choose("type", "rolling_ball");
+    QVERIFY2(w->document()->model(), qPrintable(w->document()->errorText()));
+    QVERIFY(!props()->editorFor("axis_b"));
+  }
+
+  void contactOfALeaningDisc() {
+    const std::string path = QDir(CODYNA_EXAMPLES_DIR).filePath("rolling_disc.json").toStdString();
+    const auto m = std::make_shared<const Model>(compile(load_model_spec(path), path));
+    Scene scene;
+    scene.build(m.get());
+    const int iw = m->joints[static_cast<std::size_t>(m->find_joint("wheel"))].idx_q;
+    for (const double phi : {0.0, 0.4, -0.9}) {
+      Eigen::VectorXd q = m->q0;
+      const Eigen::Quaterniond r(Eigen::AngleAxisd(phi, Eigen::Vector3d::UnitX()));
+      q.segment<3>(iw) = Eigen::Vector3d(0, 0, 0.2 * std::cos(phi));
+      q.segment<4>(iw + 3) << r.w(), r.x(), r.y(), r.z();
+      Data d(*m);
+      forward_kinematics(*m, d, q);
+      scene.update(d.oMi);
+      const auto t = itemsOf(scene, ItemKind::Contact, "contact");
+      QCOMPARE(t.size(), std::size_t(2));
+      EXPECT_NEAR3(Eigen::Vector3d(t[0].world.translation()), Eigen::Vector3d(0, 0.2 * std::sin(phi), 0));
+      EXPECT_NEAR3(Eigen::Vector3d(t[1].world.translation()), Eigen::Vector3d(0, 0.2 * std::sin(phi), 0));
+    }
   }
 
   void contactPatchOnThePlate() {
