@@ -1003,70 +1003,17 @@ void TreeDerivatives::constraint_derivatives(const Eigen::VectorXd& lambda, cons
         // height: phi = n . (c - p_a) - R = -(n . (p_a - c)) - R: the planar_revolute row along n,
         // negated
         along_row(r++, n, xa, xb, -1.0, ba, bb);
-        // no slip along t: g = t . u, u = (V_b - V_a).tail + (w_b - w_a) x P, P = c - R n (spatial
-        // velocities at the world origin); c = dg/dt = t' . u + t . u', with
-        // u' = (A_b - A_a).tail + (al_b - al_a) x P + (w_b - w_a) x P',  P' = c' - R n'
+        // no slip along t: the contact rows with P = c - R n (the disc's with d = n: n turns with
+        // body_a alone)
         const Vec6 Va = ba > 0 ? V_[ba] : Vec6::Zero(), Vb = bb > 0 ? V_[bb] : Vec6::Zero();
         const Vec6 Aa = ba > 0 ? Vec6(A_[ba] - A0) : Vec6::Zero(), Ab = bb > 0 ? Vec6(A_[bb] - A0) : Vec6::Zero();
         const Vec3 Om = Vb.head<3>() - Va.head<3>(), La = Ab.head<3>() - Aa.head<3>();
         const Vec3 P = xb.x - R * n.x, Pd = xb.xd - R * n.xd;
+        const Grad3 DP = lift(1, xb.Dx) - R * lift(0, n.Dx), DPd = lift(1, xb.Dxd) - R * lift(0, n.Dxd);
         const Vec3 u = Vb.tail<3>() - Va.tail<3>() + Om.cross(P);
         const Vec3 ud = Ab.tail<3>() - Aa.tail<3>() + La.cross(P) + Om.cross(Pd);
-        for (const Eigen::Vector3d* perp : {&cm.perp_a1, &cm.perp_a2}) {
-          const LocalKin t = kin(ba, *perp, true);
-          // g's gradient: through t, through P (n on a, c on b), and the velocities
-          gp.setZero();
-          add_grad(gp, 0, u, t.Dx);
-          const Vec3 tO = t.x.cross(Om);
-          add_grad(gp, 0, -R * tO, n.Dx);
-          add_grad(gp, 1, tO, xb.Dx);
-          const Vec3 Pt = P.cross(t.x);
-          gp.segment<3>(18 + 6) += Pt;
-          gp.segment<3>(18 + 9) += t.x;
-          gp.segment<3>(6) -= Pt;
-          gp.segment<3>(9) -= t.x;
-          // c's gradient: t' . u (t' on a; u as above with t' for t), then t . u'
-          gc.setZero();
-          add_grad(gc, 0, u, t.Dxd);
-          const Vec3 tdO = t.xd.cross(Om), Ptd = P.cross(t.xd);
-          add_grad(gc, 0, -R * tdO, n.Dx);
-          add_grad(gc, 1, tdO, xb.Dx);
-          gc.segment<3>(18 + 6) += Ptd;
-          gc.segment<3>(18 + 9) += t.xd;
-          gc.segment<3>(6) -= Ptd;
-          gc.segment<3>(9) -= t.xd;
-          add_grad(gc, 0, ud, t.Dx);
-          // t . (A_b - A_a).tail and t . ((al_b - al_a) x P) = (al_b - al_a) . (P x t)
-          gc.segment<3>(18 + 12) += Pt;
-          gc.segment<3>(18 + 15) += t.x;
-          gc.segment<3>(12) -= Pt;
-          gc.segment<3>(15) -= t.x;
-          const Vec3 tL = t.x.cross(La);
-          add_grad(gc, 0, -R * tL, n.Dx);
-          add_grad(gc, 1, tL, xb.Dx);
-          // t . (Om x P') = Om . (P' x t) = P' . (t x Om), P' = c' - R n'
-          const Vec3 Pdt = Pd.cross(t.x);
-          gc.segment<3>(18 + 6) += Pdt;
-          gc.segment<3>(6) -= Pdt;
-          add_grad(gc, 1, tO, xb.Dxd);
-          add_grad(gc, 0, -R * tO, n.Dxd);
-          row_out(r, t.xd.dot(u) + t.x.dot(ud), ba, bb);
-          // the reaction -lambda Jc_r^T: on b the wrench -lambda [P x t; t], on a its opposite
-          const double l = lambda[r];
-          const Eigen::Matrix<double, 3, 6> dt = t.Dx.leftCols<6>(), dn = n.Dx.leftCols<6>(), dc = xb.Dx.leftCols<6>();
-          const Mat3 tx = skew<double>(t.x), Px = skew<double>(P);
-          dw.setZero();
-          w << -l * Pt, -l * t.x;
-          // d(P x t) = -[t]x dP + [P]x dt, dP = dc - R dn
-          dw.block<3, 6>(0, 0).noalias() = -l * (R * tx * dn + Px * dt);
-          dw.block<3, 6>(0, 12).noalias() = l * tx * dc;
-          dw.block<3, 6>(3, 0) = -l * dt;
-          add_body_wrench(bb, w, dw, ba, bb);
-          w = -w;
-          dw = -dw;
-          add_body_wrench(ba, w, dw, ba, bb);
-          ++r;
-        }
+        for (const Eigen::Vector3d* perp : {&cm.perp_a1, &cm.perp_a2})
+          contact_row(r++, kin(ba, *perp, true), P, Pd, DP, DPd, u, ud, Om, La, ba, bb);
         break;
       }
       case ConstraintType::RollingDisc: {
