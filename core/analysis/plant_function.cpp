@@ -415,8 +415,10 @@ void PlantFunction::eval(const VecXT<S>& x, const VecXT<S>& u, VecXT<S>& xdot, V
     if (model_.motions.empty() && part_.rate_dependent.empty()) {
       if (part_.dependent.empty() && model_.nc == 0) eval_tree(x, u, xdot, y);
       else eval_closed(x, u, xdot, y);
-      return;
+    } else {
+      eval_driven(x, u, xdot, y);
     }
+    return;
   }
   const Model& m = model_;
   const int n = nz(), nw_ = nw(), nd = static_cast<int>(part_.dependent.size());
@@ -626,13 +628,18 @@ void PlantFunction::factor_dependent() const {
 }
 
 void PlantFunction::newton_dependent(const Eigen::Ref<const Eigen::VectorXd>& z) const {
-  const Model& m = model_;
-  const int nd = static_cast<int>(part_.dependent.size());
   loop_workspace();
   Workspace& W = ws_;
-  Data& d = *W.data;
   W.dq.setZero();
   for (int k = 0; k < nz(); ++k) W.dq[part_.independent[k]] = z[k];
+  newton_from_workspace();
+}
+
+void PlantFunction::newton_from_workspace() const {
+  const Model& m = model_;
+  const int nd = static_cast<int>(part_.dependent.size());
+  Workspace& W = ws_;
+  Data& d = *W.data;
   integrate_into<double>(m, q_ref_, W.dq, W.q);
   if (nd == 0) return;
   for (int it = 0;; ++it) {
@@ -678,6 +685,78 @@ void PlantFunction::eval_closed(const Eigen::VectorXd& x, const Eigen::VectorXd&
     xdot[n + k] = qdd[ind[k]];
   }
   // forward_dynamics left the kinematics of (q, v) in d
+  if (y.size() != ny()) y.resize(ny());
+  for (int k = 0; k < ny(); ++k) y[k] = sensor_value<double>(m, d, m.sensors[m.plant_outputs[k]], W.q, W.v);
+}
+
+void PlantFunction::eval_driven(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd& xdot,
+                                Eigen::VectorXd& y) const {
+  const Model& m = model_;
+  const int n = nz(), nw_ = nw(), nu_p = nu(), nmi = nm();
+  if (u.size() != nu_p && !(nmi > 0 && u.size() == nu_p + 2 * nmi))
+    throw std::invalid_argument("plant function: expected " + std::to_string(nu_p) + " or " +
+                                std::to_string(nu_p + 2 * nmi) + " inputs");
+  loop_workspace();
+  Workspace& W = ws_;
+  Data& d = *W.data;
+  W.dq.setZero();
+  W.v.setZero();
+  for (int k = 0; k < n; ++k) W.dq[part_.independent[static_cast<std::size_t>(k)]] = x[k];
+  for (int k = 0; k < nw_; ++k) W.v[rates_[static_cast<std::size_t>(k)]] = x[n + k];
+  // motion inputs: their coordinates at u (a Plant/In's value, or the nominal), u', u''
+  for (std::size_t i = 0; i < m.motions.size(); ++i) {
+    const int k = m.motions[i];
+    const ActuatorModel& a = m.actuators[static_cast<std::size_t>(k)];
+    double value = u_all_[k], rate = 0.0, acc = 0.0;
+    for (int j = 0; j < nmi; ++j) {
+      const int pos = motion_inputs_[static_cast<std::size_t>(j)];
+      if (m.plant_inputs[static_cast<std::size_t>(pos)] != k) continue;
+      value = u[pos];
+      if (u.size() > nu_p) {
+        rate = u[nu_p + j];
+        acc = u[nu_p + nmi + j];
+      }
+    }
+    W.dq[a.iv] = value - q_ref_[a.iq];
+    W.v[a.iv] = rate;
+    d.motion_acc[static_cast<Eigen::Index>(i)] = acc;
+  }
+  // the dependent positions, with the motions' coordinates where they are
+  newton_from_workspace();
+  const int nvd = static_cast<int>(vdep_.size());
+  if (nvd > 0) {
+    // the dependent velocities from Jc v = 0 on the velocity rows (the holonomic ones, then rolling's
+    // no-slip rows for the rates they fix): Jd v_dep = -(Jc over the rates) w - (Jc over the motions) u'
+    constraint_terms<double>(m, d, W.q, W.zero);
+    if (W.ev_J.rows() != nvd) {
+      W.ev_J.resize(nvd, nvd);
+      W.ev_r.resize(nvd);
+      W.ev_s.resize(nvd);
+    }
+    for (int r = 0; r < nvd; ++r) {
+      const int row = vrows_[static_cast<std::size_t>(r)];
+      for (int c = 0; c < nvd; ++c) W.ev_J(r, c) = d.Jc(row, vdep_[static_cast<std::size_t>(c)]);
+      double s = 0.0;
+      for (int c = 0; c < nw_; ++c) s += d.Jc(row, rates_[static_cast<std::size_t>(c)]) * x[n + c];
+      for (int k : m.motions) {
+        const int i = m.actuators[static_cast<std::size_t>(k)].iv;
+        s += d.Jc(row, i) * W.v[i];
+      }
+      W.ev_r[r] = -s;
+    }
+    W.ev_lu.compute(W.ev_J);
+    W.ev_s.noalias() = W.ev_lu.solve(W.ev_r);
+    for (int k = 0; k < nvd; ++k) W.v[vdep_[static_cast<std::size_t>(k)]] = W.ev_s[k];
+  }
+  W.u_all = u_all_;
+  for (int k = 0; k < nu_p; ++k) W.u_all[m.plant_inputs[static_cast<std::size_t>(k)]] = u[k];
+  const Eigen::VectorXd& qdd = forward_dynamics<double>(m, d, W.q, W.v, W.u_all);
+  tangent_rate_into<double>(m, W.dq, W.v, W.rate);
+  if (xdot.size() != n + nw_) xdot.resize(n + nw_);
+  for (int k = 0; k < n; ++k) xdot[k] = W.rate[part_.independent[static_cast<std::size_t>(k)]];
+  for (int k = 0; k < nw_; ++k) xdot[n + k] = qdd[rates_[static_cast<std::size_t>(k)]];
+  // the sensors as eval<ADScalar> reads them: the kinematics of (q, v) again
+  forward_kinematics<double>(m, d, W.q, W.v);
   if (y.size() != ny()) y.resize(ny());
   for (int k = 0; k < ny(); ++k) y[k] = sensor_value<double>(m, d, m.sensors[m.plant_outputs[k]], W.q, W.v);
 }

@@ -151,6 +151,15 @@ class PlantFunction {
   // Newton on phi(q) = 0 (the plant's rows) for the dependent coordinates at independent
   // deviations z, from the reference: leaves dq, q and the constraint terms at q in the workspace
   void newton_dependent(const Eigen::Ref<const Eigen::VectorXd>& z) const;
+  // the same from the deviations already in the workspace's dq (the independent coordinates' and
+  // the motion inputs' coordinates set, the dependent ones 0)
+  void newton_from_workspace() const;
+  // eval<double> with motion inputs or rolling's no-slip rows, into the workspace (no heap after the
+  // first call): the motions' coordinates, rates and accelerations, Newton for the dependent
+  // positions with the motions' coordinates in place, the velocities from all the velocity rows
+  // (holonomic and no-slip) with the motions' rates, the dynamics, the sensors
+  void eval_driven(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd& xdot,
+                   Eigen::VectorXd& y) const;
   void factor_dependent() const;  // Jd from the workspace's constraint terms, into its LU
 
   struct Workspace {
@@ -165,6 +174,10 @@ class PlantFunction {
     // the velocity rows' dependent columns Jvd (factored in luv), their products
     Eigen::MatrixXd Gv, Jvd, Jzv, Pv, Jav, Ph, Phx, DQv;
     Eigen::PartialPivLU<Eigen::MatrixXd> luv;
+    // eval_driven: the velocity rows' dependent columns, right-hand side and solution, and their LU
+    Eigen::MatrixXd ev_J;
+    Eigen::VectorXd ev_r, ev_s;
+    Eigen::PartialPivLU<Eigen::MatrixXd> ev_lu;
     Workspace();
     Workspace(const Workspace&);
     Workspace& operator=(const Workspace&);  // the copy makes its own

@@ -121,7 +121,7 @@ TEST(NoAllocation, ForwardDynamicsAndPlantOnEveryTreeExample) {
     if (entry.path().extension() != ".json") continue;
     const std::string name = entry.path().filename().string();
     const Model m = load(name);
-    if (m.nc != 0 || !m.motions.empty()) continue;  // motion inputs: not yet allocation-free
+    if (m.nc != 0) continue;
     ++trees;
     EXPECT_EQ(forward_dynamics_allocations(m), 0) << name << ": forward_dynamics";
     EXPECT_EQ(plant_eval_allocations(m), 0) << name << ": PlantFunction::eval<double>";
@@ -139,7 +139,7 @@ TEST(NoAllocation, ForwardDynamicsAndPlantOnEveryClosedLoopExample) {
     if (entry.path().extension() != ".json") continue;
     const std::string name = entry.path().filename().string();
     const Model m = load(name);
-    if (m.nc == 0 || !m.motions.empty()) continue;  // motion inputs: not yet allocation-free
+    if (m.nc == 0) continue;
     ++loops;
     Data d(m);
     const Eigen::VectorXd u = m.u_nominal();
@@ -153,10 +153,9 @@ TEST(NoAllocation, ForwardDynamicsAndPlantOnEveryClosedLoopExample) {
       n = c.n();
     }
     EXPECT_EQ(n, 0) << name << ": forward_dynamics";
-    // one plant evaluation: Newton for the dependent positions, Jc v = 0, the dynamics, the sensors
-    // (with rolling's no-slip rows, examples/rolling_disc.json, eval<double> takes the generic path
-    // with the rates' velocity map, which allocates: not yet allocation-free)
-    if (m.velocity_rows.empty()) EXPECT_EQ(plant_eval_allocations(m), 0) << name << ": PlantFunction::eval<double>";
+    // one plant evaluation: Newton for the dependent positions (with the motions' coordinates in
+    // place), Jc v = 0 on the velocity rows (rolling's no-slip rows too), the dynamics, the sensors
+    EXPECT_EQ(plant_eval_allocations(m), 0) << name << ": PlantFunction::eval<double>";
   }
   EXPECT_GE(loops, 3);
 }
