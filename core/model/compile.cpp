@@ -68,18 +68,32 @@ class Compiler {
     return std::move(m_);
   }
 
-  // compile_body_numbers
-  Model renumber(const Model& structure) {
+  // compile_numbers
+  Model renumber(const Model& structure, NumbersChanged what) {
     const std::size_t nb = static_cast<std::size_t>(std::count_if(structure.body_spec_index.begin(),
                                                                    structure.body_spec_index.end(),
                                                                    [](int bs) { return bs >= 0; }));
     if (spec_.bodies.size() != nb)
-      throw std::invalid_argument("compile_body_numbers: the spec has " + std::to_string(spec_.bodies.size()) +
+      throw std::invalid_argument("compile_numbers: the spec has " + std::to_string(spec_.bodies.size()) +
                                   " bodies, the structure " + std::to_string(nb));
     m_ = structure;
     m_.spec = spec_;
-    check_bodies();
-    for (int b = 1; b < m_.nbodies; ++b) set_body_numbers(b, spec_.bodies[static_cast<std::size_t>(m_.body_spec_index[b])]);
+    if (what.bodies) {
+      check_bodies();
+      for (int b = 1; b < m_.nbodies; ++b) set_body_numbers(b, spec_.bodies[static_cast<std::size_t>(m_.body_spec_index[b])]);
+    }
+    if (what.effects) {
+      const Model blank;
+      m_.has_gravity = blank.has_gravity;
+      m_.gravity = blank.gravity;
+      m_.springs.clear();
+      m_.joint_springs.clear();
+      m_.joint_frictions.clear();
+      m_.body_forces.clear();
+      m_.bushings.clear();
+      for (int b = 0; b < m_.nbodies; ++b) compiled_[m_.body_names[static_cast<std::size_t>(b)]] = b;
+      build_effects();
+    }
     return std::move(m_);
   }
 
@@ -189,7 +203,7 @@ class Compiler {
     return a.normalized();
   }
 
-  // the numbers of model body b (compile_body_numbers sets them again)
+  // the numbers of model body b (compile_numbers sets them again)
   void set_body_numbers(int b, const BodySpec& s) {
     const auto i = static_cast<std::size_t>(b);
     m_.mass[i] = s.mass;
@@ -801,8 +815,8 @@ class Compiler {
 
 Model compile_structure(const ModelSpec& spec, const std::string& file) { return Compiler(spec, file).run(); }
 
-Model compile_body_numbers(const Model& structure, const ModelSpec& spec, const std::string& file) {
-  return Compiler(spec, file).renumber(structure);
+Model compile_numbers(const Model& structure, const ModelSpec& spec, NumbersChanged what, const std::string& file) {
+  return Compiler(spec, file).renumber(structure, what);
 }
 
 }  // namespace codyna

@@ -17,11 +17,19 @@ namespace codyna {
 
 Model compile_structure(const ModelSpec& spec, const std::string& file = "");
 
+// What a parameter study's variant changes in a compiled model without changing its tree, names or
+// indices: the bodies' mass, com and inertia; the effects (gravity, springs and dampers, bushings,
+// forces: any of their fields, since nothing else refers to them).
+struct NumbersChanged {
+  bool bodies = false;
+  bool effects = false;
+};
+
 // The model of `spec` from `structure`, compile_structure's model of a spec that differs from `spec`
-// only in the bodies' mass, com and inertia (a parameter study's variants): the bodies are checked
-// and their numbers set as compile_structure does, the rest is copied (its spec need not be kept:
-// the model gets `spec`). Member for member compile_structure(spec, file) (CompileTest.BodyNumbers*).
-// Throws std::invalid_argument if `spec` has another number of bodies.
-Model compile_body_numbers(const Model& structure, const ModelSpec& spec, const std::string& file = "");
+// only in what `what` names: those are checked and made again as compile_structure does (the same
+// code), the rest is copied (the structure's spec need not be kept: the model gets `spec`). Member
+// for member compile_structure(spec, file), with its errors (Compile.*NumbersOnTheStructure*). Throws
+// std::invalid_argument if `spec` has another number of bodies.
+Model compile_numbers(const Model& structure, const ModelSpec& spec, NumbersChanged what, const std::string& file = "");
 
 }  // namespace codyna

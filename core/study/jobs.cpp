@@ -281,11 +281,11 @@ void trajectory_job(LinearizeJob& job, const LinearizeRequest& a) {
 
 namespace {
 LinearizeJob linearize_job(const LinearizeRequest& a, const ModelSpec& file_spec, const Model* structure,
-                           const StudyMessages& tell) {
+                           NumbersChanged what, const StudyMessages& tell) {
   const Names opt{a.style};
   LinearizeJob job;
   const Teller say{tell, job.notes, job.warnings};
-  job.model = structure ? study_model(linearize_spec(a, file_spec), a.model, *structure)
+  job.model = structure ? study_model(linearize_spec(a, file_spec), a.model, *structure, what)
                         : study_model(linearize_spec(a, file_spec), a.model);
   const Model& m = job.model;
   if (!m.assembly_moves.empty())
@@ -338,12 +338,12 @@ LinearizeJob linearize_job(const LinearizeRequest& a, const ModelSpec& file_spec
 }  // namespace
 
 LinearizeJob study_linearize_job(const LinearizeRequest& a, const ModelSpec& spec, const StudyMessages& tell) {
-  return linearize_job(a, spec, nullptr, tell);
+  return linearize_job(a, spec, nullptr, {}, tell);
 }
 
 LinearizeJob study_linearize_job(const LinearizeRequest& a, const ModelSpec& spec, const Model& structure,
-                                 const StudyMessages& tell) {
-  return linearize_job(a, spec, &structure, tell);
+                                 NumbersChanged what, const StudyMessages& tell) {
+  return linearize_job(a, spec, &structure, what, tell);
 }
 
 Model study_linearize_structure(const LinearizeRequest& a, const ModelSpec& spec) {

@@ -93,10 +93,10 @@ struct LinearizeJob {
 // checked before any work against replacing an input. `spec` is the model file as read.
 LinearizeJob study_linearize_job(const LinearizeRequest& r, const ModelSpec& spec, const StudyMessages& tell = {});
 // A parameter study's variant: `structure` is study_linearize_structure(r, nominal) of a nominal spec
-// that differs from `spec` only in the bodies' mass, com and inertia; the same job as above
+// that differs from `spec` only in what `what` names (compile_numbers); the same job as above
 // (study_model's overload: the tree, names and indices are not made again)
 LinearizeJob study_linearize_job(const LinearizeRequest& r, const ModelSpec& spec, const Model& structure,
-                                 const StudyMessages& tell = {});
+                                 NumbersChanged what, const StudyMessages& tell = {});
 Model study_linearize_structure(const LinearizeRequest& r, const ModelSpec& spec);
 
 struct SimulateRequest {

@@ -238,9 +238,10 @@ struct Context {
   std::vector<nlohmann::json::json_pointer> pointers;
   std::vector<ElementEdit> edits;
   bool whole_file = false;  // a varied field outside the element arrays: each variant's file is read whole
-  // the nominal model's tree, names and indices when the varied fields are bodies' mass, com and
-  // inertia alone (study_linearize_structure): a variant sets its bodies' numbers in a copy
+  // the nominal model's tree, names and indices when the varied fields leave them as they are
+  // (numbers_changed, study_linearize_structure): a variant makes what it changes in a copy
   const Model* structure = nullptr;
+  NumbersChanged changed;
   LinearizeRequest linearize;
   int nx = 0, nu = 0, ny = 0;
   std::vector<std::string> state_names;
@@ -361,19 +362,28 @@ ModelSpec variant_spec(const Context& c, const SweepVariant& v) {
   return spec;
 }
 
-// whether every varied field is a body's mass, com or inertia (or a component of them): numbers
-// that leave the compiled model's tree, names and indices as they are (compile_body_numbers)
-bool body_numbers_only(const std::vector<SweepVary>& vary) {
+// what the varied fields change of the compiled model when they leave its tree, names and indices
+// as they are (compile_numbers): a body's mass, com or inertia (or a component of them), any field of
+// an effect; nothing otherwise
+std::optional<NumbersChanged> numbers_changed(const std::vector<SweepVary>& vary) {
+  NumbersChanged what;
   for (const SweepVary& v : vary) {
     const std::string& f = v.field;
-    if (f.rfind("/bodies/", 0) != 0) return false;
-    const std::size_t a = 8, b = f.find('/', a);
-    if (b == a || b == std::string::npos || !std::all_of(f.begin() + a, f.begin() + b, ::isdigit)) return false;
+    const std::size_t a = f.find('/', 1), b = a == std::string::npos ? a : f.find('/', a + 1);
+    if (b == std::string::npos || b == a + 1 || !std::all_of(f.begin() + static_cast<long>(a) + 1, f.begin() + static_cast<long>(b), ::isdigit))
+      return std::nullopt;
+    const std::string section = f.substr(1, a - 1);
     const std::size_t e = f.find('/', b + 1);
     const std::string name = f.substr(b + 1, e == std::string::npos ? std::string::npos : e - b - 1);
-    if (name != "mass" && name != "com" && name != "inertia") return false;
+    if (section == "bodies" && (name == "mass" || name == "com" || name == "inertia"))
+      what.bodies = true;
+    else if (section == "effects")
+      what.effects = true;
+    else
+      return std::nullopt;
   }
-  return !vary.empty();
+  if (vary.empty()) return std::nullopt;
+  return what;
 }
 
 // which element each varied field belongs to (Context::edits), or whole_file
@@ -408,7 +418,7 @@ void run_variant(const Context& c, long long i, SweepVariant& v) {
       if (c.simulate) simulate_variant(c, variant_file(c, v), v);
     };
     const LinearizeJob lj =
-        c.structure ? study_linearize_job(c.linearize, spec, *c.structure) : study_linearize_job(c.linearize, spec);
+        c.structure ? study_linearize_job(c.linearize, spec, *c.structure, c.changed) : study_linearize_job(c.linearize, spec);
     const LinearSystem& sys = lj.linearization.lin.system;  // continuous
     if (sys.nx() != c.nx || sys.nu() != c.nu || sys.ny() != c.ny) {
       v.status = SweepStatus::SizeDiffers;
@@ -882,9 +892,10 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
   const LinearizeJob nominal = study_linearize_job(c.linearize, nominal_spec);
   const Model& m = nominal.model;
   std::optional<Model> structure;
-  if (!c.whole_file && body_numbers_only(job.plan.vary)) {
+  if (const std::optional<NumbersChanged> what = numbers_changed(job.plan.vary); what && !c.whole_file) {
     structure = study_linearize_structure(c.linearize, nominal_spec);
     c.structure = &*structure;
+    c.changed = *what;
   }
   const StudySpec& s = m.spec.analysis;
   if (s.discrete != 0)

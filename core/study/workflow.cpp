@@ -549,9 +549,9 @@ Model study_model(const ModelSpec& spec_in, const std::string& file) {
   return study_finish_model(compile(spec, file), spec.analysis);
 }
 
-Model study_model(const ModelSpec& spec_in, const std::string& file, const Model& structure) {
+Model study_model(const ModelSpec& spec_in, const std::string& file, const Model& structure, NumbersChanged what) {
   const ModelSpec spec = study_compiled_spec(spec_in, file);
-  Model m = compile_body_numbers(structure, spec, file);
+  Model m = compile_numbers(structure, spec, what, file);
   prepare_model(m);  // compile() is compile_structure then prepare_model
   return study_finish_model(std::move(m), spec.analysis);
 }

@@ -27,6 +27,7 @@
 #include "analysis/operating_point.hpp"
 #include "control/controllability.hpp"
 #include "io/mat_export.hpp"
+#include "model/compile.hpp"
 #include "model/model.hpp"
 #include "simulation/controller.hpp"
 #include "simulation/simulator.hpp"
@@ -38,10 +39,10 @@ namespace codyna {
 // see adopt_controller_study, which study_model applies first.
 Model study_model(const ModelSpec& spec, const std::string& file = "");
 
-// The same from `structure`, study_model_structure of a spec that differs from `spec` only in the
-// bodies' mass, com and inertia (a parameter study's variants reuse the nominal model's tree, names
-// and indices: model/compile.hpp's compile_body_numbers); the same model as study_model(spec, file).
-Model study_model(const ModelSpec& spec, const std::string& file, const Model& structure);
+// The same from `structure`, study_model_structure of a spec that differs from `spec` only in what
+// `what` names (a parameter study's variants reuse the nominal model's tree, names and indices:
+// model/compile.hpp's compile_numbers); the same model as study_model(spec, file).
+Model study_model(const ModelSpec& spec, const std::string& file, const Model& structure, NumbersChanged what);
 // compile_structure of the spec as study_model compiles it, for the overload above (without its spec)
 Model study_model_structure(const ModelSpec& spec, const std::string& file = "");
 
