@@ -101,6 +101,27 @@ MatXT<S> columns_t(const MatXT<S>& J, const std::vector<int>& cols) {
   return r;
 }
 
+// motion input i's coordinate value, rate and acceleration (Model::motions order): the Plant/In's
+// value in u and, when u carries them (nu_p + 2 nm inputs), its rate and acceleration; a motion
+// outside Plant/In stays at its nominal value, at rest
+template <class S>
+void motion_of(const Model& m, const std::vector<int>& motion_inputs, const Eigen::VectorXd& u_all, std::size_t i,
+               const VecXT<S>& u, S& value, S& rate, S& acc) {
+  const int k = m.motions[i], nu_p = static_cast<int>(m.plant_inputs.size()), nmi = static_cast<int>(motion_inputs.size());
+  value = S(u_all[k]);
+  rate = S(0.0);
+  acc = S(0.0);
+  for (int j = 0; j < nmi; ++j) {
+    const int pos = motion_inputs[static_cast<std::size_t>(j)];
+    if (m.plant_inputs[static_cast<std::size_t>(pos)] != k) continue;
+    value = u[pos];
+    if (u.size() > nu_p) {
+      rate = u[nu_p + j];
+      acc = u[nu_p + nmi + j];
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<int> CoordinatePartition::rates() const {
@@ -436,18 +457,9 @@ void PlantFunction::eval(const VecXT<S>& x, const VecXT<S>& u, VecXT<S>& xdot, V
       throw std::invalid_argument("plant function: expected " + std::to_string(nu_p) + " or " +
                                   std::to_string(nu_p + 2 * nmi) + " inputs");
     for (std::size_t i = 0; i < m.motions.size(); ++i) {
-      const int k = m.motions[i];
-      const ActuatorModel& a = m.actuators[static_cast<std::size_t>(k)];
-      S value = S(u_all_[k]), rate = S(0.0), acc = S(0.0);
-      for (int j = 0; j < nmi; ++j) {
-        const int pos = motion_inputs_[static_cast<std::size_t>(j)];
-        if (m.plant_inputs[static_cast<std::size_t>(pos)] != k) continue;
-        value = u[pos];
-        if (u.size() > nu_p) {
-          rate = u[nu_p + j];
-          acc = u[nu_p + nmi + j];
-        }
-      }
+      const ActuatorModel& a = m.actuators[static_cast<std::size_t>(m.motions[i])];
+      S value = S(0.0), rate = S(0.0), acc = S(0.0);
+      motion_of<S>(m, motion_inputs_, u_all_, i, u, value, rate, acc);
       dq[a.iv] = value - S(q_ref_[a.iq]);
       v[a.iv] = rate;
       d.motion_acc[static_cast<Eigen::Index>(i)] = acc;
@@ -705,18 +717,9 @@ void PlantFunction::eval_driven(const Eigen::VectorXd& x, const Eigen::VectorXd&
   for (int k = 0; k < nw_; ++k) W.v[rates_[static_cast<std::size_t>(k)]] = x[n + k];
   // motion inputs: their coordinates at u (a Plant/In's value, or the nominal), u', u''
   for (std::size_t i = 0; i < m.motions.size(); ++i) {
-    const int k = m.motions[i];
-    const ActuatorModel& a = m.actuators[static_cast<std::size_t>(k)];
-    double value = u_all_[k], rate = 0.0, acc = 0.0;
-    for (int j = 0; j < nmi; ++j) {
-      const int pos = motion_inputs_[static_cast<std::size_t>(j)];
-      if (m.plant_inputs[static_cast<std::size_t>(pos)] != k) continue;
-      value = u[pos];
-      if (u.size() > nu_p) {
-        rate = u[nu_p + j];
-        acc = u[nu_p + nmi + j];
-      }
-    }
+    const ActuatorModel& a = m.actuators[static_cast<std::size_t>(m.motions[i])];
+    double value = 0, rate = 0, acc = 0;
+    motion_of<double>(m, motion_inputs_, u_all_, i, u, value, rate, acc);
     W.dq[a.iv] = value - q_ref_[a.iq];
     W.v[a.iv] = rate;
     d.motion_acc[static_cast<Eigen::Index>(i)] = acc;

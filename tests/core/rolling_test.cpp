@@ -27,6 +27,7 @@
 #include "spatial/linalg.hpp"
 #include "study/files.hpp"
 #include "study/workflow.hpp"
+#include "jacobian_check.hpp"
 #include "test_util.hpp"
 
 namespace codyna {
@@ -299,16 +300,7 @@ TEST(Rolling, TheAnalyticJacobianEqualsAutomaticDifferentiation) {
       for (int i = f.nz(); i < f.nx(); ++i) x[i] = 2.0 * U(rng);
       for (int i = 0; i < f.nu(); ++i) u[i] = mod.u_nominal()[mod.plant_inputs[static_cast<std::size_t>(i)]];
       for (int i = f.nu(); i < u.size(); ++i) u[i] = U(rng);
-      Eigen::MatrixXd Ja;
-      ASSERT_TRUE(f.analytic_jacobian(x, u, Ja)) << spec.name;
-      const Eigen::MatrixXd Jd = plant_jacobian_autodiff(f, x, u);
-      ASSERT_EQ(Ja.rows(), Jd.rows());
-      ASSERT_EQ(Ja.cols(), Jd.cols());
-      const double scale = Jd.cwiseAbs().maxCoeff();
-      Eigen::Index ir = 0, ic = 0;
-      const double worst = (Ja - Jd).cwiseAbs().maxCoeff(&ir, &ic);
-      EXPECT_LT(worst, 1e-12 * scale) << spec.name << " trial " << trial << " at (" << ir << ", " << ic
-                                      << "): " << Ja(ir, ic) << " vs " << Jd(ir, ic);
+      test::expect_analytic_equals_autodiff(f, x, u, spec.name + " trial " + std::to_string(trial));
       ++checked;
     }
   }
