@@ -94,6 +94,13 @@ class Compiler {
       for (int b = 0; b < m_.nbodies; ++b) compiled_[m_.body_names[static_cast<std::size_t>(b)]] = b;
       build_effects();
     }
+    if (what.initial) {
+      if (spec_.joints.size() != structure.joints.size() - 1)
+        throw std::invalid_argument("compile_numbers: the spec has " + std::to_string(spec_.joints.size()) +
+                                    " joints, the structure " + std::to_string(structure.joints.size() - 1));
+      for (std::size_t k = 0; k < spec_.joints.size(); ++k) check_initial_values(spec_.joints[k], at("joints", k));
+      initial_state();  // q0, v0, the motions' nominal values, the couplers' offsets: all made again
+    }
     return std::move(m_);
   }
 
@@ -203,6 +210,15 @@ class Compiler {
     return a.normalized();
   }
 
+  // a joint's q0 and v0 as given (compile_numbers checks them again)
+  void check_initial_values(const JointSpec& j, const std::string& p) const {
+    if (j.q0.size() != 0 && j.q0.size() != joint_nq(j.type))
+      fail(p + "/q0", "expected " + std::to_string(joint_nq(j.type)) + " values for a " + to_string(j.type) + " joint, got " + std::to_string(j.q0.size()));
+    if (j.v0.size() != 0 && j.v0.size() != joint_nv(j.type))
+      fail(p + "/v0", "expected " + std::to_string(joint_nv(j.type)) + " values for a " + to_string(j.type) + " joint, got " + std::to_string(j.v0.size()));
+    if ((j.q0.size() && !j.q0.allFinite()) || (j.v0.size() && !j.v0.allFinite())) fail(p, "expected finite q0 and v0");
+  }
+
   // the numbers of model body b (compile_numbers sets them again)
   void set_body_numbers(int b, const BodySpec& s) {
     const auto i = static_cast<std::size_t>(b);
@@ -229,11 +245,7 @@ class Compiler {
       if (!fresh)
         fail(p + "/child", "body " + quoted(j.child) + " is already moved by joint " + quoted(joints[it->second].name) +
                                "; close kinematic loops with a constraint");
-      if (j.q0.size() != 0 && j.q0.size() != joint_nq(j.type))
-        fail(p + "/q0", "expected " + std::to_string(joint_nq(j.type)) + " values for a " + to_string(j.type) + " joint, got " + std::to_string(j.q0.size()));
-      if (j.v0.size() != 0 && j.v0.size() != joint_nv(j.type))
-        fail(p + "/v0", "expected " + std::to_string(joint_nv(j.type)) + " values for a " + to_string(j.type) + " joint, got " + std::to_string(j.v0.size()));
-      if ((j.q0.size() && !j.q0.allFinite()) || (j.v0.size() && !j.v0.allFinite())) fail(p, "expected finite q0 and v0");
+      check_initial_values(j, p);
       if (j.armature.size() != 0) {
         const int nv = joint_nv(j.type);
         if (nv == 0) fail(p + "/armature", "a fixed joint has no coordinate to carry an armature (rotor inertia)");

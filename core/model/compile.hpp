@@ -19,17 +19,20 @@ Model compile_structure(const ModelSpec& spec, const std::string& file = "");
 
 // What a parameter study's variant changes in a compiled model without changing its tree, names or
 // indices: the bodies' mass, com and inertia; the effects (gravity, springs and dampers, bushings,
-// forces: any of their fields, since nothing else refers to them).
+// forces: any of their fields, since nothing else refers to them); the joints' q0 and v0 (the
+// initial state, and what follows from it: the motion inputs' nominal values, the couplers' offsets
+// when the file gives none).
 struct NumbersChanged {
   bool bodies = false;
   bool effects = false;
+  bool initial = false;
 };
 
 // The model of `spec` from `structure`, compile_structure's model of a spec that differs from `spec`
 // only in what `what` names: those are checked and made again as compile_structure does (the same
 // code), the rest is copied (the structure's spec need not be kept: the model gets `spec`). Member
 // for member compile_structure(spec, file), with its errors (Compile.*NumbersOnTheStructure*). Throws
-// std::invalid_argument if `spec` has another number of bodies.
+// std::invalid_argument if `spec` has another number of bodies (or joints, with `initial`).
 Model compile_numbers(const Model& structure, const ModelSpec& spec, NumbersChanged what, const std::string& file = "");
 
 }  // namespace codyna

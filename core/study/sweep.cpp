@@ -364,7 +364,7 @@ ModelSpec variant_spec(const Context& c, const SweepVariant& v) {
 
 // what the varied fields change of the compiled model when they leave its tree, names and indices
 // as they are (compile_numbers): a body's mass, com or inertia (or a component of them), any field of
-// an effect; nothing otherwise
+// an effect, a joint's q0 or v0; nothing otherwise
 std::optional<NumbersChanged> numbers_changed(const std::vector<SweepVary>& vary) {
   NumbersChanged what;
   for (const SweepVary& v : vary) {
@@ -379,6 +379,8 @@ std::optional<NumbersChanged> numbers_changed(const std::vector<SweepVary>& vary
       what.bodies = true;
     else if (section == "effects")
       what.effects = true;
+    else if (section == "joints" && (name == "q0" || name == "v0"))
+      what.initial = true;
     else
       return std::nullopt;
   }
@@ -545,22 +547,11 @@ double unhex(const nlohmann::json& j) {
   return x;
 }
 
-nlohmann::json encode(const Eigen::MatrixXd& m) {
-  nlohmann::json d = nlohmann::json::array();
-  for (Eigen::Index k = 0; k < m.size(); ++k) d.push_back(hex(m.data()[k]));
-  return {m.rows(), m.cols(), d};
-}
 Eigen::MatrixXd decode_matrix(const nlohmann::json& j) {
   Eigen::MatrixXd m(j.at(0).get<Eigen::Index>(), j.at(1).get<Eigen::Index>());
   if (static_cast<Eigen::Index>(j.at(2).size()) != m.size()) throw std::runtime_error("matrix size");
   for (Eigen::Index k = 0; k < m.size(); ++k) m.data()[k] = unhex(j.at(2).at(static_cast<std::size_t>(k)));
   return m;
-}
-nlohmann::json encode(const Eigen::VectorXcd& p) {
-  Eigen::MatrixXd m(p.size(), 2);
-  m.col(0) = p.real();
-  m.col(1) = p.imag();
-  return encode(m);
 }
 Eigen::VectorXcd decode_poles(const nlohmann::json& j) {
   const Eigen::MatrixXd m = decode_matrix(j);
@@ -595,7 +586,7 @@ class JournalWriter {
   void integer(long long x) { s_ += std::to_string(x); }
   void text(const std::string& t) { s_ += nlohmann::json(t).dump(); }
   void boolean(bool b) { s_ += b ? "true" : "false"; }
-  // encode(): [rows, cols, ["hex", ...]]
+  // [rows, cols, ["hex", ...]] (what decode_matrix reads)
   void matrix(const double* data, Eigen::Index rows, Eigen::Index cols) {
     s_ += '[';
     integer(rows);
@@ -610,7 +601,7 @@ class JournalWriter {
   }
   void matrix(const Eigen::MatrixXd& m) { matrix(m.data(), m.rows(), m.cols()); }
   void vector(const Eigen::VectorXd& v) { matrix(v.data(), v.size(), 1); }
-  void poles(const Eigen::VectorXcd& p) {  // encode(VectorXcd): the real parts, then the imaginary parts
+  void poles(const Eigen::VectorXcd& p) {  // a poles x 2 matrix: the real parts, then the imaginary parts (decode_poles)
     s_ += '[';
     integer(p.size());
     s_ += ",2,[";
@@ -1081,6 +1072,12 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
   if (shard) {  // the shard's journal is its result
     journal.close();
     if (!journal) throw std::runtime_error(r.out + ": cannot finish the shard's file");
+    // written again in the variants' order (it was appended to as they finished): the same bytes
+    // whatever the threads and the order they finished in
+    std::string text = journal_head(r, model_bytes, n) + journal_request(r);
+    for (long long i = 0; i < n; ++i)
+      if (job.in_shard(i)) text += journal_line(i, job.variants[static_cast<std::size_t>(i)]);
+    write_file_atomically(r.out, text);
     job.written.push_back(r.out);
     return job;
   }

@@ -436,6 +436,26 @@ TEST(Sweep, JournalsInMemoryMergeIntoTheWholeStudysFile) {
   EXPECT_THROW(study_sweep_merge_journals({journals[0], "garbage\n"}, {"rank 0", "rank 1"}, slice), std::invalid_argument);
 }
 
+// a shard's file is its journal, appended to as variants finish; finished, it is written again in the
+// variants' order, so two threads give the bytes one gives (and a Slurm task the bytes of K/N)
+TEST(Sweep, AShardsFileIsTheSameBytesWhateverTheThreads) {
+  TempDir dir;
+  SweepRequest r;
+  r.model = kModel;
+  r.vary = {"/bodies/1/mass=5:15:40"};
+  r.shard_count = 2;
+  r.shard_index = 1;
+  r.threads = 1;
+  r.out = dir.file("one.sweep");
+  study_sweep_job(r);
+  for (int run = 0; run < 3; ++run) {
+    r.threads = 2;
+    r.out = dir.file("two_" + std::to_string(run) + ".sweep");
+    study_sweep_job(r);
+    EXPECT_EQ(slurp(r.out), slurp(dir.file("one.sweep"))) << "run " << run;
+  }
+}
+
 // the journal's lines are written without a JSON library; each must be the line nlohmann::json dumps
 // for the object it holds (sorted keys, no spaces, strings escaped), and read back bit for bit
 TEST(Sweep, JournalLinesAreWhatAJsonLibraryWrites) {
