@@ -465,6 +465,9 @@ bool PropertyEditor::applyText(const QString& field, const QString& text, QStrin
     s = next;
     s.analysis = study;
   });
+  // taken: a refusal marked here before goes (an edit that changes nothing rebuilds nothing); the
+  // document's own error, if it names this element, stays marked
+  refreshMarks();
   return true;
 }
 

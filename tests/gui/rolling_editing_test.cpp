@@ -259,6 +259,29 @@ class RollingEditingTest : public QObject {
       QCOMPARE(contact.size(), std::size_t(2));
       EXPECT_NEAR3(Eigen::Vector3d(contact[0].world.translation()), Eigen::Vector3d::Zero());
     }
+    // a wheel turned over the disc's unfocused type and body drop-downs changes nothing
+    for (const char* f : {"type", "body_b"}) {
+      drive::wheelOver(combo(f), -2);
+      drive::wheelOver(combo(f), 3);
+    }
+    QCOMPARE(combo("type")->currentText(), QString("rolling_disc"));
+    QCOMPARE(combo("body_b")->currentText(), QString("wheel"));
+    // the axle typed along y and confirmed with Enter: still upright, the same centre height
+    type("axis_b", "0, 1, 0");
+    {
+      const auto m = w->document()->model();
+      QVERIFY2(m, qPrintable(w->document()->errorText()));
+      QCOMPARE(m->constraints.at(0).axis_b, Eigen::Vector3d::UnitY());
+      EXPECT_NEAR3(ballCentre(*m, "float"), Eigen::Vector3d(0, 0, 0.05));
+    }
+    // an axle of zero: refused at the field with the reason, the model kept as it was
+    typeInto("axis_b", "0, 0, 0");
+    QCOMPARE(props()->markedField(), QString("axis_b"));
+    QVERIFY2(props()->errorText().contains("non-zero"), qPrintable(props()->errorText()));
+    QVERIFY(w->document()->model());
+    QCOMPARE(w->document()->spec().constraints.at(0).axis_b, Eigen::Vector3d::UnitY());
+    type("axis_b", "0, 1, 0");
+    QVERIFY2(w->document()->model(), qPrintable(w->document()->errorText()));
     choose("type", "rolling_ball");
     QVERIFY2(w->document()->model(), qPrintable(w->document()->errorText()));
     QVERIFY(!props()->editorFor("axis_b"));
