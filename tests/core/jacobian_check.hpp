@@ -1,5 +1,5 @@
 // The plant function's analytic Jacobian (TreeDerivatives) against automatic differentiation of
-// its eval<ADScalar>, as the rolling tests check it at random states.
+// its eval<ADScalar> and against central differences, as the rolling tests check it at random states.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -29,6 +29,19 @@ inline double expect_analytic_equals_autodiff(const PlantFunction& f, const Eige
   Eigen::Index ir = 0, ic = 0;
   const double worst = (Ja - Jd).cwiseAbs().maxCoeff(&ir, &ic);
   EXPECT_LT(worst, tol * scale) << label << " at (" << ir << ", " << ic << "): " << Ja(ir, ic) << " vs " << Jd(ir, ic);
+  return scale;
+}
+
+// plant_jacobian's exact method at (x, u) against central differences of the whole plant function
+// (position deviations too), to tol of the largest entry, which is returned
+inline double expect_exact_equals_central_differences(const PlantFunction& f, const Eigen::VectorXd& x,
+                                                      const Eigen::VectorXd& u, const std::string& label, double tol) {
+  const Eigen::MatrixXd Ja = plant_jacobian(f, x, u, JacobianMethod::Exact);
+  const Eigen::MatrixXd Jf = plant_jacobian_fd_full(f, x, u, true);
+  const double scale = Ja.cwiseAbs().maxCoeff();
+  Eigen::Index ir = 0, ic = 0;
+  const double worst = (Ja - Jf).cwiseAbs().maxCoeff(&ir, &ic);
+  EXPECT_LT(worst, tol * scale) << label << " at (" << ir << ", " << ic << "): " << Ja(ir, ic) << " vs " << Jf(ir, ic);
   return scale;
 }
 
