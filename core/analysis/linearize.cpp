@@ -1,6 +1,7 @@
 #include "analysis/linearize.hpp"
 
 #include <algorithm>
+#include <initializer_list>
 #include <memory>
 #include <cmath>
 #include <limits>
@@ -230,9 +231,10 @@ Linearization linearize_general(const Model& model, const OperatingPoint& op, co
 // the way (CRBA and a Cholesky solve; the general path evaluates ABA), equal to round-off, which
 // spares a forward-dynamics evaluation per point (a quarter of the Jacobian's cost at 7 DOF).
 struct Linearizer::Impl {
-  const Model& m;
-  const bool tree;  // no loop closures, no motion inputs: every coordinate independent, in order
+  const Model* model;
+  bool tree;  // no loop closures, no motion inputs: every coordinate independent, in order
   bool ready = false;
+  bool busy = false;  // linearize(model, op)'s kept Impl is being used (see there)
   CoordinatePartition partition;
   std::vector<std::string> state_names, state_units, input_names, input_units, output_names, output_units;
   std::vector<int> offset_q;  // [nv] the q index that x0's position entry k carries; -1: a rotation/translation tangent (0)
@@ -240,13 +242,108 @@ struct Linearizer::Impl {
   std::unique_ptr<Data> data;
   Eigen::VectorXd dq, rate;
 
-  explicit Impl(const Model& model) : m(model), tree(model.nc == 0 && model.motions.empty()) {}
+  // Every field of the model that prepare() and the workspaces it binds (TreeDerivatives, its
+  // Data and ModelConstants, the spring check's Data) read; whatever else a call needs is read
+  // from the model at the call. What was prepared stays good while these are unchanged.
+  struct Inputs {
+    std::vector<int> ints;
+    std::vector<double> nums;
+    std::vector<std::string> names;
 
-  // what depends on the model only, made at the first call
+    // calls f.ints(int...), f.nums(const double*, n) and f.name(string) over those fields, in one order
+    template <class F>
+    static void visit(const Model& m, F& f) {
+      f.ints({m.nq, m.nv, m.nbodies, m.nc, m.nu(), m.ny(), static_cast<int>(m.motions.size()),
+              static_cast<int>(m.springs.size()), static_cast<int>(m.body_forces.size()),
+              static_cast<int>(m.bushings.size()), static_cast<int>(m.plant_inputs.size()),
+              static_cast<int>(m.plant_outputs.size())});
+      for (int b = 0; b < m.nbodies; ++b) {
+        const auto i = static_cast<std::size_t>(b);
+        const JointModel& j = m.joints[i];
+        f.ints({static_cast<int>(j.type), j.parent, m.parent[i], j.idx_q, j.idx_v, j.nq, j.nv});
+        f.nums(j.X_PF.R.data(), 9);
+        f.nums(j.X_PF.p.data(), 3);
+        f.nums(j.X_CM.R.data(), 9);
+        f.nums(j.X_CM.p.data(), 3);
+        f.nums(j.axis.data(), 3);
+        f.nums(j.axis2.data(), 3);
+        f.nums(&m.mass[i], 1);
+        f.nums(m.com[i].data(), 3);
+        f.nums(m.inertia[i].data(), 36);
+      }
+      for (const ActuatorModel& a : m.actuators) f.ints({static_cast<int>(a.type), a.iv, a.iq});
+      for (int k : m.motions) f.ints({k});
+      for (int k : m.plant_inputs) {
+        f.ints({k});
+        f.name(m.actuators[static_cast<std::size_t>(k)].name);
+        f.name(m.actuators[static_cast<std::size_t>(k)].unit);
+      }
+      for (int k : m.plant_outputs) {
+        f.ints({k});
+        f.name(m.sensors[static_cast<std::size_t>(k)].name);
+        f.name(m.sensors[static_cast<std::size_t>(k)].unit);
+      }
+      for (const auto* v : {&m.v_names, &m.rate_names, &m.v_units})
+        for (const std::string& n : *v) f.name(n);
+    }
+    void fill(const Model& m) {
+      struct Writer {
+        Inputs& in;
+        std::size_t n = 0;
+        void ints(std::initializer_list<int> k) { in.ints.insert(in.ints.end(), k); }
+        void nums(const double* p, int n) { in.nums.insert(in.nums.end(), p, p + n); }
+        void name(const std::string& s) { in.names.push_back(s); }
+      } w{*this};
+      ints.clear();
+      nums.clear();
+      names.clear();
+      visit(m, w);
+    }
+    // the model's fields equal those filled (bit for bit; a NaN is unequal to itself: false)
+    bool match(const Model& m) const {
+      struct Reader {
+        const Inputs& in;
+        std::size_t ni = 0, nd = 0, ns = 0;
+        bool same = true;
+        void ints(std::initializer_list<int> k) {
+          same = same && ni + k.size() <= in.ints.size() && std::equal(k.begin(), k.end(), in.ints.begin() + static_cast<std::ptrdiff_t>(ni));
+          ni += k.size();
+        }
+        void nums(const double* p, int n) {
+          same = same && nd + static_cast<std::size_t>(n) <= in.nums.size() &&
+                 std::equal(p, p + n, in.nums.begin() + static_cast<std::ptrdiff_t>(nd));
+          nd += static_cast<std::size_t>(n);
+        }
+        void name(const std::string& s) {
+          same = same && ns < in.names.size() && in.names[ns] == s;
+          ++ns;
+        }
+      } r{*this};
+      visit(m, r);
+      return r.same && r.ni == ints.size() && r.nd == nums.size() && r.ns == names.size();
+    }
+  } prepared_from;  // the model's, as prepare() last read them
+
+  explicit Impl(const Model& m) { bind(m); }
+
+  // another model, or this one perhaps changed: what prepare() derives is made again at the next
+  // call, unless it is the model prepared last with every field prepare() reads unchanged (a NaN
+  // compares unequal: made again)
+  void bind(const Model& m) {
+    if (ready && &m == model && prepared_from.match(m)) return;
+    model = &m;
+    tree = m.nc == 0 && m.motions.empty();
+    ready = false;
+  }
+
+  // what depends on the model only, made at the first call after bind()
   void prepare(const OperatingPoint& op) {
+    const Model& m = *model;
+    ready = false;
     partition = partition_coordinates(m, op.q);  // a tree: every coordinate, in order
     state_names = plant_state_names(m, partition.independent);
     state_units = plant_state_units(m, partition.independent);
+    for (auto* v : {&input_names, &input_units, &output_names, &output_units}) v->clear();
     for (int k : m.plant_inputs) {
       input_names.push_back(m.actuators[k].name);
       input_units.push_back(m.actuators[k].unit);
@@ -261,15 +358,25 @@ struct Linearizer::Impl {
       if (j.type == JointType::Spherical || j.type == JointType::Free) continue;
       for (int c = 0; c < j.nv; ++c) offset_q[static_cast<std::size_t>(j.idx_v + c)] = j.idx_q + c;
     }
-    td = std::make_unique<TreeDerivatives>(m);
-    if (!m.springs.empty()) data = std::make_unique<Data>(m);  // for refuse_coincident_spring_dampers
-    dq = Eigen::VectorXd::Zero(m.nv);
+    if (td)
+      td->bind(m);
+    else
+      td = std::make_unique<TreeDerivatives>(m);
+    if (m.springs.empty())
+      data.reset();
+    else if (data)  // for refuse_coincident_spring_dampers
+      data->reset(m);
+    else
+      data = std::make_unique<Data>(m);
+    dq.setZero(m.nv);
     rate.resize(m.nv);
+    prepared_from.fill(m);
     ready = true;
   }
 
   void linearize_tree(const OperatingPoint& op, Linearization& out) {
     if (!ready) prepare(op);
+    const Model& m = *model;
     if (data) refuse_coincident_spring_dampers(m, op.q, *data);
     const int n = m.nv, nu = static_cast<int>(m.plant_inputs.size()), ny = static_cast<int>(m.plant_outputs.size());
     if (op.q.size() != m.nq || op.v.size() != n || op.u.size() != m.nu())
@@ -318,6 +425,7 @@ struct Linearizer::Impl {
     s.u0.resize(nu);
     for (int k = 0; k < nu; ++k) s.u0[k] = op.u[m.plant_inputs[k]];
     s.Ts = 0.0;
+    s.positions = n;
     // (written into the same Linearization point after point, they are already these: compared
     // first, which costs less than copying them again)
     for (auto [to, from] : {std::pair{&s.state_names, &state_names}, {&s.state_units, &state_units},
@@ -345,7 +453,7 @@ void Linearizer::linearize(const OperatingPoint& op, const LinearizeOptions& opt
   if (impl_->tree && options.method == JacobianMethod::Exact && options.independent.empty())
     impl_->linearize_tree(op, out);
   else
-    out = linearize_general(impl_->m, op, options);
+    out = linearize_general(*impl_->model, op, options);
 }
 
 Linearization Linearizer::linearize(const OperatingPoint& op, const LinearizeOptions& options) {
@@ -354,8 +462,28 @@ Linearization Linearizer::linearize(const OperatingPoint& op, const LinearizeOpt
   return out;
 }
 
+void Linearizer::bind(const Model& model) { impl_->bind(model); }
+
+// One Linearizer's memory kept per thread, bound again to the model at every call: everything
+// derived from the model is made again (nothing of another call's model is read; a model freed
+// and another made at its address is as safe as a new one), only the storage is reused, which
+// spares the workspaces' allocation and first touch (most of a call's cost beyond the Jacobian:
+// docs/performance.md). Not kept for models above kKeptDof coordinates (its nv x nv matrices would
+// stay allocated for the thread's life), nor while a call on the same thread is using it.
 Linearization linearize(const Model& model, const OperatingPoint& op, const LinearizeOptions& options) {
-  return Linearizer(model).linearize(op, options);
+  constexpr int kKeptDof = 200;
+  thread_local std::unique_ptr<Linearizer> kept;
+  if (model.nv > kKeptDof || (kept && kept->impl_->busy)) return Linearizer(model).linearize(op, options);
+  if (kept)
+    kept->bind(model);
+  else
+    kept = std::make_unique<Linearizer>(model);
+  struct Busy {
+    bool& b;
+    explicit Busy(bool& f) : b(f) { b = true; }
+    ~Busy() { b = false; }
+  } busy(kept->impl_->busy);
+  return kept->linearize(op, options);
 }
 
 }  // namespace codyna

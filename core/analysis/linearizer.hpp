@@ -2,6 +2,7 @@
 // from one operating point to the next (issue 22: a study, a trajectory).
 //
 //   Linearizer lz(model);                 // model must outlive lz, its numbers unchanged
+//   lz.bind(other);                       // (or bound again: another model, or this one changed)
 //   Linearization a = lz.linearize(op1);  // the same numbers as linearize(model, op1)
 //   lz.linearize(op2, options, out);      // into out, reusing its storage
 //
@@ -34,7 +35,13 @@ class Linearizer {
   Linearization linearize(const OperatingPoint& op, const LinearizeOptions& options = {});
   void linearize(const OperatingPoint& op, const LinearizeOptions& options, Linearization& out);
 
+  // linearize another model (or this one after its numbers changed) from now on, keeping the
+  // workspaces' storage: everything derived from the model is made again at the next call, as
+  // by a new Linearizer(model)
+  void bind(const Model& model);
+
  private:
+  friend Linearization linearize(const Model&, const OperatingPoint&, const LinearizeOptions&);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

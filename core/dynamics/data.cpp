@@ -5,9 +5,11 @@
 
 namespace codyna {
 
-ModelConstants::ModelConstants(const Model& model) {
+ModelConstants::ModelConstants(const Model& model) { assign(model); }
+
+void ModelConstants::assign(const Model& model) {
   const auto nb = static_cast<std::size_t>(model.nbodies);
-  joints.resize(nb);
+  joints.assign(nb, Joint{});
   com_inertia.resize(nb);
   root.assign(nb, 0);
   dof_body.assign(static_cast<std::size_t>(model.nv), 0);
@@ -51,9 +53,34 @@ ModelConstants::ModelConstants(const Model& model) {
 
 template <class S>
 DataT<S>::DataT(const Model& model) : constants(model) {
+  size_for(model);
+}
+
+template <class S>
+void DataT<S>::reset(const Model& model) {
+  // the workspaces sized at their first use start again empty for another shape, as in a new Data
+  if (tau.size() != model.nv || lambda.size() != model.nc || liMi.size() != static_cast<std::size_t>(model.nbodies) ||
+      motion_acc.size() != static_cast<Eigen::Index>(model.motions.size())) {
+    M.resize(0, 0);
+    J6a.resize(0, 0);
+    J6b.resize(0, 0);
+    Jp.resize(0, 0);
+    Jwa.resize(0, 0);
+    Jwb.resize(0, 0);
+    Jwd.resize(0, 0);  // (the loop workspace is sized by every call)
+  }
+  constants.assign(model);
+  size_for(model);
+}
+
+// every stage's arrays sized for the model and zeroed (std::vector::assign and Eigen's resize keep
+// their storage when the sizes are those they had: reset() on a model of the same shape makes no
+// heap allocation but ModelConstants' two scratch arrays)
+template <class S>
+void DataT<S>::size_for(const Model& model) {
   const auto nb = static_cast<std::size_t>(model.nbodies);
-  liMi.resize(nb);
-  oMi.resize(nb);
+  liMi.assign(nb, SE3T<S>());
+  oMi.assign(nb, SE3T<S>());
   Sb.assign(nb, Mat6xT<S>(6, 0));
   v.assign(nb, Vec6T<S>::Zero());
   cJ.assign(nb, Vec6T<S>::Zero());
@@ -65,8 +92,8 @@ DataT<S>::DataT(const Model& model) : constants(model) {
   pA.assign(nb, Vec6T<S>::Zero());
   pB.assign(nb, Vec6T<S>::Zero());
   U.assign(nb, Mat6xT<S>(6, 0));
-  Dinv.resize(nb);
-  u.resize(nb);
+  Dinv.assign(nb, typename decltype(Dinv)::value_type());
+  u.assign(nb, typename decltype(u)::value_type());
   c.assign(nb, Vec6T<S>::Zero());
   Iw.assign(nb, RigidInertiaT<S>());
   Ic.assign(nb, RigidInertiaT<S>());

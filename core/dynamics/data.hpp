@@ -32,11 +32,16 @@ struct ModelConstants {
   bool dense_mass_matrix = false;                // every pair of velocity indices is related (a chain): M has no structural zero
   bool body_force_sources = false;               // springs, body forces or body-force actuators write fext
   explicit ModelConstants(const Model& model);
+  void assign(const Model& model);  // the same as constructing it again, reusing the arrays
 };
 
 template <class S>
 struct DataT {
   explicit DataT(const Model& model);
+  // the same as DataT(model) for another model (or this one changed), reusing the memory: every
+  // member the constructor sets is set again; the workspaces sized at their first use keep their
+  // storage and are sized again by the algorithms when the sizes differ
+  void reset(const Model& model);
 
   ModelConstants constants;      // derived from the model once (see above)
 
@@ -103,6 +108,9 @@ struct DataT {
     Eigen::MatrixXd Mff;                             // [nf x nf]
     Eigen::VectorXd f;                               // [nv]
   } loop;                        // used with S = double only
+
+ private:
+  void size_for(const Model& model);
 };
 
 extern template struct DataT<double>;

@@ -149,8 +149,21 @@ void add_grad(Grad36& g, int slot, const Vec3& f, const Eigen::Matrix<double, 3,
 
 bool TreeDerivatives::supports(const Model& model) { return model.nc == 0; }
 
-TreeDerivatives::TreeDerivatives(const Model& model) : m_(model), d_(model), llt_(model.nv) {
+TreeDerivatives::TreeDerivatives(const Model& model) : m_(&model), d_(model), llt_(model.nv) { size_for(model); }
+
+void TreeDerivatives::bind(const Model& model) {
+  if (model.nv != m_->nv) llt_ = Eigen::LLT<Eigen::MatrixXd>(model.nv);
+  m_ = &model;
+  d_.reset(model);
+  size_for(model);
+}
+
+// everything the model determines, set as a new object would have it; std::vector::clear/assign
+// and Eigen's setZero keep their storage when the sizes repeat (bind() on a model of the same
+// shape makes no heap allocation but Data's constants' scratch)
+void TreeDerivatives::size_for(const Model& model) {
   const int nb = model.nbodies, nv = model.nv;
+  units_.clear();
   unit_begin_.assign(nb, 0);
   unit_end_.assign(nb, 0);
   col_unit_.assign(nv, 0);
@@ -167,9 +180,10 @@ TreeDerivatives::TreeDerivatives(const Model& model) : m_(model), d_(model), llt
     for (int u = unit_begin_[i]; u < unit_end_[i]; ++u)
       for (int c = 0; c < units_[u].n; ++c) col_unit_[units_[u].iv + c] = u;
   }
-  path_.assign(nb, {});
+  path_.resize(static_cast<std::size_t>(nb));
+  if (nb > 0) path_[0].clear();
   for (int i = 1; i < nb; ++i) {
-    path_[i] = path_[model.parent[i]];
+    path_[i].assign(path_[model.parent[i]].begin(), path_[model.parent[i]].end());
     for (int u = unit_begin_[i]; u < unit_end_[i]; ++u) path_[i].push_back(u);
   }
   const int nu = static_cast<int>(units_.size());
@@ -208,6 +222,8 @@ TreeDerivatives::TreeDerivatives(const Model& model) : m_(model), d_(model), llt
   rhs_.setZero(nv, 2 * nv + model.nu());
   const int nm = static_cast<int>(model.motions.size());
   dqdd_dacc.setZero(nv, nm);
+  driven_.clear();
+  free_.clear();
   for (int k : model.motions) driven_.push_back(model.actuators[static_cast<std::size_t>(k)].iv);
   for (int i = 0; i < nv; ++i)
     if (std::find(driven_.begin(), driven_.end(), i) == driven_.end()) free_.push_back(i);
@@ -215,7 +231,7 @@ TreeDerivatives::TreeDerivatives(const Model& model) : m_(model), d_(model), llt
     const int nf = static_cast<int>(free_.size());
     Mff_.setZero(nf, nf);
     Rf_.setZero(nf, 2 * nv + model.nu() + nm);
-    llt_ff_ = Eigen::LLT<Eigen::MatrixXd>(nf);
+    if (llt_ff_.rows() != nf) llt_ff_ = Eigen::LLT<Eigen::MatrixXd>(nf);
   }
   Minv_.setZero(nv, nv);
   scratch_.setZero(nv);
@@ -228,15 +244,15 @@ TreeDerivatives::TreeDerivatives(const Model& model) : m_(model), d_(model), llt
 
 // positions and velocities: world motion subspaces, inertias and unit velocities
 void TreeDerivatives::world_kinematics(const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
-  forward_kinematics<double>(m_, d_, q, v);
-  for (int i = 1; i < m_.nbodies; ++i) {
-    const JointModel& j = m_.joints[i];
+  forward_kinematics<double>(*m_, d_, q, v);
+  for (int i = 1; i < m_->nbodies; ++i) {
+    const JointModel& j = m_->joints[i];
     const SE3& g = d_.oMi[i];
     S_[i].resize(6, j.nv);
     for (int c = 0; c < j.nv; ++c) S_[i].col(c) = g.act_motion(Vec6(d_.Sb[i].col(c)));
     // world spatial inertia about the world origin, from mass, com and rotational inertia
-    const double mass = m_.mass[i];
-    const Vec3 cw = g.act_point(m_.com[i]);
+    const double mass = m_->mass[i];
+    const Vec3 cw = g.act_point(m_->com[i]);
     const Mat3 cx = skew<double>(cw);
     Mat6& I = I_[i];
     I.topLeftCorner<3, 3>().noalias() = g.R * Icom_[i] * g.R.transpose();
@@ -259,9 +275,9 @@ void TreeDerivatives::world_kinematics(const Eigen::VectorXd& q, const Eigen::Ve
 // accelerations for joint accelerations a (gravity enters as A_0 = -g)
 void TreeDerivatives::accelerations(const Eigen::VectorXd& v, const Eigen::VectorXd& a) {
   Vec6 A0 = Vec6::Zero();
-  if (m_.has_gravity) A0.tail<3>() = -m_.gravity;
-  for (int i = 1; i < m_.nbodies; ++i) {
-    const JointModel& j = m_.joints[i];
+  if (m_->has_gravity) A0.tail<3>() = -m_->gravity;
+  for (int i = 1; i < m_->nbodies; ++i) {
+    const JointModel& j = m_->joints[i];
     const int p = j.parent;
     Vec6 Ap = p > 0 ? A_[p] : A0;
     for (int u = unit_begin_[i]; u < unit_end_[i]; ++u) {
@@ -278,24 +294,24 @@ void TreeDerivatives::accelerations(const Eigen::VectorXd& v, const Eigen::Vecto
 
 // subtree composites of inertia, momentum and Coriolis inertia; the unit rows P, R
 void TreeDerivatives::composites() {
-  for (int i = 1; i < m_.nbodies; ++i) {
+  for (int i = 1; i < m_->nbodies; ++i) {
     Ic_[i] = I_[i];
     hc_[i].noalias() = I_[i] * V_[i];
     Bc_[i] = coriolis_inertia(V_[i], I_[i]);
   }
-  for (int i = m_.nbodies - 1; i > 0; --i) {
-    const int p = m_.parent[i];
+  for (int i = m_->nbodies - 1; i > 0; --i) {
+    const int p = m_->parent[i];
     if (p > 0) {
       Ic_[p] += Ic_[i];
       hc_[p] += hc_[i];
       Bc_[p] += Bc_[i];
     }
   }
-  for (int i = 1; i < m_.nbodies; ++i) {
+  for (int i = 1; i < m_->nbodies; ++i) {
     if (unit_begin_[i] == unit_end_[i]) continue;
     Mat6 BH = Bc_[i];
     add_momentum_operator(hc_[i], BH);
-    const JointModel& j = m_.joints[i];
+    const JointModel& j = m_->joints[i];
     for (int u = unit_begin_[i]; u < unit_end_[i]; ++u) {
       const Unit& un = units_[u];
       const auto Su = S_[i].middleCols(un.iv - j.idx_v, un.n);
@@ -307,13 +323,13 @@ void TreeDerivatives::composites() {
 
 // body forces of the RNEA and their subtree sums; tau = S^T F
 void TreeDerivatives::forces() {
-  for (int i = 1; i < m_.nbodies; ++i) {
+  for (int i = 1; i < m_->nbodies; ++i) {
     const Vec6 h = I_[i] * V_[i];
     F_[i].noalias() = I_[i] * A_[i];
     F_[i] += crf(V_[i], h);
   }
-  for (int i = m_.nbodies - 1; i > 0; --i) {
-    const JointModel& j = m_.joints[i];
+  for (int i = m_->nbodies - 1; i > 0; --i) {
+    const JointModel& j = m_->joints[i];
     if (j.nv > 0) tau.segment(j.idx_v, j.nv).noalias() = S_[i].transpose() * F_[i];
     const int p = j.parent;
     if (p > 0) F_[p] += F_[i];
@@ -322,12 +338,12 @@ void TreeDerivatives::forces() {
 
 // M(i, j) = S_i^T Ic_i S_j for unit j at or above unit i
 void TreeDerivatives::mass_matrix() {
-  for (int i = 1; i < m_.nbodies; ++i) {
+  for (int i = 1; i < m_->nbodies; ++i) {
     for (int ui = unit_begin_[i]; ui < unit_end_[i]; ++ui) {
       const Unit& a = units_[ui];
       for (int uj : path_[i]) {
         const Unit& b = units_[uj];
-        const auto Sj = S_[b.body].middleCols(b.iv - m_.joints[b.body].idx_v, b.n);
+        const auto Sj = S_[b.body].middleCols(b.iv - m_->joints[b.body].idx_v, b.n);
         if (a.n == 1 && b.n == 1) {
           M(a.iv, b.iv) = M(b.iv, a.iv) = P_[ui].row(0).dot(Vec6(Sj.col(0)));
           if (uj == ui) break;
@@ -346,19 +362,19 @@ void TreeDerivatives::mass_matrix() {
       }
     }
   }
-  if (m_.armature.size() != 0) M.diagonal() += m_.armature;  // rotor inertia
+  if (m_->armature.size() != 0) M.diagonal() += m_->armature;  // rotor inertia
 }
 
 void TreeDerivatives::differentiate_rnea() {
-  const int nb = m_.nbodies;
+  const int nb = m_->nbodies;
   dtau_dq.setZero();  // units in other branches do not depend on each other
   dtau_dv.setZero();
   for (int i = 1; i < nb; ++i) {
     if (unit_begin_[i] == unit_end_[i]) continue;
-    const JointModel& ji = m_.joints[i];
+    const JointModel& ji = m_->joints[i];
     for (int b = 0; b < nb; ++b) below_[b] = 0;
     below_[i] = 1;
-    for (int b = i + 1; b < nb; ++b) below_[b] = below_[m_.parent[b]];
+    for (int b = i + 1; b < nb; ++b) below_[b] = below_[m_->parent[b]];
     Mat6 BH = Bc_[i];
     add_momentum_operator(hc_[i], BH);
     for (int k = unit_begin_[i]; k < unit_end_[i]; ++k) {
@@ -396,7 +412,7 @@ void TreeDerivatives::differentiate_rnea() {
         const Vec6 Gv = BH * s + Ic_[i] * cv;
         auto above = [&](int j) {
           const Unit& uj = units_[j];
-          const auto Sj = S_[uj.body].middleCols(uj.iv - m_.joints[uj.body].idx_v, uj.n);
+          const auto Sj = S_[uj.body].middleCols(uj.iv - m_->joints[uj.body].idx_v, uj.n);
           if (uj.n == 1) {
             const Vec6 sj = Sj.col(0);
             dtau_dq(uj.iv, col) = sj.dot(G);
@@ -413,7 +429,7 @@ void TreeDerivatives::differentiate_rnea() {
           dtau_dv.block(uj.iv, col, uj.n, 1).noalias() = Sj.transpose() * Gv;
         };
         for (int j = unit_begin_[i]; j < k; ++j) above(j);
-        for (int j : path_[m_.parent[i]]) above(j);
+        for (int j : path_[m_->parent[i]]) above(j);
       }
     }
   }
@@ -424,7 +440,7 @@ void TreeDerivatives::rnea_derivatives(const Eigen::VectorXd& q, const Eigen::Ve
   accelerations(v, a);
   composites();
   forces();
-  add_armature_force(m_, a, tau);
+  add_armature_force(*m_, a, tau);
   differentiate_rnea();
 }
 
@@ -436,7 +452,7 @@ void TreeDerivatives::add_body_wrench(int body, const Vec6& w, const Eigen::Matr
   const std::vector<int>& path = path_[body];
   auto S_of = [&](int u) {
     const Unit& un = units_[u];
-    return S_[un.body].middleCols(un.iv - m_.joints[un.body].idx_v, un.n);
+    return S_[un.body].middleCols(un.iv - m_->joints[un.body].idx_v, un.n);
   };
   for (int pj : path) {
     const Unit& uj = units_[pj];
@@ -487,12 +503,12 @@ void TreeDerivatives::applied_force_derivatives(const Eigen::VectorXd& q, const 
   dQ_dq.setZero();
   dQ_dv.setZero();
   dQ_du.setZero();
-  for (const JointSpringModel& s : m_.joint_springs) {
+  for (const JointSpringModel& s : m_->joint_springs) {
     Q[s.iv] -= s.stiffness * (q[s.iq] - s.rest_position) + s.damping * v[s.iv];
     dQ_dq(s.iv, s.iv) -= s.stiffness;
     dQ_dv(s.iv, s.iv) -= s.damping;
   }
-  for (const JointSpringModel& s : m_.joint_frictions) {
+  for (const JointSpringModel& s : m_->joint_frictions) {
     Q[s.iv] -= s.damping * v[s.iv];
     dQ_dv(s.iv, s.iv) -= s.damping;
   }
@@ -504,7 +520,7 @@ void TreeDerivatives::applied_force_derivatives(const Eigen::VectorXd& q, const 
   // Ld = n . (xd_b - xd_a), tension T = k (L - L0) + c Ld, F = T n on x_a and -F on x_b:
   //   dn = (I - n n^T) / L d(dp),  dT = k n . d(dp) + c (vrel . dn + n . d(vrel)),  dF = n dT + T dn
   using Mat3x24 = Eigen::Matrix<double, 3, 24>;
-  for (const SpringDamperModel& s : m_.springs) {
+  for (const SpringDamperModel& s : m_->springs) {
     const LocalKin a = local_kin(d_.oMi[s.body_a], V_[s.body_a], Vec6::Zero(), s.point_a, false, s.body_a > 0);
     const LocalKin b = local_kin(d_.oMi[s.body_b], V_[s.body_b], Vec6::Zero(), s.point_b, false, s.body_b > 0);
     const Vec3 dp = b.x - a.x, vrel = b.xd - a.xd;
@@ -544,7 +560,7 @@ void TreeDerivatives::applied_force_derivatives(const Eigen::VectorXd& q, const 
     add_body_wrench(s.body_b, w, dw, s.body_a, s.body_b);
   }
   // bushings: the wrench of core/dynamics/effects.cpp as a function of both bodies' local variables
-  for (const BushingModel& bm : m_.bushings) {
+  for (const BushingModel& bm : m_->bushings) {
     const BodyAD a = body_ad(d_.oMi[bm.body_a], V_[bm.body_a], 0, bm.body_a > 0);
     const BodyAD b = body_ad(d_.oMi[bm.body_b], V_[bm.body_b], 12, bm.body_b > 0);
     const Mat3A RA = a.R * bm.X_a.R.cast<AD>(), RB = b.R * bm.X_b.R.cast<AD>();
@@ -565,7 +581,7 @@ void TreeDerivatives::applied_force_derivatives(const Eigen::VectorXd& q, const 
     dw = -dw;
     add_body_wrench(bm.body_a, w, dw, bm.body_a, bm.body_b);
   }
-  for (const BodyForceModel& f : m_.body_forces) {
+  for (const BodyForceModel& f : m_->body_forces) {
     const BodyAD a = body_ad(d_.oMi[f.body], V_[f.body], 0, f.body > 0);
     Vec3A F = f.force.cast<AD>(), T = f.torque.cast<AD>();
     if (!f.in_world) {
@@ -581,14 +597,14 @@ void TreeDerivatives::applied_force_derivatives(const Eigen::VectorXd& q, const 
     if (body <= 0) return;
     for (int pu : path_[body]) {
       const Unit& up = units_[pu];
-      const auto Sp = S_[up.body].middleCols(up.iv - m_.joints[up.body].idx_v, up.n);
+      const auto Sp = S_[up.body].middleCols(up.iv - m_->joints[up.body].idx_v, up.n);
       dQ_du.block(up.iv, k, up.n, 1).noalias() += Sp.transpose() * wu;
-      for (const auto& [mix, weight] : m_.actuators[k].driven_by)
+      for (const auto& [mix, weight] : m_->actuators[k].driven_by)
         dQ_du.block(up.iv, mix, up.n, 1).noalias() += weight * (Sp.transpose() * wu);
     }
   };
-  for (int k = 0; k < m_.nu(); ++k) {
-    const ActuatorModel& act = m_.actuators[k];
+  for (int k = 0; k < m_->nu(); ++k) {
+    const ActuatorModel& act = m_->actuators[k];
     if (act.type == ActuatorType::Mix || act.type == ActuatorType::Motion) continue;  // no force of its own
     double uk_in = u[k];  // the input with the mixes' shares
     for (const auto& [mix, weight] : act.driven_by) uk_in += weight * u[mix];
@@ -652,10 +668,10 @@ void TreeDerivatives::sensor_derivatives(const Eigen::VectorXd& q, const Eigen::
                                          const std::vector<int>& outputs) {
   const int ny = static_cast<int>(outputs.size());
   y.resize(ny);
-  dy_dq.setZero(ny, m_.nv);
-  dy_dv.setZero(ny, m_.nv);
+  dy_dq.setZero(ny, m_->nv);
+  dy_dv.setZero(ny, m_->nv);
   for (int r = 0; r < ny; ++r) {
-    const SensorModel& s = m_.sensors[outputs[r]];
+    const SensorModel& s = m_->sensors[outputs[r]];
     if (s.type == SensorType::JointPosition) {
       y[r] = q[s.iq];
       dy_dq(r, s.iv) = 1.0;
@@ -718,7 +734,7 @@ void TreeDerivatives::sensor_derivatives(const Eigen::VectorXd& q, const Eigen::
       const Eigen::Matrix<double, 6, 1> Dpose = g.segment<6>(12 * slot), Dvel = g.segment<6>(12 * slot + 6);
       for (int pu : path_[beta]) {
         const Unit& up = units_[pu];
-        const auto Sp = S_[up.body].middleCols(up.iv - m_.joints[up.body].idx_v, up.n);
+        const auto Sp = S_[up.body].middleCols(up.iv - m_->joints[up.body].idx_v, up.n);
         const Vec6 rel = V_[beta] - Vpar_[pu];
         for (int c = 0; c < up.n; ++c) {
           const Vec6 sc = Sp.col(c);
@@ -732,7 +748,7 @@ void TreeDerivatives::sensor_derivatives(const Eigen::VectorXd& q, const Eigen::
 
 void TreeDerivatives::compute(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& u_all,
                               const std::vector<int>& outputs) {
-  const int nv = m_.nv, nu = m_.nu();
+  const int nv = m_->nv, nu = m_->nu();
   // bias forces at qdd = 0, applied forces, mass matrix
   world_kinematics(q, v);
   accelerations(v, qdd_zero_);
@@ -749,7 +765,7 @@ void TreeDerivatives::compute(const Eigen::VectorXd& q, const Eigen::VectorXd& v
   // inverse dynamics at the true accelerations, and its derivatives
   accelerations(v, qdd);
   forces();
-  add_armature_force(m_, qdd, tau);
+  add_armature_force(*m_, qdd, tau);
   differentiate_rnea();
   // M^-1 once (nv right-hand sides), then products: on these sizes a matrix
   // product runs faster than triangular solves with 2 nv + nu right-hand
@@ -766,7 +782,7 @@ void TreeDerivatives::compute(const Eigen::VectorXd& q, const Eigen::VectorXd& v
   dqdd_dq.noalias() = Minv_ * rhs_.leftCols(nv);
   dqdd_dv.noalias() = Minv_ * rhs_.middleCols(nv, nv);
   for (int k = 0; k < nu; ++k) {
-    const ActuatorModel& act = m_.actuators[k];
+    const ActuatorModel& act = m_->actuators[k];
     if (act.type == ActuatorType::JointForce) dqdd_du.col(k) = act.gain * Minv_.col(act.iv);
     else dqdd_du.col(k).noalias() = Minv_ * dQ_du.col(k);
   }
@@ -781,7 +797,7 @@ void TreeDerivatives::chain_constraint_row(int row, const Grad36& gc, const Grad
     const auto Ppose = gp.segment<6>(18 * slot), PV = gp.segment<6>(18 * slot + 6);
     for (int pu : path_[beta]) {
       const Unit& up = units_[pu];
-      const auto Sp = S_[up.body].middleCols(up.iv - m_.joints[up.body].idx_v, up.n);
+      const auto Sp = S_[up.body].middleCols(up.iv - m_->joints[up.body].idx_v, up.n);
       const Vec6& Vp = Vpar_[pu];
       const Vec6 rel = V_[beta] - Vp;
       const Vec6 acc_rel = A_[beta] - Apar_[pu] - crm(Vp, rel);
@@ -808,7 +824,7 @@ void TreeDerivatives::constraint_derivatives(const Eigen::VectorXd& lambda, cons
   dc_dv.setZero();
   dphid_dq.setZero();
   Vec6 A0 = Vec6::Zero();  // the true accelerations: A_ carries gravity as A_0 = -g
-  if (m_.has_gravity) A0.tail<3>() = -m_.gravity;
+  if (m_->has_gravity) A0.tail<3>() = -m_->gravity;
   auto kin = [&](int body, const Vec3& l, bool vector) {
     return body > 0 ? local_kin(d_.oMi[body], V_[body], Vec6(A_[body] - A0), l, vector, true)
                     : local_kin(d_.oMi[0], Vec6::Zero(), Vec6::Zero(), l, vector, false);
@@ -917,7 +933,7 @@ void TreeDerivatives::constraint_derivatives(const Eigen::VectorXd& lambda, cons
     G.middleCols<18>(18 * slot) = D;
     return G;
   };
-  for (const ConstraintModel& cm : m_.constraints) {
+  for (const ConstraintModel& cm : m_->constraints) {
     if (cm.type == ConstraintType::Coupler) {
       // sum_k ratio_k q_k = offset: Jc is the ratios, c = Jc a, and the reaction -Jc^T lambda acts on
       // the coordinates themselves; nothing here depends on q or v
@@ -1069,18 +1085,18 @@ void TreeDerivatives::compute_constrained(const Eigen::VectorXd& q, const Eigen:
                                           const Eigen::VectorXd& u_all, const Eigen::VectorXd& a,
                                           const Eigen::VectorXd& lambda, const std::vector<int>& rows,
                                           const std::vector<int>& outputs) {
-  const int nv = m_.nv, nu = m_.nu(), na = static_cast<int>(rows.size());
+  const int nv = m_->nv, nu = m_->nu(), na = static_cast<int>(rows.size());
   world_kinematics(q, v);
   accelerations(v, a);
   composites();
   forces();
-  add_armature_force(m_, a, tau);
+  add_armature_force(*m_, a, tau);
   differentiate_rnea();
   applied_force_derivatives(q, v, u_all);
   constraint_derivatives(lambda, a);
   mass_matrix();
   qdd = a;
-  if (!m_.motions.empty()) {
+  if (!m_->motions.empty()) {
     solve_prescribed(rows);
     sensor_derivatives(q, v, outputs);
     return;
@@ -1129,7 +1145,7 @@ void TreeDerivatives::compute_constrained(const Eigen::VectorXd& q, const Eigen:
 // q, v and u columns and da_d = e_k for motion k's acceleration. The same Schur complement as
 // the loops without motion, on M_ff, which stays positive definite with massless driven bodies.
 void TreeDerivatives::solve_prescribed(const std::vector<int>& rows) {
-  const int nv = m_.nv, nu = m_.nu(), na = static_cast<int>(rows.size());
+  const int nv = m_->nv, nu = m_->nu(), na = static_cast<int>(rows.size());
   const int nm = static_cast<int>(driven_.size()), nf = static_cast<int>(free_.size());
   for (int i = 0; i < nf; ++i)
     for (int j = 0; j < nf; ++j) Mff_(i, j) = M(free_[i], free_[j]);

@@ -60,6 +60,9 @@ class TreeDerivatives {
   // model must outlive this object; with loop closures (model.nc > 0) only
   // compute_constrained() and rnea_derivatives() apply
   explicit TreeDerivatives(const Model& model);
+  // the same as TreeDerivatives(model) for another model (or this one changed), reusing the
+  // memory: everything derived from the model is made again, the storage kept where sizes repeat
+  void bind(const Model& model);
 
   // true when compute() can differentiate this model with these plant outputs
   // (a tree; every sensor type is supported)
@@ -134,7 +137,9 @@ class TreeDerivatives {
   void chain_constraint_row(int row, const Eigen::Matrix<double, 36, 1>& gc, const Eigen::Matrix<double, 36, 1>& gp,
                             int body_a, int body_b);
 
-  const Model& m_;
+  void size_for(const Model& model);
+
+  const Model* m_;
   Data d_;
   std::vector<Unit> units_;
   std::vector<int> unit_begin_, unit_end_;       // [nbodies] units of a body's joint

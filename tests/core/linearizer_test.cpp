@@ -6,14 +6,20 @@
 // Linearizer written into one Linearization (nothing of one point may leak into the next), on a
 // random 3-D tree with every joint type, body-force inputs and sensors of several kinds, and on
 // every tree example; and the general path (closed loops, finite differences) through it equals
-// linearize().
+// linearize(). A Linearizer bound again (bind) to other models in turn, and linearize() alone
+// (its workspaces kept per thread) on a model changed in place or made at a freed one's address,
+// give what a new Linearizer gives, bit for bit: nothing of an earlier model is read.
 #include "analysis/linearizer.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cstring>
 #include <filesystem>
+#include <algorithm>
+#include <functional>
+#include <optional>
 #include <random>
+#include <tuple>
 
 #include "analysis/operating_point.hpp"
 #include "test_util.hpp"
@@ -187,6 +193,163 @@ TEST(Linearizer, GeneralPathThroughItEqualsLinearize) {
       EXPECT_EQ(into.system.method, to_string(method)) << name;
     }
   }
+}
+
+// everything a Linearization holds, bit for bit
+void expect_same(const Linearization& a, const Linearization& b, const std::string& label) {
+  const LinearSystem &s = a.system, &t = b.system;
+  for (auto [x, y, what] : {std::tuple{&s.A, &t.A, "A"}, {&s.B, &t.B, "B"}, {&s.C, &t.C, "C"}, {&s.D, &t.D, "D"}})
+    EXPECT_TRUE(Same(*x, *y)) << label << ": " << what;
+  for (auto [x, y, what] : {std::tuple{&s.x0, &t.x0, "x0"}, {&s.u0, &t.u0, "u0"}, {&s.y0, &t.y0, "y0"},
+                            {&s.xdot0, &t.xdot0, "xdot0"}})
+    EXPECT_TRUE(Same(*x, *y)) << label << ": " << what;
+  EXPECT_EQ(s.state_names, t.state_names) << label;
+  EXPECT_EQ(s.state_units, t.state_units) << label;
+  EXPECT_EQ(s.input_names, t.input_names) << label;
+  EXPECT_EQ(s.input_units, t.input_units) << label;
+  EXPECT_EQ(s.output_names, t.output_names) << label;
+  EXPECT_EQ(s.output_units, t.output_units) << label;
+  EXPECT_EQ(s.positions, t.positions) << label;
+  EXPECT_EQ(s.model_name, t.model_name) << label;
+  EXPECT_EQ(s.operating_point, t.operating_point) << label;
+  EXPECT_EQ(a.partition.independent, b.partition.independent) << label;
+  EXPECT_EQ(a.partition.dependent, b.partition.dependent) << label;
+  EXPECT_EQ(a.fd_error, b.fd_error) << label;
+}
+
+// the examples' models, each at a moved point (velocities and inputs)
+struct Case {
+  std::string name;
+  Model m;
+  OperatingPoint op;
+};
+std::vector<Case> example_cases() {
+  std::vector<Case> cases;
+  for (const auto& entry : std::filesystem::directory_iterator(CODYNA_EXAMPLES_DIR)) {
+    if (entry.path().extension() != ".json") continue;
+    Case c{entry.path().filename().string(), test::load_example(entry.path().filename().string()), {}};
+    c.op = initial_point(c.m);
+    if (c.m.nc == 0 && c.m.motions.empty())
+      for (int k = 0; k < c.m.nv; ++k) c.op.v[k] += 0.2 + 0.05 * k;
+    for (int i : c.m.plant_inputs) c.op.u[i] += 0.3;
+    cases.push_back(std::move(c));
+  }
+  std::sort(cases.begin(), cases.end(), [](const Case& a, const Case& b) { return a.name < b.name; });
+  return cases;
+}
+
+// One Linearizer bound in turn to every example (trees and closed loops, sizes changing and
+// repeating), forwards then backwards, and linearize() alone on each: what a new Linearizer gives
+TEST(Linearizer, BoundInTurnToEveryExampleEqualsANewOne) {
+  const std::vector<Case> cases = example_cases();
+  ASSERT_GE(cases.size(), 15u);
+  Linearizer lz(cases[0].m);
+  Linearization into;
+  int n = 0;
+  for (int pass = 0; pass < 2; ++pass)
+    for (std::size_t i = 0; i < cases.size(); ++i) {
+      const Case& c = cases[pass == 0 ? i : cases.size() - 1 - i];
+      const Linearization fresh = Linearizer(c.m).linearize(c.op);
+      lz.bind(c.m);
+      lz.linearize(c.op, {}, into);
+      expect_same(into, fresh, c.name + " (bound)");
+      expect_same(linearize(c.m, c.op), fresh, c.name + " (linearize alone)");
+      ++n;
+    }
+  EXPECT_EQ(n, 2 * static_cast<int>(cases.size()));
+}
+
+// linearize() alone keeps its workspaces per thread and prepares them again unless the model is
+// the one prepared last with every field it read unchanged: a model changed in place, field by
+// field, is linearized as a new Linearizer linearizes it, and differently from before the change
+// (so that each change is seen to matter)
+TEST(Linearizer, LinearizeAloneOnAModelChangedInPlaceEqualsANewLinearizer) {
+  ModelSpec s = test::random_tree_spec(33, 8);
+  ActuatorSpec a;
+  a.name = "tau1";
+  a.joint = "j1";
+  a.unit = "N*m";
+  s.actuators.push_back(a);
+  a.name = "push";
+  a.type = ActuatorType::BodyForce;
+  a.body = "b4";
+  a.point = Eigen::Vector3d(0.1, 0.2, 0.3);
+  a.direction = Eigen::Vector3d(1, 2, 3);
+  s.actuators.push_back(a);
+  SensorSpec y;
+  y.name = "p5";
+  y.type = SensorType::PointPosition;
+  y.body = "b5";
+  y.point = Eigen::Vector3d(0.3, 0, 0);
+  y.component = 2;
+  s.sensors.push_back(y);
+  y.name = "w1";
+  y.type = SensorType::JointVelocity;
+  y.joint = "j1";
+  s.sensors.push_back(y);
+  s.plant.inputs = {"tau1", "push"};
+  s.plant.outputs = {"p5", "w1"};
+  Model m = compile(s);
+  ASSERT_EQ(m.nc, 0);
+  OperatingPoint op = initial_point(m);
+  std::mt19937 rng(5);
+  op.v = test::random_v(m, rng, 1.0);
+  op.u[0] = 0.4;
+  op.u[1] = -0.3;
+  const int b = 3;  // a body whose numbers change
+  int hinge = 0;    // a body on a revolute or prismatic joint: its axis changes
+  for (int i = 1; i < m.nbodies && !hinge; ++i)
+    if (m.joints[i].type == JointType::Revolute || m.joints[i].type == JointType::Prismatic) hinge = i;
+  ASSERT_GT(hinge, 0);
+  const std::vector<std::pair<std::string, std::function<void(Model&)>>> changes{
+      {"mass", [&](Model& x) { x.mass[b] *= 1.5; }},
+      {"inertia", [&](Model& x) { x.inertia[b](0, 0) *= 1.5; }},
+      {"com", [&](Model& x) { x.com[b].x() += 0.1; }},
+      {"joint placement", [&](Model& x) { x.joints[b].X_PF.p.y() += 0.1; }},
+      {"joint frame in the child", [&](Model& x) { x.joints[b].X_CM.p.z() -= 0.1; }},
+      {"joint axis", [&](Model& x) { x.joints[hinge].axis = Eigen::Vector3d(1, 1, 0).normalized(); }},
+      {"gravity", [&](Model& x) { x.gravity.z() *= 2; x.has_gravity = true; }},
+      {"input name", [&](Model& x) { x.actuators[x.plant_inputs[0]].name = "a longer name than a short string holds"; }},
+      {"input unit", [&](Model& x) { x.actuators[x.plant_inputs[0]].unit = "N"; }},
+      {"output name", [&](Model& x) { x.sensors[x.plant_outputs[1]].name = "w"; }},
+      {"coordinate name", [&](Model& x) { x.v_names[0] = "renamed"; }},
+      {"rate name", [&](Model& x) { x.rate_names[0] = "renamed_dot"; }},
+      {"outputs reordered", [&](Model& x) { std::swap(x.plant_outputs[0], x.plant_outputs[1]); }},
+      {"an input dropped", [&](Model& x) { x.plant_inputs.pop_back(); }},
+  };
+  for (const auto& [what, change] : changes) {
+    const Linearization before = linearize(m, op);
+    expect_same(before, Linearizer(m).linearize(op), what + ": before");
+    change(m);
+    const Linearization after = linearize(m, op);
+    expect_same(after, Linearizer(m).linearize(op), what);
+    const bool numbers = !Same(after.system.A, before.system.A) || !Same(after.system.B, before.system.B) ||
+                         !Same(after.system.C, before.system.C) || !Same(after.system.xdot0, before.system.xdot0);
+    const bool names = after.system.state_names != before.system.state_names ||
+                       after.system.input_names != before.system.input_names ||
+                       after.system.input_units != before.system.input_units ||
+                       after.system.output_names != before.system.output_names;
+    EXPECT_TRUE(numbers || names) << what << ": the change made no difference, the test checks nothing";
+  }
+}
+
+// a model freed and another made at its address, of the same shape: the other's numbers
+TEST(Linearizer, LinearizeAloneOnAnotherModelAtAFreedOnesAddress) {
+  const Model a = test::load_example("double_pendulum.json");
+  Model b = a;
+  b.mass[2] *= 2;
+  b.inertia[2] *= 2;
+  std::optional<Model> slot;
+  slot.emplace(a);
+  const Model* where = &*slot;
+  const OperatingPoint op = initial_point(a);
+  const Linearization la = linearize(*slot, op);
+  slot.emplace(b);
+  ASSERT_EQ(&*slot, where);
+  const Linearization lb = linearize(*slot, op);
+  expect_same(la, Linearizer(a).linearize(op), "a");
+  expect_same(lb, Linearizer(b).linearize(op), "b");
+  EXPECT_FALSE(Same(la.system.A, lb.system.A));
 }
 
 }  // namespace
