@@ -152,7 +152,7 @@ bool TreeDerivatives::supports(const Model& model) { return model.nc == 0; }
 TreeDerivatives::TreeDerivatives(const Model& model) : m_(&model), d_(model), llt_(model.nv) { size_for(model); }
 
 void TreeDerivatives::bind(const Model& model) {
-  if (model.nv != m_->nv) llt_ = Eigen::LLT<Eigen::MatrixXd>(model.nv);
+  if (llt_.rows() != model.nv) llt_ = Eigen::LLT<Eigen::MatrixXd>(model.nv);  // (m_ may be gone: not read)
   m_ = &model;
   d_.reset(model);
   size_for(model);
