@@ -82,6 +82,8 @@ class Compiler {
       check_bodies();
       for (int b = 1; b < m_.nbodies; ++b) set_body_numbers(b, spec_.bodies[static_cast<std::size_t>(m_.body_spec_index[b])]);
     }
+    if (what.effects || what.actuators || what.sensors)
+      for (int b = 0; b < m_.nbodies; ++b) compiled_[m_.body_names[static_cast<std::size_t>(b)]] = b;
     if (what.effects) {
       const Model blank;
       m_.has_gravity = blank.has_gravity;
@@ -91,8 +93,24 @@ class Compiler {
       m_.joint_frictions.clear();
       m_.body_forces.clear();
       m_.bushings.clear();
-      for (int b = 0; b < m_.nbodies; ++b) compiled_[m_.body_names[static_cast<std::size_t>(b)]] = b;
       build_effects();
+    }
+    // in the structure's order, under the same names: the plant's inputs and outputs, the motions
+    // and the sensors of motion forces find the same indices
+    if (what.actuators) {
+      if (spec_.actuators.size() != structure.actuators.size())
+        throw std::invalid_argument("compile_numbers: the spec has " + std::to_string(spec_.actuators.size()) +
+                                    " actuators, the structure " + std::to_string(structure.actuators.size()));
+      m_.actuators.clear();
+      m_.motions.clear();
+      build_actuators();
+    }
+    if (what.sensors) {
+      if (spec_.sensors.size() != structure.sensors.size())
+        throw std::invalid_argument("compile_numbers: the spec has " + std::to_string(spec_.sensors.size()) +
+                                    " sensors, the structure " + std::to_string(structure.sensors.size()));
+      m_.sensors.clear();
+      build_sensors();
     }
     if (what.initial) {
       if (spec_.joints.size() != structure.joints.size() - 1)

@@ -21,11 +21,16 @@ Model compile_structure(const ModelSpec& spec, const std::string& file = "");
 // indices: the bodies' mass, com and inertia; the effects (gravity, springs and dampers, bushings,
 // forces: any of their fields, since nothing else refers to them); the joints' q0 and v0 (the
 // initial state, and what follows from it: the motion inputs' nominal values, the couplers' offsets
-// when the file gives none).
+// when the file gives none); the actuators' numbers (gain, u0, min, max, point, direction, point_a,
+// point_b, a mix's weights) and the sensors' (point, axis, point_a, point_b), whose names, types and
+// the joints and bodies they name stay the structure's (the plant's inputs and outputs keep their
+// indices).
 struct NumbersChanged {
   bool bodies = false;
   bool effects = false;
   bool initial = false;
+  bool actuators = false;
+  bool sensors = false;
 };
 
 // The model of `spec` from `structure`, compile_structure's model of a spec that differs from `spec`

@@ -364,7 +364,7 @@ ModelSpec variant_spec(const Context& c, const SweepVariant& v) {
 
 // what the varied fields change of the compiled model when they leave its tree, names and indices
 // as they are (compile_numbers): a body's mass, com or inertia (or a component of them), any field of
-// an effect, a joint's q0 or v0; nothing otherwise
+// an effect, a joint's q0 or v0, an actuator's or a sensor's numbers (NumbersChanged); nothing otherwise
 std::optional<NumbersChanged> numbers_changed(const std::vector<SweepVary>& vary) {
   NumbersChanged what;
   for (const SweepVary& v : vary) {
@@ -381,6 +381,11 @@ std::optional<NumbersChanged> numbers_changed(const std::vector<SweepVary>& vary
       what.effects = true;
     else if (section == "joints" && (name == "q0" || name == "v0"))
       what.initial = true;
+    else if (section == "actuators" && (name == "gain" || name == "u0" || name == "min" || name == "max" || name == "point" ||
+                                        name == "direction" || name == "point_a" || name == "point_b" || name == "weights"))
+      what.actuators = true;
+    else if (section == "sensors" && (name == "point" || name == "axis" || name == "point_a" || name == "point_b"))
+      what.sensors = true;
     else
       return std::nullopt;
   }

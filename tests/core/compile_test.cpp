@@ -4,6 +4,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <tuple>
 #include <optional>
 #include <nlohmann/json.hpp>
 #include <random>
@@ -11,6 +13,7 @@
 #include "dynamics/constraints.hpp"
 #include "dynamics/data.hpp"
 #include "dynamics/forward_dynamics.hpp"
+#include "dynamics/sensors.hpp"
 #include "io/model_file.hpp"
 #include "model/compile.hpp"
 #include "test_util.hpp"
@@ -170,6 +173,30 @@ bool expect_same_as_compiling_again(const Model& structure, const ModelSpec& var
   const Eigen::VectorXd u = Eigen::VectorXd::Random(a->nu());
   const Eigen::VectorXd v = test::random_v(*a, rng);
   EXPECT_EQ(forward_dynamics<double>(*a, da, a->q0, v, u), forward_dynamics<double>(*b, db, b->q0, v, u));
+  EXPECT_EQ(a->plant_inputs, b->plant_inputs);
+  EXPECT_EQ(a->plant_outputs, b->plant_outputs);
+  EXPECT_EQ(a->motions, b->motions);
+  EXPECT_EQ(a->nu(), b->nu());
+  if (a->nu() != b->nu()) return false;
+  for (int k = 0; k < a->nu(); ++k) {
+    const ActuatorModel &x = a->actuators[k], &y = b->actuators[k];
+    EXPECT_EQ(std::tie(x.name, x.type, x.iv, x.iq, x.body, x.body_b, x.in_world, x.unit, x.driven_by),
+              std::tie(y.name, y.type, y.iv, y.iq, y.body, y.body_b, y.in_world, y.unit, y.driven_by));
+    EXPECT_EQ(std::tie(x.gain, x.u0, x.min, x.max), std::tie(y.gain, y.u0, y.min, y.max));
+    EXPECT_EQ(x.point, y.point);
+    EXPECT_EQ(x.point_b, y.point_b);
+    EXPECT_EQ(x.direction, y.direction);
+  }
+  EXPECT_EQ(a->ny(), b->ny());
+  if (a->ny() != b->ny()) return false;
+  std::vector<int> all(static_cast<std::size_t>(a->ny()));
+  for (int k = 0; k < a->ny(); ++k) {
+    all[static_cast<std::size_t>(k)] = k;
+    EXPECT_EQ(a->sensors[k].name, b->sensors[k].name);
+    EXPECT_EQ(a->sensors[k].unit, b->sensors[k].unit);
+  }
+  Data sa(*a), sb(*b);
+  EXPECT_EQ(sensor_outputs<double>(*a, sa, all, a->q0, v), sensor_outputs<double>(*b, sb, all, b->q0, v));
   return true;
 }
 
@@ -205,6 +232,66 @@ TEST(Compile, EffectNumbersOnTheStructureEqualCompilingAgain) {
   EXPECT_GE(variants, 40);
   RecordProperty("variants", variants);
   RecordProperty("errors", errors);
+}
+
+// compile_numbers on the actuators and the sensors: every number of every actuator's and sensor's
+// fields that NumbersChanged names, in every example (a component at a time, x 1.1 + 0.01; and each
+// actuator made invalid, its min above its max), each variant the model compile gives bit for bit (the actuators'
+// fields, the forward dynamics with every input nonzero, every sensor's value), or its error
+TEST(Compile, ActuatorAndSensorNumbersOnTheStructureEqualCompilingAgain) {
+  std::mt19937 rng(9);
+  int variants = 0, errors = 0, refused = 0, actuators = 0, sensors = 0;
+  const std::map<std::string, std::vector<std::string>> fields{
+      {"actuators", {"gain", "u0", "min", "max", "point", "direction", "point_a", "point_b", "weights"}},
+      {"sensors", {"point", "axis", "point_a", "point_b"}}};
+  for (const auto& entry : std::filesystem::directory_iterator(CODYNA_EXAMPLES_DIR)) {
+    if (entry.path().extension() != ".json") continue;
+    const std::string file = entry.path().string();
+    std::ifstream in(file);
+    const nlohmann::json j = nlohmann::json::parse(in);
+    Model structure = compile_structure(parse_model_spec(j, file), file);
+    structure.spec = ModelSpec{};
+    // refused the same way: each actuator's min above its max
+    if (j.contains("actuators"))
+      for (std::size_t k = 0; k < j["actuators"].size(); ++k) {
+        nlohmann::json edited = j;
+        edited["actuators"][k]["min"] = 2.0;
+        edited["actuators"][k]["max"] = 1.0;
+        SCOPED_TRACE(file + ": /actuators/" + std::to_string(k) + "/min");
+        ++variants;
+        ++actuators;
+        refused += !expect_same_as_compiling_again(structure, parse_model_spec(edited, file), {.actuators = true}, file, rng);
+      }
+    for (const auto& [section, names] : fields) {
+      if (!j.contains(section)) continue;
+      for (std::size_t k = 0; k < j[section].size(); ++k)
+        for (const std::string& name : names) {
+          if (!j[section][k].contains(name)) continue;
+          const std::string at = "/" + section + "/" + std::to_string(k) + "/" + name;
+          const nlohmann::json leaves = j[section][k][name].is_number() ? nlohmann::json::object({{"", j[section][k][name]}})
+                                                                         : j[section][k][name].flatten();
+          for (const auto& [leaf, value] : leaves.items()) {
+            if (!value.is_number()) continue;
+            nlohmann::json edited = j;
+            const std::string field = at + leaf;
+            edited[nlohmann::json::json_pointer(field)] = value.get<double>() * 1.1 + 0.01;
+            SCOPED_TRACE(file + ": " + field);
+            const ModelSpec variant = parse_model_spec(edited, file);
+            ++variants;
+            (section == "actuators" ? actuators : sensors) += 1;
+            NumbersChanged what;
+            (section == "actuators" ? what.actuators : what.sensors) = true;
+            errors += !expect_same_as_compiling_again(structure, variant, what, file, rng);
+          }
+        }
+    }
+  }
+  EXPECT_GE(actuators, 15);
+  EXPECT_GE(sensors, 5);
+  EXPECT_GE(refused, 15);  // every one of those edits is refused, by both
+  EXPECT_EQ(errors, 0);
+  RecordProperty("variants", variants);
+  RecordProperty("refused", refused);
 }
 
 // compile_numbers on the joints' q0 and v0: every component of every joint's q0 and v0 in every
