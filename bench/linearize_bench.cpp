@@ -6,7 +6,8 @@
 //   Linearize/<n>  linearize(model, op): the partition, the plant function, the
 //                  exact Jacobian, xdot0 and y0, names, units, x0 (everything a
 //                  LinearSystem holds), the operating point given; one call
-//                  alone (its workspaces made and freed in the call)
+//                  alone (the thread's kept workspaces bound to the model, a
+//                  new Linearization returned)
 //   Linearizer/<n> the same numbers through a Linearizer kept from call to call
 //                  (analysis/linearizer.hpp), written into the same
 //                  Linearization: what a study or a trajectory pays per point
