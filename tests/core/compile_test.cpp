@@ -200,20 +200,29 @@ bool expect_same_as_compiling_again(const Model& structure, const ModelSpec& var
   return true;
 }
 
+// every example: its file, its JSON and its compiled structure, the structure's spec dropped
+// (compile_numbers must not need it)
+template <class F>
+void for_each_example_structure(F&& f) {
+  for (const auto& entry : std::filesystem::directory_iterator(CODYNA_EXAMPLES_DIR)) {
+    if (entry.path().extension() != ".json") continue;
+    const std::string file = entry.path().string();
+    std::ifstream in(file);
+    const nlohmann::json j = nlohmann::json::parse(in);
+    Model structure = compile_structure(parse_model_spec(j, file), file);
+    structure.spec = ModelSpec{};
+    f(file, j, structure);
+  }
+}
+
 // compile_numbers on the effects: every number of every effect of every example changed (a
 // component at a time, x 1.1 + 0.01: stiffnesses, dampings, gravity, rest lengths, frames; integers
 // + 1: coordinate indices, made invalid), each variant the model compile gives bit for bit, or its error
 TEST(Compile, EffectNumbersOnTheStructureEqualCompilingAgain) {
   std::mt19937 rng(5);
   int variants = 0, errors = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(CODYNA_EXAMPLES_DIR)) {
-    if (entry.path().extension() != ".json") continue;
-    const std::string file = entry.path().string();
-    std::ifstream in(file);
-    const nlohmann::json j = nlohmann::json::parse(in);
-    if (!j.contains("effects")) continue;
-    Model structure = compile_structure(parse_model_spec(j, file), file);
-    structure.spec = ModelSpec{};
+  for_each_example_structure([&](const std::string& file, const nlohmann::json& j, const Model& structure) {
+    if (!j.contains("effects")) return;
     const nlohmann::json flat = j["effects"].flatten();
     for (const auto& [pointer, value] : flat.items()) {
       if (!value.is_number()) continue;
@@ -228,7 +237,7 @@ TEST(Compile, EffectNumbersOnTheStructureEqualCompilingAgain) {
       ++variants;
       errors += !expect_same_as_compiling_again(structure, variant, {.effects = true}, file, rng);
     }
-  }
+  });
   EXPECT_GE(variants, 40);
   RecordProperty("variants", variants);
   RecordProperty("errors", errors);
@@ -244,13 +253,7 @@ TEST(Compile, ActuatorAndSensorNumbersOnTheStructureEqualCompilingAgain) {
   const std::map<std::string, std::vector<std::string>> fields{
       {"actuators", {"gain", "u0", "min", "max", "point", "direction", "point_a", "point_b", "weights"}},
       {"sensors", {"point", "axis", "point_a", "point_b"}}};
-  for (const auto& entry : std::filesystem::directory_iterator(CODYNA_EXAMPLES_DIR)) {
-    if (entry.path().extension() != ".json") continue;
-    const std::string file = entry.path().string();
-    std::ifstream in(file);
-    const nlohmann::json j = nlohmann::json::parse(in);
-    Model structure = compile_structure(parse_model_spec(j, file), file);
-    structure.spec = ModelSpec{};
+  for_each_example_structure([&](const std::string& file, const nlohmann::json& j, const Model& structure) {
     // refused the same way: each actuator's min above its max
     if (j.contains("actuators"))
       for (std::size_t k = 0; k < j["actuators"].size(); ++k) {
@@ -285,7 +288,7 @@ TEST(Compile, ActuatorAndSensorNumbersOnTheStructureEqualCompilingAgain) {
           }
         }
     }
-  }
+  });
   EXPECT_GE(actuators, 15);
   EXPECT_GE(sensors, 5);
   EXPECT_GE(refused, 15);  // every one of those edits is refused, by both
@@ -301,13 +304,7 @@ TEST(Compile, ActuatorAndSensorNumbersOnTheStructureEqualCompilingAgain) {
 TEST(Compile, InitialValuesOnTheStructureEqualCompilingAgain) {
   std::mt19937 rng(3);
   int variants = 0, errors = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(CODYNA_EXAMPLES_DIR)) {
-    if (entry.path().extension() != ".json") continue;
-    const std::string file = entry.path().string();
-    std::ifstream in(file);
-    const nlohmann::json j = nlohmann::json::parse(in);
-    Model structure = compile_structure(parse_model_spec(j, file), file);
-    structure.spec = ModelSpec{};
+  for_each_example_structure([&](const std::string& file, const nlohmann::json& j, const Model& structure) {
     for (std::size_t k = 0; k < j["joints"].size(); ++k) {
       for (const char* key : {"q0", "v0"}) {
         if (!j["joints"][k].contains(key)) continue;
@@ -326,7 +323,7 @@ TEST(Compile, InitialValuesOnTheStructureEqualCompilingAgain) {
         }
       }
     }
-  }
+  });
   EXPECT_GE(variants, 30);
   RecordProperty("variants", variants);
   RecordProperty("errors", errors);

@@ -129,84 +129,9 @@ TEST(Linearize, FiniteDifferencesAgreeWithinTheirReportedAccuracy) {
   }
 }
 
-// a random 3-D tree with ball and free joints, inputs and outputs of every kind
-ModelSpec random_plant(unsigned seed) {
-  ModelSpec s = test::random_tree_spec(seed, 10);
-  ActuatorSpec a;
-  a.name = "tau1";
-  a.type = ActuatorType::JointForce;
-  a.joint = "j1";
-  s.actuators.push_back(a);
-  a.name = "push";
-  a.type = ActuatorType::BodyForce;
-  a.body = "b4";
-  a.point = Eigen::Vector3d(0.1, 0.2, 0.3);
-  a.direction = Eigen::Vector3d(1, 2, 3);
-  a.in_world = false;
-  s.actuators.push_back(a);
-  a.name = "twist";
-  a.type = ActuatorType::BodyTorque;
-  a.body = "b6";
-  a.direction = Eigen::Vector3d(0.3, -1, 0.5);
-  a.in_world = false;
-  s.actuators.push_back(a);
-  SensorSpec y;
-  y.name = "p5";
-  y.type = SensorType::PointPosition;
-  y.body = "b5";
-  y.point = Eigen::Vector3d(0.3, 0, 0);
-  y.component = 2;
-  y.frame = "b1";
-  s.sensors.push_back(y);
-  y.name = "v6";
-  y.type = SensorType::PointVelocity;
-  y.body = "b6";
-  y.component = 0;
-  y.frame = kGroundName;
-  s.sensors.push_back(y);
-  y.name = "ang2";
-  y.type = SensorType::BodyAngle;
-  y.body = "b2";
-  y.axis = Eigen::Vector3d(0, 0, 1);
-  s.sensors.push_back(y);
-  y.name = "dist";
-  y.type = SensorType::Distance;
-  y.body_a = "b3";
-  y.body_b = "b8";
-  y.point_b = Eigen::Vector3d(0.1, 0.1, 0.1);
-  s.sensors.push_back(y);
-  y.name = "w1";
-  y.type = SensorType::JointVelocity;
-  y.joint = "j1";
-  s.sensors.push_back(y);
-  s.plant.inputs = {"tau1", "push", "twist"};
-  s.plant.outputs = {"p5", "v6", "ang2", "dist", "w1"};
-  EffectSpec e;
-  e.name = "spring";
-  e.type = EffectType::SpringDamper;
-  e.body_a = "b3";
-  e.body_b = "b7";
-  e.stiffness = 50;
-  e.damping = 2;
-  e.rest_length = 0.1;
-  s.effects.push_back(e);
-  e.name = "fric";
-  e.type = EffectType::JointFriction;
-  e.joint = "j4";  // universal: two coordinates
-  e.dof = 1;
-  e.damping = 0.3;
-  s.effects.push_back(e);
-  e.name = "ball_damper";
-  e.type = EffectType::JointDamper;
-  e.joint = "j2";  // spherical
-  e.damping = 0.2;
-  s.effects.push_back(e);
-  return s;
-}
-
 TEST(Linearize, ExactMatchesCentralDifferencesOnRandom3DTree) {
   for (unsigned seed : {91u, 92u}) {
-    const Model m = compile(random_plant(seed));
+    const Model m = compile(test::random_plant(seed));
     std::mt19937 rng(seed);
     OperatingPoint op = initial_point(m);
     op.q = test::random_q(m, rng);
@@ -245,7 +170,7 @@ TEST(Linearize, ReusingFiniteDifferencesEqualFullEvaluations) {
     }
   };
   for (unsigned seed : {91u, 92u, 93u}) {
-    const Model m = compile(random_plant(seed));
+    const Model m = compile(test::random_plant(seed));
     std::mt19937 rng(seed);
     Eigen::VectorXd u_all(3);
     u_all << 0.7, -1.3, 0.4;

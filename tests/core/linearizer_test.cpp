@@ -125,36 +125,7 @@ void check_tree(const Model& m, unsigned seed, const std::string& name) {
 
 TEST(Linearizer, TreesBitForBitThePlantFunctionsNumbersAtEveryPointInTurn) {
   for (unsigned seed : {31u, 32u}) {
-    ModelSpec s = test::random_tree_spec(seed, 10);
-    ActuatorSpec a;
-    a.name = "tau1";
-    a.joint = "j1";
-    s.actuators.push_back(a);
-    a.name = "push";
-    a.type = ActuatorType::BodyForce;
-    a.body = "b4";
-    a.point = Eigen::Vector3d(0.1, 0.2, 0.3);
-    a.direction = Eigen::Vector3d(1, 2, 3);
-    s.actuators.push_back(a);
-    SensorSpec y;
-    y.name = "p5";
-    y.type = SensorType::PointPosition;
-    y.body = "b5";
-    y.point = Eigen::Vector3d(0.3, 0, 0);
-    y.component = 2;
-    y.frame = "b1";
-    s.sensors.push_back(y);
-    y.name = "w1";
-    y.type = SensorType::JointVelocity;
-    y.joint = "j1";
-    s.sensors.push_back(y);
-    y.name = "ang2";
-    y.type = SensorType::BodyAngle;
-    y.body = "b2";
-    y.axis = Eigen::Vector3d(0, 0, 1);
-    s.sensors.push_back(y);
-    s.plant.inputs = {"tau1", "push"};
-    s.plant.outputs = {"p5", "w1", "ang2"};
+    const ModelSpec s = test::random_plant(seed);
     const Model m = compile(s);
     ASSERT_EQ(m.nc, 0);
     check_tree(m, seed, s.name);
@@ -264,31 +235,7 @@ TEST(Linearizer, BoundInTurnToEveryExampleEqualsANewOne) {
 // field, is linearized as a new Linearizer linearizes it, and differently from before the change
 // (so that each change is seen to matter)
 TEST(Linearizer, LinearizeAloneOnAModelChangedInPlaceEqualsANewLinearizer) {
-  ModelSpec s = test::random_tree_spec(33, 8);
-  ActuatorSpec a;
-  a.name = "tau1";
-  a.joint = "j1";
-  a.unit = "N*m";
-  s.actuators.push_back(a);
-  a.name = "push";
-  a.type = ActuatorType::BodyForce;
-  a.body = "b4";
-  a.point = Eigen::Vector3d(0.1, 0.2, 0.3);
-  a.direction = Eigen::Vector3d(1, 2, 3);
-  s.actuators.push_back(a);
-  SensorSpec y;
-  y.name = "p5";
-  y.type = SensorType::PointPosition;
-  y.body = "b5";
-  y.point = Eigen::Vector3d(0.3, 0, 0);
-  y.component = 2;
-  s.sensors.push_back(y);
-  y.name = "w1";
-  y.type = SensorType::JointVelocity;
-  y.joint = "j1";
-  s.sensors.push_back(y);
-  s.plant.inputs = {"tau1", "push"};
-  s.plant.outputs = {"p5", "w1"};
+  const ModelSpec s = test::random_plant(33);
   Model m = compile(s);
   ASSERT_EQ(m.nc, 0);
   OperatingPoint op = initial_point(m);
