@@ -58,17 +58,7 @@ DataT<S>::DataT(const Model& model) : constants(model) {
 
 template <class S>
 void DataT<S>::reset(const Model& model) {
-  // the workspaces sized at their first use start again empty for another shape, as in a new Data
-  if (tau.size() != model.nv || lambda.size() != model.nc || liMi.size() != static_cast<std::size_t>(model.nbodies) ||
-      motion_acc.size() != static_cast<Eigen::Index>(model.motions.size())) {
-    M.resize(0, 0);
-    J6a.resize(0, 0);
-    J6b.resize(0, 0);
-    Jp.resize(0, 0);
-    Jwa.resize(0, 0);
-    Jwb.resize(0, 0);
-    Jwd.resize(0, 0);  // (the loop workspace is sized by every call)
-  }
+  // (the workspaces sized at their first use are sized again by the algorithms when the sizes differ)
   constants.assign(model);
   size_for(model);
 }

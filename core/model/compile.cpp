@@ -70,12 +70,16 @@ class Compiler {
 
   // compile_numbers
   Model renumber(const Model& structure, NumbersChanged what) {
-    const std::size_t nb = static_cast<std::size_t>(std::count_if(structure.body_spec_index.begin(),
-                                                                   structure.body_spec_index.end(),
-                                                                   [](int bs) { return bs >= 0; }));
-    if (spec_.bodies.size() != nb)
-      throw std::invalid_argument("compile_numbers: the spec has " + std::to_string(spec_.bodies.size()) +
-                                  " bodies, the structure " + std::to_string(nb));
+    // the spec's elements, counted against the structure's
+    const auto same_count = [](std::size_t in_spec, std::size_t in_structure, const char* what) {
+      if (in_spec != in_structure)
+        throw std::invalid_argument("compile_numbers: the spec has " + std::to_string(in_spec) + " " + what +
+                                    ", the structure " + std::to_string(in_structure));
+    };
+    same_count(spec_.bodies.size(),
+               static_cast<std::size_t>(std::count_if(structure.body_spec_index.begin(), structure.body_spec_index.end(),
+                                                      [](int bs) { return bs >= 0; })),
+               "bodies");
     m_ = structure;
     m_.spec = spec_;
     if (what.bodies) {
@@ -98,24 +102,18 @@ class Compiler {
     // in the structure's order, under the same names: the plant's inputs and outputs, the motions
     // and the sensors of motion forces find the same indices
     if (what.actuators) {
-      if (spec_.actuators.size() != structure.actuators.size())
-        throw std::invalid_argument("compile_numbers: the spec has " + std::to_string(spec_.actuators.size()) +
-                                    " actuators, the structure " + std::to_string(structure.actuators.size()));
+      same_count(spec_.actuators.size(), structure.actuators.size(), "actuators");
       m_.actuators.clear();
       m_.motions.clear();
       build_actuators();
     }
     if (what.sensors) {
-      if (spec_.sensors.size() != structure.sensors.size())
-        throw std::invalid_argument("compile_numbers: the spec has " + std::to_string(spec_.sensors.size()) +
-                                    " sensors, the structure " + std::to_string(structure.sensors.size()));
+      same_count(spec_.sensors.size(), structure.sensors.size(), "sensors");
       m_.sensors.clear();
       build_sensors();
     }
     if (what.initial) {
-      if (spec_.joints.size() != structure.joints.size() - 1)
-        throw std::invalid_argument("compile_numbers: the spec has " + std::to_string(spec_.joints.size()) +
-                                    " joints, the structure " + std::to_string(structure.joints.size() - 1));
+      same_count(spec_.joints.size(), structure.joints.size() - 1, "joints");
       for (std::size_t k = 0; k < spec_.joints.size(); ++k) check_initial_values(spec_.joints[k], at("joints", k));
       initial_state();  // q0, v0, the motions' nominal values, the couplers' offsets: all made again
     }
