@@ -18,6 +18,12 @@ for readers):
   blocks through /usr/bin/python3 with PYTHONPATH=build/python (codyna's module). Any other
   language (json, text, csv, ...) is data, not run.
   A fence without a language is an error: it would be unclear whether it runs.
+* What an Octave or Python block prints (stdout and stderr, as for a console command) is shown in
+  the fenced block right after it, with only blank lines between, whose info string is
+  `text output` (GitHub shows it as plain text); it is compared as a console command's output.
+  A block with no such output block must print nothing at all (Octave's harmless exit line, HARMLESS
+  below, excepted), so a stray warning fails the page. A `text output` block anywhere else is an
+  error: it would be checked against nothing.
 * A shell, Octave or Python block whose first line is a comment starting `# not run` (`% not run`)
   or `# syntax, not run` is not run: the comment says why (it builds, it opens a window, it is a
   syntax summary with MODEL, NAME).
@@ -58,7 +64,8 @@ HEREDOC_RE = re.compile(r"<<-?\s*(['\"]?)(\w+)\1")
 NOT_RUN_RE = re.compile(r"^\s*(#|%)\s*(not run|syntax, not run)")
 
 SHELL_LANGS = {"sh", "bash", "shell"}
-RUN_LANGS = {"console"} | SHELL_LANGS | {"octave", "matlab", "python", "python3"}
+SCRIPT_LANGS = {"octave", "matlab", "python", "python3"}
+RUN_LANGS = {"console"} | SHELL_LANGS | SCRIPT_LANGS
 
 
 class Page:
@@ -86,6 +93,7 @@ class Command:
         self.shown = shown        # list of shown output lines, or None
         self.shown_line = shown_line
         self.fails = None         # (exit code or None, message) when it is meant to fail
+        self.quiet = False        # an Octave or Python block without an output block: prints nothing
         m = None
         for physical in text.split("\n"):
             m = FAILS_RE.search(physical) or m
@@ -96,7 +104,8 @@ class Command:
 
 
 def blocks(page, lines):
-    """Yields (line number of the opening fence, language, block lines) for each fenced block."""
+    """Yields (line number of the opening fence, language, the info string's other words, block
+    lines, line number of the closing fence) for each fenced block."""
     i = 0
     while i < len(lines):
         m = FENCE_RE.match(lines[i])
@@ -106,6 +115,7 @@ def blocks(page, lines):
             i += 1
             continue
         indent, fence, lang = len(m.group(1)), m.group(2), m.group(3).lower()
+        tags = m.group(4).lower().split()
         start = i
         body = []
         i += 1
@@ -119,7 +129,12 @@ def blocks(page, lines):
         if i >= len(lines):
             page.problem(start + 1, "a fence that is never closed")
         i += 1
-        yield start + 1, lang, body
+        yield start + 1, lang, tags, body, i
+
+
+def first_text(body):
+    """The first line of a block that is not blank."""
+    return next((l for l in body if l.strip()), "")
 
 
 def split_commands(first_line, body, prompt):
@@ -311,6 +326,10 @@ def check(page, cmd, code, printed):
     elif code != 0:
         page.problem(where, f"exited {code}:{tail}")
         return
+    if cmd.quiet and printed:
+        page.problem(where, f"printed {len(printed)} line(s) but the page shows no output: show it in a "
+                            f"```text output block right after this one, or make the block quiet:{tail}")
+        return
     if cmd.shown:
         page.outputs += 1
         page.output_lines += sum(1 for l in cmd.shown if l.strip() != "...")
@@ -332,9 +351,22 @@ def run_page(page, source, codyna, scratch):
                TMPDIR=os.path.join(scratch, "tmp"))
     with open(page.path, encoding="utf-8") as f:
         lines = f.read().split("\n")
+    found = list(blocks(page, lines))
+    # the `text output` block right after an Octave or Python block (only blank lines between) is its output
+    output_of = {}
+    for k, (first, lang, tags, body, last) in enumerate(found):
+        if lang == "text" and "output" in tags and k:
+            prev = found[k - 1]
+            if (prev[1] in SCRIPT_LANGS and not NOT_RUN_RE.match(first_text(prev[3]))
+                    and not any(l.strip() for l in lines[prev[4]:first - 1])):
+                output_of[k - 1] = (first, body)
+    shown_outputs = {first for first, _ in output_of.values()}
     n = 0
-    for first, lang, body in blocks(page, lines):
+    for k, (first, lang, tags, body, last) in enumerate(found):
         n += 1
+        if lang == "text" and "output" in tags and first not in shown_outputs:
+            page.problem(first, "a `text output` block that does not follow a run Octave or Python block "
+                                "(only blank lines between): it would be checked against nothing")
         if lang == "":
             page.problem(first, "a fenced block without a language: say console, sh, octave, python "
                                 "(run) or text, json, ... (not run)")
@@ -342,18 +374,27 @@ def run_page(page, source, codyna, scratch):
         if lang not in RUN_LANGS:
             page.blocks_data += 1
             continue
-        head = next((l for l in body if l.strip()), "")
-        if NOT_RUN_RE.match(head):
+        if NOT_RUN_RE.match(first_text(body)):
             page.blocks_not_run += 1
             continue
         page.blocks_run += 1
-        if lang in ("octave", "matlab", "python", "python3"):
+        if lang in SCRIPT_LANGS:
             ext = ".m" if lang in ("octave", "matlab") else ".py"
             script = os.path.join(scratch, f"docs_block_{n}{ext}")
             with open(script, "w", encoding="utf-8") as f:
                 f.write("\n".join(body).replace("/tmp/", os.path.join(scratch, "tmp") + "/") + "\n")
             runner = "octave-cli --no-gui --quiet" if ext == ".m" else "PYTHONPATH=build/python /usr/bin/python3"
             cmd = Command(first, f"{runner} {os.path.basename(script)}")
+            if k in output_of:
+                out_first, out_body = output_of[k]
+                shown = list(out_body)
+                while shown and not shown[-1].strip():
+                    shown.pop()
+                if not shown:
+                    page.problem(out_first, "an empty `text output` block: drop it (the block must then print nothing)")
+                cmd.shown, cmd.shown_line = shown, out_first + 1
+            else:
+                cmd.quiet = True
             page.commands += 1
             code, printed = run(cmd.text, scratch, env)
             check(page, cmd, code, printed)
