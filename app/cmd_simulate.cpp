@@ -145,8 +145,11 @@ void summary(const SimulateJob& job) {
     std::cout << ")\n";
   }
   if (N == 0) return;
+  // the operating point's outputs print by the rule of every printed vector: round-off at or
+  // below 1e-12 of the vector's scale shows as 0
+  const double y0_scale = plant && plant->lin.system.y0.size() ? plant->lin.system.y0.cwiseAbs().maxCoeff() : 0.0;
   for (int k = 0; k < r.y.cols(); ++k) {
-    const double y0 = plant ? plant->lin.system.y0[k] : r.y(0, k);
+    const double y0 = plant ? shown(plant->lin.system.y0[k], y0_scale) : r.y(0, k);
     std::cout << "output " << std::left << std::setw(10) << r.output_names[k] << std::right << " start "
               << std::setw(11) << r.y(0, k) << "  end " << std::setw(11) << r.y(N - 1, k) << "  ("
               << (plant ? "y0 at the " + plant->op.kind + " point: " : std::string("start: ")) << y0 << ") ["

@@ -1,7 +1,32 @@
 #!/usr/bin/env bash
-# Configures and builds codyna into build/ (Release, -j2). Extra arguments go to cmake.
+# Configures and builds codyna into build/ (Release, -j2; Ninja when installed).
+#   scripts/build.sh [cmake args...]        everything: the CLI, the GUI, the tests, the
+#                                           benchmarks, the Python module (scripts/test.sh)
+#   scripts/build.sh --cli [cmake args...]  the command-line program `codyna` and what it links
+#                                           only (scripts/demo.sh)
+# A tree built with --cli and then without builds only the rest: the objects already made are
+# made with the same flags and stay. CODYNA_JOBS (default 2) sets the parallelism.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "$@" > build.log.tmp 2>&1 || { cat build.log.tmp; rm -f build.log.tmp; exit 1; }
+cli=0
+if [ "${1:-}" = "--cli" ]; then cli=1; shift; fi
+args=(-DCMAKE_BUILD_TYPE=Release)
+if [ ! -f build/CMakeCache.txt ]; then
+  # a new tree: Ninja schedules the objects of every target together (make waits for each
+  # target's dependencies to finish); an existing tree keeps the generator it was made with
+  if command -v ninja > /dev/null; then args+=(-G Ninja); fi
+  # the first --cli configuration leaves the rest out; a later full build turns it on
+  if [ "$cli" = 1 ]; then
+    args+=(-DCODYNA_BUILD_GUI=OFF -DCODYNA_BUILD_TESTS=OFF -DCODYNA_BUILD_BENCH=OFF -DCODYNA_BUILD_PYTHON=OFF)
+  fi
+fi
+if [ "$cli" = 0 ]; then
+  args+=(-DCODYNA_BUILD_GUI=ON -DCODYNA_BUILD_TESTS=ON -DCODYNA_BUILD_BENCH=ON -DCODYNA_BUILD_PYTHON=ON)
+fi
+cmake -S . -B build "${args[@]}" "$@" > build.log.tmp 2>&1 || { cat build.log.tmp; rm -f build.log.tmp; exit 1; }
 rm -f build.log.tmp
-cmake --build build -j "${CODYNA_JOBS:-2}"
+if [ "$cli" = 1 ]; then
+  cmake --build build -j "${CODYNA_JOBS:-2}" --target codyna
+else
+  cmake --build build -j "${CODYNA_JOBS:-2}"
+fi

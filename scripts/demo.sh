@@ -6,8 +6,10 @@
 # the linear prediction, results as HDF5 + CSV. Files land in out/demo/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-./scripts/deps.sh
-./scripts/build.sh
+# only what the demo runs: the CLI's packages and the CLI (scripts/test.sh installs and builds
+# the rest, reusing what this built)
+./scripts/deps.sh cli
+./scripts/build.sh --cli
 CODYNA=build/bin/codyna
 MODEL=examples/cart_pendulum.json
 OUT=out/demo

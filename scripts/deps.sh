@@ -1,27 +1,45 @@
 #!/usr/bin/env bash
 # Installs, from Debian packages, whatever codyna needs and the machine lacks.
-# Runs as root (or through sudo when not root). Safe to run again: it only
-# calls apt-get when a package is missing.
+#   scripts/deps.sh        everything: the CLI, the GUI, the tests, the sanitizer and fuzz
+#                          builds, the Python module, the benchmarks and their peers
+#   scripts/deps.sh cli    what the command-line program needs to build and everything it
+#                          links (scripts/demo.sh), and GNU Octave for the demo's export run
+# Runs as root (or through sudo when not root). Safe to run again: it only calls apt-get when a
+# package is missing. The cli set is part of the full one: installing it first and the rest
+# later changes nothing already built (docs/performance.md, "Build time").
 set -euo pipefail
 
-PKGS=(
+CLI_PKGS=(
   build-essential cmake pkg-config
+  ninja-build  # the build tool scripts/build.sh uses (it falls back to make without it)
   libeigen3-dev libsundials-dev libhdf5-dev libmatio-dev
-  nlohmann-json3-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
-  libmujoco-dev  # the MuJoCo peer test (tests/peers_mujoco) and MJCF import; the build skips both without
-  libmujoco-samples  # MuJoCo's own MJCF models (/usr/share/mujoco/model): imported by the peer and CLI tests
+  nlohmann-json3-dev libcli11-dev
+  libmujoco-dev  # MJCF import and export (codyna import, codyna export-mjcf); the build skips both without
   liburdfdom-dev  # URDF import (core/io/import_urdf.cpp, the ROS parser); the build works without it
+  openmpi-bin libopenmpi-dev  # mpirun -np N codyna sweep (app/sweep_mpi.cpp, tests/cli/sweep_mpi.sh); the build works without
+  octave octave-control  # the demo runs the exported .m in GNU Octave; tests check exports there
+)
+ALL_PKGS=(
+  "${CLI_PKGS[@]}"
+  libgtest-dev libgmock-dev libbenchmark-dev
+  libmujoco-samples  # MuJoCo's own MJCF models (/usr/share/mujoco/model): imported by the peer and CLI tests
   libsimbody-dev  # the Simbody peer of the work-precision study (bench/simbody_*.cpp, peer.simbody_agrees)
   clang libclang-rt-14-dev  # the libFuzzer target (scripts/fuzz.sh): clang 14 with its fuzzer/sanitizer runtimes
-  octave octave-control liboctave-dev python3 python3-scipy python3-h5py python3-numpy
+  liboctave-dev  # codyna_plant.mex, the plant stepped from Octave (app/mex)
+  python3 python3-scipy python3-h5py python3-numpy
   python3-matplotlib  # scripts/plot_work_precision.py (work-precision plots, Agg backend)
   pybind11-dev python3-dev python3-pytest  # the Python module (python/) and its pytest suite
-  openmpi-bin libopenmpi-dev  # mpirun -np N codyna sweep (app/sweep_mpi.cpp, tests/cli/sweep_mpi.sh); the build works without
   # the GUI (codyna-gui) and its tests: Qt 6 widgets, OpenGL, Charts, SVG export,
   # and a virtual X server with Mesa's software OpenGL for the rendering tests
   qt6-base-dev qt6-base-dev-tools libqt6opengl6-dev qt6-charts-dev qt6-svg-dev
   libgl-dev xvfb xauth libgl1-mesa-dri
 )
+
+case "${1:-all}" in
+  cli) PKGS=("${CLI_PKGS[@]}") ;;
+  all) PKGS=("${ALL_PKGS[@]}") ;;
+  *) echo "usage: $0 [cli]" >&2; exit 2 ;;
+esac
 
 missing=()
 for p in "${PKGS[@]}"; do

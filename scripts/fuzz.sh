@@ -27,7 +27,9 @@ else
   build="$src/build-fuzz"
   # -O1 with line tables, as fuzzing builds usually are, and without NDEBUG: the
   # assert()s and Eigen's bounds checks stay on and count as findings.
-  CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCODYNA_FUZZ=ON \
+  generator=()
+  if [ ! -f "$build/CMakeCache.txt" ] && command -v ninja > /dev/null; then generator=(-G Ninja); fi
+  CC=clang CXX=clang++ cmake -S . -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCODYNA_FUZZ=ON \
     -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" \
     -DCODYNA_BUILD_GUI=OFF -DCODYNA_BUILD_TESTS=OFF -DCODYNA_BUILD_BENCH=OFF > "$build.log.tmp" 2>&1 \
     || { cat "$build.log.tmp"; rm -f "$build.log.tmp"; exit 1; }

@@ -23,7 +23,10 @@ if [ -f "$build/CMakeCache.txt" ] && ! grep -q '^CODYNA_FUZZ:BOOL=ON' "$build/CM
 fi
 # -O1 -g0 and no -DNDEBUG: faster to build, and Eigen's size assertions stay
 # on (they found an autodiff bug that an NDEBUG build could not see)
-CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCODYNA_FUZZ=ON \
+# a new tree is made with Ninja when it is installed (an existing one keeps its generator)
+generator=()
+if [ ! -f "$build/CMakeCache.txt" ] && command -v ninja > /dev/null; then generator=(-G Ninja); fi
+CC=clang CXX=clang++ cmake -S . -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCODYNA_FUZZ=ON \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g0" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g0" \
   -DCODYNA_BUILD_GUI=ON -DCODYNA_BUILD_BENCH=OFF > "$build.log.tmp" 2>&1 \
   || { cat "$build.log.tmp"; rm -f "$build.log.tmp"; exit 1; }

@@ -164,10 +164,11 @@ extern "C" void mexFunction(int nlhs, mxArray* plhs[], int nrhs, const mxArray* 
     dispatch(nlhs, plhs, nrhs, prhs);
     return;
   } catch (const codyna::IntegratorFailure& e) {
-    message = "codyna_plant: solver failed at t = " + std::to_string(e.time()) + ": " + e.what();
+    message = "solver failed at t = " + std::to_string(e.time()) + ": " + e.what();
   } catch (const std::exception& e) {
-    message = std::string("codyna_plant: ") + e.what();
+    message = e.what();
   }
-  // raise the Octave error outside the C++ exception handlers (it does not return)
+  // raise the Octave error outside the C++ exception handlers (it does not return); Octave puts
+  // the function's name in front of the message itself ("codyna_plant: ...")
   mexErrMsgIdAndTxt("codyna:plant", "%s", message.c_str());
 }

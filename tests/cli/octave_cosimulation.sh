@@ -36,7 +36,7 @@ assert(abs(late) < 0.5 * pi / 180, 'rod not upright: %g', max(abs(late)));
 assert(umax < 200);
 % errors come back as Octave errors with codyna's message
 try, codyna_plant('step', h, [1 2], dt); error('no error'); catch e, assert(strcmp(e.identifier, 'codyna:plant')); assert(!isempty(strfind(e.message, 'expected 1 Plant/In values'))); end
-try, codyna_plant('open', fullfile(work, 'nope.json')); error('no error'); catch e, assert(!isempty(strfind(e.message, 'nope.json'))); end
+try, codyna_plant('open', fullfile(work, 'nope.json')); error('no error'); catch e, assert(!isempty(strfind(e.message, 'nope.json'))); assert(numel(strfind(e.message, 'codyna_plant:')) == 1, e.message); end
 codyna_plant('close', h);
 try, codyna_plant('outputs', h); error('no error'); catch e, assert(!isempty(strfind(e.message, 'no open plant'))); end
 printf('COSIM_OK max|theta| after 4 s = %.2e rad, max|u| = %.1f N\n', max(abs(late)), umax);
