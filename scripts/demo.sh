@@ -28,6 +28,10 @@ if command -v octave-cli > /dev/null; then
   echo
   echo "== GNU Octave runs the exported $OUT/cart_pendulum.m"
   octave-cli --no-gui --quiet --eval "run('$OUT/cart_pendulum.m'); disp('eig(A) ='); disp(eig(sys.a).'); K = lqr(sys, diag([10 100 1 1]), 0.01)" 2>/dev/null || true
+else
+  echo
+  echo "== GNU Octave is not installed: scripts/test.sh (or scripts/deps.sh) installs it; then"
+  echo "   octave-cli --eval \"run('$OUT/cart_pendulum.m'); K = lqr(sys, diag([10 100 1 1]), 0.01)\""
 fi
 echo
 echo "files written:"

@@ -3,7 +3,8 @@
 #   scripts/deps.sh        everything: the CLI, the GUI, the tests, the sanitizer and fuzz
 #                          builds, the Python module, the benchmarks and their peers
 #   scripts/deps.sh cli    what the command-line program needs to build and everything it
-#                          links (scripts/demo.sh), and GNU Octave for the demo's export run
+#                          links (scripts/demo.sh; GNU Octave, 2.5 of the 5 minutes apt takes
+#                          for this set on a fresh machine, comes with the full set)
 # Runs as root (or through sudo when not root). Safe to run again: it only calls apt-get when a
 # package is missing. The cli set is part of the full one: installing it first and the rest
 # later changes nothing already built (docs/performance.md, "Build time").
@@ -17,11 +18,11 @@ CLI_PKGS=(
   libmujoco-dev  # MJCF import and export (codyna import, codyna export-mjcf); the build skips both without
   liburdfdom-dev  # URDF import (core/io/import_urdf.cpp, the ROS parser); the build works without it
   openmpi-bin libopenmpi-dev  # mpirun -np N codyna sweep (app/sweep_mpi.cpp, tests/cli/sweep_mpi.sh); the build works without
-  octave octave-control  # the demo runs the exported .m in GNU Octave; tests check exports there
 )
 ALL_PKGS=(
   "${CLI_PKGS[@]}"
   libgtest-dev libgmock-dev libbenchmark-dev
+  octave octave-control  # the exports run in GNU Octave (tests, docs; the demo too when installed)
   libmujoco-samples  # MuJoCo's own MJCF models (/usr/share/mujoco/model): imported by the peer and CLI tests
   libsimbody-dev  # the Simbody peer of the work-precision study (bench/simbody_*.cpp, peer.simbody_agrees)
   clang libclang-rt-14-dev  # the libFuzzer target (scripts/fuzz.sh): clang 14 with its fuzzer/sanitizer runtimes
