@@ -15,7 +15,7 @@ struct ExportMjcfArgs {
   std::string model, out;
 };
 
-void run(const ExportMjcfArgs& a) {
+void run_export_mjcf(const ExportMjcfArgs& a) {
   ExportMjcfRequest r;
   r.model = a.model;
   r.out = a.out;
@@ -40,7 +40,7 @@ void add_export_mjcf(CLI::App& app) {
   auto a = std::make_shared<ExportMjcfArgs>();
   cmd->add_option("model", a->model, "the codyna model file (JSON)")->required();
   cmd->add_option("--out", a->out, "the MJCF file to write (.xml)")->required();
-  cmd->callback([a] { set_exit_code(run_guarded([&] { run(*a); })); });
+  cmd->callback([a] { set_exit_code(run_guarded([&] { run_export_mjcf(*a); })); });
 }
 
 }  // namespace codyna::cli

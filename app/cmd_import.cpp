@@ -16,7 +16,7 @@ struct ImportArgs {
   std::vector<std::string> ignore;
 };
 
-void run(const ImportArgs& a) {
+void run_import(const ImportArgs& a) {
   ImportRequest r;
   r.file = a.file;
   r.out = a.out;
@@ -45,7 +45,7 @@ void add_import(CLI::App& app) {
   for (const auto& [k, line] : import_kinds()) kinds += "\n  " + k + ": " + line;
   cmd->add_option("--ignore", a->ignore, "import without elements of this kind (repeatable or comma-separated):" + kinds)
       ->delimiter(',');
-  cmd->callback([a] { set_exit_code(run_guarded([&] { run(*a); })); });
+  cmd->callback([a] { set_exit_code(run_guarded([&] { run_import(*a); })); });
 }
 
 }  // namespace codyna::cli

@@ -45,7 +45,7 @@ std::string poles_text(const Eigen::VectorXcd& p, int precision) {
   return os.str();
 }
 
-SimulateRequest request_of(const SimulateArgs& a) {
+SimulateRequest simulate_request_of(const SimulateArgs& a) {
   SimulateRequest r;
   r.model = a.model;
   r.out = a.out;
@@ -203,8 +203,8 @@ void summary(const SimulateJob& job) {
   }
 }
 
-void run(const SimulateArgs& a) {
-  const SimulateRequest req = request_of(a);
+void run_simulate(const SimulateArgs& a) {
+  const SimulateRequest req = simulate_request_of(a);
   SimulationCallbacks cb;
   const bool bar = !a.quiet && isatty(STDERR_FILENO);
   int last = -1;
@@ -277,7 +277,7 @@ void add_simulate(CLI::App& app) {
   add_plant_flags(cmd, a->plant);
   a->cmd = cmd;
   cmd->callback([a, cmd] {
-    set_exit_code(run_guarded([&] { run(*a); }));
+    set_exit_code(run_guarded([&] { run_simulate(*a); }));
   });
 }
 

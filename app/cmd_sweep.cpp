@@ -27,7 +27,7 @@ struct SweepArgs {
 };
 
 // returns the exit code under mpirun (built with MPI), -1 when run here as one process
-int run(const SweepArgs& a) {
+int run_sweep(const SweepArgs& a) {
   const int processes = launched_processes();
   if (processes > 1 && !built_with_mpi())
     throw std::invalid_argument("started as one of " + std::to_string(processes) +
@@ -121,7 +121,7 @@ void add_sweep(CLI::App& app) {
       std::string(built_with_mpi() ? "" : " This codyna was built without MPI: under mpirun it refuses to run."));
   cmd->callback([a] {
     int mpi = -1;
-    const int code = run_guarded([&] { mpi = run(*a); });
+    const int code = run_guarded([&] { mpi = run_sweep(*a); });
     set_exit_code(code == 0 && mpi >= 0 ? mpi : code);
   });
 

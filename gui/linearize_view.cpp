@@ -43,7 +43,7 @@ constexpr int kMergeTs = 0x4c5a02;
 constexpr int kMergeSet = 0x4c5a03;      // values stepped in the coordinates-set table
 constexpr int kMergeTargets = 0x4c5a04;  // and in the output targets
 
-QStringList qlist(const std::vector<std::string>& v) {
+QStringList toQStringList(const std::vector<std::string>& v) {
   QStringList l;
   l.reserve(static_cast<qsizetype>(v.size()));
   for (const auto& s : v) l << qs(s);
@@ -406,15 +406,15 @@ void LinearizeView::refreshSteadyState() {
   syncing_ = true;
   // the names offered come from the compiled model (kept while it does not compile)
   if (const std::shared_ptr<const Model> m = doc_->model()) {
-    QStringList coords = qlist(m->v_names) + qlist(m->rate_names);
+    QStringList coords = toQStringList(m->v_names) + toQStringList(m->rate_names);
     set_table_->setChoices(coords);
-    setCheckList(trim_free_, qlist(m->v_names), s.trim_free);
+    setCheckList(trim_free_, toQStringList(m->v_names), s.trim_free);
   } else {
     setCheckList(trim_free_, {}, s.trim_free);
   }
   set_table_->setPairs(s.set);
-  setCheckList(free_inputs_, qlist(spec.plant.inputs), s.free_inputs);
-  targets_->setChoices(qlist(spec.plant.outputs));
+  setCheckList(free_inputs_, toQStringList(spec.plant.inputs), s.free_inputs);
+  targets_->setChoices(toQStringList(spec.plant.outputs));
   targets_->setPairs(s.output_targets);
   const QString op = qs(s.operating_point);
   trim_free_->setEnabled(op == QLatin1String("trim") || !s.trim_free.empty());
@@ -434,7 +434,7 @@ void LinearizeView::refreshIndependent() {
   independent_box_->setTitle(tr("Independent coordinates (%1 DOF; none checked = automatic)").arg(m->dof()));
   syncing_ = true;
   const QSignalBlocker b(independent_);
-  const QStringList names = qlist(m->v_names);
+  const QStringList names = toQStringList(m->v_names);
   bool same = independent_->count() == names.size();
   for (int i = 0; same && i < names.size(); ++i) same = independent_->item(i)->text() == names[i];
   if (!same) {
@@ -551,8 +551,8 @@ void LinearizeView::clearResult() {
 void LinearizeView::showResult() {
   const StudyLinearization& r = *result_;
   const LinearSystem& s = r.system;
-  const QStringList xs = qlist(s.state_names), us = qlist(s.input_names), ys = qlist(s.output_names);
-  const QStringList xu = qlist(s.state_units), uu = qlist(s.input_units), yu = qlist(s.output_units);
+  const QStringList xs = toQStringList(s.state_names), us = toQStringList(s.input_names), ys = toQStringList(s.output_names);
+  const QStringList xu = toQStringList(s.state_units), uu = toQStringList(s.input_units), yu = toQStringList(s.output_units);
   matrix_models_[0]->setMatrix(s.A, xs, xs, xu, xu);
   matrix_models_[1]->setMatrix(s.B, xs, us, xu, uu);
   matrix_models_[2]->setMatrix(s.C, ys, xs, yu, xu);

@@ -73,7 +73,7 @@ void hideLegendEntry(QChart* chart, QAbstractSeries* s) {
   for (QLegendMarker* m : chart->legend()->markers(s)) m->setVisible(false);
 }
 
-void styleAxis(QValueAxis* axis) {
+void stylePoleAxis(QValueAxis* axis) {
   QFont f = axis->labelsFont();
   f.setPointSizeF(8.5);
   axis->setLabelsFont(f);
@@ -104,8 +104,8 @@ PoleMap::PoleMap(QWidget* parent) : QWidget(parent) {
 
   axis_re_ = new QValueAxis;
   axis_im_ = new QValueAxis;
-  styleAxis(axis_re_);
-  styleAxis(axis_im_);
+  stylePoleAxis(axis_re_);
+  stylePoleAxis(axis_im_);
   chart_->addAxis(axis_re_, Qt::AlignBottom);
   chart_->addAxis(axis_im_, Qt::AlignLeft);
 

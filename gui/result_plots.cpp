@@ -59,7 +59,7 @@ void setAxisRange(QValueAxis* axis, double min, double max, double step) {
   step = std::max(step, (max - min) / 50.0);  // never more than ~50 ticks
   const double coarse = std::max({max - min, axis->max() - axis->min(), step});
   axis->setTickAnchor(0.0);
-  axis->setTickInterval(coarse);  // at most a few ticks in either range
+  axis->setTickInterval(coarse);  // value_at most a few ticks in either range
   axis->setRange(min, max);
   axis->setTickInterval(step);
 }
@@ -77,9 +77,9 @@ QColor seriesColor(int k) {
   return QColor(colours[k % 10]);
 }
 
-QString at(const QStringList& list, int k) { return k < list.size() ? list[k] : QString(); }
+QString value_at(const QStringList& list, int k) { return k < list.size() ? list[k] : QString(); }
 
-void hideLegendEntry(QChart* chart, QAbstractSeries* s) {
+void hidePlotLegendEntry(QChart* chart, QAbstractSeries* s) {
   for (QLegendMarker* m : chart->legend()->markers(s)) m->setVisible(false);
 }
 
@@ -87,14 +87,14 @@ void hideLegendEntry(QChart* chart, QAbstractSeries* s) {
 // names when they are few), otherwise the generic symbol only.
 QString yTitle(const QString& symbol, const QStringList& names, const QStringList& units) {
   if (names.isEmpty()) return symbol;
-  QString unit = at(units, 0).trimmed();
+  QString unit = value_at(units, 0).trimmed();
   for (int k = 1; k < names.size(); ++k)
-    if (at(units, k).trimmed() != unit) return symbol;
+    if (value_at(units, k).trimmed() != unit) return symbol;
   const QString label = names.size() <= 2 ? names.join(QStringLiteral(", ")) : symbol;
   return nameWithUnit(label, unit);
 }
 
-void styleAxis(QValueAxis* axis, const QString& title) {
+void stylePlotAxis(QValueAxis* axis, const QString& title) {
   QFont f = axis->labelsFont();
   f.setPointSizeF(8.5);
   axis->setLabelsFont(f);
@@ -169,8 +169,8 @@ void ResultPlots::buildPanel(Panel& p, const QString& title) {
 
   p.axis_t = new QValueAxis;
   p.axis_y = new QValueAxis;
-  styleAxis(p.axis_t, QStringLiteral("t [s]"));
-  styleAxis(p.axis_y, QString());
+  stylePlotAxis(p.axis_t, QStringLiteral("t [s]"));
+  stylePlotAxis(p.axis_y, QString());
   p.chart->addAxis(p.axis_t, Qt::AlignBottom);
   p.chart->addAxis(p.axis_y, Qt::AlignLeft);
 
@@ -184,7 +184,7 @@ void ResultPlots::buildPanel(Panel& p, const QString& title) {
   p.cursor->attachAxis(p.axis_t);
   p.cursor->attachAxis(p.axis_y);
   p.cursor->setVisible(false);
-  hideLegendEntry(p.chart, p.cursor);
+  hidePlotLegendEntry(p.chart, p.cursor);
 
   p.view = new ChartView(p.chart);  // takes ownership of the chart; zoom, pan, readout, copy
   p.view->setRenderHint(QPainter::Antialiasing, true);
@@ -257,7 +257,7 @@ void ResultPlots::setupSeries(Panel& p, const QStringList& names, const QStringL
   clearPanel(p);
   // attaching a series re-initializes the axes' ranges with the tick interval they have: after a
   // zoom far in, that interval laid out billions of labels (the monkey test's 32 GB request under
-  // ASan, caught in gdb at ChartValueAxisY::calculateLayout from attachAxis). Coarse until the
+  // ASan, caught in gdb value_at ChartValueAxisY::calculateLayout from attachAxis). Coarse until the
   // ranges are set again (setAxisRange sets the step).
   for (QValueAxis* a : {p.axis_t, p.axis_y}) a->setTickInterval(std::numeric_limits<double>::max() / 4);
   // the cursor is re-added last so that it is drawn over the data
@@ -281,13 +281,13 @@ void ResultPlots::setupSeries(Panel& p, const QStringList& names, const QStringL
     pen.setWidthF(1.8);
     pen.setCapStyle(Qt::RoundCap);
     pen.setJoinStyle(Qt::RoundJoin);
-    curve(nameWithUnit(names[k], at(units, k)), pen, p.series, p.data);
+    curve(nameWithUnit(names[k], value_at(units, k)), pen, p.series, p.data);
     if (withLinear) {
       QPen lpen(colour);
       lpen.setWidthF(1.6);
       lpen.setStyle(Qt::CustomDashLine);
       lpen.setDashPattern({5.0, 3.0});
-      curve(nameWithUnit(names[k] + QStringLiteral(" (linear)"), at(units, k)), lpen, p.linear, p.linear_data);
+      curve(nameWithUnit(names[k] + QStringLiteral(" (linear)"), value_at(units, k)), lpen, p.linear, p.linear_data);
     }
     if (withReference) {
       QPen rpen(colour.darker(160));
@@ -295,13 +295,13 @@ void ResultPlots::setupSeries(Panel& p, const QStringList& names, const QStringL
       rpen.setStyle(Qt::CustomDashLine);
       rpen.setDashPattern({1.0, 2.5});
       rpen.setCapStyle(Qt::RoundCap);
-      curve(nameWithUnit(names[k] + QStringLiteral(" (reference)"), at(units, k)), rpen, p.reference, p.reference_data);
+      curve(nameWithUnit(names[k] + QStringLiteral(" (reference)"), value_at(units, k)), rpen, p.reference, p.reference_data);
     }
   }
   p.chart->addSeries(p.cursor);
   p.cursor->attachAxis(p.axis_t);
   p.cursor->attachAxis(p.axis_y);
-  hideLegendEntry(p.chart, p.cursor);
+  hidePlotLegendEntry(p.chart, p.cursor);
   p.chart->legend()->setVisible(n > 0);
 }
 
@@ -405,7 +405,7 @@ QList<QPointF> ResultPlots::plotted(const QList<QPointF>& all) const {
 
 void ResultPlots::updateTimeAxis(double tEnd) {
   const NiceRange r = niceRange(0.0, tEnd, 8);
-  // a run's time axis ends at t_end itself (not a rounded-up value); live
+  // a run's time axis ends value_at t_end itself (not a rounded-up value); live
   // samples beyond it extend it to the next nice number
   const double max = tEnd > t_end_ ? r.max : tEnd;
   for (Panel* p : {&in_, &out_}) {
@@ -519,7 +519,7 @@ void ResultPlots::updateCursor(Panel& p) {
   }
   p.cursor->replace(QList<QPointF>{{cursor_t_, p.axis_y->min()}, {cursor_t_, p.axis_y->max()}});
   p.cursor->setVisible(true);
-  hideLegendEntry(p.chart, p.cursor);
+  hidePlotLegendEntry(p.chart, p.cursor);
 }
 
 QList<QPointF> ResultPlots::inputPoints(int k) const {

@@ -49,7 +49,7 @@ constexpr int kLivePlotPoints = 2000;
 
 const char* const kIntegrators[] = {"auto", "ida", "cvode-bdf", "cvode-adams", "arkode", "rk4"};
 
-QString num(double x, int digits = 6) { return QString::number(x, 'g', digits); }
+QString simNumber(double x, int digits = 6) { return QString::number(x, 'g', digits); }
 
 QString joinNumbers(const std::vector<double>& v) {
   QStringList l;
@@ -74,7 +74,7 @@ QString matrixText(const Eigen::MatrixXd& M) {
   QStringList rows;
   for (Eigen::Index r = 0; r < M.rows(); ++r) {
     QStringList cols;
-    for (Eigen::Index c = 0; c < M.cols(); ++c) cols << num(M(r, c), 4);
+    for (Eigen::Index c = 0; c < M.cols(); ++c) cols << simNumber(M(r, c), 4);
     rows << cols.join(QLatin1Char(' '));
   }
   return QLatin1Char('[') + rows.join(QStringLiteral("; ")) + QLatin1Char(']');
@@ -96,7 +96,7 @@ QString describeController(const ModelSpec& s) {
     case ControllerType::Lti:
       return QObject::tr("LTI controller with %1 states, %2, %3.")
           .arg(c.Ac.rows())
-          .arg(c.Ts > 0 ? QObject::tr("sampled (Ts = %1 s, zero-order hold)").arg(num(c.Ts)) : QObject::tr("continuous"))
+          .arg(c.Ts > 0 ? QObject::tr("sampled (Ts = %1 s, zero-order hold)").arg(simNumber(c.Ts)) : QObject::tr("continuous"))
           .arg(at);
     case ControllerType::Lqr:
       return QObject::tr("LQR designed on the plant linearized %1; Q = diag(%2), R = diag(%3).")
@@ -563,8 +563,8 @@ void SimulateView::refreshFromDocument() {
       i = integrator_->count() - 1;
     }
     integrator_->setCurrentIndex(i);
-    rtol_->setText(num(so.rtol));
-    atol_->setText(num(so.atol));
+    rtol_->setText(simNumber(so.rtol));
+    atol_->setText(simNumber(so.atol));
     compare_linear_->setChecked(st.compare_linear);
   }
   {
@@ -773,7 +773,7 @@ void SimulateView::onProgress(double t, double tEnd) {
   if (discard_run_) return;
   if (tEnd > 0) progress_->setValue(static_cast<int>(std::clamp(1000.0 * t / tEnd, 0.0, 1000.0)));
   if (!worker_->cancelRequested()) {
-    status_ = tr("running: t = %1 s of %2 s").arg(num(t, 4), num(tEnd));
+    status_ = tr("running: t = %1 s of %2 s").arg(simNumber(t, 4), simNumber(tEnd));
     status_label_->setText(status_);
   }
 }
@@ -802,10 +802,10 @@ void SimulateView::onFinished(std::shared_ptr<const SimulationResult> r) {
   const double tLast = N ? r->t.back() : 0.0;
   QString head;
   if (r->completed) {
-    head = tr("completed: t = 0 .. %1 s").arg(num(tLast));
+    head = tr("completed: t = 0 .. %1 s").arg(simNumber(tLast));
     progress_->setValue(1000);
   } else if (r->cancelled) {
-    head = tr("cancelled at t = %1 s").arg(num(tLast));
+    head = tr("cancelled at t = %1 s").arg(simNumber(tLast));
   } else {
     head = tr("failed: %1").arg(qs(r->failure));
   }
@@ -814,7 +814,7 @@ void SimulateView::onFinished(std::shared_ptr<const SimulationResult> r) {
                 .arg(N)
                 .arg(r->stats.steps)
                 .arg(qs(r->stats.integrator_choice.empty() ? r->stats.integrator : r->stats.integrator_choice))
-                .arg(num(worker_->wallTime(), 3))
+                .arg(simNumber(worker_->wallTime(), 3))
                 .arg(qs(r->controller.empty() ? worker_->controllerSource().toStdString() : r->controller));
   for (const QString& n : worker_->notes()) status_ += tr("; note: %1").arg(n);
   status_label_->setText(status_);

@@ -16,7 +16,7 @@ namespace codyna {
 
 namespace {
 
-void expect_size(const char* what, const Eigen::MatrixXd& M, Eigen::Index rows, Eigen::Index cols) {
+void expect_matrix_size(const char* what, const Eigen::MatrixXd& M, Eigen::Index rows, Eigen::Index cols) {
   if (M.rows() == rows && M.cols() == cols) return;
   std::ostringstream os;
   os << "closed loop: the controller's " << what << " is " << M.rows() << " x " << M.cols() << ", expected " << rows
@@ -32,16 +32,16 @@ ClosedLoopLinear close_loop(const LinearSystem& plant_in, const LinearLaw& law, 
   const int nx = plant_in.nx(), nu = plant_in.nu(), ny = plant_in.ny(), nz = plant_in.npositions();
   const int nd = static_cast<int>(w_in.Bw.cols());
   const int nxc = static_cast<int>(law.Ak.rows());
-  expect_size("Ak", law.Ak, nxc, nxc);
-  expect_size("Bx", law.Bx, nxc, nx);
-  expect_size("By", law.By, nxc, ny);
-  expect_size("Bv", law.Bv, nxc, ny);
-  expect_size("Br", law.Br, nxc, ny);
-  expect_size("Ck", law.Ck, nu, nxc);
-  expect_size("Dx", law.Dx, nu, nx);
-  expect_size("Dy", law.Dy, nu, ny);
-  expect_size("Dv", law.Dv, nu, ny);
-  expect_size("Dr", law.Dr, nu, ny);
+  expect_matrix_size("Ak", law.Ak, nxc, nxc);
+  expect_matrix_size("Bx", law.Bx, nxc, nx);
+  expect_matrix_size("By", law.By, nxc, ny);
+  expect_matrix_size("Bv", law.Bv, nxc, ny);
+  expect_matrix_size("Br", law.Br, nxc, ny);
+  expect_matrix_size("Ck", law.Ck, nu, nxc);
+  expect_matrix_size("Dx", law.Dx, nu, nx);
+  expect_matrix_size("Dy", law.Dy, nu, ny);
+  expect_matrix_size("Dv", law.Dv, nu, ny);
+  expect_matrix_size("Dr", law.Dr, nu, ny);
   if (w_in.Bw.rows() != nx || w_in.Dw.rows() != ny || w_in.Dw.cols() != nd)
     throw std::invalid_argument("closed loop: the disturbance columns do not fit the plant");
 

@@ -60,7 +60,7 @@ int index_of(const std::vector<std::string>& names, const std::string& name) {
   return it == names.end() ? -1 : static_cast<int>(it - names.begin());
 }
 
-std::string joined(const std::vector<std::string>& names) {
+std::string joined_names(const std::vector<std::string>& names) {
   std::string s;
   for (const std::string& n : names) s += (s.empty() ? "" : ", ") + n;
   return s.empty() ? "(none)" : s;
@@ -73,13 +73,13 @@ std::string steady_state_advice(const std::vector<std::string>& plant_inputs, co
   if (plant_inputs.empty())
     a = "the plant has no Plant/In input to free: add an actuator to plant.inputs";
   else if (!fixed_inputs.empty())
-    a = "free an input: free_inputs / --free-input " + joined(fixed_inputs);
+    a = "free an input: free_inputs / --free-input " + joined_names(fixed_inputs);
   else
     a = "every Plant/In input is free already; add one that acts on the coordinates left unbalanced";
   if (!held.empty()) {
     a += a.empty() ? "" : "; or ";
-    a += kind == "trim" ? "free a held coordinate: trim_free / --trim-free " + joined(held)
-                        : "hold fewer coordinates (analysis set / --hold; held now: " + joined(held) + ")";
+    a += kind == "trim" ? "free a held coordinate: trim_free / --trim-free " + joined_names(held)
+                        : "hold fewer coordinates (analysis set / --hold; held now: " + joined_names(held) + ")";
   }
   if (a.empty()) a = "ask for another state: a reachable output target, or the operating point initial or time=T";
   return a;
@@ -104,10 +104,10 @@ void require_steady_state(const Model& model, const OperatingPoint& op, const st
   os << ")";
   if (op.kind == "trim") {
     // every independent coordinate held, every Plant/In input solved
-    os << "; unknowns: free inputs " << joined(in_names) << ", free coordinates (none); held: " << joined(coords) << " ("
+    os << "; unknowns: free inputs " << joined_names(in_names) << ", free coordinates (none); held: " << joined_names(coords) << " ("
        << steady_state_advice(in_names, {}, coords, "trim") << ")";
   } else {
-    os << "; unknowns: free inputs (none), free coordinates " << joined(coords) << " ("
+    os << "; unknowns: free inputs (none), free coordinates " << joined_names(coords) << " ("
        << steady_state_advice(in_names, in_names, {}, "equilibrium") << ")";
   }
   throw ConvergenceError(os.str());
@@ -125,7 +125,7 @@ OperatingPoint steady_state(const Model& model, const OperatingPoint& start, con
   std::vector<int> free_u;  // positions in Plant/In
   for (const std::string& name : spec.free_inputs) {
     const int k = index_of(in_names, name);
-    if (k < 0) throw std::invalid_argument("steady state: free input \"" + name + "\" is not in Plant/In (" + joined(in_names) + ")");
+    if (k < 0) throw std::invalid_argument("steady state: free input \"" + name + "\" is not in Plant/In (" + joined_names(in_names) + ")");
     if (std::find(free_u.begin(), free_u.end(), k) == free_u.end()) free_u.push_back(k);
   }
   std::vector<int> target_y;
@@ -134,7 +134,7 @@ OperatingPoint steady_state(const Model& model, const OperatingPoint& start, con
     const int k = index_of(out_names, spec.outputs[i].first);
     if (k < 0)
       throw std::invalid_argument("steady state: output \"" + spec.outputs[i].first + "\" is not in Plant/Out (" +
-                                  joined(out_names) + ")");
+                                  joined_names(out_names) + ")");
     if (!std::isfinite(spec.outputs[i].second))
       throw std::invalid_argument("steady state: the value of output \"" + spec.outputs[i].first + "\" is not finite");
     target_y.push_back(k);
@@ -238,8 +238,8 @@ OperatingPoint steady_state(const Model& model, const OperatingPoint& start, con
     std::vector<std::string> fixed_inputs;  // Plant/In inputs the search did not solve for
     for (const std::string& name : in_names)
       if (std::find(spec.free_inputs.begin(), spec.free_inputs.end(), name) == spec.free_inputs.end()) fixed_inputs.push_back(name);
-    os << "; unknowns: free inputs " << joined(spec.free_inputs) << ", free coordinates " << joined(free_coords)
-       << "; held: " << joined(spec.held);
+    os << "; unknowns: free inputs " << joined_names(spec.free_inputs) << ", free coordinates " << joined_names(free_coords)
+       << "; held: " << joined_names(spec.held);
     if (!clamped.empty()) {
       os << "; the actuator limits bind: ";
       for (std::size_t k = 0; k < clamped.size(); ++k) os << (k ? "; " : "") << clamped[k];

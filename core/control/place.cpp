@@ -31,9 +31,9 @@ constexpr double kPlacementTol = 1e-6;    // accepted relative error of the plac
 constexpr int kTrialsSingleInput = 4;     // K is unique: only a failed solve needs another G
 constexpr int kTrialsMultiInput = 16;
 
-std::string size_of(const MatrixXd& M) { return std::to_string(M.rows()) + "x" + std::to_string(M.cols()); }
+std::string place_size(const MatrixXd& M) { return std::to_string(M.rows()) + "x" + std::to_string(M.cols()); }
 
-std::string number(Complex z) {
+std::string place_number(Complex z) {
   std::ostringstream s;
   s.precision(6);
   s << z.real();
@@ -41,21 +41,21 @@ std::string number(Complex z) {
   return s.str();
 }
 
-[[noreturn]] void fail(const std::string& what) { throw std::invalid_argument("place: " + what); }
+[[noreturn]] void place_fail(const std::string& what) { throw std::invalid_argument("place: " + what); }
 
-double norm1(const MatrixXd& M) { return M.size() == 0 ? 0.0 : M.cwiseAbs().colwise().sum().maxCoeff(); }
+double place_norm1(const MatrixXd& M) { return M.size() == 0 ? 0.0 : M.cwiseAbs().colwise().sum().maxCoeff(); }
 
 void check_inputs(const MatrixXd& A, const MatrixXd& B, const VectorXcd& poles) {
   const Index n = A.rows();
-  if (A.cols() != n || n == 0) fail("A is " + size_of(A) + ", expected a non-empty square matrix");
+  if (A.cols() != n || n == 0) place_fail("A is " + place_size(A) + ", expected a non-empty square matrix");
   if (B.rows() != n || B.cols() == 0)
-    fail("B is " + size_of(B) + ", expected " + std::to_string(n) + " rows to match A (" + size_of(A) +
+    place_fail("B is " + place_size(B) + ", expected " + std::to_string(n) + " rows to match A (" + place_size(A) +
          ") and at least one column");
   if (poles.size() != n)
-    fail("poles has " + std::to_string(poles.size()) + " entries, expected " + std::to_string(n) + " (one per state)");
-  if (!A.allFinite()) fail("A has NaN or Inf entries");
-  if (!B.allFinite()) fail("B has NaN or Inf entries");
-  if (!poles.allFinite()) fail("poles has NaN or Inf entries");
+    place_fail("poles has " + std::to_string(poles.size()) + " entries, expected " + std::to_string(n) + " (one per state)");
+  if (!A.allFinite()) place_fail("A has NaN or Inf entries");
+  if (!B.allFinite()) place_fail("B has NaN or Inf entries");
+  if (!poles.allFinite()) place_fail("poles has NaN or Inf entries");
 }
 
 // ------------------------------------------------------------------ controllability
@@ -76,7 +76,7 @@ Staircase staircase(const MatrixXd& A, const MatrixXd& B) {
   Index k = 0;
   for (bool first = true; k < n; first = false) {
     const Eigen::JacobiSVD<MatrixXd> svd(block, Eigen::ComputeFullU);
-    const double tol = kRankTol * (first ? norm1(B) : std::max(norm1(A), norm1(B)));
+    const double tol = kRankTol * (first ? place_norm1(B) : std::max(place_norm1(A), place_norm1(B)));
     const Index r = (svd.singularValues().array() > tol).count();
     if (first) out.rank_B = r;
     if (r == 0) break;
@@ -102,7 +102,7 @@ MatrixXd real_block_form(const VectorXcd& poles, Index rank_B) {
     Index repeats = 0;
     for (Index j = 0; j < n; ++j) repeats += std::abs(poles[j] - poles[i]) <= tol;
     if (repeats > rank_B)
-      fail("pole " + number(poles[i]) + " is repeated " + std::to_string(repeats) + " times, more than rank(B) = " +
+      place_fail("pole " + place_number(poles[i]) + " is repeated " + std::to_string(repeats) + " times, more than rank(B) = " +
            std::to_string(rank_B) + " (each copy needs its own input direction)");
   }
   MatrixXd Lambda = MatrixXd::Zero(n, n);
@@ -124,7 +124,7 @@ MatrixXd real_block_form(const VectorXcd& poles, Index rank_B) {
         break;
       }
     if (partner < 0)
-      fail("poles must come in complex-conjugate pairs: " + number(p) + " has no partner " + number(std::conj(p)));
+      place_fail("poles must come in complex-conjugate pairs: " + place_number(p) + " has no partner " + place_number(std::conj(p)));
     used[partner] = true;
     const double s = 0.5 * (p.real() + poles[partner].real()), w = 0.5 * std::abs(p.imag() - poles[partner].imag());
     Lambda.block(at, at, 2, 2) << s, w, -w, s;
@@ -198,22 +198,22 @@ Eigen::MatrixXd place(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const 
   const Staircase s = staircase(A, B);
   if (s.controllable < n) {
     std::string modes;
-    for (const Complex& z : s.uncontrollable_modes) modes += (modes.empty() ? "" : ", ") + number(z);
-    fail("(A, B) is not controllable: " + std::to_string(n - s.controllable) +
+    for (const Complex& z : s.uncontrollable_modes) modes += (modes.empty() ? "" : ", ") + place_number(z);
+    place_fail("(A, B) is not controllable: " + std::to_string(n - s.controllable) +
          " mode(s) cannot be moved by any feedback (at " + modes + ")");
   }
   const MatrixXd Lambda = real_block_form(poles, s.rank_B);
 
   // a fixed seed keeps the gain reproducible from run to run
   std::mt19937 rng(20240611u);
-  const double scale = std::max({norm1(A), poles.cwiseAbs().maxCoeff(), std::numeric_limits<double>::min()});
+  const double scale = std::max({place_norm1(A), poles.cwiseAbs().maxCoeff(), std::numeric_limits<double>::min()});
   const int trials = m == 1 ? kTrialsSingleInput : kTrialsMultiInput;
   // move A's spectrum off the requested poles, else the Sylvester equation is singular
   const bool pre_feedback = separation(A, poles) <= kSeparationTol * scale;
   std::optional<Trial> best;
   for (int t = 0; t < trials; ++t) {
     MatrixXd K0 = MatrixXd::Zero(m, n);
-    if (pre_feedback) K0 = random_matrix(m, n, rng) * (scale / norm1(B));
+    if (pre_feedback) K0 = random_matrix(m, n, rng) * (scale / place_norm1(B));
     const MatrixXd G = random_matrix(m, n, rng);
     std::optional<Trial> trial = sylvester_gain(A - B * K0, B, Lambda, G);
     if (!trial) continue;
@@ -225,8 +225,8 @@ Eigen::MatrixXd place(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const 
 
   const double error = placement_error(A - B * best->K, poles, scale);
   if (!(error <= kPlacementTol))
-    throw std::runtime_error("place: the placed poles miss the requested ones by " + number(error) +
-                             " (relative; eigenvector matrix condition number " + number(best->condition_X) +
+    throw std::runtime_error("place: the placed poles miss the requested ones by " + place_number(error) +
+                             " (relative; eigenvector matrix condition number " + place_number(best->condition_X) +
                              "); the placement is numerically ill-conditioned");
   return best->K;
 }

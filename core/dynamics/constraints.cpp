@@ -66,7 +66,7 @@ void coupler_row(const ConstraintModel& c, DataT<S>& d, const VecXT<S>& q, bool 
 }
 
 // a disc lying flat on its plane: |n - (n . a) a| below this has no contact direction
-constexpr double kDiscFlat = 1e-6;
+constexpr double kDiscFlatness = 1e-6;
 
 // a contact row of rolling: e . (v_b(P) - v_a(P)) with e a vector of body_a and the contact point
 // P = c - Rd (c = p_b the centre, Rd = R n for a ball, R d for a disc; Rdd its rate):
@@ -247,7 +247,7 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool with_vel
         const S kk = ad_coherent(S(k * k), nd);
         const S one = ad_coherent(S(1), nd);
         const S s2 = one - kk;
-        if (!(ad_value(s2) >= kDiscFlat * kDiscFlat))
+        if (!(ad_value(s2) >= kDiscFlatness * kDiscFlatness))
           throw std::domain_error("rolling_disc " + c.name + ": the disc lies flat on the plane (|n - (n.a) a| = " +
                                   std::to_string(std::sqrt(std::max(0.0, ad_value(s2)))) +
                                   "): its contact point is undefined there");

@@ -18,9 +18,9 @@ namespace codyna {
 
 namespace {
 
-std::string quoted(const std::string& s) { return "\"" + s + "\""; }
+std::string quoted_name(const std::string& s) { return "\"" + s + "\""; }
 
-std::string fmt(double x) {
+std::string prepare_number(double x) {
   std::ostringstream os;
   os.precision(6);
   os << x;
@@ -70,11 +70,11 @@ class Preparer {
       std::string held;
       for (int k : m_.motions) {
         const ActuatorModel& a = m_.actuators[static_cast<std::size_t>(k)];
-        held += (held.empty() ? "" : ", ") + quoted(m_.v_names[a.iv]) + " = " + fmt(q[a.iq]) + " (motion input " +
-                quoted(a.name) + ")";
+        held += (held.empty() ? "" : ", ") + quoted_name(m_.v_names[a.iv]) + " = " + prepare_number(q[a.iq]) + " (motion input " +
+                quoted_name(a.name) + ")";
       }
       fail(at("constraints", constraint_of_row(r.worst_row)),
-           "the loop cannot be assembled from the joints' q0: residual " + fmt(r.position_residual) + " on " +
+           "the loop cannot be assembled from the joints' q0: residual " + prepare_number(r.position_residual) + " on " +
                m_.row_names[r.worst_row] + " after " + std::to_string(r.iterations) + " iterations" +
                (held.empty() ? "" : " with " + held + " held where the motion puts it") +
                " (check the constraint points and the joints' q0)");
@@ -125,7 +125,7 @@ class Preparer {
       if (!(s >= 1e-3))
         fail(at("constraints", k), std::string("the disc lies flat on the plane at ") + where +
                                        " (its axle axis_b is along the plane's normal axis_a: |n - (n.a) a| = " +
-                                       fmt(s) + " < 1e-3, where its contact point is undefined; stand it up)");
+                                       prepare_number(s) + " < 1e-3, where its contact point is undefined; stand it up)");
     }
   }
 
@@ -199,8 +199,8 @@ class Preparer {
     const ActuatorModel& a = m_.actuators[static_cast<std::size_t>(motion)];
     const ConstraintModel& cm = m_.constraints[constraint_of_row(row)];
     fail(at("actuators", spec_actuator(motion)) + "/joint",
-         "the motion input " + quoted(a.name) + " drives " + quoted(m_.v_names[a.iv]) + ", which the loop closure " +
-             quoted(cm.name) + " fixes from the other coordinates at q0" +
+         "the motion input " + quoted_name(a.name) + " drives " + quoted_name(m_.v_names[a.iv]) + ", which the loop closure " +
+             quoted_name(cm.name) + " fixes from the other coordinates at q0" +
              (m_.motions.size() > 1 ? " and the other motion inputs" : "") + ": on the coordinates no motion drives the closure rows have rank " +
              std::to_string(rank_f) + ", not " + std::to_string(rank) + " (the motion over-drives or locks the loop; drive a coordinate the loop leaves free, drive fewer, or "
              "use a joint_force)");
@@ -239,7 +239,7 @@ class Preparer {
           Eigen::Index k;
           es.eigenvectors().col(0).cwiseAbs().maxCoeff(&k);
           fail("/bodies", "the mass matrix is singular at the initial state: coordinate " +
-                              quoted(m_.v_names[j.idx_v + k]) + " moves no mass or inertia (give the bodies it moves mass and inertia)" +
+                              quoted_name(m_.v_names[j.idx_v + k]) + " moves no mass or inertia (give the bodies it moves mass and inertia)" +
                               semi_definite_note(i));
         }
         Ia -= U * D.inverse() * U.transpose();
@@ -261,8 +261,8 @@ class Preparer {
       const BodySpec& b = m_.spec.bodies[m_.body_spec_index[k]];
       const Eigen::Vector3d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(b.inertia).eigenvalues();
       if (b.mass > 0 && !(ev[0] > 1e-12 * std::max(ev[2], 1e-300)))
-        return "; body " + quoted(b.name) + " has no inertia about one of its axes (principal moments " + fmt(ev[0]) + ", " +
-               fmt(ev[1]) + ", " + fmt(ev[2]) + "): a joint that turns it about that axis alone moves nothing";
+        return "; body " + quoted_name(b.name) + " has no inertia about one of its axes (principal moments " + prepare_number(ev[0]) + ", " +
+               prepare_number(ev[1]) + ", " + prepare_number(ev[2]) + "): a joint that turns it about that axis alone moves nothing";
     }
     return "";
   }

@@ -13,7 +13,7 @@ namespace codyna {
 namespace {
 
 // a header field, quoted when it holds a comma, a quote or a line break
-std::string field(const std::string& s) {
+std::string csv_field(const std::string& s) {
   if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
   std::string q = "\"";
   for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
@@ -45,7 +45,7 @@ void write_step_csv(const ClosedLoopLinear& cl, const StepResponse& step, const 
   write_csv(path, s.model_file, [&](std::ostringstream& os) {
     os << "t";
     for (const std::string& in : s.input_names)
-      for (const std::string& out : s.output_names) os << "," << field(out + "/" + in);
+      for (const std::string& out : s.output_names) os << "," << csv_field(out + "/" + in);
     os << "\n";
     for (std::size_t k = 0; k < step.t.size(); ++k) {
       os << step.t[k];
@@ -62,7 +62,7 @@ void write_frequency_csv(const ClosedLoopLinear& cl, const FrequencyResponse& f,
     os << "w";
     for (const std::string& in : s.input_names)
       for (const std::string& out : s.output_names)
-        os << "," << field(out + "/" + in + ":mag") << "," << field(out + "/" + in + ":phase_deg");
+        os << "," << csv_field(out + "/" + in + ":mag") << "," << csv_field(out + "/" + in + ":phase_deg");
     os << "\n";
     for (std::size_t k = 0; k < f.w.size(); ++k) {
       os << f.w[k];

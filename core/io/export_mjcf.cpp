@@ -23,7 +23,7 @@ namespace codyna {
 
 namespace {
 
-std::string num(double x) {
+std::string mjcf_number(double x) {
   if (x == 0) return "0";  // also -0
   if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
   // the shortest text that reads back as the same double
@@ -36,9 +36,9 @@ std::string brief(double x) {
   std::snprintf(buf, sizeof buf, "%.6g", x);
   return buf;
 }
-std::string vec(const Eigen::Vector3d& v) { return num(v.x()) + " " + num(v.y()) + " " + num(v.z()); }
+std::string vec(const Eigen::Vector3d& v) { return mjcf_number(v.x()) + " " + mjcf_number(v.y()) + " " + mjcf_number(v.z()); }
 std::string quat_text(const Eigen::Quaterniond& q) {
-  return num(q.w()) + " " + num(q.x()) + " " + num(q.y()) + " " + num(q.z());
+  return mjcf_number(q.w()) + " " + mjcf_number(q.x()) + " " + mjcf_number(q.y()) + " " + mjcf_number(q.z());
 }
 Eigen::Quaterniond quat_of(const Eigen::Matrix3d& R) {
   Eigen::Quaterniond q(R);
@@ -75,7 +75,7 @@ SE3 trans(const Eigen::Vector3d& p) { return SE3(Eigen::Matrix3d::Identity(), p)
 bool is_identity(const SE3& X) { return X.p.isZero(0.0) && X.R.isIdentity(0.0); }
 
 // unique names per MuJoCo object type
-struct Names {
+struct MjcfNames {
   std::set<std::string> used;
   std::string unique(const std::string& base) {
     std::string n = base;
@@ -138,7 +138,7 @@ class Exporter {
   std::vector<std::vector<int>> joint_elems_;  // MuJoCo joints of each codyna body's joint
   std::vector<MjJoint> mj_joints_;
   std::vector<int> iv_joint_;               // MuJoCo joint of each velocity index (-1: a ball's or free joint's)
-  Names body_names_, joint_names_, site_names_, tendon_names_, sensor_names_, eq_names_;
+  MjcfNames body_names_, joint_names_, site_names_, tendon_names_, sensor_names_, eq_names_;
   std::ostringstream sites_xml_;            // per codyna body, filled before write()
   std::map<int, std::string> body_sites_;
   std::ostringstream tendon_xml_, actuator_xml_, equality_xml_, sensor_xml_;
@@ -295,8 +295,8 @@ class Exporter {
     // point-to-point springs: spatial tendons
     for (const SpringDamperModel& s : m_.springs) {
       const std::string a = site(s.body_a, s.point_a, s.name + "_a"), b = site(s.body_b, s.point_b, s.name + "_b");
-      tendon_xml_ << "    <spatial name=" << q(tendon_names_.unique(s.name)) << " stiffness=\"" << num(s.stiffness)
-                  << "\" damping=\"" << num(s.damping) << "\" springlength=\"" << num(s.rest_length)
+      tendon_xml_ << "    <spatial name=" << q(tendon_names_.unique(s.name)) << " stiffness=\"" << mjcf_number(s.stiffness)
+                  << "\" damping=\"" << mjcf_number(s.damping) << "\" springlength=\"" << mjcf_number(s.rest_length)
                   << "\">\n      <site site=" << q(a) << "/>\n      <site site=" << q(b) << "/>\n    </spatial>\n";
       ++nsprings_;
     }
@@ -479,7 +479,7 @@ class Exporter {
         case ActuatorType::JointForce: {
           const int jj = joint_of_iv(a.iv);
           if (jj >= 0) {
-            p.line = "joint=" + q(mj_joints_[jj].name) + " gear=\"" + num(a.gain) + "\"";
+            p.line = "joint=" + q(mj_joints_[jj].name) + " gear=\"" + mjcf_number(a.gain) + "\"";
             break;
           }
           const int b = body_of_iv(a.iv);
@@ -513,7 +513,7 @@ class Exporter {
           tendon_xml_ << "    <spatial name=" << q(tn) << ">\n      <site site=" << q(sa) << "/>\n      <site site="
                       << q(sb) << "/>\n    </spatial>\n";
           ++nlines_;
-          p.line = "tendon=" + q(tn) + " gear=\"" + num(a.gain) + "\"";
+          p.line = "tendon=" + q(tn) + " gear=\"" + mjcf_number(a.gain) + "\"";
           break;
         }
         case ActuatorType::Mix:
@@ -524,7 +524,7 @@ class Exporter {
           continue;
       }
       if (std::isfinite(a.min) || std::isfinite(a.max))
-        p.line += " ctrllimited=\"true\" ctrlrange=\"" + num(a.min) + " " + num(a.max) + "\"";
+        p.line += " ctrllimited=\"true\" ctrlrange=\"" + mjcf_number(a.min) + " " + mjcf_number(a.max) + "\"";
       else
         p.line += " ctrllimited=\"false\"";
       pending_act_.push_back(p);
@@ -606,15 +606,15 @@ class Exporter {
       if (I[k] < 0 && I[k] >= -1e-15 * Imax) I[k] = 0;  // round-off of a zero moment
     // MuJoCo requires A + B >= C exactly; a thin rod's (0, I, I) may miss it by round-off
     if (I[0] + I[1] < I[2] && I[2] - (I[0] + I[1]) <= 1e-12 * Imax) I[2] = I[0] + I[1];
-    x_ << ind << "  <inertial pos=\"" << vec(com) << "\" mass=\"" << num(mass) << "\" quat=\""
+    x_ << ind << "  <inertial pos=\"" << vec(com) << "\" mass=\"" << mjcf_number(mass) << "\" quat=\""
        << quat_text(quat_of(V)) << "\" diaginertia=\"" << vec(I) << "\"/>\n";
     for (int e : js) {
       MjJoint& mj = mj_joints_[e];
       ++out_.njoints;
       if (mj.kind == Elem::Free) {
         x_ << ind << "  <joint name=" << q(mj.name) << " type=\"free\"";
-        if (mj.damping != 0) x_ << " damping=\"" << num(mj.damping) << "\"";
-        if (mj.armature != 0) x_ << " armature=\"" << num(mj.armature) << "\"";
+        if (mj.damping != 0) x_ << " damping=\"" << mjcf_number(mj.damping) << "\"";
+        if (mj.armature != 0) x_ << " armature=\"" << mjcf_number(mj.armature) << "\"";
         x_ << "/>\n";
         mj.G = SE3();
         continue;
@@ -624,12 +624,12 @@ class Exporter {
          << (mj.kind == Elem::Hinge ? "hinge" : mj.kind == Elem::Slide ? "slide" : "ball") << "\" pos=\"" << vec(mj.G.p) << "\"";
       if (mj.kind != Elem::Ball) {
         x_ << " axis=\"" << vec(mj.G.R * mj.axis) << "\"";
-        if (mj.ref != 0) x_ << " ref=\"" << num(mj.ref) << "\"";
+        if (mj.ref != 0) x_ << " ref=\"" << mjcf_number(mj.ref) << "\"";
       }
       if (mj.has_spring)
-        x_ << " stiffness=\"" << num(mj.stiffness) << "\" springref=\"" << num(mj.kref / mj.stiffness) << "\"";
-      if (mj.damping != 0) x_ << " damping=\"" << num(mj.damping) << "\"";
-      if (mj.armature != 0) x_ << " armature=\"" << num(mj.armature) << "\"";
+        x_ << " stiffness=\"" << mjcf_number(mj.stiffness) << "\" springref=\"" << mjcf_number(mj.kref / mj.stiffness) << "\"";
+      if (mj.damping != 0) x_ << " damping=\"" << mjcf_number(mj.damping) << "\"";
+      if (mj.armature != 0) x_ << " armature=\"" << mjcf_number(mj.armature) << "\"";
       x_ << "/>\n";
     }
     if (bs) {
@@ -637,11 +637,11 @@ class Exporter {
         x_ << ind << "  <geom type=\"";
         switch (s.type) {
           case ShapeType::Box: x_ << "box\" size=\"" << vec(0.5 * s.size) << "\""; break;
-          case ShapeType::Cylinder: x_ << "cylinder\" size=\"" << num(s.radius) << " " << num(0.5 * s.length) << "\""; break;
-          case ShapeType::Sphere: x_ << "sphere\" size=\"" << num(s.radius) << "\""; break;
+          case ShapeType::Cylinder: x_ << "cylinder\" size=\"" << mjcf_number(s.radius) << " " << mjcf_number(0.5 * s.length) << "\""; break;
+          case ShapeType::Sphere: x_ << "sphere\" size=\"" << mjcf_number(s.radius) << "\""; break;
         }
         x_ << " pos=\"" << vec(s.frame.position) << "\" quat=\"" << quat_text(quat_of(s.frame.rotation)) << "\" rgba=\""
-           << num(s.color[0]) << " " << num(s.color[1]) << " " << num(s.color[2]) << " " << num(s.color[3])
+           << mjcf_number(s.color[0]) << " " << mjcf_number(s.color[1]) << " " << mjcf_number(s.color[2]) << " " << mjcf_number(s.color[3])
            << "\" contype=\"0\" conaffinity=\"0\"/>\n";
         ++nshapes_;
       }
@@ -716,7 +716,7 @@ class Exporter {
     }
     auto list = [](const std::vector<double>& v) {
       std::string s;
-      for (std::size_t i = 0; i < v.size(); ++i) s += (i ? " " : "") + num(v[i]);
+      for (std::size_t i = 0; i < v.size(); ++i) s += (i ? " " : "") + mjcf_number(v[i]);
       return s;
     };
     std::vector<double> ctrl;
@@ -744,7 +744,7 @@ class Exporter {
     x_ << "  <compiler angle=\"radian\" inertiafromgeom=\"false\" balanceinertia=\"false\" boundmass=\"0\" "
           "boundinertia=\"0\" settotalmass=\"-1\"/>\n";
     const double dt = m_.spec.solver.output_step > 0 ? m_.spec.solver.output_step : 0.002;
-    x_ << "  <option gravity=\"" << vec(g) << "\" timestep=\"" << num(dt) << "\"/>\n";
+    x_ << "  <option gravity=\"" << vec(g) << "\" timestep=\"" << mjcf_number(dt) << "\"/>\n";
     x_ << "  <default>\n    <joint limited=\"false\" armature=\"0\" damping=\"0\" stiffness=\"0\" frictionloss=\"0\"/>\n"
           "    <geom contype=\"0\" conaffinity=\"0\"/>\n"
           "    <equality solimp=\"0.9999 0.9999 0.001 0.5 2\"/>\n  </default>\n";
@@ -763,7 +763,7 @@ class Exporter {
           x_ << " anchor=\"" << vec(e.anchor) << "\"/>\n";
         } else {
           x_ << "    <joint name=" << q(n) << " joint1=" << q(mj_joints_[e.b1].name) << " joint2=" << q(mj_joints_[e.b2].name)
-             << " polycoef=\"" << num(e.c0) << " " << num(e.c1) << " 0 0 0\"/>\n";
+             << " polycoef=\"" << mjcf_number(e.c0) << " " << mjcf_number(e.c1) << " 0 0 0\"/>\n";
         }
         ++out_.nequalities;
       }

@@ -28,7 +28,7 @@ std::string mjcf_reader_version() { return std::string("MuJoCo ") + mj_versionSt
 
 namespace {
 
-std::string num(double x) {
+std::string mjcf_text(double x) {
   std::ostringstream os;
   os.precision(6);
   os << x;
@@ -234,9 +234,9 @@ class MjcfImporter {
             break;
         }
         if (m_->jnt_limited[jid] && !dis(mjDSBL_LIMIT) && (type == mjJNT_HINGE || type == mjJNT_SLIDE))
-          limits_.push_back(j.name + " [" + num(m_->jnt_range[2 * jid]) + ", " + num(m_->jnt_range[2 * jid + 1]) + "]");
+          limits_.push_back(j.name + " [" + mjcf_text(m_->jnt_range[2 * jid]) + ", " + mjcf_text(m_->jnt_range[2 * jid + 1]) + "]");
         else if (m_->jnt_limited[jid] && !dis(mjDSBL_LIMIT))
-          limits_.push_back(j.name + " (cone " + num(m_->jnt_range[2 * jid + 1]) + ")");
+          limits_.push_back(j.name + " (cone " + mjcf_text(m_->jnt_range[2 * jid + 1]) + ")");
         s.joints.push_back(j);
         prev = j.child;
       }
@@ -348,8 +348,8 @@ class MjcfImporter {
         uneven = uneven || m_->dof_armature[da + k] != m_->dof_armature[da];
       }
       if (any) {
-        std::string e = joint_name_[j] + " " + num(m_->dof_armature[da]);
-        for (int k = 1; uneven && k < ndof; ++k) e += " " + num(m_->dof_armature[da + k]);
+        std::string e = joint_name_[j] + " " + mjcf_text(m_->dof_armature[da]);
+        for (int k = 1; uneven && k < ndof; ++k) e += " " + mjcf_text(m_->dof_armature[da + k]);
         if (type == mjJNT_FREE) armature_free.push_back(e);
         else if (uneven) armature_uneven.push_back(e);
         else if (!keep_armature) armature.push_back(e);
@@ -363,7 +363,7 @@ class MjcfImporter {
       for (int k = 0; k < ndof; ++k) {
         if (m_->dof_frictionloss[da + k] != 0 && !dis(mjDSBL_FRICTIONLOSS))
           friction.push_back(joint_name_[j] + (ndof > 1 ? "[" + std::to_string(k) + "]" : "") + " " +
-                             num(m_->dof_frictionloss[da + k]));
+                             mjcf_text(m_->dof_frictionloss[da + k]));
       }
       if (dis(mjDSBL_PASSIVE)) continue;
       const double k = m_->jnt_stiffness[j], c = m_->dof_damping[da];
@@ -388,7 +388,7 @@ class MjcfImporter {
           ++ndampers;
         }
       } else {
-        if (k != 0) ball_springs.push_back(joint_name_[j] + " " + num(k));
+        if (k != 0) ball_springs.push_back(joint_name_[j] + " " + mjcf_text(k));
         bool same = true;
         for (int q = 1; q < ndof; ++q) same = same && m_->dof_damping[da + q] == c;
         if (!same) damped.push_back(joint_name_[j]);
@@ -417,8 +417,8 @@ class MjcfImporter {
     add("springs", "different dampings on the coordinates of one joint", damped, true);
     if (!dis(mjDSBL_PASSIVE) && (m_->opt.density != 0 || m_->opt.viscosity != 0))
       add("fluid", "fluid forces are not modelled",
-          {"density " + num(m_->opt.density), "viscosity " + num(m_->opt.viscosity),
-           "wind [" + num(m_->opt.wind[0]) + " " + num(m_->opt.wind[1]) + " " + num(m_->opt.wind[2]) + "]"}, true);
+          {"density " + mjcf_text(m_->opt.density), "viscosity " + mjcf_text(m_->opt.viscosity),
+           "wind [" + mjcf_text(m_->opt.wind[0]) + " " + mjcf_text(m_->opt.wind[1]) + " " + mjcf_text(m_->opt.wind[2]) + "]"}, true);
   }
 
   void gravity_and_options() {
@@ -429,12 +429,12 @@ class MjcfImporter {
       e.type = EffectType::Gravity;
       e.g = g;
       r_.spec.effects.insert(r_.spec.effects.begin(), e);
-      r_.report.mapped.push_back("gravity [" + num(g.x()) + " " + num(g.y()) + " " + num(g.z()) + "] m/s^2 -> gravity effect");
+      r_.report.mapped.push_back("gravity [" + mjcf_text(g.x()) + " " + mjcf_text(g.y()) + " " + mjcf_text(g.z()) + "] m/s^2 -> gravity effect");
     } else {
       r_.report.mapped.push_back("no gravity (zero or disabled in the file)");
     }
     r_.spec.solver.output_step = m_->opt.timestep;
-    r_.report.mapped.push_back("timestep " + num(m_->opt.timestep) + " s -> solver output_step (codyna's integrators choose their own steps)");
+    r_.report.mapped.push_back("timestep " + mjcf_text(m_->opt.timestep) + " s -> solver output_step (codyna's integrators choose their own steps)");
   }
 
   void equalities() {
@@ -457,7 +457,7 @@ class MjcfImporter {
         c.point_b = v3(m_->eq_data + mjNEQDATA * e + 3);
         r_.spec.constraints.push_back(c);
         ++nconnect;
-        soft.push_back(label + " (solref " + num(m_->eq_solref[mjNREF * e]) + " " + num(m_->eq_solref[mjNREF * e + 1]) + ")");
+        soft.push_back(label + " (solref " + mjcf_text(m_->eq_solref[mjNREF * e]) + " " + mjcf_text(m_->eq_solref[mjNREF * e + 1]) + ")");
       } else if (m_->eq_type[e] == mjEQ_JOINT && linear_joint_equality(e)) {
         // MuJoCo: q1 - qpos0_1 = data0 + data1 (q2 - qpos0_2): a coupler q1 - data1 q2 = offset
         const int j1 = m_->eq_obj1id[e], j2 = m_->eq_obj2id[e];
@@ -472,7 +472,7 @@ class MjcfImporter {
         c.offset = m_->qpos0[m_->jnt_qposadr[j1]] + d[0] - d[1] * m_->qpos0[m_->jnt_qposadr[j2]];
         r_.spec.constraints.push_back(c);
         ++ncoupler;
-        soft.push_back(label + " (solref " + num(m_->eq_solref[mjNREF * e]) + " " + num(m_->eq_solref[mjNREF * e + 1]) + ")");
+        soft.push_back(label + " (solref " + mjcf_text(m_->eq_solref[mjNREF * e]) + " " + mjcf_text(m_->eq_solref[mjNREF * e + 1]) + ")");
       } else {
         static const char* types[] = {"connect", "weld", "joint", "tendon", "distance"};
         other.push_back(label + " (" + types[m_->eq_type[e]] + ")");
@@ -597,7 +597,7 @@ class MjcfImporter {
           lo = lo ? std::max(*lo, flo) : flo;
           hi = hi ? std::min(*hi, fhi) : fhi;
         } else {
-          forcerange.push_back(label + " [" + num(m_->actuator_forcerange[2 * a]) + ", " + num(m_->actuator_forcerange[2 * a + 1]) + "]");
+          forcerange.push_back(label + " [" + mjcf_text(m_->actuator_forcerange[2 * a]) + ", " + mjcf_text(m_->actuator_forcerange[2 * a + 1]) + "]");
         }
       }
       act.min = lo;

@@ -26,7 +26,7 @@ bool urdf_import_available() { return true; }
 
 namespace {
 
-std::string num(double x) {
+std::string urdf_text(double x) {
   std::ostringstream os;
   os.precision(6);
   os << x;
@@ -203,8 +203,8 @@ class UrdfImporter {
     if (uj.limits && uj.type != urdf::Joint::FIXED) {
       std::string l = uj.name;
       if (uj.type == urdf::Joint::REVOLUTE || uj.type == urdf::Joint::PRISMATIC)
-        l += " [" + num(uj.limits->lower) + ", " + num(uj.limits->upper) + "]";
-      if (uj.limits->velocity > 0) l += " velocity " + num(uj.limits->velocity);
+        l += " [" + urdf_text(uj.limits->lower) + ", " + urdf_text(uj.limits->upper) + "]";
+      if (uj.limits->velocity > 0) l += " velocity " + urdf_text(uj.limits->velocity);
       limits_.push_back(l);
     }
     if (uj.dynamics && uj.type != urdf::Joint::FIXED) {
@@ -217,7 +217,7 @@ class UrdfImporter {
         s.effects.push_back(e);
         ++ndampers_;
       }
-      if (uj.dynamics->friction != 0) friction_.push_back(uj.name + " " + num(uj.dynamics->friction));
+      if (uj.dynamics->friction != 0) friction_.push_back(uj.name + " " + urdf_text(uj.dynamics->friction));
     }
     if (uj.mimic) mimics_.push_back(&uj);
     if (scalar) {
@@ -249,7 +249,7 @@ class UrdfImporter {
       auto scalar = [](int t) {
         return t == urdf::Joint::REVOLUTE || t == urdf::Joint::CONTINUOUS || t == urdf::Joint::PRISMATIC;
       };
-      const std::string text = uj->name + " = " + num(uj->mimic->multiplier) + " " + uj->mimic->joint_name + " + " + num(uj->mimic->offset);
+      const std::string text = uj->name + " = " + urdf_text(uj->mimic->multiplier) + " " + uj->mimic->joint_name + " + " + urdf_text(uj->mimic->offset);
       if (!other || !scalar(uj->type) || !scalar(other->type) || uj->mimic->multiplier == 0 || other->name == uj->name) {
         mimic_.push_back(text + (other ? "" : " (no such joint)"));
         continue;

@@ -175,7 +175,7 @@ std::string one_line(const std::string& s) {
 }
 
 // shortest text that reads back as the same double ("0.01", not "0.010000")
-std::string number(double x) {
+std::string mat_number(double x) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.17g", x);
   for (int precision = 1; precision < 17; ++precision) {
@@ -186,7 +186,7 @@ std::string number(double x) {
   return buf;
 }
 
-std::string quoted(const std::string& s) {
+std::string quoted_text(const std::string& s) {
   std::string out = "'";
   for (char c : one_line(s)) out += c == '\'' ? std::string("''") : std::string(1, c);
   return out + "'";
@@ -247,9 +247,9 @@ VarPtr char_matrix_var(const char* name, const std::vector<std::string>& list) {
   return checked(Mat_VarCreate(name, MAT_C_CHAR, MAT_T_UINT16, 2, dims, data.data(), 0), name);
 }
 
-using Field = std::pair<const char*, VarPtr>;
+using MatField = std::pair<const char*, VarPtr>;
 
-VarPtr struct_var(const char* name, std::vector<Field> fields) {
+VarPtr struct_var(const char* name, std::vector<MatField> fields) {
   std::vector<const char*> names;
   for (const auto& f : fields) names.push_back(f.first);
   size_t dims[2] = {1, 1};
@@ -290,7 +290,7 @@ class MatWriter {
 };
 
 VarPtr info_var(const LinearSystem& s, const std::string& name) {
-  std::vector<Field> fields;
+  std::vector<MatField> fields;
   fields.emplace_back("name", char_var(nullptr, name));
   fields.emplace_back("model_name", char_var(nullptr, s.model_name));
   fields.emplace_back("model_file", char_var(nullptr, s.model_file));
@@ -336,7 +336,7 @@ std::string cellstr_literal(const char* var, const std::vector<std::string>& nam
   if (names.empty()) return std::string(var) + " = cell(0, 1);\n";
   std::string out = std::string(var) + " = { ...\n";
   for (std::size_t i = 0; i < names.size(); ++i)
-    out += "  " + quoted(names[i]) + "  % [" + (units[i].empty() ? "-" : one_line(units[i])) + "]\n";
+    out += "  " + quoted_text(names[i]) + "  % [" + (units[i].empty() ? "-" : one_line(units[i])) + "]\n";
   return out + "};\n";
 }
 
@@ -346,10 +346,10 @@ std::string header_comment(const LinearSystem& s, const std::string& name, MatVe
     << "%\n"
     << "% Model:            " << one_line(s.model_name)
     << (s.model_file.empty() ? "" : "  (" + one_line(s.model_file) + ")") << "\n"
-    << "% Operating point:  " << one_line(s.operating_point) << ", t = " << number(s.time) << " s\n"
+    << "% Operating point:  " << one_line(s.operating_point) << ", t = " << mat_number(s.time) << " s\n"
     << "% Linearization:    " << one_line(s.method) << "\n"
     << "% Time:             "
-    << (s.Ts > 0 ? "discrete, Ts = " + number(s.Ts) + " s (zero-order hold)" : std::string("continuous (Ts = 0)"))
+    << (s.Ts > 0 ? "discrete, Ts = " + mat_number(s.Ts) + " s (zero-order hold)" : std::string("continuous (Ts = 0)"))
     << "\n"
     << "%\n"
     << "% Deviations about the operating point (x0, u0, y0, xdot0 in " << name << ".mat):\n"
@@ -437,8 +437,8 @@ std::string summary_block(const LinearSystem& s, const std::string& name) {
          "end\n"
          "fprintf(['%s: %s plant of model %s at operating point %s (%s linearization),\\n' ...\n"
          "         '  %d states (%s),\\n  %d inputs (%s),\\n  %d outputs (%s).\\n'], ...\n"
-         "        '" + name + "', codyna_kind, " + quoted(or_unset(s.model_name)) + ", " +
-         quoted(or_unset(s.operating_point)) + ", " + quoted(or_unset(s.method)) + ", ...\n"
+         "        '" + name + "', codyna_kind, " + quoted_text(or_unset(s.model_name)) + ", " +
+         quoted_text(or_unset(s.operating_point)) + ", " + quoted_text(or_unset(s.method)) + ", ...\n"
          "        size(A, 1), strjoin(reshape(state_names, 1, []), ', '), ...\n"
          "        size(B, 2), strjoin(reshape(plant_inputs, 1, []), ', '), ...\n"
          "        size(C, 1), strjoin(reshape(plant_outputs, 1, []), ', '));\n"
@@ -751,7 +751,7 @@ std::string closed_loop_script(const ClosedLoopLinear& cl, const std::string& na
     << "% Model:            " << one_line(s.model_name) << (s.model_file.empty() ? "" : "  (" + one_line(s.model_file) + ")") << "\n"
     << "% Operating point:  " << one_line(s.operating_point) << "\n"
     << "% Controller:       " << one_line(cl.controller) << "\n"
-    << "% Time:             " << (s.Ts > 0 ? "discrete, Ts = " + number(s.Ts) + " s (plant by zero-order hold)" : std::string("continuous"))
+    << "% Time:             " << (s.Ts > 0 ? "discrete, Ts = " + mat_number(s.Ts) + " s (plant by zero-order hold)" : std::string("continuous"))
     << "\n%\n"
     << "% The plant linearized about its operating point with the controller's law, no saturation:\n"
     << (s.Ts > 0 ? "%   xcl[k+1] = Acl xcl[k] + Bcl w[k]\n" : "%   d(xcl)/dt = Acl xcl + Bcl w\n")
@@ -775,7 +775,7 @@ std::string closed_loop_script(const ClosedLoopLinear& cl, const std::string& na
     << "  codyna_note = '; the named state-space model is sys_cl';\n"
     << "end\n"
     << "fprintf('%s: linear closed loop of model %s, %d states, %d inputs, %d outputs%s.\\n', '" << name << "', "
-    << quoted(or_unset(s.model_name)) << ", size(Acl, 1), size(Bcl, 2), size(Ccl, 1), codyna_note);\n"
+    << quoted_text(or_unset(s.model_name)) << ", size(Acl, 1), size(Bcl, 2), size(Ccl, 1), codyna_note);\n"
     << "clear codyna_here codyna_note\n";
   return m.str();
 }
@@ -822,7 +822,7 @@ ExportPaths export_closed_loop(const ClosedLoopLinear& cl, const ModalAnalysis& 
     w.write(double_var("poles_cl", P));
     w.write(double_var("t_step", column(t_step)));
     w.write(double_var("w_freq", column(w_freq)));
-    std::vector<Field> fields;
+    std::vector<MatField> fields;
     fields.emplace_back("name", char_var(nullptr, name));
     fields.emplace_back("model_name", char_var(nullptr, s.model_name));
     fields.emplace_back("model_file", char_var(nullptr, s.model_file));

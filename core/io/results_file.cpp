@@ -145,7 +145,7 @@ void require_consistent(const R& r, const std::string& path) {
 
 using FileError = Hdf5Error;
 using Handle = Hdf5Handle;
-void check(herr_t rc, const std::string& what) { hdf5_check(rc, what); }
+void h5_check(herr_t rc, const std::string& what) { hdf5_check(rc, what); }
 
 template <class T>
 struct H5Type;
@@ -168,15 +168,15 @@ struct H5Type<int> {
 // Fixed-length, NUL-padded, tagged ASCII: what Octave's load() can read (see the header).
 Handle fixed_string_type(std::size_t width, const std::string& what) {
   Handle type(H5Tcopy(H5T_C_S1), H5Tclose, what);
-  check(H5Tset_size(type, width), what);
-  check(H5Tset_strpad(type, H5T_STR_NULLPAD), what);
+  h5_check(H5Tset_size(type, width), what);
+  h5_check(H5Tset_strpad(type, H5T_STR_NULLPAD), what);
   return type;
 }
 
 Handle utf8_text_type(const std::string& what) {
   Handle type(H5Tcopy(H5T_C_S1), H5Tclose, what);
-  check(H5Tset_size(type, H5T_VARIABLE), what);
-  check(H5Tset_cset(type, H5T_CSET_UTF8), what);
+  h5_check(H5Tset_size(type, H5T_VARIABLE), what);
+  h5_check(H5Tset_cset(type, H5T_CSET_UTF8), what);
   return type;
 }
 
@@ -195,9 +195,9 @@ void write_dataset(hid_t file, const std::string& name, hid_t file_type, hid_t m
   const std::string what = "cannot write " + name;
   Handle space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), H5Sclose, what);
   Handle links(H5Pcreate(H5P_LINK_CREATE), H5Pclose, what);
-  check(H5Pset_create_intermediate_group(links, 1), what);
+  h5_check(H5Pset_create_intermediate_group(links, 1), what);
   Handle dataset(H5Dcreate2(file, name.c_str(), file_type, space, links, H5P_DEFAULT, H5P_DEFAULT), H5Dclose, what);
-  if (element_count(dims) > 0) check(H5Dwrite(dataset, memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), what);
+  if (element_count(dims) > 0) h5_check(H5Dwrite(dataset, memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), what);
 }
 
 // `m` as a (samples x columns) dataset; a matrix without columns is (samples x 0) whatever its rows.
@@ -236,7 +236,7 @@ void write_attribute(hid_t file, const char* object, const char* name, hid_t fil
   Handle space(H5Screate(H5S_SCALAR), H5Sclose, what);
   Handle attribute(H5Acreate_by_name(file, object, name, file_type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
                    H5Aclose, what);
-  check(H5Awrite(attribute, memory_type, value), what);
+  h5_check(H5Awrite(attribute, memory_type, value), what);
 }
 
 template <class T>
@@ -293,13 +293,13 @@ Dataset open_dataset(hid_t file, const std::string& name, int rank) {
   if (found != rank)
     throw FileError(name + " has " + std::to_string(found) + " dimensions, expected " + std::to_string(rank));
   std::vector<hsize_t> dims(static_cast<std::size_t>(rank));
-  check(H5Sget_simple_extent_dims(space, dims.data(), nullptr), what);
+  h5_check(H5Sget_simple_extent_dims(space, dims.data(), nullptr), what);
   return {std::move(dataset), std::move(dims)};
 }
 
 void read_dataset(const Dataset& d, const std::string& name, hid_t memory_type, void* data) {
   if (element_count(d.dims) > 0)
-    check(H5Dread(d.handle, memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), "cannot read " + name);
+    h5_check(H5Dread(d.handle, memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), "cannot read " + name);
 }
 
 std::vector<double> read_series(hid_t file, const std::string& name) {
@@ -324,7 +324,7 @@ Strings read_strings(hid_t file, const std::string& name) {
     throw FileError(name + " is not a list of fixed-length strings");
   const std::size_t width = H5Tget_size(stored);
   const Handle type(H5Tcopy(stored), H5Tclose, what);  // same size and character set, NUL-padded
-  check(H5Tset_strpad(type, H5T_STR_NULLPAD), what);
+  h5_check(H5Tset_strpad(type, H5T_STR_NULLPAD), what);
   std::vector<char> packed(element_count(d.dims) * width);
   read_dataset(d, name, type, packed.data());
   Strings list;
@@ -336,7 +336,7 @@ Strings read_strings(hid_t file, const std::string& name) {
 void read_attribute(hid_t file, const char* object, const char* name, hid_t memory_type, void* value) {
   const std::string what = "cannot read " + attribute_label(object, name);
   Handle attribute(H5Aopen_by_name(file, object, name, H5P_DEFAULT, H5P_DEFAULT), H5Aclose, what);
-  check(H5Aread(attribute, memory_type, value), what);
+  h5_check(H5Aread(attribute, memory_type, value), what);
 }
 
 template <class T>

@@ -21,7 +21,7 @@ namespace {
 constexpr std::uintmax_t kMaxBytes = 256u << 20;
 constexpr std::size_t kMaxRows = 10000000;
 
-[[noreturn]] void fail(const std::string& path, const std::string& what) {
+[[noreturn]] void signal_fail(const std::string& path, const std::string& what) {
   throw std::invalid_argument(path + ": " + what);
 }
 
@@ -46,20 +46,20 @@ std::string shown(const std::string& s) { return "\"" + (s.size() > 40 ? s.subst
 
 void check_sample(const std::string& path, const std::string& where_t, const std::string& where_v, double t, double v,
                   const std::vector<std::pair<double, double>>& before) {
-  if (!std::isfinite(t)) fail(path, where_t + ": the time is not a finite number");
-  if (!std::isfinite(v)) fail(path, where_v + ": the value is not a finite number");
+  if (!std::isfinite(t)) signal_fail(path, where_t + ": the time is not a finite number");
+  if (!std::isfinite(v)) signal_fail(path, where_v + ": the value is not a finite number");
   if (!before.empty() && !(t > before.back().first)) {
     std::ostringstream os;
     os.precision(17);
     os << where_t << ": the time " << t << " is not after the previous one (" << before.back().first
        << "): times must increase strictly";
-    fail(path, os.str());
+    signal_fail(path, os.str());
   }
 }
 
 std::vector<std::pair<double, double>> read_csv(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, "cannot open the file");
+  if (!in) signal_fail(path, "cannot open the file");
   std::string line, name_t, name_v;
   std::vector<std::pair<double, double>> out;
   long line_no = 0;
@@ -74,9 +74,9 @@ std::vector<std::pair<double, double>> read_csv(const std::string& path) {
     if (!header) {
       double x, y;
       if (comma == std::string::npos || b.find(',') != std::string::npos)
-        fail(path, "line " + std::to_string(line_no) + ": expected a header of two column names (t,value), got " + shown(line));
+        signal_fail(path, "line " + std::to_string(line_no) + ": expected a header of two column names (t,value), got " + shown(line));
       if (parse_number(a, x) && parse_number(b, y))
-        fail(path, "line " + std::to_string(line_no) + ": expected a header of two column names (t,value) before the numbers, got " + shown(line));
+        signal_fail(path, "line " + std::to_string(line_no) + ": expected a header of two column names (t,value) before the numbers, got " + shown(line));
       name_t = trim(a);
       name_v = trim(b);
       header = true;
@@ -84,25 +84,25 @@ std::vector<std::pair<double, double>> read_csv(const std::string& path) {
     }
     const std::string row = "row " + std::to_string(out.size() + 1) + " (line " + std::to_string(line_no) + ")";
     if (comma == std::string::npos || b.find(',') != std::string::npos)
-      fail(path, row + ": expected two numbers separated by a comma (" + name_t + "," + name_v + "), got " + shown(line));
+      signal_fail(path, row + ": expected two numbers separated by a comma (" + name_t + "," + name_v + "), got " + shown(line));
     double t, v;
-    if (!parse_number(a, t)) fail(path, row + ", column " + name_t + ": expected a number, got " + shown(trim(a)));
-    if (!parse_number(b, v)) fail(path, row + ", column " + name_v + ": expected a number, got " + shown(trim(b)));
+    if (!parse_number(a, t)) signal_fail(path, row + ", column " + name_t + ": expected a number, got " + shown(trim(a)));
+    if (!parse_number(b, v)) signal_fail(path, row + ", column " + name_v + ": expected a number, got " + shown(trim(b)));
     check_sample(path, row + ", column " + name_t, row + ", column " + name_v, t, v, out);
     out.emplace_back(t, v);
-    if (out.size() > kMaxRows) fail(path, "more than 1e7 rows");
+    if (out.size() > kMaxRows) signal_fail(path, "more than 1e7 rows");
   }
-  if (!header) fail(path, "empty: expected a header line (t,value) and at least one row");
-  if (out.empty()) fail(path, "no rows after the header (" + name_t + "," + name_v + "): expected at least one");
+  if (!header) signal_fail(path, "empty: expected a header line (t,value) and at least one row");
+  if (out.empty()) signal_fail(path, "no rows after the header (" + name_t + "," + name_v + "): expected at least one");
   return out;
 }
 
 // the entries of one real vector variable, read by matio directly (to name the element of a NaN)
 std::vector<double> mat_vector(const std::string& path, const char* name) {
   std::unique_ptr<mat_t, int (*)(mat_t*)> mat(Mat_Open(path.c_str(), MAT_ACC_RDONLY), Mat_Close);
-  if (!mat) fail(path, "not a MAT file (or unreadable)");
+  if (!mat) signal_fail(path, "not a MAT file (or unreadable)");
   std::unique_ptr<matvar_t, void (*)(matvar_t*)> v(Mat_VarRead(mat.get(), name), Mat_VarFree);
-  if (!v) fail(path, std::string("no variable ") + name);
+  if (!v) signal_fail(path, std::string("no variable ") + name);
   const std::size_t n = v->rank == 2 ? v->dims[0] * v->dims[1] : 0;
   std::vector<double> out(n);
   if (v->class_type == MAT_C_DOUBLE && !v->isComplex && v->data)
@@ -110,7 +110,7 @@ std::vector<double> mat_vector(const std::string& path, const char* name) {
   else if (v->class_type == MAT_C_SINGLE && !v->isComplex && v->data)
     for (std::size_t k = 0; k < n; ++k) out[k] = static_cast<const float*>(v->data)[k];
   else
-    fail(path, std::string("variable ") + name + ": expected a real double vector");
+    signal_fail(path, std::string("variable ") + name + ": expected a real double vector");
   return out;
 }
 
@@ -122,8 +122,8 @@ std::vector<std::pair<double, double>> read_mat(const std::string& path) {
       const auto it = vars.matrices.find(name);
       if (it == vars.matrices.end()) {
         for (const SkippedVariable& s : vars.skipped)
-          if (s.name == name) fail(path, std::string("variable ") + name + " cannot be used (" + s.reason + "); expected a real vector");
-        fail(path, std::string("no variable ") + name + ": a signal .mat holds the vectors t and value");
+          if (s.name == name) signal_fail(path, std::string("variable ") + name + " cannot be used (" + s.reason + "); expected a real vector");
+        signal_fail(path, std::string("no variable ") + name + ": a signal .mat holds the vectors t and value");
       }
     }
     t = vars.matrices.at("t");
@@ -135,18 +135,18 @@ std::vector<std::pair<double, double>> read_mat(const std::string& path) {
       const std::vector<double> x = mat_vector(path, name);
       for (std::size_t k = 0; k < x.size(); ++k)
         if (!std::isfinite(x[k]))
-          fail(path, std::string("variable ") + name + ", row " + std::to_string(k + 1) + ": not a finite number");
+          signal_fail(path, std::string("variable ") + name + ", row " + std::to_string(k + 1) + ": not a finite number");
     }
     throw std::invalid_argument(e.what());
   }
   for (const auto& [name, M] : {std::pair{"t", &t}, std::pair{"value", &v}})
     if (M->rows() != 1 && M->cols() != 1)
-      fail(path, std::string("variable ") + name + " is " + std::to_string(M->rows()) + " x " + std::to_string(M->cols()) +
+      signal_fail(path, std::string("variable ") + name + " is " + std::to_string(M->rows()) + " x " + std::to_string(M->cols()) +
                      ": expected a vector");
   if (t.size() != v.size())
-    fail(path, "t has " + std::to_string(t.size()) + " entries but value has " + std::to_string(v.size()) +
+    signal_fail(path, "t has " + std::to_string(t.size()) + " entries but value has " + std::to_string(v.size()) +
                    ": expected one value per time");
-  if (t.size() == 0) fail(path, "t and value are empty: expected at least one sample");
+  if (t.size() == 0) signal_fail(path, "t and value are empty: expected at least one sample");
   std::vector<std::pair<double, double>> out;
   for (Eigen::Index k = 0; k < t.size(); ++k) {
     const std::string row = ", row " + std::to_string(k + 1);
@@ -160,9 +160,9 @@ std::vector<std::pair<double, double>> read_mat(const std::string& path) {
 
 std::vector<std::pair<double, double>> read_signal_file(const std::string& path) {
   std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) fail(path, "no such file");
-  if (!std::filesystem::is_regular_file(path, ec)) fail(path, "not a regular file");
-  if (std::filesystem::file_size(path, ec) > kMaxBytes) fail(path, "larger than 256 MiB");
+  if (!std::filesystem::exists(path, ec)) signal_fail(path, "no such file");
+  if (!std::filesystem::is_regular_file(path, ec)) signal_fail(path, "not a regular file");
+  if (std::filesystem::file_size(path, ec) > kMaxBytes) signal_fail(path, "larger than 256 MiB");
   const std::string ext = std::filesystem::path(path).extension().string();
   if (ext == ".mat" || ext == ".MAT") return read_mat(path);
   return read_csv(path);

@@ -13,9 +13,9 @@ namespace codyna {
 
 namespace {
 
-std::string quoted(const std::string& s) { return "\"" + s + "\""; }
+std::string quote(const std::string& s) { return "\"" + s + "\""; }
 
-std::string fmt(double x) {
+std::string compile_number(double x) {
   std::ostringstream os;
   os.precision(6);
   os << x;
@@ -132,7 +132,7 @@ class Compiler {
       const std::string& n = items[i].name;
       if (n.empty()) fail(at(list, i) + "/name", std::string("expected a non-empty ") + what + " name");
       auto [it, fresh] = seen.emplace(n, i);
-      if (!fresh) fail(at(list, i) + "/name", std::string("duplicate ") + what + " name " + quoted(n) + " (also " + at(list, it->second) + ")");
+      if (!fresh) fail(at(list, i) + "/name", std::string("duplicate ") + what + " name " + quote(n) + " (also " + at(list, it->second) + ")");
     }
   }
 
@@ -158,16 +158,16 @@ class Compiler {
       const BodySpec& b = spec_.bodies[i];
       const std::string p = at("bodies", i);
       if (b.mass > 0 && b.mass < std::max(1e-12 * heaviest, 1e-30))
-        fail(p + "/mass", "a mass of " + fmt(b.mass) + " kg is absurdly small beside the heaviest body (" + fmt(heaviest) +
+        fail(p + "/mass", "a mass of " + compile_number(b.mass) + " kg is absurdly small beside the heaviest body (" + compile_number(heaviest) +
                               " kg): give it a real mass, or 0 for a massless link");
       if (b.mass > 0 && b.inertia.allFinite() && b.inertia.diagonal().cwiseAbs().maxCoeff() < std::max(1e-15 * largest_moment, 1e-40))
-        fail(p + "/inertia", "principal moments this small (" + fmt(b.inertia.diagonal().maxCoeff()) +
-                                 " kg m^2) beside the model's largest (" + fmt(largest_moment) + ") are not a rigid body's");
+        fail(p + "/inertia", "principal moments this small (" + compile_number(b.inertia.diagonal().maxCoeff()) +
+                                 " kg m^2) beside the model's largest (" + compile_number(largest_moment) + ") are not a rigid body's");
     }
     for (std::size_t i = 0; i < spec_.bodies.size(); ++i) {
       const BodySpec& b = spec_.bodies[i];
       const std::string p = at("bodies", i);
-      if (!std::isfinite(b.mass) || b.mass < 0) fail(p + "/mass", "expected a non-negative mass in kg, got " + fmt(b.mass));
+      if (!std::isfinite(b.mass) || b.mass < 0) fail(p + "/mass", "expected a non-negative mass in kg, got " + compile_number(b.mass));
       if (!b.com.allFinite()) fail(p + "/com", "expected finite coordinates");
       const Eigen::Matrix3d& I = b.inertia;
       if (!I.allFinite()) fail(p + "/inertia", "expected finite entries");
@@ -179,10 +179,10 @@ class Compiler {
       // axis); whether the mass matrix stays positive definite is checked on the
       // assembled tree (check_mass_matrix), which names the coordinate that moves nothing
       if (ev[0] < -1e-12 * scale)
-        fail(p + "/inertia", "expected a positive semi-definite inertia matrix, got principal moments " + fmt(ev[0]) + ", " +
-                                 fmt(ev[1]) + ", " + fmt(ev[2]));
+        fail(p + "/inertia", "expected a positive semi-definite inertia matrix, got principal moments " + compile_number(ev[0]) + ", " +
+                                 compile_number(ev[1]) + ", " + compile_number(ev[2]));
       if (ev[0] + ev[1] < ev[2] * (1 - 1e-9))
-        fail(p + "/inertia", "principal moments " + fmt(ev[0]) + ", " + fmt(ev[1]) + ", " + fmt(ev[2]) +
+        fail(p + "/inertia", "principal moments " + compile_number(ev[0]) + ", " + compile_number(ev[1]) + ", " + compile_number(ev[2]) +
                                  " violate the triangle inequality (I1 + I2 >= I3): no rigid body has them");
       body_index_spec_[b.name] = static_cast<int>(i);
     }
@@ -198,7 +198,7 @@ class Compiler {
     if (it == compiled_.end()) {
       std::vector<std::string> names{kGroundName};
       for (const auto& b : spec_.bodies) names.push_back(b.name);
-      fail(path, "unknown body " + quoted(name) + " (bodies: " + join_names(names) + ")");
+      fail(path, "unknown body " + quote(name) + " (bodies: " + join_names(names) + ")");
     }
     return it->second;
   }
@@ -209,7 +209,7 @@ class Compiler {
     if (j < 0) {
       std::vector<std::string> names;
       for (const auto& s : spec_.joints) names.push_back(s.name);
-      fail(path, "unknown joint " + quoted(name) + " (joints: " + join_names(names) + ")");
+      fail(path, "unknown joint " + quote(name) + " (joints: " + join_names(names) + ")");
     }
     return j;
   }
@@ -218,7 +218,7 @@ class Compiler {
     const JointModel& j = m_.joints[jb];
     if (dof < 0 || dof >= j.nv)
       fail(path, "expected a coordinate index from 0 to " + std::to_string(j.nv - 1) + " of " + to_string(j.type) +
-                     " joint " + quoted(j.name) + ", got " + std::to_string(dof));
+                     " joint " + quote(j.name) + ", got " + std::to_string(dof));
   }
 
   static Eigen::Vector3d unit(const Eigen::Vector3d& a, const std::string& path, const Compiler& c) {
@@ -252,14 +252,14 @@ class Compiler {
       if (j.parent != kGroundName && !body_index_spec_.count(j.parent)) {
         std::vector<std::string> names{kGroundName};
         for (const auto& b : spec_.bodies) names.push_back(b.name);
-        fail(p + "/parent", "unknown body " + quoted(j.parent) + " (bodies: " + join_names(names) + ")");
+        fail(p + "/parent", "unknown body " + quote(j.parent) + " (bodies: " + join_names(names) + ")");
       }
       if (j.child == kGroundName) fail(p + "/child", "the ground cannot be a joint's child");
-      if (!body_index_spec_.count(j.child)) fail(p + "/child", "unknown body " + quoted(j.child));
-      if (j.child == j.parent) fail(p + "/child", "a joint cannot connect body " + quoted(j.child) + " to itself");
+      if (!body_index_spec_.count(j.child)) fail(p + "/child", "unknown body " + quote(j.child));
+      if (j.child == j.parent) fail(p + "/child", "a joint cannot connect body " + quote(j.child) + " to itself");
       auto [it, fresh] = child_of.emplace(j.child, k);
       if (!fresh)
-        fail(p + "/child", "body " + quoted(j.child) + " is already moved by joint " + quoted(joints[it->second].name) +
+        fail(p + "/child", "body " + quote(j.child) + " is already moved by joint " + quote(joints[it->second].name) +
                                "; close kinematic loops with a constraint");
       check_initial_values(j, p);
       if (j.armature.size() != 0) {
@@ -276,7 +276,7 @@ class Compiler {
     }
     for (std::size_t i = 0; i < spec_.bodies.size(); ++i)
       if (!child_of.count(spec_.bodies[i].name))
-        fail(at("bodies", i), "body " + quoted(spec_.bodies[i].name) + " is not the child of any joint (attach it, e.g. with a \"fixed\" joint)");
+        fail(at("bodies", i), "body " + quote(spec_.bodies[i].name) + " is not the child of any joint (attach it, e.g. with a \"fixed\" joint)");
 
     // stable topological order: a joint is placed once its parent is placed
     std::vector<std::size_t> order;
@@ -428,7 +428,7 @@ class Compiler {
       std::vector<std::string> rows;
       if (c.type == ConstraintType::RollingBall || c.type == ConstraintType::RollingDisc) {
         if (!std::isfinite(cs.radius) || cs.radius <= 0)
-          fail(p + "/radius", "expected a positive radius (m), got " + fmt(cs.radius));
+          fail(p + "/radius", "expected a positive radius (m), got " + compile_number(cs.radius));
         c.radius = cs.radius;
         c.axis_b = axis_b;  // rolling_disc: the axle
         // height on q; no slip along the plane's two directions, on v only
@@ -462,10 +462,10 @@ class Compiler {
       const int jb = joint(*names[k], p + "/" + keys[k]);
       const JointModel& j = m_.joints[jb];
       if (j.type != JointType::Revolute && j.type != JointType::Prismatic)
-        fail(p + "/" + keys[k], "a coupler relates scalar coordinates; " + quoted(j.name) + " is " + to_string(j.type) +
+        fail(p + "/" + keys[k], "a coupler relates scalar coordinates; " + quote(j.name) + " is " + to_string(j.type) +
                                     " (expected a revolute or prismatic joint)");
       for (int i = 0; i < c.ncoupled; ++i)
-        if (c.iv[i] == j.idx_v) fail(p + "/" + keys[k], quoted(j.name) + " is coupled to itself (expected different joints)");
+        if (c.iv[i] == j.idx_v) fail(p + "/" + keys[k], quote(j.name) + " is coupled to itself (expected different joints)");
       if (!std::isfinite(ratios[k])) fail(p + "/" + ratio_keys[k], "expected a finite ratio");
       if (ratios[k] != 0) ++nonzero;
       c.iq[c.ncoupled] = j.idx_q;
@@ -482,7 +482,7 @@ class Compiler {
   }
 
   void non_negative(double x, const std::string& path, const char* what) const {
-    if (!std::isfinite(x) || x < 0) fail(path, std::string("expected a non-negative ") + what + ", got " + fmt(x));
+    if (!std::isfinite(x) || x < 0) fail(path, std::string("expected a non-negative ") + what + ", got " + compile_number(x));
   }
 
   void build_effects() {
@@ -531,7 +531,7 @@ class Compiler {
             break;
           }
           if (!has_scalar_positions(j.type))
-            fail(p + "/joint", "a joint_spring_damper needs a joint with scalar coordinates; " + quoted(j.name) + " is " + to_string(j.type));
+            fail(p + "/joint", "a joint_spring_damper needs a joint with scalar coordinates; " + quote(j.name) + " is " + to_string(j.type));
           non_negative(e.stiffness, p + "/stiffness", "stiffness");
           if (!std::isfinite(e.rest_position)) fail(p + "/rest_position", "expected a finite number");
           s.stiffness = e.stiffness;
@@ -583,7 +583,7 @@ class Compiler {
           // (for a spherical joint an isotropic viscous torque -damping * omega)
           const int jb = joint(e.joint, p + "/joint");
           const JointModel& j = m_.joints[jb];
-          if (j.nv == 0) fail(p + "/joint", "joint " + quoted(j.name) + " is fixed: it has no coordinate to damp");
+          if (j.nv == 0) fail(p + "/joint", "joint " + quote(j.name) + " is fixed: it has no coordinate to damp");
           non_negative(e.damping, p + "/damping", "damping");
           for (int k = 0; k < j.nv; ++k) {
             JointSpringModel s;
@@ -616,16 +616,16 @@ class Compiler {
         const JointModel& j = m_.joints[jb];
         if (j.type != JointType::Revolute && j.type != JointType::Prismatic)
           fail(p + "/joint", "a motion input drives a scalar coordinate (a revolute or prismatic joint); " +
-                                 quoted(j.name) + " is " + to_string(j.type));
+                                 quote(j.name) + " is " + to_string(j.type));
         check_dof(jb, s.dof, p + "/dof");
         a.iv = j.idx_v;
         a.iq = j.idx_q;
         for (int other : m_.motions)
           if (m_.actuators[other].iv == a.iv)
-            fail(p + "/joint", quoted(j.name) + " is already driven by the motion input " + quoted(m_.actuators[other].name));
+            fail(p + "/joint", quote(j.name) + " is already driven by the motion input " + quote(m_.actuators[other].name));
         if (s.gain != 1.0) fail(p + "/gain", "a motion input has no gain (the coordinate is u itself)");
         if (s.u0 != 0.0)
-          fail(p + "/u0", "a motion input's nominal value is its joint's q0; set /joints q0 of " + quoted(j.name) + " instead");
+          fail(p + "/u0", "a motion input's nominal value is its joint's q0; set /joints q0 of " + quote(j.name) + " instead");
         a.unit = j.type == JointType::Revolute ? "rad" : "m";
         m_.motions.push_back(static_cast<int>(k));
       } else if (s.type == ActuatorType::Mix) {
@@ -672,12 +672,12 @@ class Compiler {
         if (j < 0) {
           std::vector<std::string> all;
           for (const auto& a : m_.actuators) all.push_back(a.name);
-          fail(pi, "unknown actuator " + quoted(s.drives[i]) + " (actuators: " + join_names(all) + ")");
+          fail(pi, "unknown actuator " + quote(s.drives[i]) + " (actuators: " + join_names(all) + ")");
         }
-        if (m_.actuators[j].type == ActuatorType::Mix) fail(pi, quoted(s.drives[i]) + " is a mix (a mix drives actuators, not mixes)");
+        if (m_.actuators[j].type == ActuatorType::Mix) fail(pi, quote(s.drives[i]) + " is a mix (a mix drives actuators, not mixes)");
         if (m_.actuators[j].type == ActuatorType::Motion)
-          fail(pi, quoted(s.drives[i]) + " is a motion input (a mix drives forces and torques)");
-        if (!seen.insert(j).second) fail(pi, quoted(s.drives[i]) + " is listed twice");
+          fail(pi, quote(s.drives[i]) + " is a motion input (a mix drives forces and torques)");
+        if (!seen.insert(j).second) fail(pi, quote(s.drives[i]) + " is listed twice");
         const double w = s.weights[static_cast<Eigen::Index>(i)];
         if (!std::isfinite(w)) fail(p + "/weights/" + std::to_string(i), "expected a finite weight");
         m_.actuators[j].driven_by.emplace_back(static_cast<int>(k), w);
@@ -699,7 +699,7 @@ class Compiler {
           check_dof(jb, s.dof, p + "/dof");
           const JointModel& j = m_.joints[jb];
           if (s.type == SensorType::JointPosition && !has_scalar_positions(j.type))
-            fail(p + "/joint", "joint_position needs a joint with scalar coordinates; " + quoted(j.name) + " is " + to_string(j.type) + " (use body_angle)");
+            fail(p + "/joint", "joint_position needs a joint with scalar coordinates; " + quote(j.name) + " is " + to_string(j.type) + " (use body_angle)");
           o.iq = j.idx_q + s.dof;
           o.iv = j.idx_v + s.dof;
           const bool ang = is_angular(j.type, s.dof);
@@ -720,10 +720,10 @@ class Compiler {
               driven = driven || a.iv == o.iv;
               for (const JointModel& jm : m_.joints)
                 if (jm.nv > 0 && a.iv >= jm.idx_v && a.iv < jm.idx_v + jm.nv)
-                  driven_joints.push_back(jm.name + " (by " + quoted(a.name) + ")");
+                  driven_joints.push_back(jm.name + " (by " + quote(a.name) + ")");
             }
           if (!driven)
-            fail(p + "/joint", "motion_force reads the reaction of a motion input; no motion drives " + quoted(j.name) +
+            fail(p + "/joint", "motion_force reads the reaction of a motion input; no motion drives " + quote(j.name) +
                                    (j.nv > 1 ? " dof " + std::to_string(s.dof) : std::string()) + " (" +
                                    (driven_joints.empty() ? std::string("the model has no motion input")
                                                           : "driven: " + join_names(driven_joints)) + ")");
@@ -771,10 +771,10 @@ class Compiler {
           std::vector<std::string> all;
           if (inputs) for (const auto& a : m_.actuators) all.push_back(a.name);
           else for (const auto& s : m_.sensors) all.push_back(s.name);
-          fail(p, std::string("unknown ") + (inputs ? "actuator " : "sensor ") + quoted(names[k]) + " (" +
+          fail(p, std::string("unknown ") + (inputs ? "actuator " : "sensor ") + quote(names[k]) + " (" +
                       (inputs ? "actuators: " : "sensors: ") + join_names(all) + ")");
         }
-        if (!seen.insert(names[k]).second) fail(p, quoted(names[k]) + " is listed twice");
+        if (!seen.insert(names[k]).second) fail(p, quote(names[k]) + " is listed twice");
         idx.push_back(i);
       }
       return idx;
@@ -786,9 +786,9 @@ class Compiler {
   void check_solver() {
     const SolverSpec& s = spec_.solver;
     static const std::set<std::string> integrators{"auto", "ida", "cvode-bdf", "cvode-adams", "arkode", "rk4"};
-    if (!integrators.count(s.integrator)) fail("/solver/integrator", "unknown integrator " + quoted(s.integrator) + " (expected one of: auto, ida, cvode-bdf, cvode-adams, arkode, rk4)");
+    if (!integrators.count(s.integrator)) fail("/solver/integrator", "unknown integrator " + quote(s.integrator) + " (expected one of: auto, ida, cvode-bdf, cvode-adams, arkode, rk4)");
     auto positive = [&](double x, const char* f) {
-      if (!std::isfinite(x) || x <= 0) fail(std::string("/solver/") + f, "expected a positive number, got " + fmt(x));
+      if (!std::isfinite(x) || x <= 0) fail(std::string("/solver/") + f, "expected a positive number, got " + compile_number(x));
     };
     positive(s.rtol, "rtol");
     positive(s.atol, "atol");
@@ -820,7 +820,7 @@ class Compiler {
         for (int i = 1; i < m_.nbodies; ++i)
           if (m_.joints[i].idx_v == a.iv)
             fail(at("joints", m_.joints[i].spec_index) + "/v0",
-                 "the coordinate is driven by the motion input " + quoted(a.name) +
+                 "the coordinate is driven by the motion input " + quote(a.name) +
                      ", which starts at rest (its rate u' is 0 at the nominal); expected 0");
       }
     }

@@ -10,7 +10,7 @@ namespace codyna {
 
 namespace {
 
-void check(const Model& m, const char* field, const Eigen::MatrixXd& M, Eigen::Index rows, Eigen::Index cols) {
+void check_gain_size(const Model& m, const char* field, const Eigen::MatrixXd& M, Eigen::Index rows, Eigen::Index cols) {
   if (M.rows() == rows && M.cols() == cols) return;
   std::ostringstream os;
   os << "expected a " << rows << " x " << cols << " matrix for this plant (" << m.plant_inputs.size() << " inputs, "
@@ -50,21 +50,21 @@ std::unique_ptr<Controller> make_model_controller(const Model& m, const LinearPl
     case ControllerType::None:
       return nullptr;
     case ControllerType::Pid: {
-      check(m, "kp", c.kp, nu, ny);
-      if (c.ki.size()) check(m, "ki", c.ki, nu, ny);
-      if (c.kd.size()) check(m, "kd", c.kd, nu, ny);
+      check_gain_size(m, "kp", c.kp, nu, ny);
+      if (c.ki.size()) check_gain_size(m, "ki", c.ki, nu, ny);
+      if (c.kd.size()) check_gain_size(m, "kd", c.kd, nu, ny);
       if (c.setpoint.size() && c.setpoint.size() != ny)
         throw ModelError(m.source_file, "/controller/setpoint", "expected " + std::to_string(ny) + " values (one per Plant/Out)");
       return make_pid(c.kp, c.ki, c.kd, c.setpoint.size() ? c.setpoint : s.y0, s.u0);
     }
     case ControllerType::StateFeedback:
-      check(m, "K", c.K, nu, nx);
+      check_gain_size(m, "K", c.K, nu, nx);
       return make_state_feedback(c.K, s.u0);
     case ControllerType::Lti: {
       const Eigen::Index n = c.Ac.rows();
-      check(m, "Bc", c.Bc, n, ny);
-      check(m, "Cc", c.Cc, nu, n);
-      check(m, "Dc", c.Dc, nu, ny);
+      check_gain_size(m, "Bc", c.Bc, n, ny);
+      check_gain_size(m, "Cc", c.Cc, nu, n);
+      check_gain_size(m, "Dc", c.Dc, nu, ny);
       return make_lti(c.Ac, c.Bc, c.Cc, c.Dc, c.Ts, s.y0, s.u0);
     }
     case ControllerType::Lqr: {

@@ -23,7 +23,7 @@ std::string lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return s;
 }
-std::string head_of(const std::string& path, std::size_t n) {
+std::string import_head(const std::string& path, std::size_t n) {
   std::ifstream f(path, std::ios::binary);
   std::string s(n, '\0');
   f.read(s.data(), static_cast<std::streamsize>(n));
@@ -36,7 +36,7 @@ std::string study_import_format(const std::string& path) {
   const std::string ext = lower(std::filesystem::path(path).extension().string());
   if (ext == ".urdf") return "URDF";
   if (ext == ".mjcf") return "MJCF";
-  const std::string h = head_of(path, 4096);
+  const std::string h = import_head(path, 4096);
   const auto robot = h.find("<robot"), mujoco = h.find("<mujoco");
   if (robot != std::string::npos && (mujoco == std::string::npos || robot < mujoco)) return "URDF";
   if (mujoco != std::string::npos) return "MJCF";
@@ -108,7 +108,7 @@ void study_guard_model_output(const std::string& path, const std::vector<std::st
   if (::stat(path.c_str(), &st) != 0) return;
   if (!S_ISREG(st.st_mode)) throw std::invalid_argument(path + ": exists and is not a regular file; choose another name");
   if (st.st_size == 0) return;
-  if (head_of(path, 512).find("\"codyna_model\"") == std::string::npos)
+  if (import_head(path, 512).find("\"codyna_model\"") == std::string::npos)
     throw std::invalid_argument(path + ": exists and is not a codyna model file; codyna never replaces a file it did "
                                 "not write: remove it or choose another name");
 }

@@ -51,7 +51,7 @@ std::string listed(const std::vector<std::string>& names) {
   return all.empty() ? "none" : all;
 }
 
-[[noreturn]] void fail(const Model& m, const std::string& field, const std::string& what) {
+[[noreturn]] void workflow_fail(const Model& m, const std::string& field, const std::string& what) {
   throw ModelError(m.source_file, "/analysis/" + field, what);
 }
 
@@ -60,12 +60,12 @@ std::string listed(const std::vector<std::string>& names) {
   throw ConvergenceError((m.source_file.empty() ? std::string() : m.source_file + ": ") + "/analysis/operating_point: " + what);
 }
 
-JacobianMethod method_of(const Model& m) {
+JacobianMethod method_of_model(const Model& m) {
   const std::string& s = m.spec.analysis.method;
   if (s == "exact") return JacobianMethod::Exact;
   if (s == "fd-forward") return JacobianMethod::ForwardDifference;
   if (s == "fd-central") return JacobianMethod::CentralDifference;
-  fail(m, "method", "unknown method \"" + s + "\" (expected one of: " + listed(study_methods()) + ")");
+  workflow_fail(m, "method", "unknown method \"" + s + "\" (expected one of: " + listed(study_methods()) + ")");
 }
 
 SimulationOptions solver_options(const Model& m) {
@@ -83,7 +83,7 @@ SimulationOptions solver_options(const Model& m) {
 Eigen::MatrixXd diagonal(const Model& m, const std::vector<double>& w, int n, const char* field) {
   if (w.empty()) return Eigen::MatrixXd::Identity(n, n);
   if (static_cast<int>(w.size()) != n)
-    fail(m, field, "expected " + std::to_string(n) + " weights (one per " + (n && field[0] == 'q' ? "state" : "input") +
+    workflow_fail(m, field, "expected " + std::to_string(n) + " weights (one per " + (n && field[0] == 'q' ? "state" : "input") +
                        "), got " + std::to_string(w.size()));
   return Eigen::Map<const Eigen::VectorXd>(w.data(), n).asDiagonal();
 }
@@ -141,7 +141,7 @@ SignalSpec resolved(const Model& m, const SignalSpec& s, const std::string& fiel
   try {
     r.points = read_signal_file(study_path(m, s.file));
   } catch (const std::invalid_argument& e) {
-    fail(m, field + "/file", e.what());
+    workflow_fail(m, field + "/file", e.what());
   }
   return r;
 }
@@ -190,23 +190,23 @@ void attach_disturbances(const Model& m, StudySimulation& out) {
     const std::string field = "disturbances/" + std::to_string(k);
     const auto it = std::find(names.begin(), names.end(), d.actuator);
     if (it == names.end())
-      fail(m, field + "/actuator", "no actuator named \"" + d.actuator + "\" (actuators: " + listed(names) + ")");
+      workflow_fail(m, field + "/actuator", "no actuator named \"" + d.actuator + "\" (actuators: " + listed(names) + ")");
     const int i = static_cast<int>(it - names.begin());
     if (std::find(m.plant_inputs.begin(), m.plant_inputs.end(), i) != m.plant_inputs.end())
-      fail(m, field + "/actuator", "\"" + d.actuator + "\" is a Plant/In input, driven by the controller; a disturbance " +
+      workflow_fail(m, field + "/actuator", "\"" + d.actuator + "\" is a Plant/In input, driven by the controller; a disturbance " +
                                        "goes on an actuator that is not (add one, e.g. a body_force on the same body)");
     if (std::find(actuators.begin(), actuators.end(), i) != actuators.end())
-      fail(m, field + "/actuator", "a second disturbance on \"" + d.actuator + "\"");
+      workflow_fail(m, field + "/actuator", "a second disturbance on \"" + d.actuator + "\"");
     actuators.push_back(i);
     signals.emplace_back(i, resolved(m, d, field));
     if (m.actuators[static_cast<std::size_t>(i)].type == ActuatorType::Motion) {
       // a motion input moves its coordinate: no jump in position (an infinite rate)
       const SignalSpec& sig = signals.back().second;
       if (sig.type == "step")
-        fail(m, field + "/type", "a step on the motion input \"" + d.actuator + "\" would move its coordinate at once; " +
+        workflow_fail(m, field + "/type", "a step on the motion input \"" + d.actuator + "\" would move its coordinate at once; " +
                                      "use a ramp or a table");
       if (sig.type == "sine" && std::abs(sig.amplitude * std::sin(sig.phase)) > 1e-12)
-        fail(m, field + "/phase", "a sine on the motion input \"" + d.actuator + "\" must start at 0 (phase 0 or pi), " +
+        workflow_fail(m, field + "/phase", "a sine on the motion input \"" + d.actuator + "\" must start at 0 (phase 0 or pi), " +
                                       "or its coordinate would jump");
     }
   }
@@ -289,15 +289,15 @@ void attach_anti_windup(const Model& m, StudySimulation& out) {
   if (s.anti_windup == "none") return;
   if (s.anti_windup == "back_calculation") aw.method = AntiWindup::Method::BackCalculation;
   else if (s.anti_windup == "conditional") aw.method = AntiWindup::Method::Conditional;
-  else fail(m, "anti_windup", "unknown anti-windup method \"" + s.anti_windup + "\" (expected one of: " + listed(anti_windup_methods()) + ")");
+  else workflow_fail(m, "anti_windup", "unknown anti-windup method \"" + s.anti_windup + "\" (expected one of: " + listed(anti_windup_methods()) + ")");
   aw.tracking_time = s.tracking_time;
   if (aw.method == AntiWindup::Method::BackCalculation && !(s.tracking_time > 0 && std::isfinite(s.tracking_time)))
-    fail(m, "tracking_time", "back_calculation needs a tracking time > 0 (s), e.g. the integral time kp/ki");
+    workflow_fail(m, "tracking_time", "back_calculation needs a tracking time > 0 (s), e.g. the integral time kp/ki");
   const PidGains* g = out.controller ? out.controller->pid() : nullptr;
   if (!g)
-    fail(m, "anti_windup", "applies to a PID controller; the study's controller is " +
+    workflow_fail(m, "anti_windup", "applies to a PID controller; the study's controller is " +
                                (out.controller ? out.controller->describe() : std::string("none")));
-  if (!g->Ki.size()) fail(m, "anti_windup", "the PID controller has no integral action (ki): nothing winds up");
+  if (!g->Ki.size()) workflow_fail(m, "anti_windup", "the PID controller has no integral action (ki): nothing winds up");
   out.controller = make_pid(g->Kp, g->Ki, g->Kd, g->r, g->u0, aw);
 }
 
@@ -305,18 +305,18 @@ void attach_anti_windup(const Model& m, StudySimulation& out) {
 void attach_references(const Model& m, StudySimulation& out) {
   const StudySpec& s = m.spec.analysis;
   if (!out.plant || !out.controller)
-    fail(m, "references", "a reference needs a controller to follow it (the controller source is \"" + s.controller + "\")");
+    workflow_fail(m, "references", "a reference needs a controller to follow it (the controller source is \"" + s.controller + "\")");
   const LinearSystem& sys = out.plant->lin.system;
   std::vector<std::pair<int, SignalSpec>> signals;
   std::vector<int> tracked;
   for (std::size_t k = 0; k < s.references.size(); ++k) {
     const auto it = std::find(sys.output_names.begin(), sys.output_names.end(), s.references[k].output);
     if (it == sys.output_names.end())
-      fail(m, "references/" + std::to_string(k) + "/output",
+      workflow_fail(m, "references/" + std::to_string(k) + "/output",
            "\"" + s.references[k].output + "\" is not a Plant/Out output (outputs: " + listed(sys.output_names) + ")");
     const int i = static_cast<int>(it - sys.output_names.begin());
     if (std::find(tracked.begin(), tracked.end(), i) != tracked.end())
-      fail(m, "references/" + std::to_string(k) + "/output", "a second reference for \"" + s.references[k].output + "\"");
+      workflow_fail(m, "references/" + std::to_string(k) + "/output", "a second reference for \"" + s.references[k].output + "\"");
     tracked.push_back(i);
     signals.emplace_back(i, resolved(m, s.references[k], "references/" + std::to_string(k)));
   }
@@ -449,7 +449,7 @@ StudyInitialState set_coordinates(const Model& m, Eigen::VectorXd q, Eigen::Vect
   };
   for (const auto& [name, value] : pairs) {
     if (!std::isfinite(value) || std::abs(value) > 1e6)
-      fail(m, field + "/" + name, "expected a finite number of magnitude at most 1e6 (m, rad, m/s or rad/s)");
+      workflow_fail(m, field + "/" + name, "expected a finite number of magnitude at most 1e6 (m, rad, m/s or rad/s)");
     const auto lock_joint = [&](const JointModel& j) {
       for (int k = 0; k < j.nv; ++k) hold.locked_positions.push_back(j.idx_v + k);
     };
@@ -483,7 +483,7 @@ StudyInitialState set_coordinates(const Model& m, Eigen::VectorXd q, Eigen::Vect
     }
     const auto iv = std::find(m.rate_names.begin(), m.rate_names.end(), name);
     if (iv == m.rate_names.end())
-      fail(m, field + "/" + name, "unknown coordinate \"" + name + "\" (coordinates: " + listed(m.v_names) + "; rates: " +
+      workflow_fail(m, field + "/" + name, "unknown coordinate \"" + name + "\" (coordinates: " + listed(m.v_names) + "; rates: " +
                                  listed(m.rate_names) + ")");
     v[iv - m.rate_names.begin()] = value;
     hold.locked_velocities.push_back(static_cast<int>(iv - m.rate_names.begin()));
@@ -502,7 +502,7 @@ StudyInitialState set_coordinates(const Model& m, Eigen::VectorXd q, Eigen::Vect
         os << "; closing them freely puts " << name << " at " << there << " (" << value << " asked, off by "
            << there - value << ")";
       }
-    fail(m, field, os.str());
+    workflow_fail(m, field, os.str());
   }
   return {r.q, r.v, true};
 }
@@ -594,16 +594,16 @@ OperatingPoint study_operating_point(const Model& m, const std::string& which_in
       }
       for (const std::string& name : s.trim_free)
         if (!std::count(m.v_names.begin(), m.v_names.end(), name))
-          fail(m, "trim_free", "unknown coordinate \"" + name + "\" (coordinates: " + listed(m.v_names) + ")");
+          workflow_fail(m, "trim_free", "unknown coordinate \"" + name + "\" (coordinates: " + listed(m.v_names) + ")");
       if (spec.free_inputs.empty())
         for (int k : m.plant_inputs) spec.free_inputs.push_back(m.actuators[static_cast<std::size_t>(k)].name);
     } else if (!s.trim_free.empty()) {
-      fail(m, "trim_free", "coordinates are freed for operating point trim only (an equilibrium solves every coordinate not set)");
+      workflow_fail(m, "trim_free", "coordinates are freed for operating point trim only (an equilibrium solves every coordinate not set)");
     }
     try {
       return steady_state(m, start, spec, s.independent, which);
     } catch (const std::invalid_argument& e) {
-      fail(m, "operating_point", std::string(which) + ": " + e.what());
+      workflow_fail(m, "operating_point", std::string(which) + ": " + e.what());
     } catch (const ConvergenceError& e) {
       not_converged(m, which + ": " + e.what());
     }
@@ -631,7 +631,7 @@ OperatingPoint study_operating_point(const Model& m, const std::string& which_in
     char* end = nullptr;
     const double t = std::strtod(which.c_str() + 5, &end);
     if (end == which.c_str() + 5 || *end != 0 || !std::isfinite(t) || t < 0)
-      fail(m, "operating_point", "\"" + which + "\": expected time=T with T >= 0 seconds");
+      workflow_fail(m, "operating_point", "\"" + which + "\": expected time=T with T >= 0 seconds");
     // the state the simulation reaches at t with the actuators at their nominal values (no controller)
     if (t == 0) return snapshot_point(m, 0.0, m.q0, m.v0, start.u);
     SimulationOptions o = solver_options(m);
@@ -649,16 +649,16 @@ OperatingPoint study_operating_point(const Model& m, const std::string& which_in
     const int last = r.samples() - 1;
     return snapshot_point(m, t, r.q.row(last).transpose(), r.v.row(last).transpose(), start.u);
   }
-  fail(m, "operating_point", "unknown operating point \"" + which + "\" (expected one of: initial, equilibrium, trim, time=T)");
+  workflow_fail(m, "operating_point", "unknown operating point \"" + which + "\" (expected one of: initial, equilibrium, trim, time=T)");
 }
 
 StudyLinearization study_linearize(const Model& m) {
   const StudySpec& s = m.spec.analysis;
   StudyLinearization out;
   LinearizeOptions o;
-  o.method = method_of(m);
+  o.method = method_of_model(m);
   o.independent = s.independent;
-  if (!(s.discrete >= 0) || !std::isfinite(s.discrete)) fail(m, "discrete", "expected a sample time >= 0 (0 = continuous)");
+  if (!(s.discrete >= 0) || !std::isfinite(s.discrete)) workflow_fail(m, "discrete", "expected a sample time >= 0 (0 = continuous)");
   out.op = study_operating_point(m);
   out.lin = linearize(m, out.op, o);
   out.lin.system.study = plant_study_json(s, s.operating_point);
@@ -670,7 +670,7 @@ std::string study_export_name(const Model& m) {
   const std::string& given = m.spec.analysis.export_name;
   if (given.empty()) return matlab_identifier(m.name);
   if (given != matlab_identifier(given))
-    fail(m, "export_name", "\"" + given + "\" is not a valid MATLAB identifier (try " + matlab_identifier(given) + ")");
+    workflow_fail(m, "export_name", "\"" + given + "\" is not a valid MATLAB identifier (try " + matlab_identifier(given) + ")");
   return given;
 }
 
@@ -683,8 +683,8 @@ std::string study_path(const Model& m, const std::string& path) {
 ExportPaths study_export(const Model& m, const LinearSystem& sys, const std::string& dir_in) {
   const StudySpec& s = m.spec.analysis;
   const std::string dir = dir_in.empty() ? study_path(m, s.export_dir) : dir_in;
-  if (dir.empty()) fail(m, "export_dir", "no folder to export to (choose one)");
-  if (s.mat_version != "5" && s.mat_version != "7.3") fail(m, "mat_version", "expected 5 or 7.3");
+  if (dir.empty()) workflow_fail(m, "export_dir", "no folder to export to (choose one)");
+  if (s.mat_version != "5" && s.mat_version != "7.3") workflow_fail(m, "mat_version", "expected 5 or 7.3");
   const std::string name = study_export_name(m);
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
@@ -699,7 +699,7 @@ StudySimulation study_simulation(const Model& m, const std::atomic<bool>* cancel
   out.options.compare_linear = s.compare_linear;
   const std::string& src = s.controller;
   if (std::find(study_controllers().begin(), study_controllers().end(), src) == study_controllers().end())
-    fail(m, "controller", "unknown controller source \"" + src + "\" (expected one of: " + listed(study_controllers()) + ")");
+    workflow_fail(m, "controller", "unknown controller source \"" + src + "\" (expected one of: " + listed(study_controllers()) + ")");
   const bool from_model = src == "model" && has_model_controller(m);
   const bool need_plant = from_model || src == "lqr" || src == "file" || s.compare_linear;
   if (need_plant) {
@@ -750,7 +750,7 @@ StudySimulation study_simulation(const Model& m, const std::atomic<bool>* cancel
     out.controller = make_state_feedback(out.lqr_gain, sys.u0);
     out.controller_source = "lqr";
   } else if (src == "file") {
-    if (s.controller_file.empty()) fail(m, "controller_file", "the controller source is a file, but none is named");
+    if (s.controller_file.empty()) workflow_fail(m, "controller_file", "the controller source is a file, but none is named");
     const LinearSystem& sys = out.plant->lin.system;
     const std::string path = study_path(m, s.controller_file);
     // a controller saved with the export's lists must fit this plant by name, not only by size
@@ -822,7 +822,7 @@ StudyClosedLoop study_closed_loop(const Model& m) {
   StudyClosedLoop r;
   r.setup = study_simulation(m);
   if (!r.setup.controller || !r.setup.plant)
-    fail(m, "controller", "the closed loop needs a controller: the controller source is \"" + st.controller + "\"" +
+    workflow_fail(m, "controller", "the closed loop needs a controller: the controller source is \"" + st.controller + "\"" +
                               (st.controller == "model" ? " and the model file declares none" : std::string()) +
                               " (choose lqr, file, or give the model a controller)");
   const LinearPlant& plant = *r.setup.plant;
@@ -864,8 +864,8 @@ StudyClosedLoop study_closed_loop(const Model& m) {
     r.notes.push_back("the operating point is not an equilibrium (xdot0 is not zero): the loop describes deviations "
                       "about a moving point, the responses leave out xdot0");
   const ClosedLoopSpec& c = st.closed_loop;
-  if (c.step_points < 2) fail(m, "closed_loop/step_points", "expected at least 2 points");
-  if (c.frequency_points < 2) fail(m, "closed_loop/frequency_points", "expected at least 2 points");
+  if (c.step_points < 2) workflow_fail(m, "closed_loop/step_points", "expected at least 2 points");
+  if (c.frequency_points < 2) workflow_fail(m, "closed_loop/frequency_points", "expected at least 2 points");
   const double t_end = c.step_time > 0 ? c.step_time : default_step_time(r.poles);
   r.step = step_response(r.loop.system, t_end, c.step_points);
   auto [w_min, w_max] = default_frequency_range(r.poles, r.loop.system.Ts);
@@ -874,7 +874,7 @@ StudyClosedLoop study_closed_loop(const Model& m) {
   if (!(w_max > w_min)) {
     std::ostringstream os;
     os << "the frequency range is empty (" << w_min << " .. " << w_max << " rad/s): choose frequency_max above frequency_min";
-    fail(m, "closed_loop/frequency_max", os.str());
+    workflow_fail(m, "closed_loop/frequency_max", os.str());
   }
   r.frequency = frequency_response(r.loop.system, log_grid(w_min, w_max, c.frequency_points));
   return r;
@@ -883,7 +883,7 @@ StudyClosedLoop study_closed_loop(const Model& m) {
 std::vector<std::string> study_export_closed_loop(const Model& m, const StudyClosedLoop& cl, const std::string& dir_in) {
   const StudySpec& s = m.spec.analysis;
   const std::string dir = dir_in.empty() ? study_path(m, s.export_dir) : dir_in;
-  if (dir.empty()) fail(m, "export_dir", "no folder to export to (choose one)");
+  if (dir.empty()) workflow_fail(m, "export_dir", "no folder to export to (choose one)");
   const std::string name = study_export_name(m) + "_cl";
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);

@@ -21,7 +21,7 @@ using namespace codyna::test;
 
 namespace {
 
-constexpr double kM = 2, kK = 3, kC = 0.5, kUmax = 4;
+constexpr double kCartMass = 2, kK = 3, kC = 0.5, kUmax = 4;
 
 ModelSpec saturating_pi(const std::string& anti_windup, double tracking_time = 0) {
   const std::string text = R"({"name": "slider",
@@ -44,7 +44,7 @@ ModelSpec saturating_pi(const std::string& anti_windup, double tracking_time = 0
 
 // y(t) of m y'' + c y' + k y = F from rest
 double constant_force_response(double F, double t) {
-  const double s = kC / (2 * kM), wd = std::sqrt(kK / kM - s * s);
+  const double s = kC / (2 * kCartMass), wd = std::sqrt(kK / kCartMass - s * s);
   return F / kK * (1 - std::exp(-s * t) * (std::cos(wd * t) + s / wd * std::sin(wd * t)));
 }
 
@@ -56,7 +56,7 @@ struct AwRun {
   SimulationResult r;
 };
 
-AwRun run(const ModelSpec& spec) {
+AwRun run_controller(const ModelSpec& spec) {
   const Model m = study_model(spec);
   const StudySimulation setup = study_simulation(m);
   AwRun out{0, 0, 0, 0, study_simulate(m, setup)};
@@ -78,9 +78,9 @@ AwRun run(const ModelSpec& spec) {
 }  // namespace
 
 TEST(PidAntiWindup, SaturatingPiOvershootsOnlyWithoutAntiWindup) {
-  const AwRun none = run(saturating_pi("none"));
-  const AwRun back = run(saturating_pi("back_calculation", 0.2));
-  const AwRun cond = run(saturating_pi("conditional"));
+  const AwRun none = run_controller(saturating_pi("none"));
+  const AwRun back = run_controller(saturating_pi("back_calculation", 0.2));
+  const AwRun cond = run_controller(saturating_pi("conditional"));
   for (const auto& [name, x] : {std::pair{"none", &none}, std::pair{"back_calculation", &back}, std::pair{"conditional", &cond}})
     std::printf("%-17s overshoot %.6f m, saturated for %.3f s, settled (1 cm) at %.2f s, max |y - closed form| while saturated %.2g\n",
                 name, x->overshoot, x->saturated_for, x->settle, x->worst_closed_form);
@@ -101,7 +101,7 @@ TEST(PidAntiWindup, SaturatingPiOvershootsOnlyWithoutAntiWindup) {
   EXPECT_LT(std::max(back.overshoot, cond.overshoot), linear - 0.08);
   EXPECT_GT(none.settle, 1.25 * std::max(back.settle, cond.settle));
   // the linear comparison runs the same saturation and anti-windup (RK4, 20 substeps per 0.01 s):
-  // the plant is linear, so it agrees with the nonlinear run up to RK4's error where the rates
+  // the plant is linear, so it agrees with the nonlinear run_controller up to RK4's error where the rates
   // jump (measured 1.3e-8, 3.2e-8 and 1.2e-5 m; with half the step 6.9e-10, 1.8e-9, 1.6e-6 m:
   // converging, conditional integration's switched integral the slowest)
   const double bound[3] = {1e-7, 1e-7, 3e-5};
@@ -123,11 +123,11 @@ TEST(PidAntiWindup, SaturatingPiOvershootsOnlyWithoutAntiWindup) {
   }
 }
 
-// Without saturation the anti-windup does nothing: the same run to the integrator's precision
+// Without saturation the anti-windup does nothing: the same run_controller to the integrator's precision
 TEST(PidAntiWindup, NoEffectWhileNothingSaturates) {
   ModelSpec a = saturating_pi("none"), b = saturating_pi("back_calculation", 0.2), c = saturating_pi("conditional");
   for (ModelSpec* s : {&a, &b, &c}) s->analysis.references[0].value = 0.1;  // 1.9 N at most: never at 8 N
-  const AwRun ra = run(a), rb = run(b), rc = run(c);
+  const AwRun ra = run_controller(a), rb = run_controller(b), rc = run_controller(c);
   EXPECT_LT(ra.r.u.col(0).cwiseAbs().maxCoeff(), kUmax);
   EXPECT_LT((ra.r.y - rb.r.y).cwiseAbs().maxCoeff(), 1e-12);
   EXPECT_LT((ra.r.y - rc.r.y).cwiseAbs().maxCoeff(), 1e-12);

@@ -22,9 +22,9 @@ namespace {
 
 using test::MatrixNear;
 
-constexpr double kG = 9.81;
+constexpr double kGravity = 9.81;
 
-ModelSpec parse(const std::string& text) { return study_parse_model_text(text, "coupler_test.json"); }
+ModelSpec parse_coupler(const std::string& text) { return study_parse_model_text(text, "coupler_test.json"); }
 
 // ground -> motor (disc Jm about z), ground -> wheel (disc Jl about z), motor = N wheel
 std::string gear_model(double Jm, double Jl, double N, const std::string& extra_constraint = "") {
@@ -44,7 +44,7 @@ std::string gear_model(double Jm, double Jl, double N, const std::string& extra_
 
 TEST(Coupler, GearReflectsTheRotorInertiaAsNSquared) {
   const double Jm = 0.02, Jl = 0.5, N = 7;
-  const Model m = study_model(parse(gear_model(Jm, Jl, N)));
+  const Model m = study_model(parse_coupler(gear_model(Jm, Jl, N)));
   EXPECT_EQ(m.dof(), 1);
   const StudyLinearization sl = study_linearize(m);
   const LinearSystem& s = sl.system;
@@ -63,7 +63,7 @@ TEST(Coupler, GearReflectsTheRotorInertiaAsNSquared) {
 TEST(Coupler, ARepeatedCouplerIsFoundRedundantAndNamed) {
   const std::string twice = R"(, {"name": "gear_again", "type": "coupler", "joint_a": "wheel", "ratio_a": 14,
                                   "joint_b": "motor", "ratio_b": -2})";
-  const Model m = study_model(parse(gear_model(0.02, 0.5, 7, twice)));
+  const Model m = study_model(parse_coupler(gear_model(0.02, 0.5, 7, twice)));
   ASSERT_EQ(m.nc, 2);
   ASSERT_EQ(m.redundant_rows.size(), 1u);  // one of the two, named (the pivoting keeps the better scaled)
   const std::string redundant = m.row_names[m.redundant_rows[0]];
@@ -89,7 +89,7 @@ TEST(Coupler, DifferentialOfThreeCoordinates) {
     "sensors": [{"name": "left", "type": "joint_position", "joint": "a"}],
     "plant": {"inputs": ["drive"], "outputs": ["left"]},
     "analysis": {"operating_point": "initial", "independent": ["a", "b"]}})";
-  const Model m = study_model(parse(text));
+  const Model m = study_model(parse_coupler(text));
   EXPECT_EQ(m.dof(), 2);
   const LinearSystem& s = study_linearize(m).system;
   Eigen::Matrix2d M;
@@ -128,14 +128,14 @@ std::string ball_and_beam(double q_beam, double q_r, double v_beam, double v_r) 
 
 TEST(Coupler, BallRollingOnABeamMatchesLagrangesEquations) {
   const double R = 0.015, m = 0.11, J = 0.4 * m * R * R, Ib = 0.05;
-  const Model model = study_model(parse(ball_and_beam(0, 0, 0, 0)));
+  const Model model = study_model(parse_coupler(ball_and_beam(0, 0, 0, 0)));
   EXPECT_EQ(model.dof(), 2);
   const LinearSystem& s = study_linearize(model).system;
   // T = (Ib alpha'^2 + m (r'^2 + r^2 alpha'^2) + J (alpha' - r'/R)^2) / 2, V = m g r sin(alpha):
   // at alpha = r = 0, M = [Ib + J, -J/R; -J/R, m + J/R^2], K = [0, m g; m g, 0]
   Eigen::Matrix2d M, K;
   M << Ib + J, -J / R, -J / R, m + J / (R * R);
-  K << 0, m * kG, m * kG, 0;
+  K << 0, m * kGravity, m * kGravity, 0;
   Eigen::MatrixXd A = Eigen::MatrixXd::Zero(4, 4), B = Eigen::MatrixXd::Zero(4, 1);
   A.topRightCorner(2, 2).setIdentity();
   A.bottomLeftCorner(2, 2) = -M.inverse() * K;
@@ -146,13 +146,13 @@ TEST(Coupler, BallRollingOnABeamMatchesLagrangesEquations) {
   EXPECT_TRUE(MatrixNear(s.B, B, 1e-12));
   // the rolling ball accelerates at g alpha / (1 + J/(m R^2)) = 5/7 g alpha on a held beam: the
   // r row of A against alpha is that of M^-1 K with the coupling term
-  const double held = -(m * kG) / (m + J / (R * R));
-  EXPECT_NEAR(held, -5.0 / 7.0 * kG, 1e-12);
+  const double held = -(m * kGravity) / (m + J / (R * R));
+  EXPECT_NEAR(held, -5.0 / 7.0 * kGravity, 1e-12);
 }
 
 TEST(Coupler, ExactJacobiansAgreeWithCentralDifferencesWhereTheReactionActs) {
   // away from equilibrium, moving: the rolling constraint carries a reaction
-  ModelSpec spec = parse(ball_and_beam(0.2, 0.3, -0.4, 0.7));
+  ModelSpec spec = parse_coupler(ball_and_beam(0.2, 0.3, -0.4, 0.7));
   const Model exact_model = study_model(spec);
   spec.analysis.method = "fd-central";
   const Model fd_model = study_model(spec);
@@ -191,7 +191,7 @@ TEST(Coupler, BadCouplersAreRefusedAtTheField) {
 }
 
 TEST(Coupler, RoundTripsThroughTheFileAndFollowsARename) {
-  ModelSpec spec = parse(gear_model(0.02, 0.5, 7));
+  ModelSpec spec = parse_coupler(gear_model(0.02, 0.5, 7));
   const ModelSpec again = study_parse_model(study_model_json(spec), "again");
   EXPECT_EQ(study_model_json(again), study_model_json(spec));
   EXPECT_EQ(study_model_json(spec)["constraints"][0].count("offset"), 0u);  // left out: from q0
@@ -232,8 +232,8 @@ TEST(Coupler, BallRollsDownAnInclineAtFiveSeventhsOfTheSlidingAcceleration) {
   const StudySimulation setup = study_simulation(model);
   const SimulationResult r = study_simulate(model, setup);
   ASSERT_TRUE(r.completed) << r.failure;
-  const double accel = -kG * std::sin(a) / (1 + J / (m * R * R));
-  EXPECT_NEAR(accel, -5.0 / 7.0 * kG * std::sin(a), 1e-12);
+  const double accel = -kGravity * std::sin(a) / (1 + J / (m * R * R));
+  EXPECT_NEAR(accel, -5.0 / 7.0 * kGravity * std::sin(a), 1e-12);
   for (int i = 0; i < r.samples(); ++i) {
     const double t = r.t[i];
     EXPECT_NEAR(r.y(i, 0), 0.5 * accel * t * t, 1e-8) << "t = " << t;

@@ -24,12 +24,12 @@
 namespace codyna {
 namespace {
 
-double rel_err(const Eigen::MatrixXd& a, const Eigen::MatrixXd& ref) {
+double rel_error(const Eigen::MatrixXd& a, const Eigen::MatrixXd& ref) {
   const double scale = std::max(ref.cwiseAbs().maxCoeff(), 1e-300);
   return (a - ref).cwiseAbs().maxCoeff() / scale;
 }
 
-Eigen::MatrixXd jac(const ADVec& f, int col0, int ncols) {
+Eigen::MatrixXd derivatives_jac(const ADVec& f, int col0, int ncols) {
   Eigen::MatrixXd J(f.size(), ncols);
   for (Eigen::Index r = 0; r < f.size(); ++r)
     for (int c = 0; c < ncols; ++c)
@@ -154,9 +154,9 @@ TEST(TreeDerivatives, RneaMatchesAutodiffOnRandomTrees) {
       const ADVec tau = rnea<ADScalar>(m, d, qa, va, ad_constant(a, 2 * nv));
       Eigen::VectorXd tv(nv);
       for (int i = 0; i < nv; ++i) tv[i] = tau[i].value();
-      EXPECT_LT(rel_err(td.tau, tv), 1e-12) << "seed " << seed;
-      EXPECT_LT(rel_err(td.dtau_dq, jac(tau, 0, nv)), 1e-12) << "seed " << seed;
-      EXPECT_LT(rel_err(td.dtau_dv, jac(tau, nv, nv)), 1e-12) << "seed " << seed;
+      EXPECT_LT(rel_error(td.tau, tv), 1e-12) << "seed " << seed;
+      EXPECT_LT(rel_error(td.dtau_dq, derivatives_jac(tau, 0, nv)), 1e-12) << "seed " << seed;
+      EXPECT_LT(rel_error(td.dtau_dv, derivatives_jac(tau, nv, nv)), 1e-12) << "seed " << seed;
     }
   }
 }
@@ -181,13 +181,13 @@ TEST(TreeDerivatives, ForwardDynamicsEffectsSensorsMatchAutodiff) {
       Eigen::VectorXd qv(nv), yv(y.size());
       for (int i = 0; i < nv; ++i) qv[i] = qdd[i].value();
       for (Eigen::Index i = 0; i < y.size(); ++i) yv[i] = y[i].value();
-      EXPECT_LT(rel_err(td.qdd, qv), 1e-12) << "seed " << seed;
-      EXPECT_LT(rel_err(td.dqdd_dq, jac(qdd, 0, nv)), 1e-12) << "seed " << seed;
-      EXPECT_LT(rel_err(td.dqdd_dv, jac(qdd, nv, nv)), 1e-12) << "seed " << seed;
-      EXPECT_LT(rel_err(td.dqdd_du, jac(qdd, 2 * nv, nu)), 1e-12) << "seed " << seed;
-      EXPECT_LT(rel_err(td.y, yv), 1e-13) << "seed " << seed;
-      EXPECT_LT(rel_err(td.dy_dq, jac(y, 0, nv)), 1e-12) << "seed " << seed;
-      EXPECT_LT(rel_err(td.dy_dv, jac(y, nv, nv)), 1e-12) << "seed " << seed;
+      EXPECT_LT(rel_error(td.qdd, qv), 1e-12) << "seed " << seed;
+      EXPECT_LT(rel_error(td.dqdd_dq, derivatives_jac(qdd, 0, nv)), 1e-12) << "seed " << seed;
+      EXPECT_LT(rel_error(td.dqdd_dv, derivatives_jac(qdd, nv, nv)), 1e-12) << "seed " << seed;
+      EXPECT_LT(rel_error(td.dqdd_du, derivatives_jac(qdd, 2 * nv, nu)), 1e-12) << "seed " << seed;
+      EXPECT_LT(rel_error(td.y, yv), 1e-13) << "seed " << seed;
+      EXPECT_LT(rel_error(td.dy_dq, derivatives_jac(y, 0, nv)), 1e-12) << "seed " << seed;
+      EXPECT_LT(rel_error(td.dy_dv, derivatives_jac(y, nv, nv)), 1e-12) << "seed " << seed;
     }
   }
 }
@@ -211,7 +211,7 @@ void expect_plant_agrees(const Model& m, const OperatingPoint& op, const std::st
   ASSERT_TRUE(f.analytic_jacobian(x, u, J)) << label;
   const Eigen::MatrixXd Jad = plant_jacobian_autodiff(f, x, u);
   const Eigen::MatrixXd Jex = plant_jacobian(f, x, u, JacobianMethod::Exact);
-  EXPECT_LT(rel_err(Jex, Jad), 1e-12) << label;
+  EXPECT_LT(rel_error(Jex, Jad), 1e-12) << label;
   // a second call reuses the workspace and gives the same numbers
   const Eigen::MatrixXd Jex2 = plant_jacobian(f, x, u, JacobianMethod::Exact);
   EXPECT_EQ((Jex2 - Jex).cwiseAbs().maxCoeff(), 0.0) << label;
@@ -366,10 +366,10 @@ TEST(ClosedLoopDerivatives, ReactionsAndClosureRowsMatchConstraintTerms) {
     // Jc, c = Jc a + gamma, and the reactions Q(lambda) - Q(0) = -Jc^T lambda
     td.compute_constrained(q, v, Eigen::VectorXd::Zero(m.nu()), a, lam0, {}, {});
     const Eigen::VectorXd Q0 = td.Q;
-    EXPECT_LT(rel_err(td.Jc, Jc), 1e-13) << seed;
-    EXPECT_LT(rel_err(td.c, Jc * a + gamma), 1e-13) << seed;
+    EXPECT_LT(rel_error(td.Jc, Jc), 1e-13) << seed;
+    EXPECT_LT(rel_error(td.c, Jc * a + gamma), 1e-13) << seed;
     td.compute_constrained(q, v, Eigen::VectorXd::Zero(m.nu()), a, lam, {}, {});
-    EXPECT_LT(rel_err(td.Q - Q0, -Jc.transpose() * lam), 1e-13) << seed;
+    EXPECT_LT(rel_error(td.Q - Q0, -Jc.transpose() * lam), 1e-13) << seed;
     // their derivatives against autodiff of constraint_terms (tangent seeds: q = q Exp(dq))
     const int nv = m.nv;
     ADVec dq = ad_seed(Eigen::VectorXd::Zero(nv), 2 * nv, 0), va = ad_seed(v, 2 * nv, nv);
@@ -377,14 +377,14 @@ TEST(ClosedLoopDerivatives, ReactionsAndClosureRowsMatchConstraintTerms) {
     constraint_terms<ADScalar>(m, da, integrate<ADScalar>(m, q.cast<ADScalar>(), dq), va);
     const ADVec cad = da.Jc * a.cast<ADScalar>() + da.gamma;
     const ADVec phid = da.Jc * va;
-    EXPECT_LT(rel_err(td.dc_dq, jac(cad, 0, nv)), 1e-12) << seed;
-    EXPECT_LT(rel_err(td.dc_dv, jac(cad, nv, nv)), 1e-12) << seed;
-    EXPECT_LT(rel_err(td.dphid_dq, jac(phid, 0, nv)), 1e-12) << seed;
+    EXPECT_LT(rel_error(td.dc_dq, derivatives_jac(cad, 0, nv)), 1e-12) << seed;
+    EXPECT_LT(rel_error(td.dc_dv, derivatives_jac(cad, nv, nv)), 1e-12) << seed;
+    EXPECT_LT(rel_error(td.dphid_dq, derivatives_jac(phid, 0, nv)), 1e-12) << seed;
     const ADVec react = -(da.Jc.transpose() * lam.cast<ADScalar>());
     td.compute_constrained(q, v, Eigen::VectorXd::Zero(m.nu()), a, lam, {}, {});
     const Eigen::MatrixXd dreact = td.dQ_dq;
     td.compute_constrained(q, v, Eigen::VectorXd::Zero(m.nu()), a, lam0, {}, {});
-    EXPECT_LT(rel_err(dreact - td.dQ_dq, jac(react, 0, nv)), 1e-12) << seed;
+    EXPECT_LT(rel_error(dreact - td.dQ_dq, derivatives_jac(react, 0, nv)), 1e-12) << seed;
   }
 }
 

@@ -10,18 +10,18 @@
 namespace codyna {
 namespace {
 
-double total_energy(const Model& m, const State& x) {
+double energy_of(const Model& m, const State& x) {
   Data d(m);
   return kinetic_energy<double>(m, d, x.q, x.v) + potential_energy<double>(m, d, x.q);
 }
 
 void expect_conserved(const Model& m, State x, const Eigen::VectorXd& u, double h, double t_end, double rel_tol) {
-  const double E0 = total_energy(m, x);
+  const double E0 = energy_of(m, x);
   const int steps = static_cast<int>(std::lround(t_end / h));
   double worst = 0.0;
   for (int chunk = 0; chunk < 10; ++chunk) {
     x = rk4_integrate(m, x, u, h, steps / 10);
-    worst = std::max(worst, std::abs(total_energy(m, x) - E0));
+    worst = std::max(worst, std::abs(energy_of(m, x) - E0));
   }
   const double scale = std::max(std::abs(E0), 1.0);
   EXPECT_LT(worst / scale, rel_tol) << m.name << ": E0 = " << E0 << ", worst drift " << worst;
@@ -65,7 +65,7 @@ TEST(Energy, PowerBalanceOfTheDynamicsIsZeroWhenPassive) {
   const double h = 1e-6;
   const State xp{integrate<double>(m, q, Eigen::VectorXd(h * v)), v + h * qdd};
   const State xm{integrate<double>(m, q, Eigen::VectorXd(-h * v)), v - h * qdd};
-  EXPECT_NEAR((total_energy(m, xp) - total_energy(m, xm)) / (2 * h), 0.0, 1e-6 * (1 + std::abs(total_energy(m, {q, v}))));
+  EXPECT_NEAR((energy_of(m, xp) - energy_of(m, xm)) / (2 * h), 0.0, 1e-6 * (1 + std::abs(energy_of(m, {q, v}))));
 }
 
 }  // namespace

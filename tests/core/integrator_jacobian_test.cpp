@@ -20,7 +20,7 @@
 namespace codyna {
 namespace {
 
-double rel_err(const Eigen::MatrixXd& a, const Eigen::MatrixXd& ref) {
+double rel_difference(const Eigen::MatrixXd& a, const Eigen::MatrixXd& ref) {
   if (ref.size() == 0) return 0.0;
   const double scale = std::max(ref.cwiseAbs().maxCoeff(), 1e-12);
   return (a - ref).cwiseAbs().maxCoeff() / scale;
@@ -111,11 +111,11 @@ void check_model(const Model& m, const std::string& name, std::mt19937& rng, boo
         }
     } else {
     const Eigen::MatrixXd Jfd = fd_ode(sys, y);
-    EXPECT_LT(rel_err(J, Jfd), 1e-6) << name << " ODE, state " << k;
+    EXPECT_LT(rel_difference(J, Jfd), 1e-6) << name << " ODE, state " << k;
     // the accelerations' rows on their own (they would hide under the qdot rows' scale)
-    EXPECT_LT(rel_err(J.block(nq, 0, nv, nq), Jfd.block(nq, 0, nv, nq)), 1e-6) << name << " da/dq, state " << k;
-    EXPECT_LT(rel_err(J.block(nq, nq, nv, nv), Jfd.block(nq, nq, nv, nv)), 1e-6) << name << " da/dv, state " << k;
-    EXPECT_LT(rel_err(J.block(0, 0, nq, nq), Jfd.block(0, 0, nq, nq)), 1e-6) << name << " dqdot/dq, state " << k;
+    EXPECT_LT(rel_difference(J.block(nq, 0, nv, nq), Jfd.block(nq, 0, nv, nq)), 1e-6) << name << " da/dq, state " << k;
+    EXPECT_LT(rel_difference(J.block(nq, nq, nv, nv), Jfd.block(nq, nq, nv, nv)), 1e-6) << name << " da/dv, state " << k;
+    EXPECT_LT(rel_difference(J.block(0, 0, nq, nq), Jfd.block(0, 0, nq, nq)), 1e-6) << name << " dqdot/dq, state " << k;
     }
 
     // the DAE form: consistent Y, Y', then moved off them as Newton iterates are
@@ -127,12 +127,12 @@ void check_model(const Model& m, const std::string& name, std::mt19937& rng, boo
     Eigen::MatrixXd G;
     ASSERT_TRUE(sys.dae_jacobian(0.0, Y, Yp, cj, G));
     const Eigen::MatrixXd Gfd = fd_dae(sys, Y, Yp, cj);
-    EXPECT_LT(rel_err(G, Gfd), 1e-6) << name << " DAE, state " << k;
+    EXPECT_LT(rel_difference(G, Gfd), 1e-6) << name << " DAE, state " << k;
     const int m_ = sys.ode_size();
-    EXPECT_LT(rel_err(G.block(nq, 0, nv, nq), Gfd.block(nq, 0, nv, nq)), 1e-6) << name << " dyn/dq, state " << k;
-    EXPECT_LT(rel_err(G.block(nq, nq, nv, nv), Gfd.block(nq, nq, nv, nv)), 1e-6) << name << " dyn/dv, state " << k;
+    EXPECT_LT(rel_difference(G.block(nq, 0, nv, nq), Gfd.block(nq, 0, nv, nq)), 1e-6) << name << " dyn/dq, state " << k;
+    EXPECT_LT(rel_difference(G.block(nq, nq, nv, nv), Gfd.block(nq, nq, nv, nv)), 1e-6) << name << " dyn/dv, state " << k;
     if (sys.na())
-      EXPECT_LT(rel_err(G.bottomLeftCorner(sys.na(), m_), Gfd.bottomLeftCorner(sys.na(), m_)), 1e-6)
+      EXPECT_LT(rel_difference(G.bottomLeftCorner(sys.na(), m_), Gfd.bottomLeftCorner(sys.na(), m_)), 1e-6)
           << name << " closure rows, state " << k;
   }
 }

@@ -20,7 +20,7 @@ namespace {
 
 using test::MatrixNear;
 
-constexpr double kG = 9.81, kM = 3.0, kL = 0.8, kIc = 0.05, kA = 0.5, kH = 0.3, kU0 = 40.0;
+constexpr double kGrav = 9.81, kM = 3.0, kL = 0.8, kIc = 0.05, kA = 0.5, kH = 0.3, kU0 = 40.0;
 
 // rod: pivot at the origin (revolute z), centre of mass at kL along its x; the cylinder from the
 // ground point (0, -kH) to the rod point at kA along its x
@@ -53,10 +53,10 @@ TEST(LineForce, LiftedRodMatchesTheClosedForm) {
   const double dL = kA * kH * std::cos(th) / L;  // dL/dth
   const double d_cos_over_L = (-std::sin(th) * L - std::cos(th) * dL) / (L * L);
   Eigen::MatrixXd A(2, 2), B(2, 1), C(2, 2), xdot(2, 1);
-  A << 0, 1, (kM * kG * kL * std::sin(th) + kU0 * kA * kH * d_cos_over_L) / I, 0;
+  A << 0, 1, (kM * kGrav * kL * std::sin(th) + kU0 * kA * kH * d_cos_over_L) / I, 0;
   B << 0, kA * kH * std::cos(th) / (L * I);
   C << dL, 0, 0, dL;  // the stroke and its rate dL/dth th'
-  xdot << 0, (-kM * kG * kL * std::cos(th) + kU0 * kA * kH * std::cos(th) / L) / I;
+  xdot << 0, (-kM * kGrav * kL * std::cos(th) + kU0 * kA * kH * std::cos(th) / L) / I;
   EXPECT_TRUE(MatrixNear(s.A, A, 1e-12));
   EXPECT_TRUE(MatrixNear(s.B, B, 1e-12));
   EXPECT_TRUE(MatrixNear(s.C, C, 1e-12));

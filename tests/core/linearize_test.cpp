@@ -16,7 +16,7 @@ namespace codyna {
 namespace {
 
 using test::MatrixNear;
-constexpr double g = 9.81;
+constexpr double g_lin = 9.81;
 
 // A spring-damper whose two points coincide at the operating point. Rest length 0 and no
 // damping: the force k (x_b - x_a) is smooth through the coincidence and exact and central
@@ -64,7 +64,7 @@ TEST(Linearize, PaperPendulumUpright) {
   ASSERT_NEAR(op.q[0], M_PI / 2, 1e-12);
   const double mass = 10, l = 2;
   Eigen::MatrixXd A(2, 2), B(2, 1), C(1, 2), D = Eigen::MatrixXd::Zero(1, 1);
-  A << 0, 1, 3 * g / (2 * l), 0;
+  A << 0, 1, 3 * g_lin / (2 * l), 0;
   B << 0, 3 / (mass * l * l);
   C << 1, 0;
   const LinearSystem s = linearize(m, op).system;
@@ -72,7 +72,7 @@ TEST(Linearize, PaperPendulumUpright) {
   EXPECT_TRUE(MatrixNear(s.B, B, 1e-10));
   EXPECT_TRUE(MatrixNear(s.C, C, 1e-10));
   EXPECT_TRUE(MatrixNear(s.D, D, 1e-10));
-  EXPECT_NEAR(s.A(1, 0), 3 * g / 4, 1e-10 * 3 * g / 4);
+  EXPECT_NEAR(s.A(1, 0), 3 * g_lin / 4, 1e-10 * 3 * g_lin / 4);
   EXPECT_NEAR(s.B(1, 0), 0.075, 1e-12);
   EXPECT_NEAR(s.x0[0], M_PI / 2, 1e-12);
   EXPECT_NEAR(s.y0[0], M_PI / 2, 1e-12);
@@ -86,8 +86,8 @@ TEST(Linearize, PaperPendulumAwayFromEquilibrium) {
   const OperatingPoint op = initial_point(m);
   const double th = op.q[0], l = 2;
   const LinearSystem s = linearize(m, op).system;
-  EXPECT_NEAR(s.A(1, 0), 3 * g / (2 * l) * std::sin(th), 1e-10);
-  EXPECT_NEAR(s.xdot0[1], -3 * g / (2 * l) * std::cos(th), 1e-10);  // not at rest: xdot0 != 0
+  EXPECT_NEAR(s.A(1, 0), 3 * g_lin / (2 * l) * std::sin(th), 1e-10);
+  EXPECT_NEAR(s.xdot0[1], -3 * g_lin / (2 * l) * std::cos(th), 1e-10);  // not at rest: xdot0 != 0
   EXPECT_NEAR(s.xdot0[0], 0.0, 1e-15);
 }
 
@@ -99,7 +99,7 @@ TEST(Linearize, PaperCartPendulumUpright) {
   // states [h, theta, h_dot, theta_dot] (positions first); the paper orders them
   // [h, h', theta, theta']: compare through the permutation
   Eigen::MatrixXd Ap(4, 4), Bp(4, 1), Cp(2, 4);
-  Ap << 0, 1, 0, 0, 0, 0, -3 * m3 * g / den, 0, 0, 0, 0, 1, 0, 0, 6 * (m2 + m3) * g / (den * l3), 0;
+  Ap << 0, 1, 0, 0, 0, 0, -3 * m3 * g_lin / den, 0, 0, 0, 0, 1, 0, 0, 6 * (m2 + m3) * g_lin / (den * l3), 0;
   Bp << 0, 4 / den, 0, -6 / (l3 * den);
   Cp << 1, 0, 0, 0, 0, 0, 1, 0;
   Eigen::PermutationMatrix<4> P;  // ours = P * paper
@@ -261,7 +261,7 @@ TEST(OperatingPoint, TrimHoldsThePendulumAtEightyDegrees) {
   const Model m = test::load_example("pendulum.json");
   const OperatingPoint op = trim(m, initial_point(m));
   const double mass = 10, l = 2;
-  EXPECT_NEAR(op.u[0], mass * g * l / 2 * std::cos(op.q[0]), 1e-10);
+  EXPECT_NEAR(op.u[0], mass * g_lin * l / 2 * std::cos(op.q[0]), 1e-10);
   EXPECT_LT(op.residual, 1e-12);
   EXPECT_NEAR(op.q[0], m.q0[0], 0.0);
 }

@@ -189,37 +189,37 @@ void expect_same(const Linearization& a, const Linearization& b, const std::stri
 }
 
 // the examples' models, each at a moved point (velocities and inputs)
-struct Case {
+struct LinearizerCase {
   std::string name;
   Model m;
   OperatingPoint op;
 };
-std::vector<Case> example_cases() {
-  std::vector<Case> cases;
+std::vector<LinearizerCase> example_cases() {
+  std::vector<LinearizerCase> cases;
   for (const auto& entry : std::filesystem::directory_iterator(CODYNA_EXAMPLES_DIR)) {
     if (entry.path().extension() != ".json") continue;
-    Case c{entry.path().filename().string(), test::load_example(entry.path().filename().string()), {}};
+    LinearizerCase c{entry.path().filename().string(), test::load_example(entry.path().filename().string()), {}};
     c.op = initial_point(c.m);
     if (c.m.nc == 0 && c.m.motions.empty())
       for (int k = 0; k < c.m.nv; ++k) c.op.v[k] += 0.2 + 0.05 * k;
     for (int i : c.m.plant_inputs) c.op.u[i] += 0.3;
     cases.push_back(std::move(c));
   }
-  std::sort(cases.begin(), cases.end(), [](const Case& a, const Case& b) { return a.name < b.name; });
+  std::sort(cases.begin(), cases.end(), [](const LinearizerCase& a, const LinearizerCase& b) { return a.name < b.name; });
   return cases;
 }
 
 // One Linearizer bound in turn to every example (trees and closed loops, sizes changing and
 // repeating), forwards then backwards, and linearize() alone on each: what a new Linearizer gives
 TEST(Linearizer, BoundInTurnToEveryExampleEqualsANewOne) {
-  const std::vector<Case> cases = example_cases();
+  const std::vector<LinearizerCase> cases = example_cases();
   ASSERT_GE(cases.size(), 15u);
   Linearizer lz(cases[0].m);
   Linearization into;
   int n = 0;
   for (int pass = 0; pass < 2; ++pass)
     for (std::size_t i = 0; i < cases.size(); ++i) {
-      const Case& c = cases[pass == 0 ? i : cases.size() - 1 - i];
+      const LinearizerCase& c = cases[pass == 0 ? i : cases.size() - 1 - i];
       const Linearization fresh = Linearizer(c.m).linearize(c.op);
       lz.bind(c.m);
       lz.linearize(c.op, {}, into);

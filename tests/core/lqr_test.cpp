@@ -40,7 +40,7 @@ struct Plant {
   MatrixXd A, B;
 };
 
-Plant cart_pendulum() {
+Plant cart_pendulum_lqr() {
   const double m2 = 20, m3 = 10, l3 = 2, g = 9.81, den = 4 * m2 + m3;
   Plant p{MatrixXd::Zero(4, 4), MatrixXd::Zero(4, 1)};
   p.A(0, 1) = 1;
@@ -139,7 +139,7 @@ TEST(LqrClosedForm, DoubleIntegrator) {
 // ------------------------------------------------------------------ the paper's plant
 
 TEST(Lqr, CartPendulumSolvesRiccatiAndStabilizes) {
-  const Plant p = cart_pendulum();
+  const Plant p = cart_pendulum_lqr();
   const LqrResult res = lqr(p.A, p.B, cart_Q(), cart_R());
   EXPECT_LT(care_relative_residual(p, cart_Q(), cart_R(), MatrixXd::Zero(4, 1), res.X), 1e-10);
   EXPECT_LT(relative_difference(res.X, res.X.transpose()), 1e-15);
@@ -150,7 +150,7 @@ TEST(Lqr, CartPendulumSolvesRiccatiAndStabilizes) {
 }
 
 TEST(Dlqr, CartPendulumZohSolvesRiccatiAndStabilizes) {
-  const Plant d = zoh(cart_pendulum(), 0.02);
+  const Plant d = zoh(cart_pendulum_lqr(), 0.02);
   const LqrResult res = dlqr(d.A, d.B, cart_Q(), cart_R());
   EXPECT_LT(dare_relative_residual(d, cart_Q(), cart_R(), MatrixXd::Zero(4, 1), res.X), 1e-10);
   EXPECT_LT(spectral_radius(closed_loop(d, res.K)), 1.0);
@@ -160,7 +160,7 @@ TEST(Dlqr, CartPendulumZohSolvesRiccatiAndStabilizes) {
 // the cross term, checked against the equations with N written out (not the
 // change of variables the solver uses)
 TEST(Lqr, CrossTermSatisfiesTheFullEquations) {
-  const Plant p = cart_pendulum();
+  const Plant p = cart_pendulum_lqr();
   const MatrixXd N = Eigen::Vector4d(0.1, 0, 0.2, 0.01);  // [Q N; N' R] stays positive semidefinite
   const LqrResult c = lqr(p.A, p.B, cart_Q(), cart_R(), N);
   EXPECT_LT(care_relative_residual(p, cart_Q(), cart_R(), N, c.X), 1e-10);
@@ -195,7 +195,7 @@ TEST(Lqr, RandomMultiInputPlants) {
 // ------------------------------------------------------------------ bad input
 
 TEST(Lqr, RejectsMismatchedSizesNamingTheMatrices) {
-  const Plant p = cart_pendulum();
+  const Plant p = cart_pendulum_lqr();
   EXPECT_INVALID_ARGUMENT_WITH(lqr(p.A.leftCols(3), p.B, cart_Q(), cart_R()), "lqr: A is 4x3",
                                "square");
   EXPECT_INVALID_ARGUMENT_WITH(lqr(p.A, p.B.topRows(3), cart_Q(), cart_R()), "lqr: B is 3x1",
@@ -211,7 +211,7 @@ TEST(Lqr, RejectsMismatchedSizesNamingTheMatrices) {
 }
 
 TEST(Lqr, RejectsBadWeights) {
-  const Plant p = cart_pendulum();
+  const Plant p = cart_pendulum_lqr();
   EXPECT_INVALID_ARGUMENT_WITH(lqr(p.A, p.B, cart_Q(), scalar(0)), "lqr: R is not symmetric positive definite");
   EXPECT_INVALID_ARGUMENT_WITH(lqr(p.A, p.B, cart_Q(), scalar(-1)), "R is not symmetric positive definite");
   const MatrixXd R2 = Eigen::Matrix2d{{1, 2}, {2, 1}};  // symmetric, indefinite
@@ -285,7 +285,7 @@ class OctaveLqrPeer : public ::testing::Test {
 };
 
 TEST_F(OctaveLqrPeer, LqrAndDlqrMatchOnCartPendulumAndRandomPlant) {
-  const Plant c = cart_pendulum(), d = zoh(c, 0.02);
+  const Plant c = cart_pendulum_lqr(), d = zoh(c, 0.02);
   std::mt19937 rng(11);
   std::normal_distribution<double> normal;
   const auto random = [&](int r, int cc) { return MatrixXd(MatrixXd::NullaryExpr(r, cc, [&] { return normal(rng); })); };
@@ -324,7 +324,7 @@ TEST_F(OctaveLqrPeer, LqrAndDlqrMatchOnCartPendulumAndRandomPlant) {
 }
 
 TEST_F(OctaveLqrPeer, CrossTermMatches) {
-  const Plant c = cart_pendulum(), d = zoh(c, 0.02);
+  const Plant c = cart_pendulum_lqr(), d = zoh(c, 0.02);
   const MatrixXd N = Eigen::Vector4d(0.1, 0, 0.2, 0.01);
   const CommandResult r = run_octave(
       "A = " + octave_literal(c.A) + "; B = " + octave_literal(c.B) + "; Ad = " + octave_literal(d.A) +

@@ -113,7 +113,7 @@ class TempDir {
   const std::string& path() const { return path_; }
   std::string operator/(const std::string& name) const { return (fs::path(path_) / name).string(); }
 
-  Strings files() const {  // sorted names of everything in the directory
+  Strings files() const {  // sorted_names names of everything in the directory
     Strings out;
     for (const auto& e : fs::directory_iterator(path_)) out.push_back(e.path().filename().string());
     std::sort(out.begin(), out.end());
@@ -423,7 +423,7 @@ TEST(ReadMatFile, ExplainsFilesItCannotRead) {
 
 // ------------------------------------------------------------------ peers
 
-std::vector<std::complex<double>> sorted(std::vector<std::complex<double>> v) {
+std::vector<std::complex<double>> sorted_names(std::vector<std::complex<double>> v) {
   std::sort(v.begin(), v.end(),
             [](auto a, auto b) { return a.real() != b.real() ? a.real() < b.real() : a.imag() < b.imag(); });
   return v;
@@ -498,8 +498,8 @@ TEST_F(OctavePeer, EigenvaluesMatchModalAnalysis) {
   for (const Mode& m : modal_analysis(cart_pendulum()).modes) codyna.push_back(m.eigenvalue);
   ASSERT_EQ(octave.size(), 4u);
   ASSERT_EQ(codyna.size(), 4u);
-  octave = sorted(octave);
-  codyna = sorted(codyna);
+  octave = sorted_names(octave);
+  codyna = sorted_names(codyna);
   for (std::size_t i = 0; i < 4; ++i)
     EXPECT_LE(std::abs(octave[i] - codyna[i]), 1e-10) << octave[i] << " vs " << codyna[i];
   EXPECT_NEAR(codyna[3].real(), std::sqrt(6 * 30 * 9.81 / (90 * 2)), 1e-12);  // sqrt(6 (m2+m3) g / ((4 m2+m3) l3))

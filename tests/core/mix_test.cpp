@@ -20,7 +20,7 @@ namespace {
 
 using test::MatrixNear;
 
-constexpr double kM = 2.0, kL = 0.6, kIc = 0.04, kJetAt = 0.9;
+constexpr double kMix = 2.0, kL = 0.6, kIc = 0.04, kJetAt = 0.9;
 
 // a pendulum (revolute z) driven by a motor (gain 1) and a jet at kJetAt along the rod pushing along
 // the rod's y (gain 2; in body or world axes), and a mix of both (weights 0.5, 3)
@@ -39,18 +39,18 @@ std::string driven_pendulum(const std::string& inputs, const char* jet_frame, do
     "sensors": [{"name": "angle", "type": "joint_position", "joint": "pivot"}],
     "plant": {"inputs": %s, "outputs": ["angle"]},
     "analysis": {"operating_point": "initial", "method": "%s"}})",
-                kM, kL, kIc, kIc, theta0, omega0, kJetAt, jet_frame, mix_u0, inputs.c_str(), method);
+                kMix, kL, kIc, kIc, theta0, omega0, kJetAt, jet_frame, mix_u0, inputs.c_str(), method);
   return text;
 }
 
-LinearSystem linearized(const std::string& text) {
+LinearSystem mix_linearized(const std::string& text) {
   return study_linearize(study_model(study_parse_model_text(text, "driven_pendulum.json"))).system;
 }
 
 TEST(Mix, EqualsTheActuatorsMixedByHand) {
   for (const char* frame : {"body", "world"}) {
-    const LinearSystem mixed = linearized(driven_pendulum(R"(["mix"])", frame, 0.3, 0.5, 1.5));
-    const LinearSystem apart = linearized(driven_pendulum(R"(["motor", "jet"])", frame, 0.3, 0.5, 1.5));
+    const LinearSystem mixed = mix_linearized(driven_pendulum(R"(["mix"])", frame, 0.3, 0.5, 1.5));
+    const LinearSystem apart = mix_linearized(driven_pendulum(R"(["motor", "jet"])", frame, 0.3, 0.5, 1.5));
     EXPECT_TRUE(MatrixNear(mixed.A, apart.A, 1e-15)) << frame;
     EXPECT_TRUE(MatrixNear(mixed.B, apart.B * Eigen::Vector2d(0.5, 3), 1e-14)) << frame;
     EXPECT_TRUE(MatrixNear(mixed.xdot0, apart.xdot0, 1e-15)) << frame;
@@ -58,19 +58,19 @@ TEST(Mix, EqualsTheActuatorsMixedByHand) {
 }
 
 TEST(Mix, PendulumDrivenByAMotorAndAJetMatchesTheClosedForm) {
-  const LinearSystem s = linearized(driven_pendulum(R"(["mix"])", "body", 0.3, 0.0, 0.0));
+  const LinearSystem s = mix_linearized(driven_pendulum(R"(["mix"])", "body", 0.3, 0.0, 0.0));
   // a unit of the mix: 0.5 N m from the motor and 3 * 2 N along the rod's y at kJetAt
-  const double I = kIc + kM * kL * kL;
+  const double I = kIc + kMix * kL * kL;
   EXPECT_NEAR(s.B(1, 0), (0.5 + 6 * kJetAt) / I, 1e-14);
   // with the mix at u0 = 1.5 the pendulum accelerates by that much more
-  const LinearSystem pushed = linearized(driven_pendulum(R"(["mix"])", "body", 0.3, 0.0, 1.5));
+  const LinearSystem pushed = mix_linearized(driven_pendulum(R"(["mix"])", "body", 0.3, 0.0, 1.5));
   EXPECT_NEAR(pushed.xdot0[1] - s.xdot0[1], 1.5 * (0.5 + 6 * kJetAt) / I, 1e-13);
 }
 
 TEST(Mix, ExactJacobiansAgreeWithCentralDifferences) {
   // a world-axes jet: the mixed force's moment arm turns with the rod, so A depends on the mix's input
-  const LinearSystem e = linearized(driven_pendulum(R"(["mix"])", "world", 0.8, -1.1, 2.5));
-  const LinearSystem f = linearized(driven_pendulum(R"(["mix"])", "world", 0.8, -1.1, 2.5, "fd-central"));
+  const LinearSystem e = mix_linearized(driven_pendulum(R"(["mix"])", "world", 0.8, -1.1, 2.5));
+  const LinearSystem f = mix_linearized(driven_pendulum(R"(["mix"])", "world", 0.8, -1.1, 2.5, "fd-central"));
   EXPECT_TRUE(MatrixNear(e.A, f.A, 1e-7));
   EXPECT_TRUE(MatrixNear(e.B, f.B, 1e-7));
 }

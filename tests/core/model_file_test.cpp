@@ -22,7 +22,7 @@ using nlohmann::json;
 namespace fs = std::filesystem;
 constexpr double kPi = std::numbers::pi;
 
-// A pendulum with a few of everything; the bad-input tests each break one thing in it.
+// A pendulum_spec with a few of everything; the bad-input tests each break one thing in it.
 constexpr const char* kPendulum = R"({
   "codyna_model": 1,
   "name": "pendulum",
@@ -148,45 +148,45 @@ bool same(const T& a, const T& b) {
 
 #define EXPECT_SAME(field) EXPECT_TRUE(same(a.field, b.field)) << "field " #field
 
-void expect_same(const FrameSpec& a, const FrameSpec& b) {
+void expect_same_model(const FrameSpec& a, const FrameSpec& b) {
   EXPECT_SAME(position);
   EXPECT_SAME(rotation);
 }
 
-void expect_same(const ShapeSpec& a, const ShapeSpec& b) {
+void expect_same_model(const ShapeSpec& a, const ShapeSpec& b) {
   EXPECT_SAME(type);
   EXPECT_SAME(size);
   EXPECT_SAME(radius);
   EXPECT_SAME(length);
   EXPECT_SAME(color);
-  expect_same(a.frame, b.frame);
+  expect_same_model(a.frame, b.frame);
 }
 
-void expect_same(const BodySpec& a, const BodySpec& b);
-void expect_same(const JointSpec& a, const JointSpec& b);
-void expect_same(const ConstraintSpec& a, const ConstraintSpec& b);
-void expect_same(const EffectSpec& a, const EffectSpec& b);
-void expect_same(const ActuatorSpec& a, const ActuatorSpec& b);
-void expect_same(const SensorSpec& a, const SensorSpec& b);
+void expect_same_model(const BodySpec& a, const BodySpec& b);
+void expect_same_model(const JointSpec& a, const JointSpec& b);
+void expect_same_model(const ConstraintSpec& a, const ConstraintSpec& b);
+void expect_same_model(const EffectSpec& a, const EffectSpec& b);
+void expect_same_model(const ActuatorSpec& a, const ActuatorSpec& b);
+void expect_same_model(const SensorSpec& a, const SensorSpec& b);
 
 template <class T>
-void expect_same(const std::vector<T>& a, const std::vector<T>& b) {
+void expect_same_model(const std::vector<T>& a, const std::vector<T>& b) {
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t i = 0; i < a.size(); ++i) {
     SCOPED_TRACE("element " + std::to_string(i));
-    expect_same(a[i], b[i]);
+    expect_same_model(a[i], b[i]);
   }
 }
 
-void expect_same(const BodySpec& a, const BodySpec& b) {
+void expect_same_model(const BodySpec& a, const BodySpec& b) {
   EXPECT_SAME(name);
   EXPECT_SAME(mass);
   EXPECT_SAME(com);
   EXPECT_SAME(inertia);
-  expect_same(a.shapes, b.shapes);
+  expect_same_model(a.shapes, b.shapes);
 }
 
-void expect_same(const JointSpec& a, const JointSpec& b) {
+void expect_same_model(const JointSpec& a, const JointSpec& b) {
   EXPECT_SAME(name);
   EXPECT_SAME(type);
   EXPECT_SAME(parent);
@@ -195,11 +195,11 @@ void expect_same(const JointSpec& a, const JointSpec& b) {
   EXPECT_SAME(axis2);
   EXPECT_SAME(q0);
   EXPECT_SAME(v0);
-  expect_same(a.parent_frame, b.parent_frame);
-  expect_same(a.child_frame, b.child_frame);
+  expect_same_model(a.parent_frame, b.parent_frame);
+  expect_same_model(a.child_frame, b.child_frame);
 }
 
-void expect_same(const ConstraintSpec& a, const ConstraintSpec& b) {
+void expect_same_model(const ConstraintSpec& a, const ConstraintSpec& b) {
   EXPECT_SAME(name);
   EXPECT_SAME(type);
   EXPECT_SAME(body_a);
@@ -210,7 +210,7 @@ void expect_same(const ConstraintSpec& a, const ConstraintSpec& b) {
   EXPECT_SAME(axis_b);
 }
 
-void expect_same(const EffectSpec& a, const EffectSpec& b) {
+void expect_same_model(const EffectSpec& a, const EffectSpec& b) {
   EXPECT_SAME(name);
   EXPECT_SAME(type);
   EXPECT_SAME(g);
@@ -229,7 +229,7 @@ void expect_same(const EffectSpec& a, const EffectSpec& b) {
   EXPECT_SAME(in_world);
 }
 
-void expect_same(const ActuatorSpec& a, const ActuatorSpec& b) {
+void expect_same_model(const ActuatorSpec& a, const ActuatorSpec& b) {
   EXPECT_SAME(name);
   EXPECT_SAME(type);
   EXPECT_SAME(joint);
@@ -245,7 +245,7 @@ void expect_same(const ActuatorSpec& a, const ActuatorSpec& b) {
   EXPECT_SAME(unit);
 }
 
-void expect_same(const SensorSpec& a, const SensorSpec& b) {
+void expect_same_model(const SensorSpec& a, const SensorSpec& b) {
   EXPECT_SAME(name);
   EXPECT_SAME(type);
   EXPECT_SAME(joint);
@@ -262,7 +262,7 @@ void expect_same(const SensorSpec& a, const SensorSpec& b) {
   EXPECT_SAME(unit);
 }
 
-void expect_same(const ControllerSpec& a, const ControllerSpec& b) {
+void expect_same_model(const ControllerSpec& a, const ControllerSpec& b) {
   EXPECT_SAME(type);
   EXPECT_SAME(kp);
   EXPECT_SAME(ki);
@@ -281,18 +281,18 @@ void expect_same(const ControllerSpec& a, const ControllerSpec& b) {
   EXPECT_SAME(operating_point);
 }
 
-void expect_same(const ModelSpec& a, const ModelSpec& b) {
+void expect_same_model(const ModelSpec& a, const ModelSpec& b) {
   EXPECT_SAME(name);
   EXPECT_SAME(description);
-  expect_same(a.bodies, b.bodies);
-  expect_same(a.joints, b.joints);
-  expect_same(a.constraints, b.constraints);
-  expect_same(a.effects, b.effects);
-  expect_same(a.actuators, b.actuators);
-  expect_same(a.sensors, b.sensors);
+  expect_same_model(a.bodies, b.bodies);
+  expect_same_model(a.joints, b.joints);
+  expect_same_model(a.constraints, b.constraints);
+  expect_same_model(a.effects, b.effects);
+  expect_same_model(a.actuators, b.actuators);
+  expect_same_model(a.sensors, b.sensors);
   EXPECT_SAME(plant.inputs);
   EXPECT_SAME(plant.outputs);
-  expect_same(a.controller, b.controller);
+  expect_same_model(a.controller, b.controller);
   EXPECT_SAME(solver.integrator);
   EXPECT_SAME(solver.rtol);
   EXPECT_SAME(solver.atol);
@@ -303,7 +303,7 @@ void expect_same(const ModelSpec& a, const ModelSpec& b) {
 
 #undef EXPECT_SAME
 
-ModelSpec parse(const std::string& text) { return parse_model_spec_text(text, "test.json"); }
+ModelSpec parse_model(const std::string& text) { return parse_model_spec_text(text, "test.json"); }
 
 // f() must throw a ModelError for `file` at exactly `path` whose message contains `phrase`.
 template <class F>
@@ -323,11 +323,11 @@ void expect_model_error(const json& j, const std::string& path, const std::strin
   expect_model_error([&] { parse_model_spec(j, "bad.json"); }, "bad.json", path, phrase);
 }
 
-json pendulum() { return json::parse(kPendulum); }
+json pendulum_spec() { return json::parse(kPendulum); }
 
-// The pendulum with `controller` (JSON text) as its controller.
+// The pendulum_spec with `controller` (JSON text) as its controller.
 json with_controller(const std::string& controller) {
-  json j = pendulum();
+  json j = pendulum_spec();
   j["controller"] = json::parse(controller);
   return j;
 }
@@ -345,13 +345,13 @@ void expect_exact(const Eigen::MatrixXd& actual, const Eigen::MatrixXd& expected
 
 // The rotation matrix that `rotation` (the JSON of a ROT) reads as.
 Eigen::Matrix3d read_rotation(const json& rotation) {
-  json j = pendulum();
+  json j = pendulum_spec();
   j["joints"][0]["parent_frame"]["rotation"] = rotation;
   return parse_model_spec(j, "rotation.json").joints[0].parent_frame.rotation;
 }
 
 Eigen::Matrix3d read_inertia(const json& inertia) {
-  json j = pendulum();
+  json j = pendulum_spec();
   j["bodies"][0]["inertia"] = inertia;
   return parse_model_spec(j, "inertia.json").bodies[0].inertia;
 }
@@ -373,16 +373,16 @@ Eigen::Matrix3d rot_z(double a) {
 }
 
 // A fresh, empty directory, removed at the end of the test.
-class TempDir {
+class ModelTempDir {
  public:
-  TempDir() {
+  ModelTempDir() {
     const auto* info = testing::UnitTest::GetInstance()->current_test_info();
     path_ = fs::temp_directory_path() / ("codyna_model_file_" + std::string(info->name()) + "_" +
                                          std::to_string(std::random_device{}()));
     fs::remove_all(path_);
     fs::create_directories(path_);
   }
-  ~TempDir() { fs::remove_all(path_); }
+  ~ModelTempDir() { fs::remove_all(path_); }
   const fs::path& path() const { return path_; }
   std::size_t count() const { return std::distance(fs::directory_iterator(path_), fs::directory_iterator()); }
 
@@ -393,7 +393,7 @@ class TempDir {
 // ---------------------------------------------------------------- reading
 
 TEST(ModelFile, ParsesSmallModel) {
-  const ModelSpec m = parse(kPendulum);
+  const ModelSpec m = parse_model(kPendulum);
   EXPECT_EQ(m.name, "pendulum");
   EXPECT_EQ(m.description, "a rod on a pin");
 
@@ -457,7 +457,7 @@ TEST(ModelFile, ParsesSmallModel) {
 }
 
 TEST(ModelFile, ParsesEveryElementType) {
-  const ModelSpec m = parse(kEverything);
+  const ModelSpec m = parse_model(kEverything);
   ASSERT_EQ(m.joints.size(), 8u);
   EXPECT_EQ(m.joints[0].axis, Eigen::Vector3d(1, 1, 0) / std::sqrt(2.0));
   EXPECT_EQ(m.joints[4].axis2, Eigen::Vector3d(1, 0, 1) / std::sqrt(2.0));
@@ -537,7 +537,7 @@ TEST(ModelFile, JointInitialValueForms) {
 }
 
 TEST(ModelFile, DefaultsOfOptionalFields) {
-  const ModelSpec m = parse(R"({
+  const ModelSpec m = parse_model(R"({
     "name": "bare",
     "bodies": [{"name": "b", "mass": 1, "inertia": [1, 1, 1], "shapes": [{"type": "box"}]}],
     "joints": [{"name": "j", "type": "universal", "parent": "ground", "child": "b"}],
@@ -582,7 +582,7 @@ TEST(ModelFile, ParsesPidController) {
   EXPECT_EQ(p.setpoint.size(), 0);
 
   // multivariable: nu x ny, rows in Plant/In order
-  const ModelSpec m = parse(kEverything);
+  const ModelSpec m = parse_model(kEverything);
   expect_exact(m.controller.kp, Eigen::MatrixXd{{1, 2, 3}, {4, 5, 6}});
   expect_exact(m.controller.ki, Eigen::MatrixXd{{0.1, 0, 0}, {0, 0.2, -0.3}});
   expect_exact(m.controller.kd, Eigen::MatrixXd{{0.5, 0, 0}, {0, 0, 0.25}});
@@ -640,17 +640,17 @@ TEST(ModelFile, NoController) {
   const ModelSpec m = parse_model_spec(with_controller(R"({"type": "none"})"), "none.json");
   EXPECT_EQ(m.controller.type, ControllerType::None);
   EXPECT_FALSE(to_json(m).contains("controller"));
-  EXPECT_FALSE(to_json(parse(kPendulum)).contains("controller"));
+  EXPECT_FALSE(to_json(parse_model(kPendulum)).contains("controller"));
 }
 
 // ---------------------------------------------------------------- writing
 
 TEST(ModelFile, RoundTripIsExact) {
   for (const char* text : {kPendulum, kEverything}) {
-    const ModelSpec m = parse(text);
+    const ModelSpec m = parse_model(text);
     const json j = to_json(m);
-    expect_same(parse_model_spec(j, "written.json"), m);
-    expect_same(parse(j.dump()), m);
+    expect_same_model(parse_model_spec(j, "written.json"), m);
+    expect_same_model(parse_model(j.dump()), m);
     EXPECT_EQ(to_json(parse_model_spec(j, "written.json")), j);
     EXPECT_EQ(j["bodies"][0]["inertia"].size(), 6u);
     EXPECT_TRUE(j["joints"][0]["parent_frame"]["rotation"].contains("matrix"));
@@ -662,8 +662,8 @@ TEST(ModelFile, RoundTripOfEveryControllerIsExact) {
     SCOPED_TRACE(controller);
     const ModelSpec m = parse_model_spec(with_controller(controller), "controller.json");
     const json j = to_json(m);
-    expect_same(parse_model_spec(j, "written.json"), m);
-    expect_same(parse(j.dump()), m);
+    expect_same_model(parse_model_spec(j, "written.json"), m);
+    expect_same_model(parse_model(j.dump()), m);
     EXPECT_EQ(to_json(parse_model_spec(j, "written.json")), j);
     // written as given, with operating_point made explicit, matrices always as arrays of rows
     json expected = json::parse(controller);
@@ -709,7 +709,7 @@ TEST(ModelFile, RoundTripOfBuiltSpecIsBitExact) {
   c.Dc = Eigen::MatrixXd::Random(4, 2) / 7;
   c.Ts = 1.0 / 3;
   c.operating_point = "initial";
-  expect_same(parse(to_json(m).dump()), m);
+  expect_same_model(parse_model(to_json(m).dump()), m);
 
   // and each of the other types, with the fields of the others left at their defaults
   ModelSpec pid = m;
@@ -719,7 +719,7 @@ TEST(ModelFile, RoundTripOfBuiltSpecIsBitExact) {
   pid.controller.ki = Eigen::MatrixXd::Random(2, 3) * 1e-10;
   pid.controller.kd = Eigen::MatrixXd::Random(2, 3) / 11;
   pid.controller.setpoint = Eigen::VectorXd::Random(3) * std::numbers::pi;
-  expect_same(parse(to_json(pid).dump()), pid);
+  expect_same_model(parse_model(to_json(pid).dump()), pid);
 
   ModelSpec lqr = m;
   lqr.controller = {};
@@ -727,16 +727,16 @@ TEST(ModelFile, RoundTripOfBuiltSpecIsBitExact) {
   lqr.controller.q_weights = {1.0 / 3, 0.0, 1e-300, 1e14};
   lqr.controller.r_weights = {2.0 / 3};
   lqr.controller.operating_point = "trim";
-  expect_same(parse(to_json(lqr).dump()), lqr);
+  expect_same_model(parse_model(to_json(lqr).dump()), lqr);
 }
 
 TEST(ModelFile, SaveThenLoad) {
-  const TempDir dir;
+  const ModelTempDir dir;
   const std::string path = (dir.path() / "everything.json").string();
-  const ModelSpec m = parse(kEverything);
-  save_model_spec(parse(kPendulum), path);
+  const ModelSpec m = parse_model(kEverything);
+  save_model_spec(parse_model(kPendulum), path);
   save_model_spec(m, path);  // replaces the file
-  expect_same(load_model_spec(path), m);
+  expect_same_model(load_model_spec(path), m);
   EXPECT_EQ(json::parse(std::ifstream(path)), to_json(m));
   EXPECT_EQ(dir.count(), 1u);  // no temporary left over
 
@@ -749,11 +749,11 @@ TEST(ModelFile, SaveThenLoad) {
 }
 
 TEST(ModelFile, SaveIntoMissingDirectoryThrowsAndWritesNothing) {
-  const TempDir dir;
+  const ModelTempDir dir;
   const fs::path missing = dir.path() / "missing";
   const std::string path = (missing / "m.json").string();
   try {
-    save_model_spec(parse(kPendulum), path);
+    save_model_spec(parse_model(kPendulum), path);
     ADD_FAILURE() << "save into a missing directory did not throw";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
@@ -763,14 +763,14 @@ TEST(ModelFile, SaveIntoMissingDirectoryThrowsAndWritesNothing) {
 }
 
 TEST(ModelFile, FailedSaveLeavesNoTemporaryFile) {
-  const TempDir dir;
+  const ModelTempDir dir;
   const fs::path target = dir.path() / "taken";
   fs::create_directory(target);  // a file cannot replace a directory
-  EXPECT_THROW(save_model_spec(parse(kPendulum), target.string()), std::runtime_error);
+  EXPECT_THROW(save_model_spec(parse_model(kPendulum), target.string()), std::runtime_error);
   EXPECT_EQ(dir.count(), 1u);
   EXPECT_TRUE(fs::is_directory(target));
 
-  ModelSpec m = parse(kPendulum);
+  ModelSpec m = parse_model(kPendulum);
   m.name = "\xff";  // not UTF-8: cannot be written as JSON
   const std::string path = (dir.path() / "m.json").string();
   try {
@@ -804,7 +804,7 @@ TEST(ModelFileErrors, UnknownJointTypeInFile) {
 }
 
 TEST(ModelFileErrors, UnknownTypeInEveryList) {
-  json j = pendulum();
+  json j = pendulum_spec();
   j["constraints"] = {{{"name", "c"}, {"type", "ball"}, {"body_a", "link"}, {"body_b", "ground"}}};
   const struct {
     json::json_pointer type;
@@ -826,51 +826,51 @@ TEST(ModelFileErrors, UnknownTypeInEveryList) {
 }
 
 TEST(ModelFileErrors, MissingRequiredField) {
-  json j = pendulum();
+  json j = pendulum_spec();
   j["joints"][0].erase("child");
   expect_model_error(j, "/joints/0", "missing required field \"child\"");
 
-  j = pendulum();
+  j = pendulum_spec();
   j.erase("name");
   expect_model_error(j, "", "missing required field \"name\"");
 
-  j = pendulum();
+  j = pendulum_spec();
   j["effects"] = {{{"name", "spring"}, {"type", "spring_damper"}, {"body_a", "link"}}};
   expect_model_error(j, "/effects/0", "missing required field \"body_b\"");
 }
 
 TEST(ModelFileErrors, WrongType) {
-  json j = pendulum();
+  json j = pendulum_spec();
   j["bodies"][0]["mass"] = "ten";
   expect_model_error(j, "/bodies/0/mass", "expected a number, got string \"ten\"");
 
-  j = pendulum();
+  j = pendulum_spec();
   j["bodies"][0]["com"] = {0, 1};
   expect_model_error(j, "/bodies/0/com", "expected an array of 3 numbers, got an array of 2 elements");
 
-  j = pendulum();
+  j = pendulum_spec();
   j["actuators"][0]["dof"] = 0.5;
   expect_model_error(j, "/actuators/0/dof", "expected an integer, got number 0.5");
 
-  j = pendulum();
+  j = pendulum_spec();
   j["bodies"] = {{"name", "link"}};
   expect_model_error(j, "/bodies", "expected an array, got an object");
 }
 
 TEST(ModelFileErrors, UnknownField) {
-  json j = pendulum();
+  json j = pendulum_spec();
   j["bodies"][0]["mas"] = 2.0;
   expect_model_error(j, "/bodies/0/mas", "unknown field \"mas\" (allowed: name, mass, com, inertia, shapes)");
 
   // a field of another type is unknown too
-  j = pendulum();
+  j = pendulum_spec();
   j["effects"][0]["stiffness"] = 10;
   expect_model_error(j, "/effects/0/stiffness",
                      "unknown field \"stiffness\" (allowed for a gravity effect: name, type, g)");
 }
 
 TEST(ModelFileErrors, InitialValueOfWrongLength) {
-  json j = pendulum();
+  json j = pendulum_spec();
   j["joints"][0]["q0"] = {0.1, 0.2};
   expect_model_error(j, "/joints/0/q0", "expected 1 value (nq of a revolute joint), got 2");
 
@@ -880,7 +880,7 @@ TEST(ModelFileErrors, InitialValueOfWrongLength) {
 }
 
 TEST(ModelFileErrors, NonOrthonormalRotationMatrix) {
-  json j = pendulum();
+  json j = pendulum_spec();
   j["joints"][0]["parent_frame"]["rotation"] = {{"matrix", {{1, 0, 0}, {0, 1, 1e-6}, {0, 0, 1}}}};
   expect_model_error(j, "/joints/0/parent_frame/rotation/matrix", "rotation matrix is not orthonormal");
 
@@ -889,23 +889,23 @@ TEST(ModelFileErrors, NonOrthonormalRotationMatrix) {
 }
 
 TEST(ModelFileErrors, ZeroAxis) {
-  json j = pendulum();
+  json j = pendulum_spec();
   j["joints"][0]["axis"] = {0, 0, 0};
   expect_model_error(j, "/joints/0/axis", "expected a non-zero vector");
 
-  j = pendulum();
+  j = pendulum_spec();
   j["bodies"][0]["shapes"][0]["frame"]["rotation"] = {{"quaternion", {0, 0, 0, 0}}};
   expect_model_error(j, "/bodies/0/shapes/0/frame/rotation/quaternion", "expected a non-zero quaternion");
 }
 
 TEST(ModelFileErrors, NonSymmetricInertia) {
-  json j = pendulum();
+  json j = pendulum_spec();
   j["bodies"][0]["inertia"] = {{1, 0.1, 0}, {0, 1, 0}, {0, 0, 1}};
   expect_model_error(j, "/bodies/0/inertia", "inertia matrix is not symmetric");
 }
 
 TEST(ModelFileErrors, BadRotationObject) {
-  json j = pendulum();
+  json j = pendulum_spec();
   auto& rotation = j["joints"][0]["parent_frame"]["rotation"];
   rotation = {{"rpy", {0, 0, 1}}, {"matrix", {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}}};
   expect_model_error(j, "/joints/0/parent_frame/rotation", "expected one rotation form");
@@ -914,12 +914,12 @@ TEST(ModelFileErrors, BadRotationObject) {
 }
 
 TEST(ModelFileErrors, UnsupportedFormatVersion) {
-  json j = pendulum();
+  json j = pendulum_spec();
   j["codyna_model"] = 2;
   expect_model_error(j, "/codyna_model", "unsupported format version 2");
 }
 
-// `controller` (JSON text) as the pendulum's controller must fail at `path` with `phrase`.
+// `controller` (JSON text) as the pendulum_spec's controller must fail at `path` with `phrase`.
 void expect_controller_error(const std::string& controller, const std::string& path, const std::string& phrase) {
   SCOPED_TRACE(controller);
   expect_model_error(with_controller(controller), path, phrase);
@@ -1031,7 +1031,7 @@ TEST(ModelFileErrors, FileNotFound) {
 
 // Absurd numbers are refused where they enter, with the field's path (reliability issue).
 TEST(ModelFileErrors, AbsurdNumbersAreRefusedWithTheirPath) {
-  const auto pendulum = [](const std::string& body_extra, const std::string& top_extra = "") {
+  const auto pendulum_spec = [](const std::string& body_extra, const std::string& top_extra = "") {
     return R"({"name": "p", "bodies": [{"name": "b", "mass": 1, "inertia": [1, 1, 1, 0, 0, 0])" + body_extra +
            R"(}], "joints": [{"name": "j", "type": "revolute", "parent": "ground", "child": "b"}])" + top_extra + "}";
   };
@@ -1043,11 +1043,11 @@ TEST(ModelFileErrors, AbsurdNumbersAreRefusedWithTheirPath) {
     }
     return "";
   };
-  EXPECT_EQ(error_of(pendulum(R"(, "com": [0, 1e308, 0])")), "/bodies/0/com/1: expected a number of magnitude at most 1e15, got number 1e+308");
-  EXPECT_NE(error_of(pendulum(R"(, "shapes": [{"type": "sphere", "radius": -0.1}])")).find("/bodies/0/shapes/0/radius: expected a length > 0"), std::string::npos);
-  EXPECT_NE(error_of(pendulum(R"(, "shapes": [{"type": "box", "size": [1, 0, 1]}])")).find("/bodies/0/shapes/0/size"), std::string::npos);
-  EXPECT_NE(error_of(pendulum("", R"(, "solver": {"t_end": -5})")).find("/solver/t_end: expected an end time > 0"), std::string::npos);
-  EXPECT_NE(error_of(pendulum("", R"(, "solver": {"rtol": 2})")).find("/solver/rtol"), std::string::npos);
+  EXPECT_EQ(error_of(pendulum_spec(R"(, "com": [0, 1e308, 0])")), "/bodies/0/com/1: expected a number of magnitude at most 1e15, got number 1e+308");
+  EXPECT_NE(error_of(pendulum_spec(R"(, "shapes": [{"type": "sphere", "radius": -0.1}])")).find("/bodies/0/shapes/0/radius: expected a length > 0"), std::string::npos);
+  EXPECT_NE(error_of(pendulum_spec(R"(, "shapes": [{"type": "box", "size": [1, 0, 1]}])")).find("/bodies/0/shapes/0/size"), std::string::npos);
+  EXPECT_NE(error_of(pendulum_spec("", R"(, "solver": {"t_end": -5})")).find("/solver/t_end: expected an end time > 0"), std::string::npos);
+  EXPECT_NE(error_of(pendulum_spec("", R"(, "solver": {"rtol": 2})")).find("/solver/rtol"), std::string::npos);
   // a denormal mass, and a 1e-300 inertia, beside a real body
   const std::string two = R"({"name": "p", "bodies": [{"name": "a", "mass": 1, "inertia": [1, 1, 1, 0, 0, 0]},
       {"name": "b", "mass": 1e-310, "inertia": [1, 1, 1, 0, 0, 0]}],

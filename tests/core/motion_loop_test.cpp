@@ -82,7 +82,7 @@ double drive_torque(double th, double thd, double thdd, double s) {
 
 ModelSpec example() { return study_read_model(test::example_path("slider_crank_driven.json")); }
 
-int column(const std::vector<std::string>& names, const std::string& name) {
+int motion_column(const std::vector<std::string>& names, const std::string& name) {
   const auto it = std::find(names.begin(), names.end(), name);
   EXPECT_NE(it, names.end()) << name;
   return static_cast<int>(it - names.begin());
@@ -157,8 +157,8 @@ SimulationResult run(ModelSpec spec) {
 // closed to `tol`
 void expect_closed_forms(const SimulationResult& r, const std::function<std::array<double, 3>(double)>& crank,
                          double tol = 1e-12, double torque_tol = 1e-8) {
-  const int ic = column(r.q_names, "crank_pivot"), iy = column(r.output_names, "slider_x");
-  const int is = column(r.q_names, "follower_slide"), it = column(r.output_names, "drive_torque");
+  const int ic = motion_column(r.q_names, "crank_pivot"), iy = motion_column(r.output_names, "slider_x");
+  const int is = motion_column(r.q_names, "follower_slide"), it = motion_column(r.output_names, "drive_torque");
   double worst_x = 0, worst_tau = 0, largest_tau = 0, worst_phi = 0;
   for (int i = 0; i < r.samples(); ++i) {
     const auto [th, rate, acc] = crank(r.t[i]);
@@ -180,8 +180,8 @@ TEST(MotionLoop, ACrankTurnedByARampFollowsTheClosedFormsAndTheEnergyBalance) {
   spec.solver.t_end = 1.0;
   const SimulationResult r = run(spec);
   const double w = 2 * std::numbers::pi;
-  const int is = column(r.q_names, "follower_slide"), it = column(r.output_names, "drive_torque");
-  const int vs = column(r.v_names, "follower_slide_dot");
+  const int is = motion_column(r.q_names, "follower_slide"), it = motion_column(r.output_names, "drive_torque");
+  const int vs = motion_column(r.v_names, "follower_slide_dot");
   const int N = r.samples();
   ASSERT_EQ(N, 1001);
   // the crank follows its signal exactly
@@ -242,7 +242,7 @@ TEST(MotionLoop, TheDaeIntegratorTakesMotionInputs) {
   const SimulationResult rr = run(ramp);
   const double W = 2 * std::numbers::pi;
   expect_closed_forms(rr, [&](double t) { return std::array<double, 3>{0.5 + W * t, W, 0.0}; }, 1e-8, 1e-8);
-  EXPECT_NEAR(rr.v(0, column(rr.v_names, "follower_slide_dot")), -geometry(0.5).x1 * W, 1e-12);
+  EXPECT_NEAR(rr.v(0, motion_column(rr.v_names, "follower_slide_dot")), -geometry(0.5).x1 * W, 1e-12);
 }
 
 // the crank as a Plant/In: S(s)/Theta(s) = -x_theta s^2 / (s^2 + k/m2), X/Theta = x_theta
@@ -346,7 +346,7 @@ TEST(MotionLoop, MotionsThatOverDriveOrCannotCloseTheLoopAreRefusedNamingIt) {
   // the slider driven alone, held where the rod cannot reach (x > r + l)
   spec = example();
   spec.actuators[0].joint = "slide";
-  spec.sensors.erase(spec.sensors.begin() + column({"slider_x", "follower_s", "drive_torque"}, "drive_torque"));
+  spec.sensors.erase(spec.sensors.begin() + motion_column({"slider_x", "follower_s", "drive_torque"}, "drive_torque"));
   spec.plant.outputs = {"slider_x"};
   for (JointSpec& j : spec.joints)
     if (j.name == "slide") j.q0 = Eigen::VectorXd::Constant(1, 0.45);

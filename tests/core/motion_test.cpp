@@ -38,7 +38,7 @@ cd transfer(const LinearSystem& s, cd z, int i, int j) {
 
 const double kFrequencies[10] = {0.05, 0.2, 0.7, 1.5, 3.0, 6.0, 10.0, 25.0, 60.0, 200.0};  // rad/s
 
-ModelSpec parse(const std::string& text) { return study_parse_model_text(text, "motion_test.json"); }
+ModelSpec parse_motion(const std::string& text) { return study_parse_model_text(text, "motion_test.json"); }
 
 TEST(Motion, BallAndBeamKeepsTheFeedthroughOfTheBeamsAcceleration) {
   const Model m = test::load_example("ball_beam.json");
@@ -104,7 +104,7 @@ std::string shaker(const std::string& outputs) {
 }
 
 TEST(Motion, PendulumOnAShakerFollowsTheSupportsAcceleration) {
-  const LinearSystem s = study_linearize(study_model(parse(shaker(R"(["angle", "tip_x"])")))).system;
+  const LinearSystem s = study_linearize(study_model(parse_motion(shaker(R"(["angle", "tip_x"])")))).system;
   const double m = 0.8, l = 0.6, c = l / 2, g = 9.81, I = m * l * l / 3;
   ASSERT_EQ(s.nx(), 2);
   double worst = 0;
@@ -122,7 +122,7 @@ TEST(Motion, PendulumOnAShakerFollowsTheSupportsAcceleration) {
 
 TEST(Motion, AnOutputThatFeelsTheInputsRateIsRefusedNamingBoth) {
   try {
-    study_linearize(study_model(parse(shaker(R"(["rate"])"))));
+    study_linearize(study_model(parse_motion(shaker(R"(["rate"])"))));
     FAIL() << "expected a refusal";
   } catch (const std::exception& e) {
     const std::string what = e.what();
@@ -165,7 +165,7 @@ TEST(Motion, AnalyticJacobianAgreesWithAutodiffAndCentralDifferences) {
   std::uniform_real_distribution<double> U(-1, 1);
   std::vector<std::pair<std::string, Model>> models;
   for (const char* file : {"ball_beam.json", "bus_suspension.json"}) models.emplace_back(file, test::load_example(file));
-  models.emplace_back("shaker", study_model(parse(shaker(R"(["angle", "tip_x"])"))));
+  models.emplace_back("shaker", study_model(parse_motion(shaker(R"(["angle", "tip_x"])"))));
   for (const auto& [name, m] : models) {
     const CoordinatePartition p = partition_coordinates(m, m.q0);
     const PlantFunction f(m, m.q0, m.u_nominal(), p);
@@ -239,7 +239,7 @@ std::string shaker_with_reaction(const std::string& inputs, const std::string& o
 // (F responds to its acceleration: improper); on a coordinate no motion drives, refused at the field.
 TEST(Motion, TheReactionOfAMotionIsASensor) {
   const double m = 0.8, l = 0.6, c = l / 2, g = 9.81, I = m * l * l / 3, A = 0.05, w = 2 * std::numbers::pi * 0.7;
-  const Model run = study_model(parse(shaker_with_reaction(
+  const Model run = study_model(parse_motion(shaker_with_reaction(
       "[]", R"(["angle", "rate", "force"])",
       R"(, "controller": "none", "disturbances": [{"actuator": "table", "type": "sine", "amplitude": 0.05, "frequency": 0.7}])")));
   ModelSpec spec = run.spec;
@@ -264,7 +264,7 @@ TEST(Motion, TheReactionOfAMotionIsASensor) {
 
   // held table, the motor as Plant/In: F = m c theta'' = (m c / I) (tau - m g c theta)
   const LinearSystem s =
-      study_linearize(study_model(parse(shaker_with_reaction(R"(["motor"])", R"(["angle", "force"])", "")))).system;
+      study_linearize(study_model(parse_motion(shaker_with_reaction(R"(["motor"])", R"(["angle", "force"])", "")))).system;
   ASSERT_EQ(s.nx(), 2);
   EXPECT_NEAR(s.C(1, 0), -(m * c / I) * m * g * c, 1e-12);
   EXPECT_NEAR(s.C(1, 1), 0.0, 1e-12);
@@ -272,7 +272,7 @@ TEST(Motion, TheReactionOfAMotionIsASensor) {
   EXPECT_NEAR(s.A(1, 0), -m * g * c / I, 1e-12);
   // the table as Plant/In: the reaction responds to its acceleration
   try {
-    study_linearize(study_model(parse(shaker_with_reaction(R"(["table"])", R"(["force"])", ""))));
+    study_linearize(study_model(parse_motion(shaker_with_reaction(R"(["table"])", R"(["force"])", ""))));
     FAIL() << "expected a refusal";
   } catch (const std::exception& e) {
     const std::string what = e.what();
@@ -283,7 +283,7 @@ TEST(Motion, TheReactionOfAMotionIsASensor) {
   try {
     std::string text = shaker_with_reaction(R"(["motor"])", R"(["force"])", "");
     text.replace(text.find(R"("plant":)"), 8, R"("controller": {"type": "pid", "kp": [[0.1]]}, "plant":)");
-    const Model pid = study_model(parse(text));
+    const Model pid = study_model(parse_motion(text));
     study_simulate(pid, study_simulation(pid));
     FAIL() << "expected a refusal";
   } catch (const std::exception& e) {
@@ -296,8 +296,8 @@ TEST(Motion, TheReactionOfAMotionIsASensor) {
   const std::string from = R"("type": "motion_force", "joint": "x")";
   bad.replace(bad.find(from), from.size(), R"("type": "motion_force", "joint": "theta")");
   try {
-    parse(bad);
-    study_model(parse(bad));
+    parse_motion(bad);
+    study_model(parse_motion(bad));
     FAIL() << "expected a refusal";
   } catch (const ModelError& e) {
     EXPECT_EQ(e.path().rfind("/sensors/2/joint", 0), 0u) << e.what();
@@ -308,7 +308,7 @@ TEST(Motion, TheReactionOfAMotionIsASensor) {
 TEST(Motion, BadMotionInputsAreRefusedAtTheField) {
   const auto error_path = [](const std::string& text) {
     try {
-      study_model(parse(text));
+      study_model(parse_motion(text));
     } catch (const ModelError& e) {
       return e.path() + ": " + e.what();
     }

@@ -26,7 +26,7 @@ namespace codyna {
 namespace {
 
 namespace fs = std::filesystem;
-using Strings = std::vector<std::string>;
+using ResultStrings = std::vector<std::string>;
 using nlohmann::json;
 using test::bounded;
 using test::CommandResult;
@@ -39,25 +39,25 @@ using test::shell_quoted;
 
 // ------------------------------------------------------------------ fixtures
 
-class TempDir {
+class ResultsTempDir {
  public:
-  TempDir() {
+  ResultsTempDir() {
     std::string pattern = (fs::temp_directory_path() / "codyna_results_XXXXXX").string();
     if (!::mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
     path_ = pattern;
   }
-  ~TempDir() {
+  ~ResultsTempDir() {
     std::error_code ec;
     fs::remove_all(path_, ec);
   }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
+  ResultsTempDir(const ResultsTempDir&) = delete;
+  ResultsTempDir& operator=(const ResultsTempDir&) = delete;
 
   std::string operator/(const std::string& name) const { return path_ + "/" + name; }
 
   // the names in the directory, sorted (temporary files included)
-  Strings entries() const {
-    Strings names;
+  ResultStrings entries() const {
+    ResultStrings names;
     for (const auto& e : fs::directory_iterator(path_)) names.push_back(e.path().filename().string());
     std::sort(names.begin(), names.end());
     return names;
@@ -149,7 +149,7 @@ SimulationResult partial(SimulationResult r) {
   return ::testing::AssertionSuccess();
 }
 
-void expect_same(const SimulationResult& a, const SimulationResult& b) {
+void expect_same_results(const SimulationResult& a, const SimulationResult& b) {
   EXPECT_EQ(a.t, b.t);
   EXPECT_TRUE(SameMatrix(a.q, b.q)) << "q";
   EXPECT_TRUE(SameMatrix(a.v, b.v)) << "v";
@@ -194,7 +194,7 @@ void expect_same(const SimulationResult& a, const SimulationResult& b) {
 }
 
 // `f` throws std::runtime_error whose message holds every one of `parts`
-::testing::AssertionResult ThrowsWith(const std::function<void()>& f, const Strings& parts) {
+::testing::AssertionResult ThrowsWith(const std::function<void()>& f, const ResultStrings& parts) {
   try {
     f();
   } catch (const std::runtime_error& e) {
@@ -208,10 +208,10 @@ void expect_same(const SimulationResult& a, const SimulationResult& b) {
 }
 
 void expect_round_trip(const SimulationResult& r) {
-  TempDir dir;
+  ResultsTempDir dir;
   write_results_hdf5(r, dir / "run.h5");
-  expect_same(read_results_hdf5(dir / "run.h5"), r);
-  EXPECT_EQ(dir.entries(), Strings{"run.h5"});  // no temporary file left
+  expect_same_results(read_results_hdf5(dir / "run.h5"), r);
+  EXPECT_EQ(dir.entries(), ResultStrings{"run.h5"});  // no temporary file left
 }
 
 // ------------------------------------------------------------------ HDF5
@@ -236,7 +236,7 @@ TEST(ResultsHdf5, PartialResultKeepsItsFailureText) {
 TEST(ResultsHdf5, ZeroColumnMatrixOfAnyRowCountIsStoredAsSamplesByZero) {
   SimulationResult r = without_controller(oscillator_result());
   r.xc.resize(0, 0);
-  TempDir dir;
+  ResultsTempDir dir;
   write_results_hdf5(r, dir / "run.h5");
   const SimulationResult back = read_results_hdf5(dir / "run.h5");
   EXPECT_EQ(back.xc.rows(), 50);
@@ -244,14 +244,14 @@ TEST(ResultsHdf5, ZeroColumnMatrixOfAnyRowCountIsStoredAsSamplesByZero) {
 }
 
 TEST(ResultsHdf5, MissingDirectoryLeavesNothingAndNamesThePath) {
-  TempDir dir;
+  ResultsTempDir dir;
   const std::string path = dir / "missing/run.h5";
   EXPECT_TRUE(ThrowsWith([&] { write_results_hdf5(oscillator_result(), path); }, {path, "No such file or directory"}));
   EXPECT_TRUE(dir.entries().empty());
 }
 
 TEST(ResultsHdf5, InconsistentResultIsRejectedAndTheOldFileKept) {
-  TempDir dir;
+  ResultsTempDir dir;
   const std::string path = dir / "run.h5";
   const SimulationResult good = oscillator_result();
   write_results_hdf5(good, path);
@@ -268,16 +268,16 @@ TEST(ResultsHdf5, InconsistentResultIsRejectedAndTheOldFileKept) {
   EXPECT_TRUE(rejected([](SimulationResult& r) { r.y_reference.conservativeResize(49, 2); }, "/y_reference is 49 x 2"));
   EXPECT_TRUE(rejected([](SimulationResult& r) { r.u_disturbance.conservativeResize(50, 2); },
                        "/u_disturbance is 50 x 2, expected 50 x 1 like /u"));
-  EXPECT_EQ(dir.entries(), Strings{"run.h5"});
-  expect_same(read_results_hdf5(path), good);
+  EXPECT_EQ(dir.entries(), ResultStrings{"run.h5"});
+  expect_same_results(read_results_hdf5(path), good);
   // and a good write replaces it
   const SimulationResult other = partial(oscillator_result(10));
   write_results_hdf5(other, path);
-  expect_same(read_results_hdf5(path), other);
+  expect_same_results(read_results_hdf5(path), other);
 }
 
 TEST(ResultsHdf5, ReadFailuresNameThePathAndTheReason) {
-  TempDir dir;
+  ResultsTempDir dir;
   EXPECT_TRUE(ThrowsWith([&] { read_results_hdf5(dir / "absent.h5"); }, {dir / "absent.h5", "no such file"}));
   std::ofstream(dir / "notes.h5") << "not HDF5\n";
   EXPECT_TRUE(ThrowsWith([&] { read_results_hdf5(dir / "notes.h5"); }, {dir / "notes.h5", "not an HDF5 file"}));
@@ -365,7 +365,7 @@ struct PeerCase {
   std::size_t datasets, lists;
 };
 
-std::vector<PeerCase> write_peer_cases(const TempDir& dir) {
+std::vector<PeerCase> write_peer_cases(const ResultsTempDir& dir) {
   const std::pair<std::string, SimulationResult> results[] = {
       {"full", oscillator_result()},
       {"no_controller", without_controller(oscillator_result())},
@@ -387,7 +387,7 @@ std::vector<PeerCase> write_peer_cases(const TempDir& dir) {
 TEST(ResultsFilePeer, H5pyReadsTheDocumentedLayout) {
   static const std::optional<std::string> python = python_with("numpy, h5py");
   if (!python) GTEST_SKIP() << "no python3 with numpy and h5py (set CODYNA_PYTHON; CI installs them)";
-  TempDir dir;
+  ResultsTempDir dir;
   for (const PeerCase& c : write_peer_cases(dir)) {
     const CommandResult r =
         run_command(bounded(shell_quoted(*python) + " " + shell_quoted(peer_script("read_results.py")) + " " +
@@ -402,7 +402,7 @@ TEST(ResultsFilePeer, H5pyReadsTheDocumentedLayout) {
 
 TEST(ResultsFilePeer, OctaveLoadReadsDatasetsAndNameLists) {
   if (!on_path("octave-cli")) GTEST_SKIP() << "octave-cli is not on PATH (CI installs it)";
-  TempDir dir;
+  ResultsTempDir dir;
   const std::vector<PeerCase> cases = write_peer_cases(dir);
   std::string eval = "addpath(" + octave_string(peers_dir()) + "); ";
   for (const PeerCase& c : cases)
@@ -420,20 +420,20 @@ TEST(ResultsFilePeer, OctaveLoadReadsDatasetsAndNameLists) {
 
 // ------------------------------------------------------------------ CSV
 
-Strings read_lines(const std::string& path) {
+ResultStrings read_lines(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::stringstream text;
   text << in.rdbuf();
   const std::string s = text.str();
   EXPECT_TRUE(!s.empty() && s.back() == '\n') << "the file does not end with a line break";
-  Strings lines;
+  ResultStrings lines;
   std::istringstream stream(s);
   for (std::string line; std::getline(stream, line);) lines.push_back(line);
   return lines;
 }
 
-Strings split(const std::string& line) {
-  Strings fields;
+ResultStrings split(const std::string& line) {
+  ResultStrings fields;
   std::istringstream stream(line);
   for (std::string field; std::getline(stream, field, ',');) fields.push_back(field);
   return fields;
@@ -452,10 +452,10 @@ std::vector<double> csv_row(const SimulationResult& r, int i) {
 }
 
 // Every field is "%.17g" of the expected double and parses back to it exactly.
-void expect_csv_rows(const Strings& lines, const SimulationResult& r) {
+void expect_csv_rows(const ResultStrings& lines, const SimulationResult& r) {
   ASSERT_EQ(lines.size(), r.t.size() + 1);
   for (int i = 0; i < r.samples(); ++i) {
-    const Strings fields = split(lines[i + 1]);
+    const ResultStrings fields = split(lines[i + 1]);
     const std::vector<double> want = csv_row(r, i);
     ASSERT_EQ(fields.size(), want.size()) << "row " << i;
     for (std::size_t c = 0; c < want.size(); ++c) {
@@ -471,25 +471,25 @@ void expect_csv_rows(const Strings& lines, const SimulationResult& r) {
 }
 
 TEST(ResultsCsv, HeaderAndRowsOfAFullResult) {
-  TempDir dir;
+  ResultsTempDir dir;
   const SimulationResult r = oscillator_result();
   write_results_csv(r, dir / "run.csv");
-  const Strings lines = read_lines(dir / "run.csv");
+  const ResultStrings lines = read_lines(dir / "run.csv");
   ASSERT_FALSE(lines.empty());
   EXPECT_EQ(lines[0],
             "t,slider.x,rocker.angle,slider.x_dot,rocker.angle_dot,damper_force,\"x, measured\",omega,integral_x,"
             "kinetic_energy,potential_energy,constraint_violation,\"x, measured_linear\",omega_linear,"
             "\"x, measured_reference\",omega_reference,damper_force_disturbance");
   expect_csv_rows(lines, r);
-  EXPECT_EQ(dir.entries(), Strings{"run.csv"});
+  EXPECT_EQ(dir.entries(), ResultStrings{"run.csv"});
 }
 
 TEST(ResultsCsv, ResultWithoutControllerOrLinearRun) {
-  TempDir dir;
+  ResultsTempDir dir;
   SimulationResult r = without_controller(oscillator_result(5));
   r.output_names = {"x", "omega"};
   write_results_csv(r, dir / "run.csv");
-  const Strings lines = read_lines(dir / "run.csv");
+  const ResultStrings lines = read_lines(dir / "run.csv");
   ASSERT_FALSE(lines.empty());
   EXPECT_EQ(lines[0],
             "t,slider.x,rocker.angle,slider.x_dot,rocker.angle_dot,damper_force,x,omega,"
@@ -498,7 +498,7 @@ TEST(ResultsCsv, ResultWithoutControllerOrLinearRun) {
 }
 
 TEST(ResultsCsv, FailuresLeaveNothingAndNameThePath) {
-  TempDir dir;
+  ResultsTempDir dir;
   const std::string missing = dir / "missing/run.csv";
   EXPECT_TRUE(
       ThrowsWith([&] { write_results_csv(oscillator_result(), missing); }, {missing, "No such file or directory"}));
@@ -518,7 +518,7 @@ TEST(ResultsCsv, NumbersIgnoreACommaDecimalLocale) {
       break;
     }
   if (!comma) GTEST_SKIP() << "no comma-decimal locale installed";
-  TempDir dir;
+  ResultsTempDir dir;
   const SimulationResult r = oscillator_result(3);
   write_results_csv(r, dir / "run.csv");
   std::setlocale(LC_ALL, old.c_str());

@@ -11,7 +11,7 @@ namespace {
 
 using test::MatrixNear;
 
-constexpr double g = 9.81;
+constexpr double g_rnea = 9.81;
 
 // M(q) and nle(q, v) of a model at a state, by CRBA and RNEA
 struct MassBias {
@@ -37,7 +37,7 @@ TEST(Rnea, PendulumMatchesLagrange) {
     Eigen::MatrixXd M(1, 1);
     M << mass * l * l / 3;
     Eigen::VectorXd h(1);
-    h << mass * g * l / 2 * std::cos(th);  // gravity torque, theta from the horizontal
+    h << mass * g_rnea * l / 2 * std::cos(th);  // gravity torque, theta from the horizontal
     EXPECT_TRUE(MatrixNear(mb.M, M, 1e-12));
     EXPECT_TRUE(MatrixNear(mb.h, h, 1e-12));
   }
@@ -56,7 +56,7 @@ TEST(Rnea, CartPendulumMatchesLagrange) {
     Eigen::MatrixXd M(2, 2);
     M << m2 + m3, -s * m3 * l / 2 * std::cos(th), -s * m3 * l / 2 * std::cos(th), m3 * l * l / 3;
     Eigen::VectorXd h(2);
-    h << s * m3 * l / 2 * std::sin(th) * thd * thd, -m3 * g * l / 2 * std::sin(th);
+    h << s * m3 * l / 2 * std::sin(th) * thd * thd, -m3 * g_rnea * l / 2 * std::sin(th);
     const MassBias mb = mass_bias(m, q, v);
     EXPECT_TRUE(MatrixNear(mb.M, M, 1e-12));
     EXPECT_TRUE(MatrixNear(mb.h, h, 1e-12));
@@ -75,9 +75,9 @@ TEST(Rnea, DoublePendulumMatchesLagrange) {
     M << I1 + m1 * l1 * l1 / 4 + m2 * l1 * l1 + M22 + m2 * l1 * l2 * c2, M12, M12, M22;
     const double k2 = m2 * l1 * l2 / 2 * s2;
     Eigen::VectorXd h(2);
-    h << -k2 * (2 * v[0] * v[1] + v[1] * v[1]) + m1 * g * l1 / 2 * std::sin(q[0]) +
-             m2 * g * (l1 * std::sin(q[0]) + l2 / 2 * std::sin(q[0] + q[1])),
-        k2 * v[0] * v[0] + m2 * g * l2 / 2 * std::sin(q[0] + q[1]);
+    h << -k2 * (2 * v[0] * v[1] + v[1] * v[1]) + m1 * g_rnea * l1 / 2 * std::sin(q[0]) +
+             m2 * g_rnea * (l1 * std::sin(q[0]) + l2 / 2 * std::sin(q[0] + q[1])),
+        k2 * v[0] * v[0] + m2 * g_rnea * l2 / 2 * std::sin(q[0] + q[1]);
     const MassBias mb = mass_bias(m, q, v);
     EXPECT_TRUE(MatrixNear(mb.M, M, 1e-12));
     EXPECT_TRUE(MatrixNear(mb.h, h, 1e-12));

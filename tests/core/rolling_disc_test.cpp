@@ -34,8 +34,8 @@ namespace codyna {
 namespace {
 
 // a thin uniform disc: I1 = m R^2 / 4 about a diameter, I3 = m R^2 / 2 about the axle (body y)
-constexpr double m = 1.5, R = 0.2, g = 9.81;
-constexpr double I1 = m * R * R / 4, I3 = m * R * R / 2;
+constexpr double m_disc = 1.5, R_disc = 0.2, g_disc = 9.81;
+constexpr double I1 = m_disc * R_disc * R_disc / 4, I3 = m_disc * R_disc * R_disc / 2;
 
 // the disc on the ground plane through the origin with normal n (a free joint; the axle is body y)
 ModelSpec floor_disc(const Eigen::Vector3d& n = Eigen::Vector3d::UnitZ()) {
@@ -71,7 +71,7 @@ Eigen::Vector3d contact_direction(const Eigen::Vector3d& n, const Eigen::Vector3
 // with world angular velocity w: c = R d (the contact at the origin), v_c = w x (R d)
 void set_rolling(JointSpec& j, const Eigen::Matrix3d& Rot, const Eigen::Vector3d& n, const Eigen::Vector3d& w) {
   const Eigen::Vector3d dv = contact_direction(n, Rot * Eigen::Vector3d::UnitY());
-  const Eigen::Vector3d c = R * dv, v = w.cross(R * dv);
+  const Eigen::Vector3d c = R_disc * dv, v = w.cross(R_disc * dv);
   const Eigen::Quaterniond qr(Rot);
   j.q0 = (Eigen::VectorXd(7) << c.x(), c.y(), c.z(), qr.w(), qr.x(), qr.y(), qr.z()).finished();
   // the free joint's rates in the child's axes
@@ -153,7 +153,7 @@ TEST(RollingDisc, TheRowsAreTheHeightOverRCosLeanAndTheContactPointsVelocity) {
     const Eigen::Quaterniond qr(lean(phi) * Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitY()).toRotationMatrix());
     const Eigen::VectorXd q = (Eigen::VectorXd(7) << 0.3, -0.2, h, qr.w(), qr.x(), qr.y(), qr.z()).finished();
     const Eigen::VectorXd& phi_q = constraint_residual<double>(mod, d, q);
-    EXPECT_NEAR(phi_q[0], h - R * std::cos(phi), 1e-15) << phi;
+    EXPECT_NEAR(phi_q[0], h - R_disc * std::cos(phi), 1e-15) << phi;
     EXPECT_EQ(phi_q[1], 0.0);
     EXPECT_EQ(phi_q[2], 0.0);
     // rolling (v_c = w x R d): Jc v = 0 on the three rows; slipping by s at the contact: Jc v = s
@@ -162,7 +162,7 @@ TEST(RollingDisc, TheRowsAreTheHeightOverRCosLeanAndTheContactPointsVelocity) {
     EXPECT_NEAR(dv.z(), std::cos(phi), 1e-15);
     const Eigen::Vector3d s(0.05, -0.02, 0.01);
     for (int slip = 0; slip < 2; ++slip) {
-      const Eigen::Vector3d v = w.cross(R * dv) + (slip ? s : Eigen::Vector3d::Zero());
+      const Eigen::Vector3d v = w.cross(R_disc * dv) + (slip ? s : Eigen::Vector3d::Zero());
       const Eigen::VectorXd vq = (Eigen::VectorXd(6) << Rot.transpose() * w, Rot.transpose() * v).finished();
       constraint_terms<double>(mod, d, q, vq);
       const Eigen::Vector3d Jv = d.Jc * vq;
@@ -258,7 +258,7 @@ TEST(RollingDisc, ThePlantJacobianAgreesWithCentralDifferences) {
 TEST(RollingDisc, AnUprightDiscRollsStraightAtItsSpeed) {
   ModelSpec spec = floor_disc();
   const double V = 1.2;
-  set_rolling(spec.joints.at(0), Eigen::Matrix3d::Identity(), Eigen::Vector3d::UnitZ(), Eigen::Vector3d(0, V / R, 0));
+  set_rolling(spec.joints.at(0), Eigen::Matrix3d::Identity(), Eigen::Vector3d::UnitZ(), Eigen::Vector3d(0, V / R_disc, 0));
   spec.solver.t_end = 2.0;
   const Model mod = study_model(spec);
   EXPECT_TRUE(mod.assembly_moves.empty());
@@ -268,7 +268,7 @@ TEST(RollingDisc, AnUprightDiscRollsStraightAtItsSpeed) {
   double worst = 0, slip = 0;
   for (int i = 0; i < r.samples(); ++i) {
     const double t = r.t[static_cast<std::size_t>(i)];
-    worst = std::max({worst, std::abs(r.y(i, ix) - V * t), std::abs(r.y(i, iy)), std::abs(r.y(i, iz) - R)});
+    worst = std::max({worst, std::abs(r.y(i, ix) - V * t), std::abs(r.y(i, iy)), std::abs(r.y(i, iz) - R_disc)});
     slip = std::max(slip, r.velocity_violation[static_cast<std::size_t>(i)]);
   }
   EXPECT_NEAR(r.t.back(), 2.0, 1e-12);
@@ -289,16 +289,16 @@ TEST(RollingDisc, AnUprightDiscRollsDownAnInclineAtTwoThirdsGSinB) {
   const SimulationResult r = study_simulate(mod, study_simulation(mod));
   ASSERT_TRUE(r.completed) << r.failure;
   const int ix = column(r.output_names, "x"), iy = column(r.output_names, "y"), iz = column(r.output_names, "z");
-  const double acc = m * g * std::sin(b) / (m + I3 / (R * R));
-  EXPECT_NEAR(acc, 2.0 / 3.0 * g * std::sin(b), 1e-14);
-  const Eigen::Vector3d c0 = R * n;
+  const double acc = m_disc * g_disc * std::sin(b) / (m_disc + I3 / (R_disc * R_disc));
+  EXPECT_NEAR(acc, 2.0 / 3.0 * g_disc * std::sin(b), 1e-14);
+  const Eigen::Vector3d c0 = R_disc * n;
   double worst = 0;
   for (int i = 0; i < r.samples(); ++i) {
     const double t = r.t[static_cast<std::size_t>(i)];
     const Eigen::Vector3d c = c0 + 0.5 * acc * t * t * down;
     worst = std::max(worst, (Eigen::Vector3d(r.y(i, ix), r.y(i, iy), r.y(i, iz)) - c).cwiseAbs().maxCoeff());
   }
-  EXPECT_GT(r.y(r.samples() - 1, ix) - c0.x(), 0.5);  // it rolled: about 0.9 m
+  EXPECT_GT(r.y(r.samples() - 1, ix) - c0.x(), 0.5);  // it rolled: about 0.9 m_disc
   EXPECT_LT(worst, 1e-9);
 }
 
@@ -317,8 +317,8 @@ TEST(RollingDisc, AnUprightDiscRollsDownAnInclineAtTwoThirdsGSinB) {
 // centre is at height R cos(phi) + sin(phi) = R + phi + O(phi^2).
 TEST(RollingDisc, TheLeanOfAnUprightRollingDiscOscillatesAtTheClosedFormFrequency) {
   const double Omega = 8.0, e = 1e-5;
-  const double lambda2 = ((I3 + m * R * R) * I3 * Omega * Omega / I1 - m * g * R) / (I1 + m * R * R);
-  ASSERT_NEAR(lambda2, 0.8 * (3 * Omega * Omega - g / R), 1e-12);
+  const double lambda2 = ((I3 + m_disc * R_disc * R_disc) * I3 * Omega * Omega / I1 - m_disc * g_disc * R_disc) / (I1 + m_disc * R_disc * R_disc);
+  ASSERT_NEAR(lambda2, 0.8 * (3 * Omega * Omega - g_disc / R_disc), 1e-12);
   const double lambda = std::sqrt(lambda2);  // 12.5 rad/s
   ModelSpec spec = floor_disc();
   set_rolling(spec.joints.at(0), Eigen::Matrix3d::Identity(), Eigen::Vector3d::UnitZ(), Eigen::Vector3d(e, Omega, 0));
@@ -331,7 +331,7 @@ TEST(RollingDisc, TheLeanOfAnUprightRollingDiscOscillatesAtTheClosedFormFrequenc
   double worst = 0, peak = 0;
   for (int i = 0; i < r.samples(); ++i) {
     const double t = r.t[static_cast<std::size_t>(i)];
-    const double phi = r.y(i, it) - R;
+    const double phi = r.y(i, it) - R_disc;
     worst = std::max(worst, std::abs(phi - e / lambda * std::sin(lambda * t)));
     peak = std::max(peak, std::abs(phi));
   }

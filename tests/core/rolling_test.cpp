@@ -40,7 +40,7 @@ constexpr double mass_eff = m + J / (R * R);
 
 ModelSpec plate() { return study_read_model(test::example_path("ball_plate.json")); }
 
-int column(const std::vector<std::string>& names, const std::string& name) {
+int rolling_column(const std::vector<std::string>& names, const std::string& name) {
   const auto it = std::find(names.begin(), names.end(), name);
   EXPECT_NE(it, names.end()) << name;
   return static_cast<int>(it - names.begin());
@@ -109,7 +109,7 @@ TEST(Rolling, ABallReleasedOnATiltedPlateFollowsTheClosedForm) {
   const Model mod = study_model(spec);
   const SimulationResult r = study_simulate(mod, study_simulation(mod));
   ASSERT_TRUE(r.completed) << r.failure;
-  const int ix = column(r.output_names, "X"), iy = column(r.output_names, "Y");
+  const int ix = rolling_column(r.output_names, "X"), iy = rolling_column(r.output_names, "Y");
   double worst_x = 0, worst_y = 0, worst_phi = 0, worst_slip = 0;
   for (int i = 0; i < r.samples(); ++i) {
     const double t = r.t[static_cast<std::size_t>(i)];
@@ -164,8 +164,8 @@ TEST(Rolling, ABallOnATurntableCirclesAtTwoSeventhsOfItsRate) {
   const Model mod = study_model(turntable(W));
   const SimulationResult r = study_simulate(mod, study_simulation(mod));
   ASSERT_TRUE(r.completed) << r.failure;
-  const int ipx = column(r.output_names, "px"), ipy = column(r.output_names, "py");
-  const int ivx = column(r.output_names, "vx"), ivy = column(r.output_names, "vy");
+  const int ipx = rolling_column(r.output_names, "px"), ipy = rolling_column(r.output_names, "py");
+  const int ivx = rolling_column(r.output_names, "vx"), ivy = rolling_column(r.output_names, "vy");
   // the spin-up's impulse: the centre gains kappa W z x r0 = (0, kappa W 0.1)
   const Eigen::Vector2d r0(r.y(0, ipx), r.y(0, ipy)), v0(r.y(0, ivx), r.y(0, ivy));
   EXPECT_NEAR(r0.x(), 0.1, 1e-12);
@@ -360,7 +360,7 @@ TEST(Rolling, APdOnAPushedBallMatchesItsLinearClosedLoop) {
   const SimulationResult r = study_simulate(mod, setup);
   ASSERT_TRUE(r.completed) << r.failure;
   ASSERT_EQ(r.y_linear.rows(), r.samples());
-  const int ix = column(r.output_names, "X"), iy = column(r.output_names, "Y");
+  const int ix = rolling_column(r.output_names, "X"), iy = rolling_column(r.output_names, "Y");
   EXPECT_NEAR(r.y(0, ix), 0.1, 1e-12);
   EXPECT_NEAR(r.y(0, iy), -0.05, 1e-12);
   double worst = 0;

@@ -31,14 +31,14 @@ std::string temp_dir() {
   return d.string();
 }
 
-std::string write_text(const std::string& name, const std::string& text) {
+std::string write_signal_text(const std::string& name, const std::string& text) {
   const std::string path = temp_dir() + "/" + name;
   std::ofstream(path, std::ios::binary) << text;
   return path;
 }
 
 // named double matrices in a MAT v5 file, written by matio directly
-std::string write_mat(const std::string& name, const std::vector<std::pair<std::string, Eigen::MatrixXd>>& vars,
+std::string write_signal_mat(const std::string& name, const std::vector<std::pair<std::string, Eigen::MatrixXd>>& vars,
                       mat_ft version = MAT_FT_MAT5) {
   const std::string path = temp_dir() + "/" + name;
   std::filesystem::remove(path);
@@ -54,7 +54,7 @@ std::string write_mat(const std::string& name, const std::vector<std::pair<std::
 }
 
 // the message of read_signal_file's error
-std::string error_of(const std::string& path) {
+std::string signal_error_of(const std::string& path) {
   try {
     read_signal_file(path);
   } catch (const std::invalid_argument& e) {
@@ -68,14 +68,14 @@ const std::vector<std::pair<double, double>> kPoints{{0.0, 0.0}, {1.0, 0.0}, {3.
 }  // namespace
 
 TEST(SignalFile, CsvAndMatGiveTheSamePoints) {
-  const std::string csv = write_text("ref.csv", "t,value\r\n0,0\r\n1,0\r\n\r\n3,0.2\r\n4, 0.1\r\n");
+  const std::string csv = write_signal_text("ref.csv", "t,value\r\n0,0\r\n1,0\r\n\r\n3,0.2\r\n4, 0.1\r\n");
   EXPECT_EQ(read_signal_file(csv), kPoints);
   Eigen::MatrixXd t(4, 1), v(1, 4);  // a column and a row: both vectors
   t << 0, 1, 3, 4;
   v << 0, 0, 0.2, 0.1;
-  const std::string mat = write_mat("ref.mat", {{"t", t}, {"value", v}});
+  const std::string mat = write_signal_mat("ref.mat", {{"t", t}, {"value", v}});
   EXPECT_EQ(read_signal_file(mat), kPoints);
-  const std::string mat73 = write_mat("ref73.mat", {{"t", t}, {"value", v}}, MAT_FT_MAT73);
+  const std::string mat73 = write_signal_mat("ref73.mat", {{"t", t}, {"value", v}}, MAT_FT_MAT73);
   EXPECT_EQ(read_signal_file(mat73), kPoints);
 }
 
@@ -95,33 +95,33 @@ TEST(SignalFile, TableIsInterpolatedLinearlyAndHeld) {
 
 TEST(SignalFile, BadFilesNameTheFileColumnAndWhatWasExpected) {
   const auto expect = [](const std::string& path, const std::string& part) {
-    const std::string e = error_of(path);
+    const std::string e = signal_error_of(path);
     EXPECT_EQ(e.rfind(path + ": ", 0), 0u) << e;  // starts with the file
     EXPECT_NE(e.find(part), std::string::npos) << e;
   };
   expect(temp_dir() + "/missing.csv", "no such file");
-  expect(write_text("empty.csv", ""), "empty: expected a header line (t,value)");
-  expect(write_text("noheader.csv", "0,1\n1,2\n"), "line 1: expected a header of two column names (t,value) before the numbers");
-  expect(write_text("onlyheader.csv", "time,force\n"), "no rows after the header (time,force)");
-  expect(write_text("word.csv", "time,force\n0,1\n1,abc\n"), "row 2 (line 3), column force: expected a number, got \"abc\"");
-  expect(write_text("three.csv", "time,force\n0,1,2\n"), "row 1 (line 2): expected two numbers separated by a comma (time,force)");
-  expect(write_text("back.csv", "time,force\n0,1\n2,1\n1,1\n"), "row 3 (line 4), column time: the time 1 is not after the previous one (2)");
-  expect(write_text("inf.csv", "time,force\n0,1\n1,inf\n"), "row 2 (line 3), column force: the value is not a finite number");
+  expect(write_signal_text("empty.csv", ""), "empty: expected a header line (t,value)");
+  expect(write_signal_text("noheader.csv", "0,1\n1,2\n"), "line 1: expected a header of two column names (t,value) before the numbers");
+  expect(write_signal_text("onlyheader.csv", "time,force\n"), "no rows after the header (time,force)");
+  expect(write_signal_text("word.csv", "time,force\n0,1\n1,abc\n"), "row 2 (line 3), column force: expected a number, got \"abc\"");
+  expect(write_signal_text("three.csv", "time,force\n0,1,2\n"), "row 1 (line 2): expected two numbers separated by a comma (time,force)");
+  expect(write_signal_text("back.csv", "time,force\n0,1\n2,1\n1,1\n"), "row 3 (line 4), column time: the time 1 is not after the previous one (2)");
+  expect(write_signal_text("inf.csv", "time,force\n0,1\n1,inf\n"), "row 2 (line 3), column force: the value is not a finite number");
   Eigen::MatrixXd t(3, 1), v(3, 1), w(2, 1), M(2, 2);
   t << 0, 1, 2;
   v << 1, 2, 3;
   w << 1, 2;
   M << 1, 2, 3, 4;
-  expect(write_mat("novalue.mat", {{"t", t}, {"y", v}}), "no variable value: a signal .mat holds the vectors t and value");
-  expect(write_mat("short.mat", {{"t", t}, {"value", w}}), "t has 3 entries but value has 2: expected one value per time");
-  expect(write_mat("matrix.mat", {{"t", M}, {"value", v}}), "variable t is 2 x 2: expected a vector");
+  expect(write_signal_mat("novalue.mat", {{"t", t}, {"y", v}}), "no variable value: a signal .mat holds the vectors t and value");
+  expect(write_signal_mat("short.mat", {{"t", t}, {"value", w}}), "t has 3 entries but value has 2: expected one value per time");
+  expect(write_signal_mat("matrix.mat", {{"t", M}, {"value", v}}), "variable t is 2 x 2: expected a vector");
   Eigen::MatrixXd tb = t;
   tb(2) = 0.5;
-  expect(write_mat("back.mat", {{"t", tb}, {"value", v}}), "variable t, row 3: the time 0.5 is not after the previous one (1)");
+  expect(write_signal_mat("back.mat", {{"t", tb}, {"value", v}}), "variable t, row 3: the time 0.5 is not after the previous one (1)");
   Eigen::MatrixXd vn = v;
   vn(1) = std::nan("");
-  expect(write_mat("nan.mat", {{"t", t}, {"value", vn}}), "variable value, row 2: not a finite number");
-  expect(write_text("garbage.mat", "not a mat file"), "");
+  expect(write_signal_mat("nan.mat", {{"t", t}, {"value", vn}}), "variable value, row 2: not a finite number");
+  expect(write_signal_text("garbage.mat", "not a mat file"), "");
 }
 
 namespace {
@@ -149,7 +149,7 @@ ModelSpec slider_pi(const std::string& reference_file) {
 // the exact response of the linear closed loop to the piecewise-linear r(t), computed segment by
 // segment with the matrix exponential of [[Acl, Bcl, 0], [0, 0, 1], [0, 0, 0]] (r' constant on each)
 TEST(SignalFile, ReferenceFromAFileIsFollowed) {
-  write_text("ref_follow.csv", "t,pos\n0,0\n1,0\n3,0.2\n4,0.1\n");
+  write_signal_text("ref_follow.csv", "t,pos\n0,0\n1,0\n3,0.2\n4,0.1\n");
   const Model m = study_model(slider_pi("ref_follow.csv"), temp_dir() + "/slider.json");
   const StudyClosedLoop cl = study_closed_loop(m);
   const LinearSystem& s = cl.loop.system;
@@ -195,7 +195,7 @@ TEST(SignalFile, ReferenceFromAFileIsFollowed) {
 }
 
 TEST(SignalFile, BadReferenceFileIsAnErrorAtTheField) {
-  write_text("ref_bad.csv", "t,pos\n0,0\n1,x\n");
+  write_signal_text("ref_bad.csv", "t,pos\n0,0\n1,x\n");
   const Model m = study_model(slider_pi("ref_bad.csv"), temp_dir() + "/slider.json");
   try {
     study_simulation(m);
@@ -211,7 +211,7 @@ TEST(SignalFile, BadReferenceFileIsAnErrorAtTheField) {
 // takes the file's values (interpolated) at every sample, and the run is identical to the run
 // with the table written in the model; a bad file is an error at the disturbance's field
 TEST(SignalFile, DisturbanceFromAFile) {
-  write_text("push.csv", "t,push\n0,0\n2,0\n2.5,1\n4,-0.5\n");
+  write_signal_text("push.csv", "t,push\n0,0\n2,0\n2.5,1\n4,-0.5\n");
   auto spec_with = [](const std::string& disturbance) {
     ModelSpec spec = slider_pi("ref_follow.csv");
     ActuatorSpec push;
@@ -227,7 +227,7 @@ TEST(SignalFile, DisturbanceFromAFile) {
     spec.analysis.disturbances = parse_model_spec_text(text, "d.json").analysis.disturbances;
     return spec;
   };
-  write_text("ref_follow.csv", "t,pos\n0,0\n1,0\n3,0.2\n4,0.1\n");
+  write_signal_text("ref_follow.csv", "t,pos\n0,0\n1,0\n3,0.2\n4,0.1\n");
   const std::string dir = temp_dir() + "/slider.json";
   const Model from_file = study_model(spec_with(R"({"actuator": "push", "type": "file", "file": "push.csv"})"), dir);
   const Model from_table =
@@ -247,7 +247,7 @@ TEST(SignalFile, DisturbanceFromAFile) {
                 .cwiseAbs()
                 .maxCoeff(),
             1e-3);  // the push does move the block
-  write_text("push_bad.csv", "t,push\n0,0\n0,1\n");
+  write_signal_text("push_bad.csv", "t,push\n0,0\n0,1\n");
   try {
     study_simulation(study_model(spec_with(R"({"actuator": "push", "type": "file", "file": "push_bad.csv"})"), dir));
     FAIL() << "no error";

@@ -14,10 +14,10 @@
 namespace codyna {
 namespace {
 
-constexpr double g = 9.81;
+constexpr double g_sim = 9.81;
 constexpr double deg = M_PI / 180;
 
-SimulationOptions options(const std::string& method, double t_end, double rtol = 1e-8, double atol = 1e-10) {
+SimulationOptions sim_options(const std::string& method, double t_end, double rtol = 1e-8, double atol = 1e-10) {
   SimulationOptions o;
   o.integrator.method = method;
   o.integrator.rtol = rtol;
@@ -40,11 +40,11 @@ TEST(Simulate, PaperPendulumHeldUprightByPd) {
   ASSERT_NEAR(m.q0[0], 80 * deg, 1e-12);
   const LinearPlant p = plant_at_equilibrium(m);
   // closed loop s^2 + 0.075 Kd s + 0.075 Kp - 3g/4: wn = 3 rad/s, zeta = 0.8
-  const double Kp = (9 + 3 * g / 4) / 0.075, Kd = 4.8 / 0.075;
+  const double Kp = (9 + 3 * g_sim / 4) / 0.075, Kd = 4.8 / 0.075;
   const auto pd = make_pid(Eigen::MatrixXd::Constant(1, 1, Kp), Eigen::MatrixXd(), Eigen::MatrixXd::Constant(1, 1, Kd),
                            Eigen::VectorXd::Constant(1, M_PI / 2), Eigen::VectorXd::Zero(1));
   for (const char* method : {"ida", "cvode-bdf"}) {
-    const SimulationResult r = simulate(m, pd.get(), &p, options(method, 5.0));
+    const SimulationResult r = simulate(m, pd.get(), &p, sim_options(method, 5.0));
     ASSERT_TRUE(r.completed) << r.failure;
     EXPECT_NEAR(r.y(r.samples() - 1, 0), M_PI / 2, 0.5 * deg) << method;
     // settled: after 3 s (five time constants of 1/(zeta wn)) it stays within 0.5 degree
@@ -59,11 +59,11 @@ TEST(Simulate, PaperPendulumHeldUprightByPd) {
 TEST(Simulate, PaperPendulumHeldUprightByDiscreteController) {
   const Model m = test::load_example("pendulum.json");
   const LinearPlant p = plant_at_equilibrium(m);
-  const double Kp = (9 + 3 * g / 4) / 0.075, Kd = 4.8 / 0.075, Ts = 0.005;
+  const double Kp = (9 + 3 * g_sim / 4) / 0.075, Kd = 4.8 / 0.075, Ts = 0.005;
   // xc[k+1] = e[k]; u = -Kp e - Kd (e - xc) / Ts, e = y - y0
   const auto c = make_lti(Eigen::MatrixXd::Zero(1, 1), Eigen::MatrixXd::Ones(1, 1), Eigen::MatrixXd::Constant(1, 1, Kd / Ts),
                           Eigen::MatrixXd::Constant(1, 1, -(Kp + Kd / Ts)), Ts, p.lin.system.y0, p.lin.system.u0);
-  SimulationOptions o = options("ida", 4.0);
+  SimulationOptions o = sim_options("ida", 4.0);
   const SimulationResult r = simulate(m, c.get(), &p, o);
   ASSERT_TRUE(r.completed) << r.failure;
   EXPECT_NEAR(r.y(r.samples() - 1, 0), M_PI / 2, 0.5 * deg);
@@ -75,12 +75,12 @@ TEST(Simulate, PaperPendulumHeldUprightByDiscreteController) {
 // every integrator against the fixed-step reference on a passive double pendulum
 TEST(Simulate, IntegratorsAgreeWithTheReference) {
   const Model m = test::load_example("double_pendulum.json");
-  SimulationOptions ref = options("rk4", 2.0);
+  SimulationOptions ref = sim_options("rk4", 2.0);
   ref.integrator.max_step = 1e-4;
   const SimulationResult r0 = simulate(m, nullptr, nullptr, ref);
   ASSERT_TRUE(r0.completed);
   for (const char* method : {"ida", "cvode-bdf", "cvode-adams", "arkode"}) {
-    const SimulationResult r = simulate(m, nullptr, nullptr, options(method, 2.0, 1e-10, 1e-12));
+    const SimulationResult r = simulate(m, nullptr, nullptr, sim_options(method, 2.0, 1e-10, 1e-12));
     ASSERT_TRUE(r.completed) << method << ": " << r.failure;
     ASSERT_EQ(r.samples(), r0.samples());
     EXPECT_LT((r.q - r0.q).cwiseAbs().maxCoeff(), 1e-7) << method;
@@ -108,8 +108,8 @@ TEST(Simulate, PendulumPeriodMatchesEllipticIntegral) {
     }
     K = M_PI / (2 * x);
   }
-  const double T = 4 * std::sqrt(2 * l / (3 * g)) * K;
-  SimulationOptions o = options("ida", 1.5 * T, 1e-10, 1e-12);
+  const double T = 4 * std::sqrt(2 * l / (3 * g_sim)) * K;
+  SimulationOptions o = sim_options("ida", 1.5 * T, 1e-10, 1e-12);
   o.output_step = 1e-3;
   const SimulationResult r = simulate(m, nullptr, nullptr, o);
   ASSERT_TRUE(r.completed);
@@ -128,7 +128,7 @@ TEST(Simulate, ConstraintDriftStaysBelowToleranceOnLoops) {
   for (const char* name : {"four_bar.json", "bricard.json"}) {
     const Model m = test::load_example(name);
     for (const char* method : {"ida", "cvode-bdf"}) {
-      const SimulationResult r = simulate(m, nullptr, nullptr, options(method, 3.0));
+      const SimulationResult r = simulate(m, nullptr, nullptr, sim_options(method, 3.0));
       ASSERT_TRUE(r.completed) << name << " " << method << ": " << r.failure;
       const double drift = *std::max_element(r.constraint_violation.begin(), r.constraint_violation.end());
       EXPECT_LT(drift, 1e-8) << name << " " << method;
@@ -142,7 +142,7 @@ TEST(Simulate, ConstraintDriftStaysBelowToleranceOnLoops) {
 
 TEST(Simulate, AndrewsSqueezerMatchesTheTestSetReference) {
   const Model m = test::load_example("andrews_squeezer.json");
-  SimulationOptions o = options("ida", 0.03, 1e-10, 1e-10);
+  SimulationOptions o = sim_options("ida", 0.03, 1e-10, 1e-10);
   o.output_step = 1e-3;
   const SimulationResult r = simulate(m, nullptr, nullptr, o);
   ASSERT_TRUE(r.completed) << r.failure;
@@ -165,11 +165,11 @@ TEST(Simulate, AndrewsSqueezerMatchesTheTestSetReference) {
 TEST(Simulate, LinearAndNonlinearAgreeForSmallOffsets) {
   const Model m = test::load_example("pendulum.json");
   const LinearPlant p = plant_at_equilibrium(m);
-  const double Kp = (9 + 3 * g / 4) / 0.075, Kd = 4.8 / 0.075;
+  const double Kp = (9 + 3 * g_sim / 4) / 0.075, Kd = 4.8 / 0.075;
   const auto pd = make_pid(Eigen::MatrixXd::Constant(1, 1, Kp), Eigen::MatrixXd(), Eigen::MatrixXd::Constant(1, 1, Kd),
                            Eigen::VectorXd::Constant(1, M_PI / 2), Eigen::VectorXd::Zero(1));
   auto divergence = [&](double offset) {
-    SimulationOptions o = options("ida", 3.0);
+    SimulationOptions o = sim_options("ida", 3.0);
     o.compare_linear = true;
     o.q0 = Eigen::VectorXd::Constant(1, M_PI / 2 - offset);
     o.v0 = Eigen::VectorXd::Zero(1);
@@ -194,7 +194,7 @@ TEST(Simulate, CancelKeepsThePartialResult) {
     EXPECT_EQ(s.q.size(), m.nq);
   };
   cb.cancel = &cancel;
-  const SimulationResult r = simulate(m, nullptr, nullptr, options("ida", 5.0), cb);
+  const SimulationResult r = simulate(m, nullptr, nullptr, sim_options("ida", 5.0), cb);
   EXPECT_TRUE(r.cancelled);
   EXPECT_FALSE(r.completed);
   EXPECT_EQ(r.samples(), 50);
@@ -208,7 +208,7 @@ TEST(Simulate, SolverFailureIsReportedWithTimeAndReason) {
   // at the first output time past the divergence bound, naming the coordinate
   const auto bad = make_pid(Eigen::MatrixXd::Constant(1, 1, -1e9), Eigen::MatrixXd(), Eigen::MatrixXd(),
                             Eigen::VectorXd::Constant(1, M_PI / 2), Eigen::VectorXd::Zero(1));
-  SimulationOptions o = options("rk4", 5.0);
+  SimulationOptions o = sim_options("rk4", 5.0);
   o.integrator.max_step = 0.01;
   const SimulationResult r = simulate(m, bad.get(), &p, o);
   EXPECT_FALSE(r.completed);
@@ -221,7 +221,7 @@ TEST(Simulate, SolverFailureIsReportedWithTimeAndReason) {
 TEST(Simulate, UnknownIntegratorIsAClearError) {
   const Model m = test::load_example("pendulum.json");
   try {
-    simulate(m, nullptr, nullptr, options("euler", 1.0));
+    simulate(m, nullptr, nullptr, sim_options("euler", 1.0));
     FAIL();
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("unknown integrator \"euler\""), std::string::npos);
@@ -248,7 +248,7 @@ TEST(Simulate, PaperCartPendulumHeldUprightByLqr) {
   const LqrResult d = lqr(s.A, s.B, qw.asDiagonal(), Eigen::MatrixXd::Constant(1, 1, 0.01));
   const auto c = make_state_feedback(d.K, s.u0);
   for (const char* method : {"ida", "cvode-bdf", "arkode"}) {
-    const SimulationResult r = simulate(m, c.get(), &p, options(method, 8.0));
+    const SimulationResult r = simulate(m, c.get(), &p, sim_options(method, 8.0));
     ASSERT_TRUE(r.completed) << method << ": " << r.failure;
     for (int i = 0; i < r.samples(); ++i)
       if (r.t[i] >= 5.0) {
@@ -265,7 +265,7 @@ TEST(Simulate, AbsentEffectsAreNeverEvaluated) {
   const Model m = test::load_example("pendulum.json");
   ASSERT_TRUE(m.springs.empty() && m.joint_springs.empty() && m.joint_frictions.empty() && m.body_forces.empty());
   effect_counters() = {};
-  const SimulationResult r = simulate(m, nullptr, nullptr, options("cvode-bdf", 0.5));
+  const SimulationResult r = simulate(m, nullptr, nullptr, sim_options("cvode-bdf", 0.5));
   ASSERT_TRUE(r.completed);
   EXPECT_EQ(effect_counters().springs, 0);
   EXPECT_EQ(effect_counters().joint_springs, 0);
@@ -275,7 +275,7 @@ TEST(Simulate, AbsentEffectsAreNeverEvaluated) {
   // and a declared spring is: the four-bar's crank spring, once per evaluation
   const Model fb = test::load_example("four_bar.json");
   effect_counters() = {};
-  const SimulationResult r2 = simulate(fb, nullptr, nullptr, options("cvode-bdf", 0.2));
+  const SimulationResult r2 = simulate(fb, nullptr, nullptr, sim_options("cvode-bdf", 0.2));
   ASSERT_TRUE(r2.completed);
   EXPECT_GT(effect_counters().joint_springs, r2.stats.rhs_evals / 2);
   EXPECT_EQ(effect_counters().springs, 0);
@@ -295,10 +295,10 @@ TEST(Simulate, ActuatorLimitsSaturateTheCommand) {
   s.actuators[0].max = 20.0;
   const Model m = compile(s);
   const LinearPlant p = plant_at_equilibrium(m);
-  const double Kp = (9 + 3 * g / 4) / 0.075, Kd = 4.8 / 0.075;
+  const double Kp = (9 + 3 * g_sim / 4) / 0.075, Kd = 4.8 / 0.075;
   const auto pd = make_pid(Eigen::MatrixXd::Constant(1, 1, Kp), Eigen::MatrixXd(), Eigen::MatrixXd::Constant(1, 1, Kd),
                            Eigen::VectorXd::Constant(1, M_PI / 2), Eigen::VectorXd::Zero(1));
-  const SimulationResult r = simulate(m, pd.get(), &p, options("ida", 6.0));
+  const SimulationResult r = simulate(m, pd.get(), &p, sim_options("ida", 6.0));
   ASSERT_TRUE(r.completed) << r.failure;
   EXPECT_DOUBLE_EQ(r.u(0, 0), 20.0);                 // clamped at the start (unclamped: 38.07)
   EXPECT_LE(r.u.cwiseAbs().maxCoeff(), 20.0 + 1e-12);
@@ -321,7 +321,7 @@ TEST(Simulate, SaturationThatBindsIsReported) {
   // a stiff P gain from the 10 degree offset asks for far more than 20 N m at first
   const auto pd = make_pid(Eigen::MatrixXd::Constant(1, 1, 500), Eigen::MatrixXd(), Eigen::MatrixXd::Constant(1, 1, 100),
                            p.lin.system.y0, p.lin.system.u0);
-  const SimulationResult r = simulate(m, pd.get(), &p, options("ida", 3.0));
+  const SimulationResult r = simulate(m, pd.get(), &p, sim_options("ida", 3.0));
   ASSERT_TRUE(r.completed) << r.failure;
   EXPECT_LE(r.u.col(0).maxCoeff(), 20.0 + 1e-12);
   const auto sat = saturation_report(m, r);

@@ -19,7 +19,7 @@ using namespace codyna::test;
 
 namespace {
 
-ModelSpec example(const std::string& name) { return load_model_spec(example_path(name)); }
+ModelSpec steady_example(const std::string& name) { return load_model_spec(example_path(name)); }
 
 double coordinate(const Model& m, const Eigen::VectorXd& q, const std::string& name) {
   for (std::size_t i = 0; i < m.q_names.size(); ++i)
@@ -28,7 +28,7 @@ double coordinate(const Model& m, const Eigen::VectorXd& q, const std::string& n
   return 0;
 }
 
-std::string error_of(const Model& m) {
+std::string steady_error_of(const Model& m) {
   try {
     study_operating_point(m);
   } catch (const std::exception& e) {
@@ -39,7 +39,7 @@ std::string error_of(const Model& m) {
 
 // the potential energy of the four-bar assembled with its crank at theta
 double four_bar_potential(double theta) {
-  ModelSpec spec = example("four_bar.json");
+  ModelSpec spec = steady_example("four_bar.json");
   spec.analysis.set = {{"pivot_A", theta}};
   const Model m = study_model(spec);
   Data d(m);
@@ -52,7 +52,7 @@ double four_bar_potential(double theta) {
 // the loop closes; the torque equals dV/dtheta along the loop (central differences of the
 // potential energy of assembled configurations).
 TEST(SteadyState, FourBarEquilibriumHoldsTheSetCrankWithAFreeInput) {
-  ModelSpec spec = example("four_bar.json");
+  ModelSpec spec = steady_example("four_bar.json");
   spec.analysis.set = {{"pivot_A", 1.3}};
   spec.analysis.operating_point = "equilibrium";
   spec.analysis.free_inputs = {"crank_torque"};
@@ -74,7 +74,7 @@ TEST(SteadyState, FourBarEquilibriumHoldsTheSetCrankWithAFreeInput) {
 // The equilibrium found (joint_C = pi/2, residual ~1e-15) is checked by a second method: a small
 // nonlinear oscillation about it has the period 2 pi / w of the linearization's A.
 TEST(SteadyState, BricardEquilibriumThroughSingularTrialSteps) {
-  ModelSpec spec = example("bricard.json");
+  ModelSpec spec = steady_example("bricard.json");
   spec.analysis.operating_point = "equilibrium";
   const Model m = study_model(spec);
   const StudyLinearization l = study_linearize(m);
@@ -109,10 +109,10 @@ TEST(SteadyState, BricardEquilibriumThroughSingularTrialSteps) {
 }
 
 TEST(SteadyState, HeldCoordinateWithoutAFreeInputIsRefused) {
-  ModelSpec spec = example("four_bar.json");
+  ModelSpec spec = steady_example("four_bar.json");
   spec.analysis.set = {{"pivot_A", 1.3}};
   spec.analysis.operating_point = "equilibrium";
-  const std::string e = error_of(study_model(spec));
+  const std::string e = steady_error_of(study_model(spec));
   EXPECT_NE(e.find("not found"), std::string::npos) << e;
   EXPECT_NE(e.find("held: pivot_A"), std::string::npos) << e;
 }
@@ -121,7 +121,7 @@ TEST(SteadyState, HeldCoordinateWithoutAFreeInputIsRefused) {
 // torque, the elbow free. The second link hangs vertically (elbow = -0.5) and the torque carries
 // both links: g (m1 l1/2 + m2 l1) sin(0.5).
 TEST(SteadyState, DoublePendulumTrimWithTheElbowFree) {
-  ModelSpec spec = example("double_pendulum.json");
+  ModelSpec spec = steady_example("double_pendulum.json");
   spec.analysis.set = {{"shoulder", 0.5}, {"elbow", 0.2}};
   spec.analysis.operating_point = "trim";
   spec.analysis.trim_free = {"elbow"};
@@ -136,7 +136,7 @@ TEST(SteadyState, DoublePendulumTrimWithTheElbowFree) {
 // An output target with the input free: the pendulum brought to theta = 0.3 by the torque that
 // holds it there, m g (l/2... here the com at 1 m) cos(0.3); the coordinate is solved, not set.
 TEST(SteadyState, OutputTargetReachedWithAFreeInput) {
-  ModelSpec spec = example("pendulum.json");
+  ModelSpec spec = steady_example("pendulum.json");
   spec.analysis.operating_point = "equilibrium";
   spec.analysis.free_inputs = {"torque"};
   spec.analysis.output_targets = {{"theta", 0.3}};
@@ -148,13 +148,13 @@ TEST(SteadyState, OutputTargetReachedWithAFreeInput) {
 
 // The limit binds: the torque is held at its max and the error names it with what was needed.
 TEST(SteadyState, BindingLimitIsNamedWithTheValueNeeded) {
-  ModelSpec spec = example("pendulum.json");
+  ModelSpec spec = steady_example("pendulum.json");
   spec.analysis.operating_point = "equilibrium";
   spec.analysis.free_inputs = {"torque"};
   spec.analysis.output_targets = {{"theta", 0.3}};
   spec.actuators[0].max = 50;
   spec.actuators[0].min = -50;
-  const std::string e = error_of(study_model(spec));
+  const std::string e = steady_error_of(study_model(spec));
   EXPECT_NE(e.find("torque at its max 50"), std::string::npos) << e;
   EXPECT_NE(e.find("it would need 93.7"), std::string::npos) << e;
   EXPECT_NE(e.find("/analysis/operating_point"), std::string::npos) << e;
@@ -163,7 +163,7 @@ TEST(SteadyState, BindingLimitIsNamedWithTheValueNeeded) {
 // Two inputs, one limited: the limited one stops at its limit and the other carries the rest,
 // so a steady state is still found within the limits.
 TEST(SteadyState, ALimitedInputLeavesTheRestToAnother) {
-  ModelSpec spec = example("pendulum.json");
+  ModelSpec spec = steady_example("pendulum.json");
   ActuatorSpec second = spec.actuators[0];
   second.name = "torque2";
   spec.actuators.push_back(second);
@@ -187,13 +187,13 @@ TEST(SteadyState, ALimitedInputLeavesTheRestToAnother) {
 
 // Names are checked where they enter.
 TEST(SteadyState, UnknownNamesAreRefusedWithTheList) {
-  ModelSpec spec = example("pendulum.json");
+  ModelSpec spec = steady_example("pendulum.json");
   spec.analysis.operating_point = "equilibrium";
   spec.analysis.free_inputs = {"motor"};
-  std::string e = error_of(study_model(spec));
+  std::string e = steady_error_of(study_model(spec));
   EXPECT_NE(e.find("\"motor\" is not in Plant/In (torque)"), std::string::npos) << e;
   spec.analysis.free_inputs = {"torque"};
   spec.analysis.output_targets = {{"tip_z", 1.0}};
-  e = error_of(study_model(spec));
+  e = steady_error_of(study_model(spec));
   EXPECT_NE(e.find("\"tip_z\" is not in Plant/Out (theta)"), std::string::npos) << e;
 }

@@ -12,7 +12,7 @@
 namespace codyna {
 namespace {
 
-constexpr double g = 9.81;
+constexpr double g_step = 9.81;
 
 IntegratorSettings settings(const std::string& method) {
   IntegratorSettings s;
@@ -47,7 +47,7 @@ TEST(Stepper, LoopClosedOutsideMatchesDiscreteControllerInSimulate) {
   LinearPlant p;
   p.op = static_equilibrium(m, initial_point(m));
   p.lin = linearize(m, p.op);
-  const double Kp = (9 + 3 * g / 4) / 0.075, Kd = 4.8 / 0.075, Ts = 0.005, y0 = M_PI / 2;
+  const double Kp = (9 + 3 * g_step / 4) / 0.075, Kd = 4.8 / 0.075, Ts = 0.005, y0 = M_PI / 2;
   const auto c = make_lti(Eigen::MatrixXd::Zero(1, 1), Eigen::MatrixXd::Ones(1, 1), Eigen::MatrixXd::Constant(1, 1, Kd / Ts),
                           Eigen::MatrixXd::Constant(1, 1, -(Kp + Kd / Ts)), Ts, p.lin.system.y0, p.lin.system.u0);
   SimulationOptions o;

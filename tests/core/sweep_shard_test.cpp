@@ -43,7 +43,7 @@ class SlurmArray {
   std::optional<std::string> saved_[3];
 };
 
-std::string refusal(const std::string& text, OptionStyle style) {
+std::string shard_refusal(const std::string& text, OptionStyle style) {
   try {
     const SweepShard s = study_parse_shard(text, style);
     return "accepted " + std::to_string(s.index) + "/" + std::to_string(s.count);
@@ -67,8 +67,8 @@ TEST(SweepShard, KOfNIsReadAndCheckedWithTheCommandsMessage) {
   expect_shard("999999999999999998/999999999999999999", 999999999999999998LL, 999999999999999999LL);
   for (const std::string bad : {"2/2", "-1/2", "1/0", "1 /2", " 1/2", "+1/2", "0/2/3", "a/b", "/2", "1/", "", "1", "0x1/2",
                                 "1/1e3", "1234567890123456789/1234567890123456790"})
-    EXPECT_EQ(refusal(bad, OptionStyle::Flag), "--shard " + bad + ": expected K/N with 0 <= K < N, or slurm");
-  EXPECT_EQ(refusal("2/2", OptionStyle::Keyword),
+    EXPECT_EQ(shard_refusal(bad, OptionStyle::Flag), "--shard " + bad + ": expected K/N with 0 <= K < N, or slurm");
+  EXPECT_EQ(shard_refusal("2/2", OptionStyle::Keyword),
             "shard: expected (K, N), \"K/N\" or \"slurm\" with N >= 1 and 0 <= K < N (K counts from 0, as codyna sweep "
             "--shard K/N), got '2/2'");
   // the (K, N) check alone, as the Python module's tuple is checked
@@ -100,41 +100,41 @@ TEST(SweepShard, SlurmIsTheArrayTasksIdFromItsMinOfItsCount) {
 TEST(SweepShard, SlurmOutsideAnArrayOrWithBadValuesIsRefusedNamingTheVariables) {
   {
     const SlurmArray none(std::nullopt, std::nullopt, std::nullopt);
-    EXPECT_EQ(refusal("slurm", OptionStyle::Flag),  // the command's message before the move, byte for byte
+    EXPECT_EQ(shard_refusal("slurm", OptionStyle::Flag),  // the command's message before the move, byte for byte
               "--shard slurm: SLURM_ARRAY_TASK_ID and SLURM_ARRAY_TASK_COUNT are not set (not in a Slurm job array)");
-    EXPECT_EQ(refusal("slurm", OptionStyle::Keyword),
+    EXPECT_EQ(shard_refusal("slurm", OptionStyle::Keyword),
               "shard='slurm': SLURM_ARRAY_TASK_ID and SLURM_ARRAY_TASK_COUNT are not set (not in a Slurm job array)");
   }
   {
     const SlurmArray task("1", std::nullopt, "0");
-    EXPECT_EQ(refusal("slurm", OptionStyle::Flag), "--shard slurm: SLURM_ARRAY_TASK_COUNT is not set (not in a Slurm job array)");
+    EXPECT_EQ(shard_refusal("slurm", OptionStyle::Flag), "--shard slurm: SLURM_ARRAY_TASK_COUNT is not set (not in a Slurm job array)");
   }
   {
     const SlurmArray task(std::nullopt, "2", std::nullopt);
-    EXPECT_EQ(refusal("slurm", OptionStyle::Flag), "--shard slurm: SLURM_ARRAY_TASK_ID is not set (not in a Slurm job array)");
+    EXPECT_EQ(shard_refusal("slurm", OptionStyle::Flag), "--shard slurm: SLURM_ARRAY_TASK_ID is not set (not in a Slurm job array)");
   }
   {
     const SlurmArray task("x1", "2", std::nullopt);
-    EXPECT_EQ(refusal("slurm", OptionStyle::Flag), "--shard slurm: SLURM_ARRAY_TASK_ID=x1: expected a whole number (0 or more)");
+    EXPECT_EQ(shard_refusal("slurm", OptionStyle::Flag), "--shard slurm: SLURM_ARRAY_TASK_ID=x1: expected a whole number (0 or more)");
   }
   {
     const SlurmArray task("1", "", std::nullopt);
-    EXPECT_EQ(refusal("slurm", OptionStyle::Keyword), "shard='slurm': SLURM_ARRAY_TASK_COUNT=: expected a whole number (0 or more)");
+    EXPECT_EQ(shard_refusal("slurm", OptionStyle::Keyword), "shard='slurm': SLURM_ARRAY_TASK_COUNT=: expected a whole number (0 or more)");
   }
   {
     const SlurmArray task("1", "2", "-1");
-    EXPECT_EQ(refusal("slurm", OptionStyle::Flag), "--shard slurm: SLURM_ARRAY_TASK_MIN=-1: expected a whole number (0 or more)");
+    EXPECT_EQ(shard_refusal("slurm", OptionStyle::Flag), "--shard slurm: SLURM_ARRAY_TASK_MIN=-1: expected a whole number (0 or more)");
   }
   {
     // --array=0-15:4 (a step): IDs 0, 4, 8, 12 of COUNT 4 are no set of shards
     const SlurmArray task("12", "4", "0");
-    EXPECT_EQ(refusal("slurm", OptionStyle::Flag),
+    EXPECT_EQ(shard_refusal("slurm", OptionStyle::Flag),
               "--shard slurm: SLURM_ARRAY_TASK_ID=12 - SLURM_ARRAY_TASK_MIN=0 is not a shard of SLURM_ARRAY_TASK_COUNT=4: "
               "expected 0 <= ID - MIN < COUNT (an array of consecutive tasks, e.g. --array=0-15, with no step or gaps)");
   }
   {
     const SlurmArray task("0", "0", std::nullopt);
-    EXPECT_EQ(refusal("slurm", OptionStyle::Flag),
+    EXPECT_EQ(shard_refusal("slurm", OptionStyle::Flag),
               "--shard slurm: SLURM_ARRAY_TASK_ID=0 is not a shard of SLURM_ARRAY_TASK_COUNT=0: expected 0 <= ID < COUNT "
               "(an array of consecutive tasks, e.g. --array=0-15, with no step or gaps)");
   }

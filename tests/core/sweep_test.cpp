@@ -28,14 +28,14 @@ namespace fs = std::filesystem;
 
 const std::string kModel = std::string(CODYNA_EXAMPLES_DIR) + "/cart_pendulum.json";
 
-class TempDir {
+class SweepTempDir {
  public:
-  TempDir() {
+  SweepTempDir() {
     std::string pattern = (fs::temp_directory_path() / "codyna_sweep_XXXXXX").string();
     if (!::mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
     path_ = pattern;
   }
-  ~TempDir() {
+  ~SweepTempDir() {
     std::error_code ec;
     fs::remove_all(path_, ec);
   }
@@ -45,7 +45,7 @@ class TempDir {
   std::string path_;
 };
 
-std::string slurp(const std::string& path) {
+std::string slurp_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
@@ -64,7 +64,7 @@ LinearSystem linearized_with_rod_mass(double mass) {
   return study_linearize_job(r, study_parse_model(j, kModel)).linearization.lin.system;
 }
 
-Eigen::VectorXcd sorted(Eigen::VectorXcd p) {
+Eigen::VectorXcd sorted_strings(Eigen::VectorXcd p) {
   std::sort(p.data(), p.data() + p.size(), [](const std::complex<double>& a, const std::complex<double>& b) {
     return a.real() < b.real() || (a.real() == b.real() && a.imag() < b.imag());
   });
@@ -102,19 +102,19 @@ TEST(Sweep, FixedLqrClosedLoopPolesAreEigOfEachVariantsOwnLinearization) {
     const LinearSystem own = linearized_with_rod_mass(mass);
     EXPECT_LE((v.A - own.A).norm(), 1e-12 * own.A.norm()) << "variant " << i;
     EXPECT_LE((v.B - own.B).norm(), 1e-12 * own.B.norm()) << "variant " << i;
-    const Eigen::VectorXcd expected = sorted((own.A - own.B * K).eigenvalues());
+    const Eigen::VectorXcd expected = sorted_strings((own.A - own.B * K).eigenvalues());
     ASSERT_EQ(v.closed_poles.size(), 4);
     EXPECT_LE((v.closed_poles - expected).cwiseAbs().maxCoeff(), 1e-10) << "variant " << i;
     EXPECT_NEAR(v.closed_max_real, expected.real().maxCoeff(), 1e-10);
     EXPECT_TRUE(v.stable);
-    const Eigen::VectorXcd open = sorted(own.A.eigenvalues());
+    const Eigen::VectorXcd open = sorted_strings(own.A.eigenvalues());
     EXPECT_LE((v.open_poles - open).cwiseAbs().maxCoeff(), 1e-10);
     EXPECT_GT(v.open_max_real, 0);  // upright: unstable without the controller
     EXPECT_EQ(v.uncontrollable, 0);
     // with K designed again the poles are not those of the fixed K (except at the nominal mass)
     if (i != 5) {
       const Eigen::MatrixXd Ki = study_lqr(own.A, own.B, Q, R).K;
-      spread = std::max(spread, (sorted((own.A - own.B * Ki).eigenvalues()) - expected).cwiseAbs().maxCoeff());
+      spread = std::max(spread, (sorted_strings((own.A - own.B * Ki).eigenvalues()) - expected).cwiseAbs().maxCoeff());
     }
   }
   EXPECT_GT(spread, 1e-3);  // so the test above can tell a fixed K from a redesigned one
@@ -171,12 +171,12 @@ TEST(Sweep, RedesignedLqrIsDesignedOnEachVariant) {
     const LinearSystem own = linearized_with_rod_mass(i == 0 ? 6 : 14);
     const Eigen::MatrixXd K = study_lqr(own.A, own.B, Q, R).K;
     EXPECT_LE((v.K - K).norm(), 1e-9 * K.norm());
-    EXPECT_LE((v.closed_poles - sorted((own.A - own.B * K).eigenvalues())).cwiseAbs().maxCoeff(), 1e-10);
+    EXPECT_LE((v.closed_poles - sorted_strings((own.A - own.B * K).eigenvalues())).cwiseAbs().maxCoeff(), 1e-10);
   }
 }
 
 TEST(Sweep, MonteCarloIsTheSameFileTwiceAndOnOneOrTwoThreads) {
-  TempDir dir;
+  SweepTempDir dir;
   SweepRequest r;
   r.model = kModel;
   r.vary = {"/bodies/1/mass=normal(10,2)", "/bodies/0/mass=uniform(15,25)"};
@@ -191,10 +191,10 @@ TEST(Sweep, MonteCarloIsTheSameFileTwiceAndOnOneOrTwoThreads) {
   };
   const SweepJob a = run(1, "a"), b = run(1, "b"), c = run(2, "c");
   ASSERT_EQ(a.variants.size(), 200u);
-  EXPECT_EQ(slurp(dir.file("a.h5")), slurp(dir.file("b.h5")));
-  EXPECT_EQ(slurp(dir.file("a.h5")), slurp(dir.file("c.h5")));
-  EXPECT_EQ(slurp(dir.file("a.csv")), slurp(dir.file("c.csv")));
-  EXPECT_GT(slurp(dir.file("a.h5")).size(), 200u * 16u * 8u);  // the A stack is there
+  EXPECT_EQ(slurp_file(dir.file("a.h5")), slurp_file(dir.file("b.h5")));
+  EXPECT_EQ(slurp_file(dir.file("a.h5")), slurp_file(dir.file("c.h5")));
+  EXPECT_EQ(slurp_file(dir.file("a.csv")), slurp_file(dir.file("c.csv")));
+  EXPECT_GT(slurp_file(dir.file("a.h5")).size(), 200u * 16u * 8u);  // the A stack is there
   double mean = 0, lo = 1e300, hi = -1e300;
   for (std::size_t i = 0; i < 200; ++i) {
     ASSERT_EQ(a.variants[i].values, c.variants[i].values);
@@ -290,7 +290,7 @@ TEST(Sweep, SimulateRunsEachVariantWithTheNominalGain) {
 }
 
 TEST(Sweep, AnInterruptedStudyResumesToTheSameFile) {
-  TempDir dir;
+  SweepTempDir dir;
   SweepRequest r;
   r.model = kModel;
   r.vary = {"/bodies/1/mass=normal(10,2)", "/bodies/0/mass=uniform(15,25)"};
@@ -328,15 +328,15 @@ TEST(Sweep, AnInterruptedStudyResumesToTheSameFile) {
   const SweepJob resumed = study_sweep_job(r, [&](const StudyMessage& m) { notes.push_back(m.text); });
   EXPECT_GE(resumed.resumed, 50);
   EXPECT_LT(resumed.resumed, 120);
-  EXPECT_EQ(slurp(dir.file("cut.h5")), slurp(dir.file("whole.h5")));
-  EXPECT_EQ(slurp(dir.file("cut.csv")), slurp(dir.file("whole.csv")));
+  EXPECT_EQ(slurp_file(dir.file("cut.h5")), slurp_file(dir.file("whole.h5")));
+  EXPECT_EQ(slurp_file(dir.file("cut.csv")), slurp_file(dir.file("whole.csv")));
   EXPECT_FALSE(fs::exists(study_sweep_journal_path(r.out)));
   ASSERT_FALSE(notes.empty());
   EXPECT_NE(notes.back().find("resuming: "), std::string::npos) << notes.back();
 }
 
 TEST(Sweep, ShardsMergeIntoTheWholeStudysFile) {
-  TempDir dir;
+  SweepTempDir dir;
   SweepRequest r;
   r.model = kModel;
   r.vary = {"/bodies/1/mass=normal(10,3)", "/bodies/0/mass=uniform(10,30)"};
@@ -372,8 +372,8 @@ TEST(Sweep, ShardsMergeIntoTheWholeStudysFile) {
   EXPECT_FALSE(fs::exists(outputs.out));
   const SweepJob merged = study_sweep_merge({shards[2], shards[0], shards[1]}, outputs);
   EXPECT_EQ(merged.resumed, 101);
-  EXPECT_EQ(slurp(outputs.out), slurp(r.out));
-  EXPECT_EQ(slurp(outputs.csv), slurp(r.csv));
+  EXPECT_EQ(slurp_file(outputs.out), slurp_file(r.out));
+  EXPECT_EQ(slurp_file(outputs.csv), slurp_file(r.csv));
   EXPECT_FALSE(fs::exists(study_sweep_journal_path(outputs.out)));
   // a shard of another study is refused
   SweepRequest other = r;
@@ -391,7 +391,7 @@ TEST(Sweep, ShardsMergeIntoTheWholeStudysFile) {
 // MPI's path without MPI: three slices with their journals in memory (no file written, the whole
 // study's outputs named), joined by study_sweep_merge_journals into the single run's bytes
 TEST(Sweep, JournalsInMemoryMergeIntoTheWholeStudysFile) {
-  TempDir dir;
+  SweepTempDir dir;
   SweepRequest r;
   r.model = kModel;
   r.vary = {"/bodies/1/mass=5:15:7"};
@@ -424,8 +424,8 @@ TEST(Sweep, JournalsInMemoryMergeIntoTheWholeStudysFile) {
   }
   const SweepJob merged = study_sweep_merge_journals({journals[2], journals[0], journals[1]}, {"rank 2", "rank 0", "rank 1"}, slice);
   EXPECT_EQ(merged.resumed, 7);
-  EXPECT_EQ(slurp(slice.out), slurp(r.out));
-  EXPECT_EQ(slurp(slice.csv), slurp(r.csv));
+  EXPECT_EQ(slurp_file(slice.out), slurp_file(r.out));
+  EXPECT_EQ(slurp_file(slice.csv), slurp_file(r.csv));
   ASSERT_EQ(merged.variants[3].overshoot.size(), 2);  // the figures went through the journal
   EXPECT_TRUE(std::isfinite(merged.variants[3].overshoot[0]));
   EXPECT_NEAR(merged.variants[3].settling_time[0], 4.713, 1e-3);  // h settles within the file's 5 s
@@ -439,7 +439,7 @@ TEST(Sweep, JournalsInMemoryMergeIntoTheWholeStudysFile) {
 // a shard's file is its journal, appended to as variants finish; finished, it is written again in the
 // variants' order, so two threads give the bytes one gives (and a Slurm task the bytes of K/N)
 TEST(Sweep, AShardsFileIsTheSameBytesWhateverTheThreads) {
-  TempDir dir;
+  SweepTempDir dir;
   SweepRequest r;
   r.model = kModel;
   r.vary = {"/bodies/1/mass=5:15:40"};
@@ -452,14 +452,14 @@ TEST(Sweep, AShardsFileIsTheSameBytesWhateverTheThreads) {
     r.threads = 2;
     r.out = dir.file("two_" + std::to_string(run) + ".sweep");
     study_sweep_job(r);
-    EXPECT_EQ(slurp(r.out), slurp(dir.file("one.sweep"))) << "run " << run;
+    EXPECT_EQ(slurp_file(r.out), slurp_file(dir.file("one.sweep"))) << "run " << run;
   }
 }
 
 // the journal's lines are written without a JSON library; each must be the line nlohmann::json dumps
-// for the object it holds (sorted keys, no spaces, strings escaped), and read back bit for bit
+// for the object it holds (sorted_strings keys, no spaces, strings escaped), and read back bit for bit
 TEST(Sweep, JournalLinesAreWhatAJsonLibraryWrites) {
-  TempDir dir;
+  SweepTempDir dir;
   SweepRequest r;
   r.model = kModel;
   r.vary = {"/bodies/1/mass=[-1, 0, 12]"};  // -1: a failed variant with its reason; 0: an uncontrollable mode
@@ -497,7 +497,7 @@ TEST(Sweep, JournalLinesAreWhatAJsonLibraryWrites) {
   }
 }
 
-void expect_refused(const std::vector<std::string>& vary, const std::vector<std::string>& words,
+void expect_sweep_refused(const std::vector<std::string>& vary, const std::vector<std::string>& words,
                     std::optional<long long> samples = {}, std::optional<std::uint64_t> seed = {}) {
   SweepRequest r;
   r.model = kModel;
@@ -513,23 +513,23 @@ void expect_refused(const std::vector<std::string>& vary, const std::vector<std:
 }
 
 TEST(Sweep, BadVaryIsNamed) {
-  expect_refused({"/bodies/7/mass=1:2:3"}, {"--vary", "/bodies/7/mass", "has 2 entries"});
-  expect_refused({"/bodies/1/weight=1:2:3"}, {"--vary", "no field /bodies/1/weight", "mass"});
-  expect_refused({"/bodies/1/name=1:2:3"}, {"--vary", "not a number"});
-  expect_refused({"/bodies/1/com=1:2:3"}, {"--vary", "not a number", "/bodies/1/com/0"});
-  expect_refused({"bodies/1/mass=1:2:3"}, {"--vary", "JSON pointer"});
-  expect_refused({"/bodies/1/mass"}, {"--vary", "FIELD=SPEC"});
-  expect_refused({"/bodies/1/mass=5:15"}, {"--vary", "a:b:n"});
-  expect_refused({"/bodies/1/mass=5:15:2.5"}, {"--vary", "whole number"});
-  expect_refused({"/bodies/1/mass=[1,\"a\"]"}, {"--vary", "not a number"});
-  expect_refused({"/bodies/1/mass=gauss(1,2)"}, {"--vary", "normal(mu,sigma)"});
-  expect_refused({"/bodies/1/mass=normal(1,-2)"}, {"--vary", "sigma >= 0"});
-  expect_refused({"/bodies/1/mass=uniform(3,2)"}, {"--vary", "a < b"});
-  expect_refused({"/bodies/1/mass=1:2:3", "/bodies/0/mass=normal(20,1)"}, {"--vary", "cannot be mixed"});
-  expect_refused({"/bodies/1/mass=normal(10,1)"}, {"--samples"}, {}, 1);
-  expect_refused({"/bodies/1/mass=normal(10,1)"}, {"--seed"}, 10, {});
-  expect_refused({"/bodies/1/mass=1:2:3"}, {"--samples"}, 10, {});
-  expect_refused({"/bodies/1/mass=1:2:3", "/bodies/1/mass=[4]"}, {"--vary", "twice"});
+  expect_sweep_refused({"/bodies/7/mass=1:2:3"}, {"--vary", "/bodies/7/mass", "has 2 entries"});
+  expect_sweep_refused({"/bodies/1/weight=1:2:3"}, {"--vary", "no field /bodies/1/weight", "mass"});
+  expect_sweep_refused({"/bodies/1/name=1:2:3"}, {"--vary", "not a number"});
+  expect_sweep_refused({"/bodies/1/com=1:2:3"}, {"--vary", "not a number", "/bodies/1/com/0"});
+  expect_sweep_refused({"bodies/1/mass=1:2:3"}, {"--vary", "JSON pointer"});
+  expect_sweep_refused({"/bodies/1/mass"}, {"--vary", "FIELD=SPEC"});
+  expect_sweep_refused({"/bodies/1/mass=5:15"}, {"--vary", "a:b:n"});
+  expect_sweep_refused({"/bodies/1/mass=5:15:2.5"}, {"--vary", "whole number"});
+  expect_sweep_refused({"/bodies/1/mass=[1,\"a\"]"}, {"--vary", "not a number"});
+  expect_sweep_refused({"/bodies/1/mass=gauss(1,2)"}, {"--vary", "normal(mu,sigma)"});
+  expect_sweep_refused({"/bodies/1/mass=normal(1,-2)"}, {"--vary", "sigma >= 0"});
+  expect_sweep_refused({"/bodies/1/mass=uniform(3,2)"}, {"--vary", "a < b"});
+  expect_sweep_refused({"/bodies/1/mass=1:2:3", "/bodies/0/mass=normal(20,1)"}, {"--vary", "cannot be mixed"});
+  expect_sweep_refused({"/bodies/1/mass=normal(10,1)"}, {"--samples"}, {}, 1);
+  expect_sweep_refused({"/bodies/1/mass=normal(10,1)"}, {"--seed"}, 10, {});
+  expect_sweep_refused({"/bodies/1/mass=1:2:3"}, {"--samples"}, 10, {});
+  expect_sweep_refused({"/bodies/1/mass=1:2:3", "/bodies/1/mass=[4]"}, {"--vary", "twice"});
 }
 
 TEST(Sweep, TheOutputNeverReplacesTheModel) {
