@@ -7,10 +7,13 @@ name in an anonymous namespace (or `static`) then meet: an identical signature i
 a compile error, but a different one is an overload, and a call in one file can
 silently resolve to the other file's helper (a `number(double)` beside a
 `number(std::complex<double>)`), computing something else without a word.
-Types and constants of one name in two files stop the compiler (a redefinition);
-functions may not. This check reads the sources (the project's layout: a
-namespace's contents start at column 0) and lists every internal-linkage
-function name defined in more than one file of the same target.
+Types and constants of one name in two files stop the compiler (a redefinition)
+when the two land in one batch, which depends on the batch size and the files'
+order; functions may not stop it at all. This check reads the sources (the
+project's layout: a namespace's contents start at column 0) and lists every
+internal-linkage function, type and constant name defined in more than one file
+of the same target (aliases may repeat: `using cd = std::complex<double>;` twice
+is legal, and a different one stops the compiler whatever the batches).
 
 usage: unity_names.py LIST_FILE...   (one file per target: its sources separated by ';')
 exit 1 with each clash named (the name and the files), 0 when none.
@@ -27,7 +30,7 @@ FUNC_RE = re.compile(r"^(?:static\s+)?(?:inline\s+)?(?:constexpr\s+)?(?:[\w:]+(?
 
 
 def internal_names(path):
-    """Functions defined at namespace level inside `namespace {` or with `static`."""
+    """Functions, types and constants defined at namespace level inside `namespace {` or with `static`."""
     names = set()
     anon_depth = 0  # anonymous namespaces open at this point
     stack = []      # for each open namespace: is it anonymous
@@ -59,7 +62,17 @@ def internal_names(path):
                 continue
             pending_template = False
             # a type, an alias or a constant first: their lines can look like a call
-            if TYPE_RE.match(line) or ALIAS_RE.match(line) or VAR_RE.match(line):
+            if ALIAS_RE.match(line):
+                continue
+            m = TYPE_RE.match(line)
+            if m:
+                names.add(m.group(1))
+                continue
+            m = VAR_RE.match(line)
+            if m:
+                # every name of `constexpr double a = 1, b = 2;`
+                names.update(re.findall(r"(?:^|,)\s*(?:[\w:<>\s\*&]*\s)?(\w+)\s*(?==|\{)", line.split(";")[0].split("=", 1)[0] + "=")
+                             + re.findall(r",\s*(\w+)\s*=", line))
                 continue
             m = FUNC_RE.match(line)
             if m and m.group(1) not in KEYWORDS:

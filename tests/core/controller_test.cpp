@@ -21,7 +21,7 @@ using namespace codyna::test;
 
 namespace {
 
-constexpr double kCartMass = 2, kK = 3, kC = 0.5, kUmax = 4;
+constexpr double kCartMass = 2, kCartSpring = 3, kCartDamping = 0.5, kUmax = 4;
 
 ModelSpec saturating_pi(const std::string& anti_windup, double tracking_time = 0) {
   const std::string text = R"({"name": "slider",
@@ -44,8 +44,8 @@ ModelSpec saturating_pi(const std::string& anti_windup, double tracking_time = 0
 
 // y(t) of m y'' + c y' + k y = F from rest
 double constant_force_response(double F, double t) {
-  const double s = kC / (2 * kCartMass), wd = std::sqrt(kK / kCartMass - s * s);
-  return F / kK * (1 - std::exp(-s * t) * (std::cos(wd * t) + s / wd * std::sin(wd * t)));
+  const double s = kCartDamping / (2 * kCartMass), wd = std::sqrt(kCartSpring / kCartMass - s * s);
+  return F / kCartSpring * (1 - std::exp(-s * t) * (std::cos(wd * t) + s / wd * std::sin(wd * t)));
 }
 
 struct AwRun {
@@ -119,7 +119,7 @@ TEST(PidAntiWindup, SaturatingPiOvershootsOnlyWithoutAntiWindup) {
   for (const AwRun* x : {&none, &back, &cond}) {
     const int N = x->r.samples();
     EXPECT_NEAR(x->r.y(N - 1, 0), 1.0, 1e-3);
-    EXPECT_NEAR(x->r.u(N - 1, 0), kK * x->r.y(N - 1, 0), 1e-3);
+    EXPECT_NEAR(x->r.u(N - 1, 0), kCartSpring * x->r.y(N - 1, 0), 1e-3);
   }
 }
 

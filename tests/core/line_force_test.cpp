@@ -20,7 +20,7 @@ namespace {
 
 using test::MatrixNear;
 
-constexpr double kGrav = 9.81, kM = 3.0, kL = 0.8, kIc = 0.05, kA = 0.5, kH = 0.3, kU0 = 40.0;
+constexpr double kGrav = 9.81, kBarM = 3.0, kL = 0.8, kIc = 0.05, kA = 0.5, kH = 0.3, kU0 = 40.0;
 
 // rod: pivot at the origin (revolute z), centre of mass at kL along its x; the cylinder from the
 // ground point (0, -kH) to the rod point at kA along its x
@@ -39,7 +39,7 @@ std::string lifted_rod(double theta0, double omega0, const std::string& method =
                  "body_b": "rod", "point_b": [%.17g, 0, 0]}],
     "plant": {"inputs": ["cylinder"], "outputs": ["stroke", "stroke_rate"]},
     "analysis": {"operating_point": "initial", "method": "%s"}})",
-                kM, kL, kIc, kIc, theta0, omega0, -kH, kA, kU0, -kH, kA, -kH, kA, method.c_str());
+                kBarM, kL, kIc, kIc, theta0, omega0, -kH, kA, kU0, -kH, kA, -kH, kA, method.c_str());
   return text;
 }
 
@@ -48,15 +48,15 @@ TEST(LineForce, LiftedRodMatchesTheClosedForm) {
   const Model m = study_model(study_parse_model_text(lifted_rod(th, 0.0), "lifted_rod.json"));
   const LinearSystem& s = study_linearize(m).system;
   // I th'' = -m g l cos(th) + u a h cos(th) / L(th),  L = sqrt(a^2 + h^2 + 2 a h sin(th))
-  const double I = kIc + kM * kL * kL;
+  const double I = kIc + kBarM * kL * kL;
   const double L = std::sqrt(kA * kA + kH * kH + 2 * kA * kH * std::sin(th));
   const double dL = kA * kH * std::cos(th) / L;  // dL/dth
   const double d_cos_over_L = (-std::sin(th) * L - std::cos(th) * dL) / (L * L);
   Eigen::MatrixXd A(2, 2), B(2, 1), C(2, 2), xdot(2, 1);
-  A << 0, 1, (kM * kGrav * kL * std::sin(th) + kU0 * kA * kH * d_cos_over_L) / I, 0;
+  A << 0, 1, (kBarM * kGrav * kL * std::sin(th) + kU0 * kA * kH * d_cos_over_L) / I, 0;
   B << 0, kA * kH * std::cos(th) / (L * I);
   C << dL, 0, 0, dL;  // the stroke and its rate dL/dth th'
-  xdot << 0, (-kM * kGrav * kL * std::cos(th) + kU0 * kA * kH * std::cos(th) / L) / I;
+  xdot << 0, (-kBarM * kGrav * kL * std::cos(th) + kU0 * kA * kH * std::cos(th) / L) / I;
   EXPECT_TRUE(MatrixNear(s.A, A, 1e-12));
   EXPECT_TRUE(MatrixNear(s.B, B, 1e-12));
   EXPECT_TRUE(MatrixNear(s.C, C, 1e-12));

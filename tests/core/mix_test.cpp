@@ -20,7 +20,7 @@ namespace {
 
 using test::MatrixNear;
 
-constexpr double kMix = 2.0, kL = 0.6, kIc = 0.04, kJetAt = 0.9;
+constexpr double kMix = 2.0, kMixL = 0.6, kMixIc = 0.04, kJetAt = 0.9;
 
 // a pendulum (revolute z) driven by a motor (gain 1) and a jet at kJetAt along the rod pushing along
 // the rod's y (gain 2; in body or world axes), and a mix of both (weights 0.5, 3)
@@ -39,7 +39,7 @@ std::string driven_pendulum(const std::string& inputs, const char* jet_frame, do
     "sensors": [{"name": "angle", "type": "joint_position", "joint": "pivot"}],
     "plant": {"inputs": %s, "outputs": ["angle"]},
     "analysis": {"operating_point": "initial", "method": "%s"}})",
-                kMix, kL, kIc, kIc, theta0, omega0, kJetAt, jet_frame, mix_u0, inputs.c_str(), method);
+                kMix, kMixL, kMixIc, kMixIc, theta0, omega0, kJetAt, jet_frame, mix_u0, inputs.c_str(), method);
   return text;
 }
 
@@ -60,7 +60,7 @@ TEST(Mix, EqualsTheActuatorsMixedByHand) {
 TEST(Mix, PendulumDrivenByAMotorAndAJetMatchesTheClosedForm) {
   const LinearSystem s = mix_linearized(driven_pendulum(R"(["mix"])", "body", 0.3, 0.0, 0.0));
   // a unit of the mix: 0.5 N m from the motor and 3 * 2 N along the rod's y at kJetAt
-  const double I = kIc + kMix * kL * kL;
+  const double I = kMixIc + kMix * kMixL * kMixL;
   EXPECT_NEAR(s.B(1, 0), (0.5 + 6 * kJetAt) / I, 1e-14);
   // with the mix at u0 = 1.5 the pendulum accelerates by that much more
   const LinearSystem pushed = mix_linearized(driven_pendulum(R"(["mix"])", "body", 0.3, 0.0, 1.5));

@@ -35,7 +35,7 @@ namespace {
 
 using cd = std::complex<double>;
 
-constexpr double m = 0.111, R = 0.015, J = 9.99e-6, g = 9.8;
+constexpr double m = 0.111, R = 0.015, J = 9.99e-6, g_ball = 9.8;
 constexpr double mass_eff = m + J / (R * R);
 
 ModelSpec plate() { return study_read_model(test::example_path("ball_plate.json")); }
@@ -83,7 +83,7 @@ TEST(Rolling, EachAxisOfTheBallAndPlateIsTheBallAndBeam) {
     const cd z(0, w);
     const Eigen::MatrixXcd M = z * Eigen::MatrixXcd::Identity(n, n) - s.A.cast<cd>();
     const Eigen::MatrixXcd G = s.C.cast<cd>() * M.partialPivLu().solve(s.B.cast<cd>()) + s.D.cast<cd>();
-    const cd xy = (m * g - (J / R) * z * z) / (mass_eff * z * z);
+    const cd xy = (m * g_ball - (J / R) * z * z) / (mass_eff * z * z);
     worst = std::max({worst, std::abs(G(0, 1) - xy) / std::abs(xy), std::abs(G(1, 0) + xy) / std::abs(xy)});
     cross = std::max({cross, std::abs(G(0, 0)), std::abs(G(1, 1))});
   }
@@ -113,7 +113,7 @@ TEST(Rolling, ABallReleasedOnATiltedPlateFollowsTheClosedForm) {
   double worst_x = 0, worst_y = 0, worst_phi = 0, worst_slip = 0;
   for (int i = 0; i < r.samples(); ++i) {
     const double t = r.t[static_cast<std::size_t>(i)];
-    worst_x = std::max(worst_x, std::abs(r.y(i, ix) - (X0 + m * g * std::sin(b) * t * t / (2 * mass_eff))));
+    worst_x = std::max(worst_x, std::abs(r.y(i, ix) - (X0 + m * g_ball * std::sin(b) * t * t / (2 * mass_eff))));
     worst_y = std::max(worst_y, std::abs(r.y(i, iy) - Y0));
     worst_phi = std::max(worst_phi, r.constraint_violation[static_cast<std::size_t>(i)]);
     worst_slip = std::max(worst_slip, r.velocity_violation[static_cast<std::size_t>(i)]);
