@@ -34,7 +34,6 @@ def internal_names(path):
     names = set()
     anon_depth = 0  # anonymous namespaces open at this point
     stack = []      # for each open namespace: is it anonymous
-    pending_template = False
     with open(path, encoding="utf-8", errors="replace") as f:
         for raw in f:
             line = raw.rstrip("\n")
@@ -52,15 +51,11 @@ def internal_names(path):
                 stack.append(anonymous)
                 anon_depth += anonymous
                 continue
-            if line.startswith("template"):
-                pending_template = not line.rstrip().endswith((";", "}"))
-                if pending_template:
-                    continue
-            is_static = line.startswith("static ")
-            if anon_depth == 0 and not is_static:
-                pending_template = False
+            # `template <...>` on a line of its own: the declaration follows on the next
+            if line.startswith("template") and not line.rstrip().endswith((";", "}")):
                 continue
-            pending_template = False
+            if anon_depth == 0 and not line.startswith("static "):
+                continue
             # a type, an alias or a constant first: their lines can look like a call
             if ALIAS_RE.match(line):
                 continue
@@ -70,9 +65,9 @@ def internal_names(path):
                 continue
             m = VAR_RE.match(line)
             if m:
-                # every name of `constexpr double a = 1, b = 2;`
-                names.update(re.findall(r"(?:^|,)\s*(?:[\w:<>\s\*&]*\s)?(\w+)\s*(?==|\{)", line.split(";")[0].split("=", 1)[0] + "=")
-                             + re.findall(r",\s*(\w+)\s*=", line))
+                # and the further names of `constexpr double a = 1, b = 2;`
+                names.add(m.group(1))
+                names.update(re.findall(r",\s*(\w+)\s*=", line.split(";")[0]))
                 continue
             m = FUNC_RE.match(line)
             if m and m.group(1) not in KEYWORDS:
