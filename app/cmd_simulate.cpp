@@ -276,7 +276,7 @@ void add_simulate(CLI::App& app) {
   cmd->add_option("--divergence-bound", a->divergence_bound, "end the run when a state entry grows past this")->capture_default_str();
   add_plant_flags(cmd, a->plant);
   a->cmd = cmd;
-  cmd->callback([a, cmd] {
+  cmd->callback([a] {
     set_exit_code(run_guarded([&] { run_simulate(*a); }));
   });
 }

@@ -350,7 +350,7 @@ void MainWindow::buildMenus() {
   });
 
   QMenu* help = menuBar()->addMenu(tr("&Help"));
-  QAction* a_docs = help->addAction(tr("codyna &documentation"), this, [this] {
+  QAction* a_docs = help->addAction(tr("codyna &documentation"), this, [] {
     QDesktopServices::openUrl(documentationUrl());
   });
   a_docs->setShortcut(QKeySequence::HelpContents);

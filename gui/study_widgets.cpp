@@ -263,7 +263,7 @@ void SignalTable::addRow(const SignalSpec& s) {
     changed();
   });
   for (QDoubleSpinBox* sp : {time, val, freq, phase}) connect(sp, &QDoubleSpinBox::valueChanged, this, stepped);
-  connect(data, &QLineEdit::editingFinished, this, [this, data, changed] {
+  connect(data, &QLineEdit::editingFinished, this, [data, changed] {
     if (data->isModified()) {
       data->setModified(false);
       changed();

@@ -12,6 +12,7 @@ set -euo pipefail
 
 CLI_PKGS=(
   build-essential cmake pkg-config
+  clang  # the compiler scripts/build.sh uses for new trees (half GCC's compile time, the same results)
   ninja-build  # the build tool scripts/build.sh uses (it falls back to make without it)
   libeigen3-dev libsundials-dev libhdf5-dev libmatio-dev
   nlohmann-json3-dev libcli11-dev
@@ -25,7 +26,7 @@ ALL_PKGS=(
   octave octave-control  # the exports run in GNU Octave (tests, docs; the demo too when installed)
   libmujoco-samples  # MuJoCo's own MJCF models (/usr/share/mujoco/model): imported by the peer and CLI tests
   libsimbody-dev  # the Simbody peer of the work-precision study (bench/simbody_*.cpp, peer.simbody_agrees)
-  clang libclang-rt-14-dev  # the libFuzzer target (scripts/fuzz.sh): clang 14 with its fuzzer/sanitizer runtimes
+  libclang-rt-14-dev  # clang 14's fuzzer and sanitizer runtimes (scripts/sanitize.sh, scripts/fuzz.sh)
   liboctave-dev  # codyna_plant.mex, the plant stepped from Octave (app/mex)
   python3 python3-scipy python3-h5py python3-numpy
   python3-matplotlib  # scripts/plot_work_precision.py (work-precision plots, Agg backend)

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds the core library, the CLI, the core tests and the loader's fuzz target
 # with clang, AddressSanitizer + UndefinedBehaviorSanitizer (+ libFuzzer's
-# coverage, CODYNA_FUZZ) into build-asan/ (-O1, assertions on), and runs the
+# coverage of the core, CODYNA_FUZZ) into build-asan/ (-O2, assertions on), and runs the
 # core GoogleTest suite and the CLI shell tests there (ctest -L "core|cli"),
 # then every offscreen GUI test program (tests/gui/*_test.cpp: they drive the
 # widgets as a person does; the monkey test with 5 seeds x 4000 random events).
@@ -21,22 +21,24 @@ build=build-asan
 if [ -f "$build/CMakeCache.txt" ] && ! grep -q '^CODYNA_FUZZ:BOOL=ON' "$build/CMakeCache.txt"; then
   rm -rf "$build"
 fi
-# -O1 -g0 and no -DNDEBUG: faster to build, and Eigen's size assertions stay
-# on (they found an autodiff bug that an NDEBUG build could not see)
+# -O2 -g0 and no -DNDEBUG: Eigen's size assertions stay on (they found an
+# autodiff bug that an NDEBUG build could not see). -O2 rather than -O1: at -O1
+# clang leaves Eigen's small fixed-size products as calls, each access checked
+# (docs/performance.md, "Build time")
 # a new tree is made with Ninja when it is installed (an existing one keeps its generator)
 generator=()
 if [ ! -f "$build/CMakeCache.txt" ] && command -v ninja > /dev/null; then generator=(-G Ninja); fi
 CC=clang CXX=clang++ cmake -S . -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCODYNA_FUZZ=ON \
-  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g0" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g0" \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g0" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -g0" \
   -DCODYNA_BUILD_GUI=ON -DCODYNA_BUILD_BENCH=OFF > "$build.log.tmp" 2>&1 \
   || { cat "$build.log.tmp"; rm -f "$build.log.tmp"; exit 1; }
 rm -f "$build.log.tmp"
 # Only what the selected tests run, and the fuzz target (the Octave MEX is
 # left out: an instrumented MEX cannot load into Octave).
-cmake --build "$build" -j "$jobs" --target codyna codyna_core_tests model_loader_fuzz
+# One build command for all of them: Ninja then keeps both cores busy to the end.
 gui_tests=$(cd tests/gui && ls *_test.cpp | sed 's/\.cpp$//')
 # shellcheck disable=SC2086
-cmake --build "$build" -j "$jobs" --target $gui_tests
+cmake --build "$build" -j "$jobs" --target codyna codyna_core_tests model_loader_fuzz ubsan_probe $gui_tests
 
 # LeakSanitizer is on; UBSan stops at the first finding with a stack trace.
 # Settings already in the environment are kept and take precedence.

@@ -31,22 +31,6 @@ using namespace codyna::gui;
 
 namespace {
 const QString kCart = QStringLiteral(CODYNA_EXAMPLES_DIR "/cart_pendulum.json");
-
-std::complex<double> transfer(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& C,
-                              const Eigen::MatrixXd& D, int out, int in, double w) {
-  const Eigen::Index n = A.rows();
-  const Eigen::MatrixXcd M = std::complex<double>(0, w) * Eigen::MatrixXcd::Identity(n, n) - A.cast<std::complex<double>>();
-  const Eigen::VectorXcd x = M.partialPivLu().solve(B.col(in).cast<std::complex<double>>());
-  return (C.row(out).cast<std::complex<double>>() * x)(0) + D(out, in);
-}
-
-// the angle difference a - b in degrees, brought into (-180, 180]
-double angleDiff(double a, double b) {
-  double d = std::fmod(a - b, 360.0);
-  if (d > 180) d -= 360;
-  if (d <= -180) d += 360;
-  return d;
-}
 }  // namespace
 
 class ControlViewTest : public QObject {

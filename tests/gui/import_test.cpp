@@ -177,7 +177,7 @@ class ImportTest : public QObject {
     bool closed = false;
     QTimer::singleShot(0, this, [&] {
       QDialog* dlg = nullptr;
-      QTest::qWaitFor([&] {
+      (void)QTest::qWaitFor([&] {
         dlg = qobject_cast<QDialog*>(QApplication::activeModalWidget());
         return dlg && dlg->objectName() == "importReportDialog";
       }, 10000);
