@@ -13,6 +13,7 @@ set -euo pipefail
 CLI_PKGS=(
   build-essential cmake pkg-config
   clang  # the compiler scripts/build.sh uses for new trees (half GCC's compile time, the same results)
+  libomp-dev  # OpenMP for clang: SUNDIALS' CMake package asks for it
   ninja-build  # the build tool scripts/build.sh uses (it falls back to make without it)
   libeigen3-dev libsundials-dev libhdf5-dev libmatio-dev
   nlohmann-json3-dev libcli11-dev
