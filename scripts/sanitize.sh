@@ -6,8 +6,8 @@
 # then every offscreen GUI test program (tests/gui/*_test.cpp: they drive the
 # widgets as a person does; the monkey test with 5 seeds x 4000 random events).
 # Any ASan error, leak or undefined behaviour fails the test that hit it.
-# The same build then serves scripts/fuzz.sh (CODYNA_FUZZ_BUILD=build-asan),
-# as .ci/run does. Extra arguments go to ctest (e.g. -R ModelFile).
+# The same build then serves scripts/fuzz.sh (CODYNA_FUZZ_BUILD=build-asan);
+# .ci/run has it run beside the GUI tests (CODYNA_SANITIZE_FUZZ=60). Extra arguments go to ctest (e.g. -R ModelFile).
 # CODYNA_JOBS (default 2) sets the build and test parallelism.
 # See docs/reliability.md.
 set -euo pipefail
@@ -50,7 +50,21 @@ ctest --output-on-failure -j "$jobs" -L "core|cli" "$@"
 # instrumented; what they keep until exit (fonts, the platform plugin) is
 # suppressed by name in tests/data/lsan_qt.supp, nothing of codyna's
 # (only in the full run: extra arguments select among the core and CLI tests)
+# CODYNA_SANITIZE_FUZZ=SECONDS runs scripts/fuzz.sh on this build beside them
+# (-seed=1; .ci/run): the GUI tests run one at a time, so the second core is free.
 if [ $# -eq 0 ]; then
+  fuzz_pid=
+  if [ -n "${CODYNA_SANITIZE_FUZZ:-}" ]; then
+    ( cd .. && CODYNA_FUZZ_BUILD="$build" ./scripts/fuzz.sh "$CODYNA_SANITIZE_FUZZ" -seed=1 ) > fuzz.log 2>&1 &
+    fuzz_pid=$!
+  fi
+  gui_rc=0
   LSAN_OPTIONS="suppressions=$PWD/../tests/data/lsan_qt.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}" \
-    ctest --output-on-failure -j 1 -R '^gui\.[a-z0-9_]+_test$'
+    ctest --output-on-failure -j 1 -R '^gui\.[a-z0-9_]+_test$' || gui_rc=$?
+  fuzz_rc=0
+  if [ -n "$fuzz_pid" ]; then
+    wait "$fuzz_pid" || fuzz_rc=$?
+    cat fuzz.log
+  fi
+  [ "$gui_rc" -eq 0 ] && [ "$fuzz_rc" -eq 0 ] || exit 1
 fi
