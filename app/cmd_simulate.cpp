@@ -114,7 +114,13 @@ void print_setup(const SimulateJob& job, const SimulateArgs& a) {
     for (int k : m.plant_inputs) std::cout << ", " << m.actuators[k].name << " = " << plant->op.u[k];
     std::cout << std::setprecision(6) << "\n";
   }
-  if (!m.spec.analysis.initial.empty()) {
+  if (m.spec.analysis.start == "operating-point") {
+    const std::string kind = setup.start.substr(0, setup.start.find(" + "));
+    std::cout << "start            at the " << kind << " point";
+    if (m.spec.analysis.initial.empty()) std::cout << (plant ? " (x0 of the controller's linearization)" : " (the study's operating point)");
+    else std::cout << " with the initial coordinates set: " << name_values(m.v_names, job.initial_coordinates, true, 10);
+    std::cout << std::setprecision(6) << "\n";
+  } else if (!m.spec.analysis.initial.empty()) {
     std::cout << "initial state   ";
     std::cout << " " << name_values(m.v_names, job.initial_coordinates, true, 10);
     std::cout << std::setprecision(6) << " (the study's initial state, apart from the operating point)\n";
@@ -267,7 +273,7 @@ void add_simulate(CLI::App& app) {
   cmd->add_option("--output-step", a->output_step, "output interval [s]");
   cmd->add_option("--independent", a->independent, "closed loops: independent coordinate names")->delimiter(',');
   cmd->add_option("--hold,--set", a->set, "NAME=VALUE: hold a joint coordinate (or rate, NAME_dot) in the operating-point search: set in the model's state, kept exactly by the equilibrium and trim searches, and the run's start unless --initial says otherwise (repeatable; --set is the older name)");
-  cmd->add_option("--initial", a->initial, "NAME=VALUE: the run's initial state: a joint coordinate (or rate, NAME_dot), the loops closed with it held (repeatable); the operating point is searched apart from it, from the model's state");
+  cmd->add_option("--initial", a->initial, "NAME=VALUE: the run's initial state: a joint coordinate (or rate, NAME_dot), the loops closed with it held (repeatable); the operating point is searched apart from it, from the model's state. 'operating-point': the run starts at the operating point the controller is linearized about (x0), NAME=VALUE then setting coordinates on it");
   cmd->add_option("--trim-free", a->trim_free, "trim: coordinates the trim solves instead of holding (comma-separated)")->delimiter(',');
   cmd->add_option("--free-input", a->free_inputs, "equilibrium/trim: Plant/In inputs solved for (comma-separated; trim default: all)")->delimiter(',');
   cmd->add_option("--target", a->targets, "NAME=VALUE: a Plant/Out value the equilibrium/trim must reach (repeatable)");

@@ -6,6 +6,7 @@
 
 #include "study/files.hpp"
 #include "model/errors.hpp"
+#include "study/model_issues.hpp"
 #include "study/workflow.hpp"
 
 namespace codyna::gui {
@@ -48,21 +49,21 @@ Document::Document(QObject* parent) : QObject(parent) {
 QString Document::displayName() const { return path_.isEmpty() ? QStringLiteral("untitled") : QFileInfo(path_).fileName(); }
 
 void Document::recompile() {
-  QString text, path;
-  try {
-    model_ = std::make_shared<const Model>(study_model(spec_, ss(path_)));
-  } catch (const ModelError& e) {
-    model_.reset();
-    text = qs(e.what());
-    path = qs(e.path());
-  } catch (const std::exception& e) {
-    model_.reset();
-    text = qs(e.what());
-  }
+  // the compile's own error first (errorText, errorPath), and every other problem check_model
+  // finds (issues(): all of them, in the model file's order)
+  const ModelCheck check = check_model(spec_, ss(path_));
+  model_ = check.model;
+  QList<Issue> issues;
+  for (const ModelError& e : check.issues) issues.push_back({qs(e.path()), qs(e.what()), qs(e.detail())});
+  const QString text = issues.isEmpty() ? QString() : issues[static_cast<qsizetype>(check.first)].text;
+  const QString path = issues.isEmpty() ? QString() : issues[static_cast<qsizetype>(check.first)].path;
   const bool changed = text != error_ || path != error_path_;
+  const bool issues_changed = issues != issues_;
   error_ = text;
   error_path_ = path;
+  issues_ = std::move(issues);
   emit modelChanged();
+  if (issues_changed) emit issuesChanged();
   if (changed || !text.isEmpty()) emit errorChanged(error_, error_path_);
 }
 

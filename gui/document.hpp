@@ -9,6 +9,7 @@
 #pragma once
 
 #include <QObject>
+#include <QList>
 #include <QString>
 #include <QUndoStack>
 #include <functional>
@@ -37,6 +38,15 @@ class Document : public QObject {
   // The last compile error ("" when the model compiles), and its field path ("/joints/2/parent").
   QString errorText() const { return error_; }
   QString errorPath() const { return error_path_; }
+  // Every problem of a spec that does not compile (study/model_issues.hpp), in the file's order;
+  // the error above is one of them. Empty when the model compiles.
+  struct Issue {
+    QString path;    // "/joints/2/parent" ("" when no field is to blame)
+    QString text;    // the whole message (file: path: what was expected)
+    QString detail;  // what was expected, alone
+    bool operator==(const Issue&) const = default;
+  };
+  const QList<Issue>& issues() const { return issues_; }
 
   // File operations. load() leaves the document untouched when the file does not load
   // (error set to the ModelError's text). save() writes atomically; a failed save keeps
@@ -71,6 +81,7 @@ class Document : public QObject {
   void modelChanged();                // after the compiled model was refreshed (model() may be null)
   void fileChanged();                 // path or modified state changed (window title)
   void errorChanged(const QString& text, const QString& path);
+  void issuesChanged();  // after the list of issues changed (emitted before errorChanged)
   // another model took the document's place (load, clear): every result of the old one must go
   void replaced();
 
@@ -81,6 +92,7 @@ class Document : public QObject {
   QUndoStack undo_;
   std::shared_ptr<const Model> model_;
   QString error_, error_path_;
+  QList<Issue> issues_;
 };
 
 QString qs(const std::string& s);

@@ -1,5 +1,7 @@
 #include "gui/main_window.hpp"
 
+#include "gui/issues_panel.hpp"
+
 #include <QAction>
 #include <QApplication>
 #include <QCloseEvent>
@@ -122,10 +124,20 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
   tree_->setEditTriggers(QAbstractItemView::EditKeyPressed | QAbstractItemView::DoubleClicked);
   tree_->header()->setSectionResizeMode(0, QHeaderView::ResizeToContents);
   connect(tree_model_, &QAbstractItemModel::modelReset, tree_, &QTreeView::expandAll);
+  tree_->setContextMenuPolicy(Qt::CustomContextMenu);
+  connect(tree_, &QWidget::customContextMenuRequested, this, &MainWindow::showTreeMenu);
   props_ = new PropertyEditor(doc_, this);
   auto* left = new QSplitter(Qt::Vertical, this);
   left->setObjectName("modelSplitter");
-  left->addWidget(tree_);
+  auto* tree_box = new QWidget(this);
+  auto* tree_lay = new QVBoxLayout(tree_box);
+  tree_lay->setContentsMargins(0, 0, 0, 0);
+  tree_lay->setSpacing(0);
+  add_bar_ = new QToolBar(tr("Add"), tree_box);
+  add_bar_->setObjectName("addToolbar");
+  tree_lay->addWidget(add_bar_);
+  tree_lay->addWidget(tree_, 1);
+  left->addWidget(tree_box);
   left->addWidget(props_);
   auto* left_dock = new QDockWidget(tr("Model"), this);
   left_dock->setObjectName("modelDock");
@@ -153,8 +165,23 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
   msg_dock->setObjectName("messageDock");
   msg_dock->setWidget(messages_);
   addDockWidget(Qt::BottomDockWidgetArea, msg_dock);
+  // bottom, beside the messages: every problem of the model at once
+  issues_ = new IssuesPanel(doc_, this);
+  issues_dock_ = new QDockWidget(tr("Issues"), this);
+  issues_dock_->setObjectName("issuesDock");
+  issues_dock_->setWidget(issues_);
+  addDockWidget(Qt::BottomDockWidgetArea, issues_dock_);
+  splitDockWidget(msg_dock, issues_dock_, Qt::Horizontal);
+  connect(issues_, &IssuesPanel::countChanged, this, [this](int n) {
+    issues_dock_->setWindowTitle(n == 0 ? tr("Issues") : tr("Issues (%1)").arg(n));
+  });
   resizeDocks({left_dock, in_dock}, {290, 310}, Qt::Horizontal);
   resizeDocks({msg_dock}, {90}, Qt::Vertical);
+  connect(issues_, &IssuesPanel::elementChosen, this, [this](ElementId id) { selectElement(id); });
+  connect(issues_, &IssuesPanel::otherChosen, this, [this](const QString& path) {
+    if (path.startsWith("/plant/inputs")) plant_in_->parentWidget()->raise();
+    else if (path.startsWith("/plant/outputs")) plant_out_->parentWidget()->raise();
+  });
 
   buildMenus();
   autosave_ = new Autosave(doc_, this);
@@ -176,11 +203,10 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
       if (statusBar()->currentMessage().startsWith(tr("Error:"))) statusBar()->clearMessage();
       return;
     }
+    // said, listed in the Issues panel and marked at its fields; the selection stays where the
+    // user put it (the next value typed goes where the user is looking)
+    Q_UNUSED(path);
     message(text, true);
-    if (const auto ref = element_at_path(ss(path))) {
-      selectElement(ElementId{ref->kind, ref->index});
-      props_->markField(qs(ref->field), text);
-    }
   });
   connect(doc_, &Document::specChanged, this, [this] {
     // an accepted change: an error shown for an earlier, refused one is over
@@ -289,15 +315,35 @@ void MainWindow::buildMenus() {
   a_quit->setShortcut(QKeySequence::Quit);
 
   QMenu* edit = menuBar()->addMenu(tr("&Edit"));
-  QAction* undo = doc_->undoStack()->createUndoAction(this, tr("&Undo"));
+  // Undo and Redo keep their short text (what they would undo is their tooltip and in the status
+  // bar): a menu whose width follows the last edit's name moves its items from under the pointer
+  QUndoStack* stack = doc_->undoStack();
+  QAction* undo = new QAction(tr("&Undo"), this);
+  undo->setObjectName("actionUndo");
   undo->setShortcut(QKeySequence::Undo);
-  QAction* redo = doc_->undoStack()->createRedoAction(this, tr("&Redo"));
+  undo->setEnabled(stack->canUndo());
+  connect(undo, &QAction::triggered, stack, &QUndoStack::undo);
+  connect(stack, &QUndoStack::canUndoChanged, undo, &QAction::setEnabled);
+  QAction* redo = new QAction(tr("&Redo"), this);
+  redo->setObjectName("actionRedo");
   redo->setShortcut(QKeySequence::Redo);
+  redo->setEnabled(stack->canRedo());
+  connect(redo, &QAction::triggered, stack, &QUndoStack::redo);
+  connect(stack, &QUndoStack::canRedoChanged, redo, &QAction::setEnabled);
+  auto undo_tips = [undo, redo, stack] {
+    undo->setToolTip(stack->canUndo() ? tr("Undo %1 (Ctrl+Z; inside a field Ctrl+Z undoes its text)").arg(stack->undoText()) : tr("Nothing to undo"));
+    undo->setStatusTip(undo->toolTip());
+    redo->setToolTip(stack->canRedo() ? tr("Redo %1").arg(stack->redoText()) : tr("Nothing to redo"));
+    redo->setStatusTip(redo->toolTip());
+  };
+  connect(stack, &QUndoStack::indexChanged, this, undo_tips);
+  connect(stack, &QUndoStack::cleanChanged, this, undo_tips);
+  undo_tips();
   edit->addAction(undo);
   edit->addAction(redo);
   edit->addSeparator();
   QMenu* add = edit->addMenu(tr("&Add"));
-  for (ElementKind k : kElementKinds) add->addAction(tr("Add %1").arg(to_string(k)), this, [this, k] { addElement(k); });
+  for (ElementKind k : kElementKinds) add->addAction(addElementAction(k));
   edit->addAction(tr("&Duplicate"), this, [this] { duplicateSelected(); })->setShortcut(QKeySequence(Qt::CTRL | Qt::Key_D));
   edit->addAction(tr("Re&name"), this, [this] {
     if (tree_->currentIndex().isValid()) tree_->edit(tree_->currentIndex().siblingAtColumn(0));
@@ -370,6 +416,29 @@ void MainWindow::buildMenus() {
   tb->addAction(a_export);
   tb->addAction(a_run_);
   tb->addAction(a_cancel_);
+
+  // adding, one click away above the model tree (and one key: Ctrl+Shift+B, J, L, E, U, Y)
+  add_bar_->setToolButtonStyle(Qt::ToolButtonTextOnly);
+  add_bar_->setIconSize(QSize(12, 12));
+  for (ElementKind k : kElementKinds) add_bar_->addAction(addElementAction(k));
+}
+
+// One action per kind, shared by the Edit > Add menu, the Add toolbar and the tree's context menu.
+QAction* MainWindow::addElementAction(ElementKind k) {
+  if (auto it = add_actions_.find(k); it != add_actions_.end()) return it->second;
+  static const std::map<ElementKind, std::pair<const char*, Qt::Key>> words = {
+      {ElementKind::Body, {QT_TR_NOOP("Body"), Qt::Key_B}},         {ElementKind::Joint, {QT_TR_NOOP("Joint"), Qt::Key_J}},
+      {ElementKind::Constraint, {QT_TR_NOOP("Loop closure"), Qt::Key_L}}, {ElementKind::Effect, {QT_TR_NOOP("Effect"), Qt::Key_E}},
+      {ElementKind::Actuator, {QT_TR_NOOP("Actuator"), Qt::Key_U}}, {ElementKind::Sensor, {QT_TR_NOOP("Sensor"), Qt::Key_Y}}};
+  const auto& [word, key] = words.at(k);
+  auto* a = new QAction(tr(word), this);
+  a->setObjectName(QStringLiteral("actionAdd:%1").arg(to_string(k)));
+  a->setShortcut(QKeySequence(Qt::CTRL | Qt::SHIFT | key));
+  a->setToolTip(tr("Add a %1 (%2)").arg(to_string(k), a->shortcut().toString(QKeySequence::NativeText)));
+  a->setStatusTip(a->toolTip());
+  connect(a, &QAction::triggered, this, [this, k] { addElement(k); });
+  add_actions_[k] = a;
+  return a;
 }
 
 QString MainWindow::aboutText() const {
@@ -421,8 +490,9 @@ bool MainWindow::maybeSave() {
   if (!doc_->isModified()) return true;
   const int b = ask(tr("Unsaved changes"), tr("%1 has unsaved changes. Save them?").arg(doc_->displayName()),
                     QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel);
-  if (b == QMessageBox::Cancel) return false;
+  // only Save writes the file: any other answer (the dialog closed, a button it does not know) is a no
   if (b == QMessageBox::Discard) return true;
+  if (b != QMessageBox::Save) return false;
   if (doc_->filePath().isEmpty()) {
     const QString p = chooseFile(tr("Save model as"), QString(), kFilter, true);
     return !p.isEmpty() && saveFileAs(p);
@@ -701,11 +771,108 @@ bool MainWindow::duplicateSelected() {
   return ok;
 }
 
-bool MainWindow::addElement(ElementKind k) {
+bool MainWindow::addElement(ElementKind k, const std::function<void(ModelSpec&, int)>& setup, const QString& text) {
   int made = -1;
-  const bool ok = doc_->edit(tr("Add %1").arg(to_string(k)), [&](ModelSpec& s) { made = add_element(s, k); });
+  const bool ok = doc_->edit(text.isEmpty() ? tr("Add %1").arg(to_string(k)) : text, [&](ModelSpec& s) {
+    made = add_element(s, k);
+    if (setup) setup(s, made);
+  });
   if (ok && made >= 0) selectElement(ElementId{k, made});
   return ok;
+}
+
+// The model tree's context menu: Add of the kind under the pointer (every kind on empty space), and
+// on a body or a joint the elements one attaches to it, made already attached; then Rename,
+// Duplicate and Remove of the element.
+void MainWindow::showTreeMenu(const QPoint& at) {
+  const QModelIndex index = tree_->indexAt(at);
+  const auto kind = tree_model_->kindAt(index);
+  const auto id = tree_model_->elementAt(index);
+  if (id) selectElement(*id);
+  auto* menu = new QMenu(this);
+  menu->setObjectName("treeMenu");
+  menu->setAttribute(Qt::WA_DeleteOnClose);
+  if (!kind) {
+    for (ElementKind k : kElementKinds) menu->addAction(addElementAction(k));
+  } else {
+    menu->addAction(addElementAction(*kind));
+  }
+  const ModelSpec& spec = doc_->spec();
+  auto item = [&](const QString& name, const QString& text, ElementKind k, std::function<void(ModelSpec&, int)> setup) {
+    QAction* a = menu->addAction(text);
+    a->setObjectName(name);
+    connect(a, &QAction::triggered, this, [this, k, setup, text] { addElement(k, setup, text); });
+  };
+  if (id && id->kind == ElementKind::Body && id->index < static_cast<int>(spec.bodies.size())) {
+    const std::string body = spec.bodies[id->index].name;
+    const QString b = qs(body);
+    menu->addSeparator();
+    bool moved = false;
+    for (const JointSpec& j : spec.joints) moved = moved || j.child == body;
+    if (!moved)
+      item("addJointMoving", tr("Add joint moving %1 (from ground)").arg(b), ElementKind::Joint, [body](ModelSpec& s, int k) {
+        s.joints[k].name = unique_name(s, ElementKind::Joint, body + "_joint");
+        s.joints[k].parent = kGroundName;
+        s.joints[k].child = body;
+      });
+    item("addBodyOn", tr("Add body jointed to %1").arg(b), ElementKind::Body, [body](ModelSpec& s, int k) {
+      const std::string child = s.bodies[k].name;
+      const int j = add_element(s, ElementKind::Joint);
+      s.joints[j].name = unique_name(s, ElementKind::Joint, child + "_joint");
+      s.joints[j].parent = body;
+      s.joints[j].child = child;
+    });
+    item("addSpringTo", tr("Add spring-damper from ground to %1").arg(b), ElementKind::Effect, [body](ModelSpec& s, int k) {
+      EffectSpec& e = s.effects[k];
+      e.type = EffectType::SpringDamper;
+      e.name = unique_name(s, ElementKind::Effect, body + "_spring");
+      e.body_a = kGroundName;
+      e.body_b = body;
+    });
+    item("addForceOn", tr("Add force actuator on %1").arg(b), ElementKind::Actuator, [body](ModelSpec& s, int k) {
+      ActuatorSpec& a = s.actuators[k];
+      a.type = ActuatorType::BodyForce;
+      a.name = unique_name(s, ElementKind::Actuator, body + "_force");
+      a.body = body;
+    });
+    item("addSensorOn", tr("Add position sensor on %1").arg(b), ElementKind::Sensor, [body](ModelSpec& s, int k) {
+      SensorSpec& x = s.sensors[k];
+      x.type = SensorType::PointPosition;
+      x.name = unique_name(s, ElementKind::Sensor, body + "_x");
+      x.body = body;
+    });
+  }
+  if (id && id->kind == ElementKind::Joint && id->index < static_cast<int>(spec.joints.size())) {
+    const std::string joint = spec.joints[id->index].name;
+    const QString j = qs(joint);
+    menu->addSeparator();
+    item("addActuatorOn", tr("Add actuator on %1").arg(j), ElementKind::Actuator, [joint](ModelSpec& s, int k) {
+      ActuatorSpec& a = s.actuators[k];
+      a.type = ActuatorType::JointForce;
+      a.name = unique_name(s, ElementKind::Actuator, joint + "_drive");
+      a.joint = joint;
+    });
+    item("addSensorOf", tr("Add position sensor of %1").arg(j), ElementKind::Sensor, [joint](ModelSpec& s, int k) {
+      SensorSpec& x = s.sensors[k];
+      x.type = SensorType::JointPosition;
+      x.name = unique_name(s, ElementKind::Sensor, joint + "_q");
+      x.joint = joint;
+    });
+    item("addDamperOn", tr("Add damper on %1").arg(j), ElementKind::Effect, [joint](ModelSpec& s, int k) {
+      EffectSpec& e = s.effects[k];
+      e.type = EffectType::JointDamper;
+      e.name = unique_name(s, ElementKind::Effect, joint + "_damper");
+      e.joint = joint;
+    });
+  }
+  if (id) {
+    menu->addSeparator();
+    QAction* rename = menu->addAction(tr("Rename"), this, [this, index] { tree_->edit(index.siblingAtColumn(0)); });
+    rename->setObjectName("treeRename");
+    menu->addAction(tr("Duplicate"), this, [this] { duplicateSelected(); })->setObjectName("treeDuplicate");
+    menu->addAction(tr("Remove"), this, [this] { removeSelected(); })->setObjectName("treeRemove");
+  }
+  menu->popup(tree_->viewport()->mapToGlobal(at));
 }
 
 void MainWindow::onModelChanged() {

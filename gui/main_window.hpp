@@ -10,6 +10,7 @@
 #include <QUrl>
 #include <complex>
 #include <functional>
+#include <map>
 #include <memory>
 
 #include "gui/document.hpp"
@@ -24,6 +25,8 @@ class QComboBox;
 class QLabel;
 class QTabWidget;
 class QMenu;
+class QDockWidget;
+class QToolBar;
 
 namespace codyna {
 struct SimulationResult;
@@ -39,6 +42,7 @@ class SimulateView;
 class ControlView;
 class SweepView;
 class Autosave;
+class IssuesPanel;
 
 class MainWindow : public QMainWindow {
   Q_OBJECT
@@ -59,6 +63,7 @@ class MainWindow : public QMainWindow {
   SweepView* sweepView() { return sweep_view_; }
   QTabWidget* analysisTabs() { return tabs_; }
   QPlainTextEdit* messages() { return messages_; }
+  IssuesPanel* issuesPanel() { return issues_; }
   QSlider* playbackSlider() { return slider_; }
 
   // File operations (the menu's actions call these; tests too). openFile() checks
@@ -95,7 +100,8 @@ class MainWindow : public QMainWindow {
   std::optional<ElementId> selectedElement() const;
   bool removeSelected();     // asks first when other elements refer to it
   bool duplicateSelected();
-  bool addElement(ElementKind k);
+  // adds one element of kind k, set up by `setup` (its index given) in the same undo step, and selects it
+  bool addElement(ElementKind k, const std::function<void(ModelSpec&, int)>& setup = {}, const QString& text = QString());
 
   // playback of the last simulation result in the 3-D view
   void setPlaybackTime(double t);
@@ -118,6 +124,8 @@ class MainWindow : public QMainWindow {
 
  private:
   void buildMenus();
+  QAction* addElementAction(ElementKind k);
+  void showTreeMenu(const QPoint& at);
   QString aboutText() const;
   void restoreLayout();
   void updateTitle();
@@ -145,6 +153,10 @@ class MainWindow : public QMainWindow {
   Autosave* autosave_ = nullptr;
   QTabWidget* tabs_;
   QPlainTextEdit* messages_;
+  IssuesPanel* issues_ = nullptr;
+  std::map<ElementKind, QAction*> add_actions_;
+  QToolBar* add_bar_ = nullptr;
+  QDockWidget* issues_dock_ = nullptr;
   QSlider* slider_;
   QPushButton* play_;
   QComboBox* speed_;

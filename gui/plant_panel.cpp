@@ -20,8 +20,46 @@ PlantListModel::PlantListModel(Document* doc, PlantSide side, QObject* parent)
     : QAbstractTableModel(parent), doc_(doc), side_(side) {
   connect(doc, &Document::specChanged, this, [this] {
     beginResetModel();
+    sync();
     endResetModel();
   });
+  connect(doc, &Document::replaced, this, [this] {  // another model: its own order
+    beginResetModel();
+    order_.clear();
+    sync();
+    endResetModel();
+  });
+  sync();
+}
+
+// The rows stay where they are: ticking or unticking moves nothing (the pointer's next click must land
+// on the row it aims at). What is shown is kept in order_; a name that appears (a new actuator, a
+// rename) goes to the end, one that goes is dropped, and the ticked rows hold the plant's order among
+// themselves (after an undo, a load or a reorder elsewhere, the ticked names are dealt into the
+// places ticked rows hold).
+void PlantListModel::sync() {
+  const QStringList sel = selected();
+  QStringList all = sel;
+  for (const QString& c : candidates())
+    if (!all.contains(c)) all << c;
+  // a renamed element keeps its row: names that went are taken, in order, by those that came
+  QStringList came;
+  for (const QString& n : all)
+    if (!order_.contains(n)) came << n;
+  QStringList next;
+  for (const QString& n : order_) {
+    if (all.contains(n)) {
+      if (!next.contains(n)) next << n;
+    } else if (!came.isEmpty()) {
+      next << came.takeFirst();
+    }
+  }
+  for (const QString& n : all)
+    if (!next.contains(n)) next << n;
+  qsizetype k = 0;
+  for (QString& n : next)
+    if (sel.contains(n)) n = sel[k++];
+  order_ = next;
 }
 
 QStringList PlantListModel::candidates() const {
@@ -39,19 +77,17 @@ QStringList PlantListModel::selected() const {
   return l;
 }
 
-QStringList PlantListModel::rows() const {
-  QStringList l = selected();
-  for (const QString& c : candidates())
-    if (!l.contains(c)) l << c;
-  return l;
-}
+QStringList PlantListModel::rows() const { return order_; }
 
 int PlantListModel::rowCount(const QModelIndex& parent) const { return parent.isValid() ? 0 : static_cast<int>(rows().size()); }
 int PlantListModel::columnCount(const QModelIndex& parent) const { return parent.isValid() ? 0 : (side_ == PlantSide::In ? 6 : 4); }
 
 QVariant PlantListModel::headerData(int section, Qt::Orientation o, int role) const {
   if (role != Qt::DisplayRole) return {};
-  if (o == Qt::Vertical) return section < selected().size() ? QVariant(QString::number(section + 1)) : QVariant();
+  if (o == Qt::Vertical) {
+    const qsizetype k = selected().indexOf(rows().value(section));
+    return k >= 0 ? QVariant(QString::number(k + 1)) : QVariant();
+  }
   static const QStringList in{tr("Input"), tr("Type"), tr("Unit"), tr("Nominal u0"), tr("Min"), tr("Max")};
   static const QStringList out{tr("Output"), tr("Type"), tr("Unit"), tr("Measures")};
   const QStringList& h = side_ == PlantSide::In ? in : out;
@@ -72,7 +108,7 @@ QVariant PlantListModel::data(const QModelIndex& index, int role) const {
     if (k < 0) return index.column() == 0 ? QVariant(name + tr(" (missing)")) : QVariant();
     const ActuatorSpec& a = s.actuators[k];
     switch (index.column()) {
-      case 0: return on ? QStringLiteral("u%1  %2").arg(index.row() + 1).arg(name) : name;
+      case 0: return on ? QStringLiteral("u%1  %2").arg(selected().indexOf(name) + 1).arg(name) : name;
       case 1:
         if (a.type == ActuatorType::Mix) {
           QStringList driven;
@@ -99,7 +135,7 @@ QVariant PlantListModel::data(const QModelIndex& index, int role) const {
     if (k < 0) return index.column() == 0 ? QVariant(name + tr(" (missing)")) : QVariant();
     const SensorSpec& x = s.sensors[k];
     switch (index.column()) {
-      case 0: return on ? QStringLiteral("y%1  %2").arg(index.row() + 1).arg(name) : name;
+      case 0: return on ? QStringLiteral("y%1  %2").arg(selected().indexOf(name) + 1).arg(name) : name;
       case 1: return qs(to_string(x.type));
       case 2: return qs(x.unit);
       case 3: return qs(!x.joint.empty() && (x.type == SensorType::JointPosition || x.type == SensorType::JointVelocity || x.type == SensorType::MotionForce) ? x.joint
@@ -110,12 +146,27 @@ QVariant PlantListModel::data(const QModelIndex& index, int role) const {
   return {};
 }
 
-bool PlantListModel::setChecked(const QString& name, bool on) {
-  QStringList sel = selected();
-  if (on == sel.contains(name)) return true;
-  if (on) sel << name;
-  else sel.removeAll(name);
+// the ticked rows, top to bottom, are the plant's list
+QStringList PlantListModel::tickedInOrder(const QString& also, const QString& without) const {
+  const QStringList sel = selected();
+  QStringList out;
+  for (const QString& n : order_)
+    if ((sel.contains(n) || n == also) && n != without) out << n;
+  return out;
+}
+
+bool PlantListModel::commit(const QStringList& sel) {
+  if (sel == selected()) {  // only the order of unticked rows changed: nothing of the model
+    beginResetModel();
+    endResetModel();
+    return true;
+  }
   return side_ == PlantSide::In ? doc_->setPlantInputs(sel) : doc_->setPlantOutputs(sel);
+}
+
+bool PlantListModel::setChecked(const QString& name, bool on) {
+  if (on == selected().contains(name)) return true;
+  return commit(on ? tickedInOrder(name, QString()) : tickedInOrder(QString(), name));
 }
 
 bool PlantListModel::setData(const QModelIndex& index, const QVariant& value, int role) {
@@ -127,17 +178,24 @@ Qt::ItemFlags PlantListModel::flags(const QModelIndex& index) const {
   if (!index.isValid()) return Qt::ItemIsDropEnabled;
   Qt::ItemFlags f = Qt::ItemIsEnabled | Qt::ItemIsSelectable;
   if (index.column() == 0) f |= Qt::ItemIsUserCheckable;
-  if (index.row() < selected().size()) f |= Qt::ItemIsDragEnabled;
+  f |= Qt::ItemIsDragEnabled;
   return f;
 }
 
+bool PlantListModel::moveRow(int from, int to) {
+  if (from < 0 || from >= order_.size()) return false;
+  to = std::clamp(to, 0, static_cast<int>(order_.size()) - 1);
+  if (from == to) return true;
+  order_.move(from, to);
+  return commit(tickedInOrder(QString(), QString()));
+}
+
 bool PlantListModel::moveSelected(int from, int to) {
-  QStringList sel = selected();
+  const QStringList sel = selected();
   if (from < 0 || from >= sel.size()) return false;
   to = std::clamp(to, 0, static_cast<int>(sel.size()) - 1);
   if (from == to) return true;
-  sel.move(from, to);
-  return side_ == PlantSide::In ? doc_->setPlantInputs(sel) : doc_->setPlantOutputs(sel);
+  return moveRow(static_cast<int>(order_.indexOf(sel[from])), static_cast<int>(order_.indexOf(sel[to])));
 }
 
 Qt::DropActions PlantListModel::supportedDropActions() const { return Qt::MoveAction; }
@@ -153,10 +211,10 @@ QMimeData* PlantListModel::mimeData(const QModelIndexList& indexes) const {
 bool PlantListModel::dropMimeData(const QMimeData* data, Qt::DropAction, int row, int, const QModelIndex& parent) {
   if (!data || !data->hasFormat(kMime)) return false;
   const int from = data->data(kMime).toInt();
-  int to = row >= 0 ? row : parent.isValid() ? parent.row() : static_cast<int>(selected().size());
+  int to = row >= 0 ? row : parent.isValid() ? parent.row() : static_cast<int>(order_.size());
   if (to > from) --to;  // the row is removed before it is inserted
-  moveSelected(from, to);
-  return false;  // the Document has done the move: the view must not remove anything
+  moveRow(from, to);
+  return false;  // the move is done: the view must not remove anything
 }
 
 PlantPanel::PlantPanel(Document* doc, PlantSide side, QWidget* parent) : QWidget(parent), doc_(doc), side_(side) {
@@ -206,15 +264,25 @@ PlantPanel::PlantPanel(Document* doc, PlantSide side, QWidget* parent) : QWidget
   refresh();
 }
 
+// Up/Down: one row; a ticked row passes the unticked ones up to the next ticked row, so that each
+// press changes its place in the plant's order
 void PlantPanel::moveCurrent(int delta) {
   const QModelIndex cur = view_->currentIndex();
   if (!cur.isValid()) return;
-  const QString name = model_->rows().value(cur.row());
-  const int from = static_cast<int>(model_->selected().indexOf(name));
-  if (from < 0) return;
-  model_->moveSelected(from, from + delta);
-  const int now = static_cast<int>(model_->rows().indexOf(name));
-  view_->setCurrentIndex(model_->index(now, 0));
+  const QStringList rows = model_->rows();
+  const QStringList sel = model_->selected();
+  const int from = cur.row();
+  const QString name = rows.value(from);
+  int to = from + delta;
+  if (sel.contains(name)) {
+    for (int r = from + delta; r >= 0 && r < rows.size(); r += delta)
+      if (sel.contains(rows[r])) {
+        to = r;
+        break;
+      }
+  }
+  model_->moveRow(from, to);
+  view_->setCurrentIndex(model_->index(static_cast<int>(model_->rows().indexOf(name)), 0));
 }
 
 }  // namespace codyna::gui

@@ -1,7 +1,7 @@
 // The Control Plant/In and Plant/Out panels (the paper's CADyna panels): the
-// candidate inputs (actuators) or outputs (sensors) as a checkable list. The
-// checked ones come first, in plant order (the order of u or y in the export);
-// they are reordered by drag and drop or the Up/Down buttons. Every change is one
+// candidate inputs (actuators) or outputs (sensors) as a checkable list. Rows
+// stay where they are when ticked; the ticked ones, top to bottom, are the plant's
+// order (u1, u2, ... in the export), changed by drag and drop or Up/Down. Every change is one
 // undo step on the Document, which saves the selection in the model file.
 #pragma once
 
@@ -33,14 +33,20 @@ class PlantListModel : public QAbstractTableModel {
   QMimeData* mimeData(const QModelIndexList& indexes) const override;
   bool dropMimeData(const QMimeData* data, Qt::DropAction action, int row, int column, const QModelIndex& parent) override;
 
-  QStringList rows() const;      // names in display order: selected (plant order), then the others
+  QStringList rows() const;      // names as shown; the ticked ones among them in plant order
   QStringList selected() const;  // the plant list
+  // moves the row `from` to row `to` (ticked ones change the plant's order: one undo step)
+  bool moveRow(int from, int to);
   // moves the selected entry `from` (plant position) to plant position `to`; one undo step
   bool moveSelected(int from, int to);
   bool setChecked(const QString& name, bool on);
 
  private:
   QStringList candidates() const;
+  void sync();
+  QStringList tickedInOrder(const QString& also, const QString& without) const;
+  bool commit(const QStringList& selection);
+  QStringList order_;
   Document* doc_;
   PlantSide side_;
 };

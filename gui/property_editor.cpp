@@ -315,7 +315,6 @@ PropertyEditor::PropertyEditor(Document* doc, QWidget* parent) : QWidget(parent)
   error_->setStyleSheet("QLabel { color: #a00000; background: #ffe8e8; padding: 3px; }");
   error_->setTextInteractionFlags(Qt::TextSelectableByMouse);
   error_->hide();
-  outer->addWidget(error_);
   auto* scroll = new QScrollArea(this);
   scroll->setWidgetResizable(true);
   scroll->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
@@ -326,6 +325,7 @@ PropertyEditor::PropertyEditor(Document* doc, QWidget* parent) : QWidget(parent)
   form_->setRowWrapPolicy(QFormLayout::WrapLongRows);
   scroll->setWidget(body_);
   outer->addWidget(scroll, 1);
+  outer->addWidget(error_);
   connect(doc, &Document::specChanged, this, &PropertyEditor::rebuild);
   connect(doc, &Document::errorChanged, this, &PropertyEditor::refreshMarks);
 }
@@ -333,6 +333,8 @@ PropertyEditor::PropertyEditor(Document* doc, QWidget* parent) : QWidget(parent)
 void PropertyEditor::setElement(std::optional<ElementId> id) {
   id_ = id;
   marked_.clear();
+  refusal_ = {};
+  involved_ = {};
   rebuild();
 }
 
@@ -460,37 +462,99 @@ bool PropertyEditor::applyText(const QString& field, const QString& text, QStrin
     return false;
   }
   const QString what = qs(element_name(spec, id_->kind, id_->index)) + "." + field;
+  auto own_issues = [this] {
+    QStringList paths;
+    for (const Document::Issue& issue : doc_->issues()) {
+      const auto ref = element_at_path(ss(issue.path));
+      if (ref && id_ && ref->kind == id_->kind && ref->index == id_->index) paths << issue.path;
+    }
+    return paths;
+  };
+  const QStringList before = own_issues();
+  const ElementId edited = *id_;
+  refusal_ = {};
+  // a type changed under a name the element got by default ("gravity_2"): the name follows the type
+  const std::string old_type = element_type(spec, id_->kind, id_->index);
+  const std::string old_name = element_name(spec, id_->kind, id_->index);
+  const ElementKind kind = id_->kind;
+  const int index = id_->index;
   doc_->edit(tr("Edit %1").arg(what), [&](ModelSpec& s) {
     const StudySpec study = s.analysis;  // the reader gives the same; keep the exact study anyway
     s = next;
     s.analysis = study;
+    if (field == QLatin1String("type") && is_default_name(kind, old_type, old_name)) {
+      const std::string now = element_type(s, kind, index);
+      if (now != old_type && default_name(kind, now) != default_name(kind, old_type))
+        rename_element(s, kind, index, unique_name(s, kind, default_name(kind, now)));
+    }
   });
   // taken: a refusal marked here before goes (an edit that changes nothing rebuilds nothing); the
-  // document's own error, if it names this element, stays marked
+  // document's issues on this element stay marked, and when this edit made one appear in another
+  // of its fields, the field edited is marked with it (both are involved)
+  involved_ = {};
+  if (id_ && *id_ == edited) {
+    for (const Document::Issue& issue : doc_->issues()) {
+      const auto ref = element_at_path(ss(issue.path));
+      if (!ref || ref->kind != edited.kind || ref->index != edited.index || before.contains(issue.path)) continue;
+      if (qs(ref->field) != field && !qs(ref->field).startsWith(field + "/")) involved_ = {field, issue.detail};
+    }
+  }
   refreshMarks();
   return true;
 }
 
 void PropertyEditor::markField(const QString& field, const QString& message) {
-  marked_ = field;
-  // the reason, in words, at the top of the fields (and as the field's tooltip)
-  error_->setText(field.isEmpty() || message.isEmpty() ? QString() : QStringLiteral("%1: %2").arg(QString(field).replace('/', '.'), message));
-  error_->setVisible(!error_->text().isEmpty());
-  for (auto& [key, w] : editors_) {
-    const bool bad = key == field || field.startsWith(key + "/");
-    w->setStyleSheet(bad ? "background: #ffd0d0;" : "");
-    w->setToolTip(bad ? message : w->property("help").toString());
+  refusal_ = field.isEmpty() || message.isEmpty() ? std::pair<QString, QString>() : std::pair(field, message);
+  applyMarks();
+}
+
+// Marks every field that has a problem: a value just refused (refusal_), the document's issues on
+// this element, and the field whose edit made a problem appear in another field of it (involved_:
+// a joint made its own parent is reported at its child). The reasons, one per line, in the band
+// under the fields (under, so that it never pushes a field away from the pointer).
+void PropertyEditor::applyMarks() {
+  std::vector<std::pair<QString, QString>> marks;
+  if (!refusal_.first.isEmpty()) marks.push_back(refusal_);
+  if (id_) {
+    const auto primary = element_at_path(ss(doc_->errorPath()));
+    for (const Document::Issue& issue : doc_->issues()) {
+      const auto ref = element_at_path(ss(issue.path));
+      // the element's own problems without a field (a body no joint moves) are the Issues panel's
+      if (!ref || ref->kind != id_->kind || ref->index != id_->index || ref->field.empty()) continue;
+      // the compile's own error with its whole text, as the status bar and messages show it
+      const bool is_primary = primary && primary->kind == ref->kind && primary->index == ref->index && primary->field == ref->field;
+      if (is_primary) marks.insert(marks.begin() + (refusal_.first.isEmpty() ? 0 : 1), {qs(ref->field), doc_->errorText()});
+      else marks.emplace_back(qs(ref->field), issue.detail);
+    }
+    if (!involved_.first.isEmpty() && marks.size() > (refusal_.first.isEmpty() ? 0u : 1u)) marks.push_back(involved_);
   }
+  marked_ = marks.empty() ? QString() : marks.front().first;
+  QStringList lines;
+  for (const auto& [field, message] : marks) {
+    const QString line = field.isEmpty() ? message : QStringLiteral("%1: %2").arg(QString(field).replace('/', '.'), message);
+    if (!lines.contains(line)) lines << line;
+  }
+  error_->setText(lines.join('\n'));
+  error_->setVisible(!lines.isEmpty());
+  for (auto& [key, w] : editors_) {
+    QStringList why;
+    for (const auto& [field, message] : marks)
+      if (!field.isEmpty() && (key == field || field.startsWith(key + "/"))) why << message;
+    w->setStyleSheet(why.isEmpty() ? "" : "background: #ffd0d0;");
+    w->setToolTip(why.isEmpty() ? w->property("help").toString() : why.join('\n'));
+  }
+}
+
+QStringList PropertyEditor::markedFields() const {
+  QStringList out;
+  for (const auto& [key, w] : editors_)
+    if (!w->styleSheet().isEmpty()) out << key;
+  return out;
 }
 
 QString PropertyEditor::errorText() const { return error_->text(); }
 
-void PropertyEditor::refreshMarks() {
-  if (!id_) return;
-  const auto ref = element_at_path(ss(doc_->errorPath()));
-  if (ref && ref->kind == id_->kind && ref->index == id_->index) markField(qs(ref->field), doc_->errorText());
-  else if (!marked_.isEmpty()) markField(QString(), QString());
-}
+void PropertyEditor::refreshMarks() { applyMarks(); }
 
 // Rebuilds run inside the signals of the very editors they replace (a combo
 // box's activated -> applyText -> Document::edit -> specChanged -> rebuild), and

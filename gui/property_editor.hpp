@@ -9,6 +9,7 @@
 #include <QWidget>
 #include <map>
 #include <optional>
+#include <utility>
 
 #include "gui/model_tree.hpp"
 
@@ -26,7 +27,8 @@ class PropertyEditor : public QWidget {
 
   // marks a field (its key path below the element, e.g. "parent" or "parent_frame/position") as wrong
   void markField(const QString& field, const QString& message);
-  QString markedField() const { return marked_; }
+  QString markedField() const { return marked_; }  // the first marked (a refused value's, else the model's error's)
+  QStringList markedFields() const;                // every field shown marked
   QString errorText() const;  // the reason shown at the fields ("" when none is marked)
   QWidget* editorFor(const QString& field) const;  // for tests: the editor of a field
 
@@ -49,6 +51,7 @@ class PropertyEditor : public QWidget {
   void retireEditors();                                             // takes the rows out, deletes them later
   bool isCurrent(const QString& key, const QWidget* editor) const;  // false for a retired editor
   void refreshMarks();
+  void applyMarks();
   QFormLayout* form_ = nullptr;
   QLabel* title_ = nullptr;
   QLabel* error_ = nullptr;  // the marked field's reason
@@ -57,6 +60,8 @@ class PropertyEditor : public QWidget {
   std::optional<ElementId> id_;
   std::map<QString, QWidget*> editors_;
   QString marked_;
+  std::pair<QString, QString> refusal_;   // a value just refused: field, reason
+  std::pair<QString, QString> involved_;  // the field whose edit made a problem appear in another one
 };
 
 }  // namespace codyna::gui

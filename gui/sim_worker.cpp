@@ -102,6 +102,7 @@ void SimWorker::runJob(std::shared_ptr<const codyna::Model> model) {
   const QString source = QString::fromStdString(setup.controller_source);
   QStringList notes;
   for (const std::string& n : setup.notes) notes << QString::fromStdString(n);
+  if (setup.start != "model") notes << QStringLiteral("the run starts at the %1 point").arg(QString::fromStdString(setup.start));
   QMetaObject::invokeMethod(
       this,
       [this, source, notes] {

@@ -264,6 +264,15 @@ void SimulateView::buildUi() {
   t_end_->setKeyboardTracking(false);
   t_end_->setToolTip(tr("End time of the run in s"));
   form->addRow(tr("End time"), t_end_);
+  start_ = new QComboBox(solver_box);
+  start_->setObjectName("startCombo");
+  start_->addItem(tr("the model's state"), QStringLiteral("model"));
+  start_->addItem(tr("the operating point (x0)"), QStringLiteral("operating-point"));
+  start_->setToolTip(tr("Where the run starts (the file's analysis.start, codyna simulate --initial operating-point): "
+                        "the model's own state, or the operating point the controller's plant is linearized about, "
+                        "where a regulator is designed to hold the mechanism. The initial-state table below sets "
+                        "coordinates on top of either."));
+  form->addRow(tr("Start at"), start_);
   initial_ = new NameValueTable(tr("Coordinate"), tr("Start value (m, rad, /s)"), solver_box);
   initial_->setObjectName("initialState");
   initial_->setToolTip(tr("Where the run starts, apart from the operating point (the file's analysis.initial, "
@@ -401,6 +410,10 @@ void SimulateView::buildUi() {
   connect(file_browse_, &QPushButton::clicked, this, &SimulateView::browseControllerFile);
   connect(q_weights_, &QLineEdit::editingFinished, this, [this] { weightsEdited(true); });
   connect(r_weights_, &QLineEdit::editingFinished, this, [this] { weightsEdited(false); });
+  connect(start_, &QComboBox::activated, this, [this] {
+    const std::string v = ss(start_->currentData().toString());
+    writeStudyChecked([&](StudySpec& s) { s.start = v; }, tr("Change where the run starts"), -1);
+  });
   connect(initial_, &NameValueTable::edited, this, [this](bool number) {
     const auto v = initial_->pairs();
     writeStudyChecked([&](StudySpec& s) { s.initial = v; }, tr("Change the initial state"), number ? kMergeInitial : -1);
@@ -538,6 +551,10 @@ void SimulateView::refreshFromDocument() {
   const SolverSpec& so = spec.solver;
   refreshInitialChoices();
   initial_->setPairs(st.initial);
+  {
+    const QSignalBlocker b(start_);
+    start_->setCurrentIndex(std::max(0, start_->findData(qs(st.start))));
+  }
   {
     const QSignalBlocker b(controller_combo_);
     const int i = controller_combo_->findData(qs(st.controller));

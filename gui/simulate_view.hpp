@@ -79,6 +79,7 @@ class SimulateView : public QWidget {
   ResultPlots* plots() const { return plots_; }
   SignalPlot* signalPlot() const { return signal_plot_; }
   NameValueTable* initialStateTable() const { return initial_; }
+  QComboBox* startCombo() const { return start_; }
   // isStale(): the document's model changed since the run (the results stay, marked).
   bool isStale() const;
   // Forgets the result (the document now holds another model); a running simulation is cancelled.
@@ -153,6 +154,7 @@ class SimulateView : public QWidget {
   ResultPlots* plots_ = nullptr;
   SignalPlot* signal_plot_ = nullptr;
   NameValueTable* initial_ = nullptr;
+  QComboBox* start_ = nullptr;
   QTabWidget* plot_tabs_ = nullptr;
   std::shared_ptr<const codyna::SimulationResult> result_;
   std::shared_ptr<const codyna::Model> result_model_;  // the model of the run (current or last)

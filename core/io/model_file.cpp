@@ -170,6 +170,29 @@ double read_positive_length(const Node& n) {
   return x;
 }
 
+// The values a model cannot hold, refused where they are read (a file, or codyna-gui's field, which
+// goes through this reader): compile_structure checks the same of a spec built in code.
+// A spring's or damper's coefficient (N/m, N s/m, N m/rad, N m s/rad) and a rest length: 0 or more
+double read_coefficient(const Node& n) {
+  const double x = read_number(n);
+  if (!(x >= 0)) n.expected("a non-negative number (a negative stiffness, damping or length would feed energy in)");
+  return x;
+}
+
+// the same for each axis of a bushing
+Eigen::Vector3d read_coefficients(const Node& n) {
+  Eigen::Vector3d v = read_vec3(n);
+  if (!(v.minCoeff() >= 0)) n.expected("three non-negative numbers (x, y, z of the bushing's axes)");
+  return v;
+}
+
+// a rolling ball's or disc's radius
+double read_radius(const Node& n) {
+  const double x = read_number(n);
+  if (!(x > 0)) n.expected("a positive radius (m)");
+  return x;
+}
+
 // a body's mass: 0 (a massless link between joints) or more
 double read_mass(const Node& n) {
   const double x = read_number(n);
@@ -769,7 +792,7 @@ const Schema<ConstraintSpec>& schema<ConstraintSpec>() {
            field("ratio_c", &ConstraintSpec::ratio_c, read_number,
                  [](double r) { return r == 0 ? ojson() : ojson(r); }),
            field("offset", &ConstraintSpec::offset, [](const Node& n) { return std::optional<double>(read_number(n)); }),
-           field("radius", &ConstraintSpec::radius, read_number, Need::Required)},
+           field("radius", &ConstraintSpec::radius, read_radius, Need::Required)},
       }),
       "constraint",
       [](const ConstraintSpec& c) {
@@ -795,9 +818,9 @@ const Schema<EffectSpec>& schema<EffectSpec>() {
            field("g", &EffectSpec::g, read_vec3)},
           point_pair_fields<EffectSpec>(),
           joint_dof_fields<EffectSpec>(),
-          {field("stiffness", &EffectSpec::stiffness, read_number),
-           field("damping", &EffectSpec::damping, read_number),
-           field("rest_length", &EffectSpec::rest_length, read_number),
+          {field("stiffness", &EffectSpec::stiffness, read_coefficient),
+           field("damping", &EffectSpec::damping, read_coefficient),
+           field("rest_length", &EffectSpec::rest_length, read_coefficient),
            field("rest_position", &EffectSpec::rest_position, read_number),
            field("body", &EffectSpec::body_a, read_string, Need::Required),
            field("point", &EffectSpec::point_a, read_vec3),
@@ -805,10 +828,10 @@ const Schema<EffectSpec>& schema<EffectSpec>() {
            field("torque", &EffectSpec::torque, read_vec3),
            field("frame", &EffectSpec::in_world, read_in_world, encode_in_world),
            struct_field("frame_a", &EffectSpec::frame_a), struct_field("frame_b", &EffectSpec::frame_b),
-           field("translational_stiffness", &EffectSpec::translational_stiffness, read_vec3),
-           field("translational_damping", &EffectSpec::translational_damping, read_vec3),
-           field("rotational_stiffness", &EffectSpec::rotational_stiffness, read_vec3),
-           field("rotational_damping", &EffectSpec::rotational_damping, read_vec3)},
+           field("translational_stiffness", &EffectSpec::translational_stiffness, read_coefficients),
+           field("translational_damping", &EffectSpec::translational_damping, read_coefficients),
+           field("rotational_stiffness", &EffectSpec::rotational_stiffness, read_coefficients),
+           field("rotational_damping", &EffectSpec::rotational_damping, read_coefficients)},
       }),
       "effect",
       [](const EffectSpec& e) {
@@ -1172,6 +1195,8 @@ const Schema<StudySpec>& schema<StudySpec>() {
       field("operating_point", &T::operating_point, read_study_operating_point),
       field("set", &T::set, read_set, encode_set),
       field("initial", &T::initial, read_set, encode_set),
+      field("start", &T::start, [](const Node& n) { return read_word(n, study_starts(), "start"); },
+            [](const std::string& v) { return v == "model" ? ojson() : ojson(v); }),
       field("independent", &T::independent, read_names),
       field("trim_free", &T::trim_free, read_names),
       field("free_inputs", &T::free_inputs, read_names),

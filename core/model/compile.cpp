@@ -276,7 +276,7 @@ class Compiler {
     }
     for (std::size_t i = 0; i < spec_.bodies.size(); ++i)
       if (!child_of.count(spec_.bodies[i].name))
-        fail(at("bodies", i), "body " + quote(spec_.bodies[i].name) + " is not the child of any joint (attach it, e.g. with a \"fixed\" joint)");
+        fail(at("bodies", i), unattached_body_detail(spec_.bodies[i].name));
 
     // stable topological order: a joint is placed once its parent is placed
     std::vector<std::size_t> order;
@@ -840,6 +840,10 @@ class Compiler {
 };
 
 }  // namespace
+
+std::string unattached_body_detail(const std::string& body) {
+  return "body \"" + body + "\" is not the child of any joint (attach it, e.g. with a \"fixed\" joint)";
+}
 
 Model compile_structure(const ModelSpec& spec, const std::string& file) { return Compiler(spec, file).run(); }
 

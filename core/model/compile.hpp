@@ -17,6 +17,9 @@ namespace codyna {
 
 Model compile_structure(const ModelSpec& spec, const std::string& file = "");
 
+// What compile_structure says of a body no joint moves (study/model_issues.hpp lists every one).
+std::string unattached_body_detail(const std::string& body);
+
 // What a parameter study's variant changes in a compiled model without changing its tree, names or
 // indices: the bodies' mass, com and inertia; the effects (gravity, springs and dampers, bushings,
 // forces: any of their fields, since nothing else refers to them); the joints' q0 and v0 (the

@@ -1,6 +1,7 @@
 #include "model/spec_edit.hpp"
 
 #include <algorithm>
+#include <map>
 #include <stdexcept>
 
 namespace codyna {
@@ -39,66 +40,86 @@ std::string renamed_coordinate(const std::string& name, const std::string& old, 
   return names_coordinate_of(name, old) ? now + name.substr(old.size()) : name;
 }
 
+std::string at(const char* section, std::size_t i, const char* field) {
+  return std::string("/") + section + "/" + std::to_string(i) + "/" + field;
+}
+
+// f(std::string& ref, const std::string& where, const std::string& path): every field that names a
+// body, described ("joint pivot: child") and as its model-file path ("/joints/0/child")
 template <class F>
-void for_each_body_ref(ModelSpec& s, F&& f) {  // f(std::string& ref, const std::string& where)
-  for (auto& j : s.joints) {
-    f(j.parent, "joint " + j.name + ": parent");
-    f(j.child, "joint " + j.name + ": child");
+void for_each_body_ref(ModelSpec& s, F&& f) {
+  for (std::size_t i = 0; i < s.joints.size(); ++i) {
+    auto& j = s.joints[i];
+    f(j.parent, "joint " + j.name + ": parent", at("joints", i, "parent"));
+    f(j.child, "joint " + j.name + ": child", at("joints", i, "child"));
   }
-  for (auto& c : s.constraints) {
+  for (std::size_t i = 0; i < s.constraints.size(); ++i) {
+    auto& c = s.constraints[i];
     if (c.type == ConstraintType::Coupler) continue;  // joints, not bodies
-    f(c.body_a, "constraint " + c.name + ": body_a");
-    f(c.body_b, "constraint " + c.name + ": body_b");
+    f(c.body_a, "constraint " + c.name + ": body_a", at("constraints", i, "body_a"));
+    f(c.body_b, "constraint " + c.name + ": body_b", at("constraints", i, "body_b"));
   }
-  for (auto& e : s.effects) {
+  for (std::size_t i = 0; i < s.effects.size(); ++i) {
+    auto& e = s.effects[i];
     if (e.type == EffectType::SpringDamper || e.type == EffectType::Bushing) {
-      f(e.body_a, "effect " + e.name + ": body_a");
-      f(e.body_b, "effect " + e.name + ": body_b");
+      f(e.body_a, "effect " + e.name + ": body_a", at("effects", i, "body_a"));
+      f(e.body_b, "effect " + e.name + ": body_b", at("effects", i, "body_b"));
     } else if (e.type == EffectType::BodyForce) {
-      f(e.body_a, "effect " + e.name + ": body");
+      f(e.body_a, "effect " + e.name + ": body", at("effects", i, "body"));
     }
   }
-  for (auto& a : s.actuators) {
-    if (a.type == ActuatorType::BodyForce || a.type == ActuatorType::BodyTorque) f(a.body, "actuator " + a.name + ": body");
+  for (std::size_t i = 0; i < s.actuators.size(); ++i) {
+    auto& a = s.actuators[i];
+    if (a.type == ActuatorType::BodyForce || a.type == ActuatorType::BodyTorque)
+      f(a.body, "actuator " + a.name + ": body", at("actuators", i, "body"));
     if (a.type == ActuatorType::LineForce) {
-      f(a.body_a, "actuator " + a.name + ": body_a");
-      f(a.body_b, "actuator " + a.name + ": body_b");
+      f(a.body_a, "actuator " + a.name + ": body_a", at("actuators", i, "body_a"));
+      f(a.body_b, "actuator " + a.name + ": body_b", at("actuators", i, "body_b"));
     }
   }
-  for (auto& x : s.sensors) {
+  for (std::size_t i = 0; i < s.sensors.size(); ++i) {
+    auto& x = s.sensors[i];
     switch (x.type) {
       case SensorType::PointPosition:
       case SensorType::PointVelocity:
-        f(x.body, "sensor " + x.name + ": body");
-        f(x.frame, "sensor " + x.name + ": frame");
+        f(x.body, "sensor " + x.name + ": body", at("sensors", i, "body"));
+        f(x.frame, "sensor " + x.name + ": frame", at("sensors", i, "frame"));
         break;
-      case SensorType::BodyAngle: f(x.body, "sensor " + x.name + ": body"); break;
+      case SensorType::BodyAngle: f(x.body, "sensor " + x.name + ": body", at("sensors", i, "body")); break;
       case SensorType::Distance:
       case SensorType::DistanceRate:
-        f(x.body_a, "sensor " + x.name + ": body_a");
-        f(x.body_b, "sensor " + x.name + ": body_b");
+        f(x.body_a, "sensor " + x.name + ": body_a", at("sensors", i, "body_a"));
+        f(x.body_b, "sensor " + x.name + ": body_b", at("sensors", i, "body_b"));
         break;
       default: break;
     }
   }
 }
 
+// the same for every field that names a joint
 template <class F>
 void for_each_joint_ref(ModelSpec& s, F&& f) {
-  for (auto& c : s.constraints)
+  for (std::size_t i = 0; i < s.constraints.size(); ++i) {
+    auto& c = s.constraints[i];
     if (c.type == ConstraintType::Coupler) {
-      f(c.joint_a, "constraint " + c.name + ": joint_a");
-      f(c.joint_b, "constraint " + c.name + ": joint_b");
-      if (!c.joint_c.empty()) f(c.joint_c, "constraint " + c.name + ": joint_c");
+      f(c.joint_a, "constraint " + c.name + ": joint_a", at("constraints", i, "joint_a"));
+      f(c.joint_b, "constraint " + c.name + ": joint_b", at("constraints", i, "joint_b"));
+      if (!c.joint_c.empty()) f(c.joint_c, "constraint " + c.name + ": joint_c", at("constraints", i, "joint_c"));
     }
-  for (auto& e : s.effects)
-    if (e.type == EffectType::JointSpringDamper || e.type == EffectType::JointFriction ||
-        e.type == EffectType::JointDamper)
-      f(e.joint, "effect " + e.name + ": joint");
-  for (auto& a : s.actuators)
-    if (a.type == ActuatorType::JointForce) f(a.joint, "actuator " + a.name + ": joint");
-  for (auto& x : s.sensors)
-    if (x.type == SensorType::JointPosition || x.type == SensorType::JointVelocity || x.type == SensorType::MotionForce) f(x.joint, "sensor " + x.name + ": joint");
+  }
+  for (std::size_t i = 0; i < s.effects.size(); ++i) {
+    auto& e = s.effects[i];
+    if (e.type == EffectType::JointSpringDamper || e.type == EffectType::JointFriction || e.type == EffectType::JointDamper)
+      f(e.joint, "effect " + e.name + ": joint", at("effects", i, "joint"));
+  }
+  for (std::size_t i = 0; i < s.actuators.size(); ++i)
+    if (s.actuators[i].type == ActuatorType::JointForce || s.actuators[i].type == ActuatorType::Motion)
+      f(s.actuators[i].joint, "actuator " + s.actuators[i].name + ": joint", at("actuators", i, "joint"));
+  for (std::size_t i = 0; i < s.sensors.size(); ++i) {
+    auto& x = s.sensors[i];
+    if (x.type == SensorType::JointPosition || x.type == SensorType::JointVelocity || x.type == SensorType::MotionForce)
+      f(x.joint, "sensor " + x.name + ": joint", at("sensors", i, "joint"));
+  }
 }
 
 }  // namespace
@@ -181,7 +202,7 @@ std::optional<ElementRef> element_at_path(const std::string& path) {
 std::vector<std::string> references_to(const ModelSpec& spec, ElementKind k, const std::string& name) {
   ModelSpec s = spec;  // the visitors take mutable references; nothing is changed
   std::vector<std::string> out;
-  auto collect = [&](std::string& ref, const std::string& where) {
+  auto collect = [&](std::string& ref, const std::string& where, const std::string&) {
     if (ref == name) out.push_back(where);
   };
   switch (k) {
@@ -210,6 +231,25 @@ std::vector<std::string> references_to(const ModelSpec& spec, ElementKind k, con
   return out;
 }
 
+std::vector<ReferenceField> reference_fields(const ModelSpec& spec) {
+  ModelSpec s = spec;  // the visitors take mutable references; nothing is changed
+  std::vector<ReferenceField> out;
+  for_each_body_ref(s, [&](std::string& ref, const std::string&, const std::string& path) {
+    out.push_back({ElementKind::Body, ref, path});
+  });
+  for_each_joint_ref(s, [&](std::string& ref, const std::string&, const std::string& path) {
+    out.push_back({ElementKind::Joint, ref, path});
+  });
+  for (std::size_t i = 0; i < s.actuators.size(); ++i)
+    for (std::size_t k = 0; k < s.actuators[i].drives.size(); ++k)
+      out.push_back({ElementKind::Actuator, s.actuators[i].drives[k], at("actuators", i, "drives") + "/" + std::to_string(k)});
+  for (std::size_t k = 0; k < s.plant.inputs.size(); ++k)
+    out.push_back({ElementKind::Actuator, s.plant.inputs[k], "/plant/inputs/" + std::to_string(k)});
+  for (std::size_t k = 0; k < s.plant.outputs.size(); ++k)
+    out.push_back({ElementKind::Sensor, s.plant.outputs[k], "/plant/outputs/" + std::to_string(k)});
+  return out;
+}
+
 void rename_element(ModelSpec& s, ElementKind k, int index, const std::string& now) {
   check_index(s, k, index);
   const std::string old = element_name(s, k, index);
@@ -218,7 +258,7 @@ void rename_element(ModelSpec& s, ElementKind k, int index, const std::string& n
   if (k == ElementKind::Body && now == kGroundName) throw std::invalid_argument("\"ground\" is the name of the fixed world body");
   if (find_element(s, k, now) >= 0)
     throw std::invalid_argument(std::string("another ") + to_string(k) + " is already named \"" + now + "\"");
-  auto swap = [&](std::string& ref, const std::string&) {
+  auto swap = [&](std::string& ref, const std::string&, const std::string&) {
     if (ref == old) ref = now;
   };
   switch (k) {
@@ -239,6 +279,53 @@ void rename_element(ModelSpec& s, ElementKind k, int index, const std::string& n
     case ElementKind::Constraint: break;
   }
   visit_list(s, k, [&](auto& v) { v[index].name = now; });
+}
+
+std::string default_name(ElementKind k, const std::string& type) {
+  static const std::map<std::string, std::string> effects = {
+      {"gravity", "gravity"}, {"spring_damper", "spring"}, {"joint_spring_damper", "joint_spring"},
+      {"joint_friction", "friction"}, {"joint_damper", "damper"}, {"body_force", "load"}, {"bushing", "bushing"}};
+  static const std::map<std::string, std::string> actuators = {
+      {"joint_force", "motor"}, {"body_force", "force"}, {"body_torque", "torque"},
+      {"line_force", "strut"},  {"mix", "mix"},          {"motion", "motion"}};
+  static const std::map<std::string, std::string> sensors = {
+      {"joint_position", "sensor"}, {"joint_velocity", "rate"},     {"point_position", "position"},
+      {"point_velocity", "velocity"}, {"body_angle", "angle"},       {"distance", "distance"},
+      {"distance_rate", "distance_rate"}, {"motion_force", "motion_force"}};
+  auto from = [&](const std::map<std::string, std::string>& m, const char* fallback) {
+    const auto it = m.find(type);
+    return it == m.end() ? std::string(fallback) : it->second;
+  };
+  switch (k) {
+    case ElementKind::Body: return "body";
+    case ElementKind::Joint: return "joint";
+    case ElementKind::Constraint: return "closure";
+    case ElementKind::Effect: return from(effects, "effect");
+    case ElementKind::Actuator: return from(actuators, "actuator");
+    case ElementKind::Sensor: return from(sensors, "sensor");
+  }
+  return "element";
+}
+
+bool is_default_name(ElementKind k, const std::string& type, const std::string& name) {
+  const std::string base = default_name(k, type);
+  if (name == base) return true;
+  if (name.size() <= base.size() + 1 || name.compare(0, base.size(), base) != 0 || name[base.size()] != '_') return false;
+  const std::string n = name.substr(base.size() + 1);
+  return n.size() < 6 && std::all_of(n.begin(), n.end(), [](char c) { return c >= '0' && c <= '9'; }) && n[0] != '0';
+}
+
+std::string element_type(const ModelSpec& s, ElementKind k, int i) {
+  check_index(s, k, i);
+  switch (k) {
+    case ElementKind::Body: return "";
+    case ElementKind::Joint: return to_string(s.joints[i].type);
+    case ElementKind::Constraint: return to_string(s.constraints[i].type);
+    case ElementKind::Effect: return to_string(s.effects[i].type);
+    case ElementKind::Actuator: return to_string(s.actuators[i].type);
+    case ElementKind::Sensor: return to_string(s.sensors[i].type);
+  }
+  return "";
 }
 
 int add_element(ModelSpec& s, ElementKind k) {
@@ -268,8 +355,16 @@ int add_element(ModelSpec& s, ElementKind k) {
       break;
     }
     case ElementKind::Effect: {
+      // gravity once; after it, what a model gets most: a spring-damper (a second gravity would be
+      // an error the moment it is added)
       EffectSpec e;
-      e.name = unique_name(s, k, "gravity");
+      const bool has_gravity = std::any_of(s.effects.begin(), s.effects.end(), [](const EffectSpec& x) { return x.type == EffectType::Gravity; });
+      if (has_gravity) {
+        e.type = EffectType::SpringDamper;
+        e.body_a = kGroundName;
+        e.body_b = s.bodies.empty() ? std::string() : s.bodies.back().name;
+      }
+      e.name = unique_name(s, k, default_name(k, to_string(e.type)));
       s.effects.push_back(e);
       break;
     }

@@ -74,6 +74,11 @@ struct StudySpec {
   // operating point is searched from the model's state, not from this one; only the runs
   // (simulate, linearize --trajectory) start here.
   std::vector<std::pair<std::string, double>> initial;
+  // where a run starts: "model" (the model's state, the coordinates set and `initial` on it) or
+  // "operating-point" (the point the controller's plant is linearized about, or the study's
+  // operating point without a plant; `initial` sets coordinates on top of it: an offset from the
+  // point, a disturbed start). `--initial operating-point` on the command line.
+  std::string start = "model";
   // closed loops: the independent coordinates (empty = automatic choice)
   std::vector<std::string> independent;
   // the steady-state search (operating points equilibrium and trim), as
@@ -133,6 +138,10 @@ inline const std::vector<std::string>& signal_types() {
 }
 inline const std::vector<std::string>& anti_windup_methods() {
   static const std::vector<std::string> v{"none", "back_calculation", "conditional"};
+  return v;
+}
+inline const std::vector<std::string>& study_starts() {
+  static const std::vector<std::string> v{"model", "operating-point"};
   return v;
 }
 inline const std::vector<std::string>& study_controllers() {

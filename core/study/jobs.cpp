@@ -155,7 +155,16 @@ void apply_plant(ModelSpec& spec, const PlantRequest& f, const Names& opt) {
 
 void apply_point(StudySpec& s, const PointRequest& p, const Names& opt) {
   apply_pairs(s.set, p.hold, opt("hold"));
-  apply_pairs(s.initial, p.initial, opt("initial"));
+  // --initial operating-point (or model) says where the run starts; NAME=VALUE entries set coordinates there
+  std::vector<std::string> pairs;
+  for (const std::string& v : p.initial) {
+    if (std::find(study_starts().begin(), study_starts().end(), v) != study_starts().end()) s.start = v;
+    else if (v.find('=') == std::string::npos)
+      throw std::invalid_argument(opt("initial") + " " + v + ": expected NAME=VALUE, or where the run starts: " +
+                                  study_starts()[0] + " or " + study_starts()[1]);
+    else pairs.push_back(v);
+  }
+  apply_pairs(s.initial, pairs, opt("initial"));
   if (p.trim_free) s.trim_free = *p.trim_free;
   if (p.free_inputs) s.free_inputs = *p.free_inputs;
   apply_pairs(s.output_targets, p.targets, opt("target"));

@@ -782,11 +782,28 @@ StudySimulation study_simulation(const Model& m, const std::atomic<bool>* cancel
   } else {
     out.controller_source = "none";
   }
-  if (!s.initial.empty()) {
+  if (s.start == "operating-point") {
+    // the run starts at the point the controller's plant was linearized about (x0: what a
+    // control engineer means by the start of a regulation), or the study's point without a plant;
+    // coordinates the study sets in `initial` are set on top of it
+    const OperatingPoint op = out.plant ? out.plant->op : study_operating_point(m, "", cancel);
+    out.options.q0 = op.q;
+    out.options.v0 = op.v;
+    out.start = op.kind;
+    if (!s.initial.empty()) {
+      const StudyInitialState start = set_coordinates(m, op.q, op.v, s.initial, "initial");
+      out.options.q0 = start.q;
+      out.options.v0 = start.v;
+      out.start += " + study initial";
+    }
+  } else if (s.start != "model") {
+    workflow_fail(m, "start", "unknown start \"" + s.start + "\" (expected one of: " + listed(study_starts()) + ")");
+  } else if (!s.initial.empty()) {
     // the run starts where the study's initial state says, about the operating point found above
     const StudyInitialState start = study_initial_state(m);
     out.options.q0 = start.q;
     out.options.v0 = start.v;
+    out.start = "study initial";
   }
   attach_anti_windup(m, out);
   if (!s.references.empty()) attach_references(m, out);
@@ -812,7 +829,7 @@ SimulationResult study_simulate(const Model& m, const StudySimulation& setup, co
     for (int k = 0; k < m.nu(); ++k) u[m.actuators[static_cast<std::size_t>(k)].name] = setup.plant->op.u[k];
     settings << ", \"operating_point_q\": " << q.dump() << ", \"operating_point_u\": " << u.dump();
   }
-  settings << ", \"initial_state\": \"" << (m.spec.analysis.initial.empty() ? "model" : "study initial") << "\"}";
+  settings << ", \"initial_state\": \"" << setup.start << "\"}";
   r.settings_json = settings.str();
   return r;
 }

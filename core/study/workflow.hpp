@@ -112,6 +112,10 @@ struct StudySimulation {
   Eigen::VectorXcd lqr_poles;                    // eig(A - B lqr_gain), when the source is "lqr"
   std::vector<HiddenMode> uncontrollable;        // lqr_controllable_part: the modes left as they are
   std::vector<std::string> notes;                // what a front end should tell the user
+  // where the run starts (StudySpec::start): "model", "study initial" (the model's state with the
+  // study's initial coordinates), or the operating point's kind ("equilibrium", "trim", ...), with
+  // " + study initial" when coordinates are set on it
+  std::string start = "model";
   // a linear controller (state feedback, LQR, LTI; not PID, not open loop): the poles of the
   // linear closed loop about the operating point (close_loop of analysis/closed_loop_linear.hpp,
   // saturation left out), sorted by real part; `linear_unstable` when one has a real part

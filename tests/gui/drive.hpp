@@ -68,14 +68,15 @@ inline bool pickWithKeys(QComboBox* c, const QString& text) {
   return QTest::qWaitFor([v] { return !v->isVisible(); }, 2000);
 }
 
-// the window's Edit > Add > "Add KIND" action (nullptr when there is none)
+// the window's Edit > Add > KIND action (nullptr when there is none); `kind` as the model file
+// says it: "body", "joint", "constraint", "effect", "actuator", "sensor"
 inline QAction* addAction(QMainWindow* w, const QString& kind) {
   for (QAction* top : w->menuBar()->actions()) {
     if (top->text() != "&Edit" || !top->menu()) continue;
     for (QAction* a : top->menu()->actions()) {
       if (!a->menu()) continue;
       for (QAction* b : a->menu()->actions())
-        if (b->text() == "Add " + kind) return b;
+        if (b->objectName() == "actionAdd:" + kind) return b;
     }
   }
   return nullptr;

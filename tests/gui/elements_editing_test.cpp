@@ -189,9 +189,10 @@ class ElementsEditingTest : public QObject {
     type("translational_stiffness", "100, 200, 300");
     type("rotational_stiffness", "1, 4, 9");
     QVERIFY2(w->document()->model(), qPrintable(w->document()->errorText()));
-    // a negative stiffness is refused, naming the field and what it expects
+    // a negative stiffness is refused at the field, naming it and what it expects; the model keeps its value
     typeBad("translational_stiffness", "100, -200, 300", "non-negative");
-    QVERIFY(!w->document()->model());
+    QVERIFY(w->document()->model());
+    QCOMPARE(w->document()->spec().effects.back().translational_stiffness, Eigen::Vector3d(100, 200, 300));
     type("translational_stiffness", "100, 200, 300");
 
     const LinearSystem* s = linearize("initial");

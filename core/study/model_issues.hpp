@@ -1,0 +1,29 @@
+// model_issues: every problem of a model that does not compile, at once, for an
+// editor's Issues list (codyna-gui) and `codyna check`-like front ends. study_model
+// stops at its first error; an editor needs them all (a body deleted while three
+// elements still name it is three problems, in three fields). So, besides the
+// compile's own first error, the spec's cross-references are checked one by one:
+// every field that names a body, a joint, an actuator or a sensor that is not there,
+// and every body that no joint moves. Each problem is a ModelError (file, field
+// path "/joints/2/parent", what was expected), in the model file's order.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "model/errors.hpp"
+#include "model/model.hpp"
+#include "model/model_spec.hpp"
+
+namespace codyna {
+
+struct ModelCheck {
+  std::shared_ptr<const Model> model;  // study_model(spec, file), or null when it does not compile
+  std::vector<ModelError> issues;      // empty exactly when the model compiles; in the file's order
+  std::size_t first = 0;               // which of them study_model itself reports (its first error)
+};
+
+ModelCheck check_model(const ModelSpec& spec, const std::string& file = "");
+
+}  // namespace codyna
