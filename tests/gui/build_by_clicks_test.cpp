@@ -10,6 +10,7 @@
 #include <QAction>
 #include <QApplication>
 #include <QComboBox>
+#include <QContextMenuEvent>
 #include <QDoubleSpinBox>
 #include <QLineEdit>
 #include <QMenu>
@@ -142,6 +143,28 @@ class BuildByClicksTest : public QObject {
     opt.features |= QStyleOptionViewItem::HasCheckIndicator;
     const QRect box = v->style()->subElementRect(QStyle::SE_ItemViewItemCheckIndicator, &opt, v);
     QTest::mouseClick(v->viewport(), Qt::LeftButton, {}, box.center());
+  }
+
+  // the model tree's context menu opened over `at` (a row's centre, or empty space) as a right click
+  // opens it, and its item `name` (an action's object name) clicked: "" when so
+  QString treeMenu(const QModelIndex& at, const QString& name) {
+    QTreeView* t = w->modelTree();
+    const QPoint p = at.isValid() ? t->visualRect(at).center() : QPoint(t->viewport()->width() / 2, t->viewport()->height() - 4);
+    QContextMenuEvent e(QContextMenuEvent::Mouse, p, t->viewport()->mapToGlobal(p));
+    QApplication::sendEvent(t->viewport(), &e);
+    auto* menu = qobject_cast<QMenu*>(QApplication::activePopupWidget());
+    if (!menu) return "no context menu";
+    QAction* hit = nullptr;
+    for (QAction* a : menu->actions())
+      if (a->objectName() == name) hit = a;
+    if (!hit) {
+      QStringList names;
+      for (QAction* a : menu->actions()) names << a->objectName();
+      menu->close();
+      return "no " + name + " in the menu (" + names.join(", ") + ")";
+    }
+    QTest::mouseClick(menu, Qt::LeftButton, {}, menu->actionGeometry(hit).center());
+    return QTest::qWaitFor([menu] { return !menu->isVisible(); }, 2000) ? QString() : "the menu stayed open";
   }
 
   // a reference picked from its drop-down unless it already names it (a person would leave it)
@@ -491,6 +514,57 @@ class BuildByClicksTest : public QObject {
     QCOMPARE(w->document()->spec().plant.inputs, (std::vector<std::string>{"U", "motor"}));
     const QStringList after = in->listModel()->rows();
     QVERIFY(after.indexOf("U") < after.indexOf("motor"));
+  }
+
+  // Every kind of element added from the model tree's context menu, as a right click opens it: on
+  // empty space (every kind), on a body (a joint moving it, a body jointed to it, a spring to it, a
+  // force and a sensor on it), on a joint (an actuator, a sensor, a damper), on a category; each
+  // new element is attached where it was asked for and the model compiles.
+  void treeContextMenuAddsEveryKind() {
+    QVERIFY(w->newModel());
+    const ModelSpec& s = w->document()->spec();
+    QCOMPARE(treeMenu({}, "actionAdd:body"), QString());
+    QCOMPARE(s.bodies.size(), std::size_t(1));
+    const auto body = [&] { return w->treeModel()->indexOf({ElementKind::Body, 0}); };
+    QCOMPARE(treeMenu(body(), "addJointMoving"), QString());
+    QCOMPARE(s.joints.at(0).child, std::string("body"));
+    QCOMPARE(s.joints.at(0).parent, std::string("ground"));
+    QVERIFY2(w->document()->model(), qPrintable(w->document()->errorText()));
+    // a body already moved is not offered a second joint
+    QVERIFY(treeMenu(body(), "addJointMoving").startsWith("no addJointMoving"));
+    QCOMPARE(treeMenu(body(), "addBodyOn"), QString());
+    QCOMPARE(s.bodies.size(), std::size_t(2));
+    QCOMPARE(s.joints.at(1).parent, std::string("body"));
+    QCOMPARE(s.joints.at(1).child, s.bodies.at(1).name);
+    QCOMPARE(treeMenu(body(), "addSpringTo"), QString());
+    QCOMPARE(s.effects.at(0).type, EffectType::SpringDamper);
+    QCOMPARE(s.effects.at(0).body_b, std::string("body"));
+    QCOMPARE(treeMenu(body(), "addForceOn"), QString());
+    QCOMPARE(s.actuators.at(0).type, ActuatorType::BodyForce);
+    QCOMPARE(s.actuators.at(0).body, std::string("body"));
+    QCOMPARE(treeMenu(body(), "addSensorOn"), QString());
+    QCOMPARE(s.sensors.at(0).type, SensorType::PointPosition);
+    QCOMPARE(s.sensors.at(0).body, std::string("body"));
+    const auto joint = [&] { return w->treeModel()->indexOf({ElementKind::Joint, 0}); };
+    QCOMPARE(treeMenu(joint(), "addActuatorOn"), QString());
+    QCOMPARE(s.actuators.at(1).type, ActuatorType::JointForce);
+    QCOMPARE(s.actuators.at(1).joint, s.joints.at(0).name);
+    QCOMPARE(treeMenu(joint(), "addSensorOf"), QString());
+    QCOMPARE(s.sensors.at(1).joint, s.joints.at(0).name);
+    QCOMPARE(treeMenu(joint(), "addDamperOn"), QString());
+    QCOMPARE(s.effects.at(1).type, EffectType::JointDamper);
+    QCOMPARE(s.effects.at(1).joint, s.joints.at(0).name);
+    QVERIFY2(w->document()->model(), qPrintable(w->document()->errorText()));
+    // on a category: that kind (here a loop closure, the last kind with none yet)
+    QCOMPARE(treeMenu(w->treeModel()->kindIndex(ElementKind::Constraint), "actionAdd:constraint"), QString());
+    QCOMPARE(s.constraints.size(), std::size_t(1));
+    QVERIFY(props()->element() && props()->element()->kind == ElementKind::Constraint);
+    // and Remove from the same menu on the element
+    w->setQuestionHook([](const QString& title, const QString&, int) {
+      return int(title.startsWith("Remove") ? QMessageBox::Yes : QMessageBox::Discard);
+    });
+    QCOMPARE(treeMenu(w->treeModel()->indexOf({ElementKind::Constraint, 0}), "treeRemove"), QString());
+    QVERIFY(s.constraints.empty());
   }
 };
 
