@@ -111,6 +111,10 @@ void print(const LinearizeJob& job) {
       std::cout << (k ? ", " : "") << m.rate_names[lin.partition.rate_dependent[k]];
     std::cout << " (they follow from the rolling conditions)\n";
   }
+  for (int i = 0; i < sys.nx(); ++i)
+    if (sys.shifted(i))  // a motion input's realization: not the physical rate its name began as
+      std::cout << "shifted state    " << sys.state_names[static_cast<std::size_t>(i)] << " = " << state_meaning(sys, i)
+                << " (motion inputs enter without their rates; the .mat holds state_shift)\n";
   std::cout << "\n";
   std::cout << "x0\n" << name_values(sys.state_names, sys.x0) << "u0\n" << name_values(sys.input_names, sys.u0)
             << "y0\n" << name_values(sys.output_names, sys.y0) << "xdot0\n" << name_values(sys.state_names, sys.xdot0) << "\n";

@@ -557,6 +557,12 @@ void LinearizeView::showResult() {
   matrix_models_[1]->setMatrix(s.B, xs, us, xu, uu);
   matrix_models_[2]->setMatrix(s.C, ys, xs, yu, xu);
   matrix_models_[3]->setMatrix(s.D, ys, us, yu, uu);
+  // a state a motion input's realization shifted (X2_dot~) says what it is where its name is shown
+  QStringList meanings;
+  for (int i = 0; i < s.nx(); ++i) meanings << qs(state_meaning(s, i));
+  matrix_models_[0]->setMeanings(meanings, meanings);
+  matrix_models_[1]->setMeanings(meanings, {});
+  matrix_models_[2]->setMeanings({}, meanings);
   tabs_->setTabText(0, QStringLiteral("A (%1 x %2)").arg(s.A.rows()).arg(s.A.cols()));
   tabs_->setTabText(1, QStringLiteral("B (%1 x %2)").arg(s.B.rows()).arg(s.B.cols()));
   tabs_->setTabText(2, QStringLiteral("C (%1 x %2)").arg(s.C.rows()).arg(s.C.cols()));

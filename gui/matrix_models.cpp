@@ -31,10 +31,19 @@ void MatrixTableModel::setMatrix(const Eigen::MatrixXd& m, const QStringList& ro
   col_names_ = colNames;
   row_units_ = rowUnits;
   col_units_ = colUnits;
+  row_meanings_.clear();
+  col_meanings_.clear();
   endResetModel();
 }
 
 void MatrixTableModel::clear() { setMatrix(Eigen::MatrixXd(), {}, {}); }
+
+void MatrixTableModel::setMeanings(const QStringList& rows, const QStringList& cols) {
+  row_meanings_ = rows;
+  col_meanings_ = cols;
+  if (m_.rows() > 0) emit headerDataChanged(Qt::Vertical, 0, static_cast<int>(m_.rows()) - 1);
+  if (m_.cols() > 0) emit headerDataChanged(Qt::Horizontal, 0, static_cast<int>(m_.cols()) - 1);
+}
 
 int MatrixTableModel::rowCount(const QModelIndex& parent) const {
   return parent.isValid() ? 0 : static_cast<int>(m_.rows());
@@ -82,8 +91,12 @@ QVariant MatrixTableModel::headerData(int section, Qt::Orientation orientation, 
   switch (role) {
     case Qt::DisplayRole:
       return name;
-    case Qt::ToolTipRole:
-      return withUnit(name, unit);
+    case Qt::ToolTipRole: {
+      const QString meaning = horizontal ? at(col_meanings_, section) : at(row_meanings_, section);
+      return meaning.isEmpty() ? withUnit(name, unit)
+                               : withUnit(name, unit) + "\n" +
+                                     tr("= %1: shifted, the motion inputs enter without their rates").arg(meaning);
+    }
     case Qt::UserRole:
       return unit;
     default:

@@ -26,6 +26,9 @@ class MatrixTableModel : public QAbstractTableModel {
   void setMatrix(const Eigen::MatrixXd& m, const QStringList& rowNames, const QStringList& colNames,
                  const QStringList& rowUnits = {}, const QStringList& colUnits = {});
   void clear();
+  // what a row's or column's name stands for, when it is not what it says ("X2_dot - 46.9375 W"
+  // for a shifted state X2_dot~): added to the header's tooltip ("" for none)
+  void setMeanings(const QStringList& rows, const QStringList& cols);
   const Eigen::MatrixXd& matrix() const { return m_; }
 
   int rowCount(const QModelIndex& parent = QModelIndex()) const override;
@@ -39,7 +42,7 @@ class MatrixTableModel : public QAbstractTableModel {
   QString colName(int c) const;
 
   Eigen::MatrixXd m_;
-  QStringList row_names_, col_names_, row_units_, col_units_;
+  QStringList row_names_, col_names_, row_units_, col_units_, row_meanings_, col_meanings_;
 };
 
 // One row per mode, in the ModalAnalysis order. Qt::UserRole: on column

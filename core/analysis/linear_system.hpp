@@ -21,6 +21,12 @@ struct LinearSystem {
   int npositions() const { return positions >= 0 ? positions : nx() / 2; }
   std::vector<std::string> state_names, input_names, output_names;
   std::vector<std::string> state_units, input_units, output_units;
+  // Motion inputs among the inputs: the realization without their rates keeps the model proper by
+  // shifting states, x = xi + state_shift du + state_rate_shift du' (deviations; x the physical
+  // coordinates and rates, xi the state of A, B, C, D). Each row the shift touches is named with
+  // a trailing '~' ("X2_dot~" is X2_dot - (b2/m2) W, not the wheel's velocity): state_meaning says
+  // what it is. Both [nx x nu], empty without motion inputs.
+  Eigen::MatrixXd state_shift, state_rate_shift;
 
   // provenance
   std::string model_name;        // as in the model file
@@ -34,9 +40,14 @@ struct LinearSystem {
   // back to the same plant; "" when the plant was not linearized through a study
   std::string study;
 
+  bool shifted(int i) const;  // state i is a shifted one (its name ends in '~')
   int nx() const { return static_cast<int>(A.rows()); }
   int nu() const { return static_cast<int>(B.cols()); }
   int ny() const { return static_cast<int>(C.rows()); }
 };
+
+// What state i is, in words of the physical coordinates and the inputs: "X2_dot - 46.9375 W"
+// (and "- c W'" for a rate term) for a shifted state, "" for one that is what its name says.
+std::string state_meaning(const LinearSystem& s, int i);
 
 }  // namespace codyna

@@ -4,6 +4,7 @@
 #include <initializer_list>
 #include <memory>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -159,6 +160,14 @@ void realize_motion_inputs(const Model& model, const PlantFunction& f, const Eig
   s.D += s.C * F;
   out.motion_shift = F;
   out.motion_rate_shift = B2;
+  s.state_shift = F;
+  s.state_rate_shift = B2;
+}
+
+// The rows a motion input's realization shifts get a trailing '~' (after the names are set)
+void name_shifted_states(LinearSystem& s) {
+  for (int i = 0; i < s.nx() && i < static_cast<int>(s.state_names.size()); ++i)
+    if (s.shifted(i)) s.state_names[static_cast<std::size_t>(i)] += "~";
 }
 
 }  // namespace
@@ -205,6 +214,7 @@ Linearization linearize_general(const Model& model, const OperatingPoint& op, co
   s.xdot0 = xd;
   s.state_names = f.state_names();
   s.state_units = f.state_units();
+  name_shifted_states(s);
   for (int k : model.plant_inputs) {
     s.input_names.push_back(model.actuators[k].name);
     s.input_units.push_back(model.actuators[k].unit);
@@ -484,6 +494,35 @@ Linearization linearize(const Model& model, const OperatingPoint& op, const Line
     ~Busy() { b = false; }
   } busy(kept->impl_->busy);
   return kept->linearize(op, options);
+}
+
+}  // namespace codyna
+
+namespace codyna {
+
+bool LinearSystem::shifted(int i) const {
+  auto touches = [i](const Eigen::MatrixXd& M) {
+    if (i < 0 || i >= M.rows() || M.cols() == 0) return false;
+    const double scale = std::max(1.0, M.cwiseAbs().maxCoeff());
+    return M.row(i).cwiseAbs().maxCoeff() > 1e-14 * scale;
+  };
+  return touches(state_shift) || touches(state_rate_shift);
+}
+
+std::string state_meaning(const LinearSystem& s, int i) {
+  if (!s.shifted(i) || i >= static_cast<int>(s.state_names.size())) return "";
+  std::string name = s.state_names[static_cast<std::size_t>(i)];
+  if (!name.empty() && name.back() == '~') name.pop_back();
+  std::string out = name;
+  auto term = [&](double c, int k, const char* rate) {
+    if (c == 0.0 || k >= static_cast<int>(s.input_names.size())) return;
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.6g", std::abs(c));
+    out += (c > 0 ? " - " : " + ") + std::string(buf) + " " + s.input_names[static_cast<std::size_t>(k)] + rate;
+  };
+  for (int k = 0; k < s.state_shift.cols(); ++k) term(s.state_shift(i, k), k, "");
+  for (int k = 0; k < s.state_rate_shift.cols(); ++k) term(s.state_rate_shift(i, k), k, "'");
+  return out;
 }
 
 }  // namespace codyna

@@ -45,10 +45,16 @@ std::array<NameList, 6> name_lists(const LinearSystem& s) {
 }
 
 // The numeric variables of NAME.mat in the order they are written.
+// (with motion inputs among the inputs, the shift of the states their realization makes)
 std::vector<std::pair<const char*, Eigen::MatrixXd>> plant_matrices(const LinearSystem& s) {
-  return {{"A", s.A},   {"B", s.B},   {"C", s.C},         {"D", s.D},
-          {"x0", s.x0}, {"u0", s.u0}, {"y0", s.y0},       {"xdot0", s.xdot0},
-          {"Ts", Eigen::MatrixXd::Constant(1, 1, s.Ts)}};
+  std::vector<std::pair<const char*, Eigen::MatrixXd>> v{{"A", s.A},   {"B", s.B},   {"C", s.C},   {"D", s.D},
+                                                         {"x0", s.x0}, {"u0", s.u0}, {"y0", s.y0}, {"xdot0", s.xdot0},
+                                                         {"Ts", Eigen::MatrixXd::Constant(1, 1, s.Ts)}};
+  if (s.state_shift.size() > 0) {
+    v.emplace_back("state_shift", s.state_shift);
+    v.emplace_back("state_rate_shift", s.state_rate_shift);
+  }
+  return v;
 }
 
 class PlantChecker {
@@ -316,6 +322,22 @@ void write_plant_mat(const LinearSystem& s, const std::string& name, const std::
 
 // ---------------------------------------------------------------- NAME.m
 
+// What the states marked ~ are, and the way back to the physical coordinates and rates
+std::string shifted_states_note(const LinearSystem& s) {
+  std::ostringstream out;
+  bool any = false;
+  for (int i = 0; i < s.nx(); ++i)
+    if (s.shifted(i)) {
+      if (!any)
+        out << "% States marked ~ are shifted: motion inputs enter without their rates (a proper model), and\n"
+            << "% the physical deviations are  dx_physical = dx + state_shift*du + state_rate_shift*du'\n"
+            << "% (state_shift, state_rate_shift: nx x nu, in the .mat):\n";
+      any = true;
+      out << "%   " << one_line(s.state_names[static_cast<std::size_t>(i)]) << " = " << one_line(state_meaning(s, i)) << "\n";
+    }
+  return out.str();
+}
+
 // "%   1  force  [N]" lines
 std::string signal_table(const std::vector<std::string>& names, const std::vector<std::string>& units) {
   std::size_t width = 0;
@@ -362,7 +384,7 @@ std::string header_comment(const LinearSystem& s, const std::string& name, MatVe
     << "% Inputs (plant_inputs):\n"
     << signal_table(s.input_names, s.input_units) << "% Outputs (plant_outputs):\n"
     << signal_table(s.output_names, s.output_units) << "% States (state_names):\n"
-    << signal_table(s.state_names, s.state_units) << "%\n"
+    << signal_table(s.state_names, s.state_units) << shifted_states_note(s) << "%\n"
     << "% Runs as it is in MATLAB and GNU Octave: loads " << name << ".mat from this script's\n"
     << "% folder and, when ss() exists (Control System Toolbox; Octave's control package,\n"
     << "% loaded here when installed), builds the named state-space model sys.\n"
@@ -463,7 +485,8 @@ std::string matlab_identifier(const std::string& s) {
       "function", "global", "if", "methods", "otherwise", "parfor", "persistent", "properties", "return",
       "spmd", "switch", "try", "until", "unwind_protect", "unwind_protect_cleanup", "while",
       // variables NAME.m defines (running NAME would show the variable instead)
-      "A", "B", "C", "D", "x0", "u0", "y0", "xdot0", "Ts", "info", "sys", "plant_inputs", "plant_outputs",
+      "A", "B", "C", "D", "x0", "u0", "y0", "xdot0", "Ts", "info", "sys", "plant_inputs", "plant_outputs", "state_shift",
+      "state_rate_shift",
       "state_names", "input_names", "output_names", "state_units", "input_units", "output_units", "codyna_here",
       "codyna_kind", "codyna_warnings",
       // functions NAME.m calls (NAME.m would shadow them in its folder)

@@ -55,8 +55,11 @@ TEST(Motion, BallAndBeamKeepsTheFeedthroughOfTheBeamsAcceleration) {
   }
   EXPECT_LT(worst, 1e-12);
   EXPECT_NEAR(s.D(0, 0), (J / R) / Me, 1e-15);
-  // the state is the ball's position and rate, shifted by the beam's motion (docs: motion)
-  EXPECT_EQ(s.state_names[0], "r");
+  // the state is the ball's position and rate, shifted by the beam's motion (docs: motion), and
+  // named so: r~ is r - (J/R)/Me theta (the beam's angle), not the ball's position alone
+  EXPECT_EQ(s.state_names[0], "r~");
+  EXPECT_NEAR(s.state_shift(0, 0), (J / R) / Me, 1e-15);
+  EXPECT_EQ(state_meaning(s, 0).rfind("r - ", 0), 0u) << state_meaning(s, 0);
   EXPECT_NEAR(s.x0[0], 0.5, 1e-15);
 }
 

@@ -148,7 +148,8 @@ class ElementsEditingTest : public QObject {
     const LinearSystem* s = linearize("equilibrium");
     QVERIFY(s);
     const int x1 = indexOf(s->state_names, "X1"), x2 = indexOf(s->state_names, "X2");
-    const int v1 = indexOf(s->state_names, "X1_dot"), v2 = indexOf(s->state_names, "X2_dot");
+    // X2_dot~: the wheel's rate shifted by the road's (W is a motion input among Plant/In)
+    const int v1 = indexOf(s->state_names, "X1_dot"), v2 = indexOf(s->state_names, "X2_dot~");
     const int u = indexOf(s->input_names, "U");
     QVERIFY(x1 >= 0 && x2 >= 0 && v1 >= 0 && v2 >= 0 && u >= 0);
     QVERIFY(std::abs((s->x0[x1] - s->x0[x2]) - (-m1 * g / k1)) < 1e-12);
@@ -279,7 +280,8 @@ class ElementsEditingTest : public QObject {
     const LinearSystem* s = linearize("equilibrium");
     QVERIFY(s);
     QCOMPARE(s->nx(), 2);
-    const int th = indexOf(s->state_names, "rod_pivot"), om = indexOf(s->state_names, "rod_pivot_dot");
+    // both states shifted by the shaker's motion (its acceleration swings the rod): named so
+    const int th = indexOf(s->state_names, "rod_pivot~"), om = indexOf(s->state_names, "rod_pivot_dot~");
     const int h = indexOf(s->output_names, "h"), y = indexOf(s->output_names, "theta");
     QVERIFY(th >= 0 && om >= 0 && h >= 0 && y >= 0);
     const double g = 9.81, l = 2.0, a = 3 * g / (2 * l), b = -3 / (2 * l);
