@@ -122,6 +122,10 @@ void refuse_coincident_spring_dampers(const Model& model, const Eigen::VectorXd&
 
 namespace {
 
+// the largest |entry|, 0 for an empty matrix (Eigen's maxCoeff of an empty one is undefined: a model
+// without degrees of freedom, or with no Plant/Out, has empty blocks)
+double max_abs(const Eigen::MatrixXd& M) { return M.size() ? M.cwiseAbs().maxCoeff() : 0.0; }
+
 // The realization of motion inputs. With their rates and accelerations the plant is
 //   x' = A x + B0 u + B1 u' + B2 u'',   y = C x + D0 u + D1 u' + D2 u''
 // (B1, B2 only in the velocity rows). The change of state  xi = x - B2 u' - F u,  F = A B2 + B1,
@@ -142,8 +146,7 @@ void realize_motion_inputs(const Model& model, const PlantFunction& f, const Eig
   }
   const Eigen::MatrixXd F = s.A * B2 + B1;
   const Eigen::MatrixXd rate_gain = s.C * B2 + D1;
-  const double scale = std::max({1.0, s.C.cwiseAbs().maxCoeff(), D1.cwiseAbs().maxCoeff()}) *
-                       std::max({1.0, B2.cwiseAbs().maxCoeff()});
+  const double scale = std::max({1.0, max_abs(s.C), max_abs(D1)}) * std::max(1.0, max_abs(B2));
   for (int i = 0; i < ny; ++i)
     for (int j = 0; j < nm; ++j) {
       const int c = f.motion_inputs()[static_cast<std::size_t>(j)];
@@ -196,8 +199,8 @@ Linearization linearize_general(const Model& model, const OperatingPoint& op, co
   const Eigen::MatrixXd J = plant_jacobian(f, x, ue, options.method);
   if (options.method != JacobianMethod::Exact) {
     const Eigen::MatrixXd Je = plant_jacobian(f, x, ue, JacobianMethod::Exact);
-    const double scale = std::max(Je.cwiseAbs().maxCoeff(), 1e-300);
-    out.fd_error = (J - Je).cwiseAbs().maxCoeff() / scale;
+    const double scale = std::max(max_abs(Je), 1e-300);
+    out.fd_error = max_abs(J - Je) / scale;
   }
   LinearSystem& s = out.system;
   s.A = J.topLeftCorner(nx, nx);

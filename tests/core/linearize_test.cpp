@@ -10,6 +10,8 @@
 #include "io/model_file.hpp"
 #include "dynamics/prepare.hpp"
 #include "model/errors.hpp"
+#include "study/files.hpp"
+#include "study/workflow.hpp"
 #include "test_util.hpp"
 
 namespace codyna {
@@ -276,4 +278,28 @@ TEST(OperatingPoint, EquilibriumKeepsNeutralCoordinates) {
 }
 
 }  // namespace
+}  // namespace codyna
+
+namespace codyna {
+
+// Found by the GUI's monkey building from File > New: a model without degrees of freedom linearized
+// by finite differences took the largest entry of an empty Jacobian (undefined: it crashed), and so
+// did a motion input with no Plant/Out (an empty C). Both give their empty or exact blocks.
+TEST(Linearize, EmptyBlocksAreNoLargestEntry) {
+  for (const char* method : {"fd-forward", "fd-central", "exact"}) {
+    ModelSpec empty = study_parse_model_text(
+        std::string(R"({"codyna_model": 1, "name": "e", "bodies": [], "joints": [], "analysis": {"method": ")") + method + "\"}}",
+        "empty.json");
+    const StudyLinearization l = study_linearize(study_model(empty));
+    EXPECT_EQ(l.system.nx(), 0) << method;
+  }
+  ModelSpec bus = load_model_spec(test::example_path("bus_suspension.json"));
+  bus.plant.outputs.clear();
+  bus.analysis.method = "fd-central";
+  const StudyLinearization l = study_linearize(study_model(bus));
+  EXPECT_EQ(l.system.ny(), 0);
+  EXPECT_EQ(l.system.nx(), 4);
+  EXPECT_NEAR(l.system.state_shift(3, 1), 15020.0 / 320.0, 1e-6);
+}
+
 }  // namespace codyna
