@@ -83,6 +83,35 @@ void fitAxis(QValueAxis* a, double lo, double hi) {
   a->applyNiceNumbers();
 }
 
+// A Bode axis on round values, as a control engineer reads one: ticks from 0 at the smallest of
+// `steps` that gives at most 8 of them (multiples of 20 or 10 dB; of 90 or 45 degrees), the range
+// out to whole steps
+void bodeAxis(QValueAxis* a, double lo, double hi, std::initializer_list<double> steps) {
+  if (!(lo <= hi) || !std::isfinite(lo) || !std::isfinite(hi)) {
+    fitAxis(a, 0, 0);
+    return;
+  }
+  double step = *(steps.end() - 1);
+  for (double s : steps)
+    if ((hi - lo) / s <= 8.0) {
+      step = s;
+      break;
+    }
+  double from = std::floor(lo / step) * step, to = std::ceil(hi / step) * step;
+  if (to - from < step * 0.5) to = from + step;
+  a->setTickType(QValueAxis::TicksDynamic);
+  setAxisRange(a, from, to, step);
+}
+
+// a logarithmic frequency axis from decade to decade (its ticks and labels at the decades)
+void decadeAxis(QLogValueAxis* a, double lo, double hi) {
+  if (!(lo > 0 && hi >= lo) || !std::isfinite(hi)) return;
+  const double from = std::pow(10.0, std::floor(std::log10(lo) + 1e-9));
+  double to = std::pow(10.0, std::ceil(std::log10(hi) - 1e-9));
+  if (to <= from) to = from * 10;
+  a->setRange(from, to);
+}
+
 }  // namespace
 
 ControlView::ControlView(Document* doc, QWidget* parent) : QWidget(parent), doc_(doc) {
@@ -378,6 +407,10 @@ void ControlView::redraw() {
     fitAxis(py, 0, 0);
     tx->setRange(0, 1);
     fitAxis(ty, 0, 0);
+    // nothing drawn: no title of an earlier model's curves either
+    mag_chart_->setTitle(QString());
+    phase_chart_->setTitle(QString());
+    step_chart_->setTitle(QString());
     return;
   }
   QList<QPointF> mag, phase;
@@ -396,12 +429,10 @@ void ControlView::redraw() {
   }
   mag_series_->replace(mag);
   phase_series_->replace(phase);
-  mx->setRange(f->w.front(), f->w.back());
-  px->setRange(f->w.front(), f->w.back());
-  fitAxis(my, mlo, mhi);
-  fitAxis(py, plo, phi);
-  my->setTickCount(5);
-  py->setTickCount(5);
+  decadeAxis(mx, f->w.front(), f->w.back());
+  decadeAxis(px, f->w.front(), f->w.back());
+  bodeAxis(my, mlo, mhi, {1, 2, 5, 10, 20, 40, 100, 200, 500});
+  bodeAxis(py, plo, phi, {5, 15, 45, 90, 180, 360});
   mag_chart_->setTitle(tr("Magnitude, %1 to %2").arg(input_combo_->currentText(), output_combo_->currentText()));
   phase_chart_->setTitle(tr("Phase, %1 to %2").arg(input_combo_->currentText(), output_combo_->currentText()));
 

@@ -54,6 +54,18 @@ QString num(double x) { return QString::number(x, 'g', 6); }
 
 }  // namespace
 
+namespace {
+// what a linearization depends on: the spec without where and how its export is written (a new
+// export name or folder does not make A, B, C, D out of date)
+std::string linearization_key(const ModelSpec& spec, const QString& file) {
+  ModelSpec s = spec;
+  s.analysis.export_name.clear();
+  s.analysis.export_dir.clear();
+  s.analysis.mat_version = "5";
+  return file.toStdString() + "\n" + study_model_json(s).dump();  // the file: relative paths, the export's header
+}
+}  // namespace
+
 LinearizeView::LinearizeView(Document* doc, QWidget* parent) : QWidget(parent), doc_(doc) {
   qRegisterMetaType<Eigen::VectorXcd>("Eigen::VectorXcd");
   qRegisterMetaType<std::complex<double>>("std::complex<double>");
@@ -495,6 +507,7 @@ bool LinearizeView::linearize() {
     }
     result_ = std::move(r);
     result_model_ = m;
+    result_key_ = linearization_key(doc_->spec(), doc_->filePath());
     modal_ = std::move(modal);
   } catch (const std::exception& e) {
     emit message(tr("Linearize: %1").arg(qs(e.what())));
@@ -517,7 +530,9 @@ bool LinearizeView::linearize() {
   return true;
 }
 
-bool LinearizeView::isStale() const { return !result_ || result_model_ != doc_->model(); }
+bool LinearizeView::isStale() const {
+  return !result_ || !doc_->model() || (result_model_ != doc_->model() && result_key_ != linearization_key(doc_->spec(), doc_->filePath()));
+}
 
 void LinearizeView::updateStaleness() {
   const bool stale = result_ && isStale();
@@ -673,8 +688,10 @@ bool LinearizeView::exportTo(const QString& dir, QString* error) {
   if (isStale() && !linearize()) return fail(tr("the model could not be linearized"));
   try {
     std::string target = ss(dir);
-    if (!target.empty()) target = study_path(*result_model_, target);  // relative: to the model file
-    const ExportPaths p = study_export(*result_model_, result_->system, target);
+    // the document's model now: the same linearization, with the export name and folder as they are now
+    const Model& now = doc_->model() && result_model_ != doc_->model() ? *doc_->model() : *result_model_;
+    if (!target.empty()) target = study_path(now, target);  // relative: to the model file
+    const ExportPaths p = study_export(now, result_->system, target);
     const QString mat = qs(p.mat_file), m = qs(p.m_file);
     emit exported(mat, m);
     return true;

@@ -134,6 +134,7 @@ class LinearizeView : public QWidget {
   Document* doc_;
   std::optional<codyna::StudyLinearization> result_;
   std::shared_ptr<const codyna::Model> result_model_;  // the model result_ was computed on
+  std::string result_key_;                             // its spec, but for the export's name and folder
   codyna::ModalAnalysis modal_;
   int selected_mode_ = -1;
   bool syncing_ = false;

@@ -305,9 +305,11 @@ void MainWindow::buildMenus() {
   a_import_->setToolTip(tr("Read an MJCF (MuJoCo) or URDF (ROS) model into a new, unsaved model; the report says what "
                            "was not modelled (Ctrl+I)"));
   file->addSeparator();
+  // as the Linearize view's Export button: into the study's export folder when it is set (asked only
+  // when it is not), under its export name
   QAction* a_export = file->addAction(tr("&Export plant (NAME.m + NAME.mat)..."), this, [this] {
-    const QString d = QFileDialog::getExistingDirectory(this, tr("Export plant to folder"), QFileInfo(doc_->filePath()).absolutePath());
-    if (!d.isEmpty()) exportPlant(d);
+    tabs_->setCurrentWidget(lin_view_);
+    lin_view_->exportButton()->click();
   });
   a_export->setShortcut(QKeySequence(Qt::CTRL | Qt::Key_E));
   file->addSeparator();

@@ -35,6 +35,7 @@
 
 #include "gui/chart_view.hpp"
 #include "gui/document.hpp"
+#include "model/spec_edit.hpp"
 #include "study/files.hpp"
 #include "study/workflow.hpp"
 
@@ -238,7 +239,7 @@ void SweepView::buildUi() {
   progress_->setObjectName("sweepProgress");
   progress_->setRange(0, 1);
   progress_->setValue(0);
-  progress_->setFormat(tr("%v of %m variants"));
+  progress_->setFormat(tr("not run yet"));  // "0 of 1 variants" said what was not so
   lv->addWidget(progress_);
   status_ = new QLabel(tr("Pick the fields to vary, then Run"), left);
   status_->setObjectName("sweepStatus");
@@ -367,7 +368,12 @@ void SweepView::addField(const QString& pointer, const QString& spec) {
   }
   const int r = fields_->rowCount();
   fields_->insertRow(r);
-  fields_->setItem(r, 0, new QTableWidgetItem(pointer));
+  auto* field = new QTableWidgetItem(pointer);
+  // the name the model tree gives it ("rod.mass" for /bodies/1/mass)
+  if (const auto ref = element_at_path(ss(pointer)); ref && ref->index < element_count(doc_->spec(), ref->kind))
+    field->setToolTip(QStringLiteral("%1.%2  (%3)")
+                          .arg(qs(element_name(doc_->spec(), ref->kind, ref->index)), qs(ref->field).replace('/', '.'), pointer));
+  fields_->setItem(r, 0, field);
   fields_->setItem(r, 1, new QTableWidgetItem(values));
   fields_->setCurrentCell(r, 1);
   updateButtons();
@@ -425,6 +431,7 @@ bool SweepView::run() {
   running_ = true;
   progress_->setRange(0, 1);
   progress_->setValue(0);
+  progress_->setFormat(tr("starting..."));
   setStatus(tr("Running..."), false);
   updateButtons();
   thread_ = QThread::create([this, r] {
@@ -464,6 +471,7 @@ void SweepView::cancel() {
 void SweepView::tick() {
   const long long total = total_.load(), done = done_.load();
   if (total > 0) {
+    progress_->setFormat(tr("%v of %m variants"));
     progress_->setRange(0, static_cast<int>(std::min<long long>(total, std::numeric_limits<int>::max())));
     progress_->setValue(static_cast<int>(std::min(done, total)));
   }
@@ -517,6 +525,7 @@ void SweepView::clearResult() {
   summary_->clear();
   parameter_combo_->clear();
   progress_->setValue(0);
+  progress_->setFormat(tr("not run yet"));
   updateButtons();
 }
 

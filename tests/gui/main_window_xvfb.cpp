@@ -3,7 +3,11 @@
 // view with its pole map, a simulation plot and a playback frame, written as PNGs
 // under build/screenshots; the study's steady-state search and references filled in
 // through their widgets (linearize_steady_state.png, simulate_references.png). A blank 3-D view fails (pixel statistics, not file existence).
+#include <QApplication>
+#include <QContextMenuEvent>
 #include <QDir>
+#include <QMenu>
+#include <QTreeView>
 #include <QCheckBox>
 #include <QComboBox>
 #include <QElapsedTimer>
@@ -25,7 +29,9 @@
 #include <QWindow>
 
 #include "gui/linearize_view.hpp"
+#include "gui/issues_panel.hpp"
 #include "gui/main_window.hpp"
+#include "model/spec_edit.hpp"
 #include "gui/pole_map.hpp"
 #include <QChart>
 #include "gui/result_plots.hpp"
@@ -319,6 +325,29 @@ class MainWindowXvfb : public QObject {
     QVERIFY(cv->isStale());
     QTest::qWait(200);
     save(screenOf(&w), "control_stale.png");
+
+    // the cart removed while its slider and the rod's pivot still name it: every problem in the Issues
+    // list at once, the slider's child field marked where the user looks; and the tree's context
+    // menu on a body, as a right click opens it (the whole screen: the menu is a window of its own)
+    w.document()->edit("Remove cart", [](ModelSpec& s) { remove_element(s, ElementKind::Body, 0); });
+    QVERIFY(w.issuesPanel()->count() >= 2);
+    w.selectElement(ElementId{ElementKind::Joint, 0});
+    QVERIFY(w.propertyEditor()->markedFields().contains("child"));
+    QTest::qWait(200);
+    save(screenOf(&w), "issues_panel.png");
+    w.document()->undoStack()->undo();
+    QTreeView* tree = w.modelTree();
+    const QModelIndex rod = w.treeModel()->indexOf({ElementKind::Body, 1});
+    const QPoint at = tree->visualRect(rod).center();
+    QContextMenuEvent menu_event(QContextMenuEvent::Mouse, at, tree->viewport()->mapToGlobal(at));
+    QApplication::sendEvent(tree->viewport(), &menu_event);
+    auto* menu = qobject_cast<QMenu*>(QApplication::activePopupWidget());
+    QVERIFY(menu);
+    QTest::qWait(300);
+    const QRect area = QRect(w.mapToGlobal(QPoint(0, 0)), w.size()).united(menu->geometry());
+    save(w.windowHandle()->screen()->grabWindow(0, area.x(), area.y(), area.width(), area.height()).toImage(),
+         "tree_context_menu.png");
+    menu->close();
     w.document()->undoStack()->setClean();
   }
 

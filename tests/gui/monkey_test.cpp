@@ -15,6 +15,7 @@
 // CODYNA_MONKEY_EVENTS (default 4000) sets the events per seed; the seeds are 1..5 (the even ones
 // build a model from File > New, the odd ones edit the cart-pendulum).
 #include <QAbstractItemView>
+#include <QAction>
 #include <QAbstractSpinBox>
 #include <QApplication>
 #include <QCheckBox>
@@ -138,13 +139,11 @@ class MonkeyTest : public QObject {
         if (from_empty) QVERIFY(w->newModel());
         else QVERIFY(w->openFile(model));
       }
-      if (from_empty && e % 25 == 12) {
-        // building: an element of any kind added with its shortcut now and then (Ctrl+Shift+B, J,
-        // L, E, U, Y), wherever the focus is; the random events then edit it
-        static const Qt::Key add_keys[] = {Qt::Key_B, Qt::Key_J, Qt::Key_L, Qt::Key_E, Qt::Key_U, Qt::Key_Y};
-        QWidget* f = QApplication::focusWidget();
-        QTest::keyClick(f && w->isAncestorOf(f) ? f : w.get(), add_keys[rng.bounded(int(std::size(add_keys)))],
-                        Qt::ControlModifier | Qt::ShiftModifier);
+      if (from_empty && e % 10 == 5) {
+        // building: an element of any kind added now and then (the Add bar's and Edit > Add's
+        // actions, whose shortcuts are Ctrl+Shift+B, J, L, E, U, Y), the random events then edit it
+        static const char* kinds[] = {"body", "joint", "constraint", "effect", "actuator", "sensor"};
+        if (auto* add = w->findChild<QAction*>(QStringLiteral("actionAdd:%1").arg(kinds[rng.bounded(6)]))) add->trigger();
       }
       if (e % 25 == 0) {
         // a person picks an element in the model tree now and then: a click on one of its rows
