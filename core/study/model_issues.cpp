@@ -21,18 +21,6 @@ std::string names_or_none(const std::vector<std::string>& names) {
   return out;
 }
 
-const char* section_word(ElementKind k) {
-  switch (k) {
-    case ElementKind::Body: return "bodies";
-    case ElementKind::Joint: return "joints";
-    case ElementKind::Constraint: return "constraints";
-    case ElementKind::Effect: return "effects";
-    case ElementKind::Actuator: return "actuators";
-    case ElementKind::Sensor: return "sensors";
-  }
-  return "elements";
-}
-
 // the file's order: the sections as a model file lists them, then indices as numbers, then the field
 std::tuple<int, int, std::string> file_order_key(const std::string& path) {
   if (const auto ref = element_at_path(path)) return {static_cast<int>(ref->kind), ref->index, ref->field};
@@ -60,9 +48,9 @@ ModelCheck check_model(const ModelSpec& spec, const std::string& file) {
       continue;  // a sensor's axes: empty is the ground's
     if (find_element(spec, r.target, r.name) >= 0) continue;
     const std::string detail = r.name.empty()
-                                   ? std::string("expected the name of a ") + to_string(r.target) + " (" + section_word(r.target) + ": " +
+                                   ? std::string("expected the name of a ") + to_string(r.target) + " (" + section_of(r.target) + ": " +
                                          names_or_none(element_names(spec, r.target)) + ")"
-                                   : std::string("unknown ") + to_string(r.target) + " " + in_quotes(r.name) + " (" + section_word(r.target) +
+                                   : std::string("unknown ") + to_string(r.target) + " " + in_quotes(r.name) + " (" + section_of(r.target) +
                                          ": " + names_or_none(element_names(spec, r.target)) + ")";
     found.emplace_back(file, r.path, detail);
   }
