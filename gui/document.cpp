@@ -58,12 +58,10 @@ void Document::recompile() {
   const QString text = issues.isEmpty() ? QString() : issues[static_cast<qsizetype>(check.first)].text;
   const QString path = issues.isEmpty() ? QString() : issues[static_cast<qsizetype>(check.first)].path;
   const bool changed = text != error_ || path != error_path_;
-  const bool issues_changed = issues != issues_;
   error_ = text;
   error_path_ = path;
   issues_ = std::move(issues);
   emit modelChanged();
-  if (issues_changed) emit issuesChanged();
   if (changed || !text.isEmpty()) emit errorChanged(error_, error_path_);
 }
 

@@ -44,7 +44,6 @@ class Document : public QObject {
     QString path;    // "/joints/2/parent" ("" when no field is to blame)
     QString text;    // the whole message (file: path: what was expected)
     QString detail;  // what was expected, alone
-    bool operator==(const Issue&) const = default;
   };
   const QList<Issue>& issues() const { return issues_; }
 
@@ -81,7 +80,6 @@ class Document : public QObject {
   void modelChanged();                // after the compiled model was refreshed (model() may be null)
   void fileChanged();                 // path or modified state changed (window title)
   void errorChanged(const QString& text, const QString& path);
-  void issuesChanged();  // after the list of issues changed (emitted before errorChanged)
   // another model took the document's place (load, clear): every result of the old one must go
   void replaced();
 

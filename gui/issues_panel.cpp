@@ -22,8 +22,8 @@ IssuesPanel::IssuesPanel(Document* doc, QWidget* parent) : QWidget(parent), doc_
   auto* lay = new QVBoxLayout(this);
   lay->setContentsMargins(0, 0, 0, 0);
   lay->addWidget(list_, 1);
-  connect(doc, &Document::issuesChanged, this, &IssuesPanel::rebuild);
-  connect(doc, &Document::specChanged, this, &IssuesPanel::rebuild);  // names in the Element column follow renames
+  // after every change's recompile (the issues are new then, and a rename shows in the Element column)
+  connect(doc, &Document::modelChanged, this, &IssuesPanel::rebuild);
   auto chosen = [this](QTreeWidgetItem* item) {
     if (!item) return;
     const QString path = item->data(0, Qt::UserRole).toString();
