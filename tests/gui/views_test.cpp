@@ -34,7 +34,9 @@
 #include <cmath>
 #include <functional>
 
+#include "drive.hpp"
 #include "gui/document.hpp"
+#include "gui/wheel_guard.hpp"
 #include "gui/linearize_view.hpp"
 #include "gui/matrix_models.hpp"
 #include "gui/pole_map.hpp"
@@ -718,6 +720,42 @@ class ViewsTest : public QObject {
     QVERIFY(err.contains(".h5"));
     QVERIFY2(view.savePlot(tmp.filePath("plot.png"), &err), qPrintable(err));
     QVERIFY(QFileInfo(tmp.filePath("plot.png")).size() > 0);
+  }
+
+  // "Start at" in the Simulate view, as a person uses it: a wheel turned over the closed drop-down
+  // changes nothing; "the operating point (x0)" picked from its list with the mouse is the study's
+  // start; the run then begins where core's study_simulation puts it, the equilibrium, not the
+  // model's 0.1 rad off upright; and the drop-down follows the document (undo)
+  void startAtTheOperatingPointFromTheSimulateView() {
+    WheelGuard::install();  // as codyna-gui's window installs it, before any field is polished
+    Document doc;
+    QVERIFY(doc.load(kCart));
+    SimulateView view(&doc);
+    view.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&view));
+    QComboBox* start = view.startCombo();
+    QCOMPARE(start->currentData().toString(), QString("model"));
+    drive::wheelOver(start, -1);
+    QCOMPARE(doc.spec().analysis.start, std::string("model"));
+    QVERIFY(drive::pickWithMouse(start, "the operating point (x0)"));
+    QCOMPARE(doc.spec().analysis.start, std::string("operating-point"));
+    view.endTimeSpin()->setValue(0.2);
+    QSignalSpy finished(&view, &SimulateView::runFinished);
+    QTest::mouseClick(view.runButton(), Qt::LeftButton);
+    QVERIFY(waitFor([&] { return finished.count() == 1; }));
+    const auto r = view.result();
+    QVERIFY(r && r->completed && r->samples() > 1);
+    const Model m = study_model(doc.spec(), ss(kCart));
+    const StudySimulation setup = study_simulation(m);
+    QCOMPARE(setup.start, std::string("equilibrium"));
+    QVERIFY((setup.options.q0 - m.q0).cwiseAbs().maxCoeff() > 0.05);  // the model's own start is elsewhere
+    for (int k = 0; k < m.nq; ++k) QVERIFY2(std::abs(r->q(0, k) - setup.options.q0[k]) <= 1e-12, qPrintable(QString::number(k)));
+    QVERIFY(view.worker()->notes().join("\n").contains("the run starts at the equilibrium point"));
+    // undo the end time and the start: the drop-down shows the model's state again
+    doc.undoStack()->undo();
+    doc.undoStack()->undo();
+    QCOMPARE(doc.spec().analysis.start, std::string("model"));
+    QCOMPARE(start->currentData().toString(), QString("model"));
   }
 
   void lqrWithTheLinearComparisonIsPlottedToo() {
