@@ -53,6 +53,9 @@ void Document::recompile() {
   // finds (issues(): all of them, in the model file's order)
   const ModelCheck check = check_model(spec_, ss(path_));
   model_ = check.model;
+  draft_ = check.draft;
+  draft_leaves_out_.clear();
+  for (const std::string& e : check.draft_leaves_out) draft_leaves_out_.push_back(qs(e));
   QList<Issue> issues;
   for (const ModelError& e : check.issues) issues.push_back({qs(e.path()), qs(e.what()), qs(e.detail())});
   const QString text = issues.isEmpty() ? QString() : issues[static_cast<qsizetype>(check.first)].text;

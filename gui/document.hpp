@@ -46,6 +46,11 @@ class Document : public QObject {
     QString detail;  // what was expected, alone
   };
   const QList<Issue>& issues() const { return issues_; }
+  // While the model does not compile: its draft, for the 3-D view (what compiles of it, the bodies
+  // no joint moves held in a row; study/model_issues.hpp), and what the draft leaves out
+  // ("joint pivot"). Null and empty when the model compiles.
+  std::shared_ptr<const Model> draft() const { return draft_; }
+  const QStringList& draftLeavesOut() const { return draft_leaves_out_; }
 
   // File operations. load() leaves the document untouched when the file does not load
   // (error set to the ModelError's text). save() writes atomically; a failed save keeps
@@ -91,6 +96,8 @@ class Document : public QObject {
   std::shared_ptr<const Model> model_;
   QString error_, error_path_;
   QList<Issue> issues_;
+  std::shared_ptr<const Model> draft_;
+  QStringList draft_leaves_out_;
 };
 
 QString qs(const std::string& s);

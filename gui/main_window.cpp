@@ -879,7 +879,16 @@ void MainWindow::showTreeMenu(const QPoint& at) {
 
 void MainWindow::onModelChanged() {
   animateMode(-1, {});
-  view_->setModel(doc_->model());
+  if (doc_->model() || !doc_->draft()) {
+    view_->setModel(doc_->model());
+  } else {
+    const int n = static_cast<int>(doc_->issues().size());
+    QString note = n == 1 ? tr("Draft: the model does not compile yet (1 issue, see Issues).")
+                          : tr("Draft: the model does not compile yet (%1 issues, see Issues).").arg(n);
+    const QStringList& out = doc_->draftLeavesOut();
+    if (!out.isEmpty()) note += tr("\nNot drawn: %1.").arg(out.size() > 4 ? out.mid(0, 4).join(", ") + tr(", ...") : out.join(", "));
+    view_->setDraft(doc_->draft(), note);
+  }
   if (!doc_->model()) statusBar()->showMessage(tr("The model does not compile: %1").arg(doc_->errorText().section('\n', 0, 0)));
 }
 

@@ -1,5 +1,7 @@
 #include "gui/scene3d.hpp"
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -472,16 +474,32 @@ void Scene::addDefaultLook(int i) {
   for (const auto& e : ends) extent = std::max({extent, (e - com).norm(), (e - inboard).norm()});
 
   double r_ball;
-  if (extent > 1e-9) {
-    r_ball = 0.12 * extent;
-  } else {
-    // nothing to connect: a ball of the body's radius of gyration, else a share of the scene
+  // nothing further to connect (a body just added, a free body, the last link of a chain): the solid
+  // ellipsoid of the body's mass and inertia, on its principal axes (semi-axis a_k^2 = 5 (I_1 + I_2 +
+  // I_3 - 2 I_k) / (2 m)), joined to its joint by a link; a ball of a share of the scene (or of the
+  // link) when the inertia does not make one
+  Eigen::Affine3d ellipsoid = Eigen::Affine3d::Identity();
+  bool has_ellipsoid = false;
+  r_ball = extent > 1e-9 ? 0.12 * extent : 0.05 * length_;
+  if (ends.empty()) {
     const int k = m.body_spec_index[i];
     const double mass = m.mass[i];
-    const double trace = k >= 0 ? m.spec.bodies[k].inertia.trace() : 0.0;
-    r_ball = (mass > 0 && trace > 0) ? std::sqrt(2.5 * trace / 3.0 / mass) : 0.05 * length_;
+    if (k >= 0 && mass > 0) {
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m.spec.bodies[static_cast<std::size_t>(k)].inertia);
+      const Eigen::Vector3d I = eig.eigenvalues();
+      Eigen::Vector3d a;
+      for (int c = 0; c < 3; ++c) a[c] = std::sqrt(std::max(0.0, 2.5 * (I.sum() - 2 * I[c]) / mass));
+      if (eig.info() == Eigen::Success && a.maxCoeff() > 0) {
+        r_ball = a.maxCoeff();
+        ellipsoid.translation() = com;
+        Eigen::Matrix3d R = eig.eigenvectors();
+        if (R.determinant() < 0) R.col(2) *= -1;  // a rotation: a mirror would turn the triangles inside out
+        ellipsoid.linear() = R * a.cwiseMax(1e-3 * r_ball).asDiagonal();  // a flat disc keeps a thickness
+        has_ellipsoid = true;
+      }
+    }
   }
-  const double r_link = 0.3 * r_ball;
+  const double r_link = 0.3 * (extent > 1e-9 ? std::min(r_ball, 0.12 * extent) : r_ball);
   const Eigen::Vector4f color = kPalette[static_cast<size_t>(i - 1) % kPalette.size()];
 
   auto add = [&](Prim p, const Eigen::Affine3d& local, const Eigen::Vector4f& c) {
@@ -495,7 +513,7 @@ void Scene::addDefaultLook(int i) {
   Eigen::Affine3d ball = Eigen::Affine3d::Identity();
   ball.translation() = com;
   ball.linear() *= r_ball;
-  add(Prim::Sphere, ball, color);
+  add(Prim::Sphere, has_ellipsoid ? ellipsoid : ball, color);
   const Eigen::Vector4f pin{0.5f, 0.5f, 0.55f, 1.0f};
   for (const auto& e : ends) {
     if ((e - inboard).norm() < 1e-9) continue;
@@ -692,6 +710,24 @@ void Scene::addElements(const std::vector<SE3>& oMi) {
       Item* d = local(ItemKind::Actuator, a.name, a.body, Prim::Cylinder, disc(p, a.direction, 0.06 * L, 0.005 * L),
                       color);
       d->world_axes = a.in_world;
+    }
+  }
+
+  // body forces (constant loads, shown always): an arrow from the point along the force, and for a
+  // torque an arrow along it through the point with a disc around it; dark red
+  const Eigen::Vector4f load{0.62f, 0.10f, 0.10f, 1.0f};
+  for (const BodyForceModel& f : m.body_forces) {
+    const double len = 0.2 * L;
+    if (f.force.norm() > 0) {
+      const Eigen::Vector3d u = f.force.normalized();
+      local(ItemKind::Force, f.name, f.body, Prim::Arrow, arrowAt(f.point + 0.5 * len * u, u, len, 0.6 * len), load)
+          ->world_axes = f.in_world;
+    }
+    if (f.torque.norm() > 0) {
+      const Eigen::Vector3d u = f.torque.normalized();
+      local(ItemKind::Force, f.name, f.body, Prim::Arrow, arrowAt(f.point + 0.5 * len * u, u, len, 0.6 * len), load)
+          ->world_axes = f.in_world;
+      local(ItemKind::Force, f.name, f.body, Prim::Cylinder, disc(f.point, u, 0.05 * L, 0.005 * L), load)->world_axes = f.in_world;
     }
   }
 }

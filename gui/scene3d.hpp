@@ -53,6 +53,7 @@ enum class ItemKind {
   Motion,     // a joint driven by a motion input: an arrow along its axis and a disc around it
   Actuator,   // an actuator driven by a mix: a force arrow from its point, a torque arrow and disc
   Contact,    // a rolling_ball: a thin disc of the plane under the ball at the contact, a dot on it
+  Force,      // a body_force effect: an arrow along its force from its point, an arrow and a disc for its torque
 };
 
 // how a two-point item spans the line from point_a (on `body`) to point_b (on body_b)

@@ -423,7 +423,33 @@ QString View3D::openGLUnavailableReason() {
 
 bool View3D::hasGL() const { return canvas_ != nullptr; }
 
+void View3D::setDraft(std::shared_ptr<const codyna::Model> draft, const QString& note) {
+  setModel(std::move(draft));
+  if (!draft_note_) {
+    draft_note_ = new QLabel(this);
+    draft_note_->setObjectName(QStringLiteral("view3dDraftNote"));
+    draft_note_->setWordWrap(true);
+    draft_note_->setAutoFillBackground(true);
+    draft_note_->setMargin(4);
+    draft_note_->setAttribute(Qt::WA_TransparentForMouseEvents);
+    QPalette pal = draft_note_->palette();
+    pal.setColor(QPalette::Window, QColor(255, 244, 214));
+    pal.setColor(QPalette::WindowText, QColor(90, 60, 0));
+    draft_note_->setPalette(pal);
+  }
+  draft_note_->setText(note);
+  draft_note_->setMaximumWidth(std::max(160, width() - 16));
+  draft_note_->adjustSize();
+  draft_note_->move(8, 8);
+  draft_note_->setVisible(!note.isEmpty());
+  draft_note_->raise();
+  if (auto_fit_) fitView();  // a model being built grows: keep it in sight until the user takes the camera
+}
+
+QString View3D::draftNote() const { return draft_note_ && !draft_note_->isHidden() ? draft_note_->text() : QString(); }
+
 void View3D::setModel(std::shared_ptr<const codyna::Model> model) {
+  if (draft_note_) draft_note_->hide();
   poses_.reset();
   model_ = std::move(model);
   poses_ = model_ ? std::make_unique<codyna::StudyPoses>(*model_) : nullptr;

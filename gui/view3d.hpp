@@ -51,6 +51,11 @@ class View3D : public QWidget {
   // (or one from another file / with another name); an edited model keeps it.
   void setModel(std::shared_ptr<const codyna::Model> model);
   std::shared_ptr<const codyna::Model> model() const { return model_; }
+  // a model that does not compile yet, drawn as its draft (study/model_issues.hpp: what compiles of
+  // it, the bodies no joint moves held in a row); `note` is shown over the view's top-left corner
+  // until the next setModel. The camera follows the draft as it grows until the user moves it.
+  void setDraft(std::shared_ptr<const codyna::Model> draft, const QString& note);
+  QString draftNote() const;  // "" when the model shown is not a draft
   // nq values; draws the mechanism there (setModel starts at m.q0). Cheap:
   // forward kinematics and item transforms only. Wrong sizes are ignored.
   void setConfiguration(const Eigen::VectorXd& q);
@@ -115,6 +120,7 @@ class View3D : public QWidget {
 
   GLCanvas* canvas_ = nullptr;
   QLabel* placeholder_ = nullptr;
+  QLabel* draft_note_ = nullptr;
   QPoint press_pos_, last_pos_;
   bool pressed_ = false, dragged_ = false;
   double last_frame_ms_ = 0.0;

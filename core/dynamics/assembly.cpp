@@ -13,6 +13,9 @@ namespace {
 // off the manifold a redundant constraint row is only almost dependent, and a
 // plain solve would divide by its tiny singular value
 Eigen::VectorXd min_norm_solve(const Eigen::MatrixXd& J, const Eigen::VectorXd& b) {
+  // nothing to move (every joint fixed or driven) or nothing to meet: Eigen's decompositions are not
+  // defined on an empty matrix (ColPivHouseholderQR read out of bounds on 3 x 0)
+  if (J.cols() == 0 || J.rows() == 0) return Eigen::VectorXd::Zero(J.cols());
   Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod;
   cod.setThreshold(1e-9);
   cod.compute(J);

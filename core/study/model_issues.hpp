@@ -6,6 +6,13 @@
 // every field that names a body, a joint, an actuator or a sensor that is not there,
 // and every body that no joint moves. Each problem is a ModelError (file, field
 // path "/joints/2/parent", what was expected), in the model file's order.
+//
+// A model being built does not compile for a while (three bodies added before any
+// joint), yet an editor should show what is there. The draft is the model as far as
+// it goes: a body that no joint moves is held where it is drawn (a fixed joint to the
+// ground, in a row beside the others), and each element the compile still refuses is
+// left out, one at a time, until the rest compiles. It is for drawing, never for a
+// study (its plant and analysis sections are empty).
 #pragma once
 
 #include <memory>
@@ -22,7 +29,15 @@ struct ModelCheck {
   std::shared_ptr<const Model> model;  // study_model(spec, file), or null when it does not compile
   std::vector<ModelError> issues;      // empty exactly when the model compiles; in the file's order
   std::size_t first = 0;               // which of them study_model itself reports (its first error)
+  // when the model does not compile: the draft (null when not even that compiles) and the
+  // elements it leaves out ("joint pivot", ...), in the order they were left out
+  std::shared_ptr<const Model> draft;
+  std::vector<std::string> draft_leaves_out;
 };
+
+// the draft of `spec` (see above); `left_out` receives what it leaves out
+std::shared_ptr<const Model> draft_model(const ModelSpec& spec, const std::string& file = "",
+                                         std::vector<std::string>* left_out = nullptr);
 
 ModelCheck check_model(const ModelSpec& spec, const std::string& file = "");
 

@@ -10,6 +10,7 @@
 #include "io/model_file.hpp"
 #include "model/spec_edit.hpp"
 #include "study/files.hpp"
+#include "study/tools.hpp"
 #include "study/workflow.hpp"
 #include "test_util.hpp"
 
@@ -79,6 +80,57 @@ TEST(ModelIssues, EveryBodyNoJointMovesIsListed) {
   EXPECT_EQ(issue_paths(c), (std::vector<std::string>{"/bodies/0", "/bodies/1"}));
   EXPECT_NE(c.issues[1].detail().find("\"wheel\" is not the child of any joint"), std::string::npos);
   EXPECT_EQ(c.first, 0u);
+}
+
+// A model being built shows what is there: the draft holds the bodies no joint moves in a row
+// along x (centres of mass 1.5 (r_i + r_j) apart, r the largest semi-axis of the ellipsoid of
+// equal mass and inertia), and leaves out what still refers to nothing.
+TEST(ModelIssues, TheDraftHoldsUnattachedBodiesInARow) {
+  ModelSpec s;
+  s.name = "new";
+  for (int k = 0; k < 3; ++k) add_element(s, ElementKind::Body);
+  s.bodies[1].mass = 4.0;                                              // r = sqrt(2.5 * 0.01 / 4)
+  s.bodies[2].com = Eigen::Vector3d(0.3, -0.2, 0.1);
+  s.bodies[2].inertia = Eigen::Vector3d(0.02, 0.03, 0.04).asDiagonal();  // r^2 = 2.5 (0.07 - 0.02) / 1
+  const ModelCheck c = check_model(s);
+  ASSERT_FALSE(c.model);
+  ASSERT_TRUE(c.draft);
+  EXPECT_TRUE(c.draft_leaves_out.empty());
+  const Model& m = *c.draft;
+  ASSERT_EQ(m.nbodies, 4);
+  EXPECT_EQ(m.nv, 0);
+  // a default body (1 kg, 0.01 kg m^2 about every axis): r^2 = 2.5 (0.01 + 0.01 - 0.01) / 1
+  const double r0 = std::sqrt(2.5 * 0.01), r1 = std::sqrt(2.5 * 0.01 / 4), r2 = std::sqrt(2.5 * 0.05);
+  const double x[3] = {0, 1.5 * (r0 + r1), 1.5 * (r0 + r1) + 1.5 * (r1 + r2)};
+  StudyPoses poses(m);
+  const auto& oMi = poses.at(m.q0);
+  for (int k = 0; k < 3; ++k) {
+    const int i = m.find_body(s.bodies[static_cast<std::size_t>(k)].name);
+    ASSERT_GT(i, 0);
+    EXPECT_LT((oMi[static_cast<std::size_t>(i)].act_point(m.com[static_cast<std::size_t>(i)]) - Eigen::Vector3d(x[k], 0, 0)).norm(), 1e-14) << k;
+  }
+  // the spec itself is untouched: the holders are the draft's
+  EXPECT_TRUE(s.joints.empty());
+}
+
+TEST(ModelIssues, TheDraftLeavesOutWhatRefersToNothingAndKeepsTheBodies) {
+  ModelSpec s = load_model_spec(example_path("bus_suspension.json"));
+  s.joints[1].parent = "chassis";  // not there: the joint is left out (and the sensor of its slide), its body (the wheel) held
+  const ModelCheck c = check_model(s);
+  ASSERT_FALSE(c.model);
+  ASSERT_TRUE(c.draft);
+  EXPECT_EQ(c.draft_leaves_out, (std::vector<std::string>{"joint X2", "sensor X2"}));
+  EXPECT_EQ(c.draft->nbodies, 4);  // ground, body, wheel, road: nothing of the user's is lost from sight
+  EXPECT_EQ(c.draft->springs.size(), 2u);
+  EXPECT_EQ(c.draft->nv, c.model ? -1 : study_model(load_model_spec(example_path("bus_suspension.json"))).nv - 1);  // the wheel held
+  // an element naming a body that is gone is left out
+  remove_element(s, ElementKind::Body, find_element(s, ElementKind::Body, "wheel"));
+  const ModelCheck d = check_model(s);
+  ASSERT_TRUE(d.draft);
+  EXPECT_EQ(d.draft->nbodies, 3);
+  EXPECT_GE(d.draft_leaves_out.size(), 3u);
+  // a compiling model has no draft: it is its own picture
+  EXPECT_FALSE(check_model(load_model_spec(example_path("bus_suspension.json"))).draft);
 }
 
 TEST(ModelIssues, PlantAndMixNamesThatAreGoneAreListed) {

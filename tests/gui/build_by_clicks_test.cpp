@@ -31,6 +31,7 @@
 #include "gui/linearize_view.hpp"
 #include "gui/issues_panel.hpp"
 #include "gui/main_window.hpp"
+#include "gui/view3d.hpp"
 #include "gui/plant_panel.hpp"
 #include "gui/property_editor.hpp"
 #include "gui/simulate_view.hpp"
@@ -334,6 +335,21 @@ class BuildByClicksTest : public QObject {
     add("body");
     typeHere("mass", "2500");
     typeHere("inertia", "100, 100, 100");
+    // a new body shows at once, before any joint moves it: the ellipsoid of its mass and inertia
+    // (semi-axes^2 = 5 (I_1 + I_2 + I_3 - 2 I_k) / (2 m) = 2.5 * 100 / 2500), over a note that the
+    // model is a draft
+    {
+      View3D* view = w->view3d();
+      QVERIFY(view->model());
+      QVERIFY2(view->draftNote().startsWith("Draft: the model does not compile yet (1 issue"), qPrintable(view->draftNote()));
+      int shapes = 0;
+      for (const auto& it : view->scene().items())
+        if (it.kind == gui::ItemKind::Shape && it.body == 1) {
+          ++shapes;
+          QVERIFY(it.world.linear().isApprox(Eigen::Matrix3d::Identity() * std::sqrt(0.1), 1e-12));
+        }
+      QCOMPARE(shapes, 1);
+    }
     shape("box", {"size", "1, 0.4, 0.6", "color", "0.5, 0.5, 0.55"});
     QCOMPARE(issues->count(), 1);
     add("body");
@@ -353,6 +369,22 @@ class BuildByClicksTest : public QObject {
     // three bodies, none moved yet: three issues, listed at once
     QCOMPARE(issues->count(), 3);
     QCOMPARE(issues->list()->topLevelItem(1)->text(0), QString("body wheel"));
+    // all three in sight, side by side; a click on one in the 3-D view selects it, though the model
+    // does not compile
+    {
+      View3D* view = w->view3d();
+      QVERIFY(view->draftNote().startsWith("Draft: the model does not compile yet (3 issues"));
+      for (const QString& name : {QString("body"), QString("wheel"), QString("road")}) {
+        QPointF at;
+        QVERIFY2(view->bodyScreenPos(name, &at), qPrintable(name));
+        QVERIFY2(view->rect().contains(at.toPoint()), qPrintable(name));
+        QCOMPARE(view->pickBody(at.toPoint()), name);
+      }
+      QPointF at;
+      QVERIFY(view->bodyScreenPos("wheel", &at));
+      QTest::mouseClick(view, Qt::LeftButton, {}, at.toPoint());
+      QVERIFY(props()->element() && *props()->element() == (gui::ElementId{ElementKind::Body, 1}));
+    }
 
     const char* joints[][3] = {{"X1", "body", "0, 1.5, 0"}, {"X2", "wheel", "0, 0.5, 0"}, {"road_height", "road", "0, -0.2, 0"}};
     for (const auto& j : joints) {

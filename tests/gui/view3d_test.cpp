@@ -420,6 +420,64 @@ class View3DTest : public QObject {
   // joints X1, X2 place at (0, 1.5 + X1, 0) and (0, 0.5 + X2, 0) (closed form, not the scene's own
   // kinematics); the two overlap as the strut is pulled or pushed. The road's motion input W draws a
   // cyan arrow along +y from road_height's frame at (0, -0.2, 0), with a disc around it.
+  // a body with nothing to connect is the solid ellipsoid of its mass and inertia on the principal
+  // axes: the drawn map L = R diag(a) has L L^T = Q diag(a_k^2) Q^T with a_k^2 = 5 (I_1 + I_2 + I_3 -
+  // 2 I_k) / (2 m), for the inertia Q diag(I) Q^T (closed form, independent of the eigen-solver's
+  // order and signs); a body force is an arrow along its force from its point
+  void equivalentEllipsoidAndBodyForce() {
+    codyna::ModelSpec spec;
+    spec.name = "ellipsoid";
+    codyna::BodySpec b;
+    b.name = "slab";
+    b.mass = 3;
+    b.com = {0.1, 0.2, 0.3};
+    const Eigen::Matrix3d Q = Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+    const Eigen::Vector3d I(1.0, 2.0, 2.5);
+    b.inertia = Q * I.asDiagonal() * Q.transpose();
+    spec.bodies.push_back(b);
+    codyna::JointSpec j;
+    j.name = "hold";
+    j.type = codyna::JointType::Fixed;
+    j.parent = "ground";
+    j.child = "slab";
+    j.parent_frame.position = -b.com;
+    spec.joints.push_back(j);
+    codyna::EffectSpec f;
+    f.name = "push";
+    f.type = codyna::EffectType::BodyForce;
+    f.body_a = "slab";
+    f.point_a = {0.5, 0, 0};
+    f.force = {0, 0, -20};
+    spec.effects.push_back(f);
+    auto m = std::make_shared<const codyna::Model>(codyna::compile(spec));
+    Scene scene;
+    scene.build(m.get());
+    Eigen::Vector3d a2;
+    for (int k = 0; k < 3; ++k) a2[k] = 2.5 * (I.sum() - 2 * I[k]) / b.mass;
+    const Eigen::Matrix3d expected = Q * a2.asDiagonal() * Q.transpose();
+    int shapes = 0, forces = 0;
+    for (const auto& it : scene.items()) {
+      if (it.kind == ItemKind::Shape && it.body == 1 && it.world.translation().norm() < 1e-12) {  // at the com
+        ++shapes;
+        QCOMPARE(it.prim, Prim::Sphere);
+        const Eigen::Matrix3d L = it.world.linear();
+        QVERIFY2((L * L.transpose() - expected).norm() < 1e-12 * expected.norm(), qPrintable(QString("%1 vs %2 / %3").arg((L * L.transpose()).norm()).arg(expected.norm()).arg((L * L.transpose() - expected).norm())));
+        QVERIFY(L.determinant() > 0);
+      }
+      if (it.kind == ItemKind::Force) {
+        ++forces;
+        QCOMPARE(QString::fromStdString(it.element), QString("push"));
+        // the arrow's axis (its z) points along the force, its tail at the point
+        const Eigen::Vector3d z = it.world.linear().col(2);
+        QVERIFY(z.normalized().isApprox(Eigen::Vector3d(0, 0, -1), 1e-12));
+        const Eigen::Vector3d tail = it.world * Eigen::Vector3d(0, 0, -0.5), point = Eigen::Vector3d(0.5, 0, 0) - b.com;
+        QVERIFY2((tail - point).norm() < 1e-12, "tail at the point");
+      }
+    }
+    QCOMPARE(shapes, 1);
+    QCOMPARE(forces, 1);
+  }
+
   void lineForceAndMotionOnTheBus() {
     auto m = loadExample("bus_suspension.json");
     Scene scene;
