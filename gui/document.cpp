@@ -53,9 +53,11 @@ void Document::recompile() {
   // finds (issues(): all of them, in the model file's order)
   const ModelCheck check = check_model(spec_, ss(path_));
   model_ = check.model;
-  draft_ = check.draft;
+  draft_ = check.draft.model;
   draft_leaves_out_.clear();
-  for (const std::string& e : check.draft_leaves_out) draft_leaves_out_.push_back(qs(e));
+  draft_held_.clear();
+  for (const std::string& e : check.draft.leaves_out) draft_leaves_out_.push_back(qs(e));
+  for (const std::string& b : check.draft.held) draft_held_.push_back(qs(b));
   QList<Issue> issues;
   for (const ModelError& e : check.issues) issues.push_back({qs(e.path()), qs(e.what()), qs(e.detail())});
   const QString text = issues.isEmpty() ? QString() : issues[static_cast<qsizetype>(check.first)].text;

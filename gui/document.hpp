@@ -51,6 +51,7 @@ class Document : public QObject {
   // ("joint pivot"). Null and empty when the model compiles.
   std::shared_ptr<const Model> draft() const { return draft_; }
   const QStringList& draftLeavesOut() const { return draft_leaves_out_; }
+  const QStringList& draftHeld() const { return draft_held_; }  // bodies no joint moves, held by the draft
 
   // File operations. load() leaves the document untouched when the file does not load
   // (error set to the ModelError's text). save() writes atomically; a failed save keeps
@@ -97,7 +98,7 @@ class Document : public QObject {
   QString error_, error_path_;
   QList<Issue> issues_;
   std::shared_ptr<const Model> draft_;
-  QStringList draft_leaves_out_;
+  QStringList draft_leaves_out_, draft_held_;
 };
 
 QString qs(const std::string& s);

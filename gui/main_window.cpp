@@ -201,11 +201,18 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
     if (text.isEmpty()) {
       // fixed: the old error leaves the status bar
       if (statusBar()->currentMessage().startsWith(tr("Error:"))) statusBar()->clearMessage();
+      logged_error_.clear();
       return;
     }
     // said, listed in the Issues panel and marked at its fields; the selection stays where the
-    // user put it (the next value typed goes where the user is looking)
+    // user put it (the next value typed goes where the user is looking). The log has it once while
+    // it stays (three bodies added before any joint are one line, not three)
     Q_UNUSED(path);
+    if (text == logged_error_) {
+      statusBar()->showMessage(tr("Error: %1").arg(text.section('\n', 0, 0)), 15000);
+      return;
+    }
+    logged_error_ = text;
     message(text, true);
   });
   connect(doc_, &Document::specChanged, this, [this] {
@@ -887,7 +894,7 @@ void MainWindow::onModelChanged() {
                           : tr("Draft: the model does not compile yet (%1 issues, see Issues).").arg(n);
     const QStringList& out = doc_->draftLeavesOut();
     if (!out.isEmpty()) note += tr("\nNot drawn: %1.").arg(out.size() > 4 ? out.mid(0, 4).join(", ") + tr(", ...") : out.join(", "));
-    view_->setDraft(doc_->draft(), note);
+    view_->setDraft(doc_->draft(), note, doc_->draftHeld());
   }
   if (!doc_->model()) statusBar()->showMessage(tr("The model does not compile: %1").arg(doc_->errorText().section('\n', 0, 0)));
 }

@@ -145,6 +145,7 @@ class MainWindow : public QMainWindow {
   QTreeView* tree_;
   PropertyEditor* props_;
   PlantPanel *plant_in_, *plant_out_;
+  QString logged_error_;  // the model error last written to the Messages log
   View3D* view_;
   LinearizeView* lin_view_;
   SimulateView* sim_view_;

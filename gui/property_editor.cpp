@@ -652,6 +652,7 @@ void PropertyEditor::rebuild() {
       if (is_rotation_key(key)) text = rotation_text(v);
       else if (!v.is_null()) text = value_text(v);
       auto* e = new QLineEdit(text);
+      e->setCursorPosition(0);  // a long vector shows its first entries, not the tail of its last
       if (v.is_null()) e->setPlaceholderText(tr("none"));
       e->setProperty("value", e->text());
       // a number, or a vector's entries, can be varied in a parameter study (the Sweep view)

@@ -271,7 +271,7 @@ double intersect(Prim prim, const Eigen::Affine3d& world, const Ray& ray) {
 
 // ---- scene ----
 
-void Scene::build(const Model* model) {
+void Scene::build(const Model* model, const std::vector<int>& held) {
   model_ = model;
   items_.clear();
   up_ = Eigen::Vector3d::UnitY();
@@ -364,7 +364,7 @@ void Scene::build(const Model* model) {
     return std::clamp(std::max(2.4 * ball, 0.04 * L), 0.01 * L, 0.1 * L);
   };
   for (int i = 1; i < m.nbodies; ++i)
-    if (m.parent[i] == 0) anchor(m.joints[i].X_PF.p, m.joints[i].X_PF.R, anchorSize(i, m.joints[i].X_CM.p));
+    if (m.parent[i] == 0 && std::find(held.begin(), held.end(), i) == held.end()) anchor(m.joints[i].X_PF.p, m.joints[i].X_PF.R, anchorSize(i, m.joints[i].X_CM.p));
   for (const ConstraintModel& c : m.constraints) {
     if (c.type == ConstraintType::Coupler) continue;  // couples coordinates, at no point
     if (c.type == ConstraintType::RollingBall || c.type == ConstraintType::RollingDisc)

@@ -107,7 +107,8 @@ double intersect(Prim prim, const Eigen::Affine3d& world, const Ray& ray);
 class Scene {
  public:
   // builds the items of `model` (nullptr: empty) and places them at model->q0
-  void build(const Model* model);
+  // `held`: bodies a draft holds in place (study/model_issues.hpp), drawn without a ground anchor
+  void build(const Model* model, const std::vector<int>& held = {});
   // recomputes the world transforms from body poses (oMi of forward_kinematics)
   void update(const std::vector<SE3>& oMi);
 

@@ -423,8 +423,16 @@ QString View3D::openGLUnavailableReason() {
 
 bool View3D::hasGL() const { return canvas_ != nullptr; }
 
-void View3D::setDraft(std::shared_ptr<const codyna::Model> draft, const QString& note) {
+void View3D::setDraft(std::shared_ptr<const codyna::Model> draft, const QString& note, const QStringList& held) {
   setModel(std::move(draft));
+  if (model_ && !held.isEmpty()) {
+    std::vector<int> bodies;
+    for (const QString& b : held) bodies.push_back(model_->find_body(b.toStdString()));
+    scene_.build(model_.get(), bodies);
+    scene_.update(poses_->at(q_));
+    updateSceneRadius();
+    if (canvas_) canvas_->gridChanged();
+  }
   if (!draft_note_) {
     draft_note_ = new QLabel(this);
     draft_note_->setObjectName(QStringLiteral("view3dDraftNote"));

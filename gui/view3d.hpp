@@ -18,6 +18,7 @@
 #include <QPoint>
 #include <QPointF>
 #include <QString>
+#include <QStringList>
 #include <QWidget>
 #include <Eigen/Core>
 #include <memory>
@@ -54,7 +55,8 @@ class View3D : public QWidget {
   // a model that does not compile yet, drawn as its draft (study/model_issues.hpp: what compiles of
   // it, the bodies no joint moves held in a row); `note` is shown over the view's top-left corner
   // until the next setModel. The camera follows the draft as it grows until the user moves it.
-  void setDraft(std::shared_ptr<const codyna::Model> draft, const QString& note);
+  // `held`: the bodies the draft holds (no ground anchor is drawn for them)
+  void setDraft(std::shared_ptr<const codyna::Model> draft, const QString& note, const QStringList& held = {});
   QString draftNote() const;  // "" when the model shown is not a draft
   // nq values; draws the mechanism there (setModel starts at m.q0). Cheap:
   // forward kinematics and item transforms only. Wrong sizes are ignored.

@@ -40,7 +40,8 @@ double equivalent_reach(const BodySpec& b) {
 
 }  // namespace
 
-std::shared_ptr<const Model> draft_model(const ModelSpec& spec, const std::string& file, std::vector<std::string>* left_out) {
+ModelDraft draft_model(const ModelSpec& spec, const std::string& file) {
+  ModelDraft out;
   ModelSpec d = spec;
   d.plant = {};
   d.analysis = {};
@@ -76,10 +77,15 @@ std::shared_ptr<const Model> draft_model(const ModelSpec& spec, const std::strin
   for (std::size_t attempt = 0; attempt <= 2 * most; ++attempt) {
     hold_unattached();
     try {
-      return std::make_shared<const Model>(compile(d, file));
+      out.model = std::make_shared<const Model>(compile(d, file));
+      for (const std::string& h : holders) {
+        const int j = find_element(d, ElementKind::Joint, h);
+        if (j >= 0) out.held.push_back(d.joints[static_cast<std::size_t>(j)].child);
+      }
+      return out;
     } catch (const ModelError& e) {
       const auto ref = element_at_path(e.path());
-      if (!ref || ref->index < 0 || ref->index >= element_count(d, ref->kind)) return nullptr;
+      if (!ref || ref->index < 0 || ref->index >= element_count(d, ref->kind)) return {};
       const std::string name = element_name(d, ref->kind, ref->index);
       const bool holder = ref->kind == ElementKind::Joint && std::count(holders.begin(), holders.end(), name);
       if (holder) {  // the body cannot be held either: leave it out, with its holder
@@ -87,16 +93,16 @@ std::shared_ptr<const Model> draft_model(const ModelSpec& spec, const std::strin
         remove_element(d, ref->kind, ref->index);
         const int b = find_element(d, ElementKind::Body, body);
         if (b >= 0) remove_element(d, ElementKind::Body, b);
-        if (left_out) left_out->push_back("body " + body);
+        out.leaves_out.push_back("body " + body);
         continue;
       }
-      if (left_out) left_out->push_back(std::string(to_string(ref->kind)) + " " + (name.empty() ? "(no name)" : name));
+      out.leaves_out.push_back(std::string(to_string(ref->kind)) + " " + (name.empty() ? "(no name)" : name));
       remove_element(d, ref->kind, ref->index);
     } catch (const std::exception&) {
-      return nullptr;
+      return {};
     }
   }
-  return nullptr;
+  return {};
 }
 
 ModelCheck check_model(const ModelSpec& spec, const std::string& file) {
@@ -139,7 +145,7 @@ ModelCheck check_model(const ModelSpec& spec, const std::string& file) {
                    [](const ModelError& a, const ModelError& b) { return file_order_key(a.path()) < file_order_key(b.path()); });
   for (std::size_t i = 0; i < out.issues.size(); ++i)
     if (out.issues[i].path() == compiled) out.first = i;
-  out.draft = draft_model(spec, file, &out.draft_leaves_out);
+  out.draft = draft_model(spec, file);
   return out;
 }
 

@@ -25,19 +25,20 @@
 
 namespace codyna {
 
+// the draft of a model that does not compile (see above)
+struct ModelDraft {
+  std::shared_ptr<const Model> model;   // null when not even the draft compiles
+  std::vector<std::string> leaves_out;  // the elements left out ("joint pivot", ...), in that order
+  std::vector<std::string> held;        // the bodies no joint moves, held by the draft's fixed joints
+};
+ModelDraft draft_model(const ModelSpec& spec, const std::string& file = "");
+
 struct ModelCheck {
   std::shared_ptr<const Model> model;  // study_model(spec, file), or null when it does not compile
   std::vector<ModelError> issues;      // empty exactly when the model compiles; in the file's order
   std::size_t first = 0;               // which of them study_model itself reports (its first error)
-  // when the model does not compile: the draft (null when not even that compiles) and the
-  // elements it leaves out ("joint pivot", ...), in the order they were left out
-  std::shared_ptr<const Model> draft;
-  std::vector<std::string> draft_leaves_out;
+  ModelDraft draft;                    // when the model does not compile
 };
-
-// the draft of `spec` (see above); `left_out` receives what it leaves out
-std::shared_ptr<const Model> draft_model(const ModelSpec& spec, const std::string& file = "",
-                                         std::vector<std::string>* left_out = nullptr);
 
 ModelCheck check_model(const ModelSpec& spec, const std::string& file = "");
 

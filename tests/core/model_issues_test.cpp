@@ -94,9 +94,10 @@ TEST(ModelIssues, TheDraftHoldsUnattachedBodiesInARow) {
   s.bodies[2].inertia = Eigen::Vector3d(0.02, 0.03, 0.04).asDiagonal();  // r^2 = 2.5 (0.07 - 0.02) / 1
   const ModelCheck c = check_model(s);
   ASSERT_FALSE(c.model);
-  ASSERT_TRUE(c.draft);
-  EXPECT_TRUE(c.draft_leaves_out.empty());
-  const Model& m = *c.draft;
+  ASSERT_TRUE(c.draft.model);
+  EXPECT_TRUE(c.draft.leaves_out.empty());
+  const Model& m = *c.draft.model;
+  EXPECT_EQ(c.draft.held, (std::vector<std::string>{"body", "body_2", "body_3"}));
   ASSERT_EQ(m.nbodies, 4);
   EXPECT_EQ(m.nv, 0);
   // a default body (1 kg, 0.01 kg m^2 about every axis): r^2 = 2.5 (0.01 + 0.01 - 0.01) / 1
@@ -118,19 +119,20 @@ TEST(ModelIssues, TheDraftLeavesOutWhatRefersToNothingAndKeepsTheBodies) {
   s.joints[1].parent = "chassis";  // not there: the joint is left out (and the sensor of its slide), its body (the wheel) held
   const ModelCheck c = check_model(s);
   ASSERT_FALSE(c.model);
-  ASSERT_TRUE(c.draft);
-  EXPECT_EQ(c.draft_leaves_out, (std::vector<std::string>{"joint X2", "sensor X2"}));
-  EXPECT_EQ(c.draft->nbodies, 4);  // ground, body, wheel, road: nothing of the user's is lost from sight
-  EXPECT_EQ(c.draft->springs.size(), 2u);
-  EXPECT_EQ(c.draft->nv, c.model ? -1 : study_model(load_model_spec(example_path("bus_suspension.json"))).nv - 1);  // the wheel held
+  ASSERT_TRUE(c.draft.model);
+  EXPECT_EQ(c.draft.leaves_out, (std::vector<std::string>{"joint X2", "sensor X2"}));
+  EXPECT_EQ(c.draft.held, std::vector<std::string>{"wheel"});
+  EXPECT_EQ(c.draft.model->nbodies, 4);  // ground, body, wheel, road: nothing of the user's is lost from sight
+  EXPECT_EQ(c.draft.model->springs.size(), 2u);
+  EXPECT_EQ(c.draft.model->nv, c.model ? -1 : study_model(load_model_spec(example_path("bus_suspension.json"))).nv - 1);  // the wheel held
   // an element naming a body that is gone is left out
   remove_element(s, ElementKind::Body, find_element(s, ElementKind::Body, "wheel"));
   const ModelCheck d = check_model(s);
-  ASSERT_TRUE(d.draft);
-  EXPECT_EQ(d.draft->nbodies, 3);
-  EXPECT_GE(d.draft_leaves_out.size(), 3u);
+  ASSERT_TRUE(d.draft.model);
+  EXPECT_EQ(d.draft.model->nbodies, 3);
+  EXPECT_GE(d.draft.leaves_out.size(), 3u);
   // a compiling model has no draft: it is its own picture
-  EXPECT_FALSE(check_model(load_model_spec(example_path("bus_suspension.json"))).draft);
+  EXPECT_FALSE(check_model(load_model_spec(example_path("bus_suspension.json"))).draft.model);
 }
 
 TEST(ModelIssues, PlantAndMixNamesThatAreGoneAreListed) {

@@ -351,6 +351,44 @@ class MainWindowXvfb : public QObject {
     w.document()->undoStack()->setClean();
   }
 
+  // a model being built from File > New: a car body (a 1500 kg box's inertia), a wheel (a disc's),
+  // a driver's seat (equal moments); no joint yet, so the model does not compile, and the 3-D view
+  // shows its draft: each body the ellipsoid of its mass and inertia, side by side, under a note
+  void draftOfANewModel() {
+    MainWindow w;
+    w.resize(1600, 1000);
+    w.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&w));
+    QVERIFY(w.newModel());
+    struct Part { const char* name; double mass; Eigen::Vector3d inertia; };
+    // box 4.5 x 1.4 x 1.8 m: I = m (b^2 + c^2) / 12 ...; disc r 0.3, width 0.2; a 70 kg seat
+    const Part parts[] = {{"car", 1500, Eigen::Vector3d(1500 * (1.4 * 1.4 + 1.8 * 1.8) / 12, 1500 * (4.5 * 4.5 + 1.8 * 1.8) / 12,
+                                                         1500 * (4.5 * 4.5 + 1.4 * 1.4) / 12)},
+                          {"wheel", 20, Eigen::Vector3d(20 * (3 * 0.09 + 0.04) / 12, 20 * 0.09 / 2, 20 * (3 * 0.09 + 0.04) / 12)},
+                          {"seat", 70, Eigen::Vector3d(2.5, 2.5, 2.5)}};
+    for (const Part& p : parts)
+      w.document()->edit("Add body", [&p](ModelSpec& s) {
+        const int i = add_element(s, ElementKind::Body);
+        s.bodies[static_cast<std::size_t>(i)].name = p.name;
+        s.bodies[static_cast<std::size_t>(i)].mass = p.mass;
+        s.bodies[static_cast<std::size_t>(i)].inertia = p.inertia.asDiagonal();
+      });
+    QVERIFY(!w.document()->model());
+    QCOMPARE(w.issuesPanel()->count(), 3);
+    View3D* view = w.view3d();
+    QVERIFY(view->draftNote().contains("Draft"));
+    w.selectElement(ElementId{ElementKind::Body, 1});
+    QTest::qWait(300);
+    for (const char* name : {"car", "wheel", "seat"}) {
+      QPointF at;
+      QVERIFY2(view->bodyScreenPos(name, &at) && view->rect().contains(at.toPoint()), name);
+    }
+    const QImage shot = screenOf(&w);
+    QVERIFY(stats(screenOfChild(&w, view)).foreground > 0.05);
+    save(shot, "default_shapes.png");
+    w.document()->undoStack()->setClean();
+  }
+
   // the Sweep view of issue 22: the rod mass from 5 to 15 kg, K fixed; the pole map coloured by it
   void sweepView() {
     MainWindow w;
