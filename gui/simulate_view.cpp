@@ -400,7 +400,18 @@ void SimulateView::buildUi() {
     controller_pages_->setCurrentIndex(std::max(0, i));
     if (i < 0) return;
     const std::string c = ss(controller_combo_->itemData(i).toString());
-    writeStudy([&](StudySpec& s) { s.controller = c; }, tr("Change the controller"));
+    // an LQR designed here is designed about the operating point: a regulator's run starts there
+    // (the usual choice), in the same undoable step; the Start-at drop-down shows it and takes the
+    // model's own state back. The model file's controller keeps the file's choice.
+    const StudySpec& now = doc_->spec().analysis;
+    const bool start_there = !syncing_ && c == "lqr" && now.controller != "lqr" && now.start == "model";
+    writeStudy([&](StudySpec& s) {
+      s.controller = c;
+      if (start_there) s.start = "operating-point";
+    }, start_there ? tr("Change the controller (and start at the operating point)") : tr("Change the controller"));
+    if (start_there && doc_->spec().analysis.start == "operating-point")
+      emit message(tr("The LQR is designed about the operating point: the run starts there now (Start at; "
+                      "the initial-state table sets an offset from it)."));
   });
   connect(pid_table_, &QTableWidget::cellChanged, this, &SimulateView::pidEdited);
   connect(file_edit_, &QLineEdit::editingFinished, this, [this] {

@@ -160,11 +160,12 @@ void SweepView::buildUi() {
   auto* hint = new QLabel(tr("Varied fields (right-click a number in the property editor: <i>Vary in sweep</i>)"), left);
   hint->setWordWrap(true);
   lv->addWidget(hint);
-  fields_ = new QTableWidget(0, 2, left);
+  fields_ = new QTableWidget(0, 3, left);
   fields_->setObjectName("sweepFields");
-  fields_->setHorizontalHeaderLabels({tr("Field"), tr("Values")});
+  fields_->setHorizontalHeaderLabels({tr("Field"), tr("Values"), tr("Is")});
   fields_->horizontalHeader()->setSectionResizeMode(0, QHeaderView::Stretch);
   fields_->horizontalHeader()->setSectionResizeMode(1, QHeaderView::Stretch);
+  fields_->horizontalHeader()->setSectionResizeMode(2, QHeaderView::ResizeToContents);
   fields_->verticalHeader()->setVisible(false);
   fields_->setSelectionBehavior(QAbstractItemView::SelectRows);
   // no delayed edit on a click into a selected cell: a double click, F2 or typing opens the editor
@@ -172,7 +173,8 @@ void SweepView::buildUi() {
                            QAbstractItemView::AnyKeyPressed);
   fields_->setToolTip(tr("Field: a JSON pointer into the model file (/bodies/1/mass, /joints/0/q0/0).\n"
                          "Values: a:b:n (n values from a to b), [v1,v2,...], normal(mu,sigma) or uniform(a,b).\n"
-                         "Several grids make the full grid; several distributions joint random samples."));
+                         "Several grids make the full grid; several distributions joint random samples.\n"
+                         "Is: the field as the model tree names it (rod.mass), or why the pointer names nothing."));
   fields_->setMinimumHeight(90);
   lv->addWidget(fields_, 1);
   auto* rows = new QHBoxLayout;
@@ -327,6 +329,13 @@ void SweepView::buildUi() {
     for (int r : rows) fields_->removeRow(r);
     updateButtons();
   });
+  // the Is column follows the pointer typed and the model's names
+  connect(fields_, &QTableWidget::itemChanged, this, [this](QTableWidgetItem* it) {
+    if (it && it->column() == 0) refreshFieldName(it->row());
+  });
+  connect(doc_, &Document::specChanged, this, [this] {
+    for (int r = 0; r < fields_->rowCount(); ++r) refreshFieldName(r);
+  });
   connect(run_button_, &QPushButton::clicked, this, [this] { run(); });
   connect(cancel_button_, &QPushButton::clicked, this, &SweepView::cancel);
   connect(save_button_, &QPushButton::clicked, this, &SweepView::saveDialog);
@@ -368,16 +377,49 @@ void SweepView::addField(const QString& pointer, const QString& spec) {
   }
   const int r = fields_->rowCount();
   fields_->insertRow(r);
-  auto* field = new QTableWidgetItem(pointer);
-  // the name the model tree gives it ("rod.mass" for /bodies/1/mass)
-  if (const auto ref = element_at_path(ss(pointer)); ref && ref->index < element_count(doc_->spec(), ref->kind))
-    field->setToolTip(QStringLiteral("%1.%2  (%3)")
-                          .arg(qs(element_name(doc_->spec(), ref->kind, ref->index)), qs(ref->field).replace('/', '.'), pointer));
-  fields_->setItem(r, 0, field);
+  fields_->setItem(r, 0, new QTableWidgetItem(pointer));
   fields_->setItem(r, 1, new QTableWidgetItem(values));
   fields_->setCurrentCell(r, 1);
   updateButtons();
   emit message(tr("Sweep: %1 = %2 (edit the values in the Sweep view)").arg(pointer, values));
+}
+
+QString SweepView::fieldName(const QString& pointer) const {
+  const std::string p = ss(pointer.trimmed());
+  if (p.empty()) return QString();
+  const auto ref = element_at_path(p);
+  if (!ref || ref->index < 0 || ref->index >= element_count(doc_->spec(), ref->kind) || ref->field.empty())
+    return tr("(not a field of an element)");
+  try {
+    const nlohmann::json j = study_model_json(doc_->spec());
+    const nlohmann::json::json_pointer jp(p);
+    if (!j.contains(jp)) return tr("(not in the model file)");
+    if (!j[jp].is_number()) return tr("(not a number)");
+  } catch (const std::exception&) {
+    return tr("(not a JSON pointer)");
+  }
+  // the name the model tree gives it ("rod.mass" for /bodies/1/mass)
+  return QStringLiteral("%1.%2").arg(qs(element_name(doc_->spec(), ref->kind, ref->index)), qs(ref->field).replace('/', '.'));
+}
+
+QString SweepView::shownField(const std::string& pointer) const {
+  const QString name = fieldName(qs(pointer));
+  return name.isEmpty() || name.startsWith('(') ? qs(pointer) : name;
+}
+
+void SweepView::refreshFieldName(int row) {
+  if (row < 0 || row >= fields_->rowCount()) return;
+  const QString pointer = fields_->item(row, 0) ? fields_->item(row, 0)->text() : QString();
+  const QString name = fieldName(pointer);
+  QTableWidgetItem* is = fields_->item(row, 2);
+  if (!is) {
+    is = new QTableWidgetItem;
+    is->setFlags(is->flags() & ~Qt::ItemIsEditable);
+    fields_->setItem(row, 2, is);
+  }
+  if (is->text() != name) is->setText(name);
+  is->setForeground(name.startsWith('(') ? QBrush(QColor(170, 40, 30)) : QBrush());
+  if (fields_->item(row, 0)) fields_->item(row, 0)->setToolTip(name.isEmpty() ? QString() : name + "  (" + pointer.trimmed() + ")");
 }
 
 SweepRequest SweepView::request() const {
@@ -534,7 +576,7 @@ void SweepView::showResult() {
   {
     const QSignalBlocker block(parameter_combo_);
     parameter_combo_->clear();
-    for (const SweepVary& v : job_->plan.vary) parameter_combo_->addItem(qs(v.field));
+    for (const SweepVary& v : job_->plan.vary) parameter_combo_->addItem(shownField(v.field));
   }
   drawPoles();
   drawFigure();
@@ -643,8 +685,8 @@ void SweepView::drawPoles() {
                             .arg(closed ? tr("Closed-loop") : tr("Open-loop"))
                             .arg(job_->variants.size() - job_->failed)
                             .arg(closed ? (job_->redesigned ? tr("LQR redesigned") : tr("K fixed")) : tr("no state feedback")));
-  pole_chart_->setToolTip(tr("Coloured by %1 (the colour bar)").arg(qs(first.field)));
-  if (std::isfinite(lo)) colour_bar_->setRange(qs(first.field), lo, hi);
+  pole_chart_->setToolTip(tr("Coloured by %1 (the colour bar)").arg(shownField(first.field)));
+  if (std::isfinite(lo)) colour_bar_->setRange(shownField(first.field), lo, hi);
 }
 
 QList<QPointF> SweepView::plottedPoles(int variant) const {
@@ -727,7 +769,7 @@ void SweepView::drawFigure() {
   }
   auto* ax = new QValueAxis;
   auto* ay = new QValueAxis;
-  ax->setTitleText(qs(job_->plan.vary[param].field));
+  ax->setTitleText(shownField(job_->plan.vary[param].field));
   ay->setTitleText(figure_combo_->currentText());
   ax->setLabelFormat("%.4g");
   ay->setLabelFormat("%.4g");
@@ -762,7 +804,7 @@ void SweepView::drawFigure() {
   // the legend names the scatter series only
   for (QLegendMarker* m : figure_chart_->legend()->markers())
     m->setVisible(qobject_cast<QScatterSeries*>(m->series()) != nullptr && static_cast<QScatterSeries*>(m->series())->count() > 0);
-  figure_chart_->setTitle(tr("%1 against %2").arg(figure_combo_->currentText(), qs(job_->plan.vary[param].field)));
+  figure_chart_->setTitle(tr("%1 against %2").arg(figure_combo_->currentText(), shownField(job_->plan.vary[param].field)));
 }
 
 void SweepView::fillFailed() {
@@ -771,7 +813,7 @@ void SweepView::fillFailed() {
   auto values = [&](const SweepVariant& v) {
     QStringList l;
     for (std::size_t k = 0; k < v.values.size() && k < job_->plan.vary.size(); ++k)
-      l << QStringLiteral("%1 = %2").arg(qs(job_->plan.vary[k].field), number(v.values[k]));
+      l << QStringLiteral("%1 = %2").arg(shownField(job_->plan.vary[k].field), number(v.values[k]));
     return l.join(QStringLiteral(", "));
   };
   auto add = [&](std::size_t i, const QString& status, const QString& reason) {

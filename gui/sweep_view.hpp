@@ -115,6 +115,9 @@ class SweepView : public QWidget {
   void finished();  // a study ended: completed (result() set), cancelled or refused
 
  private:
+  QString fieldName(const QString& pointer) const;  // "rod.mass", or why the pointer names nothing
+  void refreshFieldName(int row);
+  QString shownField(const std::string& pointer) const;  // the name when there is one, else the pointer
   void buildUi();
   void setStatus(const QString& text, bool error);
   void updateButtons();

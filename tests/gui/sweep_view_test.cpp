@@ -28,6 +28,8 @@
 #include "gui/main_window.hpp"
 #include "gui/property_editor.hpp"
 #include "gui/sweep_view.hpp"
+#include "model/spec_edit.hpp"
+#include <QUndoStack>
 #include "study/sweep.hpp"
 
 using namespace codyna;
@@ -233,7 +235,7 @@ class SweepViewTest : public QObject {
     QTableWidget* failed = view()->failedTable();
     QCOMPARE(failed->rowCount(), 1);
     QCOMPARE(failed->item(0, 0)->text(), QStringLiteral("0"));
-    QCOMPARE(failed->item(0, 1)->text(), QStringLiteral("/bodies/1/mass = -1"));
+    QCOMPARE(failed->item(0, 1)->text(), QStringLiteral("rod.mass = -1"));  // as the tree names it
     QCOMPARE(failed->item(0, 2)->text(), QString::fromStdString(to_string(direct.variants[0].status)));
     QCOMPARE(failed->item(0, 3)->text(), QString::fromStdString(direct.variants[0].reason));
     QVERIFY(failed->item(0, 3)->text().contains("mass"));
@@ -245,6 +247,13 @@ class SweepViewTest : public QObject {
 
   void badSpecNamesTheField() {
     QVERIFY(pickRodMass());
+    // the Is column names the field as the model tree does, and follows a rename
+    QCOMPARE(view()->fieldTable()->item(0, 2)->text(), QString("rod.mass"));
+    QVERIFY(!(view()->fieldTable()->item(0, 2)->flags() & Qt::ItemIsEditable));
+    w->document()->edit("Rename", [](ModelSpec& s) { rename_element(s, ElementKind::Body, 1, "arm"); });
+    QCOMPARE(view()->fieldTable()->item(0, 2)->text(), QString("arm.mass"));
+    w->document()->undoStack()->undo();
+    QCOMPARE(view()->fieldTable()->item(0, 2)->text(), QString("rod.mass"));
     typeSpec(0, "5:15:abc");
     QTest::mouseClick(view()->runButton(), Qt::LeftButton);
     QVERIFY(!view()->isRunning());
@@ -254,6 +263,10 @@ class SweepViewTest : public QObject {
     QTableWidget* t = view()->fieldTable();
     QCOMPARE(t->rowCount(), 2);
     typeSpec(0, "5:15:3");
+    t->item(1, 0)->setText("/bodies/7/mass");
+    QCOMPARE(t->item(1, 2)->text(), QString("(not a field of an element)"));  // said before the run
+    t->item(1, 0)->setText("/bodies/1/name");
+    QCOMPARE(t->item(1, 2)->text(), QString("(not a number)"));
     t->item(1, 0)->setText("/bodies/7/mass");
     QTest::mouseClick(view()->runButton(), Qt::LeftButton);
     QVERIFY(!view()->isRunning());

@@ -763,7 +763,21 @@ class ViewsTest : public QObject {
     QVERIFY(doc.load(kCart));
     SimulateView view(&doc);
     view.show();
+    QSignalSpy said(&view, &SimulateView::message);
     view.controllerCombo()->setCurrentIndex(view.controllerCombo()->findData("lqr"));
+    // an LQR designed here starts the run at its operating point by default, said and shown
+    QCOMPARE(doc.spec().analysis.start, std::string("operating-point"));
+    QCOMPARE(view.startCombo()->currentData().toString(), QString("operating-point"));
+    QVERIFY(!said.isEmpty() && said.last().at(0).toString().contains("the run starts there now"));
+    // one undo takes both back; redo, then the model's own state (0.1 rad off upright) picked by hand
+    doc.undoStack()->undo();
+    QCOMPARE(doc.spec().analysis.controller, std::string("model"));
+    QCOMPARE(doc.spec().analysis.start, std::string("model"));
+    doc.undoStack()->redo();
+    QCOMPARE(doc.spec().analysis.start, std::string("operating-point"));
+    QVERIFY(drive::pickWithMouse(view.startCombo(), "the model's state"));
+    QCOMPARE(doc.spec().analysis.start, std::string("model"));
+    QCOMPARE(doc.spec().analysis.controller, std::string("lqr"));
     setLine(view.qWeightsEdit(), "10, 100, 1, 1");
     setLine(view.rWeightsEdit(), "0.01");
     QTest::mouseClick(view.compareLinearCheck(), Qt::LeftButton);
