@@ -418,7 +418,18 @@ void Scene::build(const Model* model, const std::vector<int>& held) {
         axis(j.parent, j.X_PF, j.axis, revolute_color);
         axis(i, j.X_CM, j.axis2, revolute_color);
         break;
-      default: break;
+      case JointType::Spherical: {  // a ball at the joint's centre
+        Item it;
+        it.kind = ItemKind::Axis;
+        it.prim = Prim::Sphere;
+        it.body = j.parent;
+        it.local = Eigen::Translation3d(j.X_PF.p) * Eigen::Scaling(0.25 * thick);
+        it.color = revolute_color;
+        items_.push_back(it);
+        break;
+      }
+      case JointType::Planar: axis(j.parent, j.X_PF, Eigen::Vector3d::UnitZ(), slide_color); break;  // the plane's normal
+      default: break;  // fixed: welded; free: nowhere in particular
     }
   }
 

@@ -478,6 +478,22 @@ class View3DTest : public QObject {
     QCOMPARE(forces, 1);
   }
 
+  // a ball joint is marked by a ball at its centre (the heavy top's pivot, on the ground at the
+  // joint frame F's origin), drawn with the joint axes
+  void ballJointMarker() {
+    auto top = loadExample("heavy_top.json");
+    Scene scene;
+    scene.build(top.get());
+    int balls = 0;
+    for (const auto& it : scene.items())
+      if (it.kind == ItemKind::Axis && it.prim == Prim::Sphere) {
+        ++balls;
+        QVERIFY((it.world.translation() - top->joints[1].X_PF.p).norm() < 1e-12);
+        QVERIFY(it.world.linear()(0, 0) > 0);
+      }
+    QCOMPARE(balls, 1);
+  }
+
   void lineForceAndMotionOnTheBus() {
     auto m = loadExample("bus_suspension.json");
     Scene scene;
