@@ -299,14 +299,17 @@ bool ControlView::analyse() {
                      .arg(plant_->system.nu())
                      .arg(plant_->system.ny());
   if (closed_) {
-    int unstable = 0;
-    for (const Mode& md : closed_->poles.modes)
-      if (closed_->poles.Ts > 0 ? std::abs(md.eigenvalue) > 1.0 + 1e-9 : md.s.real() > 1e-9 * std::max(1.0, std::abs(md.s)))
-        ++unstable;
+    int unstable = 0, marginal = 0;  // as the core classifies them (Mode::stability)
+    for (const Mode& md : closed_->poles.modes) {
+      unstable += md.stability == Stability::Unstable;
+      marginal += md.stability == Stability::Marginal;
+    }
+    QString verdict = unstable ? tr("<span style='color:#b00000'>%1 unstable</span>").arg(unstable) : QString();
+    if (marginal) verdict += (verdict.isEmpty() ? QString() : tr(", ")) + tr("%1 on the stability boundary").arg(marginal);
     text += tr(" <b>Closed loop</b> with %1: %2 poles, %3.")
                 .arg(qs(closed_->loop.controller).toHtmlEscaped())
                 .arg(closed_->poles.modes.size())
-                .arg(unstable ? tr("<span style='color:#b00000'>%1 unstable</span>").arg(unstable) : tr("all stable"));
+                .arg(verdict.isEmpty() ? tr("all stable") : verdict);
     pole_model_->setModes(closed_->poles);
     // a controller without states acts as u = u0 - K dx: K is read off the closed loop's effort rows
     const ClosedLoopLinear& L = closed_->loop;

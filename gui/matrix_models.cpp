@@ -159,7 +159,7 @@ QVariant ModeTableModel::data(const QModelIndex& index, int role) const {
   const double hz = m.natural_frequency / (2.0 * std::numbers::pi);
   bool period = false;
   const double tau = timeConstantOrPeriod(m, &period);
-  const bool unstable = discrete ? std::abs(m.eigenvalue) > 1.0 + 1e-9 : m.s.real() > 1e-9 * std::max(1.0, std::abs(m.s));
+  const bool unstable = m.stability == codyna::Stability::Unstable;  // the core's rule (analysis/stability.hpp)
 
   if (role == Qt::DisplayRole) {
     switch (index.column()) {

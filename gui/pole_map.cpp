@@ -211,11 +211,13 @@ void PoleMap::rebuild() {
   zero_series_->replace(QList<QPointF>(zeros_.begin(), zeros_.end()));
   QList<QPointF> stable, marginal, unstable;
   for (std::size_t i = 0; i < modal_.modes.size(); ++i) {
-    const std::complex<double> e = modal_.modes[i].eigenvalue;
-    // (a discrete pole on the unit circle, or a continuous one on the imaginary axis, within rounding)
-    const double margin = discrete_ ? std::abs(e) - 1.0 : e.real();
-    const double tol = 1e-9 * std::max(1.0, discrete_ ? 1.0 : std::abs(e));
-    (margin < -tol ? stable : margin > tol ? unstable : marginal).append(poles_[i]);
+    // as the core classifies it (Mode::stability, analysis/stability.hpp): a discrete pole on the
+    // unit circle, or a continuous one on the imaginary axis, within rounding, is marginal
+    switch (modal_.modes[i].stability) {
+      case codyna::Stability::Stable: stable.append(poles_[i]); break;
+      case codyna::Stability::Marginal: marginal.append(poles_[i]); break;
+      case codyna::Stability::Unstable: unstable.append(poles_[i]); break;
+    }
   }
   stable_->replace(stable);
   marginal_->replace(marginal);
@@ -450,5 +452,9 @@ bool PoleMap::saveImage(const QString& path, QString* error) {
     if (legend_->isVisibleTo(this)) legend_->render(&painter, legend_->mapTo(this, QPoint(0, 0)));
   }, error);
 }
+
+int PoleMap::drawnStable() const { return static_cast<int>(stable_->count()); }
+int PoleMap::drawnMarginal() const { return static_cast<int>(marginal_->count()); }
+int PoleMap::drawnUnstable() const { return static_cast<int>(unstable_->count()); }
 
 }  // namespace codyna::gui

@@ -49,6 +49,10 @@ class PoleMap : public QWidget {
   int selectedMode() const { return selected_; }
 
   int poleCount() const { return static_cast<int>(poles_.size()); }
+  // how many poles are drawn stable, marginal (on the boundary) and unstable
+  int drawnStable() const;
+  int drawnMarginal() const;
+  int drawnUnstable() const;
   bool isDiscrete() const { return discrete_; }
   // Chart coordinates (Re, Im) of pole `index`: lambda, or z when discrete.
   QPointF polePosition(int index) const;

@@ -762,7 +762,8 @@ void SweepView::drawFigure() {
     const double y = value(v, &ok);
     const double x = v.values[param];
     if (!ok || !std::isfinite(x) || !std::isfinite(y)) continue;
-    const bool unstable = stability ? y >= 0 : !v.stable;
+    // the core's classification (analysis/stability.hpp): of the loop the figure shows
+    const bool unstable = figure == OpenMaxReal ? !v.open_stable : !v.stable;
     (stability && unstable ? bad : good)->append(x, y);
     pts.emplace_back(x, y);
     xmin = std::min(xmin, x), xmax = std::max(xmax, x), ymin = std::min(ymin, y), ymax = std::max(ymax, y);

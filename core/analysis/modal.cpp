@@ -94,18 +94,25 @@ ModalAnalysis modal_analysis(const LinearSystem& sys) {
   ModalAnalysis out;
   out.state_names = sys.state_names;
   out.Ts = sys.Ts;
+  out.stability_tolerance = stability_tolerance(sys.A);
   if (sys.A.size() == 0) return out;
 
   Eigen::EigenSolver<Eigen::MatrixXd> es(sys.A, /*computeEigenvectors=*/true);
   if (es.info() != Eigen::Success) throw std::runtime_error("modal_analysis: eigen decomposition did not converge");
-  for (Eigen::Index i = 0; i < sys.A.rows(); ++i)
+  for (Eigen::Index i = 0; i < sys.A.rows(); ++i) {
     out.modes.push_back(make_mode(es.eigenvalues()(i), es.eigenvectors().col(i), sys.Ts));
+    out.modes.back().stability = classify_pole(out.modes.back().eigenvalue, sys.Ts > 0, out.stability_tolerance);
+  }
   std::sort(out.modes.begin(), out.modes.end(), mode_order);
   const Eigen::MatrixXd N = generalized_null_space(
       sys.Ts > 0.0 ? Eigen::MatrixXd(sys.A - Eigen::MatrixXd::Identity(sys.A.rows(), sys.A.cols())) : sys.A);
   out.zero_count = static_cast<int>(N.cols());
   for (Eigen::Index i = 0; i < N.rows(); ++i)
     if (N.cols() > 0 && N.row(i).squaredNorm() >= 0.5) out.zero_states.push_back(static_cast<int>(i));
+  // the modes that stand for s = 0 (z = 1) are on the boundary, however their computed
+  // eigenvalues scatter (by eps^(1/k) for a k-fold zero, beyond the round-off tolerance)
+  for (int k = 0; k < out.zero_count && k < static_cast<int>(out.modes.size()); ++k)
+    out.modes[static_cast<std::size_t>(k)].stability = Stability::Marginal;
   return out;
 }
 

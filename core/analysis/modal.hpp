@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "analysis/linear_system.hpp"
+#include "analysis/stability.hpp"
 
 namespace codyna {
 
@@ -27,12 +28,14 @@ struct Mode {
   double natural_frequency = 0.0;      // rad/s, |s|
   double damping_ratio = 0.0;          // -Re(s)/|s|
   Eigen::VectorXcd shape;              // nx; largest |entry| = 1, made real and positive
+  Stability stability = Stability::Stable;  // of `eigenvalue` (analysis/stability.hpp, the one rule)
 };
 
 struct ModalAnalysis {
   std::vector<Mode> modes;              // sorted by natural frequency, then Im(s), then Re(s)
   std::vector<std::string> state_names; // nx, as in the system
   double Ts = 0.0;                      // 0: continuous
+  double stability_tolerance = 1e-9;    // stability_tolerance(A): what Mode::stability was decided with
   // The eigenvalue s = 0 (z = 1 when discrete): a rigid-body motion or an integrator. Its
   // multiplicity is the dimension of the generalized null space of A (of A - I), found by
   // growing null(A), then {x : A x in it}, ... with a rank tolerance of 1e-9 max(1, max|A_ij|):

@@ -1,5 +1,7 @@
 #include "study/jobs.hpp"
 
+#include "analysis/stability.hpp"
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
@@ -465,13 +467,7 @@ SimulateJob study_simulate_job(const SimulateRequest& a, const ModelSpec& file_s
   }
   job.saturation = saturation_report(m, r);
   const int N = r.samples();
-  {
-    std::vector<std::complex<double>> bad;
-    for (Eigen::Index k = 0; k < setup.linear_poles.size(); ++k)
-      if (setup.linear_discrete ? std::abs(setup.linear_poles[k]) > 1 + 1e-9 : setup.linear_poles[k].real() > 0)
-        bad.push_back(setup.linear_poles[k]);
-    job.unstable_poles = Eigen::Map<const Eigen::VectorXcd>(bad.data(), static_cast<Eigen::Index>(bad.size()));
-  }
+  job.unstable_poles = unstable_poles(setup.linear_poles, setup.linear_discrete, setup.linear_tolerance);
   if (N > 0) {
     job.max_abs_input.resize(static_cast<Eigen::Index>(m.plant_inputs.size()));
     for (std::size_t k = 0; k < m.plant_inputs.size(); ++k)

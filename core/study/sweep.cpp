@@ -1,5 +1,7 @@
 #include "study/sweep.hpp"
 
+#include "analysis/stability.hpp"
+
 #include <hdf5.h>
 #include <matio.h>
 #include <sys/stat.h>
@@ -210,9 +212,9 @@ double max_real(const Eigen::VectorXcd& p) {
   return p.size() ? p.real().maxCoeff() : -std::numeric_limits<double>::infinity();
 }
 
-// asymptotically stable: every pole left of the imaginary axis by more than round-off
-bool stable_poles(const Eigen::VectorXcd& p, const Eigen::MatrixXd& A) {
-  return max_real(p) < -1e-9 * std::max(1.0, A.norm());
+// asymptotically stable (analysis/stability.hpp): every pole stable, continuous or sampled
+bool stable_poles(const Eigen::VectorXcd& p, const Eigen::MatrixXd& A, bool discrete) {
+  return classify_poles(p, discrete, stability_tolerance(A)).asymptotically_stable();
 }
 
 std::string joined(const std::vector<std::string>& v) {
@@ -446,6 +448,7 @@ void run_variant(const Context& c, long long i, SweepVariant& v) {
     v.D = sys.D;
     v.open_poles = poles_of(sys.A);
     v.open_max_real = max_real(v.open_poles);
+    v.open_stable = stable_poles(v.open_poles, sys.A, sys.Ts > 0);
     v.uncontrollable = static_cast<int>(lj.uncontrollable.size());
     if (v.uncontrollable) v.uncontrollable_text = study_describe_modes(lj.uncontrollable);
     if (c.closed_loop) {
@@ -460,9 +463,9 @@ void run_variant(const Context& c, long long i, SweepVariant& v) {
       const Eigen::MatrixXd Acl = sys.A - sys.B * K;
       v.closed_poles = poles_of(Acl);
       v.closed_max_real = max_real(v.closed_poles);
-      v.stable = stable_poles(v.closed_poles, Acl);
+      v.stable = stable_poles(v.closed_poles, Acl, sys.Ts > 0);
     } else {
-      v.stable = stable_poles(v.open_poles, sys.A);
+      v.stable = stable_poles(v.open_poles, sys.A, sys.Ts > 0);
     }
     v.status = SweepStatus::Ok;
     simulate_after();
@@ -640,6 +643,7 @@ std::string journal_line(long long i, const SweepVariant& v) {
   w.key("i"), w.integer(i);
   w.key("open_max_real"), w.number(v.open_max_real);
   w.key("open_poles"), w.poles(v.open_poles);
+  w.key("open_stable"), w.boolean(v.open_stable);
   w.key("overshoot"), w.vector(v.overshoot);
   w.key("peak_input"), w.vector(v.peak_input);
   w.key("reason"), w.text(v.reason);
@@ -678,6 +682,7 @@ SweepVariant journal_variant(const nlohmann::json& j) {
   v.open_max_real = unhex(j.at("open_max_real"));
   v.closed_max_real = unhex(j.at("closed_max_real"));
   v.stable = j.at("stable").get<bool>();
+  v.open_stable = j.value("open_stable", false);  // journals before 2026-11 lack it
   v.uncontrollable = j.at("uncontrollable").get<int>();
   v.uncontrollable_text = j.at("uncontrollable_text").get<std::string>();
   v.sim_status = j.at("sim_status").get<int>();

@@ -118,7 +118,8 @@ struct SweepVariant {
   Eigen::MatrixXd A, B, C, D, K;              // continuous plant; K only when redesigned
   Eigen::VectorXcd open_poles, closed_poles;  // sorted by real part, then imaginary part
   double open_max_real = 0, closed_max_real = 0;
-  bool stable = false;                        // closed loop (no closed loop: open loop)
+  bool stable = false;                        // closed loop (no closed loop: open loop), asymptotically
+  bool open_stable = false;                   // the open loop, asymptotically (analysis/stability.hpp)
   int uncontrollable = 0;                     // modes the Plant/In inputs cannot move
   std::string uncontrollable_text;            // study_describe_modes of them
   // simulate: the run's status (-1 not run, 0 reached t_end, 1 the run failed, 2 it could not be

@@ -1,5 +1,7 @@
 #include "study/workflow.hpp"
 
+#include "analysis/stability.hpp"
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
@@ -122,9 +124,9 @@ std::vector<HiddenMode> uncontrollable(const LinearSystem& sys) {
 // An LQR needs every mode that does not decay by itself to be movable by the inputs; say which are not.
 void require_stabilizable(const Model& m, const LinearSystem& sys) {
   std::vector<HiddenMode> bad;
-  const double scale = std::max(1.0, sys.A.norm());
+  const double tol = stability_tolerance(sys.A);
   for (const HiddenMode& h : uncontrollable(sys))
-    if (h.eigenvalue.real() >= -1e-9 * scale) bad.push_back(h);
+    if (classify_pole(h.eigenvalue, sys.Ts > 0, tol) != Stability::Stable) bad.push_back(h);
   if (bad.empty()) return;
   throw std::invalid_argument((m.source_file.empty() ? std::string() : m.source_file + ": ") +
                               "lqr: the plant is not stabilizable: the Plant/In inputs cannot move " + describe(bad) +
@@ -277,9 +279,8 @@ void attach_linear_poles(StudySimulation& out) {
   });
   out.linear_poles = p;
   out.linear_discrete = loop.system.Ts > 0;
-  const double tol = 1e-9 * std::max(1.0, A.norm());
-  for (Eigen::Index k = 0; k < p.size(); ++k)
-    if (out.linear_discrete ? std::abs(p[k]) > 1 + 1e-9 : p[k].real() > tol) out.linear_unstable = true;
+  out.linear_tolerance = stability_tolerance(A);
+  out.linear_unstable = classify_poles(p, out.linear_discrete, out.linear_tolerance).unstable > 0;
 }
 
 // PID anti-windup, from the study, on whichever PID the study runs
@@ -733,9 +734,9 @@ StudySimulation study_simulation(const Model& m, const std::atomic<bool>* cancel
         std::string note = "lqr on the controllable part (" + std::to_string(d.Tc.cols()) + " of " +
                            std::to_string(sys.nx()) + " states): the Plant/In inputs cannot move " +
                            describe(out.uncontrollable) + "; these poles stay where they are";
-        const double scale = std::max(1.0, sys.A.norm());
+        const double tol = stability_tolerance(sys.A);
         for (const HiddenMode& h : out.uncontrollable)
-          if (h.eigenvalue.real() > 1e-9 * scale) {
+          if (classify_pole(h.eigenvalue, sys.Ts > 0, tol) == Stability::Unstable) {
             note += " (one of them is unstable: the loop is not stable)";
             break;
           }

@@ -123,7 +123,8 @@ struct StudySimulation {
   // Empty when there is no such controller. The run is not refused for it.
   Eigen::VectorXcd linear_poles;
   bool linear_discrete = false;
-  bool linear_unstable = false;
+  double linear_tolerance = 1e-9;  // stability_tolerance of the closed loop's A (analysis/stability.hpp)
+  bool linear_unstable = false;    // a pole classify_pole calls unstable
 };
 
 // The configuration the 3-D view draws for a linear mode: the operating point q_op moved

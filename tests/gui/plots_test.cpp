@@ -168,6 +168,7 @@ class PlotsTest : public QObject {
   void timeCursor();
   void saveImages();
   void poleMapContinuous();
+  void poleMapDrawsTheCoresStability();
   void poleMapDiscrete();
   void matrixModel();
   void modeModel();
@@ -487,6 +488,51 @@ void PlotsTest::saveImages() {
   QVERIFY(!plots.saveImage(dir.filePath("plots.bmpx"), &error));
   QVERIFY(error.contains("png"));
   QVERIFY(!plots.saveImage(dir.filePath("x.png").prepend("/proc/")));  // no error pointer: no crash
+}
+
+// The pole map draws each pole as the core classifies it (analysis/stability.hpp): poles at
+// Re = -1e-12, 0, +1e-12 and a pair on the imaginary axis marginal, -1e-6 stable, +1e-6 unstable
+// (continuous); on, inside and outside the unit circle when sampled
+void PlotsTest::poleMapDrawsTheCoresStability() {
+  for (const bool sampled : {false, true}) {
+    codyna::LinearSystem sys;
+    const double th = 0.7;
+    // blocks: real poles on the diagonal, a pair as [a b; -b a]
+    const std::vector<std::complex<double>> poles =
+        sampled ? std::vector<std::complex<double>>{{1 - 1e-12, 0}, {1, 0}, {1 + 1e-12, 0}, {0.5, 0}, {1.5, 0},
+                                                    {std::cos(th), std::sin(th)}, {0.5 * std::cos(th), 0.5 * std::sin(th)}}
+                : std::vector<std::complex<double>>{{-1e-12, 0}, {0, 0}, {1e-12, 0}, {-1e-6, 0}, {1e-6, 0}, {0, 2}, {-0.2, 3}};
+    const int n = static_cast<int>(poles.size()) + 2;
+    sys.A = Eigen::MatrixXd::Zero(n, n);
+    int k = 0;
+    for (const auto& p : poles) {
+      if (p.imag() != 0) {
+        sys.A.block<2, 2>(k, k) << p.real(), p.imag(), -p.imag(), p.real();
+        k += 2;
+      } else {
+        sys.A(k, k) = p.real();
+        ++k;
+      }
+    }
+    sys.Ts = sampled ? 0.01 : 0.0;
+    sys.B = Eigen::MatrixXd::Zero(n, 0);
+    sys.C = Eigen::MatrixXd::Zero(0, n);
+    sys.D = Eigen::MatrixXd::Zero(0, 0);
+    const codyna::ModalAnalysis modal = codyna::modal_analysis(sys);
+    PoleMap map;
+    map.resize(400, 300);
+    map.setModes(modal);
+    // 3 marginal reals and a marginal pair; stable: -1e-6 (0.5) and the pair -0.2 +- 3i (inside);
+    // unstable: +1e-6 (1.5)
+    QCOMPARE(map.drawnMarginal(), 5);
+    QCOMPARE(map.drawnStable(), sampled ? 3 : 3);
+    QCOMPARE(map.drawnUnstable(), 1);
+    // the same as the core's own count of the same poles
+    const double tol = codyna::stability_tolerance(sys.A);
+    int unstable = 0;
+    for (const auto& m : modal.modes) unstable += codyna::classify_pole(m.eigenvalue, sampled, tol) == codyna::Stability::Unstable;
+    QCOMPARE(map.drawnUnstable(), unstable);
+  }
 }
 
 void PlotsTest::poleMapContinuous() {
