@@ -10,8 +10,8 @@ set -euo pipefail
 codyna=$1 src=$2 work=$3
 rm -rf "$work" && mkdir -p "$work"
 fail() { echo "FAIL: $*"; exit 1; }
-command -v octave-cli > /dev/null || { echo "octave-cli not installed: closed-loop export check skipped"; exit 0; }
-octave-cli --no-gui --quiet --eval "pkg load control" > /dev/null 2>&1 || { echo "octave control package missing: closed-loop export check skipped"; exit 0; }
+command -v octave-cli > /dev/null || { echo "octave-cli not installed: closed-loop export check skipped"; exit 77; }
+octave-cli --no-gui --quiet --eval "pkg load control" > /dev/null 2>&1 || { echo "octave control package missing: closed-loop export check skipped"; exit 77; }
 model="$src/examples/cart_pendulum.json"
 
 "$codyna" linearize "$model" --operating-point equilibrium --lqr --q-weights 10,100,1,1 --r-weights 0.01 \

@@ -7,7 +7,7 @@
 set -euo pipefail
 codyna="$1"; src="$2"; work="$3"
 rm -rf "$work"; mkdir -p "$work"; cd "$work"
-command -v octave-cli > /dev/null || { echo "octave-cli not found: skipped"; exit 0; }
+command -v octave-cli > /dev/null || { echo "octave-cli not found: skipped"; exit 77; }
 fail() { echo "FAIL: $*"; exit 1; }
 PY=/usr/bin/python3; [ -x "$PY" ] || PY=python3
 cp "$src/examples/pendulum.json" model.json

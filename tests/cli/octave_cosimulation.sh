@@ -10,8 +10,8 @@ codyna=$1 src=$2 work=$3
 rm -rf "$work" && mkdir -p "$work"
 fail() { echo "FAIL: $*"; exit 1; }
 mexdir="$(cd "$(dirname "$codyna")/.." && pwd)/mex"
-command -v octave-cli > /dev/null || { echo "octave-cli not installed: co-simulation skipped"; exit 0; }
-[ -f "$mexdir/codyna_plant.mex" ] || { echo "codyna_plant.mex not built (liboctave-dev missing): co-simulation skipped"; exit 0; }
+command -v octave-cli > /dev/null || { echo "octave-cli not installed: co-simulation skipped"; exit 77; }
+[ -f "$mexdir/codyna_plant.mex" ] || { echo "codyna_plant.mex not built (liboctave-dev missing): co-simulation skipped"; exit 77; }
 model="$src/examples/cart_pendulum.json"
 "$codyna" linearize "$model" --operating-point equilibrium --out "$work" > /dev/null
 

@@ -9,7 +9,7 @@ set -euo pipefail
 codyna=$1 src=$2 work=$3
 rm -rf "$work" && mkdir -p "$work"
 fail() { echo "FAIL: $*"; exit 1; }
-command -v octave-cli > /dev/null || { echo "octave-cli not installed: round trip skipped"; exit 0; }
+command -v octave-cli > /dev/null || { echo "octave-cli not installed: round trip skipped"; exit 77; }
 PY=/usr/bin/python3; [ -x "$PY" ] || PY=python3
 model="$src/examples/cart_pendulum.json"
 

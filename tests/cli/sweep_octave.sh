@@ -8,8 +8,8 @@ set -euo pipefail
 codyna="$1"; src="$2"; work="$3"
 rm -rf "$work"; mkdir -p "$work"; cd "$work"
 fail() { echo "FAIL: $*"; exit 1; }
-command -v octave-cli > /dev/null || { echo "octave-cli not installed: sweep LPV check skipped"; exit 0; }
-octave-cli --no-gui --quiet --eval "pkg load control" > /dev/null 2>&1 || { echo "octave control package missing: sweep LPV check skipped"; exit 0; }
+command -v octave-cli > /dev/null || { echo "octave-cli not installed: sweep LPV check skipped"; exit 77; }
+octave-cli --no-gui --quiet --eval "pkg load control" > /dev/null 2>&1 || { echo "octave control package missing: sweep LPV check skipped"; exit 77; }
 
 "$codyna" sweep "$src/examples/cart_pendulum.json" --vary '/bodies/1/mass=[5,-1,10,15]' --vary '/bodies/0/mass=[15,25]' \
   --out rod.h5 --mat lpv/rod_study.mat > sweep.txt || fail "the sweep failed: $(cat sweep.txt)"
