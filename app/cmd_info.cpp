@@ -27,7 +27,7 @@ void print_info(const Model& m) {
   std::cout << "coordinates  ";
   for (int k = 0; k < m.nv; ++k) std::cout << (k ? ", " : "") << m.v_names[k] << " [" << m.v_units[k] << "]";
   std::cout << "\nrates        ";
-  for (int k = 0; k < m.nv; ++k) std::cout << (k ? ", " : "") << m.rate_names[k] << " [" << m.v_units[k] << "/s]";
+  for (int k = 0; k < m.nv; ++k) std::cout << (k ? ", " : "") << m.rate_names[k] << " [" << rate_unit(m.v_units[k]) << "]";
   std::cout << "\nconstraints  " << m.constraints.size() << " (" << m.nc << " equations, "
             << m.active_rows.size() << " independent"
             << (m.velocity_rows.empty() ? std::string()

@@ -600,7 +600,7 @@ void LinearizeView::showResult() {
     }
   };
   std::vector<std::string> rate_units;
-  for (const auto& u : s.state_units) rate_units.push_back(u.empty() ? "1/s" : u + "/s");
+  for (const auto& u : s.state_units) rate_units.push_back(rate_unit(u));
   add(QStringLiteral("x0"), s.state_names, s.state_units, s.x0);
   add(QStringLiteral("u0"), s.input_names, s.input_units, s.u0);
   add(QStringLiteral("y0"), s.output_names, s.output_units, s.y0);

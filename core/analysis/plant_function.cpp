@@ -993,7 +993,7 @@ std::vector<std::string> plant_state_units(const Model& model, const std::vector
   std::vector<std::string> units;
   units.reserve(independent.size() + rates.size());
   for (int i : independent) units.push_back(model.v_units[static_cast<std::size_t>(i)]);
-  for (int i : rates) units.push_back(model.v_units[static_cast<std::size_t>(i)] + "/s");
+  for (int i : rates) units.push_back(rate_unit(model.v_units[static_cast<std::size_t>(i)]));
   return units;
 }
 

@@ -46,4 +46,14 @@ Eigen::VectorXd neutral(const Model& model) {
   return q;
 }
 
+std::string rate_unit(const std::string& unit) {
+  if (unit.empty()) return "1/s";
+  const auto ends = [&](const std::string& tail) {
+    return unit.size() >= tail.size() && unit.compare(unit.size() - tail.size(), tail.size(), tail) == 0;
+  };
+  if (ends("/s")) return unit + "^2";
+  if (ends("/s^2")) return unit.substr(0, unit.size() - 1) + "3";
+  return unit + "/s";
+}
+
 }  // namespace codyna

@@ -137,7 +137,7 @@ struct Model {
   std::vector<std::string> q_names;      // [nq]
   std::vector<std::string> v_names;      // [nv] coordinates
   std::vector<std::string> v_units;      // [nv] "rad" or "m"
-  std::vector<std::string> rate_names;   // [nv] rates (units: v_units + "/s")
+  std::vector<std::string> rate_names;   // [nv] rates (units: rate_unit(v_units))
 
   // loop closures
   std::vector<ConstraintModel> constraints;
@@ -205,5 +205,9 @@ struct Model {
 
 // the zero configuration (identity quaternions)
 Eigen::VectorXd neutral(const Model& model);
+
+// The unit of the time derivative of a quantity in `unit`: the one rule every front end prints
+// rates with. "rad" -> "rad/s", "m/s" -> "m/s^2", "m/s^2" -> "m/s^3", "" (dimensionless) -> "1/s".
+std::string rate_unit(const std::string& unit);
 
 }  // namespace codyna

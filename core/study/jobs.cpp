@@ -523,7 +523,7 @@ std::string study_assembly_moves_text(const Model& m) {
     const auto ir = std::find(m.rate_names.begin(), m.rate_names.end(), a.name);
     const std::size_t i = iv != m.v_names.end() ? static_cast<std::size_t>(iv - m.v_names.begin())
                                                 : static_cast<std::size_t>(ir - m.rate_names.begin());
-    const std::string unit = i < m.v_units.size() ? m.v_units[i] + (iv != m.v_names.end() ? "" : "/s") : "";
+    const std::string unit = i < m.v_units.size() ? (iv != m.v_names.end() ? m.v_units[i] : rate_unit(m.v_units[i])) : "";
     os << (os.tellp() > 0 ? ", " : "") << a.name << " ";
     if (std::isfinite(a.from)) os << a.from << " -> " << a.to << " ";
     os << "(moved by " << a.by << " " << unit << ")";

@@ -10,6 +10,7 @@
 #include <numbers>
 
 #include "analysis/modal.hpp"
+#include "model/model.hpp"
 
 using namespace codyna;
 
@@ -126,4 +127,16 @@ TEST(Stability, ARepeatedZeroIsMarginal) {
     rule_alone_says_unstable = rule_alone_says_unstable || classify_pole(m.eigenvalue, false, modal.stability_tolerance) == Stability::Unstable;
   }
   EXPECT_TRUE(rule_alone_says_unstable);
+}
+
+// the one rate-unit rule (model/model.hpp), which codyna info, the simulate job's notes, the plant's
+// rate outputs and the GUI's xdot0 offsets all print with
+TEST(RateUnit, OfEachKindOfUnit) {
+  EXPECT_EQ(rate_unit("rad"), "rad/s");
+  EXPECT_EQ(rate_unit("m"), "m/s");
+  EXPECT_EQ(rate_unit("m/s"), "m/s^2");
+  EXPECT_EQ(rate_unit("rad/s"), "rad/s^2");
+  EXPECT_EQ(rate_unit("m/s^2"), "m/s^3");
+  EXPECT_EQ(rate_unit(""), "1/s");
+  EXPECT_EQ(rate_unit("N"), "N/s");
 }
