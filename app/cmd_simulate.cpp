@@ -266,7 +266,7 @@ void add_simulate(CLI::App& app) {
   cmd->add_flag("--compare-linear", a->compare_linear, "also simulate the linear closed loop and report where it parts from the nonlinear one");
   cmd->add_option("--linear-region", a->linear_region, "R: report when a coordinate the linear dynamics depend on is more than R (rad or m) from its operating-point value (default 0.5, or the file's analysis.linear_region)");
   cmd->add_option("--t-end", a->t_end, "end time [s] (default: the model's solver settings)");
-  cmd->add_option("--integrator", a->integrator, "auto | ida | cvode-bdf | cvode-adams | arkode | rk4 (default: the model file's solver, auto when it names none)");
+  cmd->add_option("--integrator", a->integrator, integrator_names(" | ") + " (default: the model file's solver, auto when it names none)");
   cmd->add_option("--rtol", a->rtol, "relative tolerance");
   cmd->add_option("--atol", a->atol, "absolute tolerance");
   cmd->add_option("--max-step", a->max_step, "largest step [s] (rk4: its fixed step)");

@@ -47,7 +47,6 @@ constexpr int kMergeDisturbances = 0x53490005;  // and in the disturbances table
 // stays light; the finished result is shown at the plots' own limit
 constexpr int kLivePlotPoints = 2000;
 
-const char* const kIntegrators[] = {"auto", "ida", "cvode-bdf", "cvode-adams", "arkode", "rk4"};
 
 QString simNumber(double x, int digits = 6) { return QString::number(x, 'g', digits); }
 
@@ -288,7 +287,7 @@ void SimulateView::buildUi() {
   output_step_->setToolTip(tr("Time between recorded samples in s (the integrator chooses its own steps)"));
   form->addRow(tr("Output step"), output_step_);
   integrator_ = new QComboBox(solver_box);
-  for (const char* name : kIntegrators) integrator_->addItem(QLatin1String(name), QLatin1String(name));
+  for (const char* name : codyna::kIntegratorNames) integrator_->addItem(QLatin1String(name), QLatin1String(name));
   integrator_->setToolTip(tr("auto chooses from the eigenvalues at the start (stiff: cvode-bdf; otherwise cvode-adams "
                              "for trees, arkode for closed loops; the choice is reported); or ida, cvode-bdf, "
                              "cvode-adams, arkode, the fixed-step rk4"));

@@ -785,8 +785,8 @@ class Compiler {
 
   void check_solver() {
     const SolverSpec& s = spec_.solver;
-    static const std::set<std::string> integrators{"auto", "ida", "cvode-bdf", "cvode-adams", "arkode", "rk4"};
-    if (!integrators.count(s.integrator)) fail("/solver/integrator", "unknown integrator " + quote(s.integrator) + " (expected one of: auto, ida, cvode-bdf, cvode-adams, arkode, rk4)");
+    if (!is_integrator_name(s.integrator))
+      fail("/solver/integrator", "unknown integrator " + quote(s.integrator) + " (expected one of: " + integrator_names() + ")");
     auto positive = [&](double x, const char* f) {
       if (!std::isfinite(x) || x <= 0) fail(std::string("/solver/") + f, "expected a positive number, got " + compile_number(x));
     };

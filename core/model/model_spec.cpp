@@ -119,4 +119,19 @@ std::optional<ControllerType> controller_type_from_string(const std::string& s) 
   return value_of(kControllers, s);
 }
 
+bool is_integrator_name(const std::string& name) {
+  for (const char* n : kIntegratorNames)
+    if (name == n) return true;
+  return false;
+}
+
+std::string integrator_names(const std::string& separator, bool with_auto) {
+  std::string out;
+  for (const char* n : kIntegratorNames) {
+    if (!with_auto && std::string(n) == "auto") continue;
+    out += (out.empty() ? "" : separator) + std::string(n);
+  }
+  return out;
+}
+
 }  // namespace codyna

@@ -248,8 +248,16 @@ struct ControllerSpec {
   std::string operating_point = "equilibrium";
 };
 
+// Every integrator a run can name, "auto" first (chosen per model at the start of a run,
+// simulation/integrator_choice.hpp): the one list the file check, the CLI's help, the GUI's
+// drop-down and the errors are made from.
+inline constexpr const char* kIntegratorNames[] = {"auto", "ida", "cvode-bdf", "cvode-adams", "arkode", "rk4"};
+bool is_integrator_name(const std::string& name);
+// the names joined by `separator` ("auto, ida, ..."); without "auto" when `with_auto` is false
+std::string integrator_names(const std::string& separator = ", ", bool with_auto = true);
+
 struct SolverSpec {
-  std::string integrator = "auto";  // chosen per model at the start of a run (simulation/integrator_choice.hpp)
+  std::string integrator = "auto";  // one of kIntegratorNames
   double rtol = 1e-8;
   double atol = 1e-10;
   double t_end = 5.0;

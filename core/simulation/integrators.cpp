@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "dynamics/joint.hpp"
+#include "model/model_spec.hpp"
 #include "simulation/integrator.hpp"
 #include "simulation/reference_integrator.hpp"
 
@@ -383,7 +384,7 @@ std::unique_ptr<Integrator> make_integrator(ClosedLoopSystem& system, const Inte
   if (s.method == "rk4") return std::make_unique<Rk4>(system, s);
   if (s.method == "auto")
     throw std::invalid_argument("integrator \"auto\" is chosen from the model's state: resolve it with choose_integrator first");
-  throw std::invalid_argument("unknown integrator \"" + s.method + "\" (expected ida, cvode-bdf, cvode-adams, arkode or rk4)");
+  throw std::invalid_argument("unknown integrator \"" + s.method + "\" (expected one of: " + integrator_names(", ", false) + ")");
 }
 
 struct OdeIntegrator::Impl {
