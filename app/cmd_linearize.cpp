@@ -123,12 +123,8 @@ void print(const LinearizeJob& job) {
   print_matrix("C", sys.C, sys.output_names, sys.state_names);
   print_matrix("D", sys.D, sys.output_names, sys.input_names);
   std::cout << "\n" << study_format_modes(job.modes) << "\n";
-  std::cout << "controllable     "
-            << (job.uncontrollable.empty() ? std::string("yes, every mode") : "no: " + study_describe_modes(job.uncontrollable))
-            << "\n"
-            << "observable       "
-            << (job.unobservable.empty() ? std::string("yes, every mode") : "no: " + study_describe_modes(job.unobservable))
-            << "\n\n";
+  std::cout << "controllable     " << study_hidden_modes_text(job.uncontrollable) << "\n"
+            << "observable       " << study_hidden_modes_text(job.unobservable) << "\n\n";
   std::cout << "wrote " << job.written[0] << "\nwrote " << job.written[1] << "\n";
   if (job.closed_loop) print_closed_loop(job);
 }

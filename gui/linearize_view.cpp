@@ -1,5 +1,7 @@
 #include "gui/linearize_view.hpp"
 #include "study/files.hpp"
+#include "study/jobs.hpp"
+#include "study/tools.hpp"
 
 #include <QComboBox>
 #include <QDir>
@@ -237,12 +239,19 @@ void LinearizeView::buildUi() {
   modes_split->setStretchFactor(0, 1);
   modes_split->setStretchFactor(1, 1);
 
+  hidden_label_ = new QLabel(this);
+  hidden_label_->setObjectName("controllabilityLabel");
+  hidden_label_->setWordWrap(true);
+  hidden_label_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  hidden_label_->setToolTip(tr("The modes the Plant/In inputs cannot move (A, B) and the Plant/Out outputs cannot see "
+                               "(A, C), named by their dominant states, as codyna linearize prints them"));
   auto* results = new QWidget(this);
   auto* res_layout = new QVBoxLayout(results);
   res_layout->setContentsMargins(0, 0, 0, 0);
   res_layout->addWidget(op_label_);
   res_layout->addWidget(stale_label_);
   res_layout->addWidget(tabs_, 1);
+  res_layout->addWidget(hidden_label_);
 
   auto* vsplit = new QSplitter(Qt::Vertical, this);
   vsplit->setObjectName("linearizeSplitter");
@@ -498,17 +507,20 @@ bool LinearizeView::linearize() {
     return false;
   }
   try {
-    StudyLinearization r = study_linearize(*m);
-    ModalAnalysis modal;
-    try {
-      modal = study_modes(r.system);
-    } catch (const std::exception& e) {
-      emit message(tr("Linearize: no modal analysis: %1").arg(qs(e.what())));
-    }
-    result_ = std::move(r);
+    // the job codyna linearize runs (computing only: the export is the Export button's), so the
+    // view shows what the command line prints: the modes, controllability and observability, the
+    // notes and warnings
+    LinearizeRequest request;
+    request.model = doc_->filePath().isEmpty() ? std::string("untitled.json") : ss(doc_->filePath());
+    LinearizeJob job = study_linearize_job(request, doc_->spec());
+    for (const std::string& n : job.notes) emit message(tr("Linearize: %1").arg(qs(n)));
+    for (const std::string& w : job.warnings) emit message(tr("Linearize: warning: %1").arg(qs(w)));
+    hidden_label_->setText(tr("Controllable from Plant/In: %1\nObservable from Plant/Out: %2")
+                               .arg(qs(study_hidden_modes_text(job.uncontrollable)), qs(study_hidden_modes_text(job.unobservable))));
+    result_ = std::move(job.linearization);
     result_model_ = m;
     result_key_ = linearization_key(doc_->spec(), doc_->filePath());
-    modal_ = std::move(modal);
+    modal_ = std::move(job.modes);
   } catch (const std::exception& e) {
     emit message(tr("Linearize: %1").arg(qs(e.what())));
     updateStaleness();
@@ -555,6 +567,7 @@ void LinearizeView::clearResult() {
     tabs_->setTabText(k, QLatin1String(names[k]));
   }
   offsets_->setRowCount(0);
+  hidden_label_->clear();
   mode_model_->setModes(modal_);
   pole_map_->setModes(modal_);
   syncing_ = false;

@@ -108,6 +108,7 @@ class LinearizeView : public QWidget {
   ModeTableModel* modeModel() const { return mode_model_; }
   PoleMap* poleMap() const { return pole_map_; }
   QLabel* operatingPointLabel() const { return op_label_; }
+  QLabel* controllabilityLabel() const { return hidden_label_; }
 
  signals:
   // a mode was selected (table or pole map): its index in modes(), its shape (state order) and s
@@ -158,6 +159,7 @@ class LinearizeView : public QWidget {
   QPushButton* export_button_ = nullptr;
   QLabel* op_label_ = nullptr;
   QLabel* stale_label_ = nullptr;
+  QLabel* hidden_label_ = nullptr;  // controllable / observable, as codyna linearize says it
   QTabWidget* tabs_ = nullptr;
   QTableView* matrix_views_[4] = {};
   MatrixTableModel* matrix_models_[4] = {};

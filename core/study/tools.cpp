@@ -19,6 +19,10 @@ std::vector<HiddenMode> study_unobservable(const LinearSystem& sys) {
 }
 std::string study_describe_modes(const std::vector<HiddenMode>& modes) { return describe(modes); }
 
+std::string study_hidden_modes_text(const std::vector<HiddenMode>& hidden) {
+  return hidden.empty() ? std::string("yes, every mode") : "no: " + describe(hidden);
+}
+
 LqrResult study_lqr(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& Q,
                     const Eigen::MatrixXd& R, bool discrete) {
   return discrete ? dlqr(A, B, Q, R) : lqr(A, B, Q, R);

@@ -33,6 +33,9 @@ ChannelZeros study_zeros(const LinearSystem& sys, int input, int output);
 std::vector<HiddenMode> study_uncontrollable(const LinearSystem& sys);
 std::vector<HiddenMode> study_unobservable(const LinearSystem& sys);
 std::string study_describe_modes(const std::vector<HiddenMode>& modes);
+// "yes, every mode", or "no: " and the modes: how codyna linearize and the GUI say controllability
+// (of the uncontrollable modes) and observability (of the unobservable ones)
+std::string study_hidden_modes_text(const std::vector<HiddenMode>& hidden);
 
 // LQR (u = -K x, MATLAB's sign convention) continuous or, with `discrete`, for x[k+1] = A x + B u;
 // pole placement (MATLAB's place: u = -K x puts eig(A - B K) at `poles`). Bad sizes, weights or

@@ -45,6 +45,8 @@
 #include "gui/simulate_view.hpp"
 #include "gui/study_widgets.hpp"
 #include "io/model_file.hpp"
+#include "study/jobs.hpp"
+#include "study/tools.hpp"
 #include "study/workflow.hpp"
 #include "io/mat_export.hpp"
 #include "io/results_file.hpp"
@@ -164,6 +166,37 @@ class ViewsTest : public QObject {
     doc.undoStack()->undo();
     QCOMPARE(doc.spec().analysis.method, std::string("exact"));
     QCOMPARE(view.methodCombo()->currentData().toString(), QString("exact"));
+  }
+
+  // The Linearize view says controllability and observability as codyna linearize prints them
+  // (the same job): the heavy top about its initial state has modes its support's inputs cannot
+  // move and its outputs cannot see (the CLI's text pinned in tests/data/pinned_outputs.json,
+  // lin_initial_heavy_top); the cart-pendulum is controllable and observable
+  void controllabilityAsTheCommandLineSaysIt() {
+    Document doc;
+    QVERIFY(doc.load(QStringLiteral(CODYNA_EXAMPLES_DIR "/heavy_top.json")));
+    StudySpec study = doc.spec().analysis;
+    study.operating_point = "initial";
+    QVERIFY(doc.setStudy(study));
+    LinearizeView view(&doc);
+    view.show();
+    QTest::mouseClick(view.linearizeButton(), Qt::LeftButton);
+    QVERIFY(view.result());
+    const QString shown = view.controllabilityLabel()->text();
+    LinearizeRequest r;
+    r.model = CODYNA_EXAMPLES_DIR "/heavy_top.json";
+    const LinearizeJob job = study_linearize_job(r, doc.spec());
+    QCOMPARE(shown, QString("Controllable from Plant/In: %1\nObservable from Plant/Out: %2")
+                        .arg(QString::fromStdString(study_hidden_modes_text(job.uncontrollable)),
+                             QString::fromStdString(study_hidden_modes_text(job.unobservable))));
+    QVERIFY2(shown.contains("Controllable from Plant/In: no: lambda = 0 +/- 75.0334i (support.rx, support.rz)"), qPrintable(shown));
+    QVERIFY(shown.contains("Observable from Plant/Out: no: "));
+    Document cart;
+    QVERIFY(cart.load(kCart));
+    LinearizeView cart_view(&cart);
+    QVERIFY(cart_view.linearize());
+    QCOMPARE(cart_view.controllabilityLabel()->text(),
+             QString("Controllable from Plant/In: yes, every mode\nObservable from Plant/Out: yes, every mode"));
   }
 
   void modeSelectionIsSharedByTheTableAndThePoleMap() {
