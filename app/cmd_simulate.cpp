@@ -166,9 +166,7 @@ void summary(const SimulateJob& job) {
     std::cout << "input  " << std::left << std::setw(10) << act.name << std::right << " max |u| "
               << job.max_abs_input[static_cast<Eigen::Index>(i)] << " [" << act.unit << "]\n";
   }
-  for (const Saturation& s : job.saturation)
-    std::cout << "saturation       " << s.actuator << " at its limit from t = " << s.first << " s: " << s.at_max
-              << " s at max, " << s.at_min << " s at min\n";
+  for (const Saturation& s : job.saturation) std::cout << "saturation       " << saturation_text(s) << "\n";
   std::cout << "energy           " << job.energy_start << " -> " << job.energy_end << " J\n";
   if (m.nc)
     std::cout << "constraint drift max |phi| " << job.max_constraint_violation << ", max |Jc v| " << job.max_velocity_violation

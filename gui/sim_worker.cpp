@@ -3,6 +3,7 @@
 #include <exception>
 #include <utility>
 
+#include "study/jobs.hpp"
 #include "study/workflow.hpp"
 
 namespace codyna::gui {
@@ -24,7 +25,7 @@ SimWorker::~SimWorker() {
   }
 }
 
-bool SimWorker::start(std::shared_ptr<const codyna::Model> model) {
+bool SimWorker::start(std::shared_ptr<const codyna::Model> model, const codyna::ModelSpec& file_spec, const std::string& file) {
   if (running_ || !model) return false;
   if (thread_) {  // the last run's thread has posted finished() and is about to end
     thread_->wait();
@@ -41,7 +42,7 @@ bool SimWorker::start(std::shared_ptr<const codyna::Model> model) {
   pending_.clear();
   last_t_ = 0;
   t_end_ = model->spec.solver.t_end;
-  thread_ = QThread::create([this, model] { runJob(model); });
+  thread_ = QThread::create([this, spec = file_spec, file] { runJob(spec, file); });
   thread_->setObjectName(QStringLiteral("codyna-simulation"));
   emit started();
   thread_->start();
@@ -70,7 +71,7 @@ void SimWorker::postBatch(bool force) {
       Qt::QueuedConnection);
 }
 
-void SimWorker::runJob(std::shared_ptr<const codyna::Model> model) {
+void SimWorker::runJob(const codyna::ModelSpec& spec, const std::string& file) {
   QElapsedTimer wall;
   wall.start();
   auto fail = [this](const QString& message) {
@@ -82,39 +83,13 @@ void SimWorker::runJob(std::shared_ptr<const codyna::Model> model) {
         },
         Qt::QueuedConnection);
   };
-
-  codyna::StudySimulation setup;
-  try {
-    setup = codyna::study_simulation(*model, &cancel_);
-  } catch (const codyna::StudyCancelled&) {
-    return fail(QStringLiteral("cancelled during the setup (the operating point's time=T run)"));
-  } catch (const std::exception& e) {
-    return fail(QString::fromStdString(e.what()));
-  } catch (...) {
-    return fail(QStringLiteral("the simulation setup failed (unknown error)"));
-  }
-  // a Cancel pressed while the setup ran takes effect here, before the run starts (a time=T
-  // pre-run stops at its next step; the steady-state searches are short and run to their end)
-  if (cancel_.load()) return fail(QStringLiteral("cancelled during the setup (operating point, controller design)"));
+  // the job codyna simulate runs: the study's model, controller and plant, the run, and what the
+  // command line says of it (notes, warnings, saturation), decided there, shown here
+  codyna::SimulateRequest request;
+  request.model = file.empty() ? std::string("untitled.json") : file;
   // the window keeps a run several times (plots, the signal list, runs kept for comparison):
   // it records at most kMaxSamples samples; longer records are the command line's (codyna simulate)
-  if (setup.options.max_samples > kMaxSamples) setup.options.max_samples = kMaxSamples;
-  const QString source = QString::fromStdString(setup.controller_source);
-  QStringList notes;
-  for (const std::string& n : setup.notes) notes << QString::fromStdString(n);
-  if (setup.start != "model") notes << QStringLiteral("the run starts at the %1 point").arg(QString::fromStdString(setup.start));
-  QMetaObject::invokeMethod(
-      this,
-      [this, source, notes] {
-        controller_source_ = source;
-        notes_ = notes;
-        emit setupDone(source);
-      },
-      Qt::QueuedConnection);
-
-  t_end_ = setup.options.t_end;
-  last_t_ = setup.options.t0;
-  since_post_.start();
+  request.max_samples = kMaxSamples;
   codyna::SimulationCallbacks cb;
   cb.cancel = &cancel_;
   // record() in the simulator calls on_sample, then progress, for every output time
@@ -125,10 +100,38 @@ void SimWorker::runJob(std::shared_ptr<const codyna::Model> model) {
     t_end_ = tEnd;
     postBatch(false);
   };
+  struct CancelledInSetup {};
+  std::size_t warnings_before_run = 0;
+  const auto ready = [&](const codyna::SimulateJob& job) {
+    // a Cancel pressed while the setup ran takes effect here, before the run starts (a time=T
+    // pre-run stops at its next step; the steady-state searches are short and run to their end)
+    if (cancel_.load()) throw CancelledInSetup{};
+    const QString source = QString::fromStdString(job.setup.controller_source);
+    QStringList notes;
+    for (const std::string& n : job.notes) notes << QString::fromStdString(n);
+    if (job.setup.start != "model") notes << QStringLiteral("the run starts at the %1 point").arg(QString::fromStdString(job.setup.start));
+    for (const std::string& w : job.warnings) notes << QStringLiteral("warning: %1").arg(QString::fromStdString(w));
+    warnings_before_run = job.warnings.size();
+    QMetaObject::invokeMethod(
+        this,
+        [this, source, notes] {
+          controller_source_ = source;
+          notes_ = notes;
+          emit setupDone(source);
+        },
+        Qt::QueuedConnection);
+    t_end_ = job.setup.options.t_end;
+    last_t_ = job.setup.options.t0;
+    since_post_.start();
+  };
 
-  std::shared_ptr<const codyna::SimulationResult> result;
+  codyna::SimulateJob job;
   try {
-    result = std::make_shared<const codyna::SimulationResult>(codyna::study_simulate(*model, setup, cb));
+    job = codyna::study_simulate_job(request, spec, cb, ready);
+  } catch (const CancelledInSetup&) {
+    return fail(QStringLiteral("cancelled during the setup (operating point, controller design)"));
+  } catch (const codyna::StudyCancelled&) {
+    return fail(QStringLiteral("cancelled during the setup (the operating point's time=T run)"));
   } catch (const std::exception& e) {
     return fail(QString::fromStdString(e.what()));
   } catch (...) {
@@ -136,17 +139,12 @@ void SimWorker::runJob(std::shared_ptr<const codyna::Model> model) {
   }
   postBatch(true);  // the rest, before finished()
   const double seconds = wall.nsecsElapsed() * 1e-9;
-  // what the command line warns about, said in the status too: an unstable linear closed loop,
-  // a run that left the region where the linear model holds (core's study_linear_region)
+  auto result = std::make_shared<const codyna::SimulationResult>(std::move(job.result));
   QStringList after;
-  if (setup.linear_unstable) after << QStringLiteral("the linear closed loop is unstable about the operating point");
-  const codyna::LinearRegion lr = codyna::study_linear_region(*model, setup, *result);
-  if (lr.left_at >= 0)
-    after << QStringLiteral("the state left the linear region (|%1 - its operating-point value| > %2) at t = %3 s%4")
-                 .arg(QString::fromStdString(lr.left_on))
-                 .arg(lr.bound)
-                 .arg(lr.left_at)
-                 .arg(lr.settled && lr.final_distance > lr.bound ? QStringLiteral(" and settled elsewhere") : QString());
+  for (std::size_t k = warnings_before_run; k < job.warnings.size(); ++k)
+    after << QStringLiteral("warning: %1").arg(QString::fromStdString(job.warnings[k]));
+  for (const codyna::Saturation& s : job.saturation)
+    after << QStringLiteral("saturation: %1").arg(QString::fromStdString(codyna::saturation_text(s)));
   QMetaObject::invokeMethod(
       this,
       [this, result, seconds, after] {

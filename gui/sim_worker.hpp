@@ -25,6 +25,8 @@
 #include <QString>
 #include <QStringList>
 #include <QThread>
+
+#include "model/model_spec.hpp"
 #include <QVector>
 #include <atomic>
 #include <memory>
@@ -43,9 +45,11 @@ class SimWorker : public QObject {
   explicit SimWorker(QObject* parent = nullptr);
   ~SimWorker() override;
 
-  // Starts a run of the study `model` (its spec().analysis and spec().solver).
-  // Returns false (and does nothing) when a run is still going or the model is null.
-  bool start(std::shared_ptr<const codyna::Model> model);
+  // Starts a run of the study of `file_spec` (the model file as the document holds it, its
+  // analysis and solver sections) through the job codyna simulate runs (study_simulate_job);
+  // `model` is its compiled study model (the document's), `file` the model file's path ("" when
+  // unsaved). Returns false (and does nothing) when a run is still going or the model is null.
+  bool start(std::shared_ptr<const codyna::Model> model, const codyna::ModelSpec& file_spec, const std::string& file);
   // Asks the running integrator to stop at its next output time; no-op when idle.
   void cancel();
   bool isRunning() const { return running_; }
@@ -58,8 +62,10 @@ class SimWorker : public QObject {
 
   // What the last run's setup chose ("lqr", "the model file's pid controller", ...).
   QString controllerSource() const { return controller_source_; }
-  // What the last run's setup says the user should know (an LQR on the controllable part
-  // names the modes it leaves as they are); set before setupDone().
+  // What the last run's job says the user should know, in codyna simulate's words: its notes
+  // (an LQR on the controllable part names the modes it leaves as they are) before setupDone(),
+  // then its warnings ("warning: ..." : an unstable linear closed loop, a run that left the
+  // linear region) and the actuators that sat at a limit, before finished().
   QStringList notes() const { return notes_; }
   // Wall time of the last run, setup included (seconds).
   double wallTime() const { return wall_time_; }
@@ -81,7 +87,7 @@ class SimWorker : public QObject {
   void failed(const QString& message);
 
  private:
-  void runJob(std::shared_ptr<const codyna::Model> model);  // on the worker thread
+  void runJob(const codyna::ModelSpec& spec, const std::string& file);  // on the worker thread
   void postBatch(bool force);                              // on the worker thread
 
   QThread* thread_ = nullptr;

@@ -117,7 +117,7 @@ SimulateView::SimulateView(Document* doc, QWidget* parent) : QWidget(parent), do
   connect(worker_, &SimWorker::setupDone, this, [this](const QString& source) {
     status_ = tr("running (controller: %1)…").arg(source);
     status_label_->setText(status_);
-    for (const QString& n : worker_->notes()) emit message(tr("note: %1").arg(n));
+    for (const QString& n : worker_->notes()) emit message(n.startsWith(QLatin1String("warning: ")) ? n : tr("note: %1").arg(n));
   });
   connect(doc_, &Document::specChanged, this, &SimulateView::refreshFromDocument);
   connect(doc_, &Document::replaced, this, &SimulateView::clearResult);
@@ -769,7 +769,7 @@ void SimulateView::run() {
   }
   plots_->setMaxPlotPoints(std::min(kLivePlotPoints, final_plot_points_));
   progress_->setValue(0);
-  if (!worker_->start(m)) return;
+  if (!worker_->start(m, doc_->spec(), ss(doc_->filePath()))) return;
   status_ = tr("running: setting up the controller…");
   status_label_->setText(status_);
   setRunning(true);
@@ -843,7 +843,10 @@ void SimulateView::onFinished(std::shared_ptr<const SimulationResult> r) {
                 .arg(qs(r->stats.integrator_choice.empty() ? r->stats.integrator : r->stats.integrator_choice))
                 .arg(simNumber(worker_->wallTime(), 3))
                 .arg(qs(r->controller.empty() ? worker_->controllerSource().toStdString() : r->controller));
-  for (const QString& n : worker_->notes()) status_ += tr("; note: %1").arg(n);
+  // the job's notes and warnings, in codyna simulate's words
+  for (const QString& n : worker_->notes())
+    status_ += n.startsWith(QLatin1String("warning: ")) || n.startsWith(QLatin1String("saturation: ")) ? QStringLiteral("; ") + n
+                                                                                                      : tr("; note: %1").arg(n);
   status_label_->setText(status_);
   setRunning(false);
   emit message(tr("Simulation %1").arg(status_));

@@ -18,7 +18,7 @@
 // The last five go through Document::setStudyChecked: what the core's reader or
 // study_model refuses is refused here with the core's message.
 //
-// Run starts a SimWorker (study_simulation + study_simulate on a worker
+// Run starts a SimWorker (study_simulate_job, as codyna simulate runs it, on a worker
 // thread, the code of `codyna simulate`) on the document's current model; the
 // progress bar and the live plots (ResultPlots, Plant/In = the model's
 // plant_inputs columns of u) follow its batches; at the end the full (or

@@ -435,6 +435,12 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
 
 namespace codyna {
 
+std::string saturation_text(const Saturation& s) {
+  std::ostringstream os;
+  os << s.actuator << " at its limit from t = " << s.first << " s: " << s.at_max << " s at max, " << s.at_min << " s at min";
+  return os.str();
+}
+
 std::vector<Saturation> saturation_report(const Model& model, const SimulationResult& r) {
   std::vector<Saturation> out;
   const int N = r.samples();

@@ -80,5 +80,7 @@ struct Saturation {
   double first = 0;               // time of the first sample at a limit
 };
 std::vector<Saturation> saturation_report(const Model& model, const SimulationResult& result);
+// "U at its limit from t = 0.12 s: 0.3 s at max, 0 s at min" (codyna simulate and the GUI say it so)
+std::string saturation_text(const Saturation& s);
 
 }  // namespace codyna

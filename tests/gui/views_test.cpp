@@ -845,7 +845,7 @@ class ViewsTest : public QObject {
     QTest::mouseClick(view.runButton(), Qt::LeftButton);
     QVERIFY(waitFor([&] { return finished.count() == 1; }));
     QVERIFY(view.result() && view.result()->completed);
-    QVERIFY2(view.statusText().contains("; note: the state left the linear region (|rod_pivot - its operating-point value| > 0.01) at t = 0 s"),
+    QVERIFY2(view.statusText().contains("; warning: the state left the region where the linear model holds: |rod_pivot - its operating-point value| > 0.01 at t = 0 s"),
              qPrintable(view.statusText()));
     QVERIFY2(!view.statusText().contains("unstable"), qPrintable(view.statusText()));
     // within the default 0.5 rad nothing is said
