@@ -199,6 +199,36 @@ class ViewsTest : public QObject {
              QString("Controllable from Plant/In: yes, every mode\nObservable from Plant/Out: yes, every mode"));
   }
 
+  // The run status says which actuators sat at a limit, as codyna simulate does (the same job,
+  // saturation_text): the quarter bus's LQR force U saturates under a 5000 N road force step at
+  // 0.1 s (tests/cli/compare_linear_exact.sh runs the same)
+  void saturationIsSaid() {
+    Document doc;
+    QVERIFY(doc.load(QStringLiteral(CODYNA_TEST_DATA_DIR "/bus_suspension.json")));
+    StudySpec study = doc.spec().analysis;
+    DisturbanceSpec d;
+    d.actuator = "road_force";
+    d.time = 0.1;
+    d.value = 5000;
+    study.disturbances = {d};
+    QVERIFY(doc.setStudy(study));
+    SimulateView view(&doc);
+    view.show();
+    QSignalSpy finished(&view, &SimulateView::runFinished);
+    QTest::mouseClick(view.runButton(), Qt::LeftButton);
+    QVERIFY(waitFor([&] { return finished.count() == 1; }));
+    QVERIFY(view.result() && view.result()->completed);
+    SimulateRequest r;
+    r.model = CODYNA_TEST_DATA_DIR "/bus_suspension.json";
+    const SimulateJob job = study_simulate_job(r, doc.spec());
+    QVERIFY(!job.saturation.empty());
+    for (const Saturation& s : job.saturation) {
+      const QString line = QStringLiteral("; saturation: ") + QString::fromStdString(saturation_text(s));
+      QVERIFY2(view.statusText().contains(line), qPrintable(view.statusText() + "\nlacks " + line));
+    }
+    QVERIFY(view.statusText().contains("saturation: U at its limit from t = "));
+  }
+
   void modeSelectionIsSharedByTheTableAndThePoleMap() {
     Document doc;
     QVERIFY(doc.load(kCart));
