@@ -56,6 +56,11 @@ class Preparer {
   // and the rows that depend on the others
   void assemble_loops() {
     if (m_.nc == 0) return;
+    // nothing moves (every joint fixed): no coordinate can close a loop, and the Jacobians have no
+    // columns (their blocks would address an empty matrix)
+    if (m_.nv == 0)
+      fail(at("constraints", 0), "a loop closure needs a joint that moves, and every joint here is fixed "
+                                 "(to weld two bodies, a fixed joint alone does it)");
     const Eigen::VectorXd q = m_.q0, v = m_.v0;
     check_discs_upright(q, "the joints' q0");
     const AssemblyResult r = assemble(m_, q, v);

@@ -69,14 +69,15 @@ for integ in ida cvode-bdf rk4; do
   expect 1 "no degrees of freedom" -- "$codyna" simulate fixed.json --out f.h5 --quiet --integrator $integ
 done
 # a loop closed on a body that nothing moves (a welded plate pinned away from its place): the
-# assembly has no coordinate to move; it crashed (an empty matrix decomposed) before 2026-11
+# assembly has no coordinate to move; it crashed (an empty matrix decomposed) before 2026-11, and
+# is refused before the assembly now
 cat > welded_loop.json <<'JSON'
 {"name": "welded_loop",
  "bodies": [{"name": "plate", "mass": 1, "inertia": [0.01, 0.01, 0.01]}],
  "joints": [{"name": "weld", "type": "fixed", "parent": "ground", "child": "plate"}],
  "constraints": [{"name": "pin", "type": "ball", "body_a": "ground", "point_a": [1, 0, 0], "body_b": "plate", "point_b": [0, 0, 0]}]}
 JSON
-expect 1 "/constraints/0: the loop cannot be assembled" -- "$codyna" info welded_loop.json
+expect 1 "/constraints/0: a loop closure needs a joint that moves" -- "$codyna" info welded_loop.json
 
 # divergence ends the run early, with the reason and the partial result (exit 2)
 python3 - "$src/examples/pendulum.json" > unstable.json <<'PY'
