@@ -251,16 +251,19 @@ void ControlView::buildUi() {
 }
 
 const LinearSystem* ControlView::system(System s) const {
-  if (s == Plant) return plant_ ? &plant_->system : nullptr;
-  return closed_ ? &closed_->loop.system : nullptr;
+  if (!job_) return nullptr;
+  if (s == Plant) return &job_->plant.system;
+  return job_->closed_loop ? &job_->closed_loop->loop.system : nullptr;
 }
 const FrequencyResponse* ControlView::frequency(System s) const {
-  if (s == Plant) return plant_ ? &plant_frequency_ : nullptr;
-  return closed_ ? &closed_->frequency : nullptr;
+  if (!job_) return nullptr;
+  if (s == Plant) return &job_->plant_frequency;
+  return job_->closed_loop ? &job_->closed_loop->frequency : nullptr;
 }
 const StepResponse* ControlView::step(System s) const {
-  if (s == Plant) return plant_ ? &plant_step_ : nullptr;
-  return closed_ ? &closed_->step : nullptr;
+  if (!job_) return nullptr;
+  if (s == Plant) return &job_->plant_step;
+  return job_->closed_loop ? &job_->closed_loop->step : nullptr;
 }
 
 bool ControlView::analyse() {
@@ -270,77 +273,55 @@ bool ControlView::analyse() {
     return false;
   }
   clearResult();
-  QStringList notes;
   try {
-    StudyLinearization lin = study_linearize(*m);
-    // the plant's curves on the grids the closed loop uses (core's defaults from the poles)
-    const ModalAnalysis poles = study_modes(lin.system);
-    const auto [w_lo, w_hi] = default_frequency_range(poles, lin.system.Ts);
-    const double t_step = default_step_time(poles);
-    plant_frequency_ = frequency_response(lin.system, log_grid(w_lo, w_hi, 400));
-    plant_step_ = step_response(lin.system, t_step, 500);
-    plant_ = std::move(lin);
+    ControlRequest request;
+    request.model = doc_->filePath().isEmpty() ? std::string("untitled.json") : ss(doc_->filePath());
+    job_ = study_control_job(request, doc_->spec());
   } catch (const std::exception& e) {
+    job_.reset();
     status_->setText(tr("The plant could not be linearized: %1").arg(qs(e.what())));
     emit message(tr("Analyse: %1").arg(qs(e.what())));
     return false;
   }
   model_ = m;
-  try {
-    closed_ = study_closed_loop(*m);
-    for (const auto& n : closed_->notes) notes << qs(n);
-  } catch (const std::exception& e) {
-    closed_.reset();
-    notes << tr("no closed loop: %1").arg(qs(e.what()));
-  }
+  const ControlJob& job = *job_;
+  const LinearSystem& plant = job.plant.system;
   QString text = tr("<b>Plant</b> about %1: %2 states, %3 inputs, %4 outputs.")
-                     .arg(qs(plant_->op.kind).toHtmlEscaped())
-                     .arg(plant_->system.nx())
-                     .arg(plant_->system.nu())
-                     .arg(plant_->system.ny());
-  if (closed_) {
-    int unstable = 0, marginal = 0;  // as the core classifies them (Mode::stability)
-    for (const Mode& md : closed_->poles.modes) {
-      unstable += md.stability == Stability::Unstable;
-      marginal += md.stability == Stability::Marginal;
-    }
-    QString verdict = unstable ? tr("<span style='color:#b00000'>%1 unstable</span>").arg(unstable) : QString();
-    if (marginal) verdict += (verdict.isEmpty() ? QString() : tr(", ")) + tr("%1 on the stability boundary").arg(marginal);
+                     .arg(qs(job.plant.op.kind).toHtmlEscaped())
+                     .arg(plant.nx())
+                     .arg(plant.nu())
+                     .arg(plant.ny());
+  if (const auto& cl = job.closed_loop) {
+    const PoleCount& c = job.closed_loop_count;  // as the core classifies the poles
+    QString verdict = c.unstable ? tr("<span style='color:#b00000'>%1 unstable</span>").arg(c.unstable) : QString();
+    if (c.marginal) verdict += (verdict.isEmpty() ? QString() : tr(", ")) + tr("%1 on the stability boundary").arg(c.marginal);
     text += tr(" <b>Closed loop</b> with %1: %2 poles, %3.")
-                .arg(qs(closed_->loop.controller).toHtmlEscaped())
-                .arg(closed_->poles.modes.size())
+                .arg(qs(cl->loop.controller).toHtmlEscaped())
+                .arg(cl->poles.modes.size())
                 .arg(verdict.isEmpty() ? tr("all stable") : verdict);
-    pole_model_->setModes(closed_->poles);
-    // a controller without states acts as u = u0 - K dx: K is read off the closed loop's effort rows
-    const ClosedLoopLinear& L = closed_->loop;
-    if (L.nxc == 0 && L.nu > 0 && L.nx > 0) {
-      const Eigen::MatrixXd K = -L.system.C.block(L.ny, 0, L.nu, L.nx);
-      QStringList inputs;
-      for (int k = 0; k < L.nu; ++k) inputs << qs(L.system.output_names[L.ny + k]).mid(2);  // "u_force" -> "force"
-      gain_model_->setMatrix(K, inputs, qlist(plant_->system.state_names));
-    }
+    pole_model_->setModes(cl->poles);
+    if (job.gain.size() > 0) gain_model_->setMatrix(job.gain, qlist(job.gain_inputs), qlist(job.gain_states));
   }
+  QStringList notes;
+  for (const std::string& n : job.notes) notes << qs(n);
   if (!notes.isEmpty()) text += QStringLiteral("<br>") + notes.join(QStringLiteral("<br>")).toHtmlEscaped();
   status_->setText(text);
   system_combo_->setEnabled(true);
   {
     const QSignalBlocker b(system_combo_);
-    system_combo_->setCurrentIndex(closed_ ? ClosedLoop : Plant);
+    system_combo_->setCurrentIndex(job.closed_loop ? ClosedLoop : Plant);
   }
   fillPairs();
   redraw();
   updateStaleness();
-  emit message(closed_ ? tr("Analysed the plant and the closed loop (%1)").arg(qs(closed_->loop.controller))
-                       : tr("Analysed the plant (no closed loop)"));
+  emit message(job.closed_loop ? tr("Analysed the plant and the closed loop (%1)").arg(qs(job.closed_loop->loop.controller))
+                               : tr("Analysed the plant (no closed loop)"));
   return true;
 }
 
 void ControlView::clearResult() {
   model_.reset();
-  plant_.reset();
-  closed_.reset();
-  plant_frequency_ = {};
-  plant_step_ = {};
+  job_.reset();
   gain_model_->clear();
   pole_model_->clear();
   status_->setText(tr("Not analysed yet: Analyse linearizes the plant and closes the loop with the study's controller."));
@@ -369,7 +350,7 @@ void ControlView::fillPairs() {
     if (input_combo_->findText(in) >= 0) input_combo_->setCurrentText(in);
     if (output_combo_->findText(out) >= 0) output_combo_->setCurrentText(out);
   }
-  system_combo_->setItemData(ClosedLoop, closed_ ? QVariant() : QVariant(0), Qt::UserRole - 1);  // disabled without a loop
+  system_combo_->setItemData(ClosedLoop, hasClosedLoop() ? QVariant() : QVariant(0), Qt::UserRole - 1);  // disabled without a loop
 }
 
 void ControlView::redraw() {
@@ -387,9 +368,9 @@ void ControlView::redraw() {
   const int in = input_combo_->currentIndex(), out = output_combo_->currentIndex();
   // poles of the system, zeros of the pair
   if (sys && in >= 0 && out >= 0 && in < sys->B.cols() && out < sys->C.rows()) {
-    pz_map_->setModes(study_modes(*sys));
+    pz_map_->setModes(which == Plant ? job_->plant_modes : job_->closed_loop->poles);
     try {
-      pz_map_->setZeros(study_zeros(*sys, in, out).zeros);
+      pz_map_->setZeros(study_control_zeros(*job_, which == ClosedLoop, in, out));
     } catch (const std::exception&) {
       pz_map_->setZeros({});
     }
@@ -447,8 +428,8 @@ void ControlView::redraw() {
     // the outputs of the chosen output's group: the measured outputs, or (closed loop) the efforts,
     // which are far larger and would flatten the outputs on one axis
     int first = 0, last = sys->ny();
-    if (which == ClosedLoop && closed_) {
-      const int ny = closed_->loop.ny;
+    if (which == ClosedLoop && hasClosedLoop()) {
+      const int ny = job_->closed_loop->loop.ny;
       if (out < ny) last = ny;
       else first = ny;
     }

@@ -2,10 +2,10 @@
 // engineer reads before running the nonlinear loop (Simulink Control Design's
 // Linear System Analyzer, Adams Controls' plant plots).
 //
-// "Analyse" calls core's study_linearize() (the open-loop plant, as `codyna
-// linearize` does) and study_closed_loop() (the plant closed by the study's
-// controller: the model file's PID, a K or LTI from a .mat, or the LQR the
-// Simulate view designs) on the document's model. It shows
+// "Analyse" runs core's study_control_job (study/jobs.hpp): the open-loop plant, as `codyna
+// linearize` makes it, and the plant closed by the study's controller (the model file's PID,
+// a K or LTI from a .mat, or the LQR the Simulate view designs), as `codyna linearize
+// --closed-loop` makes it, on the document's model. It shows
 //  - the controller's gain K when it has no states of its own (state feedback, LQR,
 //    P and PD: u = u0 - K dx, read off the closed loop), and the closed-loop
 //    poles (a table: eigenvalue, frequency, damping; unstable ones in red);
@@ -14,8 +14,8 @@
 //    the closed loop (chosen with three drop-downs);
 //  - the step response to a unit step on the chosen input of the outputs of
 //    the chosen output's group (exact at the samples: core's step_response).
-// Nothing is computed here: the curves are core's frequency_response() and
-// step_response() on the study's grids. An edit marks the results out of date;
+// Nothing is computed here: the curves, poles, zeros, the gain and the stability verdict are
+// the job's. An edit marks the results out of date;
 // New and Open clear them.
 #pragma once
 
@@ -23,7 +23,7 @@
 #include <memory>
 #include <optional>
 
-#include "study/workflow.hpp"
+#include "study/jobs.hpp"
 
 QT_BEGIN_NAMESPACE
 class QChart;
@@ -58,11 +58,11 @@ class ControlView : public QWidget {
 
   // what is shown: 0 = the open-loop plant, 1 = the closed loop
   enum System { Plant = 0, ClosedLoop = 1 };
-  bool hasClosedLoop() const { return closed_.has_value(); }
+  bool hasClosedLoop() const { return job_ && job_->closed_loop.has_value(); }
   const codyna::LinearSystem* system(System s) const;
   const codyna::FrequencyResponse* frequency(System s) const;
   const codyna::StepResponse* step(System s) const;
-  const codyna::StudyClosedLoop* closedLoop() const { return closed_ ? &*closed_ : nullptr; }
+  const codyna::StudyClosedLoop* closedLoop() const { return hasClosedLoop() ? &*job_->closed_loop : nullptr; }
 
   // the widgets, for tests
   QComboBox* systemCombo() const { return system_combo_; }
@@ -93,10 +93,7 @@ class ControlView : public QWidget {
 
   Document* doc_;
   std::shared_ptr<const codyna::Model> model_;  // the model the results belong to
-  std::optional<codyna::StudyLinearization> plant_;
-  codyna::FrequencyResponse plant_frequency_;
-  codyna::StepResponse plant_step_;
-  std::optional<codyna::StudyClosedLoop> closed_;
+  std::optional<codyna::ControlJob> job_;
 
   QPushButton* analyse_button_ = nullptr;
   QLabel* status_ = nullptr;

@@ -152,4 +152,14 @@ std::string format_modes(const ModalAnalysis& m) {
   return out;
 }
 
+PoleCount count_stability(const ModalAnalysis& m) {
+  PoleCount c;
+  for (const Mode& md : m.modes) {
+    c.stable += md.stability == Stability::Stable;
+    c.marginal += md.stability == Stability::Marginal;
+    c.unstable += md.stability == Stability::Unstable;
+  }
+  return c;
+}
+
 }  // namespace codyna

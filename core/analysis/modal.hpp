@@ -50,6 +50,9 @@ struct ModalAnalysis {
 // Throws std::invalid_argument if A is not square or has NaN/Inf entries.
 ModalAnalysis modal_analysis(const LinearSystem& sys);
 
+// How many modes Mode::stability calls stable, marginal, unstable (what a verdict says)
+PoleCount count_stability(const ModalAnalysis& m);
+
 // A readable table: eigenvalue, frequency (rad/s and Hz), damping, and the
 // dominant states of each mode shape (|entry| >= 0.5, largest first). The zero
 // eigenvalue is one row for all its modes ("1-12  0 (x12)") with the states of its

@@ -146,6 +146,37 @@ SimulateJob study_simulate_job(const SimulateRequest& r, const ModelSpec& spec, 
                                const std::function<void(const SimulateJob&)>& ready = {},
                                const StudyMessages& tell = {});
 
+// The Control view's analysis (codyna-gui's Analyse): the plant linearized about the study's
+// operating point with its modes and its step and frequency responses on the grids the closed
+// loop uses (the core's defaults from the plant's poles), and the study's closed loop
+// (study_closed_loop) when the study has a controller. A closed loop that cannot be made is a
+// note (the plant is still shown); a plant that cannot be linearized throws.
+struct ControlRequest {
+  OptionStyle style = OptionStyle::Flag;
+  std::string model;  // the model file (messages, relative paths)
+};
+
+struct ControlJob {
+  Model model;
+  std::vector<std::string> notes, warnings;
+  StudyLinearization plant;
+  ModalAnalysis plant_modes;
+  FrequencyResponse plant_frequency;
+  StepResponse plant_step;
+  std::optional<StudyClosedLoop> closed_loop;
+  PoleCount closed_loop_count;  // of closed_loop->poles (count_stability)
+  // A controller without states acts as u = u0 - K (x - x0): K (Plant/In x plant states) read
+  // off the closed loop's effort rows, its rows named by the Plant/In actuators, its columns by
+  // the plant's states. Empty otherwise.
+  Eigen::MatrixXd gain;
+  std::vector<std::string> gain_inputs, gain_states;
+};
+ControlJob study_control_job(const ControlRequest& r, const ModelSpec& spec, const StudyMessages& tell = {});
+
+// The transmission zeros of one channel of the job's plant (closed = false) or closed loop: the
+// Control view's pole-zero map of the pair it shows (the poles are the job's own modes).
+Eigen::VectorXcd study_control_zeros(const ControlJob& job, bool closed, int input, int output);
+
 // The model compiled as its file writes it, no study applied (validated, indexed, loops assembled,
 // redundant rows found): what `codyna info` summarizes (Model has every name, index and unit) and
 // what the co-simulation steps. ModelError names `file` and the field.

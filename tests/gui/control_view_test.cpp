@@ -120,6 +120,22 @@ class ControlViewTest : public QObject {
     QCOMPARE(cv->poleModel()->rowCount(), 4);
     for (const Mode& m : cl->poles.modes) QVERIFY(m.s.real() < 0);
     QVERIFY(cv->statusLabel()->text().contains("all stable"));
+    // what `codyna linearize --closed-loop` prints for the same model: the same poles, the same gain
+    {
+      LinearizeRequest r;
+      r.model = kCart.toStdString();
+      r.closed_loop = true;
+      const LinearizeJob cli = study_linearize_job(r, w->document()->spec());
+      QVERIFY(cli.closed_loop);
+      QCOMPARE(cli.closed_loop->poles.modes.size(), cl->poles.modes.size());
+      for (std::size_t k = 0; k < cl->poles.modes.size(); ++k) {
+        QCOMPARE(cl->poles.modes[k].eigenvalue, cli.closed_loop->poles.modes[k].eigenvalue);
+        QCOMPARE(cl->poles.modes[k].stability, cli.closed_loop->poles.modes[k].stability);
+      }
+      QCOMPARE(study_format_modes(cl->poles), study_format_modes(cli.closed_loop->poles));
+      const ClosedLoopLinear& L = cli.closed_loop->loop;
+      QCOMPARE(cv->gainModel()->matrix(), Eigen::MatrixXd(-L.system.C.block(L.ny, 0, L.nu, L.nx)));
+    }
 
     // step on the first reference: every output against RK4 on the loop's matrices
     const LinearSystem& s = *cv->system(ControlView::ClosedLoop);
