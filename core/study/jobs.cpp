@@ -52,6 +52,45 @@ struct Teller {
   }
 };
 
+// The study and solver fields a request gave, each with its option as the front end writes it.
+// A refusal of the study at FIELD[/REST] that comes from a value the request gave is said of the
+// option ("--hold cart: unknown coordinate ..."): the user typed it, the file may not have it.
+class GivenFields {
+ public:
+  explicit GivenFields(const Names& opt) : opt_(opt) {}
+  void add(bool given, const std::string& field, const std::string& dashed) {
+    if (given) fields_.emplace_back(field, opt_(dashed));
+  }
+  template <class F>
+  auto run(F&& f) const -> decltype(f()) {
+    try {
+      return f();
+    } catch (const ModelError& e) {
+      for (const auto& [field, option] : fields_) {
+        const std::string& p = e.path();
+        if (p.compare(0, field.size(), field) != 0 || (p.size() > field.size() && p[field.size()] != '/')) continue;
+        const std::string rest = p.size() > field.size() ? p.substr(field.size() + 1) : std::string();
+        throw std::invalid_argument(option + (rest.empty() ? "" : " " + rest) + ": " + e.detail());
+      }
+      throw;
+    }
+  }
+
+ private:
+  Names opt_;
+  std::vector<std::pair<std::string, std::string>> fields_;
+};
+
+void add_point_fields(GivenFields& g, const PointRequest& p) {
+  g.add(p.operating_point.has_value(), "/analysis/operating_point", "operating-point");
+  g.add(p.independent.has_value(), "/analysis/independent", "independent");
+  g.add(p.trim_free.has_value(), "/analysis/trim_free", "trim-free");
+  g.add(p.free_inputs.has_value(), "/analysis/free_inputs", "free-inputs");
+  g.add(!p.hold.empty(), "/analysis/set", "hold");
+  g.add(!p.initial.empty(), "/analysis/initial", "initial");
+  g.add(!p.targets.empty(), "/analysis/output_targets", "target");
+}
+
 void apply_pairs(std::vector<std::pair<std::string, double>>& into, const std::vector<std::string>& given_pairs,
                  const std::string& flag) {
   for (const std::string& s : given_pairs) {
@@ -348,13 +387,27 @@ LinearizeJob linearize_job(const LinearizeRequest& a, const ModelSpec& file_spec
 }
 }  // namespace
 
+namespace {
+GivenFields linearize_fields(const LinearizeRequest& a) {
+  GivenFields g(Names{a.style});
+  add_point_fields(g, a.point);
+  g.add(a.method.has_value(), "/analysis/method", "method");
+  g.add(a.discrete.has_value(), "/analysis/discrete", "discrete");
+  g.add(a.name.has_value(), "/analysis/export_name", "name");
+  g.add(a.q_weights.has_value(), "/analysis/q_weights", "q-weights");
+  g.add(a.r_weights.has_value(), "/analysis/r_weights", "r-weights");
+  g.add(a.controller.has_value(), "/analysis/controller_file", "controller");
+  return g;
+}
+}  // namespace
+
 LinearizeJob study_linearize_job(const LinearizeRequest& a, const ModelSpec& spec, const StudyMessages& tell) {
-  return linearize_job(a, spec, nullptr, {}, tell);
+  return linearize_fields(a).run([&] { return linearize_job(a, spec, nullptr, {}, tell); });
 }
 
 LinearizeJob study_linearize_job(const LinearizeRequest& a, const ModelSpec& spec, const Model& structure,
                                  NumbersChanged what, const StudyMessages& tell) {
-  return linearize_job(a, spec, &structure, what, tell);
+  return linearize_fields(a).run([&] { return linearize_job(a, spec, &structure, what, tell); });
 }
 
 Model study_linearize_structure(const LinearizeRequest& a, const ModelSpec& spec) {
@@ -419,8 +472,31 @@ ModelSpec simulate_spec(const SimulateRequest& a, ModelSpec spec) {
 
 }  // namespace
 
+namespace {
+SimulateJob simulate_job(const SimulateRequest& a, const ModelSpec& file_spec, const SimulationCallbacks& cb,
+                         const std::function<void(const SimulateJob&)>& ready, const StudyMessages& tell);
+}  // namespace
+
 SimulateJob study_simulate_job(const SimulateRequest& a, const ModelSpec& file_spec, const SimulationCallbacks& cb,
                                const std::function<void(const SimulateJob&)>& ready, const StudyMessages& tell) {
+  GivenFields g(Names{a.style});
+  add_point_fields(g, a.point);
+  g.add(a.q_weights.has_value(), "/analysis/q_weights", "q-weights");
+  g.add(a.r_weights.has_value(), "/analysis/r_weights", "r-weights");
+  g.add(a.controller.has_value(), "/analysis/controller_file", "controller");
+  g.add(a.linear_region.has_value(), "/analysis/linear_region", "linear-region");
+  g.add(a.integrator.has_value(), "/solver/integrator", "integrator");
+  g.add(a.rtol.has_value(), "/solver/rtol", "rtol");
+  g.add(a.atol.has_value(), "/solver/atol", "atol");
+  g.add(a.max_step.has_value(), "/solver/max_step", "max-step");
+  g.add(a.t_end.has_value(), "/solver/t_end", "t-end");
+  g.add(a.output_step.has_value(), "/solver/output_step", "output-step");
+  return g.run([&] { return simulate_job(a, file_spec, cb, ready, tell); });
+}
+
+namespace {
+SimulateJob simulate_job(const SimulateRequest& a, const ModelSpec& file_spec, const SimulationCallbacks& cb,
+                         const std::function<void(const SimulateJob&)>& ready, const StudyMessages& tell) {
   const Names opt{a.style};
   SimulateJob job;
   const Teller say{tell, job.notes, job.warnings};
@@ -512,6 +588,8 @@ SimulateJob study_simulate_job(const SimulateRequest& a, const ModelSpec& file_s
   }
   return job;
 }
+
+}  // namespace
 
 Model study_compile(const ModelSpec& spec, const std::string& file) { return compile(spec, file); }
 

@@ -87,6 +87,15 @@ Eigen::MatrixXd diagonal(const Model& m, const std::vector<double>& w, int n, co
   if (static_cast<int>(w.size()) != n)
     workflow_fail(m, field, "expected " + std::to_string(n) + " weights (one per " + (n && field[0] == 'q' ? "state" : "input") +
                        "), got " + std::to_string(w.size()));
+  // Q = diag(q) >= 0 and R = diag(r) > 0: what an LQR design needs, said of the weight given
+  const bool r = field[0] == 'r';
+  for (std::size_t k = 0; k < w.size(); ++k)
+    if (!std::isfinite(w[k]) || (r ? !(w[k] > 0) : !(w[k] >= 0))) {
+      std::ostringstream os;
+      os << "weight " << k + 1 << " is " << w[k] << ": expected " << (r ? "a number > 0 (R must be positive definite)"
+                                                                        : "a number >= 0 (Q must be positive semidefinite)");
+      workflow_fail(m, field, os.str());
+    }
   return Eigen::Map<const Eigen::VectorXd>(w.data(), n).asDiagonal();
 }
 
@@ -601,6 +610,11 @@ OperatingPoint study_operating_point(const Model& m, const std::string& which_in
     } else if (!s.trim_free.empty()) {
       workflow_fail(m, "trim_free", "coordinates are freed for operating point trim only (an equilibrium solves every coordinate not set)");
     }
+    std::vector<std::string> outputs;
+    for (int k : m.plant_outputs) outputs.push_back(m.sensors[static_cast<std::size_t>(k)].name);
+    for (const auto& [name, value] : s.output_targets)
+      if (!std::count(outputs.begin(), outputs.end(), name))
+        workflow_fail(m, "output_targets/" + name, "no Plant/Out output named \"" + name + "\" (Plant/Out: " + listed(outputs) + ")");
     try {
       return steady_state(m, start, spec, s.independent, which);
     } catch (const std::invalid_argument& e) {
@@ -664,6 +678,11 @@ StudyLinearization study_linearize(const Model& m) {
   out.lin = linearize(m, out.op, o);
   out.lin.system.study = plant_study_json(s, s.operating_point);
   out.system = s.discrete > 0 ? discretize_zoh(out.lin.system, s.discrete) : out.lin.system;
+  if (s.discrete > 0 && !(out.system.A.allFinite() && out.system.B.allFinite())) {
+    std::ostringstream os;
+    os << "a sample time of " << s.discrete << " s is too long for this plant: exp(A Ts) overflows";
+    workflow_fail(m, "discrete", os.str());
+  }
   return out;
 }
 

@@ -47,6 +47,18 @@ for flag in "--t-end nan" "--t-end inf" "--t-end -5" "--rtol -1" "--rtol 2" "--a
 done
 expect 1 "time=T" -- "$codyna" linearize model.json --out lin --operating-point time=inf
 expect 1 "expected a finite number" -- "$codyna" linearize model.json --out lin --set pivot=inf
+# a study value given on the command line is refused naming the flag and what was typed, not the model
+# file's field (the file does not have it)
+cart="$src/examples/cart_pendulum.json"
+expect 1 "--r-weights: weight 1 is -1: expected a number > 0" -- "$codyna" linearize "$cart" --out lin --closed-loop --lqr --r-weights -1
+expect 1 "--q-weights: expected 4 weights (one per state), got 2" -- "$codyna" linearize "$cart" --out lin --closed-loop --lqr --q-weights 1,2
+expect 1 "--discrete: a sample time of 1e+300 s is too long for this plant" -- "$codyna" linearize "$cart" --out lin --discrete 1e300
+expect 1 "--hold pivot: expected NAME=VALUE" -- "$codyna" linearize "$cart" --out lin --hold pivot
+expect 1 "--hold cart: unknown coordinate" -- "$codyna" linearize "$cart" --out lin --hold cart=1
+expect 1 "--target foo: no Plant/Out output named" -- "$codyna" linearize "$cart" --out lin --target foo=1
+expect 1 "--initial cart: unknown coordinate" -- "$codyna" simulate "$cart" --out r.h5 --quiet --initial cart=0.1
+expect 1 "--r-weights: weight 1 is 0" -- "$codyna" simulate "$cart" --out r.h5 --quiet --lqr --r-weights 0
+[ ! -e lin ] || fail "lin/ written although every linearization above was refused"
 # runs that would not end are refused before they start, with the number and the flag that raises the bound
 start=$(date +%s)
 expect 1 "--max-samples" -- "$codyna" simulate model.json --out r.h5 --quiet --t-end 1e9
