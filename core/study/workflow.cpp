@@ -614,7 +614,7 @@ OperatingPoint study_operating_point(const Model& m, const std::string& which_in
     for (int k : m.plant_outputs) outputs.push_back(m.sensors[static_cast<std::size_t>(k)].name);
     for (const auto& [name, value] : s.output_targets)
       if (!std::count(outputs.begin(), outputs.end(), name))
-        workflow_fail(m, "output_targets/" + name, "no Plant/Out output named \"" + name + "\" (Plant/Out: " + listed(outputs) + ")");
+        workflow_fail(m, "output_targets/" + name, "output \"" + name + "\" is not in Plant/Out (" + listed(outputs) + ")");
     try {
       return steady_state(m, start, spec, s.independent, which);
     } catch (const std::invalid_argument& e) {

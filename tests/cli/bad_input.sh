@@ -55,7 +55,7 @@ expect 1 "--q-weights: expected 4 weights (one per state), got 2" -- "$codyna" l
 expect 1 "--discrete: a sample time of 1e+300 s is too long for this plant" -- "$codyna" linearize "$cart" --out lin --discrete 1e300
 expect 1 "--hold pivot: expected NAME=VALUE" -- "$codyna" linearize "$cart" --out lin --hold pivot
 expect 1 "--hold cart: unknown coordinate" -- "$codyna" linearize "$cart" --out lin --hold cart=1
-expect 1 "--target foo: no Plant/Out output named" -- "$codyna" linearize "$cart" --out lin --target foo=1
+expect 1 "--target foo: output \"foo\" is not in Plant/Out" -- "$codyna" linearize "$cart" --out lin --target foo=1
 expect 1 "--initial cart: unknown coordinate" -- "$codyna" simulate "$cart" --out r.h5 --quiet --initial cart=0.1
 expect 1 "--r-weights: weight 1 is 0" -- "$codyna" simulate "$cart" --out r.h5 --quiet --lqr --r-weights 0
 [ ! -e lin ] || fail "lin/ written although every linearization above was refused"

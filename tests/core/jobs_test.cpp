@@ -198,7 +198,7 @@ TEST(Jobs, RefusalsNameTheOptionAsWritten) {
   EXPECT_INVALID_ARGUMENT_WITH(study_linearize_job(r, spec), "--discrete: a sample time of 1e+300 s is too long");
   r.discrete.reset();
   r.point.targets = {"foo=1"};
-  EXPECT_INVALID_ARGUMENT_WITH(study_linearize_job(r, spec), "--target foo: no Plant/Out output named \"foo\" (Plant/Out: h, theta)");
+  EXPECT_INVALID_ARGUMENT_WITH(study_linearize_job(r, spec), "--target foo: output \"foo\" is not in Plant/Out (h, theta)");
   // the same fields written in the model file are still the file's
   ModelSpec bad = spec;
   bad.analysis.set = {{"cart", 1.0}};
