@@ -157,6 +157,17 @@ Eigen::Vector3d quat_log(const Quat<double>& d0) {
 Quat<double> conj(const Quat<double>& a) { return {a.w, -a.x, -a.y, -a.z}; }
 }  // namespace
 
+Eigen::Vector3d rotation_log(const Eigen::Vector4d& wxyz) {
+  const double n = wxyz.norm();
+  if (!(n > 0) || !std::isfinite(n)) return Eigen::Vector3d::Zero();
+  return quat_log({wxyz[0] / n, wxyz[1] / n, wxyz[2] / n, wxyz[3] / n});
+}
+
+Eigen::Vector4d rotation_exp(const Eigen::Vector3d& r) {
+  const Quat<double> h = quat_exp<double>(r);
+  return {h.w, h.x, h.y, h.z};
+}
+
 Eigen::VectorXd difference(const Model& model, const Eigen::VectorXd& q0, const Eigen::VectorXd& q1) {
   Eigen::VectorXd dv(model.nv);
   for (int b = 1; b < model.nbodies; ++b) {

@@ -32,6 +32,12 @@ VecXT<S> integrate(const Model& model, const VecXT<S>& q, const VecXT<S>& dv);
 template <class S>
 void integrate_into(const Model& model, const VecXT<S>& q, const VecXT<S>& dv, VecXT<S>& r);
 
+// The one quaternion log and exp of the tree (what integrate and difference use for ball and free
+// joints): the rotation vector (|r| <= pi, the shorter way round) of a quaternion (w, x, y, z),
+// normalized first (a zero quaternion gives 0), and the unit quaternion of a rotation vector.
+Eigen::Vector3d rotation_log(const Eigen::Vector4d& wxyz);
+Eigen::Vector4d rotation_exp(const Eigen::Vector3d& r);
+
 // dv such that integrate(q0, dv) == q1 (double only)
 Eigen::VectorXd difference(const Model& model, const Eigen::VectorXd& q0, const Eigen::VectorXd& q1);
 

@@ -408,23 +408,6 @@ const JointModel& joint_of_v(const Model& m, int iv) {
   throw std::logic_error("velocity index out of range");
 }
 
-// the rotation vector (|r| <= pi) of a stored quaternion (w, x, y, z), and back
-Eigen::Vector3d rotation_vector(const Eigen::Vector4d& wxyz) {
-  Eigen::Quaterniond h(wxyz[0], wxyz[1], wxyz[2], wxyz[3]);
-  if (!(h.norm() > 0)) return Eigen::Vector3d::Zero();
-  h.normalize();
-  if (h.w() < 0) h.coeffs() = -h.coeffs();  // the shorter way round
-  const double s = h.vec().norm();
-  if (s < 1e-12) return 2.0 * h.vec();       // 2 asin(s)/s -> 2
-  return (2.0 * std::atan2(s, h.w()) / s) * h.vec();
-}
-
-Eigen::Vector4d quaternion_of(const Eigen::Vector3d& r) {
-  const double a = r.norm();
-  const Eigen::Vector3d axis = a > 0 ? Eigen::Vector3d(r / a) : Eigen::Vector3d::UnitX();
-  const Eigen::Quaterniond h(Eigen::AngleAxisd(a, axis));
-  return {h.w(), h.x(), h.y(), h.z()};
-}
 }  // namespace
 
 Eigen::VectorXd study_coordinates(const Model& m, const Eigen::VectorXd& q) {
@@ -433,9 +416,9 @@ Eigen::VectorXd study_coordinates(const Model& m, const Eigen::VectorXd& q) {
   for (int b = 1; b < m.nbodies; ++b) {
     const JointModel& j = m.joints[b];
     if (j.type == JointType::Spherical) {
-      c.segment<3>(j.idx_v) = rotation_vector(q.segment<4>(j.idx_q));
+      c.segment<3>(j.idx_v) = rotation_log(q.segment<4>(j.idx_q));
     } else if (j.type == JointType::Free) {
-      c.segment<3>(j.idx_v) = rotation_vector(q.segment<4>(j.idx_q + 3));
+      c.segment<3>(j.idx_v) = rotation_log(q.segment<4>(j.idx_q + 3));
       c.segment<3>(j.idx_v + 3) = q.segment<3>(j.idx_q);
     } else {
       c.segment(j.idx_v, j.nv) = q.segment(j.idx_q, j.nq);
@@ -476,9 +459,9 @@ StudyInitialState set_coordinates(const Model& m, Eigen::VectorXd q, Eigen::Vect
         lock_joint(j);
       } else {  // a component of a ball's or free joint's rotation vector
         const int iq = j.idx_q + (j.type == JointType::Free ? 3 : 0);
-        Eigen::Vector3d r = rotation_vector(q.segment<4>(iq));
+        Eigen::Vector3d r = rotation_log(q.segment<4>(iq));
         r[c] = value;
-        q.segment<4>(iq) = quaternion_of(r);
+        q.segment<4>(iq) = rotation_exp(r);
         lock_joint(j);
       }
       positions.emplace_back(name, value);
