@@ -16,11 +16,11 @@ std::string rates_said(const Model& m) {
 }
 
 struct LinearizeArgs {
-  std::string model, out, op = "equilibrium", method = "exact", mat_version = "5", name, controller;
+  std::string model, out, method = "exact", mat_version = "5", name, controller;
   double discrete = 0.0, trajectory = 0.0, trajectory_step = 0.0;
-  bool closed_loop = false, lqr = false, lqr_controllable_part = false;
-  std::vector<double> q_weights, r_weights;
-  std::vector<std::string> independent, set, initial, trim_free, free_inputs, targets;
+  bool closed_loop = false;
+  PointFlags point;
+  LqrFlags lqr;
   PlantFlags plant;
   const CLI::App* cmd = nullptr;  // to tell given flags (they override the file's analysis section)
 };
@@ -30,23 +30,14 @@ LinearizeRequest request_of(const LinearizeArgs& a) {
   r.model = a.model;
   r.out = a.out;
   r.plant = plant_request(a.plant, a.cmd);
-  if (given(a.cmd, "--operating-point")) r.point.operating_point = a.op;
+  r.point = point_request(a.point, a.cmd);
   if (given(a.cmd, "--method")) r.method = a.method;
   if (given(a.cmd, "--discrete")) r.discrete = a.discrete;
   if (given(a.cmd, "--mat-version")) r.mat_version = a.mat_version;
-  if (given(a.cmd, "--independent")) r.point.independent = a.independent;
   if (given(a.cmd, "--name")) r.name = a.name;
   r.closed_loop = a.closed_loop;
-  r.lqr = a.lqr;
   if (!a.controller.empty()) r.controller = a.controller;
-  if (given(a.cmd, "--q-weights")) r.q_weights = a.q_weights;
-  if (given(a.cmd, "--r-weights")) r.r_weights = a.r_weights;
-  r.lqr_controllable_part = a.lqr_controllable_part;
-  r.point.hold = a.set;
-  r.point.initial = a.initial;
-  if (given(a.cmd, "--trim-free")) r.point.trim_free = a.trim_free;
-  if (given(a.cmd, "--free-input")) r.point.free_inputs = a.free_inputs;
-  r.point.targets = a.targets;
+  apply_lqr_flags(a.lqr, a.cmd, r);
   if (given(a.cmd, "--trajectory")) r.trajectory = a.trajectory;
   if (given(a.cmd, "--trajectory-step")) r.trajectory_step = a.trajectory_step;
   return r;
@@ -143,25 +134,19 @@ void add_linearize(CLI::App& app) {
   auto* cmd = app.add_subcommand("linearize", "Linearize the plant (Plant/In -> Plant/Out) and export NAME.mat + NAME.m");
   cmd->add_option("model", a->model, "model file (JSON)")->required();
   cmd->add_option("--out", a->out, "output directory (created if missing)")->required();
-  cmd->add_option("--operating-point", a->op, "initial | equilibrium | trim | time=T")->capture_default_str();
+  add_point_flags(cmd, a->point, "initial | equilibrium | trim | time=T",
+                  "NAME=VALUE: hold a joint coordinate (or rate, NAME_dot) in the operating-point search: set in the model's state and kept exactly by the equilibrium and trim searches (repeatable; --set is the older name)",
+                  "NAME=VALUE: with --trajectory, the simulation's initial state (repeatable); the operating point does not depend on it");
   cmd->add_option("--method", a->method, "exact | fd-forward | fd-central")->capture_default_str();
   cmd->add_option("--discrete", a->discrete, "sample time Ts > 0: exact zero-order-hold discrete model");
   cmd->add_option("--mat-version", a->mat_version, "5 | 7.3")->capture_default_str();
-  cmd->add_option("--independent", a->independent, "closed loops: independent coordinate names")->delimiter(',');
-  cmd->add_option("--hold,--set", a->set, "NAME=VALUE: hold a joint coordinate (or rate, NAME_dot) in the operating-point search: set in the model's state and kept exactly by the equilibrium and trim searches (repeatable; --set is the older name)");
-  cmd->add_option("--initial", a->initial, "NAME=VALUE: with --trajectory, the simulation's initial state (repeatable); the operating point does not depend on it");
-  cmd->add_option("--trim-free", a->trim_free, "trim: coordinates the trim solves instead of holding (comma-separated)")->delimiter(',');
-  cmd->add_option("--free-input", a->free_inputs, "equilibrium/trim: Plant/In inputs solved for (comma-separated; trim default: all)")->delimiter(',');
-  cmd->add_option("--target", a->targets, "NAME=VALUE: a Plant/Out value the equilibrium/trim must reach (repeatable)");
   cmd->add_option("--trajectory", a->trajectory, "T: linearize along a simulation from 0 to T (the model's controller in the loop, if any) instead of at one point");
   cmd->add_option("--trajectory-step", a->trajectory_step, "DT: spacing of the points along the trajectory (default: the model's output_step)");
   cmd->add_option("--name", a->name, "plant name (default: the model name as a MATLAB identifier)");
   cmd->add_flag("--closed-loop", a->closed_loop, "also export the linear closed loop with the study's controller: NAME_cl.mat + NAME_cl.m, NAME_cl_step.csv, NAME_cl_freq.csv");
-  cmd->add_flag("--lqr", a->lqr, "the closed loop's controller: an LQR designed on this plant");
   cmd->add_option("--controller", a->controller, "the closed loop's controller: a .mat with K, Kp/Ki/Kd or Ac,Bc,Cc,Dc[,Ts] (as simulate --controller)");
-  cmd->add_flag("--lqr-controllable-part", a->lqr_controllable_part, "with --lqr on a plant that is not stabilizable: design on the controllable part");
-  cmd->add_option("--q-weights", a->q_weights, "LQR state weights (diagonal of Q), in state order")->delimiter(',');
-  cmd->add_option("--r-weights", a->r_weights, "LQR input weights (diagonal of R)")->delimiter(',');
+  add_lqr_flags(cmd, a->lqr, "the closed loop's controller: an LQR designed on this plant",
+                "with --lqr on a plant that is not stabilizable: design on the controllable part");
   add_plant_flags(cmd, a->plant);
   a->cmd = cmd;
   cmd->callback([a] { set_exit_code(run_guarded([&] { run(*a); })); });

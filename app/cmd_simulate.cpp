@@ -17,13 +17,14 @@ namespace codyna::cli {
 namespace {
 
 struct SimulateArgs {
-  std::string model, out, csv, controller, op = "equilibrium", integrator;
-  bool lqr = false, lqr_controllable_part = false, compare_linear = false, quiet = false, open_loop = false;
+  std::string model, out, csv, controller, integrator;
+  bool compare_linear = false, quiet = false, open_loop = false;
   double linear_region = 0;
-  std::vector<double> q_weights, r_weights;
   double t_end = 0, rtol = 0, atol = 0, max_step = -1, output_step = 0;
-  double max_samples = 1e7, divergence_bound = 1e8;
-  std::vector<std::string> independent, set, initial, trim_free, free_inputs, targets;
+  // the simulator's own limits unless given (shown as the defaults in --help)
+  double max_samples = SimulationOptions{}.max_samples, divergence_bound = SimulationOptions{}.divergence_bound;
+  PointFlags point;
+  LqrFlags lqr;
   PlantFlags plant;
   const CLI::App* cmd = nullptr;  // to tell given flags (they override the file's analysis and solver sections)
 };
@@ -52,28 +53,19 @@ SimulateRequest simulate_request_of(const SimulateArgs& a) {
   r.csv = a.csv;
   r.plant = plant_request(a.plant, a.cmd);
   if (!a.controller.empty()) r.controller = a.controller;
-  r.lqr = a.lqr;
   r.open_loop = a.open_loop;
-  r.lqr_controllable_part = a.lqr_controllable_part;
-  if (given(a.cmd, "--q-weights")) r.q_weights = a.q_weights;
-  if (given(a.cmd, "--r-weights")) r.r_weights = a.r_weights;
-  if (given(a.cmd, "--operating-point")) r.point.operating_point = a.op;
-  if (given(a.cmd, "--independent")) r.point.independent = a.independent;
+  apply_lqr_flags(a.lqr, a.cmd, r);
+  r.point = point_request(a.point, a.cmd);
   r.compare_linear = a.compare_linear;
   if (given(a.cmd, "--linear-region")) r.linear_region = a.linear_region;
-  r.point.hold = a.set;
-  r.point.initial = a.initial;
-  if (given(a.cmd, "--trim-free")) r.point.trim_free = a.trim_free;
-  if (given(a.cmd, "--free-input")) r.point.free_inputs = a.free_inputs;
-  r.point.targets = a.targets;
   if (!a.integrator.empty()) r.integrator = a.integrator;
   if (given(a.cmd, "--rtol")) r.rtol = a.rtol;
   if (given(a.cmd, "--atol")) r.atol = a.atol;
   if (given(a.cmd, "--max-step")) r.max_step = a.max_step;
   if (given(a.cmd, "--t-end")) r.t_end = a.t_end;
   if (given(a.cmd, "--output-step")) r.output_step = a.output_step;
-  r.max_samples = a.max_samples;
-  r.divergence_bound = a.divergence_bound;
+  if (given(a.cmd, "--max-samples")) r.max_samples = a.max_samples;
+  if (given(a.cmd, "--divergence-bound")) r.divergence_bound = a.divergence_bound;
   return r;
 }
 
@@ -256,11 +248,11 @@ void add_simulate(CLI::App& app) {
   cmd->add_option("--csv", a->csv, "also write the results as CSV");
   cmd->add_option("--controller", a->controller, "controller .mat: K (state feedback), Kp/Ki/Kd (PID) or Ac,Bc,Cc,Dc[,Ts] (LTI); default: the model file's controller, if any");
   cmd->add_flag("--open-loop", a->open_loop, "ignore the model's controller: actuators at their nominal values");
-  cmd->add_flag("--lqr", a->lqr, "design an LQR state feedback on the linearized plant and use it");
-  cmd->add_flag("--lqr-controllable-part", a->lqr_controllable_part, "with --lqr on a plant that is not stabilizable: design on the controllable part, leaving the modes no input moves (named) as they are");
-  cmd->add_option("--q-weights", a->q_weights, "LQR state weights (diagonal of Q), in state order")->delimiter(',');
-  cmd->add_option("--r-weights", a->r_weights, "LQR input weights (diagonal of R)")->delimiter(',');
-  cmd->add_option("--operating-point", a->op, "where the controller's plant is linearized: initial | equilibrium | trim | time=T")->capture_default_str();
+  add_lqr_flags(cmd, a->lqr, "design an LQR state feedback on the linearized plant and use it",
+                "with --lqr on a plant that is not stabilizable: design on the controllable part, leaving the modes no input moves (named) as they are");
+  add_point_flags(cmd, a->point, "where the controller's plant is linearized: initial | equilibrium | trim | time=T",
+                  "NAME=VALUE: hold a joint coordinate (or rate, NAME_dot) in the operating-point search: set in the model's state, kept exactly by the equilibrium and trim searches, and the run's start unless --initial says otherwise (repeatable; --set is the older name)",
+                  "NAME=VALUE: the run's initial state: a joint coordinate (or rate, NAME_dot), the loops closed with it held (repeatable); the operating point is searched apart from it, from the model's state. 'operating-point': the run starts at the operating point the controller is linearized about (x0), NAME=VALUE then setting coordinates on it");
   cmd->add_flag("--compare-linear", a->compare_linear, "also simulate the linear closed loop and report where it parts from the nonlinear one");
   cmd->add_option("--linear-region", a->linear_region, "R: report when a coordinate the linear dynamics depend on is more than R (rad or m) from its operating-point value (default 0.5, or the file's analysis.linear_region)");
   cmd->add_option("--t-end", a->t_end, "end time [s] (default: the model's solver settings)");
@@ -269,12 +261,6 @@ void add_simulate(CLI::App& app) {
   cmd->add_option("--atol", a->atol, "absolute tolerance");
   cmd->add_option("--max-step", a->max_step, "largest step [s] (rk4: its fixed step)");
   cmd->add_option("--output-step", a->output_step, "output interval [s]");
-  cmd->add_option("--independent", a->independent, "closed loops: independent coordinate names")->delimiter(',');
-  cmd->add_option("--hold,--set", a->set, "NAME=VALUE: hold a joint coordinate (or rate, NAME_dot) in the operating-point search: set in the model's state, kept exactly by the equilibrium and trim searches, and the run's start unless --initial says otherwise (repeatable; --set is the older name)");
-  cmd->add_option("--initial", a->initial, "NAME=VALUE: the run's initial state: a joint coordinate (or rate, NAME_dot), the loops closed with it held (repeatable); the operating point is searched apart from it, from the model's state. 'operating-point': the run starts at the operating point the controller is linearized about (x0), NAME=VALUE then setting coordinates on it");
-  cmd->add_option("--trim-free", a->trim_free, "trim: coordinates the trim solves instead of holding (comma-separated)")->delimiter(',');
-  cmd->add_option("--free-input", a->free_inputs, "equilibrium/trim: Plant/In inputs solved for (comma-separated; trim default: all)")->delimiter(',');
-  cmd->add_option("--target", a->targets, "NAME=VALUE: a Plant/Out value the equilibrium/trim must reach (repeatable)");
   cmd->add_flag("--quiet", a->quiet, "no progress bar");
   cmd->add_option("--max-samples", a->max_samples, "refuse runs that would record more output samples")->capture_default_str();
   cmd->add_option("--divergence-bound", a->divergence_bound, "end the run when a state entry grows past this")->capture_default_str();

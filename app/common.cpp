@@ -84,6 +84,36 @@ void add_plant_flags(CLI::App* cmd, PlantFlags& f) {
   cmd->add_option("--disturbance", f.disturbances, "a disturbance on an actuator that is not Plant/In: ACTUATOR=VALUE[@TIME] (a step adding VALUE at TIME, default 0) or a JSON object as in the file's analysis.disturbances (repeatable; replaces the file's)");
 }
 
+void add_point_flags(CLI::App* cmd, PointFlags& f, const std::string& op_help, const std::string& hold_help,
+                     const std::string& initial_help) {
+  cmd->add_option("--operating-point", f.op, op_help)->capture_default_str();
+  cmd->add_option("--independent", f.independent, "closed loops: independent coordinate names")->delimiter(',');
+  cmd->add_option("--hold,--set", f.hold, hold_help);
+  cmd->add_option("--initial", f.initial, initial_help);
+  cmd->add_option("--trim-free", f.trim_free, "trim: coordinates the trim solves instead of holding (comma-separated)")->delimiter(',');
+  cmd->add_option("--free-input", f.free_inputs, "equilibrium/trim: Plant/In inputs solved for (comma-separated; trim default: all)")->delimiter(',');
+  cmd->add_option("--target", f.targets, "NAME=VALUE: a Plant/Out value the equilibrium/trim must reach (repeatable)");
+}
+
+PointRequest point_request(const PointFlags& f, const CLI::App* cmd) {
+  PointRequest p;
+  if (given(cmd, "--operating-point")) p.operating_point = f.op;
+  if (given(cmd, "--independent")) p.independent = f.independent;
+  if (given(cmd, "--trim-free")) p.trim_free = f.trim_free;
+  if (given(cmd, "--free-input")) p.free_inputs = f.free_inputs;
+  p.hold = f.hold;
+  p.initial = f.initial;
+  p.targets = f.targets;
+  return p;
+}
+
+void add_lqr_flags(CLI::App* cmd, LqrFlags& f, const std::string& lqr_help, const std::string& part_help) {
+  cmd->add_flag("--lqr", f.lqr, lqr_help);
+  cmd->add_flag("--lqr-controllable-part", f.controllable_part, part_help);
+  cmd->add_option("--q-weights", f.q_weights, "LQR state weights (diagonal of Q), in state order")->delimiter(',');
+  cmd->add_option("--r-weights", f.r_weights, "LQR input weights (diagonal of R)")->delimiter(',');
+}
+
 int run_guarded(const std::function<void()>& f) {
   try {
     f();

@@ -14,6 +14,9 @@
 
 namespace codyna::cli {
 
+// true when the option was given on the command line (so it overrides the file)
+bool given(const CLI::App* cmd, const std::string& option);
+
 // reads the model file (errors name it) and prints its notes
 ModelSpec load_spec(const std::string& path);
 
@@ -29,6 +32,32 @@ struct PlantFlags {
 void add_plant_flags(CLI::App* cmd, PlantFlags& f);
 PlantRequest plant_request(const PlantFlags& f, const CLI::App* cmd);
 
+// The operating point's flags, the same for linearize and simulate (study/jobs.hpp's PointRequest):
+// --operating-point, --independent, --hold (--set), --initial, --trim-free, --free-input, --target.
+// `op_help` and `hold_help`/`initial_help` say what they mean for the subcommand.
+struct PointFlags {
+  std::string op = "equilibrium";
+  std::vector<std::string> independent, hold, initial, trim_free, free_inputs, targets;
+};
+void add_point_flags(CLI::App* cmd, PointFlags& f, const std::string& op_help, const std::string& hold_help,
+                     const std::string& initial_help);
+PointRequest point_request(const PointFlags& f, const CLI::App* cmd);
+
+// The LQR design's flags: --lqr, --lqr-controllable-part, --q-weights, --r-weights
+struct LqrFlags {
+  bool lqr = false, controllable_part = false;
+  std::vector<double> q_weights, r_weights;
+};
+void add_lqr_flags(CLI::App* cmd, LqrFlags& f, const std::string& lqr_help, const std::string& part_help);
+// into a request's lqr, lqr_controllable_part, q_weights, r_weights
+template <class Request>
+void apply_lqr_flags(const LqrFlags& f, const CLI::App* cmd, Request& r) {
+  r.lqr = f.lqr;
+  r.lqr_controllable_part = f.controllable_part;
+  if (given(cmd, "--q-weights")) r.q_weights = f.q_weights;
+  if (given(cmd, "--r-weights")) r.r_weights = f.r_weights;
+}
+
 // Printing (docs/linearization.md, "What is printed"): an entry whose magnitude is at most
 // 1e-12 times the largest magnitude of its vector or matrix (at least 1) is round-off and prints
 // as 0; the exported and saved values keep it.
@@ -40,9 +69,6 @@ std::string name_values(const std::vector<std::string>& names, const Eigen::Vect
 // ("columns 7 to 12 of 12" above each block after the first), round-off as 0
 void print_matrix(const char* label, const Eigen::MatrixXd& M, const std::vector<std::string>& rows,
                   const std::vector<std::string>& cols, int width = 100);
-
-// true when the option was given on the command line (so it overrides the file)
-bool given(const CLI::App* cmd, const std::string& option);
 
 // runs f; prints "codyna: error: ..." for exceptions and returns the exit code
 // (0 ok, 1 bad input such as a ModelError or std::invalid_argument, 2 other failures)
