@@ -3,75 +3,58 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "study/model_summary.hpp"
 
 namespace codyna::cli {
 
 namespace {
 int g_exit = 0;
 
-void print_info(const Model& m) {
+void print_info(const ModelSummary& m) {
   std::cout << "model        " << m.name << "\n";
-  if (!m.source_file.empty()) std::cout << "file         " << m.source_file << "\n";
-  std::cout << "DOF          " << m.dof();
-  if (m.active_velocity_rows > 0)
-    std::cout << " coordinates, " << m.rate_dof() << " rates (rolling: " << m.active_velocity_rows
+  if (!m.file.empty()) std::cout << "file         " << m.file << "\n";
+  std::cout << "DOF          " << m.dof;
+  if (m.nonholonomic_rows > 0)
+    std::cout << " coordinates, " << m.rate_dof << " rates (rolling: " << m.nonholonomic_rows
               << " non-holonomic equations remove rates, not coordinates)";
   std::cout << "\n"
             << "nq, nv       " << m.nq << ", " << m.nv << "\n"
-            << "bodies       " << m.nbodies - 1 << "\n";
-  for (int i = 1; i < m.nbodies; ++i) {
-    const JointModel& j = m.joints[i];
-    std::cout << "  " << std::left << std::setw(14) << m.body_names[i] << " mass " << std::setw(10) << m.mass[i]
-              << " joint " << j.name << " (" << to_string(j.type) << ", parent " << m.body_names[j.parent] << ")\n";
-  }
+            << "bodies       " << m.bodies.size() << "\n";
+  for (const ModelSummary::Body& b : m.bodies)
+    std::cout << "  " << std::left << std::setw(14) << b.name << " mass " << std::setw(10) << b.mass << " joint " << b.joint
+              << " (" << b.joint_type << ", parent " << b.parent << ")\n";
   std::cout << "coordinates  ";
-  for (int k = 0; k < m.nv; ++k) std::cout << (k ? ", " : "") << m.v_names[k] << " [" << m.v_units[k] << "]";
+  for (std::size_t k = 0; k < m.coordinates.size(); ++k) std::cout << (k ? ", " : "") << m.coordinates[k] << " [" << m.units[k] << "]";
   std::cout << "\nrates        ";
-  for (int k = 0; k < m.nv; ++k) std::cout << (k ? ", " : "") << m.rate_names[k] << " [" << rate_unit(m.v_units[k]) << "]";
-  std::cout << "\nconstraints  " << m.constraints.size() << " (" << m.nc << " equations, "
-            << m.active_rows.size() << " independent"
-            << (m.velocity_rows.empty() ? std::string()
-                                         : ", " + std::to_string(m.velocity_rows.size()) + " on the velocities only")
+  for (std::size_t k = 0; k < m.rates.size(); ++k) std::cout << (k ? ", " : "") << m.rates[k] << " [" << m.rate_units[k] << "]";
+  std::cout << "\nconstraints  " << m.constraints.size() << " (" << m.constraint_equations << " equations, "
+            << m.independent_equations << " independent"
+            << (m.velocity_only_equations == 0 ? std::string()
+                                               : ", " + std::to_string(m.velocity_only_equations) + " on the velocities only")
             << ")\n";
-  for (const ConstraintModel& c : m.constraints)
-    std::cout << "  " << std::left << std::setw(14) << c.name << " " << to_string(c.type) << " " << m.body_names[c.body_a]
-              << " - " << m.body_names[c.body_b] << "\n";
-  if (!m.redundant_rows.empty()) {
+  for (const ModelSummary::Constraint& c : m.constraints)
+    std::cout << "  " << std::left << std::setw(14) << c.name << " " << c.type << " " << c.body_a << " - " << c.body_b << "\n";
+  if (!m.redundant_equations.empty()) {
     std::cout << "redundant    ";
-    for (std::size_t k = 0; k < m.redundant_rows.size(); ++k) std::cout << (k ? ", " : "") << m.row_names[m.redundant_rows[k]];
+    for (std::size_t k = 0; k < m.redundant_equations.size(); ++k) std::cout << (k ? ", " : "") << m.redundant_equations[k];
     std::cout << " (dependent on the other equations; kept out of the dynamics)\n";
   }
-  if (m.nc) {
+  if (m.constraint_equations) {
     std::cout << "assembly     residual " << m.assembly_residual << "\n";
-    if (!m.assembly_moves.empty())
-      std::cout << "             moved to close the loops: " << study_assembly_moves_text(m) << "\n";
+    if (!m.assembly_moves.empty()) std::cout << "             moved to close the loops: " << m.assembly_moves << "\n";
   }
-  std::cout << "effects      " << (m.has_gravity ? "gravity" : "no gravity");
-  if (!m.springs.empty()) std::cout << ", " << m.springs.size() << " spring-damper(s)";
-  if (!m.joint_springs.empty()) std::cout << ", " << m.joint_springs.size() << " joint spring(s)";
-  {
-    // a joint_damper acts on every coordinate of its joint: count the elements, not the coordinates
-    long frictions = 0, dampers = 0;
-    for (const EffectSpec& e : m.spec.effects) {
-      if (e.type == EffectType::JointFriction) ++frictions;
-      if (e.type == EffectType::JointDamper) ++dampers;
-    }
-    if (frictions) std::cout << ", " << frictions << " joint friction(s)";
-    if (dampers) std::cout << ", " << dampers << " joint damper(s)";
-  }
-  if (!m.body_forces.empty()) std::cout << ", " << m.body_forces.size() << " body force(s)";
+  std::cout << "effects      " << (m.gravity_on ? "gravity" : "no gravity");
+  if (m.spring_dampers) std::cout << ", " << m.spring_dampers << " spring-damper(s)";
+  if (m.joint_springs) std::cout << ", " << m.joint_springs << " joint spring(s)";
+  if (m.joint_frictions) std::cout << ", " << m.joint_frictions << " joint friction(s)";
+  if (m.joint_dampers) std::cout << ", " << m.joint_dampers << " joint damper(s)";
+  if (m.body_forces) std::cout << ", " << m.body_forces << " body force(s)";
   std::cout << "\ninputs       (candidate plant inputs; * = Plant/In)\n";
-  for (int k = 0; k < m.nu(); ++k) {
-    const bool sel = std::find(m.plant_inputs.begin(), m.plant_inputs.end(), k) != m.plant_inputs.end();
-    std::cout << "  " << (sel ? "* " : "  ") << std::left << std::setw(14) << m.actuators[k].name << " "
-              << to_string(m.actuators[k].type) << " [" << m.actuators[k].unit << "]\n";
-  }
+  for (const ModelSummary::Actuator& a : m.actuators)
+    std::cout << "  " << (a.plant ? "* " : "  ") << std::left << std::setw(14) << a.name << " " << a.type << " [" << a.unit << "]\n";
   std::cout << "outputs      (candidate plant outputs; * = Plant/Out)\n";
-  for (int k = 0; k < m.ny(); ++k) {
-    const bool sel = std::find(m.plant_outputs.begin(), m.plant_outputs.end(), k) != m.plant_outputs.end();
-    std::cout << "  " << (sel ? "* " : "  ") << std::left << std::setw(14) << m.sensors[k].name << " "
-              << to_string(m.sensors[k].type) << " [" << m.sensors[k].unit << "]\n";
-  }
+  for (const ModelSummary::Sensor& y : m.sensors)
+    std::cout << "  " << (y.plant ? "* " : "  ") << std::left << std::setw(14) << y.name << " " << y.type << " [" << y.unit << "]\n";
 }
 }  // namespace
 
@@ -84,8 +67,7 @@ void add_info(CLI::App& app) {
   cmd->add_option("model", *file, "model file (JSON)")->required();
   cmd->callback([file] {
     set_exit_code(run_guarded([&] {
-      const Model m = study_compile(load_spec(*file), *file);
-      print_info(m);
+      print_info(model_summary(study_compile(load_spec(*file), *file)));
     }));
   });
 }

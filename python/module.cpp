@@ -31,6 +31,7 @@
 #include "model/model_spec.hpp"
 #include "study/files.hpp"
 #include "study/jobs.hpp"
+#include "study/model_summary.hpp"
 #include "study/sweep.hpp"
 #include "study/tools.hpp"
 #include "study/workflow.hpp"
@@ -473,42 +474,31 @@ Study study_from_json(const std::string& text, const py::object& base_dir_object
 }
 
 py::dict model_info(const Study& s) {
-  const Model m = study_compile(*s.spec, s.file);
-  const auto body = [&](int i) { return i >= 0 && i < static_cast<int>(m.body_names.size()) ? m.body_names[i] : std::string(); };
-  const auto slice = [](const std::vector<std::string>& v, int first, int n) {
-    return std::vector<std::string>(v.begin() + first, v.begin() + first + n);
-  };
+  const ModelSummary m = model_summary(study_compile(*s.spec, s.file));
   py::list bodies, joints, constraints, effects, actuators, sensors;
-  for (int i = 1; i < m.nbodies; ++i) {
-    const JointModel& j = m.joints[i];
-    bodies.append(py::dict("name"_a = m.body_names[i], "mass"_a = m.mass[i], "com"_a = m.com[i], "joint"_a = j.name,
-                           "parent"_a = body(m.parent[i])));
-    joints.append(py::dict("name"_a = j.name, "type"_a = to_string(j.type), "parent"_a = body(j.parent),
-                           "child"_a = m.body_names[i], "coordinates"_a = slice(m.v_names, j.idx_v, j.nv),
-                           "rates"_a = slice(m.rate_names, j.idx_v, j.nv), "q_names"_a = slice(m.q_names, j.idx_q, j.nq)));
-  }
-  for (const ConstraintModel& c : m.constraints)
-    constraints.append(py::dict("name"_a = c.name, "type"_a = to_string(c.type), "body_a"_a = body(c.body_a),
-                                "body_b"_a = body(c.body_b), "equations"_a = slice(m.row_names, c.row, c.nrows)));
-  for (const EffectSpec& e : m.spec.effects) effects.append(py::dict("name"_a = e.name, "type"_a = to_string(e.type)));
-  std::vector<std::string> plant_inputs, plant_outputs, redundant;
-  for (int k : m.plant_inputs) plant_inputs.push_back(m.actuators[k].name);
-  for (int k : m.plant_outputs) plant_outputs.push_back(m.sensors[k].name);
-  for (int k : m.redundant_rows) redundant.push_back(m.row_names[k]);
-  for (const ActuatorModel& a : m.actuators)
-    actuators.append(py::dict("name"_a = a.name, "type"_a = to_string(a.type), "unit"_a = a.unit, "gain"_a = a.gain,
-                              "u0"_a = a.u0, "min"_a = a.min, "max"_a = a.max));
-  for (const SensorModel& y : m.sensors) sensors.append(py::dict("name"_a = y.name, "type"_a = to_string(y.type), "unit"_a = y.unit));
-  return py::dict("name"_a = m.name, "file"_a = m.source_file, "dof"_a = m.dof(), "rate_dof"_a = m.rate_dof(),
-                  "nq"_a = m.nq, "nv"_a = m.nv, "bodies"_a = bodies, "joints"_a = joints, "coordinates"_a = m.v_names, "units"_a = m.v_units,
-                  "rates"_a = m.rate_names, "q_names"_a = m.q_names, "constraints"_a = constraints,
-                  "constraint_equations"_a = m.nc, "independent_equations"_a = m.active_rows.size(),
-                  "redundant_equations"_a = redundant, "assembly_residual"_a = m.assembly_residual,
-                  "assembly_moves"_a = study_assembly_moves_text(m), "effects"_a = effects, "gravity"_a = m.gravity,
-                  "actuators"_a = actuators, "sensors"_a = sensors, "plant_inputs"_a = plant_inputs,
-                  "plant_outputs"_a = plant_outputs, "controller"_a = to_string(m.spec.controller.type),
-                  "initial_coordinates"_a = named(m.v_names, study_coordinates(m, m.q0)),
-                  "initial_rates"_a = named(m.rate_names, m.v0));
+  for (const ModelSummary::Body& b : m.bodies)
+    bodies.append(py::dict("name"_a = b.name, "mass"_a = b.mass, "com"_a = b.com, "joint"_a = b.joint, "parent"_a = b.parent));
+  for (const ModelSummary::Joint& j : m.joints)
+    joints.append(py::dict("name"_a = j.name, "type"_a = j.type, "parent"_a = j.parent, "child"_a = j.child,
+                           "coordinates"_a = j.coordinates, "rates"_a = j.rates, "q_names"_a = j.q_names));
+  for (const ModelSummary::Constraint& c : m.constraints)
+    constraints.append(py::dict("name"_a = c.name, "type"_a = c.type, "body_a"_a = c.body_a, "body_b"_a = c.body_b,
+                                "equations"_a = c.equations));
+  for (const ModelSummary::Effect& e : m.effects) effects.append(py::dict("name"_a = e.name, "type"_a = e.type));
+  for (const ModelSummary::Actuator& a : m.actuators)
+    actuators.append(py::dict("name"_a = a.name, "type"_a = a.type, "unit"_a = a.unit, "gain"_a = a.gain, "u0"_a = a.u0,
+                              "min"_a = a.min, "max"_a = a.max));
+  for (const ModelSummary::Sensor& y : m.sensors) sensors.append(py::dict("name"_a = y.name, "type"_a = y.type, "unit"_a = y.unit));
+  return py::dict("name"_a = m.name, "file"_a = m.file, "dof"_a = m.dof, "rate_dof"_a = m.rate_dof, "nq"_a = m.nq,
+                  "nv"_a = m.nv, "bodies"_a = bodies, "joints"_a = joints, "coordinates"_a = m.coordinates, "units"_a = m.units,
+                  "rates"_a = m.rates, "q_names"_a = m.q_names, "constraints"_a = constraints,
+                  "constraint_equations"_a = m.constraint_equations, "independent_equations"_a = m.independent_equations,
+                  "redundant_equations"_a = m.redundant_equations, "assembly_residual"_a = m.assembly_residual,
+                  "assembly_moves"_a = m.assembly_moves, "effects"_a = effects, "gravity"_a = m.gravity,
+                  "actuators"_a = actuators, "sensors"_a = sensors, "plant_inputs"_a = m.plant_inputs,
+                  "plant_outputs"_a = m.plant_outputs, "controller"_a = m.controller,
+                  "initial_coordinates"_a = named(m.coordinates, m.initial_coordinates),
+                  "initial_rates"_a = named(m.rates, m.initial_rates));
 }
 
 LinearizeRequest linearize_request(const Study& s, const py::dict& options) {
