@@ -407,21 +407,7 @@ struct SweepResult {
 std::unique_ptr<SweepResult> sweep_result(SweepJob&& job) {
   auto result = std::make_unique<SweepResult>();
   result->summary = study_sweep_summary(job);
-  if (job.shard_count > 0) {
-    std::vector<SweepVariant> mine;
-    long long worst = -1, largest = -1;
-    for (long long i = 0; i < static_cast<long long>(job.variants.size()); ++i) {
-      if (!job.in_shard(i)) continue;
-      if (i == job.worst) worst = static_cast<long long>(mine.size());
-      if (i == job.largest_input) largest = static_cast<long long>(mine.size());
-      result->indices.push_back(i);
-      mine.push_back(std::move(job.variants[static_cast<std::size_t>(i)]));
-    }
-    job.variants = std::move(mine);
-    job.worst = worst;
-    job.largest_input = largest;
-  }
-  result->job = std::make_shared<const SweepJob>(std::move(job));
+  result->job = std::make_shared<const SweepJob>(study_sweep_own_variants(std::move(job), result->indices));
   return result;
 }
 
@@ -667,7 +653,7 @@ std::unique_ptr<SweepResult> do_sweep(const Study& s, const py::dict& options) {
   progress.cancel = &cancel;
   progress.done = [&](long long d, long long n) {
     // a shard counts its own variants (the core's total is the whole study's)
-    total = r.shard_count > 0 ? (r.shard_index < n ? (n - r.shard_index + r.shard_count - 1) / r.shard_count : 0) : n;
+    total = sweep_shard_size(n, r.shard_index, r.shard_count);
     done = d;
   };
   std::mutex mutex;
@@ -745,11 +731,7 @@ std::unique_ptr<SweepResult> do_sweep_merge(const py::object& shards, const py::
     for (const auto& item : shards.cast<py::iterable>()) paths.push_back(path_of(item));
   }
   // the GIL stays held: no variant is run, and the HDF5 library is serial (h5py may be in this process)
-  SweepJob job = study_sweep_merge(paths, outputs);
-  // the merge resumes the whole study from the joined journal: not news to the caller (the command
-  // does not print it either)
-  std::erase_if(job.notes, [](const std::string& n) { return n.rfind("resuming: ", 0) == 0; });
-  return sweep_result(std::move(job));
+  return sweep_result(study_sweep_merge(paths, outputs));
 }
 
 // ---------------------------------------------------------------------------------------------

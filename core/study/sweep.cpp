@@ -817,7 +817,23 @@ const char* to_string(SweepStatus s) {
 
 // ------------------------------------------------------------------ the job
 
+namespace {
+// `merging`: study_sweep_merge resumes the whole study from the journal it joined, which is not
+// news to its caller: no "resuming" note then
+SweepJob sweep_job(const SweepRequest& r, const StudyMessages& tell, const SweepProgress& progress, bool merging);
+}  // namespace
+
 SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const SweepProgress& progress) {
+  return sweep_job(r, tell, progress, false);
+}
+
+long long sweep_shard_size(long long n, long long index, long long count) {
+  if (count <= 0) return n;
+  return index < n ? (n - index + count - 1) / count : 0;
+}
+
+namespace {
+SweepJob sweep_job(const SweepRequest& r, const StudyMessages& tell, const SweepProgress& progress, bool merging) {
   const Names opt{r.style};
   SweepJob job;
   const auto note = [&](const std::string& text) {
@@ -1000,11 +1016,11 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
       }
       in.close();
       write_file_atomically(journal_path, kept);  // without the damaged lines, then appended to
-      if (job.resumed > 0 && !shard)
+      if (job.resumed > 0 && !shard && !merging)
         note("resuming: " + std::to_string(job.resumed) + " of " + std::to_string(n) + " variants were done (" +
              journal_path + ")");
       if (job.resumed > 0 && shard) {
-        const long long slice = r.shard_index < n ? (n - r.shard_index + r.shard_count - 1) / r.shard_count : 0;
+        const long long slice = sweep_shard_size(n, r.shard_index, r.shard_count);
         note("resuming: " + std::to_string(job.resumed) + " of the " + std::to_string(slice) + " variants of slice " +
              std::to_string(r.shard_index) + "/" + std::to_string(r.shard_count) + " were done (" + journal_path + ")");
       }
@@ -1051,8 +1067,7 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
     for (std::thread& t : pool) t.join();
   }
   if (fatal) std::rethrow_exception(fatal);
-  long long expected = n;
-  if (shard) expected = r.shard_index < n ? (n - r.shard_index + r.shard_count - 1) / r.shard_count : 0;
+  const long long expected = sweep_shard_size(n, r.shard_index, r.shard_count);
   if (done.load() < expected) throw StudyCancelled("the sweep was cancelled after " + std::to_string(done.load()) + " of " +
                                             std::to_string(expected) + " variants");
 
@@ -1112,6 +1127,7 @@ SweepJob study_sweep_job(const SweepRequest& r, const StudyMessages& tell, const
   }
   return job;
 }
+}  // namespace
 
 SweepJob study_sweep_merge(const std::vector<std::string>& shards, const SweepRequest& outputs, const StudyMessages& tell) {
   if (shards.empty()) throw std::invalid_argument("sweep-merge: give the shards' files");
@@ -1182,10 +1198,7 @@ SweepJob study_sweep_merge_journals(const std::vector<std::string>& journals, co
   for (const auto& [i, line] : lines) text += line + "\n";
   write_file_atomically(journal_path, text);
   try {
-    const StudyMessages quiet = [&](const StudyMessage& m) {
-      if (tell && m.text.rfind("resuming: ", 0) != 0) tell(m);
-    };
-    SweepJob job = study_sweep_job(r, quiet);
+    SweepJob job = sweep_job(r, tell, {}, true);
     if (job.resumed != n) throw std::runtime_error("sweep-merge: " + std::to_string(n - job.resumed) + " variants were run again");
     return job;
   } catch (...) {
@@ -1717,8 +1730,7 @@ std::string study_sweep_summary(const SweepJob& job) {
   const long long n = static_cast<long long>(job.variants.size());
   const std::size_t fields = job.plan.vary.size();
   if (job.shard_count > 0) {
-    long long mine = 0;
-    for (long long i = 0; i < n; ++i) mine += job.in_shard(i) ? 1 : 0;
+    const long long mine = sweep_shard_size(n, job.shard_index, job.shard_count);
     os << "shard            " << job.shard_index << "/" << job.shard_count << ": " << mine << " of the " << n
        << " variants (i % " << job.shard_count << " = " << job.shard_index << "), " << job.failed
        << " failed; codyna sweep-merge joins the shards\n";

@@ -186,6 +186,13 @@ SweepShard study_parse_shard(const std::string& text, OptionStyle style);
 // (K, N) checked: 0 <= K < N, else std::invalid_argument naming the option and `given` (as the
 // user wrote the value: "2/2", "(2, 2)").
 SweepShard study_check_shard(long long index, long long count, OptionStyle style, const std::string& given);
+// How many of a study's n variants shard `index` of `count` runs (the i with i % count == index;
+// count 0: the whole study, n)
+long long sweep_shard_size(long long n, long long index, long long count);
+// A shard's job with only its own variants, in the study's order: `indices` gets their numbers
+// in the whole study, and worst / largest_input become positions among them. A whole study's
+// job is returned as it is (indices empty: 0 .. n-1).
+SweepJob study_sweep_own_variants(SweepJob&& job, std::vector<long long>& indices);
 
 // `codyna sweep-merge`: the shards' journals (every variant in one of them, all of the same study:
 // the same model file bytes and options) joined and written to outputs.out / csv / mat exactly as

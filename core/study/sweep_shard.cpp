@@ -68,4 +68,22 @@ SweepShard study_parse_shard(const std::string& text, OptionStyle style) {
   return study_check_shard(k, n, style, as_given(text, style));
 }
 
+SweepJob study_sweep_own_variants(SweepJob&& job, std::vector<long long>& indices) {
+  indices.clear();
+  if (job.shard_count == 0) return std::move(job);
+  std::vector<SweepVariant> mine;
+  long long worst = -1, largest = -1;
+  for (long long i = 0; i < static_cast<long long>(job.variants.size()); ++i) {
+    if (!job.in_shard(i)) continue;
+    if (i == job.worst) worst = static_cast<long long>(mine.size());
+    if (i == job.largest_input) largest = static_cast<long long>(mine.size());
+    indices.push_back(i);
+    mine.push_back(std::move(job.variants[static_cast<std::size_t>(i)]));
+  }
+  job.variants = std::move(mine);
+  job.worst = worst;
+  job.largest_input = largest;
+  return std::move(job);
+}
+
 }  // namespace codyna
