@@ -14,6 +14,7 @@
 // Forces in N, moments in N m, all at the contact point in these axes.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <unsupported/Eigen/AutoDiff>
 
@@ -69,6 +70,19 @@ double tire_sign(const S& x) {
 template <class S>
 double tire_sign_nz(const S& x) {
   return tire_value(x) < 0 ? -1.0 : 1.0;
+}
+
+// The input with one derivative size in all its scalars (unseeded ones get zeros): Eigen's
+// AutoDiff adds derivative vectors of unevaluated expressions without making their sizes agree.
+inline const TireInput<double>& tire_coherent(const TireInput<double>& in) { return in; }
+template <class D>
+TireInput<Eigen::AutoDiffScalar<D>> tire_coherent(TireInput<Eigen::AutoDiffScalar<D>> in) {
+  Eigen::Index n = 0;
+  for (auto* x : {&in.Fz, &in.kappa, &in.alpha, &in.gamma, &in.phit, &in.Vx, &in.pressure})
+    n = std::max<Eigen::Index>(n, x->derivatives().size());
+  for (auto* x : {&in.Fz, &in.kappa, &in.alpha, &in.gamma, &in.phit, &in.Vx, &in.pressure})
+    if (x->derivatives().size() != n) x->derivatives() = D::Zero(n);
+  return in;
 }
 
 }  // namespace codyna
