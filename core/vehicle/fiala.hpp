@@ -55,10 +55,13 @@ TireForces<S> fiala_tire(const FialaParameters& p, const TireInput<S>& input) {
   else
     out.Fx = tire_sign(in.kappa) * (muFz - muFz * muFz / (4 * abs(in.kappa) * p.C_kappa));
   if (std::abs(tire_value(in.alpha)) <= alpha_c && tire_value(muFz) > 0) {
-    const S H = 1.0 - p.C_alpha * abs(ta) / (3.0 * muFz);
-    const S H3 = H * H * H;
-    out.Fy = -muFz * (1.0 - H3) * tire_sign(in.alpha);
-    out.Mz = muFz * p.width * (1.0 - H) * H3 * tire_sign(in.alpha);
+    // with x = C_alpha tan(alpha) / (3 mu Fz), H = 1 - |x|: (1 - H^3) sign(alpha) = x (3 - 3|x| + x^2)
+    // and (1 - H) sign(alpha) = x, written so that the derivative at alpha = 0 is -C_alpha
+    const S x = p.C_alpha * ta / (3.0 * muFz);
+    const S ax = abs(x);
+    const S H = 1.0 - ax;
+    out.Fy = -muFz * x * (3.0 - 3.0 * ax + ax * ax);
+    out.Mz = muFz * p.width * x * (H * H * H);
   } else {
     out.Fy = -muFz * tire_sign(in.alpha);
     out.Mz = muFz * 0.0;

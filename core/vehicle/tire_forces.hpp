@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <Eigen/Core>
 #include <unsupported/Eigen/AutoDiff>
 
 namespace codyna {
