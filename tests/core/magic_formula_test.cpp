@@ -373,3 +373,27 @@ TEST(MagicFormula, LimitsClampAndStandstillIsAtRest) {
     EXPECT_GT(std::abs(s.Fy), 0.0) << file;
   }
 }
+
+// Any derivative type works (the template's body is in the header): a fixed-size derivative
+// vector gives the same values and derivatives as the dynamic one compiled in the library.
+TEST(MagicFormula, FixedSizeAutodiffAgrees) {
+  using Fixed = Eigen::AutoDiffScalar<Eigen::Vector4d>;
+  const MagicFormulaParameters p = read_tir_file(mf_test_dir + "MagicFormula61_Paramerters.tir");
+  TireInput<Fixed> in;
+  in.Fz = Fixed(5000, Eigen::Vector4d::Unit(0));
+  in.kappa = Fixed(0.04, Eigen::Vector4d::Unit(1));
+  in.alpha = Fixed(-0.06, Eigen::Vector4d::Unit(2));
+  in.gamma = Fixed(0.02, Eigen::Vector4d::Unit(3));
+  in.Vx = Fixed(16.7, Eigen::Vector4d::Zero());
+  in.phit = Fixed(0.0, Eigen::Vector4d::Zero());
+  in.pressure = Fixed(0.0, Eigen::Vector4d::Zero());
+  const TireForces<Fixed> f = magic_formula(p, in);
+  const TireForces<MfAD> g = magic_formula(p, mf_test_seed(5000, 0.04, -0.06, 0.02, 16.7));
+  EXPECT_DOUBLE_EQ(f.Fy.value(), g.Fy.value());
+  EXPECT_DOUBLE_EQ(f.Mz.value(), g.Mz.value());
+  for (int j = 0; j < 4; ++j) {
+    EXPECT_DOUBLE_EQ(f.Fy.derivatives()[j], g.Fy.derivatives()[j]) << j;
+    EXPECT_DOUBLE_EQ(f.Mz.derivatives()[j], g.Mz.derivatives()[j]) << j;
+    EXPECT_DOUBLE_EQ(f.Fx.derivatives()[j], g.Fx.derivatives()[j]) << j;
+  }
+}
