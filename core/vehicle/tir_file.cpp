@@ -302,7 +302,7 @@ MagicFormulaParameters parse_tir_text(const std::string& text, const std::string
   std::string section;
   bool section_known = false;
   int line_no = 0;
-  std::size_t pos = 0;
+  std::size_t pos = text.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;  // a UTF-8 byte order mark
   while (pos <= text.size()) {
     std::size_t end = text.find_first_of("\r\n", pos);
     if (end == std::string::npos) end = text.size();

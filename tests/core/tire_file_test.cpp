@@ -154,6 +154,8 @@ TEST(TirFile, LineEndsCaseAndComments) {
   EXPECT_EQ(c.PKY1, -15);
   EXPECT_EQ(c.TYRESIDE, TireSide::Right);
   EXPECT_EQ(c.PCX1, 1.6);
+  // a UTF-8 byte order mark before the first section
+  EXPECT_EQ(parse_tir_text("\xEF\xBB\xBF" + tir_test_small, "bom.tir").PKY1, -15);
   // a number in Fortran's notation
   EXPECT_EQ(parse_tir_text(tir_test_replace(tir_test_small, "PKX1 = 16", "PKX1 = 1.6D+1"), "d.tir").PKX1, 16);
 }
