@@ -4,6 +4,7 @@
 #   core/model/                       includes nothing of dynamics/, analysis/, control/,
 #                                     simulation/, io/ or study/ (it is data and its compilation)
 #   core/simulation/                  includes nothing of io/ or study/ (files are read by io/)
+#   core/vehicle/                     includes only itself and spatial/ (tire laws and .tir files)
 # A violation stops the configuration with every offending file and line named.
 # Script mode: cmake -DCODYNA_LAYERS_ROOT=DIR -P cmake/check_layers.cmake
 function(codyna_check_layers root)
@@ -13,8 +14,9 @@ function(codyna_check_layers root)
     "gui|study,model,gui"
     "python|study,model"
     "core/model|model,spatial"
-    "core/simulation|simulation,analysis,dynamics,control,model,spatial")
-  set(core_folders spatial model dynamics analysis control simulation study io gui)
+    "core/simulation|simulation,analysis,dynamics,control,model,spatial"
+    "core/vehicle|vehicle,spatial")
+  set(core_folders spatial model dynamics analysis control simulation study io gui vehicle)
   foreach(rule ${rules})
     string(REPLACE "|" ";" parts "${rule}")
     list(GET parts 0 folder)
