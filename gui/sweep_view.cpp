@@ -848,39 +848,8 @@ bool SweepView::saveResults(const QString& path, QString* error) {
   };
   if (!job_) return fail(tr("no results to save (run a study first)"));
   if (running_) return fail(tr("a study is running"));
-  const std::string out = ss(path);
-  const std::string model = ss(doc_->filePath());
-  const QString suffix = QFileInfo(path).suffix().toLower();
   try {
-    if (suffix == QLatin1String("h5") || suffix == QLatin1String("hdf5")) {
-      study_guard_output(out, OutputKind::ResultsHdf5, {model});
-      study_write_sweep_hdf5(*job_, out);
-    } else if (suffix == QLatin1String("csv")) {
-      // as `codyna sweep --csv`: never the model file, never a file that is not a sweep CSV
-      if (!model.empty() && study_same_file(out, model)) return fail(tr("%1: this is the model file; choose another name").arg(path));
-      QFileInfo fi(path);
-      if (fi.exists()) {
-        if (!fi.isFile()) return fail(tr("%1: exists and is not a regular file; choose another name").arg(path));
-        std::ifstream in(out, std::ios::binary);
-        std::string head(14, '\0');
-        in.read(head.data(), 14);
-        if (fi.size() > 0 && head != "variant,status")
-          return fail(tr("%1: exists and is not a sweep CSV written by codyna; codyna never replaces a file it did not "
-                         "write: remove it or choose another name")
-                          .arg(path));
-      }
-      study_write_sweep_csv(*job_, out);
-    } else if (suffix == QLatin1String("mat")) {
-      const QFileInfo fi(path);
-      const std::string stem = ss(fi.completeBaseName());
-      if (study_matlab_identifier(stem) != stem)
-        return fail(tr("%1: '%2' is not a MATLAB identifier (try %3.mat)").arg(path, qs(stem), qs(study_matlab_identifier(stem))));
-      study_guard_output(out, OutputKind::PlantMat, {model});
-      study_guard_output(ss(fi.dir().filePath(fi.completeBaseName() + ".m")), OutputKind::PlantScript, {model});
-      study_write_sweep_mat(*job_, out);
-    } else {
-      return fail(tr("%1: choose .h5 (HDF5), .csv or .mat (MATLAB/Octave)").arg(path));
-    }
+    study_save_sweep(*job_, ss(path));  // the format from the suffix, every output guarded (as codyna sweep's)
   } catch (const std::exception& e) {
     return fail(qs(e.what()));
   }

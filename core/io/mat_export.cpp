@@ -476,6 +476,8 @@ std::string summary_block(const LinearSystem& s, const std::string& name) {
 
 // ---------------------------------------------------------------- public
 
+std::u16string mat_utf16(const std::string& s) { return utf16(s); }
+
 std::string matlab_identifier(const std::string& s) {
   static const char* const reserved[] = {
       // MATLAB and Octave keywords

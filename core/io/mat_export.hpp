@@ -80,6 +80,10 @@ ExportPaths export_closed_loop(const ClosedLoopLinear& cl, const ModalAnalysis& 
 // get the suffix "_plant" ("end" -> "end_plant", "A" -> "A_plant"); "" -> "plant".
 std::string matlab_identifier(const std::string& s);
 
+// Text as MATLAB stores a char array: UTF-16 code units (invalid UTF-8 bytes become U+FFFD); what
+// every MAT file codyna writes holds, the plant's and the sweep's alike
+std::u16string mat_utf16(const std::string& s);
+
 // The text of NAME.m for `sys` (what export_plant writes).
 std::string plant_script(const LinearSystem& sys, const std::string& name, MatVersion v);
 

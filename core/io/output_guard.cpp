@@ -41,6 +41,8 @@ bool written_by_codyna(const std::string& path, OutputKind k) {
       return starts_with(h, "% ") && h.substr(0, h.find('\n')).find("exported by codyna") != std::string::npos;
     case OutputKind::Mjcf:
       return starts_with(h, "<!-- MJCF written by codyna");  // io/export_mjcf.hpp's kMjcfHeader
+    case OutputKind::SweepCsv:
+      return starts_with(h, "variant,status");  // io/sweep_files.hpp's kSweepCsvHead
   }
   return false;
 }
@@ -63,6 +65,7 @@ const char* describe(OutputKind k) {
     case OutputKind::PlantMat: return "a plant .mat export";
     case OutputKind::PlantScript: return "a plant .m export";
     case OutputKind::Mjcf: return "an MJCF export";
+    case OutputKind::SweepCsv: return "a sweep CSV";
   }
   return "an output";
 }

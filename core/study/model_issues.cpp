@@ -1,11 +1,13 @@
 #include "study/model_issues.hpp"
 
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <set>
 #include <tuple>
 
+#include "dynamics/prepare.hpp"
 #include "model/compile.hpp"
 #include "model/spec_edit.hpp"
 #include "study/workflow.hpp"

@@ -20,6 +20,7 @@
 #include "study/jobs.hpp"
 #include "study/sweep.hpp"
 #include "study/tools.hpp"
+#include "io/mat_export.hpp"
 
 namespace codyna {
 namespace {
@@ -539,6 +540,35 @@ TEST(Sweep, TheOutputNeverReplacesTheModel) {
   r.out = "";
   r.csv = kModel;
   EXPECT_THROW(study_sweep_job(r), std::invalid_argument);
+}
+
+// A state named with a non-ASCII character keeps its name in the sweep's MAT file, as in the plant
+// export: both are written as UTF-16 by io/mat_export's one conversion (the sweep's writer once
+// turned each such byte into '?')
+TEST(Sweep, NonAsciiStateNamesSurviveTheMatExport) {
+  SweepTempDir dir;
+  std::string text = slurp_file(kModel);
+  for (std::size_t at = 0; (at = text.find("rod_pivot", at)) != std::string::npos; at += 14) text.replace(at, 9, "rod_\u03b8iv");
+  const std::string model = dir.file("theta.json");
+  std::ofstream(model) << text;
+  SweepRequest r;
+  r.model = model;
+  r.vary = {"/bodies/1/mass=5:6:2"};
+  r.threads = 1;
+  r.mat = dir.file("theta_sweep.mat");
+  const SweepJob job = study_sweep_job(r);
+  ASSERT_EQ(job.failed, 0);
+  const std::string theta = "rod_\u03b8iv";  // the JSON escape read as UTF-8
+  const std::string name = std::string("rod_") + "\xce\xb8" + "iv";
+  ASSERT_NE(std::find(job.state_names.begin(), job.state_names.end(), name), job.state_names.end()) << theta;
+  const MatVariables sweep = read_mat_file(r.mat);
+  EXPECT_EQ(sweep.strings.at("state_names"), job.state_names);
+  LinearizeRequest lr;
+  lr.model = model;
+  lr.out = dir.file("plant");
+  const LinearizeJob plant = study_linearize_job(lr, study_read_model(model));
+  const MatVariables exported = read_mat_file(plant.written[0]);
+  EXPECT_EQ(exported.strings.at("state_names"), sweep.strings.at("state_names"));
 }
 
 }  // namespace

@@ -1,0 +1,39 @@
+#include "analysis/response_figures.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace codyna {
+
+void response_figures(const std::vector<double>& t, const Eigen::MatrixXd& e, Eigen::VectorXd& overshoot,
+                      Eigen::VectorXd& settling) {
+  const Eigen::Index N = e.rows();
+  for (Eigen::Index j = 0; j < e.cols(); ++j) {
+    const auto col = e.col(j);
+    if (N == 0 || !col.allFinite()) continue;
+    Eigen::Index peak = 0;
+    const double E = col.cwiseAbs().maxCoeff(&peak);
+    if (E == 0) {
+      overshoot[j] = 0;
+      settling[j] = t[0];
+      continue;
+    }
+    const double s = col[peak] > 0 ? 1.0 : -1.0;
+    overshoot[j] = 100.0 * std::max(0.0, (-s * col).maxCoeff()) / E;
+    const double band = 0.02 * E;
+    Eigen::Index k = N - 1;
+    if (std::abs(col[k]) > band) continue;
+    while (k > 0 && std::abs(col[k - 1]) <= band) --k;
+    if (k == 0) {
+      settling[j] = t[0];
+      continue;
+    }
+    // e(k-1) is outside the band, e(k) inside: where the line between them meets it
+    const double a = col[k - 1], b = col[k], edge = a > 0 ? band : -band;
+    const double f = (a - edge) / (a - b);
+    const std::size_t i = static_cast<std::size_t>(k);
+    settling[j] = t[i - 1] + f * (t[i] - t[i - 1]);
+  }
+}
+
+}  // namespace codyna
