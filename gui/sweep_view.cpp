@@ -49,11 +49,6 @@ enum Figure { ClosedMaxReal = 0, OpenMaxReal, PeakInput, FinalError };
 
 QString number(double x) { return QString::number(x, 'g', 10); }
 
-bool is_random_spec(const QString& spec) {
-  const QString s = spec.trimmed();
-  return s.startsWith(QLatin1String("normal")) || s.startsWith(QLatin1String("uniform"));
-}
-
 // a round range about [lo, hi] with a margin
 void fit_axis(QValueAxis* a, double lo, double hi) {
   if (!std::isfinite(lo) || !std::isfinite(hi)) lo = -1, hi = 1;
@@ -432,7 +427,7 @@ SweepRequest SweepView::request() const {
     const QString f = fields_->item(row, 0) ? fields_->item(row, 0)->text().trimmed() : QString();
     const QString s = fields_->item(row, 1) ? fields_->item(row, 1)->text().trimmed() : QString();
     if (f.isEmpty() && s.isEmpty()) continue;
-    random = random || is_random_spec(s);
+    random = random || study_sweep_spec_is_random(ss(s));  // the core's grammar says
     r.vary.push_back(ss(f + "=" + s));
   }
   if (random) {

@@ -82,6 +82,9 @@ std::string study_sweep_journal_path(const std::string& out);
 // Parses the --vary texts against the model file's JSON (the field must hold a number) and the
 // sampling options; std::invalid_argument naming the option for anything wrong.
 SweepPlan study_sweep_plan(const SweepRequest& r, const nlohmann::json& model_file);
+// true when SPEC (the text after FIELD=) names a distribution, normal(...) or uniform(...), as
+// the plan reads it: a study with one needs samples and a seed
+bool study_sweep_spec_is_random(const std::string& spec);
 
 struct SweepProgress {
   std::function<void(long long done, long long total)> done;  // called from the workers (serialised)

@@ -48,6 +48,9 @@ std::string trim(std::string s) {
   return s.substr(a, b - a + 1);
 }
 
+// SPEC begins NAME( (a distribution's call)
+bool sweep_starts_call(const std::string& spec, const char* name) { return spec.rfind(std::string(name) + "(", 0) == 0; }
+
 bool parse_number(const std::string& text, double& out) {
   const std::string t = trim(text);
   if (t.empty()) return false;
@@ -113,8 +116,8 @@ SweepVary parse_vary(const std::string& text, const nlohmann::json& file, const 
   const std::string grammar = "expected a:b:n (n values from a to b), [v1,v2,...], normal(mu,sigma) or uniform(a,b)";
   if (s.empty()) throw std::invalid_argument(label + ": no SPEC after = (" + grammar + ")");
   const auto two_args = [&](const char* name, double& x, double& y) {
+    if (!sweep_starts_call(s, name)) return false;
     const std::string head = std::string(name) + "(";
-    if (s.rfind(head, 0) != 0) return false;
     if (s.back() != ')') throw std::invalid_argument(label + ": " + name + "(...) is not closed by )");
     const std::string inner = s.substr(head.size(), s.size() - head.size() - 1);
     const auto comma = inner.find(',');
@@ -206,6 +209,11 @@ SweepPlan study_sweep_plan(const SweepRequest& r, const nlohmann::json& file) {
     }
   }
   return plan;
+}
+
+bool study_sweep_spec_is_random(const std::string& spec) {
+  const std::string s = trim(spec);
+  return sweep_starts_call(s, "normal") || sweep_starts_call(s, "uniform");
 }
 
 }  // namespace codyna
