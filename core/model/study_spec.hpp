@@ -56,6 +56,11 @@ struct ClosedLoopSpec {
 
 // r(t) of a signal about the base value y0
 double signal_value(const SignalSpec& s, double t, double y0);
+// its rate and acceleration (right-continuous: a ramp's rate is its slope from `time` on), and
+// the times where its rate jumps: what a motion input driven by it needs
+double signal_rate(const SignalSpec& s, double t);
+double signal_acceleration(const SignalSpec& s, double t);
+std::vector<double> signal_rate_jumps(const SignalSpec& s);
 
 struct StudySpec {
   // effects (ModelSpec::effects, by name) switched off for this study: they are
@@ -166,6 +171,36 @@ inline double signal_value(const SignalSpec& s, double t, double y0) {
   if (s.type == "ramp") return y0 + s.slope * (t - s.time);
   if (s.type == "sine") return y0 + s.amplitude * std::sin(2 * std::numbers::pi * s.frequency * (t - s.time) + s.phase);
   return y0;
+}
+
+inline double signal_rate(const SignalSpec& s, double t) {
+  if (s.type == "table" || s.type == "file") {
+    const auto& p = s.points;
+    for (std::size_t k = 1; k < p.size(); ++k)
+      if (t >= p[k - 1].first && t < p[k].first) return (p[k].second - p[k - 1].second) / (p[k].first - p[k - 1].first);
+    return 0.0;
+  }
+  if (t < s.time) return 0.0;
+  const double w = 2 * std::numbers::pi * s.frequency;
+  if (s.type == "ramp") return s.slope;
+  if (s.type == "sine") return s.amplitude * w * std::cos(w * (t - s.time) + s.phase);
+  return 0.0;
+}
+
+inline double signal_acceleration(const SignalSpec& s, double t) {
+  if (s.type != "sine" || t < s.time) return 0.0;
+  const double w = 2 * std::numbers::pi * s.frequency;
+  return -s.amplitude * w * w * std::sin(w * (t - s.time) + s.phase);
+}
+
+inline std::vector<double> signal_rate_jumps(const SignalSpec& s) {
+  if (s.type == "table" || s.type == "file") {
+    std::vector<double> t;
+    for (const auto& p : s.points) t.push_back(p.first);
+    return t;
+  }
+  if (s.type == "ramp" || s.type == "sine") return {s.time};
+  return {};
 }
 
 }  // namespace codyna
