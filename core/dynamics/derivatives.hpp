@@ -64,8 +64,8 @@ class TreeDerivatives {
   // memory: everything derived from the model is made again, the storage kept where sizes repeat
   void bind(const Model& model);
 
-  // true when compute() can differentiate this model with these plant outputs
-  // (a tree; every sensor type is supported)
+  // true when compute() applies: a tree (no loop closures; every effect and sensor type is
+  // differentiated); closed loops go through compute_constrained()
   static bool supports(const Model& model);
 
   // Closed loops: everything at (q, v, u_all) for joint accelerations a and

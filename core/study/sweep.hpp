@@ -1,4 +1,4 @@
-// Parameter studies (issue 22, first slice: one machine): `codyna sweep MODEL.json --vary
+// Parameter studies (docs/parameter-studies.md; threads, Slurm shards and MPI ranks): `codyna sweep MODEL.json --vary
 // FIELD=SPEC ... --out STUDY.h5`. Every variant is the model file with some numbers replaced
 // (FIELD is a JSON pointer into the file, the paths ModelError prints: /bodies/1/mass), read,
 // compiled and linearized by the file's "analysis" choices through study_linearize_job; its open-

@@ -10,10 +10,12 @@
 //   study_simulation       the controller and plant a closed-loop run needs, and
 //   study_simulate         the run itself (callbacks for progress, samples, cancel)
 //
-// `codyna linearize|simulate` and codyna-gui both fill a StudySpec (the file's
-// "analysis" section, then flags or widgets) and call these; neither decides
-// anything the other would have to repeat. Bad choices throw ModelError naming
-// the file and the field ("/analysis/operating_point") or std::invalid_argument.
+// These are the steps; the front ends (the CLI, codyna-gui, Python) do not call them one by
+// one: each runs a job (study/jobs.hpp), which applies its request to the model file's
+// "analysis" section and calls these in order. The steps live in workflow.cpp (model, operating
+// point, linearization, export) and workflow_simulation.cpp (the closed-loop run). Bad choices
+// throw ModelError naming the file and the field ("/analysis/operating_point"), which a job
+// says of the flag or keyword when its request gave the value, or std::invalid_argument.
 #pragma once
 
 #include <atomic>
