@@ -334,6 +334,65 @@ TEST(TireEffect, TheExactJacobianOfACarWithTiresEqualsCentralDifferencesAndAutod
   }
 }
 
+// a Magic Formula tire on the ground and a Fiala tire on a road carried by a moving platform (a
+// vertical slider, tilted road normal): the exact Jacobian (the road body's derivatives too) equals
+// central differences and automatic differentiation, and the road takes the tire's reaction
+TEST(TireEffect, AMagicFormulaTireAndARoadOnAMovingBodyDifferentiateExactly) {
+  char text[5000];
+  std::snprintf(text, sizeof text, R"({"name": "tires",
+    "bodies": [{"name": "platform", "mass": 50, "inertia": [1, 1, 1]},
+               {"name": "w1", "mass": 15, "inertia": [0.4, 0.8, 0.4]}, {"name": "w2", "mass": 15, "inertia": [0.4, 0.8, 0.4]}],
+    "joints": [{"name": "lift", "type": "prismatic", "parent": "ground", "child": "platform", "axis": [0, 0, 1], "v0": 0.1},
+               {"name": "j1", "type": "free", "parent": "ground", "child": "w1", "q0": [0, 0, 0.305, 0.9998, 0.02, 0, 0.01],
+                "v0": [0.1, 42, 0.2, 12, 0.5, 0.01]},
+               {"name": "j2", "type": "free", "parent": "ground", "child": "w2", "q0": [2, 0, 0.39, 0.999, 0.03, 0, 0.02],
+                "v0": [0.05, 38, 0.1, 11, -0.4, 0.02]}],
+    "effects": [{"name": "gravity", "type": "gravity", "g": [0, 0, -9.81]},
+                {"name": "t1", "type": "tire", "body": "w1", "law": "magic_formula", "file": "%s"},
+                {"name": "t2", "type": "tire", "body": "w2", "unloaded_radius": 0.3, "law": "fiala", "longitudinal_stiffness": 9e4,
+                 "cornering_stiffness": 6e4, "friction": 1, "sliding_friction": 0.8, "width": 0.2, "rolling_resistance": 0.01,
+                 "vertical_stiffness": 2.5e5, "vertical_damping": 500,
+                 "road": {"body": "platform", "point": [2, 0, 0.1], "normal": [0.02, 0.01, 1]}}],
+    "actuators": [{"name": "push", "type": "joint_force", "joint": "lift"}],
+    "sensors": [{"name": "h", "type": "joint_position", "joint": "lift"}],
+    "plant": {"inputs": ["push"], "outputs": ["h"]}})",
+                tire_effect_tir.c_str());
+  const Model mod = study_model(study_parse_model_text(text, "tires.json"));
+  ASSERT_EQ(mod.tires.size(), 2u);
+  ASSERT_EQ(mod.tires[1].road_body, mod.find_body("platform"));
+  // the road's reaction: the slider takes minus the tire force along its axis
+  Data d(mod);
+  forward_kinematics<double>(mod, d, mod.q0, mod.v0);
+  TireContact<double> c;
+  for (const TireModel& t : mod.tires) {
+    ASSERT_TRUE(tire_contact<double>(t, d.oMi[t.body].R, d.oMi[t.body].p, angular_velocity<double>(d, t.body),
+                                     point_velocity<double>(d, t.body, Eigen::Vector3d::Zero()), d.oMi[t.road_body].R,
+                                     d.oMi[t.road_body].p, angular_velocity<double>(d, t.road_body),
+                                     point_velocity<double>(d, t.road_body, Eigen::Vector3d::Zero()), c))
+        << t.name;
+    EXPECT_GT(c.force.z(), 1000.0) << t.name;
+    EXPECT_GT(std::abs(c.out.Fx), 10.0) << t.name;
+    EXPECT_GT(std::abs(c.out.Fy), 10.0) << t.name;
+  }
+  // c: the Fiala tire on the platform
+  const Eigen::VectorXd u = Eigen::VectorXd::Zero(mod.nu());
+  const Eigen::VectorXd Q = applied_forces<double>(mod, d, mod.q0, mod.v0, u);
+  EXPECT_NEAR(Q[mod.joints[mod.find_joint("lift")].idx_v], -c.force.z(), 1e-9 * c.force.z());
+  EXPECT_GT(std::abs(c.penetration_rate), 0.01);  // the platform rises under the wheel
+  const CoordinatePartition p = partition_coordinates(mod, mod.q0);
+  const PlantFunction f(mod, mod.q0, mod.u_nominal(), p);
+  const Eigen::VectorXd x = f.qv_to_state(mod.q0, mod.v0);
+  const Eigen::VectorXd up = Eigen::VectorXd::Constant(f.nu(), 0.3);
+  Eigen::MatrixXd Ja;
+  ASSERT_TRUE(f.analytic_jacobian(x, up, Ja));
+  const Eigen::MatrixXd Jf = plant_jacobian_fd_full(f, x, up, true);
+  const double scale = Ja.cwiseAbs().maxCoeff();
+  const double worst = (Ja - Jf).cwiseAbs().maxCoeff() / scale;
+  EXPECT_LT(worst, 1e-6);
+  EXPECT_GT(test::expect_analytic_equals_autodiff(f, x, up, "tires on a moving road", 1e-12), 1.0);
+  std::printf("[ TireEffect ] magic formula and moving road: |exact - central| / max|J| = %.2e, max|J| = %.3g\n", worst, scale);
+}
+
 // the book's .tir tire on a model equals magic_formula evaluated directly at the slips the contact
 // hands it, and the file's [VERTICAL] gives the load
 TEST(TireEffect, ATirTireEqualsTheMagicFormulaAtTheSameSlips) {
