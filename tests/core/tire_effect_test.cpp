@@ -234,6 +234,53 @@ TEST(TireEffect, TheForceIsContinuousAndDifferentiableThroughStandstill) {
   }
 }
 
+// a wheel in a vertical plane (planar joint: x, height, spin). Dropped 5 mm above its static
+// height at rest, it settles at the static deflection m g / k and stays where it fell. Sliding at
+// 5 m/s at that height without spin, the tire spins it up to free rolling (kappa -> 0) while the
+// angular momentum about a point of the road is kept (the load stays m g, the linear tire makes no
+// rolling resistance): V = m h V0 / (m h + I / R0)
+std::string tire_effect_planar_wheel(double z0, double V0) {
+  char text[3000];
+  std::snprintf(text, sizeof text, R"({"name": "planar_wheel",
+    "bodies": [{"name": "wheel", "mass": 20, "inertia": [0.5, 0.5, 0.9]}],
+    "joints": [{"name": "J", "type": "planar", "parent": "ground", "child": "wheel",
+                "parent_frame": {"rotation": {"axis": [1, 0, 0], "angle": 1.5707963267948966}},
+                "q0": [0, %.17g, 0], "v0": [%.17g, 0, 0]}],
+    "effects": [{"name": "gravity", "type": "gravity", "g": [0, 0, -9.81]},
+                {"name": "tire", "type": "tire", "body": "wheel", "spin_axis": [0, 0, -1], "unloaded_radius": 0.3,
+                 "law": "linear", "longitudinal_stiffness": 60000, "cornering_stiffness": 50000,
+                 "vertical_stiffness": 200000, "vertical_damping": 2000}],
+    "solver": {"t_end": 2, "output_step": 0.01}})",
+                z0, V0);
+  return text;
+}
+
+TEST(TireEffect, ADroppedWheelSettlesAndASlidingWheelSpinsUpToRolling) {
+  const double m = 20, I = 0.9, k = 200000, R0 = 0.3, g = 9.81, V0 = 5;
+  const double h = R0 - m * g / k;
+  {
+    const Model mod = study_model(study_parse_model_text(tire_effect_planar_wheel(h + 0.005, 0.0), "dropped_wheel.json"));
+    const SimulationResult r = study_simulate(mod, study_simulation(mod));
+    ASSERT_TRUE(r.completed) << r.failure;
+    const Eigen::Index last = r.q.rows() - 1;
+    EXPECT_NEAR(r.q(last, 1), h, 1e-9);
+    EXPECT_LT(r.q.col(0).cwiseAbs().maxCoeff(), 1e-12);  // no slip, no force along the road
+    EXPECT_LT(r.q.col(2).cwiseAbs().maxCoeff(), 1e-12);
+    EXPECT_LT(r.q.col(1).minCoeff(), h);  // it did bounce into the tire
+  }
+  const Model mod = study_model(study_parse_model_text(tire_effect_planar_wheel(h, V0), "sliding_wheel.json"));
+  const SimulationResult r = study_simulate(mod, study_simulation(mod));
+  ASSERT_TRUE(r.completed) << r.failure;
+  const Eigen::Index last = r.q.rows() - 1;
+  const double V = r.v(last, 0), height = r.q(last, 1), Omega = -r.v(last, 2);  // the angle is about -y
+  EXPECT_NEAR(height, h, 1e-9);
+  EXPECT_NEAR(Omega * R0, V, 1e-6 * V);  // free rolling: kappa = 0
+  const double expected = m * h * V0 / (m * h + I / R0);
+  EXPECT_NEAR(V, expected, 1e-6 * expected);
+  std::printf("[ TireEffect ] sliding wheel: final V %.9f m/s (angular momentum: %.9f), kappa %.2e\n", V, expected,
+              -(V - Omega * R0) / V);
+}
+
 // ------------------------------------------------------------------ the Jacobian of a car with tires
 
 // a car on a free joint with four wheels spinning on revolute joints (front ones on steered
