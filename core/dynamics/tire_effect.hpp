@@ -87,7 +87,9 @@ TireForces<S> tire_effect_law(const TireModel& t, const TireInput<S>& in) {
     }
     case TireLaw::MagicFormula: break;
   }
-  return magic_formula<S>(*t.mf, in);
+  MagicFormulaOptions options;
+  options.mount = t.side == 1 ? TireMount::Left : t.side == 2 ? TireMount::Right : TireMount::AsFile;
+  return magic_formula<S>(*t.mf, in, options);
 }
 
 // The contact of tire t: wheel pose (R, p), angular velocity w and velocity v of its origin, the road

@@ -890,6 +890,16 @@ const Schema<EffectSpec>& schema<EffectSpec>() {
            tire_law_field("width", &EffectSpec::width, read_coefficient, {"fiala"}),
            tire_law_field("rolling_resistance", &EffectSpec::rolling_resistance, read_coefficient, {"fiala"}),
            tire_law_field("file", &EffectSpec::file, read_string, {"magic_formula"}),
+           {"side", Need::Optional,
+            [](const Node& n, EffectSpec& s) {
+              if (s.law != "magic_formula")
+                n.fail("field \"side\" belongs to the tire law magic_formula, not to " + quote(s.law));
+              s.side = read_string(n);
+              if (s.side != "left" && s.side != "right") n.fail("unknown side " + quote(s.side) + " (expected one of: left, right)");
+            },
+            [](ojson& j, const EffectSpec& s) {
+              if (s.law == "magic_formula" && !s.side.empty()) j["side"] = s.side;
+            }},
            field("vertical_stiffness", &EffectSpec::vertical_stiffness,
                  [](const Node& n) { return std::optional<double>(read_coefficient(n)); }),
            field("vertical_damping", &EffectSpec::vertical_damping,
@@ -912,7 +922,7 @@ const Schema<EffectSpec>& schema<EffectSpec>() {
           case EffectType::Tire:
             return element_keys({"body", "center", "spin_axis", "unloaded_radius", "rolling_radius", "road", "law",
                                  "longitudinal_stiffness", "cornering_stiffness", "camber_stiffness", "friction",
-                                 "sliding_friction", "trail", "width", "rolling_resistance", "file", "vertical_stiffness",
+                                 "sliding_friction", "trail", "width", "rolling_resistance", "file", "side", "vertical_stiffness",
                                  "vertical_damping", "low_speed"});
         }
         return element_keys({});

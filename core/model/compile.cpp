@@ -642,6 +642,9 @@ class Compiler {
       } catch (const std::exception& x) {
         fail(p + "/file", x.what());
       }
+      if (e.side == "left") t.side = 1;
+      else if (e.side == "right") t.side = 2;
+      else if (!e.side.empty()) fail(p + "/side", "unknown side " + quote(e.side) + " (expected one of: left, right)");
       given_by_file(e.unloaded_radius, "/unloaded_radius", "[DIMENSION] UNLOADED_RADIUS");
       t.unloaded_radius = t.mf->UNLOADED_RADIUS;
       if (!t.mf->was_defaulted("VERTICAL/VERTICAL_STIFFNESS")) {

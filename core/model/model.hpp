@@ -101,6 +101,7 @@ struct TireModel {
   double C_kappa = 0, C_alpha = 0, C_gamma = 0, friction = 0, sliding_friction = 0, trail = 0, width = 0,
          rolling_resistance = 0;
   std::shared_ptr<const MagicFormulaParameters> mf;       // magic_formula: the .tir file read
+  int side = 0;                                           // magic_formula: 0 as the file, 1 left, 2 right
 };
 
 struct ActuatorModel {

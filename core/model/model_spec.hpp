@@ -166,7 +166,8 @@ struct EffectSpec {
   // cornering_stiffness, camber_stiffness, friction, trail), fiala (longitudinal_stiffness,
   // cornering_stiffness, friction, sliding_friction, width, rolling_resistance), magic_formula (file:
   // a .tir file, relative to the model file; its [DIMENSION] UNLOADED_RADIUS and [VERTICAL]
-  // VERTICAL_STIFFNESS, VERTICAL_DAMPING stand for the fields, which it then refuses)
+  // VERTICAL_STIFFNESS, VERTICAL_DAMPING stand for the fields, which it then refuses; side: the
+  // side of the car the tire is mounted on, mirrored when the file's TYRESIDE is the other)
   Eigen::Vector3d center = Eigen::Vector3d::Zero();                   // m, wheel body
   Eigen::Vector3d spin_axis = Eigen::Vector3d::UnitY();               // wheel body
   std::optional<double> unloaded_radius;                              // m
@@ -182,6 +183,7 @@ struct EffectSpec {
   double width = 0.0;                                                 // m (fiala)
   double rolling_resistance = 0.0;                                    // m (fiala)
   std::string file;                                                   // magic_formula: the .tir file
+  std::string side;                                                   // magic_formula: "left", "right" or "" (as the file)
   std::optional<double> vertical_stiffness, vertical_damping;         // N/m, N s/m
   double low_speed = 0.1;                                             // m/s: the slips' regularization
 };

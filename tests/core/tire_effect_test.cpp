@@ -468,6 +468,25 @@ TEST(TireEffect, ATirTireEqualsTheMagicFormulaAtTheSameSlips) {
     EXPECT_NEAR(c.force.dot(c.ez), mf.VERTICAL_STIFFNESS * c.penetration + mf.VERTICAL_DAMPING * c.penetration_rate, 1e-9);
     EXPECT_NEAR(c.moment.dot(c.ez), direct.Mz, 1e-12 * std::abs(direct.Mz) + 1e-9);
   }
+  // mounted on the left: MFeval's MF 6.1 file describes a right tire (TYRESIDE, with lateral shifts),
+  // so it is mirrored
+  const std::string file61 = std::string(CODYNA_TEST_DATA_DIR) + "/tires/MagicFormula61_Paramerters.tir";
+  const MagicFormulaParameters mf61 = read_tir_file(file61);
+  ASSERT_EQ(mf61.TYRESIDE, TireSide::Right);
+  char left[500];
+  std::snprintf(left, sizeof left, R"("spin_axis": [0, 1, 0], "law": "magic_formula", "file": "%s", "side": "left")", file61.c_str());
+  const Model mirrored = study_model(study_parse_model_text(tire_effect_wheel(left, "[0, 0, 0.38, 1, 0, 0, 0]", "[0, 0, 0, 0, 0, 0]"), "w.json"));
+  Eigen::VectorXd v(6);
+  v << 0.1, 40, 0.2, 15, 1.5, 0;
+  bool on = false;
+  const TireContact<double> c = tire_effect_contact_at(mirrored, mirrored.q0, v, &on);
+  ASSERT_TRUE(on);
+  MagicFormulaOptions options;
+  options.mount = TireMount::Left;
+  const TireForces<double> direct = magic_formula<double>(mf61, c.input, options);
+  EXPECT_EQ(c.out.Fy, direct.Fy);
+  EXPECT_EQ(c.out.Mz, direct.Mz);
+  EXPECT_GT(std::abs(c.out.Fy - magic_formula<double>(mf61, c.input).Fy), 1.0);
 }
 
 // ------------------------------------------------------------------ the model file
@@ -497,6 +516,8 @@ TEST(TireEffect, BadInputIsRefusedAtTheField) {
   EXPECT_NE(std::string(e.what()).find("linear, fiala, magic_formula"), std::string::npos) << e.what();
   e = tire_effect_refusal(base + R"("law": "linear", "file": "x.tir")");
   EXPECT_EQ(e.path(), "/effects/1/file");
+  e = tire_effect_refusal(base + R"("law": "linear", "side": "left")");
+  EXPECT_EQ(e.path(), "/effects/1/side");
   e = tire_effect_refusal(R"("vertical_stiffness": 200000, "law": "linear")");
   EXPECT_EQ(e.path(), "/effects/1");
   EXPECT_NE(std::string(e.what()).find("unloaded_radius"), std::string::npos) << e.what();
@@ -551,7 +572,7 @@ TEST(TireEffect, TheModelFileRoundTripsEveryLaw) {
        {std::string(tire_effect_linear_fields) + R"(, "friction": 0.9, "trail": 0.02, "rolling_radius": 0.29, "low_speed": 0.3)",
         std::string(R"("unloaded_radius": 0.31, "law": "fiala", "longitudinal_stiffness": 1e5, "cornering_stiffness": 8e4,
                        "friction": 1.1, "sliding_friction": 0.9, "width": 0.2, "rolling_resistance": 0.012, "vertical_stiffness": 2e5)"),
-        std::string(mf_fields)}) {
+        std::string(mf_fields), std::string(mf_fields) + R"(, "side": "left")"}) {
     const ModelSpec a = study_parse_model_text(tire_effect_wheel(fields, "[0, 0, 0.29, 1, 0, 0, 0]", "[0, 0, 0, 0, 0, 0]"), "a.json");
     const nlohmann::json j = study_model_json(a);
     const ModelSpec b = study_parse_model(j, "b.json");
@@ -560,6 +581,7 @@ TEST(TireEffect, TheModelFileRoundTripsEveryLaw) {
     EXPECT_EQ(eb.type, EffectType::Tire);
     EXPECT_EQ(eb.law, ea.law);
     EXPECT_EQ(eb.file, ea.file);
+    EXPECT_EQ(eb.side, ea.side);
     EXPECT_EQ(eb.unloaded_radius, ea.unloaded_radius);
     EXPECT_EQ(eb.rolling_radius, ea.rolling_radius);
     EXPECT_EQ(eb.cornering_stiffness, ea.cornering_stiffness);
