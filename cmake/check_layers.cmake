@@ -2,7 +2,8 @@
 # rule at configure time (CMakeLists.txt includes it) and in CTest (layers.* tests):
 #   front ends (app/, gui/, python/)  include from the core only study/ and model/
 #   core/model/                       includes nothing of dynamics/, analysis/, control/,
-#                                     simulation/, io/ or study/ (it is data and its compilation)
+#                                     simulation/, io/ or study/ (it is data and its compilation;
+#                                     vehicle/, below it, reads a tire effect's .tir file)
 #   core/simulation/                  includes nothing of io/ or study/ (files are read by io/)
 #   core/vehicle/                     includes only itself and spatial/ (tire laws and .tir files)
 # A violation stops the configuration with every offending file and line named.
@@ -13,7 +14,7 @@ function(codyna_check_layers root)
     "app|study,model,gui"
     "gui|study,model,gui"
     "python|study,model"
-    "core/model|model,spatial"
+    "core/model|model,spatial,vehicle"
     "core/simulation|simulation,analysis,dynamics,control,model,spatial"
     "core/vehicle|vehicle,spatial")
   set(core_folders spatial model dynamics analysis control simulation study io gui vehicle)

@@ -268,7 +268,7 @@ struct Linearizer::Impl {
     static void visit(const Model& m, F& f) {
       f.ints({m.nq, m.nv, m.nbodies, m.nc, m.nu(), m.ny(), static_cast<int>(m.motions.size()),
               static_cast<int>(m.springs.size()), static_cast<int>(m.body_forces.size()),
-              static_cast<int>(m.bushings.size()), static_cast<int>(m.plant_inputs.size()),
+              static_cast<int>(m.bushings.size()), static_cast<int>(m.tires.size()), static_cast<int>(m.plant_inputs.size()),
               static_cast<int>(m.plant_outputs.size())});
       for (int b = 0; b < m.nbodies; ++b) {
         const auto i = static_cast<std::size_t>(b);

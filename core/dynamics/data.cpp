@@ -46,7 +46,8 @@ void ModelConstants::assign(const Model& model) {
   for (int a = 0; a < model.nv; ++a)
     for (int b = a; b >= 0; b = dof_parent[b]) ++pairs;
   dense_mass_matrix = pairs == static_cast<long>(model.nv) * (model.nv + 1) / 2;
-  body_force_sources = !model.springs.empty() || !model.body_forces.empty() || !model.bushings.empty();
+  body_force_sources = !model.springs.empty() || !model.body_forces.empty() || !model.bushings.empty() ||
+                       !model.tires.empty();
   for (const ActuatorModel& a : model.actuators)
     if (a.type != ActuatorType::JointForce && a.type != ActuatorType::Motion) body_force_sources = true;
 }

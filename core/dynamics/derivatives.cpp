@@ -8,6 +8,7 @@
 
 #include "dynamics/kinematics.hpp"
 #include "dynamics/sensors.hpp"
+#include "dynamics/tire_effect.hpp"
 
 namespace codyna {
 
@@ -580,6 +581,21 @@ void TreeDerivatives::applied_force_derivatives(const Eigen::VectorXd& q, const 
     w = -w;
     dw = -dw;
     add_body_wrench(bm.body_a, w, dw, bm.body_a, bm.body_b);
+  }
+  // tires: the contact, slips and law of dynamics/tire_effect.hpp on the wheel's (slot 0) and the
+  // road body's (slot 12) local variables
+  for (const TireModel& t : m_->tires) {
+    const BodyAD a = body_ad(d_.oMi[t.body], V_[t.body], 0, t.body > 0);
+    const BodyAD r = body_ad(d_.oMi[t.road_body], V_[t.road_body], 12, t.road_body > 0);
+    TireContact<AD> c;
+    if (!tire_contact<AD>(t, a.R, a.p, a.w, a.point_velocity(a.p), r.R, r.p, r.w, r.point_velocity(r.p), c)) continue;
+    wrench_value(c.point, c.force, c.moment, w, dw);
+    add_body_wrench(t.body, w, dw, t.body, t.road_body);
+    if (t.road_body > 0) {
+      w = -w;
+      dw = -dw;
+      add_body_wrench(t.road_body, w, dw, t.body, t.road_body);
+    }
   }
   for (const BodyForceModel& f : m_->body_forces) {
     const BodyAD a = body_ad(d_.oMi[f.body], V_[f.body], 0, f.body > 0);

@@ -1,10 +1,13 @@
 #include "dynamics/effects.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include "dynamics/kinematics.hpp"
 #include "dynamics/rnea.hpp"
 #include "dynamics/sensors.hpp"
+#include "dynamics/tire_effect.hpp"
 #include "spatial/autodiff.hpp"
 
 namespace codyna {
@@ -23,6 +26,27 @@ void add_world_force(DataT<S>& d, int body, const Eigen::Vector3d& p, const Vec3
   const Vec3T<S> f = Rt * F;
   d.fext[body].template tail<3>() += f;
   d.fext[body].template head<3>() += p.cast<S>().cross(f) + Rt * T;
+}
+// adds a world force F at the world point x and a world torque T to body's fext
+template <class S>
+void tire_effect_add_wrench(DataT<S>& d, int body, const Vec3T<S>& x, const Vec3T<S>& F, const Vec3T<S>& T) {
+  if (body == 0) return;
+  const Mat3T<S> Rt = d.oMi[body].R.transpose();
+  const Vec3T<S> f = Rt * F;
+  const Vec3T<S> xl = Rt * Vec3T<S>(x - d.oMi[body].p);
+  d.fext[body].template tail<3>() += f;
+  d.fext[body].template head<3>() += xl.cross(f) + Rt * T;
+}
+
+// a body's pose and velocity, every entry with one derivative size (no-op for double)
+template <class S>
+struct TireEffectBody {
+  Mat3T<S> R;
+  Vec3T<S> p, w, v;
+};
+template <class S>
+TireEffectBody<S> tire_effect_body(const DataT<S>& d, int body) {
+  return {d.oMi[body].R, d.oMi[body].p, angular_velocity<S>(d, body), point_velocity<S>(d, body, Eigen::Vector3d::Zero())};
 }
 }  // namespace
 
@@ -96,6 +120,27 @@ const VecXT<S>& applied_forces(const Model& model, DataT<S>& d, const VecXT<S>& 
     const Vec3T<S> Fw = RA * F, Tw = RA * T;
     add_world_force<S>(d, b.body_b, b.X_b.p, Fw, Tw);  // on B at its origin, the reaction on A at the same point
     add_world_force<S>(d, b.body_a, b.X_a.p, Vec3T<S>(-Fw), Vec3T<S>(-(Tw + Vec3T<S>(xB - xA).cross(Fw))));
+    any_body_force = true;
+  }
+  for (const TireModel& t : model.tires) {
+    ++count.tires;
+    TireEffectBody<S> wb = tire_effect_body<S>(d, t.body), rb = tire_effect_body<S>(d, t.road_body);
+    if constexpr (!std::is_same_v<S, double>) {
+      // the ground's constants with the wheel's derivative size
+      Eigen::Index n = 0;
+      for (TireEffectBody<S>* b : {&wb, &rb})
+        n = std::max({n, ad_size(b->R), ad_size(b->p), ad_size(b->w), ad_size(b->v)});
+      for (TireEffectBody<S>* b : {&wb, &rb}) {
+        ad_make_coherent(b->R, n);
+        ad_make_coherent(b->p, n);
+        ad_make_coherent(b->w, n);
+        ad_make_coherent(b->v, n);
+      }
+    }
+    TireContact<S> c;
+    if (!tire_contact<S>(t, wb.R, wb.p, wb.w, wb.v, rb.R, rb.p, rb.w, rb.v, c)) continue;
+    tire_effect_add_wrench<S>(d, t.body, c.point, c.force, c.moment);
+    tire_effect_add_wrench<S>(d, t.road_body, c.point, Vec3T<S>(-c.force), Vec3T<S>(-c.moment));
     any_body_force = true;
   }
   for (int k = 0; k < model.nu(); ++k) {

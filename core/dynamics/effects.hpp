@@ -16,7 +16,7 @@ const VecXT<S>& applied_forces(const Model& model, DataT<S>& data, const VecXT<S
 
 // Counts of effect evaluations since start (test hook proving absent effects cost nothing).
 struct EffectCounters {
-  long springs = 0, joint_springs = 0, joint_frictions = 0, body_forces = 0, actuators = 0;
+  long springs = 0, joint_springs = 0, joint_frictions = 0, body_forces = 0, actuators = 0, tires = 0;
 };
 EffectCounters& effect_counters();
 

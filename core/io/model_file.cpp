@@ -811,6 +811,47 @@ const Schema<ConstraintSpec>& schema<ConstraintSpec>() {
 }
 
 template <>
+const Schema<RoadSpec>& schema<RoadSpec>() {
+  static const Schema<RoadSpec> s{{
+      field("body", &RoadSpec::body, read_string),
+      field("point", &RoadSpec::point, read_vec3),
+      field("normal", &RoadSpec::normal, read_direction),
+  }};
+  return s;
+}
+
+// "linear" | "fiala" | "magic_formula"
+std::string read_tire_law(const Node& n) {
+  const std::string s = read_string(n);
+  for (const char* law : kTireLawNames)
+    if (s == law) return s;
+  n.fail("unknown tire law " + quote(s) + " (expected one of: linear, fiala, magic_formula)");
+}
+
+// A tire law's own field: read only for a tire whose law (read before it) uses it, written only then.
+template <class T, class Read>
+Field<EffectSpec> tire_law_field(std::string_view key, T EffectSpec::*m, Read read,
+                                 std::vector<std::string_view> laws) {
+  const auto uses = [laws](const std::string& law) { return std::find(laws.begin(), laws.end(), law) != laws.end(); };
+  return {key, Need::Optional,
+          [key, m, read, laws, uses](const Node& n, EffectSpec& s) {
+            if (!uses(s.law))
+              n.fail("field " + quote(key) + " belongs to the tire law" + (laws.size() > 1 ? "s " : " ") + join(laws) +
+                     ", not to " + quote(s.law));
+            s.*m = read(n);
+          },
+          [key, m, uses](ojson& j, const EffectSpec& s) {
+            if (uses(s.law)) j[std::string(key)] = encode(s.*m);
+          }};
+}
+
+double read_positive_speed(const Node& n) {
+  const double x = read_number(n);
+  if (!(x > 0)) n.expected("a speed > 0 (m/s)");
+  return x;
+}
+
+template <>
 const Schema<EffectSpec>& schema<EffectSpec>() {
   static const Schema<EffectSpec> s{
       fields<EffectSpec>({
@@ -832,6 +873,38 @@ const Schema<EffectSpec>& schema<EffectSpec>() {
            field("translational_damping", &EffectSpec::translational_damping, read_coefficients),
            field("rotational_stiffness", &EffectSpec::rotational_stiffness, read_coefficients),
            field("rotational_damping", &EffectSpec::rotational_damping, read_coefficients)},
+          {field("center", &EffectSpec::center, read_vec3),
+           field("spin_axis", &EffectSpec::spin_axis, read_direction),
+           field("unloaded_radius", &EffectSpec::unloaded_radius,
+                 [](const Node& n) { return std::optional<double>(read_positive_length(n)); }),
+           field("rolling_radius", &EffectSpec::rolling_radius, read_positive_length,
+                 [](double r) { return r > 0 ? ojson(r) : ojson(); }),
+           struct_field("road", &EffectSpec::road),
+           field("law", &EffectSpec::law, read_tire_law, Need::Required),
+           tire_law_field("longitudinal_stiffness", &EffectSpec::longitudinal_stiffness, read_coefficient, {"linear", "fiala"}),
+           tire_law_field("cornering_stiffness", &EffectSpec::cornering_stiffness, read_coefficient, {"linear", "fiala"}),
+           tire_law_field("camber_stiffness", &EffectSpec::camber_stiffness, read_number, {"linear"}),
+           tire_law_field("friction", &EffectSpec::friction, read_coefficient, {"linear", "fiala"}),
+           tire_law_field("sliding_friction", &EffectSpec::sliding_friction, read_coefficient, {"fiala"}),
+           tire_law_field("trail", &EffectSpec::trail, read_number, {"linear"}),
+           tire_law_field("width", &EffectSpec::width, read_coefficient, {"fiala"}),
+           tire_law_field("rolling_resistance", &EffectSpec::rolling_resistance, read_coefficient, {"fiala"}),
+           tire_law_field("file", &EffectSpec::file, read_string, {"magic_formula"}),
+           {"side", Need::Optional,
+            [](const Node& n, EffectSpec& s) {
+              if (s.law != "magic_formula")
+                n.fail("field \"side\" belongs to the tire law magic_formula, not to " + quote(s.law));
+              s.side = read_string(n);
+              if (s.side != "left" && s.side != "right") n.fail("unknown side " + quote(s.side) + " (expected one of: left, right)");
+            },
+            [](ojson& j, const EffectSpec& s) {
+              if (s.law == "magic_formula" && !s.side.empty()) j["side"] = s.side;
+            }},
+           field("vertical_stiffness", &EffectSpec::vertical_stiffness,
+                 [](const Node& n) { return std::optional<double>(read_coefficient(n)); }),
+           field("vertical_damping", &EffectSpec::vertical_damping,
+                 [](const Node& n) { return std::optional<double>(read_coefficient(n)); }),
+           field("low_speed", &EffectSpec::low_speed, read_positive_speed)},
       }),
       "effect",
       [](const EffectSpec& e) {
@@ -846,6 +919,11 @@ const Schema<EffectSpec>& schema<EffectSpec>() {
           case EffectType::Bushing:
             return element_keys({"body_a", "frame_a", "body_b", "frame_b", "translational_stiffness", "translational_damping",
                                  "rotational_stiffness", "rotational_damping"});
+          case EffectType::Tire:
+            return element_keys({"body", "center", "spin_axis", "unloaded_radius", "rolling_radius", "road", "law",
+                                 "longitudinal_stiffness", "cornering_stiffness", "camber_stiffness", "friction",
+                                 "sliding_friction", "trail", "width", "rolling_resistance", "file", "side", "vertical_stiffness",
+                                 "vertical_damping", "low_speed"});
         }
         return element_keys({});
       }};

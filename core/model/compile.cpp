@@ -4,9 +4,12 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <set>
 #include <sstream>
+
+#include "vehicle/tir_file.hpp"
 
 
 namespace codyna {
@@ -97,6 +100,7 @@ class Compiler {
       m_.joint_frictions.clear();
       m_.body_forces.clear();
       m_.bushings.clear();
+      m_.tires.clear();
       build_effects();
     }
     // in the structure's order, under the same names: the plant's inputs and outputs, the motions
@@ -578,6 +582,9 @@ class Compiler {
           m_.bushings.push_back(b);
           break;
         }
+        case EffectType::Tire:
+          m_.tires.push_back(build_tire(e, p));
+          break;
         case EffectType::JointDamper: {
           // one damping value on every velocity coordinate of the joint: -damping * v
           // (for a spherical joint an isotropic viscous torque -damping * omega)
@@ -597,6 +604,100 @@ class Compiler {
         }
       }
     }
+  }
+
+  // a tire effect: the wheel, the road, the law's numbers (a .tir file read relative to the model file)
+  TireModel build_tire(const EffectSpec& e, const std::string& p) const {
+    TireModel t;
+    t.name = e.name;
+    t.body = body(e.body_a, p + "/body", false);
+    t.road_body = body(e.road.body, p + "/road/body");
+    if (t.road_body == t.body) fail(p + "/road/body", "expected a road on another body than the wheel");
+    if (!e.center.allFinite()) fail(p + "/center", "expected finite components");
+    t.center = e.center;
+    const double axis_length = e.spin_axis.norm();
+    if (!std::isfinite(axis_length) || !(axis_length > 0))
+      fail(p + "/spin_axis", "expected a non-zero spin axis (the wheel's axle, wheel body coordinates)");
+    t.axis = e.spin_axis / axis_length;
+    const double normal_length = e.road.normal.norm();
+    if (!std::isfinite(normal_length) || !(normal_length > 0)) fail(p + "/road/normal", "expected a non-zero road normal");
+    if (!e.road.point.allFinite()) fail(p + "/road/point", "expected finite components");
+    t.road_point = e.road.point;
+    t.road_normal = e.road.normal / normal_length;
+    const auto positive = [&](double x, const std::string& key, const char* what) {
+      if (!std::isfinite(x) || !(x > 0)) fail(p + key, std::string("expected a positive ") + what + ", got " + compile_number(x));
+    };
+    const auto given_by_file = [&](const std::optional<double>& field, const std::string& key, const char* tir_key) {
+      if (field) fail(p + key, std::string("given by the .tir file (") + tir_key + "); leave the field out");
+    };
+    if (!std::isfinite(e.low_speed) || !(e.low_speed > 0)) fail(p + "/low_speed", "expected a positive speed (m/s), got " + compile_number(e.low_speed));
+    t.low_speed = e.low_speed;
+    if (e.law == "magic_formula") {
+      t.law = TireLaw::MagicFormula;
+      if (e.file.empty()) fail(p + "/file", "expected the .tir file of the magic_formula law");
+      std::filesystem::path path(e.file);
+      if (path.is_relative() && !file_.empty()) path = std::filesystem::path(file_).parent_path() / path;
+      try {
+        t.mf = std::make_shared<const MagicFormulaParameters>(read_tir_file(path.string()));
+      } catch (const std::exception& x) {
+        fail(p + "/file", x.what());
+      }
+      if (e.side == "left") t.side = 1;
+      else if (e.side == "right") t.side = 2;
+      else if (!e.side.empty()) fail(p + "/side", "unknown side " + quote(e.side) + " (expected one of: left, right)");
+      given_by_file(e.unloaded_radius, "/unloaded_radius", "[DIMENSION] UNLOADED_RADIUS");
+      t.unloaded_radius = t.mf->UNLOADED_RADIUS;
+      if (!t.mf->was_defaulted("VERTICAL/VERTICAL_STIFFNESS")) {
+        given_by_file(e.vertical_stiffness, "/vertical_stiffness", "[VERTICAL] VERTICAL_STIFFNESS");
+        t.vertical_stiffness = t.mf->VERTICAL_STIFFNESS;
+      } else {
+        if (!e.vertical_stiffness) fail(p + "/vertical_stiffness", "expected a vertical stiffness (N/m): the .tir file gives none");
+        t.vertical_stiffness = *e.vertical_stiffness;
+      }
+      if (!t.mf->was_defaulted("VERTICAL/VERTICAL_DAMPING")) {
+        given_by_file(e.vertical_damping, "/vertical_damping", "[VERTICAL] VERTICAL_DAMPING");
+        t.vertical_damping = t.mf->VERTICAL_DAMPING;
+      } else {
+        t.vertical_damping = e.vertical_damping.value_or(0.0);
+      }
+    } else if (e.law == "linear" || e.law == "fiala") {
+      t.law = e.law == "linear" ? TireLaw::Linear : TireLaw::Fiala;
+      if (!e.unloaded_radius) fail(p, "missing required field \"unloaded_radius\"");
+      t.unloaded_radius = *e.unloaded_radius;
+      if (!e.vertical_stiffness) fail(p, "missing required field \"vertical_stiffness\"");
+      t.vertical_stiffness = *e.vertical_stiffness;
+      t.vertical_damping = e.vertical_damping.value_or(0.0);
+      non_negative(e.longitudinal_stiffness, p + "/longitudinal_stiffness", "longitudinal slip stiffness");
+      non_negative(e.cornering_stiffness, p + "/cornering_stiffness", "cornering stiffness");
+      non_negative(e.friction, p + "/friction", "friction coefficient");
+      t.C_kappa = e.longitudinal_stiffness;
+      t.C_alpha = e.cornering_stiffness;
+      t.friction = e.friction;
+      if (t.law == TireLaw::Linear) {
+        if (!std::isfinite(e.camber_stiffness)) fail(p + "/camber_stiffness", "expected a finite number");
+        if (!std::isfinite(e.trail)) fail(p + "/trail", "expected a finite number");
+        t.C_gamma = e.camber_stiffness;
+        t.trail = e.trail;
+      } else {
+        positive(e.longitudinal_stiffness, "/longitudinal_stiffness", "longitudinal slip stiffness (N)");
+        positive(e.cornering_stiffness, "/cornering_stiffness", "cornering stiffness (N/rad)");
+        positive(e.friction, "/friction", "friction coefficient");
+        non_negative(e.sliding_friction, p + "/sliding_friction", "sliding friction coefficient");
+        non_negative(e.width, p + "/width", "width");
+        non_negative(e.rolling_resistance, p + "/rolling_resistance", "rolling resistance");
+        t.sliding_friction = e.sliding_friction > 0 ? e.sliding_friction : e.friction;
+        t.width = e.width;
+        t.rolling_resistance = e.rolling_resistance;
+      }
+    } else {
+      fail(p + "/law", "unknown tire law " + quote(e.law) + " (expected one of: linear, fiala, magic_formula)");
+    }
+    positive(t.unloaded_radius, "/unloaded_radius", "unloaded radius (m)");
+    non_negative(t.vertical_stiffness, p + "/vertical_stiffness", "vertical stiffness");
+    non_negative(t.vertical_damping, p + "/vertical_damping", "vertical damping");
+    non_negative(e.rolling_radius, p + "/rolling_radius", "rolling radius");
+    t.rolling_radius = e.rolling_radius > 0 ? e.rolling_radius : t.unloaded_radius;
+    return t;
   }
 
   void build_actuators() {

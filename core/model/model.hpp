@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -76,6 +77,31 @@ struct BushingModel {
   SE3 X_a, X_b;  // the bushing's frames in body_a's and body_b's frames
   Eigen::Vector3d kt = Eigen::Vector3d::Zero(), ct = Eigen::Vector3d::Zero();  // translational, A's axes
   Eigen::Vector3d kr = Eigen::Vector3d::Zero(), cr = Eigen::Vector3d::Zero();  // rotational, A's axes
+};
+
+struct MagicFormulaParameters;  // vehicle/tir_file.hpp
+
+enum class TireLaw { Linear, Fiala, MagicFormula };
+
+// A tire (EffectType::Tire; dynamics/tire_effect.hpp evaluates it): the wheel body's centre and unit
+// spin axis, the road plane on road_body, the vertical spring-damper and the force law's numbers.
+struct TireModel {
+  std::string name;
+  int body = 0;                                           // the wheel
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();       // wheel body coordinates
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitY();        // unit, wheel body coordinates
+  double unloaded_radius = 0, rolling_radius = 0;         // m (rolling_radius: Re of the slip)
+  int road_body = 0;
+  Eigen::Vector3d road_point = Eigen::Vector3d::Zero();   // road body coordinates
+  Eigen::Vector3d road_normal = Eigen::Vector3d::UnitZ(); // unit, road body coordinates
+  double vertical_stiffness = 0, vertical_damping = 0;    // N/m, N s/m
+  double low_speed = 0.1;                                 // m/s
+  TireLaw law = TireLaw::Linear;
+  // linear and fiala (fiala: friction = mu_max, sliding_friction = mu_min)
+  double C_kappa = 0, C_alpha = 0, C_gamma = 0, friction = 0, sliding_friction = 0, trail = 0, width = 0,
+         rolling_resistance = 0;
+  std::shared_ptr<const MagicFormulaParameters> mf;       // magic_formula: the .tir file read
+  int side = 0;                                           // magic_formula: 0 as the file, 1 left, 2 right
 };
 
 struct ActuatorModel {
@@ -159,6 +185,7 @@ struct Model {
   std::vector<JointSpringModel> joint_frictions;  // damping only
   std::vector<BodyForceModel> body_forces;
   std::vector<BushingModel> bushings;
+  std::vector<TireModel> tires;
 
   std::vector<ActuatorModel> actuators;  // [nu_all]
   std::vector<SensorModel> sensors;      // [ny_all]

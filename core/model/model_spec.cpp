@@ -37,7 +37,7 @@ constexpr std::array<std::pair<ConstraintType, const char*>, 6> kConstraints{{
     {ConstraintType::RollingBall, "rolling_ball"},
     {ConstraintType::RollingDisc, "rolling_disc"},
 }};
-constexpr std::array<std::pair<EffectType, const char*>, 7> kEffects{{
+constexpr std::array<std::pair<EffectType, const char*>, 8> kEffects{{
     {EffectType::Gravity, "gravity"},
     {EffectType::SpringDamper, "spring_damper"},
     {EffectType::JointSpringDamper, "joint_spring_damper"},
@@ -45,6 +45,7 @@ constexpr std::array<std::pair<EffectType, const char*>, 7> kEffects{{
     {EffectType::JointDamper, "joint_damper"},
     {EffectType::BodyForce, "body_force"},
     {EffectType::Bushing, "bushing"},
+    {EffectType::Tire, "tire"},
 }};
 constexpr std::array<std::pair<ActuatorType, const char*>, 6> kActuators{{
     {ActuatorType::JointForce, "joint_force"},

@@ -120,7 +120,20 @@ enum class EffectType {
   BodyForce,         // constant force at a body point and constant torque; in world or body axes
   Bushing,           // linear 6-component spring-damper between frame_a on body_a and frame_b on body_b
                      // (Adams' BUSHING): translations and small rotations of B in A's axes
+  Tire,              // a tire on a wheel body (body_a) rolling on a road plane: contact, slips, a force law
+                     // (linear, fiala, magic_formula from a .tir file); docs/tires.md
 };
+
+// A tire's road: the plane through `point` with normal `normal` (both in `body`'s coordinates; the
+// ground by default), the wheel on the side the normal points to.
+struct RoadSpec {
+  std::string body = kGroundName;
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+};
+
+// The tire force laws an effect of type tire may name, as written in a model file.
+inline constexpr const char* kTireLawNames[] = {"linear", "fiala", "magic_formula"};
 
 struct EffectSpec {
   std::string name;
@@ -146,6 +159,33 @@ struct EffectSpec {
   Eigen::Vector3d translational_damping = Eigen::Vector3d::Zero();    // N s/m
   Eigen::Vector3d rotational_stiffness = Eigen::Vector3d::Zero();     // N m/rad
   Eigen::Vector3d rotational_damping = Eigen::Vector3d::Zero();       // N m s/rad
+  // tire (docs/tires.md, ISO-W axes at the contact): on the wheel body body_a, its centre `center`
+  // and spin axis `spin_axis` (wheel body coordinates; the axle pointing to the wheel's left, so that
+  // rolling forward is a positive spin about it), the unloaded radius, the road, a force law and the
+  // vertical spring-damper of the tire's deflection. Law fields: linear (longitudinal_stiffness,
+  // cornering_stiffness, camber_stiffness, friction, trail), fiala (longitudinal_stiffness,
+  // cornering_stiffness, friction, sliding_friction, width, rolling_resistance), magic_formula (file:
+  // a .tir file, relative to the model file; its [DIMENSION] UNLOADED_RADIUS and [VERTICAL]
+  // VERTICAL_STIFFNESS, VERTICAL_DAMPING stand for the fields, which it then refuses; side: the
+  // side of the car the tire is mounted on, mirrored when the file's TYRESIDE is the other)
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();                   // m, wheel body
+  Eigen::Vector3d spin_axis = Eigen::Vector3d::UnitY();               // wheel body
+  std::optional<double> unloaded_radius;                              // m
+  double rolling_radius = 0.0;                                        // m; 0: the unloaded radius
+  RoadSpec road;
+  std::string law = "linear";                                         // one of kTireLawNames
+  double longitudinal_stiffness = 0.0;                                // N (per unit slip)
+  double cornering_stiffness = 0.0;                                   // N/rad (positive)
+  double camber_stiffness = 0.0;                                      // N/rad (linear)
+  double friction = 0.0;                                              // linear: mu (0: none); fiala: mu_max
+  double sliding_friction = 0.0;                                      // fiala: mu_min (0: = friction)
+  double trail = 0.0;                                                 // m (linear)
+  double width = 0.0;                                                 // m (fiala)
+  double rolling_resistance = 0.0;                                    // m (fiala)
+  std::string file;                                                   // magic_formula: the .tir file
+  std::string side;                                                   // magic_formula: "left", "right" or "" (as the file)
+  std::optional<double> vertical_stiffness, vertical_damping;         // N/m, N s/m
+  double low_speed = 0.1;                                             // m/s: the slips' regularization
 };
 
 // Actuators are the candidate plant inputs: each takes one scalar u.

@@ -66,6 +66,9 @@ void for_each_body_ref(ModelSpec& s, F&& f) {
       f(e.body_b, "effect " + e.name + ": body_b", at("effects", i, "body_b"));
     } else if (e.type == EffectType::BodyForce) {
       f(e.body_a, "effect " + e.name + ": body", at("effects", i, "body"));
+    } else if (e.type == EffectType::Tire) {
+      f(e.body_a, "effect " + e.name + ": body", at("effects", i, "body"));
+      if (e.road.body != kGroundName) f(e.road.body, "effect " + e.name + ": road body", at("effects", i, "road/body"));
     }
   }
   for (std::size_t i = 0; i < s.actuators.size(); ++i) {
@@ -284,7 +287,8 @@ void rename_element(ModelSpec& s, ElementKind k, int index, const std::string& n
 std::string default_name(ElementKind k, const std::string& type) {
   static const std::map<std::string, std::string> effects = {
       {"gravity", "gravity"}, {"spring_damper", "spring"}, {"joint_spring_damper", "joint_spring"},
-      {"joint_friction", "friction"}, {"joint_damper", "damper"}, {"body_force", "load"}, {"bushing", "bushing"}};
+      {"joint_friction", "friction"}, {"joint_damper", "damper"}, {"body_force", "load"}, {"bushing", "bushing"},
+      {"tire", "tire"}};
   static const std::map<std::string, std::string> actuators = {
       {"joint_force", "motor"}, {"body_force", "force"}, {"body_torque", "torque"},
       {"line_force", "strut"},  {"mix", "mix"},          {"motion", "motion"}};
