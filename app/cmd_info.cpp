@@ -49,6 +49,7 @@ void print_info(const ModelSummary& m) {
   if (m.joint_frictions) std::cout << ", " << m.joint_frictions << " joint friction(s)";
   if (m.joint_dampers) std::cout << ", " << m.joint_dampers << " joint damper(s)";
   if (m.body_forces) std::cout << ", " << m.body_forces << " body force(s)";
+  if (m.tires) std::cout << ", " << m.tires << " tire(s)";
   std::cout << "\ninputs       (candidate plant inputs; * = Plant/In)\n";
   for (const ModelSummary::Actuator& a : m.actuators)
     std::cout << "  " << (a.plant ? "* " : "  ") << std::left << std::setw(14) << a.name << " " << a.type << " [" << a.unit << "]\n";

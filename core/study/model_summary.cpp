@@ -47,6 +47,7 @@ ModelSummary model_summary(const Model& m) {
     s.effects.push_back({e.name, to_string(e.type)});
     s.joint_frictions += e.type == EffectType::JointFriction;
     s.joint_dampers += e.type == EffectType::JointDamper;
+    s.tires += e.type == EffectType::Tire;
   }
   s.gravity_on = m.has_gravity;
   s.gravity = m.gravity;

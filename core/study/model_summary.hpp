@@ -54,7 +54,7 @@ struct ModelSummary {
   bool gravity_on = false;
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
   // elements per kind (a joint damper counts once, whatever its joint's coordinates)
-  int spring_dampers = 0, joint_springs = 0, joint_frictions = 0, joint_dampers = 0, body_forces = 0;
+  int spring_dampers = 0, joint_springs = 0, joint_frictions = 0, joint_dampers = 0, body_forces = 0, tires = 0;
   std::vector<Actuator> actuators;
   std::vector<Sensor> sensors;
   std::vector<std::string> plant_inputs, plant_outputs;
