@@ -84,8 +84,9 @@ void fitAxis(QValueAxis* a, double lo, double hi) {
 }
 
 // A Bode axis on round values, as a control engineer reads one: ticks from 0 at the smallest of
-// `steps` that gives at most 8 of them (multiples of 20 or 10 dB; of 90 or 45 degrees), the range
-// out to whole steps
+// `steps` whose whole-step range holds at most kBodeIntervals of them (so that six labels fit a
+// short chart: more were drawn as "..."); a flat curve gets one step on either side
+constexpr double kBodeIntervals = 5;
 void bodeAxis(QValueAxis* a, double lo, double hi, std::initializer_list<double> steps) {
   if (!(lo <= hi) || !std::isfinite(lo) || !std::isfinite(hi)) {
     fitAxis(a, 0, 0);
@@ -93,12 +94,12 @@ void bodeAxis(QValueAxis* a, double lo, double hi, std::initializer_list<double>
   }
   double step = *(steps.end() - 1);
   for (double s : steps)
-    if ((hi - lo) / s <= 8.0) {
+    if (std::ceil(hi / s) - std::floor(lo / s) <= kBodeIntervals) {
       step = s;
       break;
     }
   double from = std::floor(lo / step) * step, to = std::ceil(hi / step) * step;
-  if (to - from < step * 0.5) to = from + step;
+  if (to - from < step * 0.5) from -= step, to += step;
   a->setTickType(QValueAxis::TicksDynamic);
   setAxisRange(a, from, to, step);
 }

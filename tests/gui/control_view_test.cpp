@@ -11,6 +11,7 @@
 #include <QTabWidget>
 #include <QTemporaryDir>
 #include <QTest>
+#include <QValueAxis>
 #include <QUndoStack>
 #include <Eigen/LU>
 #include <cmath>
@@ -99,6 +100,32 @@ class ControlViewTest : public QObject {
     QCOMPARE(map->zeroCount(), 2);
     for (int k = 0; k < 2; ++k) QVERIFY(std::hypot(map->zeroPosition(k).x(), map->zeroPosition(k).y()) < 1e-6);
     QCOMPARE(map->poleCount(), 4);
+  }
+
+  // the Bode axes on round steps with few enough ticks that their labels fit (at most 6: more were
+  // drawn as "..."), the curve inside the range; a flat phase gets a step on either side
+  void bodeAxesHoldFewRoundTicks() {
+    ControlView* cv = w->controlView();
+    w->analysisTabs()->setCurrentWidget(cv);
+    QVERIFY(cv->analyse());
+    cv->systemCombo()->setCurrentIndex(ControlView::Plant);
+    cv->inputCombo()->setCurrentText("force");
+    cv->outputCombo()->setCurrentText("theta");
+    for (const char* name : {"bodeMagnitude", "bodePhase"}) {
+      auto* view = cv->findChild<ChartView*>(name);
+      QVERIFY2(view, name);
+      auto* y = qobject_cast<QValueAxis*>(view->chart()->axes(Qt::Vertical).value(0));
+      QVERIFY(y);
+      const double interval = y->tickInterval(), span = y->max() - y->min();
+      QVERIFY2(interval > 0 && span / interval <= 5 + 1e-9, qPrintable(QString("%1: %2 ticks").arg(name).arg(span / interval)));
+      QVERIFY2(std::abs(std::remainder(y->min(), interval)) < 1e-9 * interval, name);  // on whole steps
+      const QList<QPointF> points = QString(name) == "bodeMagnitude" ? cv->magnitudePoints() : cv->phasePoints();
+      QVERIFY(!points.isEmpty());
+      for (const QPointF& p : points) QVERIFY(p.y() >= y->min() && p.y() <= y->max());
+      if (QString(name) == "bodePhase") {  // force -> theta: 0 degrees at every frequency
+        QCOMPARE(y->min(), -y->max());
+      }
+    }
   }
 
   void closedLoopStepGainAndPoles() {
