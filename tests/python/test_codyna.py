@@ -5,6 +5,10 @@ the command line's output bit for bit (np.array_equal, never allclose):
   * every example's A, B, C, D, x0, u0, y0, xdot0 and names equal the CLI's NAME.mat, also
     discrete (Ts = 0.01) and by central differences on the cart-pendulum, along a trajectory,
     with held coordinates given as a dict, and for the linear closed loop (NAME_cl.mat);
+  * the paper's example as scripts/demo.sh runs it (cart-pendulum, equilibrium): the CLI's MAT
+    v7.3 export read by h5py gives the module's A, B, C, D, offsets and names (bits, and 1e-12
+    relative), the CLI's modes table is modes_text, numpy's eig of its A the module's eigenvalues
+    to 1e-12 of the spectral radius, and its closed loop's poles_cl (scipy.io) the module's poles;
   * Linearization.export writes the CLI's files (every variable of NAME.mat, the NAME.m text);
   * the cart-pendulum's closed loop (lqr=True, t_end=2) equals the CLI's HDF5 trajectory, and
     Simulation.save writes an HDF5 whose every dataset equals the CLI's;
@@ -187,6 +191,79 @@ def test_closed_loop_equals_cli(tmp_path):
         assert same(getattr(cl, key), d[key + "cl"]), key
     assert np.all(cl.poles().real < 0)
     assert codyna.Study(CART).linearize().closed_loop is None
+
+
+def h5_matrix(f, key):
+    """A MAT v7.3 double as MATLAB sees it (HDF5 holds MATLAB's column-major layout: transposed)."""
+    return np.array(f[key], dtype=float).T
+
+
+def h5_names(f, key):
+    """A MAT v7.3 cellstr: references to uint16 character arrays."""
+    return ["".join(map(chr, np.array(f[ref]).ravel())) for ref in np.array(f[key]).ravel()]
+
+
+def relative_gap(actual, expected):
+    """max |actual - expected| / max |expected| (the absolute gap where expected is all zeros)."""
+    actual, expected = np.asarray(actual), np.asarray(expected)
+    assert actual.shape == expected.shape, (actual.shape, expected.shape)
+    if actual.size == 0:
+        return 0.0
+    gap, scale = np.max(np.abs(actual - expected)), np.max(np.abs(expected))
+    return gap / scale if scale > 0 else gap
+
+
+def matched(actual, expected):
+    """expected reordered to pair each of actual's eigenvalues with its nearest (one to one)."""
+    left, order = list(expected), []
+    for a in actual:
+        k = int(np.argmin([abs(a - e) for e in left]))
+        order.append(left.pop(k))
+    return np.array(order)
+
+
+def test_cli_and_python_agree_on_the_papers_example(tmp_path):
+    # the demo's run (scripts/demo.sh): codyna linearize on the paper's cart-pendulum at its
+    # equilibrium, through the command, its MAT v7.3 (HDF5) export read by h5py, against the
+    # module's Study.linearize: A, B, C, D, offsets and names from the same core, so the same bits
+    # (the 1e-12 relative bound is asserted too, and implied); the eigenvalues: the modes table the
+    # command prints is the module's modes_text, and numpy's eig of the command's A agrees with
+    # Linearization.eigenvalues() to 1e-12 of the spectral radius (two eigenvalue codes)
+    stdout, _ = cli("linearize", CART, "--operating-point", "equilibrium", "--mat-version", "7.3", "--out", tmp_path / "h5")
+    lin = codyna.Study(CART).linearize(operating_point="equilibrium")
+    with h5py.File(tmp_path / "h5" / "cart_pendulum.mat", "r") as f:
+        assert f["A"].attrs["MATLAB_class"] == b"double"
+        for key in ("A", "B", "C", "D"):
+            expected = h5_matrix(f, key)
+            assert relative_gap(getattr(lin, key), expected) <= 1e-12, key
+            assert np.array_equal(getattr(lin, key), expected), key
+        for key in ("x0", "u0", "y0", "xdot0"):
+            expected = np.array(f[key], dtype=float).ravel()
+            assert relative_gap(getattr(lin, key), expected) <= 1e-12, key
+            assert np.array_equal(getattr(lin, key), expected), key
+        assert lin.Ts == float(np.array(f["Ts"]).ravel()[0]) == 0.0
+        for key in ("state_names", "input_names", "output_names"):
+            assert getattr(lin, key) == h5_names(f, key), key
+        A = h5_matrix(f, "A")
+    assert lin.A.shape == (4, 4) and lin.state_names == ["cart_slider", "rod_pivot", "cart_slider_dot", "rod_pivot_dot"]
+    ev = lin.eigenvalues()
+    assert ev.shape == (4,) and np.max(np.abs(ev.real)) > 3  # the inverted pendulum's unstable pair +-3.13
+    assert relative_gap(ev, matched(ev, np.linalg.eigvals(A))) <= 1e-12
+    assert "\n" + lin.modes_text + "\n" in stdout
+
+    # the closed loop with the model file's LQR: its poles are in NAME_cl.mat (MAT v5, scipy.io)
+    # as the command computed them, and must be the module's to the bit
+    stdout, _ = cli("linearize", CART, "--operating-point", "equilibrium", "--closed-loop", "--out", tmp_path / "cl")
+    cl = codyna.Study(CART).linearize(operating_point="equilibrium", closed_loop=True).closed_loop
+    d = scipy.io.loadmat(tmp_path / "cl" / "cart_pendulum_cl.mat")
+    for key in ("A", "B", "C", "D"):
+        assert relative_gap(getattr(cl, key), d[key + "cl"]) <= 1e-12, key
+        assert np.array_equal(getattr(cl, key), d[key + "cl"]), key
+    poles = d["poles_cl"][:, 0] + 1j * d["poles_cl"][:, 1]
+    assert poles.shape == (4,) and np.all(poles.real < 0)
+    assert relative_gap(cl.poles(), poles) <= 1e-12
+    assert np.array_equal(cl.poles(), poles)
+    assert "\n" + cl.poles_text + "\n" in stdout
 
 
 def test_export_writes_the_cli_files(tmp_path):
