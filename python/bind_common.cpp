@@ -3,6 +3,7 @@
 // conversions several studies share. Conversion only.
 #include "bind_common.hpp"
 
+#include <algorithm>
 #include <cstdio>
 
 namespace codyna::python {
