@@ -84,8 +84,9 @@ void print(const LinearizeJob& job) {
   const LinearSystem& sys = job.linearization.system;
   std::cout << "model            " << m.name << " (" << m.dof() << " DOF" << rates_said(m) << ")\n"
             << "operating point  " << op.kind;
-  if (op.kind == "equilibrium" || op.kind == "trim")
+  if (op.kind == "equilibrium" || op.kind == "trim" || op.kind == "steady")
     std::cout << " (residual " << op.residual << ", " << op.iterations << " iterations)";
+  if (op.motion) std::cout << "\nmotion           " << study_motion_text(m, op);
   std::cout << "\nmethod           " << job.method;
   if (job.method != "exact") std::cout << " (max relative difference from exact: " << lin.fd_error << ")";
   std::cout << "\ntime             " << (sys.Ts > 0 ? "discrete, Ts = " + std::to_string(sys.Ts) : std::string("continuous")) << "\n";
@@ -116,6 +117,7 @@ void print(const LinearizeJob& job) {
   std::cout << "\n" << study_format_modes(job.modes) << "\n";
   std::cout << "controllable     " << study_hidden_modes_text(job.uncontrollable) << "\n"
             << "observable       " << study_hidden_modes_text(job.unobservable) << "\n\n";
+  if (job.linearization.handling) std::cout << study_handling_text(*job.linearization.handling) << "\n";
   std::cout << "wrote " << job.written[0] << "\nwrote " << job.written[1] << "\n";
   if (job.closed_loop) print_closed_loop(job);
 }
@@ -134,7 +136,7 @@ void add_linearize(CLI::App& app) {
   auto* cmd = app.add_subcommand("linearize", "Linearize the plant (Plant/In -> Plant/Out) and export NAME.mat + NAME.m");
   cmd->add_option("model", a->model, "model file (JSON)")->required();
   cmd->add_option("--out", a->out, "output directory (created if missing)")->required();
-  add_point_flags(cmd, a->point, "initial | equilibrium | trim | time=T",
+  add_point_flags(cmd, a->point, "initial | equilibrium | trim | steady | time=T",
                   "NAME=VALUE: hold a joint coordinate (or rate, NAME_dot) in the operating-point search: set in the model's state and kept exactly by the equilibrium and trim searches (repeatable; --set is the older name)",
                   "NAME=VALUE: with --trajectory, the simulation's initial state (repeatable); the operating point does not depend on it");
   cmd->add_option("--method", a->method, "exact | fd-forward | fd-central")->capture_default_str();

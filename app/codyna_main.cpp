@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
   codyna::cli::add_import(app);
   codyna::cli::add_export_mjcf(app);
   codyna::cli::add_sweep(app);
+  codyna::cli::add_tire(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

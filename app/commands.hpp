@@ -12,6 +12,7 @@ void add_simulate(CLI::App& app);
 void add_import(CLI::App& app);
 void add_export_mjcf(CLI::App& app);
 void add_sweep(CLI::App& app);
+void add_tire(CLI::App& app);
 int exit_code();
 void set_exit_code(int code);
 

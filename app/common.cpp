@@ -92,7 +92,12 @@ void add_point_flags(CLI::App* cmd, PointFlags& f, const std::string& op_help, c
   cmd->add_option("--initial", f.initial, initial_help);
   cmd->add_option("--trim-free", f.trim_free, "trim: coordinates the trim solves instead of holding (comma-separated)")->delimiter(',');
   cmd->add_option("--free-input", f.free_inputs, "equilibrium/trim: Plant/In inputs solved for (comma-separated; trim default: all)")->delimiter(',');
-  cmd->add_option("--target", f.targets, "NAME=VALUE: a Plant/Out value the equilibrium/trim must reach (repeatable)");
+  cmd->add_option("--target", f.targets, "NAME=VALUE: a Plant/Out value the equilibrium/trim/steady motion must reach (repeatable)");
+  cmd->add_option("--steady-body", f.steady_body, "steady: the body whose speed and turn are given (default: the first on a free or planar joint to ground)");
+  cmd->add_option("--speed", f.speed, "steady: forward speed of that body's centre of mass, m/s (default: as at the start)");
+  cmd->add_option("--yaw-rate", f.yaw_rate, "steady: yaw rate, rad/s (> 0 turns left)");
+  cmd->add_option("--radius", f.radius, "steady: radius of the path of its centre of mass, m (> 0 left, < 0 right)");
+  cmd->add_option("--lateral-acceleration", f.lateral_acceleration, "steady: lateral acceleration, m/s^2 (> 0 left)");
 }
 
 PointRequest point_request(const PointFlags& f, const CLI::App* cmd) {
@@ -104,6 +109,11 @@ PointRequest point_request(const PointFlags& f, const CLI::App* cmd) {
   p.hold = f.hold;
   p.initial = f.initial;
   p.targets = f.targets;
+  if (given(cmd, "--steady-body")) p.steady_body = f.steady_body;
+  if (given(cmd, "--speed")) p.speed = f.speed;
+  if (given(cmd, "--yaw-rate")) p.yaw_rate = f.yaw_rate;
+  if (given(cmd, "--radius")) p.radius = f.radius;
+  if (given(cmd, "--lateral-acceleration")) p.lateral_acceleration = f.lateral_acceleration;
   return p;
 }
 

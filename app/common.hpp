@@ -33,11 +33,14 @@ void add_plant_flags(CLI::App* cmd, PlantFlags& f);
 PlantRequest plant_request(const PlantFlags& f, const CLI::App* cmd);
 
 // The operating point's flags, the same for linearize and simulate (study/jobs.hpp's PointRequest):
-// --operating-point, --independent, --hold (--set), --initial, --trim-free, --free-input, --target.
+// --operating-point, --independent, --hold (--set), --initial, --trim-free, --free-input, --target,
+// and the steady motion's --steady-body, --speed, --yaw-rate, --radius, --lateral-acceleration.
 // `op_help` and `hold_help`/`initial_help` say what they mean for the subcommand.
 struct PointFlags {
   std::string op = "equilibrium";
   std::vector<std::string> independent, hold, initial, trim_free, free_inputs, targets;
+  std::string steady_body;
+  double speed = 0, yaw_rate = 0, radius = 0, lateral_acceleration = 0;
 };
 void add_point_flags(CLI::App* cmd, PointFlags& f, const std::string& op_help, const std::string& hold_help,
                      const std::string& initial_help);

@@ -95,6 +95,7 @@ void LinearizeView::buildUi() {
   op_combo_->addItem(tr("initial (the model's initial state)"), QStringLiteral("initial"));
   op_combo_->addItem(tr("equilibrium (static, at rest)"), QStringLiteral("equilibrium"));
   op_combo_->addItem(tr("trim (inputs that hold the initial configuration)"), QStringLiteral("trim"));
+  op_combo_->addItem(tr("steady (a motion: speed and turn)"), QStringLiteral("steady"));
   op_combo_->addItem(tr("time=T (state of an open-loop run at T)"), QStringLiteral("time"));
   op_combo_->setToolTip(tr("Where A, B, C, D are taken: the model's initial state, a static equilibrium (at rest, "
                            "accelerations zero), a trim (the inputs that hold the initial configuration) or the "
@@ -160,7 +161,7 @@ void LinearizeView::buildUi() {
   ind_layout->addWidget(independent_);
 
   // the steady-state search (operspec): what an equilibrium or a trim holds, solves and reaches
-  steady_box_ = new QGroupBox(tr("Steady-state search (equilibrium, trim)"), this);
+  steady_box_ = new QGroupBox(tr("Steady-state search (equilibrium, trim, steady)"), this);
   auto* steady = new QFormLayout(steady_box_);
   steady->setRowWrapPolicy(QFormLayout::WrapAllRows);
   set_table_ = new NameValueTable(tr("Coordinate"), tr("Value (m, rad, /s)"), steady_box_);
@@ -179,6 +180,31 @@ void LinearizeView::buildUi() {
   trim_free_->setMaximumHeight(70);
   trim_free_->setToolTip(tr("Trim only: coordinates the trim solves instead of holding them at the initial state"));
   steady->addRow(tr("Coordinates a trim solves"), trim_free_);
+  // operating point steady: the motion held (a car straight or turning, a rolling disc)
+  steady_speed_ = new QDoubleSpinBox(steady_box_);
+  steady_speed_->setRange(-1e4, 1e4);
+  steady_speed_->setDecimals(4);
+  steady_speed_->setSuffix(QStringLiteral(" m/s"));
+  steady_speed_->setSpecialValueText(tr("as at the start"));
+  steady_speed_->setKeyboardTracking(false);
+  steady_speed_->setToolTip(tr("Steady motion: the forward speed of the steady body's centre of mass (0 = as at the start)"));
+  steady->addRow(tr("Steady motion: speed"), steady_speed_);
+  steady_turn_ = new QComboBox(steady_box_);
+  steady_turn_->addItem(tr("straight"), QStringLiteral("straight"));
+  steady_turn_->addItem(tr("yaw rate (rad/s)"), QStringLiteral("yaw_rate"));
+  steady_turn_->addItem(tr("path radius (m)"), QStringLiteral("radius"));
+  steady_turn_->addItem(tr("lateral acceleration (m/s^2)"), QStringLiteral("lateral_acceleration"));
+  steady_turn_->setToolTip(tr("Steady motion: straight, or a turn given by its yaw rate, path radius or lateral "
+                              "acceleration (> 0 turns left)"));
+  steady_turn_value_ = new QDoubleSpinBox(steady_box_);
+  steady_turn_value_->setRange(-1e6, 1e6);
+  steady_turn_value_->setDecimals(4);
+  steady_turn_value_->setKeyboardTracking(false);
+  steady_turn_value_->setToolTip(tr("The turn's yaw rate, radius or lateral acceleration"));
+  auto* turn_row = new QHBoxLayout;
+  turn_row->addWidget(steady_turn_, 1);
+  turn_row->addWidget(steady_turn_value_);
+  steady->addRow(tr("Steady motion: turn"), turn_row);
 
   linearize_button_ = new QPushButton(tr("Linearize"), this);
   linearize_button_->setDefault(true);
@@ -289,6 +315,9 @@ void LinearizeView::buildUi() {
   // ---- widgets -> study (each change one undo step)
   connect(op_combo_, &QComboBox::currentIndexChanged, this, [this] { opChanged(); });
   connect(op_time_, &QDoubleSpinBox::valueChanged, this, [this] { opChanged(); });
+  connect(steady_speed_, &QDoubleSpinBox::valueChanged, this, [this] { steadyChanged(); });
+  connect(steady_turn_, &QComboBox::currentIndexChanged, this, [this] { steadyChanged(); });
+  connect(steady_turn_value_, &QDoubleSpinBox::valueChanged, this, [this] { steadyChanged(); });
   connect(method_combo_, &QComboBox::currentIndexChanged, this, [this](int i) {
     if (i < 0) return;
     const std::string m = ss(method_combo_->itemData(i).toString());
@@ -379,6 +408,25 @@ void LinearizeView::opChanged() {
   writeStudy([&](StudySpec& s) { s.operating_point = op; }, tr("Change the operating point"), key);
 }
 
+void LinearizeView::steadyChanged() {
+  if (syncing_) return;
+  const double speed = steady_speed_->value();
+  const QString turn = steady_turn_->currentData().toString();
+  const double value = steady_turn_value_->value();
+  steady_turn_value_->setEnabled(turn != QLatin1String("straight"));
+  writeStudy(
+      [&](StudySpec& s) {
+        s.steady.speed = speed != 0.0 ? std::optional<double>(speed) : std::nullopt;
+        s.steady.yaw_rate.reset();
+        s.steady.radius.reset();
+        s.steady.lateral_acceleration.reset();
+        if (turn == QLatin1String("yaw_rate")) s.steady.yaw_rate = value;
+        if (turn == QLatin1String("radius")) s.steady.radius = value;
+        if (turn == QLatin1String("lateral_acceleration")) s.steady.lateral_acceleration = value;
+      },
+      tr("Change the steady motion"));
+}
+
 void LinearizeView::refreshFromDocument() {
   syncing_ = true;
   const StudySpec& s = doc_->spec().analysis;
@@ -434,11 +482,31 @@ void LinearizeView::refreshSteadyState() {
     setCheckList(trim_free_, {}, s.trim_free);
   }
   set_table_->setPairs(s.set);
-  setCheckList(free_inputs_, toQStringList(spec.plant.inputs), s.free_inputs);
+  // a steady motion may solve any actuator (a drive force that is not a plant input); the others Plant/In
+  QStringList offered = toQStringList(spec.plant.inputs);
+  if (s.operating_point == "steady")
+    for (const ActuatorSpec& a : spec.actuators)
+      if (!offered.contains(qs(a.name))) offered << qs(a.name);
+  setCheckList(free_inputs_, offered, s.free_inputs);
   targets_->setChoices(toQStringList(spec.plant.outputs));
   targets_->setPairs(s.output_targets);
   const QString op = qs(s.operating_point);
   trim_free_->setEnabled(op == QLatin1String("trim") || !s.trim_free.empty());
+  {
+    const QSignalBlocker b1(steady_speed_), b2(steady_turn_), b3(steady_turn_value_);
+    steady_speed_->setValue(s.steady.speed.value_or(0.0));
+    QString turn = QStringLiteral("straight");
+    double value = 0.0;
+    if (s.steady.yaw_rate) turn = QStringLiteral("yaw_rate"), value = *s.steady.yaw_rate;
+    if (s.steady.radius) turn = QStringLiteral("radius"), value = *s.steady.radius;
+    if (s.steady.lateral_acceleration) turn = QStringLiteral("lateral_acceleration"), value = *s.steady.lateral_acceleration;
+    steady_turn_->setCurrentIndex(steady_turn_->findData(turn));
+    steady_turn_value_->setValue(value);
+    const bool steady = op == QLatin1String("steady");
+    steady_speed_->setEnabled(steady);
+    steady_turn_->setEnabled(steady);
+    steady_turn_value_->setEnabled(steady && turn != QLatin1String("straight"));
+  }
   syncing_ = false;
 }
 
@@ -622,8 +690,12 @@ void LinearizeView::showResult() {
 
   // operating point and provenance
   QString text = tr("<b>Operating point</b> %1").arg(qs(r.op.kind).toHtmlEscaped());
-  if (r.op.kind == "equilibrium" || r.op.kind == "trim")
+  if (r.op.kind == "equilibrium" || r.op.kind == "trim" || r.op.kind == "steady")
     text += tr(" (residual %1, %2 iterations)").arg(num(r.op.residual)).arg(r.op.iterations);
+  if (r.op.motion && result_model_)
+    text += tr("<br><b>Motion</b> %1").arg(qs(study_motion_text(*result_model_, r.op)).toHtmlEscaped());
+  if (r.lin.about_motion)
+    text += tr("<br>Linearized about the motion (the state's deviation from the pose that moves with it)");
   if (r.op.kind.rfind("time=", 0) == 0) text += tr(" (t = %1 s)").arg(num(r.op.t));
   text += tr(" &nbsp; <b>Jacobians</b> %1").arg(qs(s.method));
   if (r.lin.fd_error > 0) text += tr(" (max relative difference from exact %1)").arg(num(r.lin.fd_error));
@@ -635,6 +707,8 @@ void LinearizeView::showResult() {
     for (int i : r.lin.partition.independent) ind << qs(result_model_->v_names[i]);
     text += tr("<br><b>Independent coordinates</b> %1").arg(ind.join(QStringLiteral(", ")).toHtmlEscaped());
   }
+  if (r.handling)
+    text += QStringLiteral("<br><pre>") + qs(study_handling_text(*r.handling)).toHtmlEscaped() + QStringLiteral("</pre>");
   op_label_->setText(text);
 
   // modes

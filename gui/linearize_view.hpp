@@ -87,6 +87,9 @@ class LinearizeView : public QWidget {
   // The widgets, for the main window and tests.
   QComboBox* operatingPointCombo() const { return op_combo_; }
   QDoubleSpinBox* operatingTimeSpin() const { return op_time_; }
+  QDoubleSpinBox* steadySpeedSpin() const { return steady_speed_; }
+  QComboBox* steadyTurnCombo() const { return steady_turn_; }
+  QDoubleSpinBox* steadyTurnValueSpin() const { return steady_turn_value_; }
   QComboBox* methodCombo() const { return method_combo_; }
   QDoubleSpinBox* sampleTimeSpin() const { return ts_spin_; }
   QComboBox* matVersionCombo() const { return mat_combo_; }
@@ -124,6 +127,7 @@ class LinearizeView : public QWidget {
   void refreshSteadyState();   // the names offered and the study's choices of the steady-state search
   void writeStudy(const std::function<void(codyna::StudySpec&)>& change, const QString& text, int mergeKey = -1);
   void opChanged();
+  void steadyChanged();  // the steady motion's speed and turn -> the study
   void independentChanged(QListWidgetItem* item);
   void showResult();
   void updateStaleness();
@@ -142,6 +146,10 @@ class LinearizeView : public QWidget {
 
   QComboBox* op_combo_ = nullptr;
   QDoubleSpinBox* op_time_ = nullptr;
+  // operating point steady: the forward speed (0 = as at the start) and the turn (what, how much)
+  QDoubleSpinBox* steady_speed_ = nullptr;
+  QComboBox* steady_turn_ = nullptr;
+  QDoubleSpinBox* steady_turn_value_ = nullptr;
   QComboBox* method_combo_ = nullptr;
   QDoubleSpinBox* ts_spin_ = nullptr;
   QComboBox* mat_combo_ = nullptr;

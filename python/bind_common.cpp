@@ -247,6 +247,11 @@ void take_point(Keywords& k, PointRequest& p) {
   p.hold = k.pairs("hold");
   p.initial = k.pairs("initial");
   p.targets = k.pairs("target", "targets");
+  p.steady_body = k.text("steady_body");
+  p.speed = k.number("speed");
+  p.yaw_rate = k.number("yaw_rate");
+  p.radius = k.number("radius");
+  p.lateral_acceleration = k.number("lateral_acceleration");
 }
 
 void take_plant(Keywords& k, PlantRequest& p) {

@@ -205,8 +205,17 @@ void bind_linear_system(py::class_<LinearizationResult>& c) {
         if (l.job->trajectory) return py::none();
         const OperatingPoint& op = l.job->linearization.op;
         return operating_point_of(l.job->model, op, study_coordinates(l.job->model, op.q));
-      }, "kind (initial, equilibrium, trim, time=T), t, residual, iterations, coordinates and rates by\n"
+      }, "kind (initial, equilibrium, trim, steady, time=T), t, residual, iterations, coordinates and rates by\n"
          "name, inputs (every actuator) by name, and q, v, u as arrays; None along a trajectory")
+      .def_property_readonly("handling", [](L l) -> py::object {
+        if (l.job->trajectory || !l.job->linearization.handling) return py::none();
+        py::dict d;
+        for (const auto& [name, value] : l.job->linearization.lin.system.handling) d[py::str(name)] = value;
+        return d;
+      }, "at operating point steady with the study's handling section: the handling numbers by name\n"
+         "(speed, wheelbase, yaw_rate_gain, lateral_acceleration_gain, understeer_gradient (rad per m/s^2),\n"
+         "understeer_gradient_deg_per_g, characteristic_speed, critical_speed, yaw_natural_frequency,\n"
+         "yaw_damping_ratio[, sideslip_gain]; docs/vehicles.md), as NAME.mat's handling; else None")
       .def_property_readonly("notes", [](L l) { return l.job->notes; }, "notes for the user (what codyna linearize prints as notes)")
       .def_property_readonly("warnings", [](L l) { return l.job->warnings; }, "warnings for the user (what codyna linearize prints as warnings)");
 }

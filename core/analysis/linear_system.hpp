@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace codyna {
@@ -39,6 +40,10 @@ struct LinearSystem {
   // disabled_effects), exported as codyna_study so that a controller saved with it comes
   // back to the same plant; "" when the plant was not linearized through a study
   std::string study;
+  // numbers read at the operating point that travel with the plant, name -> value in SI units
+  // (the handling numbers of a car at a steady motion: analysis/handling.hpp); exported as the
+  // struct `handling` of NAME.mat when there are any
+  std::vector<std::pair<std::string, double>> handling;
 
   bool shifted(int i) const;  // state i is a shifted one (its name ends in '~')
   int nx() const { return static_cast<int>(A.rows()); }

@@ -1,5 +1,6 @@
 #include "analysis/linearize.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <initializer_list>
 #include <memory>
@@ -179,11 +180,38 @@ namespace {
 
 // closed loops, motion inputs, finite differences, chosen independent coordinates: a plant
 // function made for this operating point
-Linearization linearize_general(const Model& model, const OperatingPoint& op, const LinearizeOptions& options) {
+// the largest distance from an eigenvalue of A to the nearest of B's not taken yet, relative to
+// their largest modulus (the same spectrum: 0)
+// (eigenvalues within 1e-4 of the largest modulus of 0 count as 0: a motion's cyclic coordinates
+// make Jordan blocks at 0, whose computed eigenvalues scatter by eps^(1/k))
+double spectrum_distance(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) {
+  if (A.rows() == 0 || A.rows() != B.rows()) return A.rows() == B.rows() ? 0.0 : 1.0;
+  Eigen::VectorXcd a = A.eigenvalues(), b = B.eigenvalues();
+  double scale = 1e-300, worst = 0;
+  for (Eigen::Index i = 0; i < a.size(); ++i) scale = std::max({scale, std::abs(a[i]), std::abs(b[i])});
+  for (Eigen::Index i = 0; i < a.size(); ++i) {
+    if (std::abs(a[i]) < 1e-4 * scale) a[i] = 0;
+    if (std::abs(b[i]) < 1e-4 * scale) b[i] = 0;
+  }
+  std::vector<bool> taken(static_cast<std::size_t>(b.size()), false);
+  for (Eigen::Index i = 0; i < a.size(); ++i) {
+    Eigen::Index best = -1;
+    for (Eigen::Index k = 0; k < b.size(); ++k)
+      if (!taken[static_cast<std::size_t>(k)] && (best < 0 || std::abs(a[i] - b[k]) < std::abs(a[i] - b[best]))) best = k;
+    taken[static_cast<std::size_t>(best)] = true;
+    worst = std::max(worst, std::abs(a[i] - b[best]));
+  }
+  return worst / scale;
+}
+
+Linearization linearize_general(const Model& model, const OperatingPoint& op, const LinearizeOptions& options,
+                                bool check_motion = true) {
   refuse_coincident_spring_dampers(model, op.q);
   Linearization out;
   out.partition = partition_coordinates(model, op.q, options.independent);
-  const PlantFunction f(model, op.q, op.u, out.partition);
+  PlantFunction f(model, op.q, op.u, out.partition);
+  if (op.motion && op.motion->turns()) f.set_motion(*op.motion);
+  out.about_motion = f.motion() != nullptr;
   const int nx = f.nx(), nu = f.nu(), ny = f.ny();
   // state at the operating point: zero deviation, independent velocities
   Eigen::VectorXd x = Eigen::VectorXd::Zero(nx);
@@ -215,6 +243,7 @@ Linearization linearize_general(const Model& model, const OperatingPoint& op, co
   s.u0 = u;
   s.y0 = y;
   s.xdot0 = xd;
+  if (out.about_motion) out.motion_residual = xd.size() ? xd.lpNorm<Eigen::Infinity>() : 0.0;
   s.state_names = f.state_names();
   s.state_units = f.state_units();
   name_shifted_states(s);
@@ -232,6 +261,31 @@ Linearization linearize_general(const Model& model, const OperatingPoint& op, co
   s.method = to_string(options.method);
   s.time = op.t;
   s.codyna_version = CODYNA_VERSION;
+  if (out.about_motion && check_motion) {
+    // the same a while further along the motion: A's eigenvalues are the motion's only if they
+    // do not change along it
+    OperatingPoint later = op;
+    advance_motion(model, *later.motion, motion_check_time(*later.motion), later.q, later.v);
+    normalize(model, later.q);
+    try {
+      const Linearization there = linearize_general(model, later, options, false);
+      // the states keep their axes along the motion when no body spins and no planar joint (whose
+      // velocities are the world's) turns: then A itself is compared, else its eigenvalues
+      bool same_axes = there.partition.independent == out.partition.independent &&
+                       there.partition.rate_dependent == out.partition.rate_dependent;
+      for (const JointMotion& jm : op.motion->joints)
+        same_axes = same_axes && jm.spin_rate == 0.0 &&
+                    !(model.joints[static_cast<std::size_t>(jm.body)].type == JointType::Planar && jm.yaw_rate != 0.0);
+      if (same_axes && there.system.A.rows() == s.A.rows()) {
+        const double scale = std::max(max_abs(s.A), 1e-300);
+        out.motion_drift = max_abs(there.system.A - s.A) / scale;
+      } else {
+        out.motion_drift = spectrum_distance(s.A, there.system.A);
+      }
+    } catch (const std::exception&) {
+      out.motion_drift = 1.0;  // nowhere to linearize there: not a motion to speak of
+    }
+  }
   return out;
 }
 
@@ -463,7 +517,8 @@ Linearizer::Linearizer(const Model& model) : impl_(std::make_unique<Impl>(model)
 Linearizer::~Linearizer() = default;
 
 void Linearizer::linearize(const OperatingPoint& op, const LinearizeOptions& options, Linearization& out) {
-  if (impl_->tree && options.method == JacobianMethod::Exact && options.independent.empty())
+  if (impl_->tree && options.method == JacobianMethod::Exact && options.independent.empty() &&
+      !(op.motion && op.motion->turns()))
     impl_->linearize_tree(op, out);
   else
     out = linearize_general(*impl_->model, op, options);

@@ -39,6 +39,13 @@ struct Linearization {
   // motion inputs among Plant/In: the state is xi = x - motion_rate_shift u' - motion_shift u
   // (deviations; see linearize.cpp), which keeps the model proper; both empty without them
   Eigen::MatrixXd motion_shift, motion_rate_shift;  // [nx x nu]
+  // About a steady motion that turns (OperatingPoint::motion; steady_motion.hpp): the state's
+  // largest rate |x'| left at the operating point in the moving frame (0 for a relative
+  // equilibrium), and the largest change of A a time further along the motion, relative to its
+  // largest entry (of its eigenvalues, relative to their largest modulus, when a body spins or a
+  // planar joint turns: their states' axes turn; 0 when A is the motion's). Both 0 otherwise.
+  bool about_motion = false;
+  double motion_residual = 0.0, motion_drift = 0.0;
 };
 
 Linearization linearize(const Model& model, const OperatingPoint& op, const LinearizeOptions& options = {});

@@ -11,9 +11,11 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "analysis/steady_motion.hpp"
 #include "model/model.hpp"
 
 namespace codyna {
@@ -25,6 +27,9 @@ struct OperatingPoint {
   Eigen::VectorXd u;             // one value per actuator (Model::actuators)
   double residual = 0.0;         // max |qdd| left by equilibrium / trim
   int iterations = 0;
+  // a steady motion (steady_motion below): the frame the state moves with; linearize() takes
+  // the state's deviation from the pose that moves with it (steady_motion.hpp)
+  std::optional<SteadyMotion> motion;
 };
 
 OperatingPoint initial_point(const Model& model);
@@ -66,6 +71,30 @@ void require_steady_state(const Model& model, const OperatingPoint& op, const st
 // the coordinates held; `kind` "trim" frees held coordinates, an equilibrium holds fewer.
 std::string steady_state_advice(const std::vector<std::string>& plant_inputs, const std::vector<std::string>& fixed_inputs,
                                 const std::vector<std::string>& held, const std::string& kind);
+
+// A steady motion (issue 39): a car straight at a speed or in a steady turn, a disc rolling. The
+// body `body` (on a free or planar joint to ground; "" = the first such body) moves at forward
+// speed `speed` (of its centre of mass along its heading: its x axis in the road plane, or for a
+// body symmetric about an axle the direction it rolls; default: as at the start) and turns at
+// `yaw_rate`, or on a path of `radius` (> 0 left), or at `lateral_acceleration` (> 0 left; at
+// most one of the three; none: straight). Solved: the actuators `free_inputs` (any actuator;
+// default Plant/In), every coordinate but those the user holds and those along which the motion
+// may sit anywhere (the road plane, the heading, wheel spin angles, every coordinate the
+// dynamics do not depend on), every velocity, and the moving frame's rates, so that in the frame
+// that moves with the motion nothing changes (steady_motion.hpp); `outputs` reach their values.
+// The result's `motion` is that frame: linearize() takes A about it. Throws
+// std::invalid_argument for a bad spec (naming the field), ConvergenceError when no steady
+// motion is found (saying what is left and what to free).
+struct SteadyMotionSpec {
+  std::string body;
+  std::optional<double> speed, yaw_rate, radius, lateral_acceleration;
+  std::vector<std::string> free_inputs;
+  std::vector<std::string> held;
+  std::vector<std::pair<std::string, double>> outputs;
+};
+
+OperatingPoint steady_motion(const Model& model, const OperatingPoint& start, const SteadyMotionSpec& spec,
+                             const std::vector<std::string>& independent = {});
 
 OperatingPoint snapshot_point(const Model& model, double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
                               const Eigen::VectorXd& u);

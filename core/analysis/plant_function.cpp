@@ -375,6 +375,7 @@ double fd_step(bool central, double xk) {
 
 bool PlantFunction::fd_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& u, bool central,
                                 Eigen::MatrixXd& J) const {
+  if (motion_) return false;
   const Model& m = model_;
   if (m.nc != 0 || !part_.dependent.empty() || !m.motions.empty()) return false;
   const int n = nz(), nx_p = 2 * n, nu_p = nu(), ny_p = ny(), rows = nx_p + ny_p;
@@ -433,13 +434,15 @@ bool PlantFunction::fd_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd&
 template <class S>
 void PlantFunction::eval(const VecXT<S>& x, const VecXT<S>& u, VecXT<S>& xdot, VecXT<S>& y) const {
   if constexpr (std::is_same_v<S, double>) {
-    if (model_.motions.empty() && part_.rate_dependent.empty()) {
+    if (motion_) {
+      // about a steady motion: the generic evaluation below, in double
+    } else if (model_.motions.empty() && part_.rate_dependent.empty()) {
       if (part_.dependent.empty() && model_.nc == 0) eval_tree(x, u, xdot, y);
       else eval_closed(x, u, xdot, y);
     } else {
       eval_driven(x, u, xdot, y);
     }
-    return;
+    if (!motion_) return;
   }
   const Model& m = model_;
   const int n = nz(), nw_ = nw(), nd = static_cast<int>(part_.dependent.size());
@@ -539,8 +542,17 @@ void PlantFunction::eval(const VecXT<S>& x, const VecXT<S>& u, VecXT<S>& xdot, V
   const VecXT<S> q = integrate<S>(m, q_ref_.cast<S>(), dq);
   VecXT<S> u_all = u_all_.cast<S>();
   for (int k = 0; k < nu(); ++k) u_all[m.plant_inputs[k]] = u[k];
-  const VecXT<S> qdd = forward_dynamics<S>(m, d, q, v, u_all);
-  const VecXT<S> rate = tangent_rate<S>(m, dq, v);
+  VecXT<S> qdd = forward_dynamics<S>(m, d, q, v, u_all);
+  VecXT<S> rate;
+  if (motion_) {
+    // the rates in the frame that moves with the motion (steady_motion.hpp)
+    VecXT<S> v_ref;
+    motion_reference_velocity<S>(m, *motion_, q, v_ref);
+    rate = tangent_rate<S>(m, dq, VecXT<S>(v - v_ref));
+    motion_acceleration_terms<S>(m, *motion_, v, qdd);
+  } else {
+    rate = tangent_rate<S>(m, dq, v);
+  }
   xdot.resize(n + nw_);
   for (int k = 0; k < n; ++k) xdot[k] = rate[ind[k]];
   for (int k = 0; k < nw_; ++k) xdot[n + k] = qdd[rates_[k]];
@@ -568,7 +580,10 @@ void PlantFunction::take_workspace(PlantFunction& other) {
   }
 }
 
+void PlantFunction::set_motion(const SteadyMotion& motion) { motion_ = std::make_shared<const SteadyMotion>(motion); }
+
 bool PlantFunction::analytic_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::MatrixXd& J) const {
+  if (motion_) return false;
   const Model& m = model_;
   if (m.nc != 0 || !m.motions.empty()) return closed_loop_jacobian(x, u, J);
   if (!part_.dependent.empty()) return false;

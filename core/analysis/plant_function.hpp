@@ -20,6 +20,7 @@
 
 #include <Eigen/LU>
 
+#include "analysis/steady_motion.hpp"
 #include "dynamics/data.hpp"
 
 namespace codyna {
@@ -112,6 +113,14 @@ class PlantFunction {
   // Returns false for closed loops.
   bool fd_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& u, bool central, Eigen::MatrixXd& J) const;
 
+  // About a steady motion (analysis/steady_motion.hpp): the state is then the deviation from the
+  // pose that moves with `motion`'s frame, and eval gives its rates in that frame. The analytic
+  // and the finite-difference fast paths do not apply (analytic_jacobian and fd_jacobian return
+  // false): the exact Jacobian is automatic differentiation of eval. (A motion that does not turn,
+  // SteadyMotion::turns, changes only the positions' rates by constants, nothing of A.)
+  void set_motion(const SteadyMotion& motion);
+  const SteadyMotion* motion() const { return motion_.get(); }
+
   const CoordinatePartition& partition() const { return part_; }
   const Eigen::VectorXd& u_all() const { return u_all_; }
 
@@ -132,6 +141,7 @@ class PlantFunction {
   // velocities solved from them (dependent, then rate_dependent)
   std::vector<int> vrows_, rates_, vdep_;
   std::vector<int> motion_inputs_;
+  std::shared_ptr<const SteadyMotion> motion_;
 
   // workspace of analytic_jacobian, made on first use; a copy starts without one
   // eval<double> on a tree, into the workspace (no heap after the first call)

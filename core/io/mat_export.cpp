@@ -317,6 +317,11 @@ void write_plant_mat(const LinearSystem& s, const std::string& name, const std::
   }
   w.write(info_var(s, name));
   if (!s.study.empty()) w.write(char_var("codyna_study", s.study));
+  if (!s.handling.empty()) {
+    std::vector<MatField> fields;
+    for (const auto& [field, value] : s.handling) fields.emplace_back(field.c_str(), double_var(nullptr, Eigen::MatrixXd::Constant(1, 1, value)));
+    w.write(struct_var("handling", std::move(fields)));
+  }
   w.close();
 }
 

@@ -468,7 +468,7 @@ double read_sample_time(const Node& n) {
 
 // Where the plant is linearized for a controller.
 std::string read_operating_point(const Node& n) {
-  static const std::vector<std::string_view> names{"initial", "equilibrium", "trim"};
+  static const std::vector<std::string_view> names{"initial", "equilibrium", "trim", "steady"};
   const std::string s = read_string(n);
   if (std::find(names.begin(), names.end(), s) == names.end())
     n.fail("unknown operating point " + quote(s) + " (expected one of: " + join(names) + ")");
@@ -1121,13 +1121,13 @@ std::string read_word(const Node& n, const std::vector<std::string>& words, cons
 
 std::string read_study_operating_point(const Node& n) {
   const std::string s = read_string(n);
-  if (s == "initial" || s == "equilibrium" || s == "trim") return s;
+  if (s == "initial" || s == "equilibrium" || s == "trim" || s == "steady") return s;
   if (s.rfind("time=", 0) == 0) {
     char* end = nullptr;
     const double t = std::strtod(s.c_str() + 5, &end);
     if (end != s.c_str() + 5 && *end == 0 && std::isfinite(t) && t >= 0) return s;
   }
-  n.fail("unknown operating point " + quote(s) + " (expected one of: initial, equilibrium, trim, time=T with T >= 0 seconds)");
+  n.fail("unknown operating point " + quote(s) + " (expected one of: initial, equilibrium, trim, steady, time=T with T >= 0 seconds)");
 }
 
 std::vector<std::pair<std::string, double>> read_set(const Node& n) {
@@ -1262,6 +1262,42 @@ const Schema<ClosedLoopSpec>& schema<ClosedLoopSpec>() {
   return s;
 }
 
+template <>
+const Schema<SteadySpec>& schema<SteadySpec>() {
+  using T = SteadySpec;
+  const auto finite = [](const Node& n) { return std::optional<double>(read_number(n)); };
+  static const Schema<T> s{{
+      field("body", &T::body, read_string, encode_optional_text),
+      field("speed", &T::speed, finite),
+      field("yaw_rate", &T::yaw_rate, finite),
+      field("radius", &T::radius,
+            [](const Node& n) {
+              const double r = read_number(n);
+              if (!(std::abs(r) > 0)) n.expected("a path radius, not 0 (m; > 0 turns left, < 0 right)");
+              return std::optional<double>(r);
+            }),
+      field("lateral_acceleration", &T::lateral_acceleration, finite),
+  }};
+  return s;
+}
+
+ojson write_steady(const SteadySpec& c) { return c == SteadySpec{} ? ojson() : write_struct(c); }
+
+template <>
+const Schema<HandlingSpec>& schema<HandlingSpec>() {
+  using T = HandlingSpec;
+  static const Schema<T> s{{
+      field("steer", &T::steer, read_string, encode_optional_text),
+      field("yaw_rate", &T::yaw_rate, read_string, encode_optional_text),
+      field("lateral_acceleration", &T::lateral_acceleration, read_string, encode_optional_text),
+      field("sideslip", &T::sideslip, read_string, encode_optional_text),
+      field("wheelbase", &T::wheelbase, [](const Node& n) { return std::optional<double>(read_positive_length(n)); }),
+  }};
+  return s;
+}
+
+ojson write_handling(const HandlingSpec& c) { return c == HandlingSpec{} ? ojson() : write_struct(c); }
+
 // A default closed-loop analysis is left out of the file.
 ojson write_closed_loop(const ClosedLoopSpec& c) { return c == ClosedLoopSpec{} ? ojson() : write_struct(c); }
 
@@ -1279,6 +1315,8 @@ const Schema<StudySpec>& schema<StudySpec>() {
       field("trim_free", &T::trim_free, read_names),
       field("free_inputs", &T::free_inputs, read_names),
       field("output_targets", &T::output_targets, read_set, encode_set),
+      field("steady", &T::steady, read_struct<SteadySpec>, write_steady),
+      field("handling", &T::handling, read_struct<HandlingSpec>, write_handling),
       field("method", &T::method, [](const Node& n) { return read_word(n, study_methods(), "method"); }),
       field("discrete", &T::discrete,
             [](const Node& n) {

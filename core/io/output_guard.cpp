@@ -43,6 +43,8 @@ bool written_by_codyna(const std::string& path, OutputKind k) {
       return starts_with(h, "<!-- MJCF written by codyna");  // io/export_mjcf.hpp's kMjcfHeader
     case OutputKind::SweepCsv:
       return starts_with(h, "variant,status");  // io/sweep_files.hpp's kSweepCsvHead
+    case OutputKind::TireCsv:
+      return starts_with(h, "Fx,Fy,Fz,");
   }
   return false;
 }
@@ -66,6 +68,7 @@ const char* describe(OutputKind k) {
     case OutputKind::PlantScript: return "a plant .m export";
     case OutputKind::Mjcf: return "an MJCF export";
     case OutputKind::SweepCsv: return "a sweep CSV";
+    case OutputKind::TireCsv: return "a tire CSV";
   }
   return "an output";
 }

@@ -22,6 +22,7 @@ enum class OutputKind {
   CurvesCsv,    // step or frequency responses of a closed loop (io/curves_file.hpp)
   Mjcf,         // a model exported as MJCF (io/export_mjcf.hpp; its first line says codyna wrote it)
   SweepCsv,     // a parameter study's table (io/sweep_files.hpp; it begins "variant,status")
+  TireCsv,      // a tire test rig's table (study/tire_job.hpp; it begins "Fx,Fy,Fz,")
 };
 
 const char* describe(OutputKind k);  // "an HDF5 results file", ...

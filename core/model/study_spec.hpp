@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -62,12 +63,31 @@ double signal_rate(const SignalSpec& s, double t);
 double signal_acceleration(const SignalSpec& s, double t);
 std::vector<double> signal_rate_jumps(const SignalSpec& s);
 
+// The steady motion of operating point "steady" (analysis/operating_point.hpp, SteadyMotionSpec):
+// the body whose speed and turn are given ("" = the first body on a free or planar joint to
+// ground), its forward speed (unset = as at the start) and at most one of yaw rate, path radius
+// (> 0 left) and lateral acceleration (> 0 left); none = straight.
+struct SteadySpec {
+  std::string body;
+  std::optional<double> speed, yaw_rate, radius, lateral_acceleration;
+  bool operator==(const SteadySpec&) const = default;
+};
+
+// The handling numbers at a steady motion (analysis/handling.hpp): the Plant/In steer input, the
+// Plant/Out yaw rate and, when the model has them, lateral acceleration and sideslip; the
+// wheelbase (unset = the distance between the foremost and the rearmost tire along the heading).
+struct HandlingSpec {
+  std::string steer, yaw_rate, lateral_acceleration, sideslip;
+  std::optional<double> wheelbase;
+  bool operator==(const HandlingSpec&) const = default;
+};
+
 struct StudySpec {
   // effects (ModelSpec::effects, by name) switched off for this study: they are
   // left out of the compiled model, so a run never evaluates them
   std::vector<std::string> disabled_effects;
 
-  // operating point: "initial", "equilibrium", "trim" or "time=T" (T >= 0, seconds)
+  // operating point: "initial", "equilibrium", "trim", "steady" or "time=T" (T >= 0, seconds)
   std::string operating_point = "equilibrium";
   // the held coordinates of the operating-point search (`--hold`, alias `--set`): joint
   // coordinates and rates (q names as `codyna info` prints them, rates as NAME_dot) set in
@@ -96,6 +116,11 @@ struct StudySpec {
   std::vector<std::string> trim_free;
   std::vector<std::string> free_inputs;
   std::vector<std::pair<std::string, double>> output_targets;
+  // operating point "steady": the motion held (the free_inputs, held coordinates and output
+  // targets above apply to it too)
+  SteadySpec steady;
+  // handling numbers at a steady motion: computed when `steer` and `yaw_rate` are named
+  HandlingSpec handling;
 
   // linearization and export
   std::string method = "exact";  // "exact", "fd-forward", "fd-central"

@@ -209,6 +209,14 @@ void apply_point(StudySpec& s, const PointRequest& p, const Names& opt) {
   if (p.trim_free) s.trim_free = *p.trim_free;
   if (p.free_inputs) s.free_inputs = *p.free_inputs;
   apply_pairs(s.output_targets, p.targets, opt("target"));
+  if (p.steady_body) s.steady.body = *p.steady_body;
+  if (p.speed) s.steady.speed = *p.speed;
+  // the turn: one of three, a given one replaces the file's
+  if (p.yaw_rate || p.radius || p.lateral_acceleration) {
+    s.steady.yaw_rate = p.yaw_rate;
+    s.steady.radius = p.radius;
+    s.steady.lateral_acceleration = p.lateral_acceleration;
+  }
 }
 
 JacobianMethod method_of(const std::string& s, const Names& opt) {
@@ -330,6 +338,30 @@ void trajectory_job(LinearizeJob& job, const LinearizeRequest& a) {
 }  // namespace
 
 namespace {
+// what the user should know of a point that moves: the motion, the frame A is taken in, and
+// whether its eigenvalues are the motion's
+template <class Say>
+void motion_notes(const Model& m, const StudyLinearization& sl, const Say& say) {
+  if (sl.op.motion) say.note("steady motion: " + study_motion_text(m, sl.op));
+  if (sl.lin.about_motion) {
+    say.note("linearized about the motion: the state is the deviation from the pose that moves with it "
+             "(turning with it), so A is the same wherever along the motion it is taken");
+    std::ostringstream os;
+    if (sl.lin.motion_residual > 1e-6)
+      os << "the state is not steady in the moving frame (rates left " << sl.lin.motion_residual << ")";
+    if (sl.lin.motion_drift > 1e-6)
+      os << (os.tellp() ? "; " : "") << "A's eigenvalues change along the motion (by " << sl.lin.motion_drift
+         << " of their largest)";
+    if (os.tellp())
+      say.warning("not a relative equilibrium: " + os.str() +
+                  "; the eigenvalues describe this instant, not the motion's stability");
+  } else if (sl.op.kind != "steady" && motion_of_state(m, sl.op.q, sl.op.v).turns()) {
+    say.warning("the operating point moves (a free, planar or ball joint turning): A is taken in the coordinates "
+                "fixed at this instant, and its eigenvalues are not the motion's stability; operating point steady "
+                "finds the steady motion and linearizes about it");
+  }
+}
+
 LinearizeJob linearize_job(const LinearizeRequest& a, const ModelSpec& file_spec, const Model* structure,
                            NumbersChanged what, const StudyMessages& tell) {
   const Names opt{a.style};
@@ -370,6 +402,7 @@ LinearizeJob linearize_job(const LinearizeRequest& a, const ModelSpec& file_spec
     throw std::invalid_argument(opt("initial") + ": the initial state of a run; linearize uses it with " + opt("trajectory") +
                                 " only (the operating point's coordinates are " + opt("hold") + " NAME=VALUE)");
   job.linearization = study_linearize(m);
+  motion_notes(m, job.linearization, say);
   // the closed loop's operating point (the model controller's own may differ) is found before
   // anything is written, so that a search that fails leaves no export behind
   if (m.spec.analysis.closed_loop.enabled) job.closed_loop = study_closed_loop(m);

@@ -48,9 +48,12 @@ struct PlantRequest {
 // The operating point's choices shared by linearize and simulate. hold, initial and targets are
 // NAME=VALUE texts (a name given again replaces its value), added to the file's lists.
 struct PointRequest {
-  std::optional<std::string> operating_point;  // initial | equilibrium | trim | time=T
+  std::optional<std::string> operating_point;  // initial | equilibrium | trim | steady | time=T
   std::optional<std::vector<std::string>> independent, trim_free, free_inputs;
   std::vector<std::string> hold, initial, targets;
+  // operating point steady (StudySpec::steady): each given replaces the file's
+  std::optional<std::string> steady_body;
+  std::optional<double> speed, yaw_rate, radius, lateral_acceleration;
 };
 
 struct LinearizeRequest {

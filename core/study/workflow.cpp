@@ -1,4 +1,6 @@
 #include "study/workflow.hpp"
+#include "dynamics/data.hpp"
+#include "dynamics/kinematics.hpp"
 #include "study/workflow_detail.hpp"
 
 #include "analysis/stability.hpp"
@@ -232,7 +234,7 @@ Eigen::VectorXd study_coordinates(const Model& m, const Eigen::VectorXd& q) {
   return c;
 }
 
-namespace {
+namespace workflow_detail {
 // `pairs` set on (q, v) and the loops closed with them held; errors at /analysis/FIELD[/NAME]
 StudyInitialState set_coordinates(const Model& m, Eigen::VectorXd q, Eigen::VectorXd v,
                                   const std::vector<std::pair<std::string, double>>& pairs, const std::string& field) {
@@ -305,7 +307,7 @@ StudyInitialState set_coordinates(const Model& m, Eigen::VectorXd q, Eigen::Vect
   return {r.q, r.v, true};
 }
 
-}  // namespace
+}  // namespace workflow_detail
 
 namespace {
 // the spec study_model compiles: the controller file's study adopted, disabled effects left out
@@ -411,6 +413,26 @@ OperatingPoint study_operating_point(const Model& m, const std::string& which_in
       not_converged(m, which + ": " + e.what());
     }
   }
+  if (which == "steady") {
+    if (!s.trim_free.empty())
+      workflow_fail(m, "trim_free", "coordinates are freed for operating point trim only (a steady motion solves every coordinate not held)");
+    SteadyMotionSpec spec;
+    spec.body = s.steady.body;
+    spec.speed = s.steady.speed;
+    spec.yaw_rate = s.steady.yaw_rate;
+    spec.radius = s.steady.radius;
+    spec.lateral_acceleration = s.steady.lateral_acceleration;
+    spec.free_inputs = s.free_inputs;
+    spec.held = set_positions;
+    spec.outputs = s.output_targets;
+    try {
+      return steady_motion(m, start, spec, s.independent);
+    } catch (const std::invalid_argument& e) {
+      workflow_fail(m, "steady", e.what());
+    } catch (const ConvergenceError& e) {
+      not_converged(m, e.what());
+    }
+  }
   if (which == "equilibrium") {
     const OperatingPoint op = static_equilibrium(m, start, s.independent);
     try {
@@ -452,7 +474,179 @@ OperatingPoint study_operating_point(const Model& m, const std::string& which_in
     const int last = r.samples() - 1;
     return snapshot_point(m, t, r.q.row(last).transpose(), r.v.row(last).transpose(), start.u);
   }
-  workflow_fail(m, "operating_point", "unknown operating point \"" + which + "\" (expected one of: initial, equilibrium, trim, time=T)");
+  workflow_fail(m, "operating_point", "unknown operating point \"" + which + "\" (expected one of: initial, equilibrium, trim, steady, time=T)");
+}
+
+namespace {
+
+int plant_position(const std::vector<std::string>& names, const std::string& name) {
+  const auto it = std::find(names.begin(), names.end(), name);
+  return it == names.end() ? -1 : static_cast<int>(it - names.begin());
+}
+
+// the steady body of a steady motion (its first joint on ground that is free or planar, or the named one)
+int steady_body(const Model& m, const OperatingPoint& op) {
+  if (!op.motion) return -1;
+  const std::string& named = m.spec.analysis.steady.body;
+  for (const JointMotion& jm : op.motion->joints) {
+    const JointModel& j = m.joints[static_cast<std::size_t>(jm.body)];
+    if (j.parent != 0 || (j.type != JointType::Free && j.type != JointType::Planar)) continue;
+    if (named.empty() || m.body_names[static_cast<std::size_t>(jm.body)] == named) return jm.body;
+  }
+  return -1;
+}
+
+// the steady body's heading (world, in the road plane) and its centre of mass's forward speed
+void steady_heading(const Model& m, const OperatingPoint& op, int body, Eigen::Vector3d& h, double& speed) {
+  Data d(m);
+  forward_kinematics<double>(m, d, op.q, op.v);
+  const Eigen::Vector3d n = road_normal(m);
+  const Eigen::Matrix3d R = d.oMi[static_cast<std::size_t>(body)].R;
+  const Eigen::Vector3d a = spin_symmetry_axis(m, body);
+  h = a.squaredNorm() > 0 ? Eigen::Vector3d((R * (m.joints[static_cast<std::size_t>(body)].X_CM.R * a)).cross(n))
+                          : Eigen::Vector3d(R.col(0) - n.dot(R.col(0)) * n);
+  h.normalize();
+  speed = h.dot(point_velocity<double>(d, body, m.com[static_cast<std::size_t>(body)]));
+}
+
+HandlingNumbers study_handling(const Model& m, const StudyLinearization& sl) {
+  const HandlingSpec& hs = m.spec.analysis.handling;
+  const LinearSystem& sys = sl.lin.system;
+  const auto index = [&](const std::vector<std::string>& names, const std::string& name, const char* field, const char* what) {
+    if (name.empty()) return -1;
+    const int k = plant_position(names, name);
+    if (k < 0) workflow_fail(m, std::string("handling/") + field, "\"" + name + "\" is not " + what + " (" + listed(names) + ")");
+    return k;
+  };
+  if (hs.steer.empty()) workflow_fail(m, "handling/steer", "name the steer input (a Plant/In) for the handling numbers");
+  if (hs.yaw_rate.empty()) workflow_fail(m, "handling/yaw_rate", "name the yaw-rate output (a Plant/Out) for the handling numbers");
+  const int steer = index(sys.input_names, hs.steer, "steer", "a Plant/In input");
+  const int yaw = index(sys.output_names, hs.yaw_rate, "yaw_rate", "a Plant/Out output");
+  const int ay = index(sys.output_names, hs.lateral_acceleration, "lateral_acceleration", "a Plant/Out output");
+  const int beta = index(sys.output_names, hs.sideslip, "sideslip", "a Plant/Out output");
+  const int body = steady_body(m, sl.op);
+  if (body < 0) workflow_fail(m, "handling", "the handling numbers need the steady body of operating point steady");
+  Eigen::Vector3d h;
+  double speed = 0;
+  steady_heading(m, sl.op, body, h, speed);
+  double L = hs.wheelbase.value_or(0.0);
+  if (!hs.wheelbase) {
+    // the foremost and the rearmost tire along the heading
+    if (m.tires.empty()) workflow_fail(m, "handling/wheelbase", "the model has no tires to measure the wheelbase between: give it");
+    Data d(m);
+    forward_kinematics<double>(m, d, sl.op.q, sl.op.v);
+    double lo = 0, hi = 0;
+    for (std::size_t k = 0; k < m.tires.size(); ++k) {
+      const double x = h.dot(point_position<double>(d, m.tires[k].body, m.tires[k].center));
+      lo = k ? std::min(lo, x) : x;
+      hi = k ? std::max(hi, x) : x;
+    }
+    L = hi - lo;
+  }
+  // a planar joint's velocities are the world's: in body axes, dv_b = Rz(-psi0) (dv - J v0 dpsi)
+  // (J the quarter turn), the heading no longer reaches the velocities and a steady turn is steady
+  LinearSystem body_axes = sys;
+  {
+    const CoordinatePartition& part = sl.lin.partition;
+    const std::vector<int> rates = part.rates();
+    const int nz = static_cast<int>(part.independent.size());
+    const auto pos = [&](const std::vector<int>& v, int iv) {
+      const auto it = std::find(v.begin(), v.end(), iv);
+      return it == v.end() ? -1 : static_cast<int>(it - v.begin());
+    };
+    Eigen::MatrixXd T = Eigen::MatrixXd::Identity(sys.nx(), sys.nx());
+    bool any = false;
+    for (int b = 1; b < m.nbodies; ++b) {
+      const JointModel& j = m.joints[static_cast<std::size_t>(b)];
+      if (j.type != JointType::Planar) continue;
+      const int ipsi = pos(part.independent, j.idx_v + 2), ivx = pos(rates, j.idx_v), ivy = pos(rates, j.idx_v + 1);
+      if (ipsi < 0 || ivx < 0 || ivy < 0) continue;
+      const double psi = sl.op.q[j.idx_q + 2];
+      const Eigen::Vector2d v0(sl.op.v[j.idx_v], sl.op.v[j.idx_v + 1]);
+      Eigen::Matrix2d Rt;
+      Rt << std::cos(psi), std::sin(psi), -std::sin(psi), std::cos(psi);  // Rz(-psi)
+      const Eigen::Vector2d Jv(-v0.y(), v0.x());
+      const int rx = nz + ivx, ry = nz + ivy;
+      T(rx, rx) = Rt(0, 0);
+      T(rx, ry) = Rt(0, 1);
+      T(ry, rx) = Rt(1, 0);
+      T(ry, ry) = Rt(1, 1);
+      const Eigen::Vector2d c = -Rt * Jv;
+      T(rx, ipsi) = c.x();
+      T(ry, ipsi) = c.y();
+      any = true;
+    }
+    if (any) {
+      const Eigen::MatrixXd Ti = T.inverse();
+      body_axes.A = T * sys.A * Ti;
+      body_axes.B = T * sys.B;
+      body_axes.C = sys.C * Ti;
+    }
+  }
+  try {
+    return handling_numbers(body_axes, steer, yaw, ay, beta, speed, L);
+  } catch (const std::invalid_argument& e) {
+    workflow_fail(m, "handling", e.what());
+  }
+}
+
+}  // namespace
+
+std::string study_motion_text(const Model& m, const OperatingPoint& op) {
+  if (!op.motion) return "";
+  std::ostringstream os;
+  os.precision(6);
+  const int body = steady_body(m, op);
+  if (body >= 0) {
+    Eigen::Vector3d h;
+    double speed = 0;
+    steady_heading(m, op, body, h, speed);
+    os << m.body_names[static_cast<std::size_t>(body)] << " at " << speed << " m/s";
+  }
+  for (const JointMotion& jm : op.motion->joints) {
+    const JointModel& j = m.joints[static_cast<std::size_t>(jm.body)];
+    std::string parts;
+    if (j.parent == 0 && (jm.yaw_rate != 0 || jm.velocity.squaredNorm() > 0)) {
+      std::ostringstream p;
+      p.precision(6);
+      if (jm.yaw_rate == 0) p << "straight";
+      else p << "yaw rate " << jm.yaw_rate << " rad/s (path radius " << jm.velocity.norm() / std::abs(jm.yaw_rate) << " m)";
+      parts += p.str();
+    }
+    if (jm.spin_rate != 0) {
+      std::ostringstream p;
+      p.precision(6);
+      p << (parts.empty() ? "" : ", ") << "spin " << jm.spin_rate << " rad/s about its axle";
+      parts += p.str();
+    }
+    if (!parts.empty()) os << (os.tellp() ? "; " : "") << "joint " << j.name << ": " << parts;
+  }
+  std::vector<std::string> adv;
+  for (int i : op.motion->cyclic) {
+    std::ostringstream p;
+    p.precision(6);
+    p << m.v_names[static_cast<std::size_t>(i)] << " at " << op.motion->rates[i] << "/s";
+    adv.push_back(p.str());
+  }
+  if (!adv.empty()) os << (os.tellp() ? "; " : "") << "advancing freely (cyclic): " << joined(adv);
+  return os.str();
+}
+
+std::string study_handling_text(const HandlingNumbers& h) {
+  std::ostringstream os;
+  os.precision(6);
+  os << "handling numbers at " << h.speed << " m/s, wheelbase " << h.wheelbase << " m\n"
+     << "  yaw-rate gain              " << h.yaw_rate_gain << " 1/s (yaw rate per steer angle, steady state)\n"
+     << "  lateral-acceleration gain  " << h.lateral_acceleration_gain << " m/s^2 per rad"
+     << (h.lateral_acceleration_output ? "" : " (speed x yaw-rate gain)") << "\n";
+  if (h.sideslip_given) os << "  sideslip gain              " << h.sideslip_gain << " per rad\n";
+  os << "  understeer gradient        " << h.understeer_gradient << " rad/(m/s^2) = " << h.understeer_gradient_deg_per_g
+     << " deg/g\n";
+  if (h.characteristic_speed > 0) os << "  characteristic speed       " << h.characteristic_speed << " m/s (understeer)\n";
+  if (h.critical_speed > 0) os << "  critical speed             " << h.critical_speed << " m/s (oversteer)\n";
+  if (h.yaw_natural_frequency > 0)
+    os << "  yaw natural frequency      " << h.yaw_natural_frequency << " rad/s, damping ratio " << h.yaw_damping_ratio << "\n";
+  return os.str();
 }
 
 StudyLinearization study_linearize(const Model& m) {
@@ -465,6 +659,21 @@ StudyLinearization study_linearize(const Model& m) {
   out.op = study_operating_point(m);
   out.lin = linearize(m, out.op, o);
   out.lin.system.study = plant_study_json(s, s.operating_point);
+  if (out.op.kind == "steady" && (!s.handling.steer.empty() || !s.handling.yaw_rate.empty())) {
+    out.handling = study_handling(m, out);
+    const HandlingNumbers& h = *out.handling;
+    out.lin.system.handling = {{"speed", h.speed},
+                               {"wheelbase", h.wheelbase},
+                               {"yaw_rate_gain", h.yaw_rate_gain},
+                               {"lateral_acceleration_gain", h.lateral_acceleration_gain},
+                               {"understeer_gradient", h.understeer_gradient},
+                               {"understeer_gradient_deg_per_g", h.understeer_gradient_deg_per_g},
+                               {"characteristic_speed", h.characteristic_speed},
+                               {"critical_speed", h.critical_speed},
+                               {"yaw_natural_frequency", h.yaw_natural_frequency},
+                               {"yaw_damping_ratio", h.yaw_damping_ratio}};
+    if (h.sideslip_given) out.lin.system.handling.emplace_back("sideslip_gain", h.sideslip_gain);
+  }
   out.system = s.discrete > 0 ? discretize_zoh(out.lin.system, s.discrete) : out.lin.system;
   if (s.discrete > 0 && !(out.system.A.allFinite() && out.system.B.allFinite())) {
     std::ostringstream os;

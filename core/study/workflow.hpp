@@ -24,6 +24,7 @@
 #include <string>
 
 #include "analysis/closed_loop_linear.hpp"
+#include "analysis/handling.hpp"
 #include "analysis/linearize.hpp"
 #include "analysis/modal.hpp"
 #include "analysis/operating_point.hpp"
@@ -92,7 +93,15 @@ struct StudyLinearization {
   OperatingPoint op;
   Linearization lin;    // continuous
   LinearSystem system;  // what is exported: lin.system, or its ZOH form when study.discrete > 0
+  // at a steady motion whose study names the steer input and the yaw-rate output (StudySpec::handling)
+  std::optional<HandlingNumbers> handling;
 };
+
+// What the operating point's motion is, for the user: the steady body's speed and turn, the frame
+// the state moves with, the coordinates that advance (empty when the point is not a motion).
+std::string study_motion_text(const Model& model, const OperatingPoint& op);
+// The handling numbers as the command line prints them (one per line, with units).
+std::string study_handling_text(const HandlingNumbers& h);
 
 StudyLinearization study_linearize(const Model& model);
 

@@ -13,6 +13,7 @@
 #include "io/mat_export.hpp"
 #include "model/model.hpp"
 #include "simulation/simulator.hpp"
+#include "study/workflow.hpp"
 
 namespace codyna::workflow_detail {
 
@@ -32,6 +33,10 @@ Eigen::MatrixXd diagonal(const Model& m, const std::vector<double>& w, int n, co
 std::string plant_study_json(const StudySpec& s, const std::string& operating_point);
 // the modes the inputs cannot move (an eigenvalue within round-off of 0 reported as 0)
 std::vector<HiddenMode> uncontrollable(const LinearSystem& sys);
+// `pairs` (coordinate or rate name -> value) set on (q, v) and the loops closed with them held;
+// errors at /analysis/FIELD[/NAME] (study/workflow.cpp)
+StudyInitialState set_coordinates(const Model& m, Eigen::VectorXd q, Eigen::VectorXd v,
+                                  const std::vector<std::pair<std::string, double>>& pairs, const std::string& field);
 // an LQR needs every mode that does not decay by itself to be movable: says which are not
 void require_stabilizable(const Model& m, const LinearSystem& sys);
 

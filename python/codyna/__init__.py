@@ -119,6 +119,11 @@ class Study:
         free_inputs=None,
         target=None,
         targets=None,
+        steady_body=None,
+        speed=None,
+        yaw_rate=None,
+        radius=None,
+        lateral_acceleration=None,
         trajectory=None,
         trajectory_step=None,
         name=None,
@@ -143,7 +148,12 @@ class Study:
         Every keyword is a flag of `codyna linearize` (dashes become underscores); one left
         out (or None) keeps the model file's choice:
 
-        operating_point   "initial", "equilibrium", "trim" or "time=T"
+        operating_point   "initial", "equilibrium", "trim", "steady" or "time=T"
+        steady_body, speed, yaw_rate, radius, lateral_acceleration   operating point steady:
+                          the body whose forward speed (m/s) and turn (one of yaw rate rad/s,
+                          path radius m, lateral acceleration m/s^2; > 0 left) are held
+                          (docs/vehicles.md); the result's handling gives the handling numbers
+                          when the study names its steer input and yaw-rate output
         method            "exact", "fd-forward" or "fd-central"
         discrete          sample time Ts > 0: the exact zero-order-hold model (0: continuous)
         mat_version       "5" or "7.3" (export)
@@ -152,7 +162,8 @@ class Study:
                           operating-point search (also "NAME=VALUE" strings)
         initial           {name: value}: with trajectory only, the run's initial state
         trim_free         trim: coordinates solved instead of held (list of names)
-        free_input        equilibrium/trim: Plant/In inputs solved for (alias free_inputs)
+        free_input        equilibrium/trim: Plant/In inputs solved for (alias free_inputs);
+                          steady: any actuator
         target            {output: value}: Plant/Out values the search must reach (alias targets)
         trajectory        T: linearize along a simulation from 0 to T (the model's controller
                           in the loop); A, B, C, D are then stacked along a first axis, one per
@@ -205,6 +216,11 @@ class Study:
         free_inputs=None,
         target=None,
         targets=None,
+        steady_body=None,
+        speed=None,
+        yaw_rate=None,
+        radius=None,
+        lateral_acceleration=None,
         inputs=None,
         outputs=None,
         disable_effect=None,

@@ -172,6 +172,46 @@ class ViewsTest : public QObject {
   // (the same job): the heavy top about its initial state has modes its support's inputs cannot
   // move and its outputs cannot see (the CLI's text pinned in tests/data/pinned_outputs.json,
   // lin_initial_heavy_top); the cart-pendulum is controllable and observable
+  // operating point steady on the single-track car: a turn set in the view's fields (typed, as a
+  // person does), the drive force freed by its check box; the result says the motion and the
+  // handling numbers, the same as the study's
+  void aSteadyTurnIsSetInTheFieldsAndLinearized() {
+    Document doc;
+    QVERIFY(doc.load(QStringLiteral(CODYNA_EXAMPLES_DIR "/single_track_car.json")));
+    LinearizeView view(&doc);
+    view.show();
+    QCOMPARE(view.operatingPointCombo()->currentData().toString(), QString("steady"));
+    QVERIFY(view.steadySpeedSpin()->isEnabled());
+    QCOMPARE(view.steadySpeedSpin()->value(), 30.0);
+    QVERIFY(!view.steadyTurnValueSpin()->isEnabled());  // straight
+    view.steadyTurnCombo()->setCurrentIndex(view.steadyTurnCombo()->findData("radius"));
+    QVERIFY(view.steadyTurnValueSpin()->isEnabled());
+    QDoubleSpinBox* value = view.steadyTurnValueSpin();
+    value->setFocus();
+    value->selectAll();
+    QTest::keyClicks(value, "120");
+    QTest::keyClick(value, Qt::Key_Return);
+    QVERIFY(doc.spec().analysis.steady.radius.has_value());
+    QCOMPARE(*doc.spec().analysis.steady.radius, 120.0);
+    // the free inputs offer every actuator at a steady motion: check steer and drive
+    QListWidget* free = view.freeInputsList();
+    for (const char* name : {"steer", "drive"}) {
+      const auto items = free->findItems(QString::fromLatin1(name), Qt::MatchExactly);
+      QCOMPARE(items.size(), 1);
+      items.front()->setCheckState(Qt::Checked);
+    }
+    QCOMPARE(doc.spec().analysis.free_inputs, (std::vector<std::string>{"steer", "drive"}));
+    QVERIFY(view.linearize());
+    QVERIFY(view.result()->handling.has_value());
+    QVERIFY(view.result()->lin.about_motion);
+    const QString label = view.operatingPointLabel()->text();
+    QVERIFY2(label.contains("Motion") && label.contains("understeer gradient"), qPrintable(label));
+    // the same numbers as the study without the view
+    const StudyLinearization direct = study_linearize(*doc.model());
+    QCOMPARE(view.result()->handling->understeer_gradient, direct.handling->understeer_gradient);
+    QCOMPARE(view.result()->op.u, direct.op.u);
+  }
+
   void controllabilityAsTheCommandLineSaysIt() {
     Document doc;
     QVERIFY(doc.load(QStringLiteral(CODYNA_EXAMPLES_DIR "/heavy_top.json")));

@@ -961,3 +961,29 @@ def test_sweep_shard_refusals(tmp_path):
     with pytest.raises(ValueError, match="^shard: a Study.from_json has no model file for sweep_merge"):
         codyna.Study.from_json(open(CART).read()).sweep(vary=SHARD_GRID, shard=(0, 2), out=tmp_path / "s.sweep")
     assert os.listdir(tmp_path) == []
+
+
+def test_a_steady_turn_and_its_handling_numbers_as_the_command_gives_them(tmp_path):
+    # the single-track car (Rajamani's bicycle) at its steady motion straight at 30 m/s: the
+    # handling numbers equal the closed forms (K = m/L (b/Cf - a/Cr), U_ch = sqrt(L/K)) and the
+    # command's NAME.mat struct `handling` to the bit; a steady turn of 120 m (steer and drive
+    # solved) holds r R = V and linearizes about the motion
+    car = os.path.join(os.path.dirname(CART), "single_track_car.json")
+    lin = codyna.Study(car).linearize()
+    assert lin.operating_point["kind"] == "steady"
+    m, L, a, b, C = 1573.0, 2.68, 1.1, 1.58, 160000.0
+    K = m / L * (b / C - a / C)
+    h = lin.handling
+    assert abs(h["understeer_gradient"] - K) <= 1e-10 * K
+    assert abs(h["characteristic_speed"] - (L / K) ** 0.5) <= 1e-10 * (L / K) ** 0.5
+    cli("linearize", car, "--out", tmp_path)
+    import scipy.io
+    mat = scipy.io.loadmat(tmp_path / "single_track_car.mat", squeeze_me=True)
+    for key, value in h.items():
+        assert float(mat["handling"][key]) == value, key
+    turn = codyna.Study(car).linearize(radius=120.0, free_input=["steer", "drive"])
+    r = turn.handling
+    assert r["speed"] == pytest.approx(30.0, rel=1e-9)
+    assert any("linearized about the motion" in n for n in turn.notes), turn.notes
+    with pytest.raises(codyna.ModelError, match="radius"):
+        codyna.Study(car).linearize(radius=0.0)
