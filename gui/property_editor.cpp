@@ -38,7 +38,8 @@ QStringList type_names(ElementKind k) {
       return {"gravity", "spring_damper", "joint_spring_damper", "joint_friction", "joint_damper", "body_force", "bushing"};
     case ElementKind::Actuator: return {"joint_force", "body_force", "body_torque", "line_force", "mix", "motion"};
     case ElementKind::Sensor:
-      return {"joint_position", "joint_velocity", "point_position", "point_velocity", "body_angle", "distance", "distance_rate", "motion_force"};
+      return {"joint_position", "joint_velocity", "point_position", "point_velocity", "body_angle", "distance", "distance_rate", "motion_force",
+              "angular_velocity", "acceleration", "tire"};
     default: return {};
   }
 }

@@ -686,8 +686,54 @@ void TreeDerivatives::sensor_derivatives(const Eigen::VectorXd& q, const Eigen::
   y.resize(ny);
   dy_dq.setZero(ny, m_->nv);
   dy_dv.setZero(ny, m_->nv);
+  dy_da.setZero(ny, m_->nv);
+  dy_du.setZero(ny, m_->nu());
+  dy_dacc.setZero(ny, static_cast<Eigen::Index>(m_->motions.size()));
+  bool reads_acc = false;
   for (int r = 0; r < ny; ++r) {
     const SensorModel& s = m_->sensors[outputs[r]];
+    if (s.type == SensorType::Acceleration) {
+      // y = e . x'' (e the frame's axis, x'' the point's acceleration; less g for the specific
+      // force, which A_ carries as A_0 = -g) over [pose, V, A] of the body (slot 0) and the frame
+      // (slot 1), chained at the accelerations a: the columns of a in dy_da
+      reads_acc = true;
+      Vec6 A0 = Vec6::Zero();
+      if (m_->has_gravity) A0.tail<3>() = -m_->gravity;
+      const Vec6 Ab = s.body > 0 ? Vec6(s.specific_force ? A_[s.body] : Vec6(A_[s.body] - A0))
+                                 : Vec6(s.specific_force ? A0 : Vec6::Zero());
+      const LocalKin xb = s.body > 0 ? local_kin(d_.oMi[s.body], V_[s.body], Ab, s.point, false, true)
+                                     : local_kin(d_.oMi[0], Vec6::Zero(), Ab, s.point, false, false);
+      const Vec3 unit_c = Vec3::Unit(s.component);
+      const LocalKin e = s.frame > 0 ? local_kin(d_.oMi[s.frame], V_[s.frame], Vec6::Zero(), unit_c, true, true)
+                                     : local_kin(d_.oMi[0], Vec6::Zero(), Vec6::Zero(), unit_c, true, false);
+      Grad36 g = Grad36::Zero();
+      add_grad(g, 0, e.x, xb.Dxdd);
+      add_grad(g, 1, xb.xdd, e.Dx);
+      y[r] = e.x.dot(xb.xdd);
+      for (int slot = 0; slot < 2; ++slot) {
+        const int beta = slot == 0 ? s.body : s.frame;
+        if (beta <= 0) continue;
+        const auto Cpose = g.segment<6>(18 * slot), CV = g.segment<6>(18 * slot + 6), CA = g.segment<6>(18 * slot + 12);
+        for (int pu : path_[beta]) {
+          const Unit& up = units_[pu];
+          const auto Sp = S_[up.body].middleCols(up.iv - m_->joints[up.body].idx_v, up.n);
+          const Vec6& Vp = Vpar_[pu];
+          const Vec6 rel = V_[beta] - Vp;
+          const Vec6 acc_rel = A_[beta] - Apar_[pu] - crm(Vp, rel);
+          const Vec6 vel_after = V_[beta] - Vu_[pu] - Vp;
+          for (int k = 0; k < up.n; ++k) {
+            const Vec6 sc = Sp.col(k);
+            const Vec6 dV = crm(sc, rel);                      // dV_beta / dq_s
+            const Vec6 dA = crm(Vp, dV) + crm(sc, acc_rel);    // dA_beta / dq_s at fixed a
+            const int col = up.iv + k;
+            dy_dq(r, col) += Cpose.dot(sc) + CV.dot(dV) + CA.dot(dA);
+            dy_dv(r, col) += CV.dot(sc) + CA.dot(crm(sc, vel_after));
+            dy_da(r, col) += CA.dot(sc);
+          }
+        }
+      }
+      continue;
+    }
     if (s.type == SensorType::JointPosition) {
       y[r] = q[s.iq];
       dy_dq(r, s.iv) = 1.0;
@@ -739,6 +785,36 @@ void TreeDerivatives::sensor_derivatives(const Eigen::VectorXd& q, const Eigen::
         value = L.value() > 1e-12 ? AD(dp.dot(dv) / L) : AD(0.0);
         break;
       }
+      case SensorType::AngularVelocity: {
+        ba = s.body;
+        bb = s.frame;
+        const BodyAD a = body_ad(d_.oMi[ba], V_[ba], 0, ba > 0);
+        const BodyAD f = body_ad(d_.oMi[bb], V_[bb], 12, bb > 0);
+        value = Vec3A(f.R.transpose() * a.w)[s.component];
+        break;
+      }
+      case SensorType::Tire: {
+        // the contact of dynamics/tire_effect.hpp on the wheel's (slot 0) and the road's (slot 12) variables
+        const TireModel& t = m_->tires[static_cast<std::size_t>(s.tire)];
+        ba = t.body;
+        bb = t.road_body;
+        const BodyAD a = body_ad(d_.oMi[ba], V_[ba], 0, ba > 0);
+        const BodyAD rb = body_ad(d_.oMi[bb], V_[bb], 12, bb > 0);
+        TireContact<AD> c;
+        value = AD(0.0);
+        if (tire_contact<AD>(t, a.R, a.p, a.w, a.point_velocity(a.p), rb.R, rb.p, rb.w, rb.point_velocity(rb.p), c)) {
+          switch (s.quantity) {
+            case TireQuantity::SlipAngle: value = c.input.alpha; break;
+            case TireQuantity::LongitudinalSlip: value = c.input.kappa; break;
+            case TireQuantity::Camber: value = c.input.gamma; break;
+            case TireQuantity::Fx: value = c.out.Fx; break;
+            case TireQuantity::Fy: value = c.out.Fy; break;
+            case TireQuantity::Fz: value = c.input.Fz; break;
+            case TireQuantity::Mz: value = c.out.Mz; break;
+          }
+        }
+        break;
+      }
       default:
         throw std::logic_error("TreeDerivatives: unknown sensor type");
     }
@@ -758,6 +834,32 @@ void TreeDerivatives::sensor_derivatives(const Eigen::VectorXd& q, const Eigen::
           dy_dv(r, up.iv + c) += Dvel.dot(sc);
         }
       }
+    }
+  }
+  if (!reads_acc) return;
+  // the accelerations' own dependence: y(q, v, a(q, v, u)), a the dynamics' accelerations
+  dy_dq.noalias() += dy_da * dqdd_dq;
+  dy_dv.noalias() += dy_da * dqdd_dv;
+  dy_du.noalias() = dy_da * dqdd_du;
+  if (dqdd_dacc.rows() == m_->nv && dqdd_dacc.cols() == dy_dacc.cols()) dy_dacc.noalias() = dy_da * dqdd_dacc;
+  if (feedthrough_read) return;
+  // A caller that does not read dy_du and dy_dacc takes D from dy_dq and dy_dv alone: right for a
+  // motion input's value and rate (coordinates of q and v), wrong for a force input's or a motion's
+  // acceleration column. Refused where such a column is not zero rather than left out.
+  for (int r = 0; r < ny; ++r) {
+    const SensorModel& s = m_->sensors[outputs[r]];
+    if (s.type != SensorType::Acceleration) continue;
+    for (int k : m_->plant_inputs) {
+      const ActuatorModel& act = m_->actuators[static_cast<std::size_t>(k)];
+      double lost = 0;
+      if (act.type != ActuatorType::Motion) lost = dy_du(r, k);
+      else
+        for (std::size_t j = 0; j < m_->motions.size(); ++j)
+          if (m_->motions[j] == k && static_cast<Eigen::Index>(j) < dy_dacc.cols()) lost = dy_dacc(r, static_cast<Eigen::Index>(j));
+      if (lost != 0.0)
+        throw std::runtime_error("the exact Jacobian: the acceleration sensor \"" + s.name + "\" reads the input \"" +
+                                 act.name + "\" directly (D = " + std::to_string(lost) +
+                                 "), which the exact linearization does not take yet; linearize with --method fd-central");
     }
   }
 }

@@ -103,7 +103,18 @@ class TreeDerivatives {
   // prescribed acceleration; its coordinate's value and rate are the columns of dqdd_dq and dqdd_dv
   Eigen::MatrixXd dqdd_dacc;                // [nv x motions]
   Eigen::VectorXd y;                        // [outputs]
-  Eigen::MatrixXd dy_dq, dy_dv;             // [outputs x nv]
+  Eigen::MatrixXd dy_dq, dy_dv;             // [outputs x nv] (through the accelerations too)
+  // sensors that read the accelerations (acceleration): their derivatives with respect to the
+  // joint accelerations a at fixed (q, v), and through a(q, v, u) with respect to every actuator's
+  // input (the D matrix's columns: dy_du = dy_da dqdd_du) and each motion's prescribed acceleration;
+  // zero rows for the other sensors
+  Eigen::MatrixXd dy_da;                    // [outputs x nv]
+  Eigen::MatrixXd dy_du;                    // [outputs x nu_all]
+  Eigen::MatrixXd dy_dacc;                  // [outputs x motions]
+  // A caller that puts dy_du and dy_dacc into D sets this; otherwise compute() and
+  // compute_constrained() refuse an acceleration sensor whose D column for a Plant/In force input
+  // or a motion input's acceleration is not zero (it would be left out silently)
+  bool feedthrough_read = false;
   // parts (also set by compute())
   Eigen::VectorXd tau;                      // RNEA at (q, v, qdd) without applied forces
   Eigen::MatrixXd dtau_dq, dtau_dv;         // [nv x nv]

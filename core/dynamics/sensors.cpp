@@ -1,11 +1,55 @@
 #include "dynamics/sensors.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include "dynamics/kinematics.hpp"
+#include "dynamics/tire_effect.hpp"
 #include "spatial/autodiff.hpp"
 
 namespace codyna {
+
+namespace {
+// body i's spatial acceleration in its own axes (gravity not included) at the joint accelerations
+// qdd, from what forward_kinematics(q, v) wrote (liMi, Sb, v, cJ): the recursion of
+// forward_kinematics(q, v, qdd) along the body's ancestors only (no heap)
+template <class S>
+Vec6T<S> sensor_body_acceleration(const Model& model, const DataT<S>& d, int i, const VecXT<S>& v, const VecXT<S>& qdd) {
+  if (i <= 0) return Vec6T<S>::Zero();
+  const JointModel& j = model.joints[static_cast<std::size_t>(i)];
+  const Vec6T<S> ap = sensor_body_acceleration<S>(model, d, j.parent, v, qdd);
+  Vec6T<S> vJ = Vec6T<S>::Zero(), aJ = Vec6T<S>::Zero();
+  for (int c = 0; c < j.nv; ++c) {
+    vJ += d.Sb[i].col(c) * v[j.idx_v + c];
+    aJ += d.Sb[i].col(c) * qdd[j.idx_v + c];
+  }
+  return Vec6T<S>(d.liMi[i].inv_act_motion(ap) + aJ + d.cJ[i] + cross_motion<S>(d.v[i], vJ));
+}
+
+// the tire's contact state as the tire effect computes it (false: off the road, no force)
+template <class S>
+bool sensor_tire_contact(const DataT<S>& d, const TireModel& t, TireContact<S>& c) {
+  Mat3T<S> Rw = d.oMi[t.body].R, Rr = d.oMi[t.road_body].R;
+  Vec3T<S> pw = d.oMi[t.body].p, pr = d.oMi[t.road_body].p;
+  Vec3T<S> ww = angular_velocity<S>(d, t.body), wr = angular_velocity<S>(d, t.road_body);
+  Vec3T<S> vw = point_velocity<S>(d, t.body, Eigen::Vector3d::Zero()), vr = point_velocity<S>(d, t.road_body, Eigen::Vector3d::Zero());
+  if constexpr (!std::is_same_v<S, double>) {
+    // the ground's constants with the wheel's derivative size (as applied_forces does)
+    const Eigen::Index n = std::max({ad_size(Rw), ad_size(pw), ad_size(ww), ad_size(vw), ad_size(Rr), ad_size(pr),
+                                     ad_size(wr), ad_size(vr)});
+    ad_make_coherent(Rw, n);
+    ad_make_coherent(pw, n);
+    ad_make_coherent(ww, n);
+    ad_make_coherent(vw, n);
+    ad_make_coherent(Rr, n);
+    ad_make_coherent(pr, n);
+    ad_make_coherent(wr, n);
+    ad_make_coherent(vr, n);
+  }
+  return tire_contact<S>(t, Rw, pw, ww, vw, Rr, pr, wr, vr, c);
+}
+}  // namespace
 
 template <class S>
 S sensor_value(const Model& model, const DataT<S>& d, const SensorModel& s, const VecXT<S>& q, const VecXT<S>& v) {
@@ -41,6 +85,36 @@ S sensor_value(const Model& model, const DataT<S>& d, const SensorModel& s, cons
       if (!(ad_value(L) > 1e-12)) return S(0);
       const Vec3T<S> dv = point_velocity<S>(d, s.body_b, s.point_b) - point_velocity<S>(d, s.body_a, s.point_a);
       return S(dp.dot(dv)) / L;
+    }
+    case SensorType::AngularVelocity: {
+      const Vec3T<S> w = angular_velocity<S>(d, s.body);
+      return Vec3T<S>(d.oMi[s.frame].R.transpose() * w)[s.component];
+    }
+    case SensorType::Acceleration: {
+      // the accelerations forward_dynamics kept on this data (at the same q, v and inputs)
+      if (d.qdd.size() != model.nv) return S(0);
+      const Vec6T<S> a = sensor_body_acceleration<S>(model, d, s.body, v, d.qdd);
+      const Vec6T<S>& vb = d.v[s.body];
+      const Vec3T<S> w = vb.template head<3>(), al = a.template head<3>();
+      const Vec3T<S> r = s.point.cast<S>();
+      const Vec3T<S> vp = Vec3T<S>(vb.template tail<3>()) + w.cross(r);
+      Vec3T<S> aw = d.oMi[s.body].R * Vec3T<S>(Vec3T<S>(a.template tail<3>()) + al.cross(r) + w.cross(vp));
+      if (s.specific_force && model.has_gravity) aw -= model.gravity.cast<S>();
+      return Vec3T<S>(d.oMi[s.frame].R.transpose() * aw)[s.component];
+    }
+    case SensorType::Tire: {
+      TireContact<S> c;
+      if (!sensor_tire_contact<S>(d, model.tires[static_cast<std::size_t>(s.tire)], c)) return S(0);
+      switch (s.quantity) {
+        case TireQuantity::SlipAngle: return c.input.alpha;
+        case TireQuantity::LongitudinalSlip: return c.input.kappa;
+        case TireQuantity::Camber: return c.input.gamma;
+        case TireQuantity::Fx: return c.out.Fx;
+        case TireQuantity::Fy: return c.out.Fy;
+        case TireQuantity::Fz: return c.input.Fz;
+        case TireQuantity::Mz: return c.out.Mz;
+      }
+      return S(0);
     }
     case SensorType::MotionForce:
       // kept by forward_dynamics on this data (at the same q, v and inputs)

@@ -1,6 +1,8 @@
 // Sensor outputs: one scalar per sensor (see SensorType). Needs
-// forward_kinematics(q, v) on data; motion_force reads the reaction that
-// forward_dynamics (which runs the kinematics too) kept on data. sensor_outputs evaluates only the sensors
+// forward_kinematics(q, v) on data; motion_force reads the reaction and acceleration the joint
+// accelerations qdd that forward_dynamics (which runs the kinematics too) kept on data, so both need
+// forward_dynamics at the same q, v and inputs first (sensor_reads_accelerations); tire sensors
+// evaluate the tire's contact as the tire effect does. sensor_outputs evaluates only the sensors
 // listed in `which` (indices into Model::sensors), so outputs nobody asked
 // for are never computed.
 #pragma once

@@ -963,6 +963,22 @@ const Schema<ActuatorSpec>& schema<ActuatorSpec>() {
   return s;
 }
 
+// a tire sensor's quantity: one of kTireQuantityNames
+std::string read_tire_quantity(const Node& n) {
+  const std::string s = read_string(n);
+  std::string all;
+  for (const char* q : kTireQuantityNames) {
+    if (s == q) return s;
+    all += (all.empty() ? "" : ", ") + std::string(q);
+  }
+  n.fail("unknown tire quantity " + quote(s) + " (expected one of: " + all + ")");
+}
+
+bool read_sensor_flag(const Node& n) {
+  if (!n.value().is_boolean()) n.expected("true or false");
+  return n.value().get<bool>();
+}
+
 template <>
 const Schema<SensorSpec>& schema<SensorSpec>() {
   static const Schema<SensorSpec> s{
@@ -974,6 +990,9 @@ const Schema<SensorSpec>& schema<SensorSpec>() {
            field("point", &SensorSpec::point, read_vec3),
            field("component", &SensorSpec::component, read_component, encode_component),
            field("frame", &SensorSpec::frame, read_string), field("axis", &SensorSpec::axis, read_direction),
+           field("specific_force", &SensorSpec::specific_force, read_sensor_flag, [](bool b) { return ojson(b); }),
+           field("tire", &SensorSpec::tire, read_string, Need::Required),
+           field("quantity", &SensorSpec::quantity, read_tire_quantity, Need::Required),
            field("unit", &SensorSpec::unit, read_string, encode_optional_text)},
       }),
       "sensor",
@@ -987,6 +1006,10 @@ const Schema<SensorSpec>& schema<SensorSpec>() {
           case SensorType::BodyAngle: return element_keys({"body", "axis"}, {"unit"});
           case SensorType::Distance:
           case SensorType::DistanceRate: return element_keys(point_pair_and({}), {"unit"});
+          case SensorType::AngularVelocity: return element_keys({"body", "component", "frame"}, {"unit"});
+          case SensorType::Acceleration:
+            return element_keys({"body", "point", "component", "frame", "specific_force"}, {"unit"});
+          case SensorType::Tire: return element_keys({"tire", "quantity"}, {"unit"});
         }
         return element_keys({}, {"unit"});
       }};

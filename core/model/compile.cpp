@@ -855,6 +855,49 @@ class Compiler {
           o.point_b = s.point_b;
           o.unit = s.type == SensorType::Distance ? "m" : "m/s";
           break;
+        case SensorType::AngularVelocity:
+        case SensorType::Acceleration:
+          o.body = body(s.body, p + "/body");
+          o.frame = body(s.frame, p + "/frame");
+          if (s.component < 0 || s.component > 2) fail(p + "/component", "expected x, y or z (0, 1 or 2)");
+          o.component = s.component;
+          o.point = s.point;
+          o.specific_force = s.specific_force;
+          o.unit = s.type == SensorType::AngularVelocity ? "rad/s" : "m/s^2";
+          break;
+        case SensorType::Tire: {
+          // the tires are built (build_effects) before the sensors
+          int found = -1;
+          std::vector<std::string> names;
+          for (std::size_t t = 0; t < m_.tires.size(); ++t) {
+            names.push_back(m_.tires[t].name);
+            if (m_.tires[t].name == s.tire) found = static_cast<int>(t);
+          }
+          if (found < 0) {
+            bool other_effect = false;
+            for (const EffectSpec& e : spec_.effects) other_effect = other_effect || e.name == s.tire;
+            fail(p + "/tire", (other_effect ? quote(s.tire) + " is an effect but not a tire" : "unknown tire " + quote(s.tire)) +
+                                  " (tires: " + (names.empty() ? std::string("none") : join_names(names)) + ")");
+          }
+          o.tire = found;
+          int qi = -1;
+          for (int k = 0; k < static_cast<int>(std::size(kTireQuantityNames)); ++k)
+            if (s.quantity == kTireQuantityNames[k]) qi = k;
+          if (qi < 0) {
+            std::string all;
+            for (const char* q : kTireQuantityNames) all += (all.empty() ? "" : ", ") + std::string(q);
+            fail(p + "/quantity", "unknown tire quantity " + quote(s.quantity) + " (expected one of: " + all + ")");
+          }
+          o.quantity = static_cast<TireQuantity>(qi);
+          switch (o.quantity) {
+            case TireQuantity::SlipAngle:
+            case TireQuantity::Camber: o.unit = "rad"; break;
+            case TireQuantity::LongitudinalSlip: o.unit = ""; break;
+            case TireQuantity::Mz: o.unit = "N m"; break;
+            default: o.unit = "N"; break;
+          }
+          break;
+        }
       }
       if (!s.unit.empty()) o.unit = s.unit;
       m_.sensors.push_back(o);

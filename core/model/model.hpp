@@ -122,18 +122,24 @@ struct ActuatorModel {
   std::vector<std::pair<int, double>> driven_by;
 };
 
+// what a tire sensor reads (kTireQuantityNames' order)
+enum class TireQuantity { SlipAngle, LongitudinalSlip, Camber, Fx, Fy, Fz, Mz };
+
 struct SensorModel {
   std::string name;
   SensorType type = SensorType::JointPosition;
   int iq = 0, iv = 0;              // joint sensors
-  int body = 0;                    // point sensors, body_angle
+  int body = 0;                    // point sensors, body_angle, angular_velocity, acceleration
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
   int component = 0;
-  int frame = 0;                   // body whose axes express point sensors (0 = ground)
+  int frame = 0;                   // body whose axes express point sensors, angular_velocity, acceleration (0 = ground)
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ(), perp1 = Eigen::Vector3d::UnitX(), perp2 = Eigen::Vector3d::UnitY();
   Eigen::Matrix3d R0 = Eigen::Matrix3d::Identity();  // body_angle: body orientation at zero configuration
   int body_a = 0, body_b = 0;
   Eigen::Vector3d point_a = Eigen::Vector3d::Zero(), point_b = Eigen::Vector3d::Zero();
+  int tire = 0;                    // tire: index into Model::tires
+  TireQuantity quantity = TireQuantity::SlipAngle;
+  bool specific_force = false;     // acceleration: a - g (gravity the model's gravity effect)
   std::string unit;
 };
 

@@ -55,7 +55,7 @@ constexpr std::array<std::pair<ActuatorType, const char*>, 6> kActuators{{
     {ActuatorType::Mix, "mix"},
     {ActuatorType::Motion, "motion"},
 }};
-constexpr std::array<std::pair<SensorType, const char*>, 8> kSensors{{
+constexpr std::array<std::pair<SensorType, const char*>, 11> kSensors{{
     {SensorType::JointPosition, "joint_position"},
     {SensorType::JointVelocity, "joint_velocity"},
     {SensorType::PointPosition, "point_position"},
@@ -64,6 +64,9 @@ constexpr std::array<std::pair<SensorType, const char*>, 8> kSensors{{
     {SensorType::Distance, "distance"},
     {SensorType::DistanceRate, "distance_rate"},
     {SensorType::MotionForce, "motion_force"},
+    {SensorType::AngularVelocity, "angular_velocity"},
+    {SensorType::Acceleration, "acceleration"},
+    {SensorType::Tire, "tire"},
 }};
 constexpr std::array<std::pair<ShapeType, const char*>, 3> kShapes{{
     {ShapeType::Box, "box"},
@@ -108,6 +111,7 @@ const char* to_string(ConstraintType t) { return name_of(kConstraints, t); }
 const char* to_string(EffectType t) { return name_of(kEffects, t); }
 const char* to_string(ActuatorType t) { return name_of(kActuators, t); }
 const char* to_string(SensorType t) { return name_of(kSensors, t); }
+bool sensor_reads_accelerations(SensorType t) { return t == SensorType::MotionForce || t == SensorType::Acceleration; }
 const char* to_string(ShapeType t) { return name_of(kShapes, t); }
 const char* to_string(ControllerType t) { return name_of(kControllers, t); }
 std::optional<JointType> joint_type_from_string(const std::string& s) { return value_of(kJoints, s); }

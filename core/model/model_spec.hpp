@@ -232,7 +232,15 @@ enum class SensorType {
   DistanceRate,    // its rate d|p_b - p_a|/dt = n . (v_b - v_a) (0 where the points coincide)
   MotionForce,     // joint, dof driven by a motion input: the generalized force (N, N m) the motion supplies
                    // to hold the coordinate on its course, (M qdd + nle - Q) there; needs the accelerations
+  AngularVelocity, // body's angular velocity (relative to ground), its component in the axes of `frame` (a gyro)
+  Acceleration,    // body, point: the point's acceleration (relative to ground), component in the axes of
+                   // `frame`; specific_force: a - g as an accelerometer reads it, else a; needs the accelerations
+  Tire,            // tire (an effect of type tire): one of kTireQuantityNames, as the tire effect computes it
 };
+
+// What a tire sensor reads (SensorSpec::quantity), as written in a model file: the slips, camber and
+// the force and aligning moment at the contact in the tire's ISO-W axes (docs/model-format.md).
+inline constexpr const char* kTireQuantityNames[] = {"slip_angle", "longitudinal_slip", "camber", "Fx", "Fy", "Fz", "Mz"};
 
 struct SensorSpec {
   std::string name;
@@ -247,8 +255,15 @@ struct SensorSpec {
   std::string body_a, body_b;  // distance, distance_rate
   Eigen::Vector3d point_a = Eigen::Vector3d::Zero();
   Eigen::Vector3d point_b = Eigen::Vector3d::Zero();
+  std::string tire;                     // tire: the tire effect's name
+  std::string quantity = "slip_angle";  // tire: one of kTireQuantityNames
+  bool specific_force = false;          // acceleration: true a - g (an accelerometer), false a
   std::string unit;
 };
+
+// true for the sensor types that read the accelerations (motion_force, acceleration): their value
+// needs forward_dynamics at the same state and inputs, and depends on the inputs directly (D)
+bool sensor_reads_accelerations(SensorType t);
 
 // The Plant/In and Plant/Out panels: names of actuators and sensors, in order.
 struct PlantSpec {

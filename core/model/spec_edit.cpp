@@ -85,6 +85,8 @@ void for_each_body_ref(ModelSpec& s, F&& f) {
     switch (x.type) {
       case SensorType::PointPosition:
       case SensorType::PointVelocity:
+      case SensorType::AngularVelocity:
+      case SensorType::Acceleration:
         f(x.body, "sensor " + x.name + ": body", at("sensors", i, "body"));
         f(x.frame, "sensor " + x.name + ": frame", at("sensors", i, "frame"));
         break;
@@ -228,6 +230,8 @@ std::vector<std::string> references_to(const ModelSpec& spec, ElementKind k, con
     case ElementKind::Effect:
       if (std::count(s.analysis.disabled_effects.begin(), s.analysis.disabled_effects.end(), name))
         out.push_back("analysis: disabled effects");
+      for (const auto& x : s.sensors)
+        if (x.type == SensorType::Tire && x.tire == name) out.push_back("sensor " + x.name + ": tire");
       break;
     case ElementKind::Constraint: break;
   }
@@ -246,6 +250,8 @@ std::vector<ReferenceField> reference_fields(const ModelSpec& spec) {
   for (std::size_t i = 0; i < s.actuators.size(); ++i)
     for (std::size_t k = 0; k < s.actuators[i].drives.size(); ++k)
       out.push_back({ElementKind::Actuator, s.actuators[i].drives[k], at("actuators", i, "drives") + "/" + std::to_string(k)});
+  for (std::size_t i = 0; i < s.sensors.size(); ++i)
+    if (s.sensors[i].type == SensorType::Tire) out.push_back({ElementKind::Effect, s.sensors[i].tire, at("sensors", i, "tire")});
   for (std::size_t k = 0; k < s.plant.inputs.size(); ++k)
     out.push_back({ElementKind::Actuator, s.plant.inputs[k], "/plant/inputs/" + std::to_string(k)});
   for (std::size_t k = 0; k < s.plant.outputs.size(); ++k)
@@ -278,6 +284,8 @@ void rename_element(ModelSpec& s, ElementKind k, int index, const std::string& n
     case ElementKind::Sensor: std::replace(s.plant.outputs.begin(), s.plant.outputs.end(), old, now); break;
     case ElementKind::Effect:
       std::replace(s.analysis.disabled_effects.begin(), s.analysis.disabled_effects.end(), old, now);
+      for (auto& x : s.sensors)
+        if (x.type == SensorType::Tire && x.tire == old) x.tire = now;
       break;
     case ElementKind::Constraint: break;
   }
@@ -295,7 +303,8 @@ std::string default_name(ElementKind k, const std::string& type) {
   static const std::map<std::string, std::string> sensors = {
       {"joint_position", "sensor"}, {"joint_velocity", "rate"},     {"point_position", "position"},
       {"point_velocity", "velocity"}, {"body_angle", "angle"},       {"distance", "distance"},
-      {"distance_rate", "distance_rate"}, {"motion_force", "motion_force"}};
+      {"distance_rate", "distance_rate"}, {"motion_force", "motion_force"}, {"angular_velocity", "rate_gyro"},
+      {"acceleration", "accelerometer"}, {"tire", "tire_sensor"}};
   auto from = [&](const std::map<std::string, std::string>& m, const char* fallback) {
     const auto it = m.find(type);
     return it == m.end() ? std::string(fallback) : it->second;

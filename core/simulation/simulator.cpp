@@ -197,11 +197,14 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
     throw std::invalid_argument("simulate: state feedback needs the linearized plant it was designed on");
   if (controller && !controller->needs_state())
     for (int k : model.plant_outputs)
-      if (model.sensors[static_cast<std::size_t>(k)].type == SensorType::MotionForce)
+      if (sensor_reads_accelerations(model.sensors[static_cast<std::size_t>(k)].type)) {
+        const bool reaction = model.sensors[static_cast<std::size_t>(k)].type == SensorType::MotionForce;
         throw std::invalid_argument("simulate: the controller measures \"" + model.sensors[static_cast<std::size_t>(k)].name +
-                                    "\", a motion input's reaction force, which depends on the inputs the controller "
+                                    (reaction ? "\", a motion input's reaction force" : "\", an acceleration") +
+                                    ", which depends on the inputs the controller "
                                     "computes (an algebraic loop); feed back positions or velocities, or use state "
-                                    "feedback (the reaction is then recorded as an output)");
+                                    "feedback (the " + (reaction ? "reaction" : "acceleration") + " is then recorded as an output)");
+      }
   const auto wall0 = std::chrono::steady_clock::now();
 
   std::optional<PlantFunction> pf;
@@ -273,8 +276,8 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
 
   Recorder rec;
   Data d(model);
-  bool reactions = false;  // a motion's reaction among the outputs: the accelerations at each sample
-  for (int k : model.plant_outputs) reactions = reactions || model.sensors[static_cast<std::size_t>(k)].type == SensorType::MotionForce;
+  bool reactions = false;  // a motion's reaction or an acceleration among the outputs: the accelerations at each sample
+  for (int k : model.plant_outputs) reactions = reactions || sensor_reads_accelerations(model.sensors[static_cast<std::size_t>(k)].type);
   Eigen::VectorXd motion_acc;
   auto record = [&](double t) {
     Eigen::VectorXd q = y.head(model.nq), v = y.segment(model.nq, model.nv);

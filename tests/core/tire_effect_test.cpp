@@ -630,9 +630,11 @@ TEST(TireEffect, SingleTrackCarIsTheBicycleModel) {
   ASSERT_EQ(mod.tires.size(), 2u);
   const LinearSystem s = study_linearize(mod).system;
   ASSERT_EQ(s.B.cols(), 1);
-  ASSERT_EQ(s.C.rows(), 2);
+  ASSERT_EQ(s.C.rows(), 3);
   ASSERT_EQ(s.output_names[0], "yaw_rate");
   ASSERT_EQ(s.output_names[1], "lateral_velocity");
+  ASSERT_EQ(s.output_names[2], "lateral_acceleration");  // an acceleration sensor (issue 39)
+  EXPECT_EQ(s.output_units[2], "m/s^2");
   // the steer input enters by its value only (massless wheels: no rate or acceleration columns)
   if (s.state_rate_shift.size() > 0) EXPECT_EQ(s.state_rate_shift.cwiseAbs().maxCoeff(), 0.0);
   const TireEffectBicycle bike;
@@ -642,27 +644,41 @@ TEST(TireEffect, SingleTrackCarIsTheBicycleModel) {
     const Eigen::VectorXcd xs = M.partialPivLu().solve(s.B.cast<std::complex<double>>());
     return (s.C.row(output).cast<std::complex<double>>() * xs)(0) + s.D(output, 0);
   };
-  double worst_r = 0, worst_v = 0, worst_ay = 0;
+  double worst_r = 0, worst_v = 0, worst_ay = 0, worst_sensor = 0;
   for (int i = 0; i <= 60; ++i) {
     const double w = 0.1 * std::pow(1000.0, i / 60.0);  // 0.1 .. 100 rad/s
     const std::complex<double> sc(0.0, w);
     const std::complex<double> r = model_tf(sc, 0), v = model_tf(sc, 1);
     const std::complex<double> ay = sc * v + bike.U * r;  // a_y = v' + U r
+    const std::complex<double> ay_sensor = model_tf(sc, 2);  // the chassis CG's acceleration, its own y
     worst_r = std::max(worst_r, std::abs(r - bike.yaw(sc)) / std::abs(bike.yaw(sc)));
     worst_v = std::max(worst_v, std::abs(v - bike.lateral(sc)) / std::abs(bike.lateral(sc)));
     worst_ay = std::max(worst_ay, std::abs(ay - bike.lateral_acceleration(sc)) / std::abs(bike.lateral_acceleration(sc)));
+    worst_sensor = std::max(worst_sensor, std::abs(ay_sensor - bike.lateral_acceleration(sc)) / std::abs(bike.lateral_acceleration(sc)));
   }
   EXPECT_LT(worst_r, 1e-8);
   EXPECT_LT(worst_v, 1e-8);
   EXPECT_LT(worst_ay, 1e-8);
+  EXPECT_LT(worst_sensor, 1e-8);
+  // the steer reaches the lateral acceleration directly: D = C_f / m, the closed form's s -> infinity
+  // limit (s v(s) -> B_v = C_f / m, U r(s) -> 0); the yaw rate and lateral velocity have none
+  EXPECT_NEAR(s.D(2, 0), bike.Cf / bike.m, 1e-8 * bike.Cf / bike.m);
+  EXPECT_EQ(s.D(0, 0), 0.0);
+  EXPECT_EQ(s.D(1, 0), 0.0);
+  // the same D by automatic differentiation and by central differences of the plant function
+  LinearizeOptions central;
+  central.method = JacobianMethod::CentralDifference;
+  const LinearSystem sc = linearize(mod, study_operating_point(mod), central).system;
+  EXPECT_NEAR(sc.D(2, 0), s.D(2, 0), 1e-6 * s.D(2, 0));
   // the steady state: understeer gradient and the yaw-rate gain U / (L + K U^2)
   const double K = bike.K(), L = bike.L(), U = bike.U;
   const double gain = U / (L + K * U * U);
   EXPECT_NEAR(std::abs(bike.yaw(std::complex<double>(0.0, 0.0))), gain, 1e-12 * gain);
   const double dc = model_tf(std::complex<double>(0.0, 1e-5), 0).real();
   EXPECT_NEAR(dc, gain, 1e-6 * gain);
-  std::printf("[ TireEffect ] single track: largest relative TF difference over 0.1..100 rad/s: r %.2e, v %.2e, a_y %.2e\n",
-              worst_r, worst_v, worst_ay);
+  std::printf("[ TireEffect ] single track: largest relative TF difference over 0.1..100 rad/s: r %.2e, v %.2e, a_y %.2e, "
+              "a_y sensor %.2e; D(a_y, steer) = %.12g (C_f / m = %.12g)\n",
+              worst_r, worst_v, worst_ay, worst_sensor, s.D(2, 0), bike.Cf / bike.m);
   std::printf("[ TireEffect ] K = %.6g rad/(m/s^2) (%.4g deg/g), characteristic speed %.4g m/s, yaw-rate gain %.6g 1/s (model %.6g)\n",
               K, K * 180 / M_PI * 9.81, K > 0 ? std::sqrt(L / K) : 0.0, gain, dc);
 }
