@@ -1016,7 +1016,7 @@ TEST(ModelFileErrors, BadLqrWeight) {
 
 TEST(ModelFileErrors, BadOperatingPoint) {
   expect_controller_error(R"({"type": "lqr", "operating_point": "upright"})", "/controller/operating_point",
-                          "unknown operating point \"upright\" (expected one of: initial, equilibrium, trim)");
+                          "unknown operating point \"upright\" (expected one of: initial, equilibrium, trim, steady)");
   expect_controller_error(R"({"type": "lqr", "operating_point": 0})", "/controller/operating_point",
                           "expected a string, got number 0");
 }
