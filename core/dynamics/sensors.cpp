@@ -1,5 +1,7 @@
 #include "dynamics/sensors.hpp"
 
+#include <stdexcept>
+
 #include <algorithm>
 #include <cmath>
 #include <type_traits>
@@ -18,6 +20,10 @@ template <class S>
 Vec6T<S> sensor_body_acceleration(const Model& model, const DataT<S>& d, int i, const VecXT<S>& v, const VecXT<S>& qdd) {
   if (i <= 0) return Vec6T<S>::Zero();
   const JointModel& j = model.joints[static_cast<std::size_t>(i)];
+  // the accelerations and the motion subspaces come from forward_dynamics on this data: without
+  // them there is no acceleration to read (a caller's error, said rather than read out of range)
+  if (qdd.size() != model.nv || d.Sb[static_cast<std::size_t>(i)].cols() < j.nv)
+    throw std::logic_error("acceleration sensor: the accelerations were not computed on this data (run forward_dynamics first)");
   const Vec6T<S> ap = sensor_body_acceleration<S>(model, d, j.parent, v, qdd);
   Vec6T<S> vJ = Vec6T<S>::Zero(), aJ = Vec6T<S>::Zero();
   for (int c = 0; c < j.nv; ++c) {
