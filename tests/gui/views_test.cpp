@@ -176,6 +176,7 @@ class ViewsTest : public QObject {
   // person does), the drive force freed by its check box; the result says the motion and the
   // handling numbers, the same as the study's
   void aSteadyTurnIsSetInTheFieldsAndLinearized() {
+    WheelGuard::install();  // as codyna-gui's main window does
     Document doc;
     QVERIFY(doc.load(QStringLiteral(CODYNA_EXAMPLES_DIR "/single_track_car.json")));
     LinearizeView view(&doc);
@@ -184,7 +185,12 @@ class ViewsTest : public QObject {
     QVERIFY(view.steadySpeedSpin()->isEnabled());
     QCOMPARE(view.steadySpeedSpin()->value(), 30.0);
     QVERIFY(!view.steadyTurnValueSpin()->isEnabled());  // straight
-    view.steadyTurnCombo()->setCurrentIndex(view.steadyTurnCombo()->findData("radius"));
+    // a wheel turned over the closed combo does not change it (the view's wheel guard), the popup picks
+    const int before_wheel = view.steadyTurnCombo()->currentIndex();
+    drive::wheelOver(view.steadyTurnCombo(), -2);
+    QCOMPARE(view.steadyTurnCombo()->currentIndex(), before_wheel);
+    QVERIFY(drive::pickWithMouse(view.steadyTurnCombo(), QStringLiteral("path radius (m)")));
+    QCOMPARE(view.steadyTurnCombo()->currentData().toString(), QString("radius"));
     QVERIFY(view.steadyTurnValueSpin()->isEnabled());
     QDoubleSpinBox* value = view.steadyTurnValueSpin();
     value->setFocus();
