@@ -429,6 +429,7 @@ struct Linearizer::Impl {
       td->bind(m);
     else
       td = std::make_unique<TreeDerivatives>(m);
+    td->feedthrough_read = true;  // D from dy_du below (acceleration sensors)
     if (m.springs.empty())
       data.reset();
     else if (data)  // for refuse_coincident_spring_dampers
@@ -474,7 +475,8 @@ struct Linearizer::Impl {
     s.C.resize(ny, 2 * n);
     s.C.leftCols(n) = d.dy_dq;
     s.C.rightCols(n) = d.dy_dv;
-    s.D.setZero(ny, nu);
+    s.D.resize(ny, nu);
+    for (int k = 0; k < nu; ++k) s.D.col(k) = d.dy_du.col(m.plant_inputs[k]);  // zero but for acceleration sensors
     // x0dot and y0: the accelerations and sensor values the Jacobian was taken at (its
     // qdd, by CRBA and a Cholesky solve, agrees with ABA's to round-off), and the
     // positions' rate at a zero deviation

@@ -599,6 +599,7 @@ bool PlantFunction::analytic_jacobian(const Eigen::VectorXd& x, const Eigen::Vec
   ws_.v = x.tail(n);
   ws_.u_all = u_all_;
   for (int k = 0; k < nu_p; ++k) ws_.u_all[m.plant_inputs[k]] = u[k];
+  td.feedthrough_read = true;  // D from dy_du below (acceleration sensors)
   td.compute(q_ref_, ws_.v, ws_.u_all, m.plant_outputs);
   if (J.rows() != 2 * n + ny_p || J.cols() != 2 * n + nu_p) J.resize(2 * n + ny_p, 2 * n + nu_p);
   J.setZero();
@@ -617,6 +618,7 @@ bool PlantFunction::analytic_jacobian(const Eigen::VectorXd& x, const Eigen::Vec
   for (int k = 0; k < nu_p; ++k) J.block(n, 2 * n + k, n, 1) = td.dqdd_du.col(m.plant_inputs[k]);
   J.block(2 * n, 0, ny_p, n) = td.dy_dq;
   J.block(2 * n, n, ny_p, n) = td.dy_dv;
+  for (int k = 0; k < nu_p; ++k) J.block(2 * n, 2 * n + k, ny_p, 1) = td.dy_du.col(m.plant_inputs[k]);
   return true;
 }
 
@@ -869,6 +871,7 @@ bool PlantFunction::closed_loop_jacobian(const Eigen::VectorXd& x, const Eigen::
   }
   // the constrained accelerations and multipliers, then their derivatives
   forward_dynamics<double>(m, d, q_ref_, W.v, W.u_all);
+  td.feedthrough_read = true;  // D from dy_du and dy_dacc below (acceleration sensors)
   td.compute_constrained(q_ref_, W.v, W.u_all, d.qdd, d.lambda, d.loop.rows, m.plant_outputs);
   // H = dv/d[z, u] at fixed [w, u']: Jd dv_dep = -(d(Jc v)/dq) G on the plant's rows (with rolling:
   // on the velocity rows, for the velocities' dependent columns)
@@ -946,6 +949,16 @@ bool PlantFunction::closed_loop_jacobian(const Eigen::VectorXd& x, const Eigen::
       J.block(nxr, value_col(j), ny_p, 1).noalias() += td.dy_dv * W.H.col(n + j);
       if (rates) J.block(nxr, rate_col(j), ny_p, 1).noalias() = td.dy_dv * Gv.col(nw_ + j);
     }
+    // the accelerations' direct dependence on the inputs (acceleration sensors; zero otherwise): a
+    // force input's column, a motion's acceleration column (its value and rate came through q, v)
+    for (int k = 0; k < nu_p; ++k)
+      if (m.actuators[static_cast<std::size_t>(m.plant_inputs[k])].type != ActuatorType::Motion)
+        J.block(nxr, nxr + k, ny_p, 1) = td.dy_du.col(m.plant_inputs[k]);
+    if (rates)
+      for (std::size_t i = 0; i < m.motions.size(); ++i)
+        for (int j = 0; j < nmi; ++j)
+          if (m.plant_inputs[motion_inputs_[j]] == m.motions[i])
+            J.block(nxr, acc_col(j), ny_p, 1) = td.dy_dacc.col(static_cast<Eigen::Index>(i));
   }
   return true;
 }
