@@ -213,7 +213,7 @@ void bind_linear_system(py::class_<LinearizationResult>& c) {
         for (const auto& [name, value] : l.job->linearization.lin.system.handling) d[py::str(name)] = value;
         return d;
       }, "at operating point steady with the study's handling section: the handling numbers by name\n"
-         "(speed, wheelbase, yaw_rate_gain, lateral_acceleration_gain, understeer_gradient (rad per m/s^2),\n"
+         "(speed, wheelbase, steering_ratio, yaw_rate_gain, lateral_acceleration_gain, understeer_gradient (rad per m/s^2),\n"
          "understeer_gradient_deg_per_g, characteristic_speed, critical_speed, yaw_natural_frequency,\n"
          "yaw_damping_ratio[, sideslip_gain]; docs/vehicles.md), as NAME.mat's handling; else None")
       .def_property_readonly("notes", [](L l) { return l.job->notes; }, "notes for the user (what codyna linearize prints as notes)")

@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
+#include <Eigen/QR>
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
@@ -15,6 +16,16 @@ namespace {
 
 constexpr double kStandardGravity = 9.80665;  // m/s^2 per g
 constexpr double kPi = 3.14159265358979323846;
+
+// null(M) as columns: the right singular vectors of singular values at most `tol` (absolute)
+Eigen::MatrixXd null_space(const Eigen::MatrixXd& M, double tol) {
+  if (M.rows() == 0 || M.cols() == 0) return Eigen::MatrixXd::Identity(M.cols(), M.cols());
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(M, Eigen::ComputeFullV);
+  const Eigen::VectorXd& sv = svd.singularValues();
+  Eigen::Index rank = 0;
+  while (rank < sv.size() && sv[rank] > tol) ++rank;
+  return svd.matrixV().rightCols(M.cols() - rank);
+}
 
 // the steady-state response of the outputs to a unit step of input `in`: A x + B e = 0 solved
 // with the smallest x; refused when no x solves it or when the outputs depend on which one does
@@ -48,46 +59,42 @@ Eigen::VectorXd steady_gain(const LinearSystem& s, int in, const std::vector<int
   return y;
 }
 
-// The states that do not reach the outputs `rows` of C: the largest set S with A[not S, S] = 0 and
-// C[rows, S] = 0 (the position on the road, the heading, a coasting speed: what advances freely
-// without changing the response). The others, in order.
-std::vector<int> reaching_states(const LinearSystem& s, const std::vector<int>& rows) {
-  const Eigen::Index n = s.A.rows();
-  const double scale = std::max(s.A.size() ? s.A.cwiseAbs().maxCoeff() : 0.0, 1e-300);
-  const double cscale = std::max(s.C.size() ? s.C.cwiseAbs().maxCoeff() : 0.0, 1e-300);
-  std::vector<bool> in_s(static_cast<std::size_t>(n), true);
-  for (bool changed = true; changed;) {
-    changed = false;
-    for (Eigen::Index j = 0; j < n; ++j) {
-      if (!in_s[static_cast<std::size_t>(j)]) continue;
-      bool reaches = false;
-      for (int r : rows) reaches |= std::abs(s.C(r, j)) > 1e-13 * cscale;
-      for (Eigen::Index i = 0; i < n && !reaches; ++i)
-        reaches = !in_s[static_cast<std::size_t>(i)] && std::abs(s.A(i, j)) > 1e-13 * scale;
-      if (reaches) {
-        in_s[static_cast<std::size_t>(j)] = false;
-        changed = true;
-      }
-    }
+// The part of the state a steady motion may leave drifting: the largest subspace S of positions
+// (no velocity part) that the outputs `rows` do not read (C S = 0) and that the dynamics keep (A S
+// inside S): the road position, the heading, the wheels' spin angles, in whatever combination of
+// coordinates the chart gives them (a pitched chassis' forward position is its body x and z
+// together; its heading about the road's normal, its own z and x). Found as the unobservable
+// subspace of (A, [C_rows; the velocities]): S0 = ker, S_k+1 = {z in S_k : A z in S_k}.
+// Returns an orthonormal basis of S's orthogonal complement: the states that matter.
+Eigen::MatrixXd kept_directions(const LinearSystem& s, const std::vector<int>& rows) {
+  const Eigen::Index n = s.A.rows(), np = std::min<Eigen::Index>(s.npositions(), n);
+  const double ascale = std::max(s.A.size() ? s.A.norm() : 0.0, 1e-300);
+  const double cscale = std::max(s.C.size() ? s.C.norm() : 0.0, 1e-300);
+  Eigen::MatrixXd H(static_cast<Eigen::Index>(rows.size()) + (n - np), n);
+  H.setZero();
+  for (std::size_t k = 0; k < rows.size(); ++k) H.row(static_cast<Eigen::Index>(k)) = s.C.row(rows[k]) / cscale;
+  for (Eigen::Index i = 0; i < n - np; ++i) H(static_cast<Eigen::Index>(rows.size()) + i, np + i) = 1.0;
+  Eigen::MatrixXd S = null_space(H, 1e-12);
+  for (Eigen::Index dim = -1; S.cols() > 0 && S.cols() != dim;) {
+    dim = S.cols();
+    const Eigen::MatrixXd AS = s.A * S / ascale;
+    const Eigen::MatrixXd out = AS - S * (S.transpose() * AS);  // A S's part outside S
+    S = S * null_space(out, 1e-10);
   }
-  std::vector<int> keep;
-  for (Eigen::Index j = 0; j < n; ++j)
-    if (!in_s[static_cast<std::size_t>(j)]) keep.push_back(static_cast<int>(j));
-  return keep;
+  // the complement
+  if (S.cols() == 0) return Eigen::MatrixXd::Identity(n, n);
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(S);
+  const Eigen::MatrixXd Q = qr.householderQ() * Eigen::MatrixXd::Identity(n, n);
+  return Q.rightCols(n - S.cols());
 }
 
-LinearSystem kept_states(const LinearSystem& s, const std::vector<int>& keep) {
+// the system on the directions T (orthonormal columns): x = T z
+LinearSystem on_directions(const LinearSystem& s, const Eigen::MatrixXd& T) {
   LinearSystem r;
-  const Eigen::Index m = static_cast<Eigen::Index>(keep.size());
-  r.A.resize(m, m);
-  r.B.resize(m, s.B.cols());
-  r.C.resize(s.C.rows(), m);
+  r.A = T.transpose() * s.A * T;
+  r.B = T.transpose() * s.B;
+  r.C = s.C * T;
   r.D = s.D;
-  for (Eigen::Index i = 0; i < m; ++i) {
-    r.B.row(i) = s.B.row(keep[static_cast<std::size_t>(i)]);
-    r.C.col(i) = s.C.col(keep[static_cast<std::size_t>(i)]);
-    for (Eigen::Index j = 0; j < m; ++j) r.A(i, j) = s.A(keep[static_cast<std::size_t>(i)], keep[static_cast<std::size_t>(j)]);
-  }
   r.output_names = s.output_names;
   return r;
 }
@@ -95,7 +102,7 @@ LinearSystem kept_states(const LinearSystem& s, const std::vector<int>& keep) {
 }  // namespace
 
 HandlingNumbers handling_numbers(const LinearSystem& sys, int steer, int yaw_rate, int lateral_acceleration, int sideslip,
-                                 double speed, double wheelbase) {
+                                 double speed, double wheelbase, double steering_ratio) {
   if (steer < 0 || steer >= sys.B.cols()) throw std::invalid_argument("handling: no steer input among Plant/In");
   if (yaw_rate < 0 || yaw_rate >= sys.C.rows()) throw std::invalid_argument("handling: no yaw-rate output among Plant/Out");
   if (!(speed > 0)) throw std::invalid_argument("handling: the forward speed must be > 0 (it is " + std::to_string(speed) + " m/s)");
@@ -103,11 +110,14 @@ HandlingNumbers handling_numbers(const LinearSystem& sys, int steer, int yaw_rat
   HandlingNumbers h;
   h.speed = speed;
   h.wheelbase = wheelbase;
+  if (!(std::abs(steering_ratio) > 0) || !std::isfinite(steering_ratio))
+    throw std::invalid_argument("handling: the steering ratio must be a number other than 0");
+  h.steering_ratio = steering_ratio;
   std::vector<int> outs{yaw_rate};
   if (lateral_acceleration >= 0) outs.push_back(lateral_acceleration);
   if (sideslip >= 0) outs.push_back(sideslip);
-  // the states that reach these outputs (the road position and heading do not, in body axes)
-  const LinearSystem red = kept_states(sys, reaching_states(sys, outs));
+  // less what may drift unseen (the road position, the heading, the spin angles)
+  const LinearSystem red = on_directions(sys, kept_directions(sys, outs));
   const Eigen::VectorXd g = steady_gain(red, steer, outs);
   h.yaw_rate_gain = g[0];
   h.lateral_acceleration_output = lateral_acceleration >= 0;
@@ -116,7 +126,7 @@ HandlingNumbers handling_numbers(const LinearSystem& sys, int steer, int yaw_rat
   if (sideslip >= 0) h.sideslip_gain = g[static_cast<Eigen::Index>(outs.size()) - 1];
   if (!(std::abs(h.lateral_acceleration_gain) > 0))
     throw std::invalid_argument("handling: the steer does not reach the lateral acceleration (its gain is 0)");
-  h.understeer_gradient = 1.0 / h.lateral_acceleration_gain - wheelbase / (speed * speed);
+  h.understeer_gradient = 1.0 / (steering_ratio * h.lateral_acceleration_gain) - wheelbase / (speed * speed);
   h.understeer_gradient_deg_per_g = h.understeer_gradient * 180.0 / kPi * kStandardGravity;
   if (h.understeer_gradient > 0) h.characteristic_speed = std::sqrt(wheelbase / h.understeer_gradient);
   if (h.understeer_gradient < 0) h.critical_speed = std::sqrt(-wheelbase / h.understeer_gradient);

@@ -28,6 +28,7 @@ namespace codyna {
 
 struct HandlingNumbers {
   double speed = 0, wheelbase = 0;                     // U (m/s), L (m)
+  double steering_ratio = 1;                           // steer input per road-wheel angle
   double yaw_rate_gain = 0, lateral_acceleration_gain = 0, sideslip_gain = 0;
   bool sideslip_given = false, lateral_acceleration_output = false;
   double understeer_gradient = 0;                      // rad per m/s^2
@@ -38,9 +39,11 @@ struct HandlingNumbers {
 };
 
 // sys: the plant; steer: its input's index; yaw_rate, lateral_acceleration, sideslip: output
-// indices (-1 when the model has none; yaw_rate is required). Throws std::invalid_argument when a
-// gain is not defined (the steady state is not unique, or the steer does not reach the yaw rate).
+// indices (-1 when the model has none; yaw_rate is required); steering_ratio: the steer input per
+// road-wheel angle (the gains are per steer input; the understeer gradient is per road-wheel
+// angle, K = 1 / (ratio G_ay) - L / U^2). Throws std::invalid_argument when a gain is not defined
+// (the steady state is not unique, or the steer does not reach the yaw rate).
 HandlingNumbers handling_numbers(const LinearSystem& sys, int steer, int yaw_rate, int lateral_acceleration, int sideslip,
-                                 double speed, double wheelbase);
+                                 double speed, double wheelbase, double steering_ratio = 1.0);
 
 }  // namespace codyna

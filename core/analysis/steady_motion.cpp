@@ -195,11 +195,17 @@ void advance_motion(const Model& model, SteadyMotion& motion, double T, Eigen::V
     const int iq = j.idx_q, iv = j.idx_v;
     const double r = jm.yaw_rate;
     const Eigen::Matrix3d G = Eigen::AngleAxisd(r * T, jm.normal).toRotationMatrix();
-    // the point the frame turns about (r != 0), or its translation
+    // a point p of the moving frame after T: it turns by G about the centre c = o + (n x V) / r, so
+    // p + (G - I)(p - o) - (G - I)/r (n x V); (G - I)/r = (sin(rT)/r) [n]x + ((1 - cos(rT))/r) [n]x^2
+    // is taken in that form, which is exact as r goes to 0 (a translation V T), where c is far away
+    // and c + G (p - c) would lose every digit (a straight run's yaw rate at round-off)
+    const double th = r * T;
+    const double a = std::abs(th) < 1e-4 ? T * (1 - th * th / 6) : std::sin(th) / r;
+    const double b = std::abs(th) < 1e-4 ? T * th * (0.5 - th * th / 24) : (1 - std::cos(th)) / r;
     auto moved = [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
-      if (r == 0.0) return p + jm.velocity * T;
-      const Eigen::Vector3d c = jm.origin + jm.normal.cross(jm.velocity) / r;
-      return c + G * (p - c);
+      const Eigen::Vector3d w = jm.normal.cross(jm.velocity);
+      const Eigen::Vector3d nw = jm.normal.cross(w);
+      return p + (G - Eigen::Matrix3d::Identity()) * (p - jm.origin) - a * nw - b * jm.normal.cross(nw);
     };
     if (j.type == JointType::Planar) {
       const Eigen::Vector3d p = moved(Eigen::Vector3d(q[iq], q[iq + 1], 0.0));
@@ -230,7 +236,9 @@ void advance_motion(const Model& model, SteadyMotion& motion, double T, Eigen::V
 double motion_check_time(const SteadyMotion& motion) {
   double fastest = 0;
   for (const JointMotion& jm : motion.joints) fastest = std::max({fastest, std::abs(jm.yaw_rate), std::abs(jm.spin_rate)});
-  return fastest > 0 ? 0.5 / fastest : 1.0;
+  // half a radian of the fastest turn or spin, at most a second (a yaw rate at round-off is not a
+  // turn whose half radian takes 1e30 s)
+  return fastest > 0.5 ? 0.5 / fastest : 1.0;
 }
 
 template void motion_reference_velocity<double>(const Model&, const SteadyMotion&, const VecXT<double>&, VecXT<double>&);

@@ -1315,6 +1315,12 @@ const Schema<HandlingSpec>& schema<HandlingSpec>() {
       field("lateral_acceleration", &T::lateral_acceleration, read_string, encode_optional_text),
       field("sideslip", &T::sideslip, read_string, encode_optional_text),
       field("wheelbase", &T::wheelbase, [](const Node& n) { return std::optional<double>(read_positive_length(n)); }),
+      field("steering_ratio", &T::steering_ratio,
+            [](const Node& n) {
+              const double r = read_number(n);
+              if (!(std::abs(r) > 0) || !std::isfinite(r)) n.expected("a steering ratio: steer input per road-wheel angle, not 0");
+              return std::optional<double>(r);
+            }),
   }};
   return s;
 }

@@ -75,10 +75,12 @@ struct SteadySpec {
 
 // The handling numbers at a steady motion (analysis/handling.hpp): the Plant/In steer input, the
 // Plant/Out yaw rate and, when the model has them, lateral acceleration and sideslip; the
-// wheelbase (unset = the distance between the foremost and the rearmost tire along the heading).
+// wheelbase (unset = the distance between the foremost and the rearmost tire along the heading);
+// the steering ratio: steer input per road-wheel angle (unset = 1: the steer is the road wheels'
+// angle; a steering wheel's angle through a 16:1 gear is 16).
 struct HandlingSpec {
   std::string steer, yaw_rate, lateral_acceleration, sideslip;
-  std::optional<double> wheelbase;
+  std::optional<double> wheelbase, steering_ratio;
   bool operator==(const HandlingSpec&) const = default;
 };
 

@@ -584,7 +584,7 @@ HandlingNumbers study_handling(const Model& m, const StudyLinearization& sl) {
     }
   }
   try {
-    return handling_numbers(body_axes, steer, yaw, ay, beta, speed, L);
+    return handling_numbers(body_axes, steer, yaw, ay, beta, speed, L, hs.steering_ratio.value_or(1.0));
   } catch (const std::invalid_argument& e) {
     workflow_fail(m, "handling", e.what());
   }
@@ -609,7 +609,8 @@ std::string study_motion_text(const Model& m, const OperatingPoint& op) {
     if (j.parent == 0 && (jm.yaw_rate != 0 || jm.velocity.squaredNorm() > 0)) {
       std::ostringstream p;
       p.precision(6);
-      if (jm.yaw_rate == 0) p << "straight";
+      // a path of a radius beyond 1e9 m (a yaw rate at round-off) is straight for every purpose
+      if (jm.yaw_rate == 0 || jm.velocity.norm() > 1e9 * std::abs(jm.yaw_rate)) p << "straight";
       else p << "yaw rate " << jm.yaw_rate << " rad/s (path radius " << jm.velocity.norm() / std::abs(jm.yaw_rate) << " m)";
       parts += p.str();
     }
@@ -635,13 +636,15 @@ std::string study_motion_text(const Model& m, const OperatingPoint& op) {
 std::string study_handling_text(const HandlingNumbers& h) {
   std::ostringstream os;
   os.precision(6);
-  os << "handling numbers at " << h.speed << " m/s, wheelbase " << h.wheelbase << " m\n"
+  os << "handling numbers at " << h.speed << " m/s, wheelbase " << h.wheelbase << " m";
+  if (h.steering_ratio != 1.0) os << ", steering ratio " << h.steering_ratio << " (steer per road-wheel angle)";
+  os << "\n"
      << "  yaw-rate gain              " << h.yaw_rate_gain << " 1/s (yaw rate per steer angle, steady state)\n"
      << "  lateral-acceleration gain  " << h.lateral_acceleration_gain << " m/s^2 per rad"
      << (h.lateral_acceleration_output ? "" : " (speed x yaw-rate gain)") << "\n";
   if (h.sideslip_given) os << "  sideslip gain              " << h.sideslip_gain << " per rad\n";
   os << "  understeer gradient        " << h.understeer_gradient << " rad/(m/s^2) = " << h.understeer_gradient_deg_per_g
-     << " deg/g\n";
+     << " deg/g" << (h.steering_ratio != 1.0 ? " (road-wheel angle)" : "") << "\n";
   if (h.characteristic_speed > 0) os << "  characteristic speed       " << h.characteristic_speed << " m/s (understeer)\n";
   if (h.critical_speed > 0) os << "  critical speed             " << h.critical_speed << " m/s (oversteer)\n";
   if (h.yaw_natural_frequency > 0)
@@ -664,6 +667,7 @@ StudyLinearization study_linearize(const Model& m) {
     const HandlingNumbers& h = *out.handling;
     out.lin.system.handling = {{"speed", h.speed},
                                {"wheelbase", h.wheelbase},
+                               {"steering_ratio", h.steering_ratio},
                                {"yaw_rate_gain", h.yaw_rate_gain},
                                {"lateral_acceleration_gain", h.lateral_acceleration_gain},
                                {"understeer_gradient", h.understeer_gradient},
