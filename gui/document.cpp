@@ -174,9 +174,13 @@ bool Document::save(QString* error) {
 
 bool Document::saveAs(const QString& path, QString* error) {
   try {
+    // the model's relative file references (a tire's .tir, the study's files) keep naming the
+    // same files from the new folder
+    const ModelSpec moved_spec = study_rebase_paths(spec_, ss(path_), ss(path));
     // a file that would not load again is not written (the one on disk stays as it was)
-    (void)study_parse_model(study_model_json(spec_), ss(path));
-    study_save_model(spec_, ss(path));
+    (void)study_parse_model(study_model_json(moved_spec), ss(path));
+    study_save_model(moved_spec, ss(path));
+    if (study_model_json(moved_spec) != study_model_json(spec_)) restore(moved_spec);
   } catch (const std::exception& e) {
     if (error) *error = qs(e.what());
     return false;  // still modified

@@ -73,8 +73,15 @@ STEEL = [0.55, 0.55, 0.6, 1]
 TIRE_BLACK = [0.08, 0.08, 0.08, 1]
 
 # the chassis
+# drawn as a frame (two side rails, cross members) and a cabin above the axles' parts, so that the
+# suspension stays in sight and every part can be picked in the 3-D view
+RED = [0.62, 0.1, 0.1, 1]
 body("chassis", M_CHASSIS, [520, 2100, 2300],
-     [{"type": "box", "size": [4.4, 1.7, 0.55], "frame": {"position": [-0.15, 0, 0.25]}, "color": [0.62, 0.1, 0.1, 1]}])
+     [{"type": "box", "size": [3.9, 0.08, 0.1], "frame": {"position": [-0.1, 0.3, 0.2]}, "color": RED},
+      {"type": "box", "size": [3.9, 0.08, 0.1], "frame": {"position": [-0.1, -0.3, 0.2]}, "color": RED},
+      {"type": "box", "size": [0.08, 0.52, 0.08], "frame": {"position": [1.7, 0, 0.2]}, "color": RED},
+      {"type": "box", "size": [0.08, 0.52, 0.08], "frame": {"position": [-1.95, 0, 0.2]}, "color": RED},
+      {"type": "box", "size": [1.4, 1.2, 0.4], "frame": {"position": [-0.3, 0, 0.75]}, "color": [0.62, 0.1, 0.1, 0.6]}])
 joints.append({"name": "body", "type": "free", "parent": "ground", "child": "chassis",
                "q0": [0, 0, 0.55, 1, 0, 0, 0], "v0": [0, 0, 0, SPEED, 0, 0]})
 
@@ -84,9 +91,9 @@ joints.append({"name": "body", "type": "free", "parent": "ground", "child": "cha
 SW = [0.55, 0.37, 0.30]
 COLUMN_STIFFNESS, COLUMN_DAMPING = 2000.0, 5.0   # N m/rad, N m s/rad at the steering wheel
 body("steering_wheel", 0, [0, 0, 0],
-     [{"type": "cylinder", "radius": 0.19, "length": 0.03, "frame": {"rotation": {"axis": [0, 1, 0], "angle": math.pi / 2}}, "color": [0.1, 0.1, 0.1, 1]}])
+     [{"type": "cylinder", "radius": 0.19, "length": 0.12, "frame": {"rotation": {"axis": [0, 1, 0], "angle": math.pi / 2}}, "color": [0.55, 0.55, 0.6, 1]}])
 joint("steering_column", "revolute", "chassis", "steering_wheel", SW, axis=[-1, 0, 0])
-body("steering_shaft", 1.0, [0.01, 0.005, 0.005], [rod([0, 0, 0], [0.45, 0, -0.4], 0.015, STEEL)])
+body("steering_shaft", 1.0, [0.01, 0.005, 0.005], [rod([0.08, 0, -0.07], [0.45, 0, -0.4], 0.015, STEEL)])
 joint("steering_shaft", "revolute", "chassis", "steering_shaft", SW, axis=[-1, 0, 0])
 effects.append({"name": "column_torsion", "type": "bushing", "body_a": "steering_wheel", "body_b": "steering_shaft",
                 "rotational_stiffness": [COLUMN_STIFFNESS, 0, 0]})
@@ -210,7 +217,11 @@ for t in ("fl", "fr", "rl", "rr"):
 model = {
     "codyna_model": 1,
     "name": "sedan",
-    "description": "",
+    "description": ("A full car for issue 39 (docs/vehicles.md, The sedan), written by scripts/make_sedan.py: chassis on a free joint, "
+                    "double-wishbone front suspension steered by the steering wheel (motion input steer, rad at the wheel) through a "
+                    "compliant column, a 16:1 pinion and a rack with tie rods; trailing-arm rear; coil-overs; anti-roll bars; "
+                    "Magic Formula 6.1 tires; drive and brake torques. Operating point: steady, straight at 25 m/s, steer and drive solved; "
+                    "a turn: --lateral-acceleration 3.92266 (0.4 g). Plant/In steer; Plant/Out yaw rate, lateral acceleration, roll rate."),
     "bodies": bodies, "joints": joints, "constraints": constraints, "effects": effects,
     "actuators": actuators, "sensors": sensors,
     "plant": {"inputs": ["steer"], "outputs": ["yaw_rate", "lateral_acceleration", "roll_rate"]},

@@ -36,6 +36,9 @@ struct HandlingNumbers {
   double characteristic_speed = 0;                     // m/s, K > 0 (0 otherwise)
   double critical_speed = 0;                           // m/s, K < 0 (0 otherwise)
   double yaw_natural_frequency = 0, yaw_damping_ratio = 0;
+  // taken in a turn (the caller says): the gains hold the other inputs (a drive torque), not the
+  // speed, so they are not the constant-speed gains of the bicycle model
+  bool in_turn = false;
 };
 
 // sys: the plant; steer: its input's index; yaw_rate, lateral_acceleration, sideslip: output

@@ -251,6 +251,9 @@ struct SteadySearch {
   // moves the iterate to xi
   void accept(const Eigen::VectorXd& xi) {
     Trial t = trial(xi);
+    // a motion input's coordinate is where its value puts it (the plant function reads the value;
+    // the operating point's q must say the same: the steering wheel turned by the steer found)
+    for (int k : m.motions) q[m.actuators[static_cast<std::size_t>(k)].iq] = t.u_all[k];
     PlantFunction f(m, q, t.u_all, part);
     f.state_to_qv(t.x, q, v);
     normalize(m, q);

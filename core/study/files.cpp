@@ -5,6 +5,8 @@
 #include "io/model_file.hpp"
 #include "io/results_file.hpp"
 
+#include <filesystem>
+
 namespace codyna {
 
 ModelSpec study_read_model(const std::string& path) { return load_model_spec(path); }
@@ -14,6 +16,27 @@ ModelSpec study_parse_model_text(const std::string& text, const std::string& lab
 }
 nlohmann::json study_model_json(const ModelSpec& spec) { return to_json(spec); }
 void study_save_model(const ModelSpec& spec, const std::string& path) { save_model_spec(spec, path); }
+
+ModelSpec study_rebase_paths(ModelSpec spec, const std::string& from, const std::string& to) {
+  namespace fs = std::filesystem;
+  if (from.empty() || to.empty()) return spec;
+  const fs::path old_dir = fs::absolute(fs::path(from)).parent_path().lexically_normal();
+  const fs::path new_dir = fs::absolute(fs::path(to)).parent_path().lexically_normal();
+  if (old_dir == new_dir) return spec;
+  const auto rebase = [&](std::string& p) {
+    if (p.empty() || fs::path(p).is_absolute()) return;
+    const fs::path target = (old_dir / p).lexically_normal();
+    const fs::path rel = target.lexically_relative(new_dir);
+    p = (rel.empty() ? target : rel).generic_string();
+  };
+  for (EffectSpec& e : spec.effects) rebase(e.file);
+  StudySpec& s = spec.analysis;
+  rebase(s.controller_file);
+  rebase(s.export_dir);
+  for (SignalSpec& r : s.references) rebase(r.file);
+  for (DisturbanceSpec& d : s.disturbances) rebase(d.file);
+  return spec;
+}
 
 void study_write_results(const SimulationResult& r, const std::string& hdf5_path, const std::string& csv_path) {
   write_results(r, hdf5_path, csv_path);

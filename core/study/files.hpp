@@ -26,6 +26,12 @@ ModelSpec study_parse_model_text(const std::string& text, const std::string& lab
 nlohmann::json study_model_json(const ModelSpec& spec);
 // Writes the model file atomically (a temporary file renamed into place).
 void study_save_model(const ModelSpec& spec, const std::string& path);
+// The model's references to other files are relative to the model file's folder (a tire's .tir
+// `file`, the study's `controller_file` and `export_dir`, a reference's or disturbance's `file`):
+// the model moved from the file `from` to the file `to` (Save As into another folder) names the
+// same files again. Relative paths are rewritten relative to `to`'s folder (lexically, as short
+// as they come: "../examples/tires/x.tir"); absolute ones and empty ones stay. `from` empty: as is.
+ModelSpec study_rebase_paths(ModelSpec spec, const std::string& from, const std::string& to);
 
 // Results: HDF5 and/or CSV (an empty path is skipped), each atomically.
 void study_write_results(const SimulationResult& r, const std::string& hdf5_path, const std::string& csv_path = "");

@@ -584,7 +584,10 @@ HandlingNumbers study_handling(const Model& m, const StudyLinearization& sl) {
     }
   }
   try {
-    return handling_numbers(body_axes, steer, yaw, ay, beta, speed, L, hs.steering_ratio.value_or(1.0));
+    HandlingNumbers out = handling_numbers(body_axes, steer, yaw, ay, beta, speed, L, hs.steering_ratio.value_or(1.0));
+    for (const JointMotion& jm : sl.op.motion->joints)
+      out.in_turn = out.in_turn || (jm.yaw_rate != 0 && jm.velocity.norm() < 1e9 * std::abs(jm.yaw_rate));
+    return out;
   } catch (const std::invalid_argument& e) {
     workflow_fail(m, "handling", e.what());
   }
@@ -649,6 +652,8 @@ std::string study_handling_text(const HandlingNumbers& h) {
   if (h.critical_speed > 0) os << "  critical speed             " << h.critical_speed << " m/s (oversteer)\n";
   if (h.yaw_natural_frequency > 0)
     os << "  yaw natural frequency      " << h.yaw_natural_frequency << " rad/s, damping ratio " << h.yaw_damping_ratio << "\n";
+  if (h.in_turn)
+    os << "  (in a turn: the gains hold the other inputs, e.g. a drive, not the speed; they are not the constant-speed gains)\n";
   return os.str();
 }
 

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "io/model_file.hpp"
+#include "study/files.hpp"
 #include "test_util.hpp"
 
 namespace codyna::test {
@@ -67,7 +68,8 @@ TEST_P(ExampleRoundTrip, SaveLoadGivesSameSpecAndSameBytes) {
   const std::string first = (dir.path() / "first.json").string();
   const std::string second = (dir.path() / "second.json").string();
 
-  const ModelSpec original = load_model_spec(source);
+  // moved to another folder, its relative file references (the sedan's .tir) are rewritten
+  const ModelSpec original = study_rebase_paths(load_model_spec(source), source, first);
   save_model_spec(original, first);
   const ModelSpec reloaded = load_model_spec(first);
   const nlohmann::json a = to_json(original), b = to_json(reloaded);
@@ -90,6 +92,33 @@ std::string test_name(const testing::TestParamInfo<std::string>& info) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Examples, ExampleRoundTrip, testing::ValuesIn(example_files()), test_name);
+
+TEST(RebasePaths, RelativeReferencesNameTheSameFilesFromTheNewFolder) {
+  ModelSpec spec = load_model_spec(example_path("sedan.json"));
+  spec.analysis.controller_file = "gains/k.mat";
+  spec.analysis.export_dir = "/abs/out";
+  SignalSpec r;
+  r.type = "file";
+  r.file = "road.csv";
+  spec.analysis.references.push_back(r);
+  const ModelSpec moved = study_rebase_paths(spec, "/a/b/model.json", "/a/c/d/copy.json");
+  for (const EffectSpec& e : moved.effects)
+    if (e.type == EffectType::Tire) EXPECT_EQ(e.file, "../../b/tires/MagicFormula61_Paramerters.tir");
+  EXPECT_EQ(moved.analysis.controller_file, "../../b/gains/k.mat");
+  EXPECT_EQ(moved.analysis.export_dir, "/abs/out");  // absolute: as it was
+  EXPECT_EQ(moved.analysis.references.at(0).file, "../../b/road.csv");
+  // into a subfolder and back: the same text; the same folder: untouched
+  const ModelSpec back = study_rebase_paths(moved, "/a/c/d/copy.json", "/a/b/again.json");
+  EXPECT_EQ(back.analysis.controller_file, "gains/k.mat");
+  EXPECT_EQ(back.analysis.references.at(0).file, "road.csv");
+  EXPECT_EQ(to_json(study_rebase_paths(spec, "/a/b/model.json", "/a/b/other.json")), to_json(spec));
+  // and the sedan saved elsewhere compiles there, its tires found
+  const ScratchDir dir;
+  const std::string copy = (dir.path() / "sub" / "sedan_copy.json").string();
+  fs::create_directories(dir.path() / "sub");
+  save_model_spec(study_rebase_paths(load_model_spec(example_path("sedan.json")), example_path("sedan.json"), copy), copy);
+  EXPECT_NO_THROW((void)compile(load_model_spec(copy), copy));
+}
 
 TEST(ExampleFiles, AreFound) { EXPECT_GE(example_files().size(), 5u) << CODYNA_EXAMPLES_DIR; }
 

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "analysis/linearize.hpp"
+#include "analysis/plant_function.hpp"
 #include "analysis/steady_motion.hpp"
 #include "dynamics/data.hpp"
 #include "dynamics/kinematics.hpp"
@@ -145,4 +146,62 @@ TEST(Sedan, ASteadyTurnIsTheSameMotionAllAlongAndASimulationStaysOnIt) {
   EXPECT_LT(worst_v, 1e-6);
   std::printf("[ Sedan ] 2 s on the turn from its steady state: |radius - R| %.2e m, |w - w0| %.2e rad/s, |v - v0| %.2e m/s\n",
               worst_radius, worst_rate, worst_v);
+}
+
+// The analytic Jacobian (TreeDerivatives through the closed loops, the tires, the bushing, the
+// steering motion's value, rate and acceleration columns) equals automatic differentiation of the
+// same plant function: at the model's start (off equilibrium: the springs' design lengths, every
+// acceleration non-zero) and on the 0.4 g turn, braking and accelerating there
+TEST(Sedan, TheAnalyticJacobianEqualsAutodiffOffEquilibriumAndInATurn) {
+  const Model start = sedan_model(0);
+  const Model turn = sedan_model(0.4 * 9.80665);
+  const StudyLinearization sl = study_linearize(turn);
+  const int brake = turn.find_actuator("brake");
+  ASSERT_GE(brake, 0);
+  struct Case {
+    const char* label;
+    const Model* m;
+    Eigen::VectorXd q, v, u;
+  };
+  std::vector<Case> cases{{"start", &start, start.q0, start.v0, start.u_nominal()},
+                          {"turn", &turn, sl.op.q, sl.op.v, sl.op.u}};
+  Case braking = cases[1], accelerating = cases[1];
+  braking.label = "turn, braking 800 N m";
+  braking.u[brake] = 800;
+  accelerating.label = "turn, accelerating";
+  accelerating.u[turn.find_actuator("drive")] += 600;
+  cases.push_back(braking);
+  cases.push_back(accelerating);
+  for (const Case& c : cases) {
+    const CoordinatePartition p = partition_coordinates(*c.m, c.q, c.m->spec.analysis.independent);
+    const PlantFunction f(*c.m, c.q, c.u, p);
+    Eigen::VectorXd x = f.qv_to_state(c.q, c.v);
+    x.head(f.nz()).setZero();  // at the reference itself (its round-off), as linearize takes it
+    Eigen::VectorXd u(f.nu() + 2 * f.nm());
+    u.setZero();
+    for (int k = 0; k < f.nu(); ++k) u[k] = c.u[c.m->plant_inputs[static_cast<std::size_t>(k)]];
+    // the steer's value where its coordinate is (the analytic path is taken there)
+    for (int j = 0; j < f.nm(); ++j) {
+      const int k = f.motion_inputs()[j];
+      const double at = c.q[c.m->actuators[static_cast<std::size_t>(c.m->plant_inputs[static_cast<std::size_t>(k)])].iq];
+      EXPECT_NEAR(u[k], at, 1e-12) << c.label;
+      u[k] = at;
+    }
+    u[f.nu()] = 0.3;            // the steering wheel turning, and accelerating
+    u[f.nu() + f.nm()] = 0.3;
+    Eigen::MatrixXd analytic;
+    ASSERT_TRUE(f.analytic_jacobian(x, u, analytic)) << c.label;
+    const Eigen::MatrixXd ad = plant_jacobian_autodiff(f, x, u);
+    const double scale = ad.cwiseAbs().maxCoeff();
+    Eigen::Index ir = 0, ic = 0;
+    const double e = (analytic - ad).cwiseAbs().maxCoeff(&ir, &ic) / scale;
+    EXPECT_LT(e, 1e-10) << c.label << " at (" << ir << ", " << ic << "): " << analytic(ir, ic) << " vs " << ad(ir, ic);
+    // row by row for the outputs (C, D), which are small beside A's entries
+    const Eigen::Index ny = f.ny();
+    const double ec = (analytic.bottomRows(ny) - ad.bottomRows(ny)).cwiseAbs().maxCoeff() /
+                      std::max(1.0, ad.bottomRows(ny).cwiseAbs().maxCoeff());
+    EXPECT_LT(ec, 1e-10) << c.label << " (outputs)";
+    std::printf("[ Sedan ] %-24s analytic against autodiff: %.2e (outputs %.2e), of %lld x %lld\n", c.label, e, ec,
+                static_cast<long long>(analytic.rows()), static_cast<long long>(analytic.cols()));
+  }
 }
