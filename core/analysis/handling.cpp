@@ -59,6 +59,43 @@ Eigen::VectorXd steady_gain(const LinearSystem& s, int in, const std::vector<int
   return y;
 }
 
+// The same with some inputs free and some outputs held at zero: [A B_h; C_z D_zh] [x; u_h] =
+// -[b; d_z], the smallest [x; u_h] (a drive torque that holds the speed: u_h the drive, the held
+// output the speed's change)
+Eigen::VectorXd held_steady_gain(const LinearSystem& s, int in, const std::vector<int>& outputs, const std::vector<int>& free_in,
+                                 const std::vector<int>& held_out) {
+  const Eigen::Index n = s.A.rows(), nh = static_cast<Eigen::Index>(free_in.size()), nz = static_cast<Eigen::Index>(held_out.size());
+  Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n + nz, n + nh);
+  Eigen::VectorXd rhs(n + nz);
+  M.topLeftCorner(n, n) = s.A;
+  rhs.head(n) = -s.B.col(in);
+  for (Eigen::Index j = 0; j < nh; ++j) M.block(0, n + j, n, 1) = s.B.col(free_in[static_cast<std::size_t>(j)]);
+  for (Eigen::Index i = 0; i < nz; ++i) {
+    const int r = held_out[static_cast<std::size_t>(i)];
+    M.block(n + i, 0, 1, n) = s.C.row(r);
+    for (Eigen::Index j = 0; j < nh; ++j) M(n + i, n + j) = s.D(r, free_in[static_cast<std::size_t>(j)]);
+    rhs[n + i] = -s.D(r, in);
+  }
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(M, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  svd.setThreshold(1e-10);
+  const Eigen::VectorXd xu = svd.solve(rhs);
+  if ((M * xu - rhs).norm() > 1e-8 * std::max(rhs.norm(), 1e-300))
+    throw std::invalid_argument("the steer input has no steady state with the speed held (the free inputs cannot hold it)");
+  const Eigen::Index rank = svd.rank();
+  const Eigen::MatrixXd N = svd.matrixV().rightCols(M.cols() - rank);
+  Eigen::VectorXd y(static_cast<Eigen::Index>(outputs.size()));
+  for (std::size_t k = 0; k < outputs.size(); ++k) {
+    Eigen::RowVectorXd row(n + nh);
+    row.head(n) = s.C.row(outputs[k]);
+    for (Eigen::Index j = 0; j < nh; ++j) row[n + j] = s.D(outputs[k], free_in[static_cast<std::size_t>(j)]);
+    if (N.cols() > 0 && (row * N).cwiseAbs().maxCoeff() > 1e-8 * std::max(row.cwiseAbs().maxCoeff(), 1e-300))
+      throw std::invalid_argument("the steady-state value of output \"" + s.output_names[static_cast<std::size_t>(outputs[k])] +
+                                  "\" is not defined: it depends on a state that stays where it is put (a neutral mode)");
+    y[static_cast<Eigen::Index>(k)] = row.dot(xu) + s.D(outputs[k], in);
+  }
+  return y;
+}
+
 // The part of the state a steady motion may leave drifting: the largest subspace S of positions
 // (no velocity part) that the outputs `rows` do not read (C S = 0) and that the dynamics keep (A S
 // inside S): the road position, the heading, the wheels' spin angles, in whatever combination of
@@ -102,7 +139,7 @@ LinearSystem on_directions(const LinearSystem& s, const Eigen::MatrixXd& T) {
 }  // namespace
 
 HandlingNumbers handling_numbers(const LinearSystem& sys, int steer, int yaw_rate, int lateral_acceleration, int sideslip,
-                                 double speed, double wheelbase, double steering_ratio) {
+                                 double speed, double wheelbase, double steering_ratio, const SpeedHold* hold) {
   if (steer < 0 || steer >= sys.B.cols()) throw std::invalid_argument("handling: no steer input among Plant/In");
   if (yaw_rate < 0 || yaw_rate >= sys.C.rows()) throw std::invalid_argument("handling: no yaw-rate output among Plant/Out");
   if (!(speed > 0)) throw std::invalid_argument("handling: the forward speed must be > 0 (it is " + std::to_string(speed) + " m/s)");
@@ -117,8 +154,31 @@ HandlingNumbers handling_numbers(const LinearSystem& sys, int steer, int yaw_rat
   if (lateral_acceleration >= 0) outs.push_back(lateral_acceleration);
   if (sideslip >= 0) outs.push_back(sideslip);
   // less what may drift unseen (the road position, the heading, the spin angles)
+  Eigen::VectorXd g;
+  if (hold && hold->B.cols() > 0) {
+    // the speed held by the free inputs: the system with their columns and the speed's row
+    const Eigen::Index n = sys.A.rows(), nu = sys.B.cols(), nh = hold->B.cols(), ny = sys.C.rows();
+    if (hold->B.rows() != n || hold->D.rows() != ny || hold->D.cols() != nh || hold->speed.size() != n)
+      throw std::invalid_argument("handling: the speed hold's matrices do not fit the plant");
+    LinearSystem aug = sys;
+    aug.B.resize(n, nu + nh);
+    aug.B << sys.B, hold->B;
+    aug.C.resize(ny + 1, n);
+    aug.C << sys.C, hold->speed;
+    aug.D = Eigen::MatrixXd::Zero(ny + 1, nu + nh);
+    aug.D.topLeftCorner(ny, nu) = sys.D;
+    aug.D.topRightCorner(ny, nh) = hold->D;
+    aug.output_names.push_back("speed");
+    std::vector<int> seen = outs, free_in;
+    seen.push_back(static_cast<int>(ny));
+    for (Eigen::Index j = 0; j < nh; ++j) free_in.push_back(static_cast<int>(nu + j));
+    const LinearSystem red = on_directions(aug, kept_directions(aug, seen));
+    g = held_steady_gain(red, steer, outs, free_in, {static_cast<int>(ny)});
+    h.speed_held = true;
+  } else {
+    g = steady_gain(on_directions(sys, kept_directions(sys, outs)), steer, outs);
+  }
   const LinearSystem red = on_directions(sys, kept_directions(sys, outs));
-  const Eigen::VectorXd g = steady_gain(red, steer, outs);
   h.yaw_rate_gain = g[0];
   h.lateral_acceleration_output = lateral_acceleration >= 0;
   h.lateral_acceleration_gain = lateral_acceleration >= 0 ? g[1] : speed * g[0];

@@ -39,6 +39,15 @@ struct HandlingNumbers {
   // taken in a turn (the caller says): the gains hold the other inputs (a drive torque), not the
   // speed, so they are not the constant-speed gains of the bicycle model
   bool in_turn = false;
+  bool speed_held = false;  // the gains hold the speed (SpeedHold given)
+};
+
+// The speed held in the steady state by some inputs that are not Plant/In (a drive torque): their
+// columns of B and D in the same linearization, and the row of the speed's change in the state
+// (the steady body's velocity direction). The gains are then the constant-speed gains.
+struct SpeedHold {
+  Eigen::MatrixXd B, D;    // [nx x nh], [ny x nh]
+  Eigen::RowVectorXd speed;  // [nx]
 };
 
 // sys: the plant; steer: its input's index; yaw_rate, lateral_acceleration, sideslip: output
@@ -47,6 +56,7 @@ struct HandlingNumbers {
 // angle, K = 1 / (ratio G_ay) - L / U^2). Throws std::invalid_argument when a gain is not defined
 // (the steady state is not unique, or the steer does not reach the yaw rate).
 HandlingNumbers handling_numbers(const LinearSystem& sys, int steer, int yaw_rate, int lateral_acceleration, int sideslip,
-                                 double speed, double wheelbase, double steering_ratio = 1.0);
+                                 double speed, double wheelbase, double steering_ratio = 1.0,
+                                 const SpeedHold* hold = nullptr);
 
 }  // namespace codyna

@@ -223,13 +223,18 @@ const VecXT<S>& prescribed_dynamics(const Model& model, DataT<S>& d, const VecXT
   }
   d.qdd.setZero(nv);
   d.lambda.setZero(model.nc);
+  // one derivative size for every entry the solves below combine (a constant's empty vector
+  // beside a variable's inside a product is lost: a drive torque's column of B came out zero)
+  const Eigen::Index nd = std::max({ad_size(Mff), ad_size(B), ad_size(d.gamma), ad_size(d.motion_acc), ad_size(v)});
+  ad_make_coherent(Mff, nd);
+  ad_make_coherent(B, nd);
   if (nf > 0) {
     const MatXT<S> X = cholesky_solve<S>(Mff, B);
     VecXT<S> qf = X.col(0);
     if (na > 0) {
       VecXT<S> crhs(na);
       for (int k = 0; k < na; ++k) {
-        crhs[k] = d.gamma[rows[k]];
+        crhs[k] = ad_coherent(d.gamma[rows[k]], nd);
         for (int j = 0; j < nm; ++j) {
           const S p = d.Jc(rows[k], dr[j]) * d.motion_acc[j];
           crhs[k] = crhs[k] + p;

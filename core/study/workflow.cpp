@@ -546,6 +546,7 @@ HandlingNumbers study_handling(const Model& m, const StudyLinearization& sl) {
   // a planar joint's velocities are the world's: in body axes, dv_b = Rz(-psi0) (dv - J v0 dpsi)
   // (J the quarter turn), the heading no longer reaches the velocities and a steady turn is steady
   LinearSystem body_axes = sys;
+  Eigen::MatrixXd T_axes = Eigen::MatrixXd::Identity(sys.nx(), sys.nx());
   {
     const CoordinatePartition& part = sl.lin.partition;
     const std::vector<int> rates = part.rates();
@@ -577,14 +578,86 @@ HandlingNumbers study_handling(const Model& m, const StudyLinearization& sl) {
       any = true;
     }
     if (any) {
+      T_axes = T;
       const Eigen::MatrixXd Ti = T.inverse();
       body_axes.A = T * sys.A * Ti;
       body_axes.B = T * sys.B;
       body_axes.C = sys.C * Ti;
     }
   }
+  // the speed held by the steady motion's other free inputs (a drive torque): their B and D columns
+  // (a linearization with them among the inputs, when they are not Plant/In) and the row of the
+  // speed's change, v^ . (dv + dw x c) in the steady body's axes (v^ its centre of mass' velocity
+  // direction, c the centre of mass from the joint's origin)
+  SpeedHold hold;
+  {
+    std::vector<int> holders;
+    const int steer_act = m.plant_inputs[static_cast<std::size_t>(steer)];
+    for (const std::string& name : m.spec.analysis.free_inputs) {
+      const int k = m.find_actuator(name);
+      if (k >= 0 && k != steer_act) holders.push_back(k);
+    }
+    const JointModel& j = m.joints[static_cast<std::size_t>(body)];
+    const CoordinatePartition& part = sl.lin.partition;
+    const std::vector<int> rates = part.rates();
+    const int nz = static_cast<int>(part.independent.size());
+    const auto state_of = [&](int iv) {
+      const auto it = std::find(rates.begin(), rates.end(), iv);
+      return it == rates.end() ? -1 : nz + static_cast<int>(it - rates.begin());
+    };
+    Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(sys.nx());
+    bool row_ok = !holders.empty();
+    if (row_ok && j.type == JointType::Free) {
+      const Eigen::Vector3d w = sl.op.v.segment<3>(j.idx_v), vo = sl.op.v.segment<3>(j.idx_v + 3);
+      const Eigen::Vector3d c = j.X_CM.R.transpose() * (m.com[static_cast<std::size_t>(body)] - j.X_CM.p);
+      const Eigen::Vector3d vc = vo + w.cross(c);
+      const Eigen::Vector3d dir = vc / std::max(vc.norm(), 1e-300), cw = c.cross(dir);
+      for (int a = 0; a < 3; ++a) {
+        const int sv = state_of(j.idx_v + 3 + a), sw = state_of(j.idx_v + a);
+        row_ok = row_ok && sv >= 0 && sw >= 0;
+        if (sv >= 0) row[sv] = dir[a];
+        if (sw >= 0) row[sw] = cw[a];
+      }
+    } else if (row_ok && j.type == JointType::Planar) {
+      // body_axes' rows of the planar velocities are already in the body's axes
+      const double psi = sl.op.q[j.idx_q + 2];
+      const Eigen::Vector2d vw(sl.op.v[j.idx_v], sl.op.v[j.idx_v + 1]);
+      const Eigen::Vector2d vb(std::cos(psi) * vw.x() + std::sin(psi) * vw.y(), -std::sin(psi) * vw.x() + std::cos(psi) * vw.y());
+      const Eigen::Vector2d dir = vb / std::max(vb.norm(), 1e-300);
+      const int sx = state_of(j.idx_v), sy = state_of(j.idx_v + 1);
+      row_ok = sx >= 0 && sy >= 0;
+      if (row_ok) row[sx] = dir.x(), row[sy] = dir.y();
+    } else {
+      row_ok = false;
+    }
+    if (row_ok) {
+      Model with = m;
+      for (int k : holders)
+        if (std::find(with.plant_inputs.begin(), with.plant_inputs.end(), k) == with.plant_inputs.end()) with.plant_inputs.push_back(k);
+      // their columns by central differences: automatic differentiation loses a joint torque's
+      // column on some models with motion inputs (the sedan's left rear drive: an open bug), and
+      // these columns enter only the steady-state gains
+      LinearizeOptions o;
+      o.method = JacobianMethod::CentralDifference;
+      o.independent = m.spec.analysis.independent;
+      const Linearization lw = linearize(with, sl.op, o);
+      if (lw.system.state_names == sys.state_names && lw.system.A.rows() == sys.A.rows()) {
+        hold.B.resize(sys.nx(), static_cast<Eigen::Index>(holders.size()));
+        hold.D.resize(sys.C.rows(), static_cast<Eigen::Index>(holders.size()));
+        for (std::size_t h = 0; h < holders.size(); ++h) {
+          const auto at = std::find(with.plant_inputs.begin(), with.plant_inputs.end(), holders[h]) - with.plant_inputs.begin();
+          hold.B.col(static_cast<Eigen::Index>(h)) = lw.system.B.col(at);
+          hold.D.col(static_cast<Eigen::Index>(h)) = lw.system.D.col(at);
+        }
+        // in the body's axes, as body_axes (the planar velocities turned by T; B's rows alike)
+        hold.B = T_axes * hold.B;
+        hold.speed = row;
+      }
+    }
+  }
   try {
-    HandlingNumbers out = handling_numbers(body_axes, steer, yaw, ay, beta, speed, L, hs.steering_ratio.value_or(1.0));
+    HandlingNumbers out = handling_numbers(body_axes, steer, yaw, ay, beta, speed, L, hs.steering_ratio.value_or(1.0),
+                                           hold.B.cols() > 0 ? &hold : nullptr);
     for (const JointMotion& jm : sl.op.motion->joints)
       out.in_turn = out.in_turn || (jm.yaw_rate != 0 && jm.velocity.norm() < 1e9 * std::abs(jm.yaw_rate));
     return out;
@@ -652,8 +725,9 @@ std::string study_handling_text(const HandlingNumbers& h) {
   if (h.critical_speed > 0) os << "  critical speed             " << h.critical_speed << " m/s (oversteer)\n";
   if (h.yaw_natural_frequency > 0)
     os << "  yaw natural frequency      " << h.yaw_natural_frequency << " rad/s, damping ratio " << h.yaw_damping_ratio << "\n";
-  if (h.in_turn)
-    os << "  (in a turn: the gains hold the other inputs, e.g. a drive, not the speed; they are not the constant-speed gains)\n";
+  if (h.speed_held) os << "  (the speed held by the other free inputs: constant-speed gains)\n";
+  else if (h.in_turn)
+    os << "  (in a turn: the gains hold the other inputs, not the speed: free a drive to hold it; they are not the constant-speed gains)\n";
   return os.str();
 }
 
