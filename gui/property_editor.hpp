@@ -35,6 +35,10 @@ class PropertyEditor : public QWidget {
   // applies `text` as the new value of `field` (what typing + Enter does); false with *error when rejected
   bool applyText(const QString& field, const QString& text, QString* error = nullptr);
 
+  // a tire's "..." beside its file: a file dialog (objectName "tireFileDialog", Qt's own, window-modal)
+  // whose chosen .tir is stored relative to the model file
+  void chooseTireFile();
+
   static QString unitOf(const QString& key);
   // the tooltip of a field: what it means, with its unit (`type`: the element's type, where a
   // field means something of its own for it: a rolling_ball's axis_a is its plane's normal)
