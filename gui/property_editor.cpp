@@ -535,6 +535,13 @@ bool PropertyEditor::applyText(const QString& field, const QString& text, QStrin
             element[key] = 0.05;
           } else if (key == "law") {  // a tire: linear until another law is picked
             element[key] = "linear";
+          } else if (key == "tire" && id_->kind == ElementKind::Sensor) {  // a tire sensor: the first tire
+            std::string first;
+            for (const auto& e : spec.effects)
+              if (e.type == EffectType::Tire && first.empty()) first = e.name;
+            element[key] = first;
+          } else if (key == "quantity") {
+            element[key] = kTireQuantityNames[0];
           } else {
             break;
           }
@@ -740,11 +747,15 @@ void PropertyEditor::rebuild() {
     QWidget* row = nullptr;  // what the form holds, when not the editor alone
     const QString last = key.section('/', -1);
     const bool shape_type = key.startsWith("shapes/") && last == "type";
-    if (tire && (key == QLatin1String("law") || key == QLatin1String("side")) && v.is_string()) {
-      // a tire's law and side: picked from their lists (the side: as the .tir file says, or one)
+    if (v.is_string() && ((tire && (key == QLatin1String("law") || key == QLatin1String("side"))) ||
+                          (kind == ElementKind::Sensor && key == QLatin1String("quantity")))) {
+      // a tire's law and side, a tire sensor's quantity: picked from their lists (the side: as the
+      // .tir file says, or one)
       auto* c = new QComboBox;
       if (key == QLatin1String("law")) {
         for (const char* law : kTireLawNames) c->addItem(QString::fromLatin1(law));
+      } else if (key == QLatin1String("quantity")) {
+        for (const char* q : kTireQuantityNames) c->addItem(QString::fromLatin1(q));
       } else {
         c->addItems({kAsTheFile, "left", "right"});
       }

@@ -83,8 +83,14 @@ void tire_fit_axes(QChart* c, const QString& x_title, const QString& y_title) {
   if (!(xlo <= xhi)) xlo = -1, xhi = 1;
   if (!(ylo <= yhi)) ylo = -1, yhi = 1;
   const NiceRange rx = niceRange(xlo, xhi, 6), ry = niceRange(ylo, yhi, 6);
-  setAxisRange(x, rx.min, rx.max, rx.step);
-  setAxisRange(y, ry.min, ry.max, ry.step);
+  // the ticks' labels with the step's decimals: Qt adds the step to the first tick, so a tick at 0
+  // after -0.3 + 3 x 0.1 is 5.6e-17, which "%g" would print as such
+  for (auto [a, r] : {std::pair{x, rx}, std::pair{y, ry}}) {
+    const double big = std::max(std::abs(r.min), std::abs(r.max));
+    if (r.step >= 1e-4 && big < 1e7) a->setLabelFormat(QStringLiteral("%.%1f").arg(std::max(0, int(std::ceil(-std::log10(r.step) - 1e-9)))));
+    else a->setLabelFormat("%.4g");
+    setAxisRange(a, r.min, r.max, r.step);
+  }
 }
 
 QLineSeries* tire_series(QChart* c, const QString& name) {
@@ -397,7 +403,7 @@ bool TireView::refresh() {
       const Eigen::Index i = static_cast<Eigen::Index>(l) * n + k;
       pfy << QPointF(lat.rows(i, ca) / kTireDeg, lat.rows(i, cFy));
       pmz << QPointF(lat.rows(i, ca) / kTireDeg, lat.rows(i, cMz));
-      pfx << QPointF(lon.rows(i, ck), lon.rows(i, cFx));
+      pfx << QPointF(100.0 * lon.rows(i, ck), lon.rows(i, cFx));  // in percent: round ticks, 0 exactly
     }
     fy->replace(pfy);
     mz->replace(pmz);
@@ -412,10 +418,9 @@ bool TireView::refresh() {
     }
     s->replace(p);
   }
-  combined_->chart()->setTitle(tr("Combined slip at %1: Fy against Fx, kappa from -%2 to %2")
-                                   .arg(tire_load_text(base.loads[base.loads.size() / 2]), kappa_max_->text().trimmed()));
+  combined_->chart()->setTitle(tr("Combined slip at %1, kappa swept").arg(tire_load_text(base.loads[base.loads.size() / 2])));
   tire_fit_axes(lateral_->chart(), tr("slip angle alpha [deg]"), tr("Fy [N]"));
-  tire_fit_axes(longitudinal_->chart(), tr("longitudinal slip kappa [-]"), tr("Fx [N]"));
+  tire_fit_axes(longitudinal_->chart(), tr("longitudinal slip kappa [%]"), tr("Fx [N]"));
   tire_fit_axes(aligning_->chart(), tr("slip angle alpha [deg]"), tr("Mz [N m]"));
   tire_fit_axes(combined_->chart(), tr("Fx [N]"), tr("Fy [N]"));
   return true;

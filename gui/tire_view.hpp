@@ -2,7 +2,7 @@
 // of the model being edited (its law and numbers as the simulation uses them) or a .tir file opened
 // here, at the loads typed and one camber and forward speed:
 //   - Fy over the slip angle alpha (kappa = 0), one curve per load,
-//   - Fx over the longitudinal slip kappa (alpha = 0), one curve per load,
+//   - Fx over the longitudinal slip kappa in percent (alpha = 0), one curve per load,
 //   - Mz over the slip angle (kappa = 0), one curve per load,
 //   - combined slip: Fy against Fx at the middle load, one curve per fixed slip angle, kappa swept.
 // ISO-W axes and signs (docs/tires.md): a positive slip angle gives a negative Fy. Every number
@@ -46,7 +46,7 @@ class TireView : public QWidget {
   QLineEdit* speedEdit() const { return speed_; }
   QLineEdit* ellipseAlphasEdit() const { return ellipse_alphas_; }
   ChartView* lateralView() const { return lateral_; }          // Fy [N] over alpha [deg]
-  ChartView* longitudinalView() const { return longitudinal_; }  // Fx [N] over kappa [-]
+  ChartView* longitudinalView() const { return longitudinal_; }  // Fx [N] over kappa [%]
   ChartView* aligningView() const { return aligning_; }        // Mz [N m] over alpha [deg]
   ChartView* combinedView() const { return combined_; }        // Fy [N] over Fx [N]
   QString errorText() const;

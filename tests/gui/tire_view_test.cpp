@@ -191,13 +191,13 @@ class TireViewTest : public QObject {
     for (const QPointF& p : fy->points()) QVERIFY(close_to(p.y(), -90000.0 * p.x() * kDeg, 1e-12));
     QVERIFY(close_to(fy->at(120).x(), 15.0, 1e-14) && fy->at(120).y() < 0);  // positive slip angle, negative Fy
     for (const QPointF& p : series(v->aligningView(), "Fz = 4000 N")->points()) QCOMPARE(p.y(), 0.0);
-    for (const QPointF& p : series(v->longitudinalView(), "Fz = 2000 N")->points()) QVERIFY(close_to(p.y(), 100000.0 * p.x(), 1e-12));
+    for (const QPointF& p : series(v->longitudinalView(), "Fz = 2000 N")->points()) QVERIFY(close_to(p.y(), 100000.0 * p.x() / 100.0, 1e-12));
     // axes with units
     QChart* c = v->lateralView()->chart();
     QCOMPARE(c->axes(Qt::Horizontal).value(0)->titleText(), QString("slip angle alpha [deg]"));
     QCOMPARE(c->axes(Qt::Vertical).value(0)->titleText(), QString("Fy [N]"));
     QCOMPARE(v->aligningView()->chart()->axes(Qt::Vertical).value(0)->titleText(), QString("Mz [N m]"));
-    QCOMPARE(v->longitudinalView()->chart()->axes(Qt::Horizontal).value(0)->titleText(), QString("longitudinal slip kappa [-]"));
+    QCOMPARE(v->longitudinalView()->chart()->axes(Qt::Horizontal).value(0)->titleText(), QString("longitudinal slip kappa [%]"));
     // the curves follow an edit of the tire
     QVERIFY(drive::typeTaken(w.get(), "cornering_stiffness", "70000").isEmpty());
     fy = series(v->lateralView(), "Fz = 4000 N");
@@ -259,7 +259,7 @@ class TireViewTest : public QObject {
         const Eigen::VectorXd a = job(load, fy->at(k).x() * kDeg, 0.0);
         QVERIFY2(close_to(fy->at(k).y(), a(1), 1e-12), qPrintable(QString("%1 %2").arg(fy->at(k).y(), 0, 'g', 17).arg(a(1), 0, 'g', 17)));
         QVERIFY(close_to(mz->at(k).y(), a(5), 1e-12));
-        const Eigen::VectorXd b = job(load, 0.0, fx->at(k).x());
+        const Eigen::VectorXd b = job(load, 0.0, fx->at(k).x() / 100.0);
         QVERIFY(close_to(fx->at(k).y(), b(0), 1e-12));
       }
     }
@@ -340,7 +340,7 @@ class TireViewTest : public QObject {
     TireRequest q;
     q.tir = ss(dir.filePath("tires/PacejkaBook_Defaults.tir"));
     q.loads = {4000};
-    q.kappa = {fx->at(70).x()};
+    q.kappa = {fx->at(70).x() / 100.0};
     q.alpha = {0.0};
     q.gamma = {0.0};
     QVERIFY(close_to(fx->at(70).y(), study_tire_job(q).rows(0, 0), 1e-12));
@@ -377,6 +377,21 @@ class TireViewTest : public QObject {
         ++found;
     }
     QCOMPARE(found, 1);
+  }
+
+  // a tire sensor by clicks: "tire" picked from a sensor's type list, its tire and quantity from theirs
+  void tireSensorByClicks() {
+    QVERIFY(drive::addElement(w.get(), "sensor").isEmpty());
+    const int k = props()->element()->index;
+    QVERIFY(drive::pickWithMouse(combo("type"), "tire"));
+    const SensorSpec& s = w->document()->spec().sensors[static_cast<std::size_t>(k)];
+    QCOMPARE(s.type, SensorType::Tire);
+    QCOMPARE(s.tire, std::string("tire"));
+    QVERIFY(combo("tire") && combo("tire")->findText("tire") >= 0);
+    QVERIFY(drive::pickWithMouse(combo("quantity"), "Fy"));
+    QCOMPARE(w->document()->spec().sensors[static_cast<std::size_t>(k)].quantity, std::string("Fy"));
+    QVERIFY2(w->document()->errorText().isEmpty(), qPrintable(w->document()->errorText()));
+    QCOMPARE(w->document()->model()->sensors.back().unit, std::string("N"));
   }
 };
 
