@@ -185,7 +185,7 @@ TireView::TireView(Document* doc, QWidget* parent) : QWidget(parent), doc_(doc) 
   auto view = [this](const QString& title, const QString& name) {
     auto* v = new ChartView(tire_chart(title), this);
     v->setObjectName(name);
-    v->setMinimumSize(220, 140);
+    v->setMinimumSize(160, 90);  // the window fits 1024 x 700 (gui.editing_test)
     v->setFrameShape(QFrame::NoFrame);
     return v;
   };
