@@ -849,6 +849,12 @@ void MainWindow::showTreeMenu(const QPoint& at) {
       e.body_a = kGroundName;
       e.body_b = body;
     });
+    item("addTireOn", tr("Add tire on %1").arg(b), ElementKind::Effect, [body](ModelSpec& s, int k) {
+      EffectSpec& e = s.effects[k];
+      PropertyEditor::firstTire(e);
+      e.name = unique_name(s, ElementKind::Effect, body + "_tire");
+      e.body_a = body;
+    });
     item("addForceOn", tr("Add force actuator on %1").arg(b), ElementKind::Actuator, [body](ModelSpec& s, int k) {
       ActuatorSpec& a = s.actuators[k];
       a.type = ActuatorType::BodyForce;

@@ -169,6 +169,7 @@ bool is_clearable(ElementKind k, const QString& key, bool tire = false) {
 // its law changed): a passenger car's tire of 0.3 m on a linear or Fiala law; a magic_formula tire
 // takes its radius and vertical stiffness from the .tir file, so the fields that would override
 // them are dropped (its `file` is chosen next, in the file dialog)
+// (the same first numbers as PropertyEditor::firstTire)
 void give_tire_law_numbers(json& e) {
   if (!e.is_object()) return;
   const std::string law = e.contains("law") && e["law"].is_string() ? e["law"].get<std::string>() : "linear";
@@ -177,13 +178,16 @@ void give_tire_law_numbers(json& e) {
     for (const char* key : {"unloaded_radius", "vertical_stiffness", "vertical_damping"}) e.erase(key);
     return;
   }
-  if (!positive("unloaded_radius")) e["unloaded_radius"] = 0.3;
-  if (!positive("vertical_stiffness")) e["vertical_stiffness"] = 200000.0;
-  if (!e.contains("vertical_damping")) e["vertical_damping"] = 500.0;
+  EffectSpec first;
+  PropertyEditor::firstTire(first);
+  if (!positive("unloaded_radius")) e["unloaded_radius"] = *first.unloaded_radius;
+  if (!positive("vertical_stiffness")) e["vertical_stiffness"] = *first.vertical_stiffness;
+  if (!e.contains("vertical_damping")) e["vertical_damping"] = *first.vertical_damping;
   // Fiala's stiffnesses and friction must be positive; a linear tire keeps a 0 it was given
   const bool fiala = law == "fiala";
-  if (fiala ? !positive("longitudinal_stiffness") : !e.contains("longitudinal_stiffness")) e["longitudinal_stiffness"] = 100000.0;
-  if (fiala ? !positive("cornering_stiffness") : !e.contains("cornering_stiffness")) e["cornering_stiffness"] = 80000.0;
+  if (fiala ? !positive("longitudinal_stiffness") : !e.contains("longitudinal_stiffness"))
+    e["longitudinal_stiffness"] = first.longitudinal_stiffness;
+  if (fiala ? !positive("cornering_stiffness") : !e.contains("cornering_stiffness")) e["cornering_stiffness"] = first.cornering_stiffness;
   if (fiala && !positive("friction")) e["friction"] = 1.0;
 }
 
@@ -419,6 +423,16 @@ void PropertyEditor::setElement(std::optional<ElementId> id) {
   refusal_ = {};
   involved_ = {};
   rebuild();
+}
+
+void PropertyEditor::firstTire(EffectSpec& e) {
+  e.type = EffectType::Tire;
+  e.law = "linear";
+  e.unloaded_radius = 0.3;
+  e.vertical_stiffness = 200000.0;
+  e.vertical_damping = 500.0;
+  e.longitudinal_stiffness = 100000.0;
+  e.cornering_stiffness = 80000.0;
 }
 
 // The tire's .tir file chosen in a file dialog (Qt's own, window-modal: the same everywhere, and a

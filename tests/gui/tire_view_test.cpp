@@ -14,6 +14,9 @@
 #include <QApplication>
 #include <QChart>
 #include <QComboBox>
+#include <QContextMenuEvent>
+#include <QMenu>
+#include <QTreeView>
 #include <QDialogButtonBox>
 #include <QDir>
 #include <QFile>
@@ -392,6 +395,36 @@ class TireViewTest : public QObject {
     QCOMPARE(w->document()->spec().sensors[static_cast<std::size_t>(k)].quantity, std::string("Fy"));
     QVERIFY2(w->document()->errorText().isEmpty(), qPrintable(w->document()->errorText()));
     QCOMPARE(w->document()->model()->sensors.back().unit, std::string("N"));
+  }
+
+  // the wheel's context menu in the model tree, opened as a right click opens it: "Add tire on
+  // wheel" makes a second tire on it, which compiles and is shown in the Tire view's list
+  void tireFromTheWheelsContextMenu() {
+    QTreeView* t = w->modelTree();
+    const QModelIndex at = w->treeModel()->indexOf({ElementKind::Body, 0});
+    t->scrollTo(at);
+    const QPoint p = t->visualRect(at).center();
+    QContextMenuEvent e(QContextMenuEvent::Mouse, p, t->viewport()->mapToGlobal(p));
+    QApplication::sendEvent(t->viewport(), &e);
+    auto* menu = qobject_cast<QMenu*>(QApplication::activePopupWidget());
+    QVERIFY(menu);
+    QAction* hit = nullptr;
+    for (QAction* a : menu->actions())
+      if (a->objectName() == "addTireOn") hit = a;
+    QVERIFY(hit);
+    QCOMPARE(hit->text(), QString("Add tire on wheel"));
+    QTest::mouseClick(menu, Qt::LeftButton, {}, menu->actionGeometry(hit).center());
+    QVERIFY(QTest::qWaitFor([menu] { return !menu->isVisible(); }, 2000));
+    const EffectSpec& added = w->document()->spec().effects.back();
+    QCOMPARE(added.type, EffectType::Tire);
+    QCOMPARE(added.name, std::string("wheel_tire"));
+    QCOMPARE(added.body_a, std::string("wheel"));
+    QCOMPARE(added.law, std::string("linear"));
+    QVERIFY2(w->document()->errorText().isEmpty(), qPrintable(w->document()->errorText()));
+    QCOMPARE(w->document()->model()->tires.size(), std::size_t(2));
+    QVERIFY(w->tireView()->sourceBox()->findText("wheel_tire") >= 0);
+    QCOMPARE(w->tireView()->sourceBox()->currentText(), QString("wheel_tire"));  // selected: shown
+    QVERIFY(series(w->tireView()->lateralView(), "Fz = 4000 N"));
   }
 };
 
