@@ -938,11 +938,13 @@ void PropertyEditor::rebuild() {
       add_row(key, v);
     }
   };
-  // name and type first, then the rest
-  if (j.contains("name")) add_row("name", j["name"]);
-  if (j.contains("type")) add_row("type", j["type"]);
+  // name and type first (a tire: then its wheel, law and file), then the rest
+  std::vector<std::string> first{"name", "type"};
+  if (tire) first.insert(first.end(), {"body", "law", "file", "side"});
+  for (const std::string& key : first)
+    if (j.contains(key)) add(qs(key), j[key]);
   for (const auto& [key, v] : j.items()) {
-    if (key == "name" || key == "type") continue;
+    if (std::find(first.begin(), first.end(), key) != first.end()) continue;
     add(qs(key), v);
   }
   if (!focused.isEmpty()) {
