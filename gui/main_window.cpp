@@ -41,6 +41,7 @@
 #include "gui/autosave.hpp"
 #include "gui/control_view.hpp"
 #include "gui/sweep_view.hpp"
+#include "gui/tire_view.hpp"
 #include "gui/linearize_view.hpp"
 #include "gui/plant_panel.hpp"
 #include "gui/property_editor.hpp"
@@ -107,6 +108,10 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
   sweep_view_ = new SweepView(doc_, this);
   tabs_->addTab(sweep_view_, tr("Sweep"));
   tabs_->setTabToolTip(3, tr("A parameter study: the closed-loop poles and figures of every variant of the model"));
+  tire_view_ = new TireView(doc_, this);
+  tabs_->addTab(tire_view_, tr("Tire"));
+  tabs_->setTabToolTip(4, tr("The tire test rig: Fy, Fx and Mz over the slips at several loads, and combined slip, for a "
+                             "tire of the model or a .tir file (codyna tire)"));
   auto* centre = new QSplitter(Qt::Vertical, this);
   centre->setObjectName("centreSplitter");
   centre->addWidget(top);
@@ -227,6 +232,11 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
     QString body;
     if (id && id->kind == ElementKind::Body) body = qs(doc_->spec().bodies[id->index].name);
     if (id && id->kind == ElementKind::Joint) body = qs(doc_->spec().joints[id->index].child);
+    // a tire selected: the Tire view shows its curves (its wheel is tinted)
+    if (id && id->kind == ElementKind::Effect && doc_->spec().effects[id->index].type == EffectType::Tire) {
+      tire_view_->showTire(qs(doc_->spec().effects[id->index].name));
+      body = qs(doc_->spec().effects[id->index].body_a);
+    }
     view_->setHighlight(body);
   });
   connect(tree_model_, &ModelTreeModel::renameFailed, this, [this](const QString& m) { message(m, true); });
@@ -252,6 +262,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
   connect(sim_view_, &SimulateView::message, this, [this](const QString& m) { message(m); });
   connect(control_view_, &ControlView::message, this, [this](const QString& m) { message(m); });
   connect(sweep_view_, &SweepView::message, this, [this](const QString& m) { message(m); });
+  connect(tire_view_, &TireView::message, this, [this](const QString& m) { message(m); });
   connect(props_, &PropertyEditor::varyRequested, this, [this](const QString& pointer) {
     sweep_view_->addField(pointer);
     tabs_->setCurrentWidget(sweep_view_);
@@ -837,6 +848,12 @@ void MainWindow::showTreeMenu(const QPoint& at) {
       e.name = unique_name(s, ElementKind::Effect, body + "_spring");
       e.body_a = kGroundName;
       e.body_b = body;
+    });
+    item("addTireOn", tr("Add tire on %1").arg(b), ElementKind::Effect, [body](ModelSpec& s, int k) {
+      EffectSpec& e = s.effects[k];
+      PropertyEditor::firstTire(e);
+      e.name = unique_name(s, ElementKind::Effect, body + "_tire");
+      e.body_a = body;
     });
     item("addForceOn", tr("Add force actuator on %1").arg(b), ElementKind::Actuator, [body](ModelSpec& s, int k) {
       ActuatorSpec& a = s.actuators[k];

@@ -41,6 +41,7 @@ class LinearizeView;
 class SimulateView;
 class ControlView;
 class SweepView;
+class TireView;
 class Autosave;
 class IssuesPanel;
 
@@ -61,6 +62,7 @@ class MainWindow : public QMainWindow {
   SimulateView* simulateView() { return sim_view_; }
   ControlView* controlView() { return control_view_; }
   SweepView* sweepView() { return sweep_view_; }
+  TireView* tireView() { return tire_view_; }
   QTabWidget* analysisTabs() { return tabs_; }
   QPlainTextEdit* messages() { return messages_; }
   IssuesPanel* issuesPanel() { return issues_; }
@@ -151,6 +153,7 @@ class MainWindow : public QMainWindow {
   SimulateView* sim_view_;
   ControlView* control_view_ = nullptr;
   SweepView* sweep_view_ = nullptr;
+  TireView* tire_view_ = nullptr;
   Autosave* autosave_ = nullptr;
   QTabWidget* tabs_;
   QPlainTextEdit* messages_;

@@ -3,6 +3,9 @@
 #include <QApplication>
 #include <QCheckBox>
 #include <QComboBox>
+#include <QDir>
+#include <QFileDialog>
+#include <QFileInfo>
 #include <QFormLayout>
 #include <QLabel>
 #include <QHBoxLayout>
@@ -29,13 +32,15 @@ using nlohmann::json;
 namespace {
 
 const QStringList kBodyRefs{"parent", "child", "body", "body_a", "body_b", "frame"};
+// a magic_formula tire's side as its .tir file says (the field left out)
+const QString kAsTheFile = QStringLiteral("as the file");
 
 QStringList type_names(ElementKind k) {
   switch (k) {
     case ElementKind::Joint: return {"revolute", "prismatic", "fixed", "spherical", "universal", "cylindrical", "planar", "free"};
     case ElementKind::Constraint: return {"ball", "revolute", "planar_revolute", "coupler", "rolling_ball", "rolling_disc"};
     case ElementKind::Effect:
-      return {"gravity", "spring_damper", "joint_spring_damper", "joint_friction", "joint_damper", "body_force", "bushing"};
+      return {"gravity", "spring_damper", "joint_spring_damper", "joint_friction", "joint_damper", "body_force", "bushing", "tire"};
     case ElementKind::Actuator: return {"joint_force", "body_force", "body_torque", "line_force", "mix", "motion"};
     case ElementKind::Sensor:
       return {"joint_position", "joint_velocity", "point_position", "point_velocity", "body_angle", "distance", "distance_rate", "motion_force",
@@ -144,10 +149,46 @@ json rotation_value(const QString& text) {
   return json{{"rpy", rpy}};
 }
 
-// Fields that are empty by default (a number that may be left out: an actuator's limits)
-bool is_clearable(ElementKind k, const QString& key) {
+// A tire's numbers that may be left out: a magic_formula tire takes them from its .tir file, a
+// rolling radius left out is the unloaded radius
+const QStringList kTireOptional{"unloaded_radius", "rolling_radius", "vertical_stiffness", "vertical_damping"};
+
+bool is_tire(const ModelSpec& spec, ElementKind k, int index) {
+  return k == ElementKind::Effect && index >= 0 && index < static_cast<int>(spec.effects.size()) &&
+         spec.effects[static_cast<std::size_t>(index)].type == EffectType::Tire;
+}
+
+// Fields that are empty by default (a number that may be left out: an actuator's limits, a tire's
+// radius or vertical stiffness given by its .tir file)
+bool is_clearable(ElementKind k, const QString& key, bool tire = false) {
   return (k == ElementKind::Actuator && (key == QLatin1String("min") || key == QLatin1String("max"))) ||
-         (k == ElementKind::Constraint && key == QLatin1String("offset"));
+         (k == ElementKind::Constraint && key == QLatin1String("offset")) || (tire && kTireOptional.contains(key));
+}
+
+// A tire element's first numbers for its law, given where the element has none (a new tire, or
+// its law changed): a passenger car's tire of 0.3 m on a linear or Fiala law; a magic_formula tire
+// takes its radius and vertical stiffness from the .tir file, so the fields that would override
+// them are dropped (its `file` is chosen next, in the file dialog)
+// (the same first numbers as PropertyEditor::firstTire)
+void give_tire_law_numbers(json& e) {
+  if (!e.is_object()) return;
+  const std::string law = e.contains("law") && e["law"].is_string() ? e["law"].get<std::string>() : "linear";
+  auto positive = [&](const char* key) { return e.contains(key) && e[key].is_number() && e[key].get<double>() > 0; };
+  if (law == "magic_formula") {
+    for (const char* key : {"unloaded_radius", "vertical_stiffness", "vertical_damping"}) e.erase(key);
+    return;
+  }
+  EffectSpec first;
+  PropertyEditor::firstTire(first);
+  if (!positive("unloaded_radius")) e["unloaded_radius"] = *first.unloaded_radius;
+  if (!positive("vertical_stiffness")) e["vertical_stiffness"] = *first.vertical_stiffness;
+  if (!e.contains("vertical_damping")) e["vertical_damping"] = *first.vertical_damping;
+  // Fiala's stiffnesses and friction must be positive; a linear tire keeps a 0 it was given
+  const bool fiala = law == "fiala";
+  if (fiala ? !positive("longitudinal_stiffness") : !e.contains("longitudinal_stiffness"))
+    e["longitudinal_stiffness"] = first.longitudinal_stiffness;
+  if (fiala ? !positive("cornering_stiffness") : !e.contains("cornering_stiffness")) e["cornering_stiffness"] = first.cornering_stiffness;
+  if (fiala && !positive("friction")) e["friction"] = 1.0;
 }
 
 // The element as the editor shows it: what the model file writes, and every optional
@@ -180,6 +221,17 @@ json shown_element(const ModelSpec& spec, ElementKind k, int index) {
       break;
     case ElementKind::Sensor:
       if (!e.contains("unit")) e["unit"] = "";
+      break;
+    case ElementKind::Effect:
+      if (spec.effects[static_cast<std::size_t>(index)].type == EffectType::Tire) {
+        // the numbers a .tir file gives (or that have a default) as "none" until typed
+        for (const QString& key : kTireOptional)
+          if (!e.contains(ss(key))) e[ss(key)] = nullptr;
+        if (spec.effects[static_cast<std::size_t>(index)].law == "magic_formula") {
+          if (!e.contains("side")) e["side"] = "";
+          if (!e.contains("file")) e["file"] = "";
+        }
+      }
       break;
     case ElementKind::Constraint:
       if (spec.constraints[index].type == ConstraintType::Coupler) {
@@ -223,6 +275,37 @@ QString PropertyEditor::fieldHelp(ElementKind kind, const QString& key, const QS
     if (key == QLatin1String("radius")) return QStringLiteral("Radius of the rolling disc (m, > 0)");
     const auto r = rolling.find(key);
     if (r != rolling.end()) return unit.isEmpty() ? r->second : QStringLiteral("%1 [%2]").arg(r->second, unit);
+  }
+  // a tire's fields (docs/model-format.md, "Tires"; docs/tires.md: ISO-W axes)
+  if (kind == ElementKind::Effect && type == QLatin1String("tire")) {
+    static const std::map<QString, QString> tire{
+        {"body", "The wheel body the tire is on (not the ground)"},
+        {"center", "The wheel centre, in the wheel body's frame"},
+        {"spin_axis", "The axle, in the wheel body's frame, pointing to the wheel's left (rolling forward is a "
+                      "positive spin about it)"},
+        {"unloaded_radius", "Radius of the unloaded tire (> 0; a magic_formula tire takes the .tir file's)"},
+        {"rolling_radius", "Effective rolling radius Re in the longitudinal slip (empty: the unloaded radius)"},
+        {"law", "The force law: linear (stiffnesses), fiala (the brush model) or magic_formula (a .tir file)"},
+        {"file", "The .tir property file (MF 5.2, 6.1, 6.2), relative to the model file"},
+        {"side", "The side of the car the tire is on; a file made for the other side is mirrored"},
+        {"longitudinal_stiffness", "Longitudinal slip stiffness: Fx per unit slip kappa (>= 0; fiala > 0)"},
+        {"cornering_stiffness", "Cornering stiffness: Fy = -C alpha (ISO-W; >= 0; fiala > 0)"},
+        {"camber_stiffness", "Camber stiffness (linear)"},
+        {"friction", "Friction coefficient: linear, the friction circle's mu (0: none); fiala, mu at zero slip"},
+        {"sliding_friction", "Fiala: mu at full slip (0: the friction)"},
+        {"trail", "Linear: pneumatic trail, Mz = -trail Fy"},
+        {"width", "Fiala: tread width, for the aligning moment"},
+        {"rolling_resistance", "Fiala: My = -rolling_resistance Fz sign(Omega)"},
+        {"vertical_stiffness", "Vertical stiffness: Fz = k deflection + c rate (>= 0; magic_formula: the .tir "
+                               "file's when it gives one)"},
+        {"vertical_damping", "Vertical damping (>= 0; magic_formula: the .tir file's when it gives one)"},
+        {"low_speed", "Below this forward speed the slips' denominator is regularized (> 0)"},
+        {"road/body", "The body that carries the road plane (ground: the world)"},
+        {"road/point", "A point of the road plane, in its body's frame"},
+        {"road/normal", "The road's normal, in its body's frame (the wheel rolls on the side it points to)"},
+    };
+    const auto r = tire.find(key);
+    if (r != tire.end()) return unit.isEmpty() ? r->second : QStringLiteral("%1 [%2]").arg(r->second, unit);
   }
   static const std::map<QString, QString> meaning{
       {"name", "The element's name; references to it follow a rename"},
@@ -298,7 +381,10 @@ QString PropertyEditor::unitOf(const QString& key) {
       {"stiffness", "N/m | N m/rad"}, {"damping", "N s/m | N m s/rad"}, {"rest_position", "rad | m"},
       {"force", "N"}, {"torque", "N m"}, {"g", "m/s²"}, {"q0", "rad | m"}, {"v0", "rad/s | m/s"}, {"armature", "kg m² | kg"},
       {"rotation", "matrix | axis-angle"}, {"axis", "unit vector"}, {"axis2", "unit vector"}, {"direction", "unit vector"},
-      {"color", "rgba 0..1"}};
+      {"color", "rgba 0..1"}, {"center", "m"}, {"spin_axis", "unit vector"}, {"normal", "unit vector"},
+      {"unloaded_radius", "m"}, {"rolling_radius", "m"}, {"longitudinal_stiffness", "N"}, {"cornering_stiffness", "N/rad"},
+      {"camber_stiffness", "N/rad"}, {"trail", "m"}, {"width", "m"}, {"rolling_resistance", "m"},
+      {"vertical_stiffness", "N/m"}, {"vertical_damping", "N s/m"}, {"low_speed", "m/s"}};
   const QString last = key.section('/', -1);
   const auto it = units.find(last);
   return it == units.end() ? QString() : it->second;
@@ -339,6 +425,44 @@ void PropertyEditor::setElement(std::optional<ElementId> id) {
   rebuild();
 }
 
+void PropertyEditor::firstTire(EffectSpec& e) {
+  e.type = EffectType::Tire;
+  e.law = "linear";
+  e.unloaded_radius = 0.3;
+  e.vertical_stiffness = 200000.0;
+  e.vertical_damping = 500.0;
+  e.longitudinal_stiffness = 100000.0;
+  e.cornering_stiffness = 80000.0;
+}
+
+// The tire's .tir file chosen in a file dialog (Qt's own, window-modal: the same everywhere, and a
+// test drives it as a person does); stored relative to the model file, as the core reads it (an
+// unsaved model: the absolute path). The path goes through applyText, so a file that does not read
+// is the compile's error at the field, with the reader's message naming the file, section and key.
+void PropertyEditor::chooseTireFile() {
+  if (!id_ || !is_tire(doc_->spec(), id_->kind, id_->index)) return;
+  const ElementId id = *id_;
+  const QString model_dir = doc_->filePath().isEmpty() ? QString() : QFileInfo(doc_->filePath()).absolutePath();
+  QString start = model_dir.isEmpty() ? QDir::currentPath() : model_dir;
+  const std::string now = doc_->spec().effects[static_cast<std::size_t>(id.index)].file;
+  if (!now.empty()) {
+    const QFileInfo f(QDir(start), qs(now));
+    if (f.absoluteDir().exists()) start = f.absoluteFilePath();
+  }
+  auto* d = new QFileDialog(this, tr("Tire property file"), start, tr("Tire property files (*.tir);;All files (*)"));
+  d->setObjectName("tireFileDialog");
+  d->setOption(QFileDialog::DontUseNativeDialog);
+  d->setFileMode(QFileDialog::ExistingFile);
+  d->setAcceptMode(QFileDialog::AcceptOpen);
+  d->setAttribute(Qt::WA_DeleteOnClose);
+  connect(d, &QFileDialog::fileSelected, this, [this, id, model_dir](const QString& path) {
+    if (!id_ || !(*id_ == id) || path.isEmpty()) return;  // another element shown meanwhile
+    const QString stored = model_dir.isEmpty() ? QFileInfo(path).absoluteFilePath() : QDir(model_dir).relativeFilePath(path);
+    applyText("file", stored);
+  });
+  d->open();
+}
+
 QWidget* PropertyEditor::editorFor(const QString& field) const {
   const auto it = editors_.find(field);
   return it == editors_.end() ? nullptr : it->second;
@@ -366,10 +490,12 @@ bool PropertyEditor::applyText(const QString& field, const QString& text, QStrin
   const json old = shown.contains(at) ? shown[at] : json();
   json value;
   bool clear = false;
+  const bool tire = is_tire(spec, id_->kind, id_->index);
   try {
     if (is_rotation_key(field)) value = rotation_value(text);
-    else if (is_clearable(id_->kind, field) && text.trimmed().isEmpty()) clear = true;
-    else if (old.is_null() && is_clearable(id_->kind, field)) value = parse_text(text, json(0.0));
+    else if (is_clearable(id_->kind, field, tire) && text.trimmed().isEmpty()) clear = true;
+    else if (tire && field == QLatin1String("side") && (text.trimmed().isEmpty() || text == kAsTheFile)) clear = true;
+    else if (old.is_null() && is_clearable(id_->kind, field, tire)) value = parse_text(text, json(0.0));
     else if (field == QLatin1String("armature")) value = parse_text(text, json::array());  // one value, or one per coordinate
     else value = parse_text(text, old);
   } catch (const std::exception& e) {
@@ -381,7 +507,9 @@ bool PropertyEditor::applyText(const QString& field, const QString& text, QStrin
   } else {
     set_at(j, base + "/" + field, value);
   }
-  if (field.section('/', -1) == QLatin1String("type")) {
+  // a tire's law changed: its fields as for a type change (the old law's dropped, the new one's given)
+  const bool tire_law = tire && field == QLatin1String("law");
+  if (field.section('/', -1) == QLatin1String("type") || tire_law) {
     // keep only what the new type accepts: drop the fields the reader calls unknown, and
     // initial values sized for the old type (a joint's q0, v0); give the fields the new type
     // requires and the old one lacked a first value (a coupler's joints: the model's first two;
@@ -419,6 +547,15 @@ bool PropertyEditor::applyText(const QString& field, const QString& text, QStrin
             element[key] = json::array({1.0});
           } else if (key == "radius") {  // a rolling ball or disc: 5 cm
             element[key] = 0.05;
+          } else if (key == "law") {  // a tire: linear until another law is picked
+            element[key] = "linear";
+          } else if (key == "tire" && id_->kind == ElementKind::Sensor) {  // a tire sensor: the first tire
+            std::string first;
+            for (const auto& e : spec.effects)
+              if (e.type == EffectType::Tire && first.empty()) first = e.name;
+            element[key] = first;
+          } else if (key == "quantity") {
+            element[key] = kTireQuantityNames[0];
           } else {
             break;
           }
@@ -426,7 +563,9 @@ bool PropertyEditor::applyText(const QString& field, const QString& text, QStrin
         }
         if (p.rfind(ss(base) + "/", 0) != 0) break;
         const std::string last = p.substr(p.rfind('/') + 1);
-        const bool unknown = e.detail().find("unknown field") != std::string::npos;
+        // a field the new type does not know, or one of another tire law than the new one's
+        const bool unknown = e.detail().find("unknown field") != std::string::npos ||
+                             e.detail().find("belongs to the tire law") != std::string::npos;
         const bool sized = last == "q0" || last == "v0" || last == "armature";
         if (!unknown && !sized) break;
         json& parent = j[json::json_pointer(p).parent_pointer()];
@@ -437,6 +576,8 @@ bool PropertyEditor::applyText(const QString& field, const QString& text, QStrin
     // a rolling disc's axle (axis_b, z when not given, as is the plane's normal axis_a) must not be
     // along the normal, where the disc lies flat: then a direction normal to it
     json& element = j[json::json_pointer(ss(base))];
+    if ((id_->kind == ElementKind::Effect && field == QLatin1String("type") && value == json("tire")) || tire_law)
+      give_tire_law_numbers(element);
     if (value == json("rolling_disc") && element.is_object()) {
       auto vec = [&](const char* key) {
         const json& a = element.contains(key) ? element[key] : json::array({0.0, 0.0, 1.0});
@@ -611,11 +752,69 @@ void PropertyEditor::rebuild() {
   const ElementKind kind = id_->kind;
   const int index = id_->index;
 
+  const bool tire = is_tire(spec, kind, index);
+  QStringList tires;  // a tire sensor's choices
+  for (const auto& e : spec.effects)
+    if (e.type == EffectType::Tire) tires << qs(e.name);
   auto add_row = [&](const QString& key, const json& v) {
     QWidget* editor = nullptr;
+    QWidget* row = nullptr;  // what the form holds, when not the editor alone
     const QString last = key.section('/', -1);
     const bool shape_type = key.startsWith("shapes/") && last == "type";
-    if (last == "type") {
+    if (v.is_string() && ((tire && (key == QLatin1String("law") || key == QLatin1String("side"))) ||
+                          (kind == ElementKind::Sensor && key == QLatin1String("quantity")))) {
+      // a tire's law and side, a tire sensor's quantity: picked from their lists (the side: as the
+      // .tir file says, or one)
+      auto* c = new QComboBox;
+      if (key == QLatin1String("law")) {
+        for (const char* law : kTireLawNames) c->addItem(QString::fromLatin1(law));
+      } else if (key == QLatin1String("quantity")) {
+        for (const char* q : kTireQuantityNames) c->addItem(QString::fromLatin1(q));
+      } else {
+        c->addItems({kAsTheFile, "left", "right"});
+      }
+      const QString now = qs(v.get<std::string>());
+      c->setCurrentIndex(std::max(0, c->findText(now)));
+      connect(c, &QComboBox::activated, this, [this, c, key, now] {
+        if (isCurrent(key, c) && c->currentText() != (now.isEmpty() ? kAsTheFile : now)) applyText(key, c->currentText());
+      });
+      editor = c;
+    } else if (tire && key == QLatin1String("file") && v.is_string()) {
+      // the .tir file: typed (relative to the model file), or chosen in a file dialog with "..."
+      auto* e = new QLineEdit(qs(v.get<std::string>()));
+      e->setPlaceholderText(tr("a .tir file: choose it with ..."));
+      e->setProperty("value", e->text());
+      connect(e, &QLineEdit::editingFinished, this, [this, e, key] {
+        if (isCurrent(key, e) && e->text() != e->property("value").toString()) applyText(key, e->text());
+      });
+      auto* browse = new QPushButton(QStringLiteral("..."));
+      browse->setObjectName("browse:" + key);
+      browse->setToolTip(tr("Choose the tire's .tir property file (stored relative to the model file)"));
+      browse->setMaximumWidth(32);
+      connect(browse, &QPushButton::clicked, this, [this] { chooseTireFile(); });
+      row = new QWidget;
+      auto* hl = new QHBoxLayout(row);
+      hl->setContentsMargins(0, 0, 0, 0);
+      hl->setSpacing(2);
+      hl->addWidget(e, 1);
+      hl->addWidget(browse);
+      editor = e;
+    } else if (kind == ElementKind::Sensor && key == QLatin1String("tire") && v.is_string()) {
+      // a tire sensor's tire: one of the model's tire effects (or a name typed)
+      auto* c = new QComboBox;
+      c->setEditable(true);
+      c->addItems(tires);
+      const int at = c->findText(qs(v.get<std::string>()));
+      if (at >= 0) c->setCurrentIndex(at);
+      else c->setEditText(qs(v.get<std::string>()));
+      auto apply = [this, c, key] {
+        if (isCurrent(key, c) && c->currentText() != c->property("value").toString()) applyText(key, c->currentText());
+      };
+      connect(c, &QComboBox::activated, this, apply);
+      connect(c->lineEdit(), &QLineEdit::editingFinished, this, apply);
+      c->setProperty("value", qs(v.get<std::string>()));
+      editor = c;
+    } else if (last == "type") {
       auto* c = new QComboBox;
       c->addItems(shape_type ? QStringList{"box", "cylinder", "sphere"} : type_names(kind));
       c->setCurrentText(qs(v.get<std::string>()));
@@ -654,7 +853,12 @@ void PropertyEditor::rebuild() {
       else if (!v.is_null()) text = value_text(v);
       auto* e = new QLineEdit(text);
       e->setCursorPosition(0);  // a long vector shows its first entries, not the tail of its last
-      if (v.is_null()) e->setPlaceholderText(tr("none"));
+      if (v.is_null()) {
+        const bool from_file = tire && doc_->spec().effects[static_cast<std::size_t>(index)].law == "magic_formula";
+        e->setPlaceholderText(from_file ? tr("from the .tir file")
+                              : key == QLatin1String("rolling_radius") ? tr("the unloaded radius")
+                                                                       : tr("none"));
+      }
       e->setProperty("value", e->text());
       // a number, or a vector's entries, can be varied in a parameter study (the Sweep view)
       if (!is_rotation_key(key) && (v.is_number() || (is_number_array(v) && !v.empty()))) {
@@ -692,7 +896,7 @@ void PropertyEditor::rebuild() {
     label.replace('/', '.');
     editor->setProperty("help", fieldHelp(kind, key, unit, j.contains("type") && j["type"].is_string() ? qs(j["type"].get<std::string>()) : QString()));
     editor->setToolTip(editor->property("help").toString());
-    form_->addRow(unit.isEmpty() ? label : QStringLiteral("%1 [%2]").arg(label, unit), editor);
+    form_->addRow(unit.isEmpty() ? label : QStringLiteral("%1 [%2]").arg(label, unit), row ? row : editor);
   };
   // objects one level down (frames), rotations as one field, a body's shapes each with its fields
   std::function<void(const QString&, const json&)> add = [&](const QString& key, const json& v) {
@@ -734,11 +938,13 @@ void PropertyEditor::rebuild() {
       add_row(key, v);
     }
   };
-  // name and type first, then the rest
-  if (j.contains("name")) add_row("name", j["name"]);
-  if (j.contains("type")) add_row("type", j["type"]);
+  // name and type first (a tire: then its wheel, law and file), then the rest
+  std::vector<std::string> first{"name", "type"};
+  if (tire) first.insert(first.end(), {"body", "law", "file", "side"});
+  for (const std::string& key : first)
+    if (j.contains(key)) add(qs(key), j[key]);
   for (const auto& [key, v] : j.items()) {
-    if (key == "name" || key == "type") continue;
+    if (std::find(first.begin(), first.end(), key) != first.end()) continue;
     add(qs(key), v);
   }
   if (!focused.isEmpty()) {

@@ -35,6 +35,15 @@ class PropertyEditor : public QWidget {
   // applies `text` as the new value of `field` (what typing + Enter does); false with *error when rejected
   bool applyText(const QString& field, const QString& text, QString* error = nullptr);
 
+  // a new tire's first numbers (a linear passenger-car tire of 0.3 m: cornering stiffness 80000 N/rad,
+  // longitudinal slip stiffness 100000 N, vertical stiffness 200000 N/m, damping 500 N s/m), as a
+  // type changed to tire gets them
+  static void firstTire(EffectSpec& e);
+
+  // a tire's "..." beside its file: a file dialog (objectName "tireFileDialog", Qt's own, window-modal)
+  // whose chosen .tir is stored relative to the model file
+  void chooseTireFile();
+
   static QString unitOf(const QString& key);
   // the tooltip of a field: what it means, with its unit (`type`: the element's type, where a
   // field means something of its own for it: a rolling_ball's axis_a is its plane's normal)

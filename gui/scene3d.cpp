@@ -550,6 +550,17 @@ void Scene::addDefaultLook(int i) {
       add(Prim::Cylinder, T, color);
     } else add(Prim::Sphere, Eigen::Translation3d(c->point_b) * Eigen::Scaling(c->radius), color);
   }
+  // a tire on this body: the tire itself, dark, its unloaded radius about its spin axis at its centre
+  // (0.35 of the radius wide)
+  for (const TireModel& t : m.tires) {
+    if (t.body != i || !(t.unloaded_radius > 0)) continue;
+    Eigen::Affine3d T = Eigen::Affine3d::Identity();
+    T.translation() = t.center;
+    const double r = t.unloaded_radius;
+    T.linear() = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), t.axis).toRotationMatrix() *
+                 Eigen::Vector3d(r, r, 0.35 * r).asDiagonal();
+    add(Prim::Cylinder, T, {0.16f, 0.16f, 0.18f, 1.0f});
+  }
 }
 
 Eigen::Affine3d spanTransform(const Item& it, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {

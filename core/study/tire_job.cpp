@@ -55,8 +55,9 @@ std::vector<double> study_tire_grid(const std::string& text, const std::string& 
 }
 
 TireJob study_tire_job(const TireRequest& r) {
-  if (r.tir.empty() == r.model.empty()) throw std::invalid_argument("--tir or --model: give one of them (a .tir file, or a model file with --tire NAME)");
-  if (!r.model.empty() && r.tire.empty()) throw std::invalid_argument("--tire: name the model's tire element to evaluate");
+  const bool from_model = !r.model.empty() || r.spec;
+  if (r.tir.empty() == !from_model) throw std::invalid_argument("--tir or --model: give one of them (a .tir file, or a model file with --tire NAME)");
+  if (from_model && r.tire.empty()) throw std::invalid_argument("--tire: name the model's tire element to evaluate");
   if (!r.tir.empty() && !r.tire.empty()) throw std::invalid_argument("--tire: names a model's tire element, goes with --model (not --tir)");
   if (!(r.speed > 0) || !std::isfinite(r.speed)) throw std::invalid_argument("--speed: expected a forward speed > 0 m/s");
   TireJob job;
@@ -77,18 +78,19 @@ TireJob study_tire_job(const TireRequest& r) {
     if (!t.mf->defaulted.empty()) job.notes.push_back(std::to_string(t.mf->defaulted.size()) + " keys the file does not give take their defaults");
   } else {
     if (!r.side.empty()) throw std::invalid_argument("--side: goes with --tir (a model's tire element has its own side)");
-    model = std::make_unique<Model>(study_model(study_read_model(r.model), r.model));
+    model = std::make_unique<Model>(study_model(r.spec ? *r.spec : study_read_model(r.model), r.model));
+    const std::string model_name = r.model.empty() ? std::string("the model") : r.model;
     std::vector<std::string> names;
     for (const TireModel& m : model->tires) names.push_back(m.name);
     const auto it = std::find(names.begin(), names.end(), r.tire);
     if (it == names.end()) {
       std::string all;
       for (const std::string& n : names) all += (all.empty() ? "" : ", ") + n;
-      throw std::invalid_argument("--tire " + r.tire + ": no such tire in " + r.model + " (tires: " + (all.empty() ? "none" : all) + ")");
+      throw std::invalid_argument("--tire " + r.tire + ": no such tire in " + model_name + " (tires: " + (all.empty() ? "none" : all) + ")");
     }
     t = model->tires[static_cast<std::size_t>(it - names.begin())];
     const char* law = t.law == TireLaw::Linear ? "linear" : t.law == TireLaw::Fiala ? "fiala" : "magic_formula";
-    job.tire = r.model + ": " + r.tire + " (" + law + ")";
+    job.tire = model_name + ": " + r.tire + " (" + law + ")";
   }
   std::vector<double> loads = r.loads;
   if (loads.empty()) {

@@ -18,9 +18,14 @@
 
 namespace codyna {
 
+struct ModelSpec;
+
 struct TireRequest {
   std::string tir;                   // a .tir file, or
   std::string model, tire;           // a model file and the name of its tire element
+  const ModelSpec* spec = nullptr;   // or the model as edited (a GUI's document), read instead of
+                                     // the file `model`, which then only places relative paths
+                                     // (its .tir files) and names it in messages ("" when unsaved)
   std::string side;                  // .tir: "" (as the file), "left" or "right"
   std::vector<double> loads, kappa, alpha, gamma;
   double speed = 16.7;               // m/s

@@ -41,6 +41,7 @@
 #include "gui/property_editor.hpp"
 #include "gui/chart_view.hpp"
 #include "gui/sweep_view.hpp"
+#include "gui/tire_view.hpp"
 #include "gui/view3d.hpp"
 #include "simulation/result.hpp"
 
@@ -411,6 +412,29 @@ class MainWindowXvfb : public QObject {
     sv->resultTabs()->setCurrentIndex(1);
     QTest::qWait(300);
     save(screenOfChild(&w, sv), "sweep_figure.png");
+    w.document()->undoStack()->setClean();
+  }
+
+  // the Tire view of issue 39: the MF 6.1 file of tests/data opened beside the single-track car
+  void tireView() {
+    MainWindow w;
+    w.resize(1600, 1000);
+    w.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&w));
+    QVERIFY(w.openFile(QStringLiteral(CODYNA_EXAMPLES_DIR "/single_track_car.json")));
+    TireView* tv = w.tireView();
+    w.analysisTabs()->setCurrentWidget(tv);
+    w.findChild<QSplitter*>("centreSplitter")->setSizes({300, 640});
+    w.selectElement(ElementId{ElementKind::Effect, 1});  // front_tire
+    tv->showTirFile(QStringLiteral(CODYNA_TEST_DATA_DIR "/tires/MagicFormula61_Paramerters.tir"));
+    QVERIFY2(tv->errorText().isEmpty(), qPrintable(tv->errorText()));
+    QTest::qWait(300);
+    for (ChartView* c : {tv->lateralView(), tv->longitudinalView(), tv->aligningView(), tv->combinedView()}) {
+      QCOMPARE(c->chart()->series().isEmpty(), false);
+      QVERIFY2(stats(screenOfChild(&w, c)).foreground > 0.003, qPrintable(c->objectName()));
+    }
+    save(screenOf(&w), "tire_view.png");
+    save(screenOfChild(&w, tv), "tire_curves.png");
     w.document()->undoStack()->setClean();
   }
 };
