@@ -149,7 +149,12 @@ const VecXT<S>& applied_forces(const Model& model, DataT<S>& d, const VecXT<S>& 
     if (a.type == ActuatorType::Mix) continue;  // acts through the actuators it drives
     if (a.type == ActuatorType::Motion) continue;  // prescribes its coordinate (forward_dynamics)
     S input = u[k];
-    for (const auto& [mix, weight] : a.driven_by) input = input + S(weight) * u[mix];
+    // (each product evaluated into an S before the sum: an unevaluated autodiff product of a
+    // constant input, whose derivatives are empty, beside a variable's loses the derivatives)
+    for (const auto& [mix, weight] : a.driven_by) {
+      const S term = S(weight) * u[mix];
+      input = input + term;
+    }
     const S value = S(a.gain) * input;
     if (a.type == ActuatorType::JointForce) {
       d.Q[a.iv] += value;

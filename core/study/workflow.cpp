@@ -634,11 +634,8 @@ HandlingNumbers study_handling(const Model& m, const StudyLinearization& sl) {
       Model with = m;
       for (int k : holders)
         if (std::find(with.plant_inputs.begin(), with.plant_inputs.end(), k) == with.plant_inputs.end()) with.plant_inputs.push_back(k);
-      // their columns by central differences: automatic differentiation loses a joint torque's
-      // column on some models with motion inputs (the sedan's left rear drive: an open bug), and
-      // these columns enter only the steady-state gains
       LinearizeOptions o;
-      o.method = JacobianMethod::CentralDifference;
+      o.method = method_of_model(m);
       o.independent = m.spec.analysis.independent;
       const Linearization lw = linearize(with, sl.op, o);
       if (lw.system.state_names == sys.state_names && lw.system.A.rows() == sys.A.rows()) {

@@ -236,3 +236,31 @@ TEST(Sedan, ConstantSpeedGainsInATurnAreTheSlopesOfTheSteadyTurns) {
   std::printf("[ Sedan ] at 0.4 g, 25 m/s: G_ay %.8g (steady turns %.8g), G_r %.8g (%.8g), K %.5g deg/g\n",
               h.lateral_acceleration_gain, G_ay, h.yaw_rate_gain, G_r, h.understeer_gradient_deg_per_g);
 }
+
+// The drive and brake torques' columns of B with them in Plant/In (the steer a motion input, the
+// brake not an input: a constant beside the variables in the mix's sum), exact against central
+// differences column by column. Regression: automatic differentiation lost the left rear drive's
+// column entirely (an unevaluated product of the brake's constant input in the mix's sum).
+TEST(Sedan, TorqueInputsColumnsEqualCentralDifferences) {
+  Model mod = sedan_model(0.4 * 9.80665);
+  const OperatingPoint op = study_operating_point(mod);
+  for (const char* name : {"drive", "drive_rl", "drive_rr", "brake_fl"}) mod.plant_inputs.push_back(mod.find_actuator(name));
+  LinearizeOptions o;
+  o.independent = mod.spec.analysis.independent;
+  const Linearization ex = linearize(mod, op, o);
+  o.method = JacobianMethod::CentralDifference;
+  const Linearization fd = linearize(mod, op, o);
+  ASSERT_EQ(ex.system.B.cols(), 5);
+  for (Eigen::Index c = 1; c < 5; ++c) {
+    const double scale = fd.system.B.col(c).cwiseAbs().maxCoeff();
+    ASSERT_GT(scale, 0.1);
+    const double e = (ex.system.B.col(c) - fd.system.B.col(c)).cwiseAbs().maxCoeff() / scale;
+    EXPECT_LT(e, 1e-6) << ex.system.input_names[static_cast<std::size_t>(c)];
+    // the chassis' rows (small beside the wheels'), on their own
+    const double ec = (ex.system.B.col(c).segment(15, 6) - fd.system.B.col(c).segment(15, 6)).cwiseAbs().maxCoeff() /
+                      fd.system.B.col(c).segment(15, 6).cwiseAbs().maxCoeff();
+    EXPECT_LT(ec, 1e-5) << ex.system.input_names[static_cast<std::size_t>(c)] << " (chassis rows)";
+    std::printf("[ Sedan ] B column %-9s exact against central differences %.2e (chassis rows %.2e)\n",
+                ex.system.input_names[static_cast<std::size_t>(c)].c_str(), e, ec);
+  }
+}
