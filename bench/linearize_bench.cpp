@@ -44,7 +44,11 @@
 #include "analysis/operating_point.hpp"
 #include "dynamics/prepare.hpp"
 #include "io/model_file.hpp"
+#include "dynamics/data.hpp"
+#include "dynamics/forward_dynamics.hpp"
+#include "simulation/simulator.hpp"
 #include "study/sweep.hpp"
+#include "study/workflow.hpp"
 #include "bench_models.hpp"
 
 namespace {
@@ -153,6 +157,87 @@ int register_all() {
   return 0;
 }
 const int registered = register_all();
+
+// The sedan (examples/sedan.json, issue 39) on its steady 0.4 g turn at 25 m/s: the steady search
+// from the model's start (SedanSteadyTurn), linearize() about the motion found (SedanLinearize:
+// automatic differentiation of the motion-frame plant function, and the check a time further along
+// the turn, which linearizes once more), one forward-dynamics evaluation there (SedanDynamics: what
+// an integrator step costs per evaluation) and one second simulated from the turn
+// (SedanSimulate1s, the model's integrator); the NoTires variants leave the four tire effects out
+// (the same state) for the tires' share of the first two.
+struct SedanBench {
+  Model with, without;
+  OperatingPoint op;
+  SedanBench() {
+    const std::string path = std::string(CODYNA_SOURCE_DIR) + "/examples/sedan.json";
+    ModelSpec spec = load_model_spec(path);
+    spec.analysis.steady.lateral_acceleration = 0.4 * 9.80665;
+    with = study_model(spec, path);
+    op = study_operating_point(with);
+    spec.analysis.disabled_effects = {"tire_fl", "tire_fr", "tire_rl", "tire_rr"};
+    std::vector<SensorSpec> kept;
+    for (const SensorSpec& s : spec.sensors)
+      if (s.name.rfind("Fz_", 0) != 0 && s.name.rfind("slip_angle_", 0) != 0) kept.push_back(s);
+    spec.sensors = kept;
+    without = study_model(spec, path);
+  }
+};
+const SedanBench& sedan_bench() {
+  static const SedanBench s;
+  return s;
+}
+
+void SedanSteadyTurn(benchmark::State& state) {
+  const SedanBench& b = sedan_bench();
+  for (auto _ : state) {
+    const OperatingPoint op = study_operating_point(b.with);
+    benchmark::DoNotOptimize(op.q.data());
+  }
+}
+BENCHMARK(SedanSteadyTurn)->Unit(benchmark::kMillisecond);
+
+void SedanLinearize(benchmark::State& state) {
+  const SedanBench& b = sedan_bench();
+  const Model& m = state.range(0) ? b.with : b.without;
+  LinearizeOptions o;
+  o.independent = m.spec.analysis.independent;
+  for (auto _ : state) {
+    const Linearization l = linearize(m, b.op, o);
+    benchmark::DoNotOptimize(l.system.A.data());
+  }
+}
+BENCHMARK(SedanLinearize)->ArgName("tires")->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
+
+void SedanDynamics(benchmark::State& state) {
+  const SedanBench& b = sedan_bench();
+  const Model& m = state.range(0) ? b.with : b.without;
+  Data d(m);
+  for (auto _ : state) {
+    const Eigen::VectorXd& qdd = forward_dynamics<double>(m, d, b.op.q, b.op.v, b.op.u);
+    benchmark::DoNotOptimize(qdd.data());
+  }
+}
+BENCHMARK(SedanDynamics)->ArgName("tires")->Arg(1)->Arg(0)->Unit(benchmark::kMicrosecond);
+
+void SedanSimulate1s(benchmark::State& state) {
+  const SedanBench& b = sedan_bench();
+  Model run = b.with;
+  for (std::size_t k = 0; k < run.actuators.size(); ++k) run.actuators[k].u0 = b.op.u[static_cast<Eigen::Index>(k)];
+  SimulationOptions so;
+  so.q0 = b.op.q;
+  so.v0 = b.op.v;
+  so.t_end = 1.0;
+  so.output_step = 0.01;
+  long steps = 0;
+  for (auto _ : state) {
+    const SimulationResult r = simulate(run, nullptr, nullptr, so);
+    if (!r.completed) state.SkipWithError("the run did not complete");
+    steps = r.stats.steps;
+    benchmark::DoNotOptimize(r.q.data());
+  }
+  state.counters["steps"] = static_cast<double>(steps);
+}
+BENCHMARK(SedanSimulate1s)->Unit(benchmark::kMillisecond);
 
 constexpr int kVariants = 200;
 

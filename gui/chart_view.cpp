@@ -2,6 +2,7 @@
 
 #include <QApplication>
 #include <QChart>
+#include <QLegend>
 #include <QClipboard>
 #include <QContextMenuEvent>
 #include <QDialog>
@@ -34,6 +35,23 @@
 #include "gui/image_export.hpp"
 
 namespace codyna::gui {
+
+QChart* ChartView::compactChart(const QString& title) {
+  auto* c = new QChart;
+  c->setTitle(title);
+  QFont tf = c->titleFont();
+  tf.setBold(true);
+  tf.setPointSizeF(9);
+  c->setTitleFont(tf);
+  c->setBackgroundRoundness(0);
+  c->setMargins(QMargins(2, 0, 6, 0));
+  c->setAnimationOptions(QChart::NoAnimation);
+  c->legend()->setAlignment(Qt::AlignRight);
+  QFont lf = c->legend()->font();
+  lf.setPointSizeF(8);
+  c->legend()->setFont(lf);
+  return c;
+}
 
 ChartView::ChartView(QChart* chart, QWidget* parent) : QChartView(chart, parent) {
   setRubberBand(QChartView::RectangleRubberBand);

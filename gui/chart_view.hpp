@@ -17,6 +17,9 @@ class ChartView : public QChartView {
   Q_OBJECT
  public:
   explicit ChartView(QChart* chart, QWidget* parent = nullptr);
+  // a chart laid out for the small panels of the views: a bold 9 pt title, no rounding, narrow
+  // margins, no animation, the legend on the right in 8 pt (no axes)
+  static QChart* compactChart(const QString& title);
 
   QString dataCsv() const;  // the curves as plotted (visible series with a name or the only one)
   QString readout() const;  // what the corner shows ("" outside the plot area)

@@ -36,22 +36,7 @@ QStringList qlist(const std::vector<std::string>& v) {
   return l;
 }
 
-QChart* makeChart(const QString& title) {
-  auto* c = new QChart;
-  c->setTitle(title);
-  QFont tf = c->titleFont();
-  tf.setBold(true);
-  tf.setPointSizeF(9);
-  c->setTitleFont(tf);
-  c->setBackgroundRoundness(0);
-  c->setMargins(QMargins(2, 0, 6, 0));
-  c->setAnimationOptions(QChart::NoAnimation);
-  c->legend()->setAlignment(Qt::AlignRight);
-  QFont lf = c->legend()->font();
-  lf.setPointSizeF(8);
-  c->legend()->setFont(lf);
-  return c;
-}
+QChart* makeChart(const QString& title) { return ChartView::compactChart(title); }
 
 // small fonts and few ticks, so that the labels fit a short chart (no "..." for a number)
 void styleAxis(QAbstractAxis* a, const QString& title) {

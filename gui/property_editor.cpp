@@ -722,6 +722,25 @@ void PropertyEditor::retireEditors() {
   editors_.clear();
 }
 
+QWidget* PropertyEditor::nameCombo(const QStringList& names, const QString& value, const QString& key) {
+  auto* c = new QComboBox;
+  c->setEditable(true);
+  c->addItems(names);
+  // the entry itself when it is one (so that arrow keys step from it), else the text as typed
+  const int at = c->findText(value);
+  if (at >= 0) c->setCurrentIndex(at);
+  else c->setEditText(value);
+  // a pick from the list (activated) and typed text confirmed (editingFinished) both apply; the
+  // second of the two sees the value already applied and does nothing
+  auto apply = [this, c, key] {
+    if (isCurrent(key, c) && c->currentText() != c->property("value").toString()) applyText(key, c->currentText());
+  };
+  connect(c, &QComboBox::activated, this, apply);
+  connect(c->lineEdit(), &QLineEdit::editingFinished, this, apply);
+  c->setProperty("value", value);
+  return c;
+}
+
 bool PropertyEditor::isCurrent(const QString& key, const QWidget* editor) const {
   const auto it = editors_.find(key);
   return it != editors_.end() && it->second == editor;
@@ -801,19 +820,7 @@ void PropertyEditor::rebuild() {
       editor = e;
     } else if (kind == ElementKind::Sensor && key == QLatin1String("tire") && v.is_string()) {
       // a tire sensor's tire: one of the model's tire effects (or a name typed)
-      auto* c = new QComboBox;
-      c->setEditable(true);
-      c->addItems(tires);
-      const int at = c->findText(qs(v.get<std::string>()));
-      if (at >= 0) c->setCurrentIndex(at);
-      else c->setEditText(qs(v.get<std::string>()));
-      auto apply = [this, c, key] {
-        if (isCurrent(key, c) && c->currentText() != c->property("value").toString()) applyText(key, c->currentText());
-      };
-      connect(c, &QComboBox::activated, this, apply);
-      connect(c->lineEdit(), &QLineEdit::editingFinished, this, apply);
-      c->setProperty("value", qs(v.get<std::string>()));
-      editor = c;
+      editor = nameCombo(tires, qs(v.get<std::string>()), key);
     } else if (last == "type") {
       auto* c = new QComboBox;
       c->addItems(shape_type ? QStringList{"box", "cylinder", "sphere"} : type_names(kind));
@@ -824,22 +831,7 @@ void PropertyEditor::rebuild() {
       editor = c;
     } else if (v.is_string() && (kBodyRefs.contains(last) || last == "joint" || last.startsWith("joint_"))) {
       const bool joint_ref = last == "joint" || last.startsWith("joint_");
-      auto* c = new QComboBox;
-      c->setEditable(true);
-      c->addItems(joint_ref ? joints : bodies);
-      // the entry itself when it is one (so that arrow keys step from it), else the text as typed
-      const int at = c->findText(qs(v.get<std::string>()));
-      if (at >= 0) c->setCurrentIndex(at);
-      else c->setEditText(qs(v.get<std::string>()));
-      // a pick from the list (activated) and typed text confirmed (editingFinished) both
-      // apply; the second of the two sees the value already applied and does nothing
-      auto apply = [this, c, key] {
-        if (isCurrent(key, c) && c->currentText() != c->property("value").toString()) applyText(key, c->currentText());
-      };
-      connect(c, &QComboBox::activated, this, apply);
-      connect(c->lineEdit(), &QLineEdit::editingFinished, this, apply);
-      c->setProperty("value", qs(v.get<std::string>()));
-      editor = c;
+      editor = nameCombo(joint_ref ? joints : bodies, qs(v.get<std::string>()), key);
     } else if (v.is_boolean()) {
       auto* c = new QCheckBox;
       c->setChecked(v.get<bool>());

@@ -59,6 +59,9 @@ class PropertyEditor : public QWidget {
   void rebuild();
   void retireEditors();                                             // takes the rows out, deletes them later
   bool isCurrent(const QString& key, const QWidget* editor) const;  // false for a retired editor
+  // an editable list of names (bodies, joints, tires) showing `value`, applied to `key` when
+  // one is picked or typed text is confirmed
+  QWidget* nameCombo(const QStringList& names, const QString& value, const QString& key);
   void refreshMarks();
   void applyMarks();
   QFormLayout* form_ = nullptr;

@@ -37,19 +37,7 @@ const char* const kTireElementTag = "element:";
 const char* const kTireFileTag = "file:";
 
 QChart* tire_chart(const QString& title) {
-  auto* c = new QChart;
-  c->setTitle(title);
-  QFont tf = c->titleFont();
-  tf.setBold(true);
-  tf.setPointSizeF(9);
-  c->setTitleFont(tf);
-  c->setBackgroundRoundness(0);
-  c->setMargins(QMargins(2, 0, 6, 0));
-  c->setAnimationOptions(QChart::NoAnimation);
-  c->legend()->setAlignment(Qt::AlignRight);
-  QFont lf = c->legend()->font();
-  lf.setPointSizeF(8);
-  c->legend()->setFont(lf);
+  QChart* c = ChartView::compactChart(title);
   auto axis = [](const QString& title) {
     auto* a = new QValueAxis;
     QFont f = a->labelsFont();

@@ -12,12 +12,15 @@
 //   yaw natural frequency and damping ratio: of the pair of poles that carry most of the yaw-rate
 //                              response to steer (a complex pair, or two real poles:
 //                              wn = sqrt(p1 p2), zeta = -(p1 + p2) / (2 wn))
-// The steady-state gains are those of A x + B u = 0, y = C x + D u on the states that reach the
-// outputs (the road position and the heading, whose columns vanish but in their own rows when the
-// velocities are in body axes, are left out: they advance in a steady turn); A may still be singular
-// (a coasting speed): the gain is taken when every solution gives the same output, and refused
-// otherwise. A planar joint's velocities are the world's: the caller puts them in body axes first
-// (study_handling).
+// The steady-state gains are those of A x + B u = 0, y = C x + D u less what drifts unseen: the
+// largest subspace of positions that the outputs do not read and the dynamics keep (the road
+// position, the heading, the spin angles, in whatever combination of coordinates the chart gives
+// them: a pitched chassis' forward position is its body x and z together) is taken out first. With
+// a SpeedHold (the steady motion's other free inputs: a drive) the speed's change is held at zero
+// by them: the constant-speed gains. A may still be singular (a coasting speed): the gain is taken
+// when every solution gives the same output, and refused otherwise. The understeer gradient is per
+// road-wheel angle: the steer input divided by the steering ratio. A planar joint's velocities are
+// the world's: the caller puts them in body axes first (study_handling).
 #pragma once
 
 #include <string>
