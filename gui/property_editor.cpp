@@ -300,6 +300,10 @@ QString PropertyEditor::fieldHelp(ElementKind kind, const QString& key, const QS
                                "file's when it gives one)"},
         {"vertical_damping", "Vertical damping (>= 0; magic_formula: the .tir file's when it gives one)"},
         {"low_speed", "Below this forward speed the slips' denominator is regularized (> 0)"},
+        {"longitudinal_relaxation_length", "Transient slip: the longitudinal slip builds up over this rolled distance "
+                                           "(a state per tire; 0: at once)"},
+        {"lateral_relaxation_length", "Transient slip: the slip angle builds up over this rolled distance (a state per "
+                                      "tire; 0: at once)"},
         {"road/body", "The body that carries the road plane (ground: the world)"},
         {"road/point", "A point of the road plane, in its body's frame"},
         {"road/normal", "The road's normal, in its body's frame (the wheel rolls on the side it points to)"},
@@ -384,7 +388,8 @@ QString PropertyEditor::unitOf(const QString& key) {
       {"color", "rgba 0..1"}, {"center", "m"}, {"spin_axis", "unit vector"}, {"normal", "unit vector"},
       {"unloaded_radius", "m"}, {"rolling_radius", "m"}, {"longitudinal_stiffness", "N"}, {"cornering_stiffness", "N/rad"},
       {"camber_stiffness", "N/rad"}, {"trail", "m"}, {"width", "m"}, {"rolling_resistance", "m"},
-      {"vertical_stiffness", "N/m"}, {"vertical_damping", "N s/m"}, {"low_speed", "m/s"}};
+      {"vertical_stiffness", "N/m"}, {"vertical_damping", "N s/m"}, {"low_speed", "m/s"},
+      {"longitudinal_relaxation_length", "m"}, {"lateral_relaxation_length", "m"}};
   const QString last = key.section('/', -1);
   const auto it = units.find(last);
   return it == units.end() ? QString() : it->second;

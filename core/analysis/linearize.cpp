@@ -13,6 +13,7 @@
 
 #include "analysis/linearizer.hpp"
 #include "dynamics/derivatives.hpp"
+#include "dynamics/effects.hpp"
 #include "dynamics/forward_dynamics.hpp"
 #include "dynamics/joint.hpp"
 #include "dynamics/kinematics.hpp"
@@ -216,6 +217,16 @@ Linearization linearize_general(const Model& model, const OperatingPoint& op, co
   // state at the operating point: zero deviation, independent velocities
   Eigen::VectorXd x = Eigen::VectorXd::Zero(nx);
   for (int k = 0; k < f.nw(); ++k) x[f.nz() + k] = op.v[f.rates()[static_cast<std::size_t>(k)]];
+  if (f.ns() > 0) {
+    // the effect states: the operating point's, or at rest at (q, v): a tire's deflections carry
+    // the steady slips (the states of a steady motion; at any other point, the consistent start)
+    if (op.s.size() == f.ns()) {
+      x.tail(f.ns()) = op.s;
+    } else {
+      Data d(model);
+      x.tail(f.ns()) = effect_states_steady(model, d, op.q, op.v);
+    }
+  }
   Eigen::VectorXd u(nu);
   for (int k = 0; k < nu; ++k) u[k] = op.u[model.plant_inputs[k]];
 
@@ -239,6 +250,7 @@ Linearization linearize_general(const Model& model, const OperatingPoint& op, co
   Eigen::VectorXd xd, y;
   f.eval<double>(x, u, xd, y);
   s.x0 = f.state_offset(op.v);
+  s.x0.tail(f.ns()) = x.tail(f.ns());
   s.positions = f.nz();
   s.u0 = u;
   s.y0 = y;
@@ -399,7 +411,7 @@ struct Linearizer::Impl {
   void bind(const Model& m) {
     if (ready && &m == model && prepared_from.match(m)) return;
     model = &m;
-    tree = m.nc == 0 && m.motions.empty();
+    tree = m.nc == 0 && m.motions.empty() && m.ns == 0;  // (effect states: the general path)
     ready = false;
   }
 

@@ -43,7 +43,7 @@ Eigen::VectorXd rest_accelerations(const PlantFunction& f, const Eigen::VectorXd
   Eigen::VectorXd x = Eigen::VectorXd::Zero(f.nx()), xd, y;
   x.head(f.nz()) = z;
   f.eval<double>(x, u, xd, y);
-  return xd.tail(f.nw());
+  return xd.segment(f.nz(), f.nw());
 }
 
 Eigen::VectorXd plant_u(const Model& m, const Eigen::VectorXd& u_all) {
@@ -147,7 +147,7 @@ OperatingPoint steady_state(const Model& model, const OperatingPoint& start, con
     x.head(f.nz()) = z;
     f.eval<double>(x, uu, xd, y);
     Eigen::VectorXd r(f.nw() + static_cast<Eigen::Index>(target_y.size()));
-    r.head(f.nw()) = xd.tail(f.nw());
+    r.head(f.nw()) = xd.segment(f.nz(), f.nw());
     for (std::size_t i = 0; i < target_y.size(); ++i)
       r[f.nw() + static_cast<Eigen::Index>(i)] = y[target_y[i]] - target[static_cast<Eigen::Index>(i)];
     return r;

@@ -25,6 +25,9 @@ struct OperatingPoint {
   double t = 0.0;
   Eigen::VectorXd q, v;          // nq, nv (on the constraint manifold)
   Eigen::VectorXd u;             // one value per actuator (Model::actuators)
+  // the effect states (Model::ns: the tires' transient slip); empty: at rest at (q, v)
+  // (effect_states_steady), which every operating point codyna finds is
+  Eigen::VectorXd s;
   double residual = 0.0;         // max |qdd| left by equilibrium / trim
   int iterations = 0;
   // a steady motion (steady_motion below): the frame the state moves with; linearize() takes

@@ -375,7 +375,7 @@ double fd_step(bool central, double xk) {
 
 bool PlantFunction::fd_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& u, bool central,
                                 Eigen::MatrixXd& J) const {
-  if (motion_) return false;
+  if (motion_ || ns() > 0) return false;
   const Model& m = model_;
   if (m.nc != 0 || !part_.dependent.empty() || !m.motions.empty()) return false;
   const int n = nz(), nx_p = 2 * n, nu_p = nu(), ny_p = ny(), rows = nx_p + ny_p;
@@ -434,15 +434,15 @@ bool PlantFunction::fd_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd&
 template <class S>
 void PlantFunction::eval(const VecXT<S>& x, const VecXT<S>& u, VecXT<S>& xdot, VecXT<S>& y) const {
   if constexpr (std::is_same_v<S, double>) {
-    if (motion_) {
-      // about a steady motion: the generic evaluation below, in double
+    if (motion_ || ns() > 0) {
+      // about a steady motion, or with effect states: the generic evaluation below, in double
     } else if (model_.motions.empty() && part_.rate_dependent.empty()) {
       if (part_.dependent.empty() && model_.nc == 0) eval_tree(x, u, xdot, y);
       else eval_closed(x, u, xdot, y);
     } else {
       eval_driven(x, u, xdot, y);
     }
-    if (!motion_) return;
+    if (!motion_ && ns() == 0) return;
   }
   const Model& m = model_;
   const int n = nz(), nw_ = nw(), nd = static_cast<int>(part_.dependent.size());
@@ -542,6 +542,7 @@ void PlantFunction::eval(const VecXT<S>& x, const VecXT<S>& u, VecXT<S>& xdot, V
   const VecXT<S> q = integrate<S>(m, q_ref_.cast<S>(), dq);
   VecXT<S> u_all = u_all_.cast<S>();
   for (int k = 0; k < nu(); ++k) u_all[m.plant_inputs[k]] = u[k];
+  if (ns() > 0) d.s = x.tail(ns());  // the effect states: applied_forces reads them, writes their rates
   VecXT<S> qdd = forward_dynamics<S>(m, d, q, v, u_all);
   VecXT<S> rate;
   if (motion_) {
@@ -553,9 +554,10 @@ void PlantFunction::eval(const VecXT<S>& x, const VecXT<S>& u, VecXT<S>& xdot, V
   } else {
     rate = tangent_rate<S>(m, dq, v);
   }
-  xdot.resize(n + nw_);
+  xdot.resize(n + nw_ + ns());
   for (int k = 0; k < n; ++k) xdot[k] = rate[ind[k]];
   for (int k = 0; k < nw_; ++k) xdot[n + k] = qdd[rates_[k]];
+  for (int k = 0; k < ns(); ++k) xdot[n + nw_ + k] = d.sdot[k];
   forward_kinematics<S>(m, d, q, v);
   y = sensor_outputs<S>(m, d, m.plant_outputs, q, v);
 }
@@ -583,7 +585,7 @@ void PlantFunction::take_workspace(PlantFunction& other) {
 void PlantFunction::set_motion(const SteadyMotion& motion) { motion_ = std::make_shared<const SteadyMotion>(motion); }
 
 bool PlantFunction::analytic_jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::MatrixXd& J) const {
-  if (motion_) return false;
+  if (motion_ || ns() > 0) return false;  // effect states: automatic differentiation of eval
   const Model& m = model_;
   if (m.nc != 0 || !m.motions.empty()) return closed_loop_jacobian(x, u, J);
   if (!part_.dependent.empty()) return false;
@@ -977,17 +979,26 @@ void PlantFunction::state_to_qv(const Eigen::VectorXd& x, Eigen::VectorXd& q, Ei
   for (int k = 0; k < nw(); ++k) v[rates_[static_cast<std::size_t>(k)]] = x[n + k];
   if (!vdep_.empty()) {
     const Eigen::MatrixXd J = active_jacobian(model_, q, vrows_);
-    const Eigen::VectorXd vd = -columns(J, vdep_).partialPivLu().solve(columns(J, rates_) * x.tail(nw()));
+    const Eigen::VectorXd vd = -columns(J, vdep_).partialPivLu().solve(columns(J, rates_) * x.segment(n, nw()));
     for (std::size_t k = 0; k < vdep_.size(); ++k) v[vdep_[k]] = vd[static_cast<Eigen::Index>(k)];
   }
 }
 
 Eigen::VectorXd PlantFunction::qv_to_state(const Eigen::VectorXd& q, const Eigen::VectorXd& v) const {
+  if (ns() == 0) return qv_to_state(q, v, Eigen::VectorXd());
+  Data d(model_);
+  return qv_to_state(q, v, effect_states_steady(model_, d, q, v));
+}
+
+Eigen::VectorXd PlantFunction::qv_to_state(const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+                                           const Eigen::VectorXd& s) const {
+  if (s.size() != ns()) throw std::invalid_argument("plant function: expected " + std::to_string(ns()) + " effect states");
   const Eigen::VectorXd dq = difference(model_, q_ref_, q);
   const int n = nz();
-  Eigen::VectorXd x(n + nw());
+  Eigen::VectorXd x(nx());
   for (int k = 0; k < n; ++k) x[k] = dq[part_.independent[k]];
   for (int k = 0; k < nw(); ++k) x[n + k] = v[rates_[static_cast<std::size_t>(k)]];
+  x.tail(ns()) = s;
   return x;
 }
 
@@ -1013,6 +1024,7 @@ std::vector<std::string> plant_state_names(const Model& model, const std::vector
   names.reserve(independent.size() + rates.size());
   for (int i : independent) names.push_back(model.v_names[static_cast<std::size_t>(i)]);
   for (int i : rates) names.push_back(model.rate_names[static_cast<std::size_t>(i)]);
+  names.insert(names.end(), model.s_names.begin(), model.s_names.end());  // the effect states, last
   return names;
 }
 
@@ -1022,6 +1034,7 @@ std::vector<std::string> plant_state_units(const Model& model, const std::vector
   units.reserve(independent.size() + rates.size());
   for (int i : independent) units.push_back(model.v_units[static_cast<std::size_t>(i)]);
   for (int i : rates) units.push_back(rate_unit(model.v_units[static_cast<std::size_t>(i)]));
+  units.insert(units.end(), model.s_units.begin(), model.s_units.end());
   return units;
 }
 
@@ -1043,7 +1056,7 @@ std::vector<std::string> PlantFunction::state_units() const {
 
 Eigen::VectorXd PlantFunction::state_offset(const Eigen::VectorXd& v_ref) const {
   const int n = nz();
-  Eigen::VectorXd x0 = Eigen::VectorXd::Zero(n + nw());
+  Eigen::VectorXd x0 = Eigen::VectorXd::Zero(nx());
   for (int k = 0; k < n; ++k) {
     const int i = part_.independent[k];
     int c = 0;
@@ -1053,6 +1066,7 @@ Eigen::VectorXd PlantFunction::state_offset(const Eigen::VectorXd& v_ref) const 
     if (j.type != JointType::Spherical && j.type != JointType::Free) x0[k] = q_ref_[j.idx_q + c];
   }
   for (int k = 0; k < nw(); ++k) x0[n + k] = v_ref[rates_[static_cast<std::size_t>(k)]];
+  // the effect states are absolute in x: their offset is 0 (x0 holds their values at the reference)
   return x0;
 }
 

@@ -1,8 +1,9 @@
 // The plant as a first-order system in minimal coordinates about a base
 // configuration q_ref:
-//   x = [z; w]   z: tangent deviation of the independent coordinates from q_ref
+//   x = [z; w; s] z: tangent deviation of the independent coordinates from q_ref
 //                w: the independent velocities (as many as z, fewer with rolling's
 //                   non-holonomic rows: then some of z's rates follow from w)
+//                s: the effect states (Model::ns: a tire's transient slip), absolute values
 //   xdot = f(x, u),  y = h(x, u)       u: values of the Plant/In actuators
 // For a tree every coordinate is independent. For closed loops the
 // independent coordinates come from coordinate partitioning of the constraint
@@ -67,7 +68,9 @@ class PlantFunction {
   int nz() const { return static_cast<int>(part_.independent.size()); }
   // the independent velocities: nz() less the active non-holonomic rows (rolling); nz() otherwise
   int nw() const { return static_cast<int>(rates_.size()); }
-  int nx() const { return nz() + nw(); }
+  // the effect states (Model::ns: the tires' transient slip), last in x, absolute values
+  int ns() const { return model_.ns; }
+  int nx() const { return nz() + nw() + ns(); }
   // velocity indices of the state's velocities w (CoordinatePartition::rates())
   const std::vector<int>& rates() const { return rates_; }
   int nu() const { return static_cast<int>(model_.plant_inputs.size()); }
@@ -83,8 +86,10 @@ class PlantFunction {
 
   // the full configuration and velocity of state x (double)
   void state_to_qv(const Eigen::VectorXd& x, Eigen::VectorXd& q, Eigen::VectorXd& v) const;
-  // x of a full (q, v) near q_ref: z = difference(q_ref, q)[independent], w = v[independent]
+  // x of a full (q, v) near q_ref: z = difference(q_ref, q)[independent], w = v[independent], and
+  // the effect states s (without s: those at rest at (q, v), effect_states_steady)
   Eigen::VectorXd qv_to_state(const Eigen::VectorXd& q, const Eigen::VectorXd& v) const;
+  Eigen::VectorXd qv_to_state(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& s) const;
 
   // names and units, in state order; absolute values of the additive coordinates at x = 0
   std::vector<std::string> state_names() const;

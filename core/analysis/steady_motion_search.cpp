@@ -19,6 +19,7 @@
 #include "analysis/linearize.hpp"
 #include "analysis/operating_point.hpp"
 #include "analysis/plant_function.hpp"
+#include "dynamics/effects.hpp"
 #include "dynamics/joint.hpp"
 #include "dynamics/kinematics.hpp"
 #include "model/errors.hpp"
@@ -271,8 +272,25 @@ struct SteadySearch {
 
 }  // namespace
 
+namespace {
+OperatingPoint steady_motion_search(const Model& model, const OperatingPoint& start, const SteadyMotionSpec& spec,
+                                    const std::vector<std::string>& independent);
+}  // namespace
+
 OperatingPoint steady_motion(const Model& model, const OperatingPoint& start, const SteadyMotionSpec& spec,
                              const std::vector<std::string>& independent) {
+  if (model.ns == 0) return steady_motion_search(model, start, spec, independent);
+  // Effect states (a tire's transient slip) rest where their rates vanish, and there the forces are
+  // those of the same model without them (the deflections carry the steady slips): the search
+  // runs on that model, whose Jacobian sees how the forces follow the slips (with the states held
+  // fixed they would not, and Newton could walk to a wheel turned across the road); the states
+  // are at rest at the motion found (OperatingPoint::s left empty)
+  return steady_motion_search(without_effect_states(model), start, spec, independent);
+}
+
+namespace {
+OperatingPoint steady_motion_search(const Model& model, const OperatingPoint& start, const SteadyMotionSpec& spec,
+                                    const std::vector<std::string>& independent) {
   SteadySearch S(model, spec);
   S.independent = independent;
   S.q = start.q;
@@ -415,5 +433,6 @@ OperatingPoint steady_motion(const Model& model, const OperatingPoint& start, co
   }
   return op;
 }
+}  // namespace
 
 }  // namespace codyna

@@ -98,6 +98,8 @@ void DataT<S>::size_for(const Model& model) {
   lambda = VecXT<S>::Zero(model.nc);
   motion_acc = VecXT<S>::Zero(static_cast<Eigen::Index>(model.motions.size()));
   motion_force = VecXT<S>::Zero(static_cast<Eigen::Index>(model.motions.size()));
+  s = VecXT<S>::Zero(model.ns);
+  sdot = VecXT<S>::Zero(model.ns);
   phi = VecXT<S>::Zero(model.nc);
   Jc = MatXT<S>::Zero(model.nc, model.nv);
   gamma = VecXT<S>::Zero(model.nc);

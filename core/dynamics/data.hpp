@@ -69,6 +69,9 @@ struct DataT {
   // coordinates (the caller sets q, v there), and the generalized force each then applies
   // (M qdd + nle - Q on its coordinate: the reaction a motion actuator must supply)
   VecXT<S> motion_acc, motion_force;  // [motions]
+  // effect states (Model::ns: a tire's transient slip): their values, which applied_forces reads
+  // (the caller sets them; zeros after construction), and their rates, which it writes
+  VecXT<S> s, sdot;              // [ns]
 
   // articulated-body workspace (aba)
   std::vector<Mat6T<S>> IA;      // [nbodies] articulated inertia, body coordinates

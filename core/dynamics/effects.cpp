@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <type_traits>
 
 #include "dynamics/kinematics.hpp"
@@ -122,23 +123,31 @@ const VecXT<S>& applied_forces(const Model& model, DataT<S>& d, const VecXT<S>& 
     add_world_force<S>(d, b.body_a, b.X_a.p, Vec3T<S>(-Fw), Vec3T<S>(-(Tw + Vec3T<S>(xB - xA).cross(Fw))));
     any_body_force = true;
   }
+  if (d.sdot.size() != model.ns) d.sdot.resize(model.ns);
+  if (d.s.size() != model.ns) d.s = VecXT<S>::Zero(model.ns);
   for (const TireModel& t : model.tires) {
     ++count.tires;
     TireEffectBody<S> wb = tire_effect_body<S>(d, t.body), rb = tire_effect_body<S>(d, t.road_body);
+    const bool lag = t.state_x >= 0 || t.state_y >= 0;
     if constexpr (!std::is_same_v<S, double>) {
-      // the ground's constants with the wheel's derivative size
+      // the ground's constants with the wheel's derivative size (and the effect states likewise)
       Eigen::Index n = 0;
       for (TireEffectBody<S>* b : {&wb, &rb})
         n = std::max({n, ad_size(b->R), ad_size(b->p), ad_size(b->w), ad_size(b->v)});
+      if (lag) n = std::max(n, ad_size(d.s));
       for (TireEffectBody<S>* b : {&wb, &rb}) {
         ad_make_coherent(b->R, n);
         ad_make_coherent(b->p, n);
         ad_make_coherent(b->w, n);
         ad_make_coherent(b->v, n);
       }
+      if (lag) ad_make_coherent(d.s, n);
     }
     TireContact<S> c;
-    if (!tire_contact<S>(t, wb.R, wb.p, wb.w, wb.v, rb.R, rb.p, rb.w, rb.v, c)) continue;
+    const bool touches = tire_contact<S>(t, wb.R, wb.p, wb.w, wb.v, rb.R, rb.p, rb.w, rb.v, c, lag ? &d.s : nullptr);
+    if (t.state_x >= 0) d.sdot[t.state_x] = c.rate_x;
+    if (t.state_y >= 0) d.sdot[t.state_y] = c.rate_y;
+    if (!touches) continue;
     tire_effect_add_wrench<S>(d, t.body, c.point, c.force, c.moment);
     tire_effect_add_wrench<S>(d, t.road_body, c.point, Vec3T<S>(-c.force), Vec3T<S>(-c.moment));
     any_body_force = true;
@@ -181,6 +190,35 @@ const VecXT<S>& applied_forces(const Model& model, DataT<S>& d, const VecXT<S>& 
   }
   if (any_body_force) add_body_forces_to_generalized<S>(model, d, d.Q);
   return d.Q;
+}
+
+Eigen::VectorXd effect_states_steady(const Model& model, DataT<double>& d, const Eigen::VectorXd& q,
+                                     const Eigen::VectorXd& v) {
+  Eigen::VectorXd s = Eigen::VectorXd::Zero(model.ns);
+  if (model.ns == 0) return s;
+  forward_kinematics<double>(model, d, q, v);
+  for (const TireModel& t : model.tires) {
+    if (t.state_x < 0 && t.state_y < 0) continue;
+    const TireEffectBody<double> wb = tire_effect_body<double>(d, t.body), rb = tire_effect_body<double>(d, t.road_body);
+    TireContact<double> c;
+    if (!tire_contact<double>(t, wb.R, wb.p, wb.w, wb.v, rb.R, rb.p, rb.w, rb.v, c)) continue;  // off the road: 0
+    // du/dt = 0: the deflections whose slips are the steady ones
+    if (t.state_x >= 0) s[t.state_x] = t.relaxation_x * c.input.kappa;
+    if (t.state_y >= 0) s[t.state_y] = t.relaxation_y * std::tan(c.input.alpha);
+  }
+  return s;
+}
+
+Model without_effect_states(const Model& model) {
+  Model m = model;
+  for (TireModel& t : m.tires) {
+    t.relaxation_x = t.relaxation_y = 0;
+    t.state_x = t.state_y = -1;
+  }
+  m.ns = 0;
+  m.s_names.clear();
+  m.s_units.clear();
+  return m;
 }
 
 template const VecXT<double>& applied_forces<double>(const Model&, DataT<double>&, const VecXT<double>&,

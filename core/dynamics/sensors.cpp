@@ -53,7 +53,11 @@ bool sensor_tire_contact(const DataT<S>& d, const TireModel& t, TireContact<S>& 
     ad_make_coherent(wr, n);
     ad_make_coherent(vr, n);
   }
-  return tire_contact<S>(t, Rw, pw, ww, vw, Rr, pr, wr, vr, c);
+  // with transient slip, the deflections the caller set in d.s (the slips the law takes)
+  if (t.state_x < 0 && t.state_y < 0) return tire_contact<S>(t, Rw, pw, ww, vw, Rr, pr, wr, vr, c);
+  VecXT<S> s = d.s;  // sized Model::ns by the Data
+  if constexpr (!std::is_same_v<S, double>) ad_make_coherent(s, std::max(ad_size(s), ad_size(pw)));
+  return tire_contact<S>(t, Rw, pw, ww, vw, Rr, pr, wr, vr, c, &s);
 }
 }  // namespace
 

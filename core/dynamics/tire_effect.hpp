@@ -21,6 +21,15 @@
 // jumps where the wheel touches down). The law gives Fx, Fy, Mx, My, Mz at P in these axes; the
 // wheel takes F = Fx x + Fy y + Fz z at P and M = Mx x + My y + Mz z, i.e. about its centre the
 // wrench (F, M + (P - c) x F); a road on a moving body takes the opposite.
+//
+// Transient slip (relaxation; Pacejka, Tire and Vehicle Dynamics, the linear first-order model in
+// its deflection form): a tire with relaxation lengths sigma_x, sigma_y > 0 carries the contact's
+// longitudinal and lateral deflections u_x, u_y as states, with
+//   du_x/dt = -(Vx - Omega Re) - |Vx|_v u_x / sigma_x,   kappa' = u_x / sigma_x
+//   du_y/dt = Vy - |Vx|_v u_y / sigma_y,                 alpha' = atan(u_y / sigma_y)
+// and the law takes kappa', alpha' for kappa, alpha. At rest in the states (du/dt = 0) they equal the
+// steady slips above; a slip that changes reaches the force after about sigma / |Vx| seconds. Off the
+// road the deflections relax at the rate of the lowest regularized speed (v_low / 2).
 #pragma once
 
 #include <cmath>
@@ -42,6 +51,7 @@ struct TireContact {
   S penetration{0.0}, penetration_rate{0.0}, Vx{0.0}, Vy{0.0}, omega{0.0};
   TireInput<S> input;                  // Fz, kappa, alpha, gamma, Vx handed to the law
   TireForces<S> out;                   // the law's forces and moments at P
+  S rate_x{0.0}, rate_y{0.0};          // transient slip: du_x/dt, du_y/dt (0 without the state)
 };
 
 // asin with its derivative 1 / sqrt(1 - x^2) (an evaluated scalar)
@@ -94,14 +104,20 @@ TireForces<S> tire_effect_law(const TireModel& t, const TireInput<S>& in) {
 
 // The contact of tire t: wheel pose (R, p), angular velocity w and velocity v of its origin, the road
 // body's likewise (world axes). Fills c; false when the tire carries no force (off the road, or the
-// wheel lying flat on it), c's forces then zero.
+// wheel lying flat on it), c's forces then zero. states: the effect states (Data::s) when the tire has
+// transient slip (t.state_x, t.state_y; nullptr: the steady slips, as at rest in the states).
 template <class S>
 bool tire_contact(const TireModel& t, const Mat3T<S>& Rw, const Vec3T<S>& pw, const Vec3T<S>& ww, const Vec3T<S>& vw,
-                  const Mat3T<S>& Rr, const Vec3T<S>& pr, const Vec3T<S>& wr, const Vec3T<S>& vr, TireContact<S>& c) {
+                  const Mat3T<S>& Rr, const Vec3T<S>& pr, const Vec3T<S>& wr, const Vec3T<S>& vr, TireContact<S>& c,
+                  const VecXT<S>* states = nullptr) {
   using std::sqrt;
   const S zero = pw[0] * 0.0;
   c.force = Vec3T<S>::Constant(zero);
   c.moment = Vec3T<S>::Constant(zero);
+  const bool lag_x = states && t.state_x >= 0, lag_y = states && t.state_y >= 0;
+  // off the road: the deflections relax (at v_low / 2 over the length)
+  c.rate_x = lag_x ? S((*states)[t.state_x] * (-0.5 * t.low_speed / t.relaxation_x)) : zero;
+  c.rate_y = lag_y ? S((*states)[t.state_y] * (-0.5 * t.low_speed / t.relaxation_y)) : zero;
   const Vec3T<S> a = Rw * t.axis.cast<S>();
   c.center = Rw * t.center.cast<S>() + pw;
   const Vec3T<S> n = Rr * t.road_normal.cast<S>();
@@ -138,9 +154,23 @@ bool tire_contact(const TireModel& t, const Mat3T<S>& Rw, const Vec3T<S>& pw, co
   c.Vy = c.ey.dot(V);
   const S speed = tire_effect_speed<S>(c.Vx, t.low_speed);
   c.input.Fz = Fz;
-  c.input.kappa = -(c.Vx - c.omega * t.rolling_radius) / speed;
-  const S ratio = c.Vy / speed;
-  c.input.alpha = tire_atan(ratio);
+  const S slip_x = c.Vx - c.omega * t.rolling_radius;
+  if (lag_x) {
+    const S ux = (*states)[t.state_x];
+    c.rate_x = -slip_x - speed * ux / t.relaxation_x;
+    c.input.kappa = ux / t.relaxation_x;
+  } else {
+    c.input.kappa = -slip_x / speed;
+  }
+  if (lag_y) {
+    const S uy = (*states)[t.state_y];
+    c.rate_y = c.Vy - speed * uy / t.relaxation_y;
+    const S ratio = uy / t.relaxation_y;
+    c.input.alpha = tire_atan(ratio);
+  } else {
+    const S ratio = c.Vy / speed;
+    c.input.alpha = tire_atan(ratio);
+  }
   c.input.gamma = tire_effect_asin(na);
   c.input.Vx = c.Vx;
   c.input.phit = zero;

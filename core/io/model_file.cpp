@@ -904,7 +904,11 @@ const Schema<EffectSpec>& schema<EffectSpec>() {
                  [](const Node& n) { return std::optional<double>(read_coefficient(n)); }),
            field("vertical_damping", &EffectSpec::vertical_damping,
                  [](const Node& n) { return std::optional<double>(read_coefficient(n)); }),
-           field("low_speed", &EffectSpec::low_speed, read_positive_speed)},
+           field("low_speed", &EffectSpec::low_speed, read_positive_speed),
+           field("longitudinal_relaxation_length", &EffectSpec::longitudinal_relaxation_length, read_coefficient,
+                 [](double r) { return r > 0 ? ojson(r) : ojson(); }),
+           field("lateral_relaxation_length", &EffectSpec::lateral_relaxation_length, read_coefficient,
+                 [](double r) { return r > 0 ? ojson(r) : ojson(); })},
       }),
       "effect",
       [](const EffectSpec& e) {
@@ -923,7 +927,8 @@ const Schema<EffectSpec>& schema<EffectSpec>() {
             return element_keys({"body", "center", "spin_axis", "unloaded_radius", "rolling_radius", "road", "law",
                                  "longitudinal_stiffness", "cornering_stiffness", "camber_stiffness", "friction",
                                  "sliding_friction", "trail", "width", "rolling_resistance", "file", "side", "vertical_stiffness",
-                                 "vertical_damping", "low_speed"});
+                                 "vertical_damping", "low_speed", "longitudinal_relaxation_length",
+                                 "lateral_relaxation_length"});
         }
         return element_keys({});
       }};

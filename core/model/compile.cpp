@@ -584,6 +584,7 @@ class Compiler {
         }
         case EffectType::Tire:
           m_.tires.push_back(build_tire(e, p));
+          add_tire_states(m_.tires.back());
           break;
         case EffectType::JointDamper: {
           // one damping value on every velocity coordinate of the joint: -damping * v
@@ -697,7 +698,28 @@ class Compiler {
     non_negative(t.vertical_damping, p + "/vertical_damping", "vertical damping");
     non_negative(e.rolling_radius, p + "/rolling_radius", "rolling radius");
     t.rolling_radius = e.rolling_radius > 0 ? e.rolling_radius : t.unloaded_radius;
+    if (!std::isfinite(e.longitudinal_relaxation_length))
+      fail(p + "/longitudinal_relaxation_length", "expected a finite length (m)");
+    if (!std::isfinite(e.lateral_relaxation_length)) fail(p + "/lateral_relaxation_length", "expected a finite length (m)");
+    non_negative(e.longitudinal_relaxation_length, p + "/longitudinal_relaxation_length", "relaxation length");
+    non_negative(e.lateral_relaxation_length, p + "/lateral_relaxation_length", "relaxation length");
+    t.relaxation_x = e.longitudinal_relaxation_length;
+    t.relaxation_y = e.lateral_relaxation_length;
     return t;
+  }
+
+  // the transient slip's states of tire t (its contact's deflections), after the others
+  void add_tire_states(TireModel& t) {
+    if (t.relaxation_x > 0) {
+      t.state_x = m_.ns++;
+      m_.s_names.push_back(t.name + ".deflection_x");
+      m_.s_units.push_back("m");
+    }
+    if (t.relaxation_y > 0) {
+      t.state_y = m_.ns++;
+      m_.s_names.push_back(t.name + ".deflection_y");
+      m_.s_units.push_back("m");
+    }
   }
 
   void build_actuators() {

@@ -102,6 +102,10 @@ struct TireModel {
          rolling_resistance = 0;
   std::shared_ptr<const MagicFormulaParameters> mf;       // magic_formula: the .tir file read
   int side = 0;                                           // magic_formula: 0 as the file, 1 left, 2 right
+  // transient slip (dynamics/tire_effect.hpp): relaxation lengths (m; 0: none) and the indices of
+  // the contact's longitudinal and lateral deflections in the effect states (Model::ns; -1: none)
+  double relaxation_x = 0, relaxation_y = 0;
+  int state_x = -1, state_y = -1;
 };
 
 struct ActuatorModel {
@@ -192,6 +196,11 @@ struct Model {
   std::vector<BodyForceModel> body_forces;
   std::vector<BushingModel> bushings;
   std::vector<TireModel> tires;
+  // Effect states: first-order states that force elements carry (a tire's transient slip), in
+  // every plant and simulation state after the velocities. Their rates come from applied_forces
+  // (Data::s in, Data::sdot out); effect_states_steady gives the values at which they rest.
+  int ns = 0;
+  std::vector<std::string> s_names, s_units;  // [ns]: TIRE.deflection_x, TIRE.deflection_y; "m"
 
   std::vector<ActuatorModel> actuators;  // [nu_all]
   std::vector<SensorModel> sensors;      // [ny_all]

@@ -186,6 +186,10 @@ struct EffectSpec {
   std::string side;                                                   // magic_formula: "left", "right" or "" (as the file)
   std::optional<double> vertical_stiffness, vertical_damping;         // N/m, N s/m
   double low_speed = 0.1;                                             // m/s: the slips' regularization
+  // transient slip (docs/tires.md, "Relaxation"): the contact's longitudinal and lateral deflections
+  // as states, relaxing over these lengths; 0: the slips act at once (no state)
+  double longitudinal_relaxation_length = 0.0;                        // m
+  double lateral_relaxation_length = 0.0;                             // m
 };
 
 // Actuators are the candidate plant inputs: each takes one scalar u.

@@ -99,6 +99,12 @@ ControllerInput ClosedLoopSystem::measure(double t, const Eigen::VectorXd& q, co
     }
     if (!ad_data_) ad_data_ = std::make_unique<DataT<ADScalar>>(model_);
     DataT<ADScalar>& d = *ad_data_;
+    if (model_.ns) {
+      // the effect states move too: their rates depend on q, v and s only (not on the inputs)
+      forward_kinematics<double>(model_, data_, q, v);
+      applied_forces<double>(model_, data_, q, v, u_nominal_);
+      for (int i = 0; i < model_.ns; ++i) d.s[i] = ADScalar(data_.s[i], Eigen::VectorXd::Constant(1, data_.sdot[i]));
+    }
     const ADVec qa = integrate<ADScalar>(model_, q.cast<ADScalar>(), dq);
     forward_kinematics<ADScalar>(model_, d, qa, va);
     const ADVec y = sensor_outputs<ADScalar>(model_, d, out, qa, va);
@@ -112,7 +118,7 @@ ControllerInput ClosedLoopSystem::measure(double t, const Eigen::VectorXd& q, co
     forward_kinematics<double>(model_, data_, q, v);
     in.y = sensor_outputs<double>(model_, data_, out, q, v);
   }
-  if (controller_ && controller_->needs_state()) in.x = plant_->qv_to_state(q, v) - x_ref_;
+  if (controller_ && controller_->needs_state()) in.x = plant_->qv_to_state(q, v, data_.s) - x_ref_;
   return in;
 }
 
@@ -171,15 +177,17 @@ void ClosedLoopSystem::apply_motions(double t, Eigen::VectorXd& q, Eigen::Vector
 
 void ClosedLoopSystem::rhs(double t, const Eigen::VectorXd& y, Eigen::VectorXd& ydot) {
   ++evaluations_;
-  const int nq = model_.nq, nv = model_.nv, nx = nxc();
+  const int nq = model_.nq, nv = model_.nv, nx = nxc(), ns_ = ns();
   Eigen::VectorXd q = y.head(nq), v = y.segment(nq, nv);
   const Eigen::VectorXd xc = y.tail(nx);
+  if (ns_) data_.s = y.segment(nq + nv, ns_);
   apply_motions(t, q, v);
   const Eigen::VectorXd u = inputs(t, q, v, xc);
   ydot.resize(ode_size());
   ydot.head(nq) = qdot<double>(model_, q, v);
   if (model_.nc == 0 || !model_.motions.empty()) ydot.segment(nq, nv) = forward_dynamics<double>(model_, data_, q, v, u, stab_);
   else ydot.segment(nq, nv) = loop_accelerations(model_, data_, stab_, q, v, u);
+  if (ns_) ydot.segment(nq + nv, ns_) = data_.sdot;  // applied_forces wrote them at (q, v, s)
   if (nx) ydot.tail(nx) = controller_rates(t, q, v, xc, u);
 }
 
@@ -195,9 +203,10 @@ Eigen::VectorXd ClosedLoopSystem::controller_rates(double t, const Eigen::Vector
 
 void ClosedLoopSystem::residual(double t, const Eigen::VectorXd& Y, const Eigen::VectorXd& Yp, Eigen::VectorXd& F) {
   ++evaluations_;
-  const int nq = model_.nq, nv = model_.nv, nx = nxc(), n = na();
+  const int nq = model_.nq, nv = model_.nv, nx = nxc(), n = na(), ns_ = ns();
   Eigen::VectorXd q = Y.head(nq), v = Y.segment(nq, nv);
-  const Eigen::VectorXd xc = Y.segment(nq + nv, nx);
+  const Eigen::VectorXd xc = Y.segment(nq + nv + ns_, nx);
+  if (ns_) data_.s = Y.segment(nq + nv, ns_);
   Eigen::VectorXd vp = Yp.segment(nq, nv);
   // motion inputs: their coordinates, rates and accelerations are the signal's (as in rhs); their
   // balance, which holds their unknown reaction, is replaced below by v_d' = u''
@@ -227,7 +236,8 @@ void ClosedLoopSystem::residual(double t, const Eigen::VectorXd& Y, const Eigen:
     const int iv = model_.actuators[static_cast<std::size_t>(model_.motions[i])].iv;
     F[nq + iv] = Yp[nq + iv] - vp[iv];
   }
-  if (nx) F.segment(nq + nv, nx) = Yp.segment(nq + nv, nx) - controller_rates(t, q, v, xc, u);
+  if (ns_) F.segment(nq + nv, ns_) = Yp.segment(nq + nv, ns_) - data_.sdot;  // applied_forces above
+  if (nx) F.segment(nq + nv + ns_, nx) = Yp.segment(nq + nv + ns_, nx) - controller_rates(t, q, v, xc, u);
 }
 
 void ClosedLoopSystem::consistent(double t, const Eigen::VectorXd& y_in, Eigen::VectorXd& Y, Eigen::VectorXd& Yp) {
@@ -246,6 +256,7 @@ void ClosedLoopSystem::consistent(double t, const Eigen::VectorXd& y_in, Eigen::
   Y.head(ode_size()) = y;
   Yp.head(ode_size()) = yd;
   if (na()) {
+    if (ns()) data_.s = y.segment(model_.nq + model_.nv, ns());
     constraint_terms<double>(model_, data_, y.head(model_.nq), y.segment(model_.nq, model_.nv));
     rows_ = partition_rows(data_.Jc, 1e-9, na()).independent;
     // multipliers for these rows (forward_dynamics gives them on its independent rows)
@@ -349,8 +360,9 @@ Eigen::Matrix<double, 3, 4> rotation_tangent(const Eigen::Vector4d& p) {
 
 bool ClosedLoopSystem::exact_dae_jacobian() const {
   // (rolling's no-slip rows have no analytic derivatives yet: SUNDIALS' difference quotients)
+  // (nor the effect states: the tires' transient slip)
   return nxc() == 0 && (!controller_ || controller_->sample_time() > 0) && model_.motions.empty() &&
-         model_.velocity_rows.empty();
+         model_.velocity_rows.empty() && model_.ns == 0;
 }
 
 bool ClosedLoopSystem::exact_ode_jacobian() const {

@@ -1,12 +1,14 @@
 // The closed loop as equations an integrator can step:
-//   ODE form  y = [q; v; xc]            y' = [qdot(q, v); qdd(q, v, u); dxc/dt]
-//   DAE form  Y = [q; v; xc; lambda]    F(t, Y, Y') = [q' - qdot(q, v);
+//   ODE form  y = [q; v; s; xc]         y' = [qdot(q, v); qdd(q, v, s, u); ds/dt; dxc/dt]
+//   DAE form  Y = [q; v; s; xc; lambda] F(t, Y, Y') = [q' - qdot(q, v);
 //                                                      M v' + nle - Q(u) + Ja^T lambda;
+//                                                      s' - ds/dt (q, v, s);
 //                                                      dxc/dt residual;
 //                                                      Ja v' + gamma + stab]      (index 1)
 // (the residual system (3) of the paper, with the output equation evaluated
 // separately). u = saturate(controller(y, ...)) on Plant/In, nominal u0 on the
-// other actuators. xc holds only continuous controller states; a discrete
+// other actuators. s: the effect states (Model::ns, a tire's transient slip). xc holds only
+// continuous controller states; a discrete
 // controller's state and held output live in the simulator.
 // Not thread-safe: one ClosedLoopSystem per simulation (it owns a Data).
 #pragma once
@@ -37,8 +39,12 @@ class ClosedLoopSystem {
   int nq() const { return model_.nq; }
   int nv() const { return model_.nv; }
   int nxc() const { return continuous_states_; }
+  int ns() const { return model_.ns; }
   int na() const { return static_cast<int>(model_.active_rows.size()); }
-  int ode_size() const { return nq() + nv() + nxc(); }
+  int ode_size() const { return nq() + nv() + ns() + nxc(); }
+  // The effect states the next measure() and inputs() see (a state's s; rhs and residual set them
+  // from their y). Needed before measuring at a recorded sample when ns() > 0.
+  void set_effect_states(const Eigen::VectorXd& s) const { data_.s = s; }
   int dae_size() const { return ode_size() + na(); }
   const Model& model() const { return model_; }
 

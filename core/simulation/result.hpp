@@ -30,6 +30,7 @@ struct SimulationResult {
   Eigen::MatrixXd u;                           // [N x nu] every actuator's value (after saturation)
   Eigen::MatrixXd y;                           // [N x ny] plant outputs (Plant/Out)
   Eigen::MatrixXd xc;                          // [N x nxc] controller states (may have 0 columns)
+  Eigen::MatrixXd s;                           // [N x ns] effect states (a tire's transient slip; may have 0 columns)
   std::vector<double> kinetic_energy, potential_energy;  // [N]
   std::vector<double> constraint_violation;    // [N] max |phi(q)| (0 for trees)
   std::vector<double> velocity_violation;      // [N] max |Jc v|
@@ -41,6 +42,7 @@ struct SimulationResult {
   Eigen::MatrixXd u_disturbance;               // [N x nu] d(t) added to each actuator (empty: no disturbance)
 
   std::vector<std::string> q_names, v_names, input_names, output_names, controller_state_names;
+  std::vector<std::string> s_names;            // [ns] Model::s_names (units Model::s_units)
   std::vector<std::string> input_units, output_units;
 
   SolverStats stats;

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "dynamics/assembly.hpp"
+#include "dynamics/effects.hpp"
 #include "dynamics/forward_dynamics.hpp"
 #include "dynamics/energy.hpp"
 #include "dynamics/kinematics.hpp"
@@ -19,7 +20,7 @@ namespace {
 // the samples recorded so far, grown row by row
 struct Recorder {
   std::vector<double> t;
-  std::vector<Eigen::VectorXd> q, v, u, y, xc;
+  std::vector<Eigen::VectorXd> q, v, u, y, xc, s;
   std::vector<double> T, V, pv, vv;
   std::vector<Eigen::VectorXd> y_linear;
   std::vector<Eigen::VectorXd> r, d;  // reference and disturbance at each sample (when the run has them)
@@ -245,14 +246,22 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
     v0 += prescribed_velocity_jump(model, dj, q0, jump0);  // jump0 on the driven coordinates
   }
   sys.apply_motions(o.t0, q0, v0);
+  Eigen::VectorXd s0 = o.s0;
+  if (s0.size() == 0) {
+    Data ds(model);
+    s0 = effect_states_steady(model, ds, q0, v0);
+  }
+  if (s0.size() != model.ns) throw std::invalid_argument("simulate: the initial effect states have the wrong size");
+  const int ns = model.ns, i_s = model.nq + model.nv;  // s in y: i_s .. i_s + ns
   Eigen::VectorXd y(sys.ode_size());
-  y << q0, v0, Eigen::VectorXd::Zero(sys.nxc());
+  y << q0, v0, s0, Eigen::VectorXd::Zero(sys.nxc());
 
   const bool discrete = controller && controller->sample_time() > 0;
   const double Ts = discrete ? controller->sample_time() : 0;
   Eigen::VectorXd xcd = Eigen::VectorXd::Zero(discrete ? controller->nxc() : 0);
   long sample_index = 0;
   auto controller_sample = [&](double t) {
+    sys.set_effect_states(y.segment(i_s, ns));
     const ControllerInput in = sys.measure(t, y.head(model.nq), y.segment(model.nq, model.nv));
     sys.set_held(controller->output(in, xcd));
     xcd = controller->update(in, xcd);
@@ -283,6 +292,9 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
     Eigen::VectorXd q = y.head(model.nq), v = y.segment(model.nq, model.nv);
     sys.apply_motions(t, q, v, &motion_acc);  // exactly where they are driven (the state integrates their rates)
     const Eigen::VectorXd xc = discrete ? xcd : Eigen::VectorXd(y.tail(sys.nxc()));
+    const Eigen::VectorXd s = y.segment(i_s, ns);
+    sys.set_effect_states(s);
+    d.s = s;
     const Eigen::VectorXd u = sys.inputs(t, q, v, y.tail(sys.nxc()));
     if (reactions) {
       d.motion_acc = motion_acc;
@@ -297,6 +309,7 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
     rec.u.push_back(u);
     rec.y.push_back(out);
     rec.xc.push_back(xc);
+    rec.s.push_back(s);
     rec.T.push_back(kinetic_energy<double>(model, d, q, v));
     rec.V.push_back(potential_energy<double>(model, d, q));
     rec.pv.push_back(pv);
@@ -344,7 +357,8 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
       std::ostringstream os;
       const std::string what = worst < model.nq ? model.q_names[worst]
                                : worst < model.nq + model.nv ? model.rate_names[worst - model.nq]
-                                                             : "controller state " + std::to_string(worst - model.nq - model.nv);
+                               : worst < i_s + ns ? model.s_names[static_cast<std::size_t>(worst - i_s)]
+                                                 : "controller state " + std::to_string(worst - i_s - ns);
       os << "t = " << t << " s: diverged: " << what << " = " << y[worst] << " is past the bound "
          << o.divergence_bound << " (the last sane sample is at t = " << (rec.t.empty() ? o.t0 : rec.t.back()) << " s)";
       r.failure = os.str();
@@ -390,6 +404,8 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
   r.u = Recorder::stack(rec.u, model.nu());
   r.y = Recorder::stack(rec.y, static_cast<Eigen::Index>(model.plant_outputs.size()));
   r.xc = Recorder::stack(rec.xc, discrete ? controller->nxc() : sys.nxc());
+  r.s = Recorder::stack(rec.s, ns);
+  r.s_names = model.s_names;
   r.kinetic_energy = rec.T;
   r.potential_energy = rec.V;
   r.constraint_violation = rec.pv;

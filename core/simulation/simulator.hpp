@@ -24,6 +24,8 @@ struct SimulationOptions {
   IntegratorSettings integrator;
   double t0 = 0.0, t_end = 5.0, output_step = 0.01;
   Eigen::VectorXd q0, v0;              // initial state; empty = the model's (assembled) initial state
+  Eigen::VectorXd s0;                  // initial effect states (Model::ns); empty = at rest at (q0, v0)
+                                       // (effect_states_steady: a tire's steady slips)
   double projection_tolerance = 1e-9;  // closed loops: at every stop (output time, controller sample)
                                        // project when max |phi| (or max |Jc v| / max(1, |v|)) exceeds it
   Baumgarte stabilization{};           // optional, on the acceleration-level constraints

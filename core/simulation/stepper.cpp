@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "dynamics/assembly.hpp"
+#include "dynamics/effects.hpp"
 #include "simulation/integrator_choice.hpp"
 
 namespace codyna {
@@ -40,7 +41,8 @@ void Stepper::set_state(double t0, const Eigen::VectorXd& q_in, const Eigen::Vec
   }
   t_ = t0;
   y_.resize(sys_.ode_size());
-  y_ << q, v;
+  Data d(model_);
+  y_ << q, v, effect_states_steady(model_, d, q, v);  // the effect states at rest there
   Eigen::VectorXd u(nu());
   for (int k = 0; k < nu(); ++k) u[k] = model_.actuators[model_.plant_inputs[k]].u0;
   sys_.set_held(u);
@@ -52,7 +54,10 @@ void Stepper::reset(double t0, const Eigen::VectorXd& q_in, const Eigen::VectorX
   measure();
 }
 
-void Stepper::measure() { out_ = sys_.measure(t_, q(), v()).y; }
+void Stepper::measure() {
+  sys_.set_effect_states(y_.segment(model_.nq + model_.nv, model_.ns));
+  out_ = sys_.measure(t_, q(), v()).y;
+}
 
 const Eigen::VectorXd& Stepper::step(const Eigen::VectorXd& u, double dt) {
   if (u.size() != nu()) {

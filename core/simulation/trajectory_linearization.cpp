@@ -13,8 +13,9 @@ std::vector<Linearization> linearize_along(const Model& model, const SimulationR
   std::vector<Linearization> out;
   Linearizer linearizer(model);  // the workspaces and names, made once for every point
   for (int k = 0; k < r.samples(); k += stride) {
-    const OperatingPoint op = snapshot_point(model, r.t[k], r.q.row(k).transpose(), r.v.row(k).transpose(),
-                                             r.u.row(k).transpose());
+    OperatingPoint op = snapshot_point(model, r.t[k], r.q.row(k).transpose(), r.v.row(k).transpose(),
+                                       r.u.row(k).transpose());
+    if (r.s.cols() == model.ns && r.s.rows() == r.samples()) op.s = r.s.row(k).transpose();  // the run's effect states
     try {
       out.push_back(linearizer.linearize(op, options));
     } catch (const std::invalid_argument& e) {
