@@ -125,6 +125,8 @@ void bind_samples(py::class_<SimulationRun>& c) {
       .def_property_readonly("u", [](S s) { return s.job.result.u; }, "every actuator's value after saturation (N x nu), input_names")
       .def_property_readonly("y", [](S s) { return s.job.result.y; }, "Plant/Out (N x ny), output_names")
       .def_property_readonly("xc", [](S s) { return s.job.result.xc; }, "controller states (N x nxc), controller_state_names")
+      .def_property_readonly("s", [](S s) { return s.job.result.s; },
+                             "effect states (N x ns): the tires' contact deflections (transient slip), s_names")
       .def_property_readonly("y_linear", [](S s) { return or_none(s.job.result.y_linear); },
                              "the linear closed loop's outputs from the same start (compare_linear=True), else None")
       .def_property_readonly("y_reference", [](S s) { return or_none(s.job.result.y_reference); },
@@ -146,7 +148,8 @@ void bind_samples(py::class_<SimulationRun>& c) {
       .def_property_readonly("output_names", [](S s) { return s.job.result.output_names; }, "Plant/Out names (y's columns)")
       .def_property_readonly("input_units", [](S s) { return s.job.result.input_units; }, "units of u's columns")
       .def_property_readonly("output_units", [](S s) { return s.job.result.output_units; }, "units of y's columns")
-      .def_property_readonly("controller_state_names", [](S s) { return s.job.result.controller_state_names; }, "names of xc's columns");
+      .def_property_readonly("controller_state_names", [](S s) { return s.job.result.controller_state_names; }, "names of xc's columns")
+      .def_property_readonly("s_names", [](S s) { return s.job.result.s_names; }, "names of s's columns (TIRE.deflection_x, TIRE.deflection_y; m)");
 }
 
 // Simulation's controller: where it came from, its design, its linear closed loop

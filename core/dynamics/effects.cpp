@@ -203,8 +203,8 @@ Eigen::VectorXd effect_states_steady(const Model& model, DataT<double>& d, const
     TireContact<double> c;
     if (!tire_contact<double>(t, wb.R, wb.p, wb.w, wb.v, rb.R, rb.p, rb.w, rb.v, c)) continue;  // off the road: 0
     // du/dt = 0: the deflections whose slips are the steady ones
-    if (t.state_x >= 0) s[t.state_x] = t.relaxation_x * c.input.kappa;
-    if (t.state_y >= 0) s[t.state_y] = t.relaxation_y * std::tan(c.input.alpha);
+    if (t.state_x >= 0) s[t.state_x] = c.sigma_x * c.input.kappa;
+    if (t.state_y >= 0) s[t.state_y] = c.sigma_y * std::tan(c.input.alpha);
   }
   return s;
 }

@@ -39,6 +39,7 @@
 #include "vehicle/fiala.hpp"
 #include "vehicle/linear_tire.hpp"
 #include "vehicle/magic_formula.hpp"
+#include "vehicle/magic_formula_relaxation.hpp"
 
 namespace codyna {
 
@@ -52,6 +53,7 @@ struct TireContact {
   TireInput<S> input;                  // Fz, kappa, alpha, gamma, Vx handed to the law
   TireForces<S> out;                   // the law's forces and moments at P
   S rate_x{0.0}, rate_y{0.0};          // transient slip: du_x/dt, du_y/dt (0 without the state)
+  S sigma_x{0.0}, sigma_y{0.0};        // transient slip: the relaxation lengths at this contact
 };
 
 // asin with its derivative 1 / sqrt(1 - x^2) (an evaluated scalar)
@@ -68,6 +70,13 @@ S tire_effect_speed(const S& Vx, double v_low) {
   const double v = tire_value(Vx);
   if (std::abs(v) >= v_low) return v >= 0 ? S(Vx) : S(-Vx);
   return S(Vx * Vx * (0.5 / v_low) + 0.5 * v_low);
+}
+
+// a Magic Formula tire's options: mounted on the side the element says
+inline MagicFormulaOptions tire_effect_mf_options(const TireModel& t) {
+  MagicFormulaOptions options;
+  options.mount = t.side == 1 ? TireMount::Left : t.side == 2 ? TireMount::Right : TireMount::AsFile;
+  return options;
 }
 
 // The tire's force law at one contact state.
@@ -97,9 +106,7 @@ TireForces<S> tire_effect_law(const TireModel& t, const TireInput<S>& in) {
     }
     case TireLaw::MagicFormula: break;
   }
-  MagicFormulaOptions options;
-  options.mount = t.side == 1 ? TireMount::Left : t.side == 2 ? TireMount::Right : TireMount::AsFile;
-  return magic_formula<S>(*t.mf, in, options);
+  return magic_formula<S>(*t.mf, in, tire_effect_mf_options(t));
 }
 
 // The contact of tire t: wheel pose (R, p), angular velocity w and velocity v of its origin, the road
@@ -154,24 +161,36 @@ bool tire_contact(const TireModel& t, const Mat3T<S>& Rw, const Vec3T<S>& pw, co
   c.Vy = c.ey.dot(V);
   const S speed = tire_effect_speed<S>(c.Vx, t.low_speed);
   c.input.Fz = Fz;
+  c.input.gamma = tire_effect_asin(na);
+  if (t.state_x >= 0 || t.state_y >= 0) {
+    // the relaxation lengths: the element's, or the .tir file's at this load and camber
+    if (t.relaxation_from_file) {
+      const std::pair<S, S> lengths = magic_formula_relaxation_lengths<S>(*t.mf, Fz, c.input.gamma, c.Vx, tire_effect_mf_options(t));
+      c.sigma_x = lengths.first;
+      c.sigma_y = lengths.second;
+    } else {
+      c.sigma_x = zero + t.relaxation_x;
+      c.sigma_y = zero + t.relaxation_y;
+    }
+  }
   const S slip_x = c.Vx - c.omega * t.rolling_radius;
   if (lag_x) {
     const S ux = (*states)[t.state_x];
-    c.rate_x = -slip_x - speed * ux / t.relaxation_x;
-    c.input.kappa = ux / t.relaxation_x;
+    const S kappa = ux / c.sigma_x;
+    c.rate_x = -slip_x - speed * kappa;
+    c.input.kappa = kappa;
   } else {
     c.input.kappa = -slip_x / speed;
   }
   if (lag_y) {
     const S uy = (*states)[t.state_y];
-    c.rate_y = c.Vy - speed * uy / t.relaxation_y;
-    const S ratio = uy / t.relaxation_y;
+    const S ratio = uy / c.sigma_y;
+    c.rate_y = c.Vy - speed * ratio;
     c.input.alpha = tire_atan(ratio);
   } else {
     const S ratio = c.Vy / speed;
     c.input.alpha = tire_atan(ratio);
   }
-  c.input.gamma = tire_effect_asin(na);
   c.input.Vx = c.Vx;
   c.input.phit = zero;
   c.input.pressure = zero;

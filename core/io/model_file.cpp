@@ -173,6 +173,8 @@ double read_positive_length(const Node& n) {
 // The values a model cannot hold, refused where they are read (a file, or codyna-gui's field, which
 // goes through this reader): compile_structure checks the same of a spec built in code.
 // A spring's or damper's coefficient (N/m, N s/m, N m/rad, N m s/rad) and a rest length: 0 or more
+bool read_bool(const Node& n);  // true or false (below)
+
 double read_coefficient(const Node& n) {
   const double x = read_number(n);
   if (!(x >= 0)) n.expected("a non-negative number (a negative stiffness, damping or length would feed energy in)");
@@ -908,7 +910,16 @@ const Schema<EffectSpec>& schema<EffectSpec>() {
            field("longitudinal_relaxation_length", &EffectSpec::longitudinal_relaxation_length, read_coefficient,
                  [](double r) { return r > 0 ? ojson(r) : ojson(); }),
            field("lateral_relaxation_length", &EffectSpec::lateral_relaxation_length, read_coefficient,
-                 [](double r) { return r > 0 ? ojson(r) : ojson(); })},
+                 [](double r) { return r > 0 ? ojson(r) : ojson(); }),
+           {"relaxation_from_file", Need::Optional,
+            [](const Node& n, EffectSpec& s) {
+              if (s.law != "magic_formula")
+                n.fail("field \"relaxation_from_file\" belongs to the tire law magic_formula, not to " + quote(s.law));
+              s.relaxation_from_file = read_bool(n);
+            },
+            [](ojson& j, const EffectSpec& s) {
+              if (s.relaxation_from_file) j["relaxation_from_file"] = true;
+            }}},
       }),
       "effect",
       [](const EffectSpec& e) {
@@ -928,7 +939,7 @@ const Schema<EffectSpec>& schema<EffectSpec>() {
                                  "longitudinal_stiffness", "cornering_stiffness", "camber_stiffness", "friction",
                                  "sliding_friction", "trail", "width", "rolling_resistance", "file", "side", "vertical_stiffness",
                                  "vertical_damping", "low_speed", "longitudinal_relaxation_length",
-                                 "lateral_relaxation_length"});
+                                 "lateral_relaxation_length", "relaxation_from_file"});
         }
         return element_keys({});
       }};

@@ -59,6 +59,11 @@ const OptionalField kOptional[] = {
     {"/u_disturbance", &R::u_disturbance, &R::u, "/u", &R::input_names, "_disturbance"},
 };
 
+// the effect states (a tire's contact deflections): written only when the model has them, so that
+// the files of every other model keep their bytes
+constexpr const char* kEffectStates = "/s";
+constexpr const char* kEffectStateNames = "/names/effect_states";
+
 struct SeriesField {
   const char* dataset;
   std::vector<double> R::*values;
@@ -133,6 +138,9 @@ std::string inconsistency(const R& r) {
       return std::string(f.dataset) + " is " + std::to_string(m.rows()) + " x " + std::to_string(m.cols()) +
              ", expected " + std::to_string(n) + " x " + std::to_string(cols) + " like " + f.like_dataset;
   }
+  if (r.s.cols() > 0 && (static_cast<std::size_t>(r.s.rows()) != n || r.s_names.size() != static_cast<std::size_t>(r.s.cols())))
+    return std::string(kEffectStates) + " is " + std::to_string(r.s.rows()) + " x " + std::to_string(r.s.cols()) + " with " +
+           std::to_string(r.s_names.size()) + " names (" + kEffectStateNames + ")" + samples;
   return {};
 }
 
@@ -260,6 +268,10 @@ void write_contents(hid_t file, const R& r) {
   }
   for (const OptionalField& f : kOptional)
     if ((r.*f.values).cols() > 0) write_matrix(file, f.dataset, r.*f.values, samples);
+  if (r.s.cols() > 0) {
+    write_matrix(file, kEffectStates, r.s, samples);
+    write_strings(file, kEffectStateNames, r.s_names);
+  }
   for (const SeriesField& f : kSeries) write_series(file, f.dataset, r.*f.values);
   for (const UnitsField& f : kUnits) write_strings(file, f.dataset, r.*f.units);
 
@@ -374,6 +386,10 @@ R read_contents(hid_t file) {
   }
   for (const OptionalField& f : kOptional)
     if (H5Lexists(file, f.dataset, H5P_DEFAULT) > 0) r.*f.values = read_matrix(file, f.dataset);
+  if (H5Lexists(file, kEffectStates, H5P_DEFAULT) > 0) {
+    r.s = read_matrix(file, kEffectStates);
+    r.s_names = read_strings(file, kEffectStateNames);
+  }
   for (const SeriesField& f : kSeries) r.*f.values = read_series(file, f.dataset);
   for (const UnitsField& f : kUnits) r.*f.units = read_strings(file, f.dataset);
 
@@ -407,6 +423,7 @@ std::vector<CsvColumn> csv_columns(const R& r) {
   for (const SeriesField& f : kSeries)
     if (f.csv_header) columns.push_back({f.csv_header, (r.*f.values).data()});
   for (const OptionalField& f : kOptional) add_matrix(r.*f.values, r.*f.names, f.csv_suffix);  // none when absent
+  add_matrix(r.s, r.s_names, "");  // the effect states, when the model has them
   return columns;
 }
 

@@ -8,6 +8,9 @@
 //   /y_linear                        double (N x ny), only when y_linear has columns (a linear run)
 //   /y_reference                     double (N x ny), only when the run had references r(t)
 //   /u_disturbance                   double (N x nu), only when the run had disturbances d(t)
+//   /s, /names/effect_states         double (N x ns) and its names, only when the model has effect
+//                                    states (a tire's contact deflections: transient slip); CSV:
+//                                    their columns last
 //   /energy/kinetic                  double (N)
 //   /energy/potential                double (N)
 //   /constraints/position_violation  double (N)   (SimulationResult::constraint_violation)

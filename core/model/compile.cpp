@@ -1,5 +1,7 @@
 #include "model/compile.hpp"
 
+#include <initializer_list>
+
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <algorithm>
@@ -9,6 +11,7 @@
 #include <set>
 #include <sstream>
 
+#include "vehicle/magic_formula_relaxation.hpp"
 #include "vehicle/tir_file.hpp"
 
 
@@ -705,6 +708,29 @@ class Compiler {
     non_negative(e.lateral_relaxation_length, p + "/lateral_relaxation_length", "relaxation length");
     t.relaxation_x = e.longitudinal_relaxation_length;
     t.relaxation_y = e.lateral_relaxation_length;
+    if (e.relaxation_from_file) {
+      const std::string key = p + "/relaxation_from_file";
+      if (t.law != TireLaw::MagicFormula) fail(key, "expected a magic_formula tire (the lengths come from its .tir file)");
+      if (t.relaxation_x > 0 || t.relaxation_y > 0)
+        fail(key, "the relaxation lengths come from the .tir file: leave out longitudinal_relaxation_length and "
+                  "lateral_relaxation_length, or this field");
+      const bool mf52 = t.mf->version == MagicFormulaVersion::MF52;
+      for (const char* k : mf52 ? std::initializer_list<const char*>{"LONGITUDINAL_COEFFICIENTS/PTX1", "LATERAL_COEFFICIENTS/PTY1",
+                                                                     "LATERAL_COEFFICIENTS/PTY2"}
+                                : std::initializer_list<const char*>{"STRUCTURAL/LONGITUDINAL_STIFFNESS",
+                                                                     "STRUCTURAL/LATERAL_STIFFNESS"})
+        if (t.mf->was_defaulted(k))
+          fail(key, std::string("the .tir file gives no ") + k + ", which the relaxation lengths of its version need");
+      t.relaxation_from_file = true;
+      // at the nominal load, upright
+      const double Fz0 = t.mf->FNOMIN;
+      const auto [sx, sy] = magic_formula_relaxation_lengths<double>(*t.mf, Fz0, 0.0, t.mf->LONGVL);
+      if (!std::isfinite(sx) || !(sx > 0) || !std::isfinite(sy) || !(sy > 0))
+        fail(key, "the .tir file's relaxation lengths at FNOMIN are " + compile_number(sx) + " m and " + compile_number(sy) +
+                      " m: expected positive lengths");
+      t.relaxation_x = sx;
+      t.relaxation_y = sy;
+    }
     return t;
   }
 

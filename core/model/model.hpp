@@ -106,6 +106,9 @@ struct TireModel {
   // the contact's longitudinal and lateral deflections in the effect states (Model::ns; -1: none)
   double relaxation_x = 0, relaxation_y = 0;
   int state_x = -1, state_y = -1;
+  // magic_formula: the lengths from the .tir file at the contact's load (tire_relaxation_lengths;
+  // relaxation_x, relaxation_y then hold them at FNOMIN, upright: what a tire off the road relaxes by)
+  bool relaxation_from_file = false;
 };
 
 struct ActuatorModel {

@@ -190,6 +190,9 @@ struct EffectSpec {
   // as states, relaxing over these lengths; 0: the slips act at once (no state)
   double longitudinal_relaxation_length = 0.0;                        // m
   double lateral_relaxation_length = 0.0;                             // m
+  // magic_formula: both relaxation lengths from the .tir file at the tire's load (MF 5.2: PTX1-3,
+  // PTY1-2; MF 6.1, 6.2: the slip stiffnesses over the carcass stiffnesses of [STRUCTURAL])
+  bool relaxation_from_file = false;
 };
 
 // Actuators are the candidate plant inputs: each takes one scalar u.

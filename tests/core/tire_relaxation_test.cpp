@@ -19,7 +19,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "analysis/linearize.hpp"
 #include "analysis/plant_function.hpp"
@@ -30,6 +32,8 @@
 #include "study/files.hpp"
 #include "study/workflow.hpp"
 #include "test_util.hpp"
+#include "vehicle/magic_formula_relaxation.hpp"
+#include "vehicle/tir_file.hpp"
 
 using namespace codyna;
 
@@ -235,13 +239,18 @@ TEST(TireRelaxation, ARunStartedOnASteadyTurnStaysOnItWithTheDeflectionsSteady) 
 // The sedan (Magic Formula 6.1, closed-loop suspensions) with both relaxations on its four tires:
 // the exact Jacobian (automatic differentiation of the plant) equals central differences, at the
 // steady turn and with the deflections moved off their rest
-TEST(TireRelaxation, TheSedansJacobianWithDeflectionsEqualsCentralDifferences) {
+namespace {
+void sedan_jacobian_check(bool from_file) {
   const std::string path = test::example_path("sedan.json");
   ModelSpec spec = study_read_model(path);
   for (EffectSpec& e : spec.effects)
     if (e.type == EffectType::Tire) {
-      e.longitudinal_relaxation_length = 0.15;
-      e.lateral_relaxation_length = 0.45;
+      if (from_file) {
+        e.relaxation_from_file = true;
+      } else {
+        e.longitudinal_relaxation_length = 0.15;
+        e.lateral_relaxation_length = 0.45;
+      }
     }
   spec.analysis.steady.lateral_acceleration = 0.4 * 9.80665;
   const Model mod = study_model(spec, path);
@@ -253,7 +262,7 @@ TEST(TireRelaxation, TheSedansJacobianWithDeflectionsEqualsCentralDifferences) {
   ASSERT_EQ(s.nx(), 38);  // the sedan's 30 and 8 deflections
   // the deflections' rows: each decays at U / sigma at fixed motion (its own diagonal entry)
   const double U = 25.0;
-  for (int k = 0; k < 8; ++k) {
+  for (int k = 0; k < 8 && !from_file; ++k) {
     const double sigma = k % 2 ? 0.45 : 0.15;
     const int i = 30 + k;
     EXPECT_NEAR(s.A(i, i), -U / sigma, 0.02 * U / sigma) << s.state_names[static_cast<std::size_t>(i)];
@@ -293,10 +302,17 @@ TEST(TireRelaxation, TheSedansJacobianWithDeflectionsEqualsCentralDifferences) {
     const double e_s = (Je.middleCols(30, 8) - Jr).cwiseAbs().maxCoeff() / Je.middleCols(30, 8).cwiseAbs().maxCoeff();
     EXPECT_LT(e_all, 1e-6) << (moved ? "off rest" : "at rest");
     EXPECT_LT(e_s, 1e-9) << (moved ? "off rest" : "at rest");
-    std::printf("[ TireRelaxation ] sedan in the 0.4 g turn%s: exact vs central differences %.2e (the deflections' columns vs extrapolated differences %.2e)\n",
-                moved ? ", deflections moved" : "", e_all, e_s);
+    std::printf("[ TireRelaxation ] sedan (%s) in the 0.4 g turn%s: exact vs central differences %.2e (the deflections' columns vs extrapolated differences %.2e)\n",
+                from_file ? "lengths from the .tir" : "0.15 / 0.45 m", moved ? ", deflections moved" : "", e_all, e_s);
   }
 }
+
+}  // namespace
+
+TEST(TireRelaxation, TheSedansJacobianWithDeflectionsEqualsCentralDifferences) { sedan_jacobian_check(false); }
+
+// the lengths from the .tir file depend on the load: their derivative is in the exact Jacobian too
+TEST(TireRelaxation, TheSedansJacobianWithTheTirFilesLengthsEqualsCentralDifferences) { sedan_jacobian_check(true); }
 
 TEST(TireRelaxation, BadLengthsAreRefusedNamingTheFieldAndASavedModelKeepsThem) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "codyna_tire_relaxation_test";
@@ -327,5 +343,113 @@ TEST(TireRelaxation, BadLengthsAreRefusedNamingTheFieldAndASavedModelKeepsThem) 
   } catch (const std::exception& e) {
     EXPECT_NE(std::string(e.what()).find("lateral_relaxation_length"), std::string::npos) << e.what();
   }
+  // the .tir's lengths asked of a linear tire: refused naming the field and the law
+  std::string linear = text;
+  linear.replace(linear.find("\"lateral_relaxation_length\": -0.6"), std::string("\"lateral_relaxation_length\": -0.6").size(),
+                 "\"relaxation_from_file\": true");
+  try {
+    study_parse_model_text(linear, "lag.json");
+    ADD_FAILURE() << "relaxation_from_file on a linear tire was accepted";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("relaxation_from_file"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("magic_formula"), std::string::npos) << e.what();
+  }
+  // on the sedan's Magic Formula tires with a length given as well: refused
+  const std::string sedan = test::example_path("sedan.json");
+  ModelSpec both = study_read_model(sedan);
+  for (EffectSpec& e : both.effects)
+    if (e.type == EffectType::Tire) {
+      e.relaxation_from_file = true;
+      e.lateral_relaxation_length = 0.4;
+    }
+  try {
+    study_model(both, sedan);
+    ADD_FAILURE() << "relaxation_from_file with a lateral_relaxation_length was accepted";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("relaxation_from_file"), std::string::npos) << e.what();
+  }
   std::filesystem::remove_all(dir);
+}
+
+// the deflections reach the results files (HDF5 /s, /names/effect_states; the CSV's last columns)
+// and come back; a model without them writes neither
+TEST(TireRelaxation, TheDeflectionsAreInTheResultsFiles) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "codyna_tire_relaxation_results";
+  std::filesystem::create_directories(dir);
+  const Model mod = study_model(single_track_with_lag(0.6));
+  Eigen::VectorXd v0 = mod.v0;
+  v0[mod.joints[static_cast<std::size_t>(mod.find_joint("body"))].idx_v + 1] = 0.02;
+  SimulationOptions so;
+  so.v0 = v0;
+  so.t_end = 0.2;
+  so.output_step = 0.05;
+  const SimulationResult r = simulate(mod, nullptr, nullptr, so);
+  ASSERT_TRUE(r.completed);
+  const std::string h5 = (dir / "lag.h5").string(), csv = (dir / "lag.csv").string();
+  study_write_results(r, h5, csv);
+  const SimulationResult back = study_read_results(h5);
+  ASSERT_EQ(back.s.rows(), r.s.rows());
+  ASSERT_EQ(back.s.cols(), 2);
+  EXPECT_EQ((back.s - r.s).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(back.s_names, r.s_names);
+  std::ifstream in(csv);
+  std::string header;
+  std::getline(in, header);
+  const std::string tail = ",front_tire.deflection_y,rear_tire.deflection_y";
+  ASSERT_GE(header.size(), tail.size());
+  EXPECT_EQ(header.substr(header.size() - tail.size()), tail) << header;
+  // without relaxation: no /s
+  const SimulationResult plain = simulate(study_model(single_track_with_lag(0)), nullptr, nullptr, so);
+  const std::string h5b = (dir / "plain.h5").string();
+  study_write_results(plain, h5b);
+  EXPECT_EQ(study_read_results(h5b).s.cols(), 0);
+  std::filesystem::remove_all(dir);
+}
+
+// The .tir file's relaxation lengths (vehicle/magic_formula_relaxation.hpp) against the formulas
+// written out with the files' numbers: the book file's closed forms (Kxk = PKX1 Fz, Kya = PKY1 Fz0
+// sin(2 atan(Fz / (PKY2 Fz0)))), MF 5.2's PTX, PTY formulas, and MF 6.1's slip stiffnesses from
+// MFeval's table over its carcass stiffnesses
+TEST(TireRelaxation, TheTirFilesLengthsAreTheFormulasWithTheFilesNumbers) {
+  const std::string dir = std::string(CODYNA_TEST_DATA_DIR) + "/tires/";
+  // book file (MF 6.1, PCFX/PCFY 0): at 4000 N sigma_kappa = 64000 / 400000, sigma_alpha = 48000 / 100000
+  const MagicFormulaParameters book = read_tir_file(dir + "PacejkaBook_Defaults.tir");
+  const auto [bx, by] = magic_formula_relaxation_lengths<double>(book, 4000.0, 0.0, 16.7);
+  EXPECT_NEAR(bx, 0.16, 1e-12);
+  EXPECT_NEAR(by, 0.48, 1e-12);
+  // MF 5.2: R0 0.4, FNOMIN 9416.6, PTX1 1.1898, PTX2 -6.148e-4, PTX3 -0.3717, PTY1 1.6245, PTY2 2.8506, PKY3 0.944
+  const MagicFormulaParameters mf52 = read_tir_file(dir + "MagicFormula52_Paramerters.tir");
+  for (const auto& [n, g] : {std::pair{1.0, 0.0}, std::pair{2.0, 0.05}, std::pair{0.5, -0.03}}) {
+    const double Fz = n * 9416.6, dfz = n - 1;
+    const auto [sx, sy] = magic_formula_relaxation_lengths<double>(mf52, Fz, g, 16.7);
+    EXPECT_NEAR(sx, (1.1898 - 6.148e-4 * dfz) * std::exp(0.3717 * dfz) * 0.4 * n, 1e-12) << n;
+    EXPECT_NEAR(sy, (1 - 0.944 * std::abs(g)) * 1.6245 * std::sin(2 * std::atan(n / 2.8506)) * 0.4, 1e-12) << n;
+  }
+  // MF 6.1: Kxk, Kya from MFeval's table (Fz 3376, 6752, 10128 N), over LONGITUDINAL_STIFFNESS 407611.8
+  // (1 + PCFX1 dfz + PCFX2 dfz^2)(1 + PCFX3 dpi) and LATERAL_STIFFNESS 235336.8 (...)
+  const MagicFormulaParameters mf61 = read_tir_file(dir + "MagicFormula61_Paramerters.tir");
+  std::ifstream table(std::string(CODYNA_TEST_DATA_DIR) + "/tires/mfeval/MagicFormula61_Paramerters.csv");
+  ASSERT_TRUE(table.good());
+  std::string line;
+  std::getline(table, line);  // Fz,kappa,alpha,gamma,Vx,Fx,Fy,Mz,Mx,My,Kxk,Kya,Re
+  int checked = 0;
+  double worst = 0;
+  while (std::getline(table, line)) {
+    std::vector<double> v;
+    std::stringstream row(line);
+    for (std::string cell; std::getline(row, cell, ',');) v.push_back(std::stod(cell));
+    if (v.size() < 13 || std::abs(v[1]) > 1e-12 || std::abs(v[2]) > 1e-12) continue;  // the rows at zero slip
+    const double Fz = v[0], gamma = v[3], dfz = (Fz - 6752) / 6752;
+    const double dpi = (mf61.INFLPRES - mf61.NOMPRES) / mf61.NOMPRES;
+    const double CFx = 407611.8 * (1 + mf61.PCFX1 * dfz + mf61.PCFX2 * dfz * dfz) * (1 + mf61.PCFX3 * dpi);
+    const double CFy = 235336.8 * (1 + mf61.PCFY1 * dfz + mf61.PCFY2 * dfz * dfz) * (1 + mf61.PCFY3 * dpi);
+    const auto [sx, sy] = magic_formula_relaxation_lengths<double>(mf61, Fz, gamma, v[4]);
+    worst = std::max({worst, std::abs(sx - v[10] / CFx) / sx, std::abs(sy - std::abs(v[11]) / CFy) / sy});
+    ++checked;
+  }
+  EXPECT_GE(checked, 6);
+  EXPECT_LT(worst, 1e-9);
+  std::printf("[ TireRelaxation ] .tir lengths: book file 0.16 / 0.48 m at 4000 N; MF 5.2 the PTX/PTY formulas; MF 6.1 "
+              "MFeval's Kxk, Kya over the carcass stiffnesses at %d loads and cambers: %.2e relative\n",
+              checked, worst);
 }
