@@ -27,6 +27,12 @@ void print_info(const ModelSummary& m) {
   for (std::size_t k = 0; k < m.coordinates.size(); ++k) std::cout << (k ? ", " : "") << m.coordinates[k] << " [" << m.units[k] << "]";
   std::cout << "\nrates        ";
   for (std::size_t k = 0; k < m.rates.size(); ++k) std::cout << (k ? ", " : "") << m.rates[k] << " [" << m.rate_units[k] << "]";
+  if (!m.effect_states.empty()) {  // (a line only for the models that have them)
+    std::cout << "\neffect states ";
+    for (std::size_t k = 0; k < m.effect_states.size(); ++k)
+      std::cout << (k ? ", " : "") << m.effect_states[k] << " [" << m.effect_state_units[k] << "]";
+    std::cout << " (the tires' transient slip)";
+  }
   std::cout << "\nconstraints  " << m.constraints.size() << " (" << m.constraint_equations << " equations, "
             << m.independent_equations << " independent"
             << (m.velocity_only_equations == 0 ? std::string()

@@ -44,7 +44,7 @@ py::dict model_info(const Study& s) {
   for (const ModelSummary::Sensor& y : m.sensors) sensors.append(py::dict("name"_a = y.name, "type"_a = y.type, "unit"_a = y.unit));
   return py::dict("name"_a = m.name, "file"_a = m.file, "dof"_a = m.dof, "rate_dof"_a = m.rate_dof, "nq"_a = m.nq,
                   "nv"_a = m.nv, "bodies"_a = bodies, "joints"_a = joints, "coordinates"_a = m.coordinates, "units"_a = m.units,
-                  "rates"_a = m.rates, "q_names"_a = m.q_names, "constraints"_a = constraints,
+                  "rates"_a = m.rates, "q_names"_a = m.q_names, "effect_states"_a = m.effect_states, "constraints"_a = constraints,
                   "constraint_equations"_a = m.constraint_equations, "independent_equations"_a = m.independent_equations,
                   "redundant_equations"_a = m.redundant_equations, "assembly_residual"_a = m.assembly_residual,
                   "assembly_moves"_a = m.assembly_moves, "effects"_a = effects, "gravity"_a = m.gravity,

@@ -176,6 +176,7 @@ void ClosedLoopSystem::apply_motions(double t, Eigen::VectorXd& q, Eigen::Vector
 }
 
 void ClosedLoopSystem::rhs(double t, const Eigen::VectorXd& y, Eigen::VectorXd& ydot) {
+  check_cancel();
   ++evaluations_;
   const int nq = model_.nq, nv = model_.nv, nx = nxc(), ns_ = ns();
   Eigen::VectorXd q = y.head(nq), v = y.segment(nq, nv);
@@ -202,6 +203,7 @@ Eigen::VectorXd ClosedLoopSystem::controller_rates(double t, const Eigen::Vector
 }
 
 void ClosedLoopSystem::residual(double t, const Eigen::VectorXd& Y, const Eigen::VectorXd& Yp, Eigen::VectorXd& F) {
+  check_cancel();
   ++evaluations_;
   const int nq = model_.nq, nv = model_.nv, nx = nxc(), n = na(), ns_ = ns();
   Eigen::VectorXd q = Y.head(nq), v = Y.segment(nq, nv);

@@ -13,7 +13,9 @@
 // Not thread-safe: one ClosedLoopSystem per simulation (it owns a Data).
 #pragma once
 
+#include <atomic>
 #include <limits>
+#include <stdexcept>
 
 #include <Eigen/Core>
 #include <functional>
@@ -72,6 +74,11 @@ class ClosedLoopSystem {
   // every actuator's value at a state (controller output on Plant/In, saturated)
   Eigen::VectorXd inputs(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& xc) const;
 
+  // A flag the caller sets to stop: rhs() and residual() then throw (the integrator stops inside
+  // its step, however long the step: a stiff run's output interval may take minutes); the caller
+  // tells the cancellation from a failure by the flag
+  void set_cancel(const std::atomic<bool>* cancel) { cancel_ = cancel; }
+
   void rhs(double t, const Eigen::VectorXd& y, Eigen::VectorXd& ydot);
   void residual(double t, const Eigen::VectorXd& Y, const Eigen::VectorXd& Yp, Eigen::VectorXd& F);
   // from an ODE-layout y: the DAE's consistent Y (with lambda) and Y'
@@ -123,6 +130,10 @@ class ClosedLoopSystem {
   mutable Data data_;
   mutable std::unique_ptr<DataT<ADScalar>> ad_data_;  // output rates (PD), made on first use
   long evaluations_ = 0;
+  const std::atomic<bool>* cancel_ = nullptr;
+  void check_cancel() const {
+    if (cancel_ && cancel_->load(std::memory_order_relaxed)) throw std::runtime_error("cancelled");
+  }
   // exact Jacobians: made on first use
   std::unique_ptr<TreeDerivatives> deriv_;
   Eigen::MatrixXd tangent_map_;  // [nv x nq] d(tangent)/dq at the last q

@@ -321,6 +321,7 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
   };
   record(o.t0);
 
+  sys.set_cancel(cb.cancel);  // from here a cancel stops the integrator inside its step
   const double eps = 1e-12 * std::max(1.0, std::abs(o.t_end));
   // drift the integrator leaves on the loops is not covered by its error test (IDA's
   // index-1 form): a drift of 1e-9 allowed at 1e-10 costs Andrews' squeezer two digits
@@ -343,6 +344,10 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
     try {
       integrator->advance(target);
     } catch (const IntegratorFailure& f) {
+      if (cb.cancel && cb.cancel->load()) {  // stopped inside the step (ClosedLoopSystem::set_cancel)
+        r.cancelled = true;
+        break;
+      }
       std::ostringstream os;
       os << "t = " << f.time() << " s: " << f.what();
       r.failure = os.str();

@@ -21,6 +21,8 @@ ModelSummary model_summary(const Model& m) {
   s.file = m.source_file;
   s.dof = m.dof();
   s.rate_dof = m.rate_dof();
+  s.effect_states = m.s_names;
+  s.effect_state_units = m.s_units;
   s.nq = m.nq;
   s.nv = m.nv;
   s.nonholonomic_rows = m.active_velocity_rows;

@@ -45,6 +45,7 @@ struct ModelSummary {
   std::vector<Body> bodies;   // without the ground
   std::vector<Joint> joints;
   std::vector<std::string> coordinates, units, rates, rate_units, q_names;
+  std::vector<std::string> effect_states, effect_state_units;  // a tire's deflections (transient slip)
   std::vector<Constraint> constraints;
   int constraint_equations = 0, independent_equations = 0, velocity_only_equations = 0;
   std::vector<std::string> redundant_equations;

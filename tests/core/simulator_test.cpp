@@ -201,6 +201,47 @@ TEST(Simulate, CancelKeepsThePartialResult) {
   EXPECT_NEAR(r.t.back(), 0.49, 1e-12);
 }
 
+// A cancel stops the integrator inside a long output interval (a stiff run may spend minutes in
+// one), not only between samples: a controller that sets the flag at its 500th evaluation, one
+// output interval of 1000 s. The run ends there, cancelled, not failed, with its first sample.
+namespace {
+struct CancellingController : Controller {
+  std::atomic<bool>* flag = nullptr;
+  mutable long calls = 0, after = 0;
+  Eigen::VectorXd output(const ControllerInput&, const Eigen::VectorXd&) const override {
+    if (flag->load()) ++after;
+    if (++calls == 500) *flag = true;
+    return Eigen::VectorXd::Zero(1);
+  }
+  std::string describe() const override { return "sets the cancel flag"; }
+};
+}  // namespace
+
+TEST(Simulate, CancelStopsInsideALongOutputInterval) {
+  const Model m = test::load_example("pendulum.json");
+  ASSERT_EQ(m.plant_inputs.size(), 1u);
+  const LinearPlant p = plant_at_equilibrium(m);
+  std::atomic<bool> cancel{false};
+  CancellingController c;
+  c.flag = &cancel;
+  SimulationCallbacks cb;
+  cb.cancel = &cancel;
+  for (const char* method : {"cvode-bdf", "ida", "arkode", "rk4"}) {
+    cancel = false;
+    c.calls = c.after = 0;
+    SimulationOptions o = sim_options(method, 1000.0);
+    o.output_step = 1000.0;
+    o.integrator.rtol = o.integrator.atol = 1e-10;
+    if (std::string(method) == "rk4") o.integrator.max_step = 1e-3;
+    const SimulationResult r = simulate(m, &c, &p, o, cb);
+    EXPECT_TRUE(r.cancelled) << method;
+    EXPECT_FALSE(r.completed) << method;
+    EXPECT_TRUE(r.failure.empty()) << method << ": " << r.failure;
+    EXPECT_EQ(r.samples(), 1) << method;
+    EXPECT_LE(c.after, 10) << method;  // the controller's evaluations after the flag: none or a few
+  }
+}
+
 TEST(Simulate, SolverFailureIsReportedWithTimeAndReason) {
   const Model m = test::load_example("pendulum.json");
   const LinearPlant p = plant_at_equilibrium(m);
