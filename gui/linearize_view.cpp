@@ -4,6 +4,8 @@
 #include "study/tools.hpp"
 
 #include <QComboBox>
+#include <QFontDatabase>
+#include <QPlainTextEdit>
 #include <QDir>
 #include <QDoubleSpinBox>
 #include <QFileDialog>
@@ -245,6 +247,17 @@ void LinearizeView::buildUi() {
   offsets_->setEditTriggers(QAbstractItemView::NoEditTriggers);
   offsets_->horizontalHeader()->setStretchLastSection(true);
   tabs_->addTab(offsets_, tr("Offsets x0, u0, y0"));
+  // the handling numbers of a steady motion: their own tab, so that the operating point's text
+  // above the matrices stays short enough never to be cut off by the splitter
+  handling_ = new QPlainTextEdit(tabs_);
+  handling_->setObjectName("handlingText");
+  handling_->setReadOnly(true);
+  handling_->setLineWrapMode(QPlainTextEdit::NoWrap);
+  handling_->setFont(QFontDatabase::systemFont(QFontDatabase::FixedFont));
+  handling_->setToolTip(tr("A car's handling numbers at the steady motion, from the linear model's steady-state gains "
+                           "from steer (docs/vehicles.md), as codyna linearize prints them"));
+  tabs_->addTab(handling_, tr("Handling"));
+  tabs_->setTabVisible(tabs_->indexOf(handling_), false);
 
   mode_model_ = new ModeTableModel(this);
   mode_view_ = new QTableView(this);
@@ -635,6 +648,8 @@ void LinearizeView::clearResult() {
     tabs_->setTabText(k, QLatin1String(names[k]));
   }
   offsets_->setRowCount(0);
+  handling_->clear();
+  tabs_->setTabVisible(tabs_->indexOf(handling_), false);
   hidden_label_->clear();
   mode_model_->setModes(modal_);
   pole_map_->setModes(modal_);
@@ -707,8 +722,15 @@ void LinearizeView::showResult() {
     for (int i : r.lin.partition.independent) ind << qs(result_model_->v_names[i]);
     text += tr("<br><b>Independent coordinates</b> %1").arg(ind.join(QStringLiteral(", ")).toHtmlEscaped());
   }
-  if (r.handling)
-    text += QStringLiteral("<br><pre>") + qs(study_handling_text(*r.handling)).toHtmlEscaped() + QStringLiteral("</pre>");
+  if (r.handling) {
+    text += tr("<br><b>Handling</b> understeer gradient %1 deg/g, yaw-rate gain %2 1/s (all in the Handling tab)")
+                .arg(num(r.handling->understeer_gradient_deg_per_g))
+                .arg(num(r.handling->yaw_rate_gain));
+    handling_->setPlainText(qs(study_handling_text(*r.handling)));
+  } else {
+    handling_->clear();
+  }
+  tabs_->setTabVisible(tabs_->indexOf(handling_), r.handling.has_value());
   op_label_->setText(text);
 
   // modes

@@ -28,6 +28,8 @@
 #include <QTableView>
 #include <QTableWidget>
 #include <QTemporaryDir>
+#include <QPlainTextEdit>
+#include <QTabWidget>
 #include <QTest>
 #include <QThread>
 #include <QUndoStack>
@@ -216,6 +218,19 @@ class ViewsTest : public QObject {
     const StudyLinearization direct = study_linearize(*doc.model());
     QCOMPARE(view.result()->handling->understeer_gradient, direct.handling->understeer_gradient);
     QCOMPARE(view.result()->op.u, direct.op.u);
+    // every handling number in the Handling tab, as codyna linearize prints them; the tab goes with
+    // a result that has none
+    QTabWidget* tabs = view.resultTabs();
+    const int handling = tabs->indexOf(view.handlingText());
+    QVERIFY(tabs->isTabVisible(handling));
+    QCOMPARE(view.handlingText()->toPlainText(), QString::fromStdString(study_handling_text(*direct.handling)));
+    QVERIFY(view.handlingText()->toPlainText().contains("characteristic speed"));
+    QVERIFY(doc.load(QStringLiteral(CODYNA_EXAMPLES_DIR "/cart_pendulum.json")));
+    QVERIFY(!tabs->isTabVisible(handling));
+    QVERIFY(view.handlingText()->toPlainText().isEmpty());
+    QVERIFY(view.linearize());
+    QVERIFY(!view.result()->handling.has_value());
+    QVERIFY(!tabs->isTabVisible(handling));
   }
 
   void controllabilityAsTheCommandLineSaysIt() {
