@@ -56,6 +56,25 @@ QStringList toQStringList(const std::vector<std::string>& v) {
 
 QString num(double x) { return QString::number(x, 'g', 6); }
 
+// a spin box that keeps what the study says (a QDoubleSpinBox rounds its value to its decimals:
+// with four, a lateral acceleration of 3.92266 became 3.9227 and a yaw rate of 0.00004 became 0,
+// written back to the study at the next edit of the steady motion) and shows it without trailing
+// zeros ("25 m/s", "3.92266")
+class ExactSpinBox : public QDoubleSpinBox {
+ public:
+  explicit ExactSpinBox(QWidget* parent) : QDoubleSpinBox(parent) { setDecimals(12); }
+  QString textFromValue(double v) const override {
+    QString t = locale().toString(v, 'g', 15);
+    if (t.contains(QLatin1Char('e'), Qt::CaseInsensitive)) t = locale().toString(v, 'f', decimals());
+    if (t.contains(locale().decimalPoint())) {  // no trailing zeros, no lone decimal point
+      while (t.endsWith(QLatin1Char('0'))) t.chop(1);
+      if (t.endsWith(locale().decimalPoint())) t.chop(locale().decimalPoint().size());
+    }
+    t.remove(locale().groupSeparator());
+    return t;
+  }
+};
+
 }  // namespace
 
 namespace {
@@ -183,9 +202,8 @@ void LinearizeView::buildUi() {
   trim_free_->setToolTip(tr("Trim only: coordinates the trim solves instead of holding them at the initial state"));
   steady->addRow(tr("Coordinates a trim solves"), trim_free_);
   // operating point steady: the motion held (a car straight or turning, a rolling disc)
-  steady_speed_ = new QDoubleSpinBox(steady_box_);
+  steady_speed_ = new ExactSpinBox(steady_box_);
   steady_speed_->setRange(-1e4, 1e4);
-  steady_speed_->setDecimals(4);
   steady_speed_->setSuffix(QStringLiteral(" m/s"));
   steady_speed_->setSpecialValueText(tr("as at the start"));
   steady_speed_->setKeyboardTracking(false);
@@ -198,9 +216,8 @@ void LinearizeView::buildUi() {
   steady_turn_->addItem(tr("lateral acceleration (m/s^2)"), QStringLiteral("lateral_acceleration"));
   steady_turn_->setToolTip(tr("Steady motion: straight, or a turn given by its yaw rate, path radius or lateral "
                               "acceleration (> 0 turns left)"));
-  steady_turn_value_ = new QDoubleSpinBox(steady_box_);
+  steady_turn_value_ = new ExactSpinBox(steady_box_);
   steady_turn_value_->setRange(-1e6, 1e6);
-  steady_turn_value_->setDecimals(4);
   steady_turn_value_->setKeyboardTracking(false);
   steady_turn_value_->setToolTip(tr("The turn's yaw rate, radius or lateral acceleration"));
   auto* turn_row = new QHBoxLayout;
