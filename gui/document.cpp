@@ -24,6 +24,13 @@ class SpecCommand : public QUndoCommand {
   void undo() override { doc_->restore(before_); }
   void redo() override { doc_->restore(after_); }
   int id() const override { return key_; }
+  // the model moved from file `from` to `to` (Save As into another folder): its relative file
+  // references in both states name the same files from there (else an Undo after the move would
+  // read a tire's .tir, or a namesake of it, relative to the new folder)
+  void rebase(const std::string& from, const std::string& to) {
+    before_ = study_rebase_paths(std::move(before_), from, to);
+    after_ = study_rebase_paths(std::move(after_), from, to);
+  }
   bool mergeWith(const QUndoCommand* other) override {
     const auto* o = static_cast<const SpecCommand*>(other);
     if (o->key_ != key_ || key_ < 0) return false;
@@ -187,6 +194,12 @@ bool Document::saveAs(const QString& path, QString* error) {
   }
   const QString abs = QFileInfo(path).absoluteFilePath();
   const bool moved = abs != path_;
+  if (moved && !path_.isEmpty()) {
+    // the edits before the move keep naming the files they named (every command is a SpecCommand,
+    // owned by the stack, which hands them out const)
+    for (int i = 0; i < undo_.count(); ++i)
+      const_cast<SpecCommand*>(static_cast<const SpecCommand*>(undo_.command(i)))->rebase(ss(path_), ss(abs));
+  }
   path_ = abs;
   undo_.setClean();
   if (moved) recompile();  // relative paths of the study now resolve against the new folder

@@ -4,6 +4,8 @@
 #include "study/tools.hpp"
 
 #include <QComboBox>
+#include <QFontDatabase>
+#include <QPlainTextEdit>
 #include <QDir>
 #include <QDoubleSpinBox>
 #include <QFileDialog>
@@ -53,6 +55,25 @@ QStringList toQStringList(const std::vector<std::string>& v) {
 }
 
 QString num(double x) { return QString::number(x, 'g', 6); }
+
+// a spin box that keeps what the study says (a QDoubleSpinBox rounds its value to its decimals:
+// with four, a lateral acceleration of 3.92266 became 3.9227 and a yaw rate of 0.00004 became 0,
+// written back to the study at the next edit of the steady motion) and shows it without trailing
+// zeros ("25 m/s", "3.92266")
+class ExactSpinBox : public QDoubleSpinBox {
+ public:
+  explicit ExactSpinBox(QWidget* parent) : QDoubleSpinBox(parent) { setDecimals(12); }
+  QString textFromValue(double v) const override {
+    QString t = locale().toString(v, 'g', 15);
+    if (t.contains(QLatin1Char('e'), Qt::CaseInsensitive)) t = locale().toString(v, 'f', decimals());
+    if (t.contains(locale().decimalPoint())) {  // no trailing zeros, no lone decimal point
+      while (t.endsWith(QLatin1Char('0'))) t.chop(1);
+      if (t.endsWith(locale().decimalPoint())) t.chop(locale().decimalPoint().size());
+    }
+    t.remove(locale().groupSeparator());
+    return t;
+  }
+};
 
 }  // namespace
 
@@ -181,9 +202,8 @@ void LinearizeView::buildUi() {
   trim_free_->setToolTip(tr("Trim only: coordinates the trim solves instead of holding them at the initial state"));
   steady->addRow(tr("Coordinates a trim solves"), trim_free_);
   // operating point steady: the motion held (a car straight or turning, a rolling disc)
-  steady_speed_ = new QDoubleSpinBox(steady_box_);
+  steady_speed_ = new ExactSpinBox(steady_box_);
   steady_speed_->setRange(-1e4, 1e4);
-  steady_speed_->setDecimals(4);
   steady_speed_->setSuffix(QStringLiteral(" m/s"));
   steady_speed_->setSpecialValueText(tr("as at the start"));
   steady_speed_->setKeyboardTracking(false);
@@ -196,9 +216,8 @@ void LinearizeView::buildUi() {
   steady_turn_->addItem(tr("lateral acceleration (m/s^2)"), QStringLiteral("lateral_acceleration"));
   steady_turn_->setToolTip(tr("Steady motion: straight, or a turn given by its yaw rate, path radius or lateral "
                               "acceleration (> 0 turns left)"));
-  steady_turn_value_ = new QDoubleSpinBox(steady_box_);
+  steady_turn_value_ = new ExactSpinBox(steady_box_);
   steady_turn_value_->setRange(-1e6, 1e6);
-  steady_turn_value_->setDecimals(4);
   steady_turn_value_->setKeyboardTracking(false);
   steady_turn_value_->setToolTip(tr("The turn's yaw rate, radius or lateral acceleration"));
   auto* turn_row = new QHBoxLayout;
@@ -245,6 +264,17 @@ void LinearizeView::buildUi() {
   offsets_->setEditTriggers(QAbstractItemView::NoEditTriggers);
   offsets_->horizontalHeader()->setStretchLastSection(true);
   tabs_->addTab(offsets_, tr("Offsets x0, u0, y0"));
+  // the handling numbers of a steady motion: their own tab, so that the operating point's text
+  // above the matrices stays short enough never to be cut off by the splitter
+  handling_ = new QPlainTextEdit(tabs_);
+  handling_->setObjectName("handlingText");
+  handling_->setReadOnly(true);
+  handling_->setLineWrapMode(QPlainTextEdit::NoWrap);
+  handling_->setFont(QFontDatabase::systemFont(QFontDatabase::FixedFont));
+  handling_->setToolTip(tr("A car's handling numbers at the steady motion, from the linear model's steady-state gains "
+                           "from steer (docs/vehicles.md), as codyna linearize prints them"));
+  tabs_->addTab(handling_, tr("Handling"));
+  tabs_->setTabVisible(tabs_->indexOf(handling_), false);
 
   mode_model_ = new ModeTableModel(this);
   mode_view_ = new QTableView(this);
@@ -635,6 +665,8 @@ void LinearizeView::clearResult() {
     tabs_->setTabText(k, QLatin1String(names[k]));
   }
   offsets_->setRowCount(0);
+  handling_->clear();
+  tabs_->setTabVisible(tabs_->indexOf(handling_), false);
   hidden_label_->clear();
   mode_model_->setModes(modal_);
   pole_map_->setModes(modal_);
@@ -707,8 +739,15 @@ void LinearizeView::showResult() {
     for (int i : r.lin.partition.independent) ind << qs(result_model_->v_names[i]);
     text += tr("<br><b>Independent coordinates</b> %1").arg(ind.join(QStringLiteral(", ")).toHtmlEscaped());
   }
-  if (r.handling)
-    text += QStringLiteral("<br><pre>") + qs(study_handling_text(*r.handling)).toHtmlEscaped() + QStringLiteral("</pre>");
+  if (r.handling) {
+    text += tr("<br><b>Handling</b> understeer gradient %1 deg/g, yaw-rate gain %2 1/s (all in the Handling tab)")
+                .arg(num(r.handling->understeer_gradient_deg_per_g))
+                .arg(num(r.handling->yaw_rate_gain));
+    handling_->setPlainText(qs(study_handling_text(*r.handling)));
+  } else {
+    handling_->clear();
+  }
+  tabs_->setTabVisible(tabs_->indexOf(handling_), r.handling.has_value());
   op_label_->setText(text);
 
   // modes

@@ -46,6 +46,7 @@ class QListWidget;
 class QListWidgetItem;
 class QPushButton;
 class QTabWidget;
+class QPlainTextEdit;
 class QTableView;
 class QTableWidget;
 class QGroupBox;
@@ -112,6 +113,10 @@ class LinearizeView : public QWidget {
   PoleMap* poleMap() const { return pole_map_; }
   QLabel* operatingPointLabel() const { return op_label_; }
   QLabel* controllabilityLabel() const { return hidden_label_; }
+  // the handling numbers of a steady motion (as codyna linearize prints them), in the results'
+  // Handling tab, shown only when the result has them
+  QPlainTextEdit* handlingText() const { return handling_; }
+  QTabWidget* resultTabs() const { return tabs_; }
 
  signals:
   // a mode was selected (table or pole map): its index in modes(), its shape (state order) and s
@@ -172,6 +177,7 @@ class LinearizeView : public QWidget {
   QTableView* matrix_views_[4] = {};
   MatrixTableModel* matrix_models_[4] = {};
   QTableWidget* offsets_ = nullptr;
+  QPlainTextEdit* handling_ = nullptr;
   QTableView* mode_view_ = nullptr;
   ModeTableModel* mode_model_ = nullptr;
   PoleMap* pole_map_ = nullptr;

@@ -382,6 +382,13 @@ void MainWindow::buildMenus() {
   com->setChecked(false);
   com->setToolTip(tr("A dark ball at each body's centre of mass"));
   connect(com, &QAction::toggled, view_, &View3D::setShowCom);
+  QAction* tire_forces = view->addAction(tr("Show &tire forces"));
+  tire_forces->setObjectName("actionShowTireForces");
+  tire_forces->setCheckable(true);
+  tire_forces->setChecked(true);
+  tire_forces->setToolTip(tr("Each tire's contact force at the state shown: the load and the in-plane force, as arrows "
+                             "from the contact point (the legend gives the scale)"));
+  connect(tire_forces, &QAction::toggled, view_, &View3D::setShowTireForces);
 
   view->addSeparator();
   for (QDockWidget* d : findChildren<QDockWidget*>()) view->addAction(d->toggleViewAction());
@@ -935,7 +942,12 @@ void MainWindow::setPlaybackTime(double t) {
   const int k = std::clamp(static_cast<int>(it - ts.begin()), 0, result_->samples() - 1);
   play_t_ = ts[k];
   const auto model = doc_->model();
-  if (model && result_->q.cols() == model->nq) view_->setConfiguration(result_->q.row(k).transpose());
+  if (model && result_->q.cols() == model->nq) {
+    if (result_->v.cols() == model->nv && result_->v.rows() == result_->q.rows())
+      view_->setState(result_->q.row(k).transpose(), result_->v.row(k).transpose());
+    else
+      view_->setConfiguration(result_->q.row(k).transpose());
+  }
   sim_view_->plots()->setTimeCursor(play_t_);
   time_label_->setText(QStringLiteral("t = %1 s").arg(play_t_, 0, 'f', 3));
   if (slider_->value() != k) {
@@ -971,8 +983,8 @@ void MainWindow::animateMode(int index, const Eigen::VectorXcd& shape) {
     // back to the operating point of a current linearization, else the initial state
     if (const auto m = doc_->model()) {
       const auto* r = lin_view_->result();
-      const bool at_op = r && !lin_view_->isStale() && r->op.q.size() == m->nq;
-      view_->setConfiguration(at_op ? r->op.q : m->q0);
+      const bool at_op = r && !lin_view_->isStale() && r->op.q.size() == m->nq && r->op.v.size() == m->nv;
+      view_->setState(at_op ? r->op.q : m->q0, at_op ? r->op.v : m->v0);
     }
   }
 }
@@ -998,7 +1010,9 @@ void MainWindow::stepAnimation() {
   if (!model || !lin || lin->op.q.size() != model->nq) return;
   mode_phase_ += 2 * M_PI * kFrameMs / 1500.0;  // one period in 1.5 s whatever the frequency
   const Eigen::VectorXd q = study_mode_pose(*model, lin->op.q, lin->system.state_names, mode_shape_, mode_phase_);
-  view_->setConfiguration(q);
+  // the tire forces follow the pose, at the operating point's velocities
+  if (lin->op.v.size() == model->nv) view_->setState(q, lin->op.v);
+  else view_->setConfiguration(q);
 }
 
 }  // namespace codyna::gui

@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <functional>
+#include <cstdio>
 #include <limits>
 
 #include "study/tools.hpp"
@@ -458,8 +459,61 @@ void Scene::build(const Model* model, const std::vector<int>& held) {
     items_.push_back(it);
   }
 
+  // the tire forces' scale: a tire's share of the weight (1 kN without gravity) drawn about a
+  // quarter of the mechanism's size long, rounded down to 1, 2 or 5 times a power of ten in the
+  // legend's unit (kN from 1 kN on)
+  tire_force_scale_ = 0.0;
+  if (!m.tires.empty()) {
+    double total = 0;
+    for (int i = 1; i < m.nbodies; ++i) total += m.mass[i];
+    double share = m.has_gravity ? total * m.gravity.norm() / static_cast<double>(m.tires.size()) : 0.0;
+    if (!(share > 0)) share = 1000.0;
+    tire_force_unit_ = share >= 1000.0 ? 1000.0 : 1.0;
+    const double per_unit = 0.25 * L / share * tire_force_unit_;  // metres per unit force
+    const double decade = std::pow(10.0, std::floor(std::log10(per_unit)));
+    double nice = decade;
+    for (double f : {2.0, 5.0})
+      if (f * decade <= per_unit * (1 + 1e-12)) nice = f * decade;
+    tire_force_scale_ = nice / tire_force_unit_;
+  }
+
   update(oMi);
   placeGrid(oMi);
+}
+
+std::string Scene::tireForceScaleText() const {
+  if (!(tire_force_scale_ > 0)) return {};
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "1 %s = %.3g m", tire_force_unit_ > 1 ? "kN" : "N", tire_force_scale_ * tire_force_unit_);
+  return buf;
+}
+
+void Scene::setTireForces(const std::vector<TireContactReport>& contacts) {
+  items_.erase(std::remove_if(items_.begin(), items_.end(),
+                              [](const Item& it) { return it.kind == ItemKind::TireLoad || it.kind == ItemKind::TireInPlane; }),
+               items_.end());
+  if (!model_ || !(tire_force_scale_ > 0)) return;
+  // one thickness for every arrow (a shaft 0.8 % of the mechanism's size in radius), thinner for a
+  // short one, so that a small force is a short thin arrow and not a blob
+  const double thick_max = 0.35 * length_;
+  auto arrow = [&](ItemKind kind, const TireContactReport& c, const Eigen::Vector3d& F, const Eigen::Vector4f& color) {
+    const double len = F.norm() * tire_force_scale_;
+    if (!(len > 1e-9 * length_)) return;  // no force, no direction
+    Item it;
+    it.kind = kind;
+    it.prim = Prim::Arrow;
+    it.body = 0;
+    it.element = c.name;
+    it.local = arrowAt(c.point + 0.5 * len * F / F.norm(), F / F.norm(), len, std::min(thick_max, 2.0 * len));
+    it.world = it.local;
+    it.color = color;
+    items_.push_back(it);
+  };
+  for (const TireContactReport& c : contacts) {
+    if (!c.in_contact) continue;
+    arrow(ItemKind::TireLoad, c, c.Fz * c.ez, {0.12f, 0.38f, 0.95f, 1.0f});
+    arrow(ItemKind::TireInPlane, c, c.Fx * c.ex + c.Fy * c.ey, {0.00f, 0.62f, 0.56f, 1.0f});
+  }
 }
 
 void Scene::addDefaultLook(int i) {
@@ -756,6 +810,7 @@ void Scene::addElements(const std::vector<SE3>& oMi) {
 
 void Scene::update(const std::vector<SE3>& oMi) {
   for (Item& it : items_) {
+    if (it.kind == ItemKind::TireLoad || it.kind == ItemKind::TireInPlane) continue;  // placed in world axes
     if (it.span == Span::Contact) {
       const SE3& A = oMi[it.body];
       Eigen::Affine3d X = Eigen::Affine3d::Identity();

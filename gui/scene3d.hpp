@@ -5,7 +5,8 @@
 // - Scene: the items of a Model (its declared shapes, or a default look for
 //   bodies without shapes, joint axes, body triads, springs, ground anchors)
 //   with their world transforms for one configuration, a ground grid and
-//   ray picking against the same transforms that are drawn.
+//   ray picking against the same transforms that are drawn; the tires' contact forces at one
+//   state as arrows at their contact points (setTireForces, core's study_tire_contacts).
 // - Camera: an orbit camera (yaw about "up", pitch above the ground plane)
 //   with projection to pixels and the pixel ray, for drawing and picking.
 #pragma once
@@ -15,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "study/tire_contacts.hpp"
 #include "study/tools.hpp"
 #include "model/model.hpp"
 
@@ -54,6 +56,10 @@ enum class ItemKind {
   Actuator,   // an actuator driven by a mix: a force arrow from its point, a torque arrow and disc
   Contact,    // a rolling_ball: a thin disc of the plane under the ball at the contact, a dot on it
   Force,      // a body_force effect: an arrow along its force from its point, an arrow and a disc for its torque
+  // a tire's contact force on the wheel, from its contact point: the load Fz ez (TireLoad) and the
+  // in-plane force Fx ex + Fy ey (TireInPlane), tireForceScale() metres per newton; world items
+  TireLoad,
+  TireInPlane,
 };
 
 // how a two-point item spans the line from point_a (on `body`) to point_b (on body_b)
@@ -111,6 +117,15 @@ class Scene {
   void build(const Model* model, const std::vector<int>& held = {});
   // recomputes the world transforms from body poses (oMi of forward_kinematics)
   void update(const std::vector<SE3>& oMi);
+  // replaces the tire force arrows by those of `contacts` (one per tire of the model, as
+  // study_tire_contacts gives them; empty: none drawn): per tire in contact a TireLoad arrow and,
+  // unless it is zero, a TireInPlane arrow, from the contact point, tireForceScale() m per N long
+  void setTireForces(const std::vector<TireContactReport>& contacts);
+  // metres of arrow per newton: a round number (1, 2 or 5 times a power of ten) that draws a
+  // tire's share of the weight about a quarter of the mechanism's size long; 0 without tires
+  double tireForceScale() const { return tire_force_scale_; }
+  // the scale as the legend says it: "1 kN = 0.2 m" ("" without tires)
+  std::string tireForceScaleText() const;
 
   const Model* model() const { return model_; }
   const std::vector<Item>& items() const { return items_; }
@@ -144,6 +159,8 @@ class Scene {
   Eigen::Vector3d up_ = Eigen::Vector3d::UnitY();
   Eigen::Vector3d grid_center_ = Eigen::Vector3d::Zero();
   double grid_half_ = 2.0, grid_step_ = 0.5;
+  double tire_force_scale_ = 0.0;  // m per N
+  double tire_force_unit_ = 1.0;   // N in the legend's unit (1 or 1000)
 };
 
 // Orbit camera. Pixel coordinates are widget coordinates: x right, y down.

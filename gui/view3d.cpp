@@ -12,11 +12,13 @@
 #include <QOpenGLShaderProgram>
 #include <QOpenGLVertexArrayObject>
 #include <QOpenGLWidget>
+#include <QPainter>
 #include <QVBoxLayout>
 #include <QWheelEvent>
 #include <algorithm>
 #include <array>
 #include <memory>
+#include <stdexcept>
 
 #include "study/tools.hpp"
 
@@ -223,15 +225,21 @@ class GLCanvas : public QOpenGLWidget, protected QOpenGLExtraFunctions {
 
     const int hl = owner_->highlight_body_;
     const auto selected = [hl](const Item& it) { return it.kind == ItemKind::Shape && it.body == hl && hl > 0; };
-    auto drawItems = [&](bool overlays, float alpha) {
+    // layers: 0 the bodies and elements; 1 the overlays: frames and joint axes, centres of mass,
+    // and the elements' marks (couplers, motion inputs, mixed actuators), which sit in bodies too
+    // and are shown and hidden with the frames (View > Show frames); 2 the tire forces, which start
+    // at the contact inside the tire. Layers 1 and 2 are drawn over the bodies, faint where hidden.
+    const auto layerOf = [](const Item& it) {
+      if (it.kind == ItemKind::TireLoad || it.kind == ItemKind::TireInPlane) return 2;
+      const bool overlay = it.kind == ItemKind::Axis || it.kind == ItemKind::Frame || it.kind == ItemKind::Com ||
+                           it.kind == ItemKind::Coupler || it.kind == ItemKind::Motion || it.kind == ItemKind::Actuator;
+      return overlay ? 1 : 0;
+    };
+    auto drawItems = [&](int layer, float alpha) {
+      const bool overlays = layer > 0;
       for (const Item& it : scene.items()) {
-        // overlays: frames and joint axes, centres of mass; drawn over the bodies (faint where hidden)
-        // and the elements' marks (couplers, motion inputs, mixed actuators), which sit in bodies too
-        // and are shown and hidden with the frames (View > Show frames)
-        const bool overlay = it.kind == ItemKind::Axis || it.kind == ItemKind::Frame || it.kind == ItemKind::Com ||
-                             it.kind == ItemKind::Coupler || it.kind == ItemKind::Motion || it.kind == ItemKind::Actuator;
-        if (overlay != overlays) continue;
-        if (it.kind == ItemKind::Com ? !owner_->show_com_ : overlay && !owner_->show_frames_) continue;
+        if (layerOf(it) != layer) continue;
+        if (it.kind == ItemKind::Com ? !owner_->show_com_ : layer == 1 && !owner_->show_frames_) continue;
         const Eigen::Matrix4f MV = V * it.world.matrix().cast<float>();
         const Eigen::Matrix3f A = MV.topLeftCorner<3, 3>();
         if (std::abs(A.determinant()) < 1e-30f) continue;  // degenerate (zero-length spring)
@@ -250,7 +258,7 @@ class GLCanvas : public QOpenGLWidget, protected QOpenGLExtraFunctions {
         if (!overlays && selected(it)) glDisable(GL_STENCIL_TEST);
       }
     };
-    drawItems(false, 1.0f);
+    drawItems(0, 1.0f);
     if (hl > 0) {
       // the outline: the selected shapes grown by ~2.5 px, drawn where the stencil is not set,
       // over everything (a body behind another still shows where it is)
@@ -282,17 +290,18 @@ class GLCanvas : public QOpenGLWidget, protected QOpenGLExtraFunctions {
       glStencilMask(0xFF);
       glDisable(GL_STENCIL_TEST);
     }
-    if (owner_->show_frames_ || owner_->show_com_) {
-      // frames and axes often sit inside bodies: show their hidden parts faintly first
+    for (int layer : {1, 2}) {
+      if (layer == 1 && !owner_->show_frames_ && !owner_->show_com_) continue;
+      // frames, axes and the tire forces often sit inside bodies: show their hidden parts faintly first
       glDepthFunc(GL_GREATER);
       glDepthMask(GL_FALSE);
       glEnable(GL_BLEND);
       glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
-      drawItems(true, 0.4f);
+      drawItems(layer, 0.4f);
       glDisable(GL_BLEND);
       glDepthMask(GL_TRUE);
       glDepthFunc(GL_LEQUAL);
-      drawItems(true, 1.0f);
+      drawItems(layer, 1.0f);
     }
     program_->release();
 
@@ -430,6 +439,7 @@ void View3D::setDraft(std::shared_ptr<const codyna::Model> draft, const QString&
     for (const QString& b : held) bodies.push_back(model_->find_body(b.toStdString()));
     scene_.build(model_.get(), bodies);
     scene_.update(poses_->at(q_));
+    updateTireForces();
     updateSceneRadius();
     if (canvas_) canvas_->gridChanged();
   }
@@ -462,10 +472,12 @@ void View3D::setModel(std::shared_ptr<const codyna::Model> model) {
   model_ = std::move(model);
   poses_ = model_ ? std::make_unique<codyna::StudyPoses>(*model_) : nullptr;
   q_ = model_ ? model_->q0 : Eigen::VectorXd();
+  v_ = model_ ? model_->v0 : Eigen::VectorXd();
   scene_.build(model_.get());
   if (model_ && q_.size() == model_->nq) {
     scene_.update(poses_->at(q_));
   }
+  updateTireForces();
   highlight_body_ = model_ ? model_->find_body(highlight_.toStdString()) : -1;
   camera_.setUp(scene_.up());
   updateSceneRadius();
@@ -482,8 +494,70 @@ void View3D::setModel(std::shared_ptr<const codyna::Model> model) {
 void View3D::setConfiguration(const Eigen::VectorXd& q) {
   if (!model_ || q.size() != model_->nq) return;
   q_ = q;
+  if (v_.size() != model_->nv) v_ = Eigen::VectorXd::Zero(model_->nv);
   scene_.update(poses_->at(q_));
+  updateTireForces();
   requestPaint();
+}
+
+void View3D::setState(const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
+  if (!model_ || q.size() != model_->nq || v.size() != model_->nv) return;
+  v_ = v;
+  setConfiguration(q);
+}
+
+void View3D::setShowTireForces(bool on) {
+  show_tire_forces_ = on;
+  updateTireForces();
+  requestPaint();
+}
+
+QString View3D::tireForceLegend() const {
+  if (!tire_legend_ || tire_legend_->isHidden()) return {};
+  return tire_legend_->property("plainText").toString();
+}
+
+void View3D::updateTireForces() {
+  contacts_.clear();
+  if (model_ && show_tire_forces_ && !model_->tires.empty() && q_.size() == model_->nq && v_.size() == model_->nv) {
+    try {
+      contacts_ = codyna::study_tire_contacts(*model_, q_, v_);
+    } catch (const std::exception&) {
+      contacts_.clear();  // a state the model cannot hold: nothing to draw
+    }
+  }
+  scene_.setTireForces(contacts_);
+  const std::string scale = scene_.tireForceScaleText();
+  const bool shown = !scale.empty() && std::any_of(contacts_.begin(), contacts_.end(),
+                                                   [](const codyna::TireContactReport& c) { return c.in_contact; });
+  if (!shown) {
+    if (tire_legend_) tire_legend_->hide();
+    return;
+  }
+  if (!tire_legend_) {
+    tire_legend_ = new QLabel(this);
+    tire_legend_->setObjectName(QStringLiteral("view3dTireLegend"));
+    tire_legend_->setTextFormat(Qt::RichText);
+    tire_legend_->setAutoFillBackground(true);
+    tire_legend_->setMargin(4);
+    tire_legend_->setAttribute(Qt::WA_TransparentForMouseEvents);
+    QPalette pal = tire_legend_->palette();
+    pal.setColor(QPalette::Window, QColor(250, 250, 252));
+    pal.setColor(QPalette::WindowText, QColor(40, 44, 52));
+    tire_legend_->setPalette(pal);
+  }
+  const QString s = QString::fromStdString(scale);
+  tire_legend_->setProperty("plainText",
+                            tr("tire forces at the contact points, %1: blue the load Fz, teal the in-plane force Fx ex + Fy ey")
+                                .arg(s));
+  tire_legend_->setText(tr("tire forces at the contact points, <b>%1</b><br><span style=\"color:#1f61f2\">&#9632;</span> load "
+                           "F<sub>z</sub> &nbsp; <span style=\"color:#009e8f\">&#9632;</span> in-plane F<sub>x</sub> e<sub>x</sub> "
+                           "+ F<sub>y</sub> e<sub>y</sub>")
+                            .arg(s));
+  tire_legend_->adjustSize();
+  tire_legend_->move(8, std::max(8, height() - tire_legend_->height() - 8));
+  tire_legend_->show();
+  tire_legend_->raise();
 }
 
 void View3D::setHighlight(const QString& bodyName) {
@@ -545,13 +619,22 @@ bool View3D::bodyScreenPos(const QString& bodyName, QPointF* pos) const {
 QImage View3D::grabImage() {
   if (canvas_) {
     QImage img = canvas_->grabFramebuffer();
-    if (!img.isNull()) return img;
+    if (!img.isNull()) {
+      if (tire_legend_ && !tire_legend_->isHidden()) {
+        // the legend is a widget over the canvas, not in its framebuffer: put it where it is seen
+        // (a painter on an image works in its logical pixels, the widgets')
+        QPainter painter(&img);
+        tire_legend_->render(&painter, tire_legend_->pos());
+      }
+      return img;
+    }
   }
   return grab().toImage();
 }
 
 void View3D::resizeEvent(QResizeEvent* e) {
   QWidget::resizeEvent(e);
+  if (tire_legend_) tire_legend_->move(8, std::max(8, height() - tire_legend_->height() - 8));
   syncViewport();
   if (auto_fit_) fitView();  // the first layout pass gives the real aspect ratio
 }

@@ -4,6 +4,8 @@
 // default ball-and-link look for bodies without shapes), joint axes, body
 // frames, centres of mass (on request), ground anchors, springs, the selected
 // body tinted and outlined (its silhouette, also where other bodies hide it),
+// the tires' contact forces at the state (q, v) shown (arrows from the contact
+// points, core's study_tire_contacts, with a legend giving their scale),
 // and a ground grid normal to "up"
 // (-gravity, else +y), with an orbit camera:
 //   left drag: orbit    middle drag or shift + left drag: pan    wheel: zoom
@@ -23,8 +25,10 @@
 #include <Eigen/Core>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "gui/scene3d.hpp"
+#include "study/tire_contacts.hpp"
 #include "study/tools.hpp"
 #include "model/model.hpp"
 
@@ -58,10 +62,21 @@ class View3D : public QWidget {
   // `held`: the bodies the draft holds (no ground anchor is drawn for them)
   void setDraft(std::shared_ptr<const codyna::Model> draft, const QString& note, const QStringList& held = {});
   QString draftNote() const;  // "" when the model shown is not a draft
-  // nq values; draws the mechanism there (setModel starts at m.q0). Cheap:
-  // forward kinematics and item transforms only. Wrong sizes are ignored.
+  // nq values; draws the mechanism there (setModel starts at m.q0, v0). Cheap:
+  // forward kinematics and item transforms only. Wrong sizes are ignored. The
+  // tire forces are those at q with the velocities last given (setState).
   void setConfiguration(const Eigen::VectorXd& q);
+  // the state (nq and nv values): the mechanism at q and the tires' contact forces at (q, v).
+  // Wrong sizes are ignored.
+  void setState(const Eigen::VectorXd& q, const Eigen::VectorXd& v);
   const Eigen::VectorXd& configuration() const { return q_; }
+  const Eigen::VectorXd& velocities() const { return v_; }
+  // the tires' contacts drawn now (empty: a model without tires, or the tire forces hidden)
+  const std::vector<codyna::TireContactReport>& tireContacts() const { return contacts_; }
+  void setShowTireForces(bool on);             // the tire force arrows and their legend, default on
+  bool showTireForces() const { return show_tire_forces_; }
+  // the legend's text ("" when no tire force is drawn)
+  QString tireForceLegend() const;
   void setHighlight(const QString& bodyName);  // "" none
   QString highlight() const { return highlight_; }
   void setShowFrames(bool on);                 // body triads and joint axes, default on
@@ -85,7 +100,8 @@ class View3D : public QWidget {
   const Camera& camera() const { return camera_; }
   const Scene& scene() const { return scene_; }
 
-  // what is shown: the GL framebuffer with hasGL(), else the placeholder's grab()
+  // what is shown: the GL framebuffer with hasGL() (and the tire forces' legend over it), else
+  // the placeholder's grab()
   QImage grabImage();
   double lastFrameMs() const { return last_frame_ms_; }  // CPU time of the last paint, after glFinish
   int framesDrawn() const { return frames_; }
@@ -108,21 +124,24 @@ class View3D : public QWidget {
   void syncViewport();
   void updateSceneRadius();
   void requestPaint();
+  void updateTireForces();  // contacts_ and the scene's arrows at (q_, v_), the legend
 
   std::shared_ptr<const codyna::Model> model_;
   std::unique_ptr<codyna::StudyPoses> poses_;  // the body poses at q_
-  Eigen::VectorXd q_;
+  Eigen::VectorXd q_, v_;
+  std::vector<codyna::TireContactReport> contacts_;
   Scene scene_;
   Camera camera_;
   QString highlight_;
   int highlight_body_ = -1;
-  bool show_frames_ = true, show_grid_ = true, show_com_ = false;
+  bool show_frames_ = true, show_grid_ = true, show_com_ = false, show_tire_forces_ = true;
   std::string fitted_for_;   // source file and name of the model the camera was fitted to
   bool auto_fit_ = true;      // refit on resize until the user moves the camera
 
   GLCanvas* canvas_ = nullptr;
   QLabel* placeholder_ = nullptr;
   QLabel* draft_note_ = nullptr;
+  QLabel* tire_legend_ = nullptr;
   QPoint press_pos_, last_pos_;
   bool pressed_ = false, dragged_ = false;
   double last_frame_ms_ = 0.0;

@@ -446,6 +446,55 @@ class EditingTest : public QObject {
     QCOMPARE(w->document()->filePath(), QFileInfo(dir.filePath("mine.json")).absoluteFilePath());
   }
 
+  // Save As into another folder rewrites a tire's relative .tir path (study_rebase_paths); Undo
+  // and Redo after it bring back edits made before it with their paths rewritten too, so that the
+  // tire still reads its own file and not a namesake beside the new file (here another tire:
+  // PacejkaBook_Defaults.tir, radius 0.3135 m, against the sedan's 0.393581 m)
+  void undoAfterSaveAsKeepsTheTireFile() {
+    QTemporaryDir tmp;
+    QDir root(tmp.path());
+    QVERIFY(root.mkpath("a/tires") && root.mkpath("b/deeper/tires"));
+    const QString tir = "tires/MagicFormula61_Paramerters.tir";
+    QVERIFY(QFile::copy(QStringLiteral(CODYNA_EXAMPLES_DIR "/sedan.json"), root.filePath("a/sedan.json")));
+    QVERIFY(QFile::copy(QStringLiteral(CODYNA_EXAMPLES_DIR "/") + tir, root.filePath("a/" + tir)));
+    QVERIFY(QFile::copy(QStringLiteral(CODYNA_TEST_DATA_DIR "/tires/PacejkaBook_Defaults.tir"), root.filePath("b/deeper/" + tir)));
+    QVERIFY(w->openFile(root.filePath("a/sedan.json")));
+    Document* doc = w->document();
+    const auto radius = [doc] { return doc->model() ? doc->model()->tires.at(0).unloaded_radius : -1.0; };
+    const auto file = [doc] { return doc->spec().effects.at(3).file; };  // tire_fl
+    QCOMPARE(doc->spec().effects.at(3).name, std::string("tire_fl"));
+    QCOMPARE(file(), tir.toStdString());
+    QCOMPARE(radius(), 0.393581);
+    QVERIFY(doc->edit("chassis mass", [](ModelSpec& m) { m.bodies.at(0).mass = 1400; }));
+    QVERIFY(doc->edit("wheel_fl mass", [](ModelSpec& m) { m.bodies.at(8).mass = 21; }));
+    QVERIFY(w->saveFileAs(root.filePath("b/deeper/sedan.json")));
+    const std::string moved = "../../a/" + tir.toStdString();
+    QCOMPARE(file(), moved);
+    QCOMPARE(radius(), 0.393581);
+    doc->undoStack()->undo();  // the wheel's mass back: the tire as it was named before the move
+    QCOMPARE(doc->spec().bodies.at(8).mass, 20.0);
+    QCOMPARE(file(), moved);
+    QCOMPARE(radius(), 0.393581);
+    doc->undoStack()->undo();
+    QCOMPARE(doc->spec().bodies.at(0).mass, 1350.0);
+    QCOMPARE(file(), moved);
+    QCOMPARE(radius(), 0.393581);
+    doc->undoStack()->redo();
+    doc->undoStack()->redo();
+    QCOMPARE(doc->spec().bodies.at(8).mass, 21.0);
+    QCOMPARE(file(), moved);
+    QCOMPARE(radius(), 0.393581);
+    QVERIFY(doc->undoStack()->isClean());
+    // saved back beside the first file: the path is short again, and Undo still reads it
+    doc->undoStack()->undo();
+    QVERIFY(w->saveFileAs(root.filePath("a/again.json")));
+    QCOMPARE(file(), tir.toStdString());
+    doc->undoStack()->undo();
+    QCOMPARE(file(), tir.toStdString());
+    QCOMPARE(radius(), 0.393581);
+    doc->undoStack()->setClean();
+  }
+
   // a zero eigenvalue has no damping ratio: "-" in the mode table, not -1
   void zeroEigenvalueHasNoDamping() {
     LinearSystem s;

@@ -209,6 +209,51 @@ class MainWindowTest : public QObject {
     QCOMPARE(w->playbackSlider()->maximum(), c->samples() - 1);
   }
 
+  // the 3-D view's tire forces are those of the state it shows: the initial state on opening, the
+  // operating point after Linearize (the sedan straight at 25 m/s: the four loads carry the weight,
+  // the rear tires drive), and each playback sample's q and v
+  void sedanTireForcesFollowTheStateShown() {
+    QVERIFY(w->openFile(QStringLiteral(CODYNA_EXAMPLES_DIR "/sedan.json")));
+    const auto m = w->document()->model();
+    QVERIFY(m);
+    View3D* view = w->view3d();
+    QCOMPARE(view->velocities(), m->v0);
+    QCOMPARE(view->tireContacts().size(), size_t(4));
+    LinearizeView* lv = w->linearizeView();
+    w->analysisTabs()->setCurrentWidget(lv);
+    QTest::mouseClick(lv->linearizeButton(), Qt::LeftButton);
+    QVERIFY(lv->result());
+    const auto& op = lv->result()->op;
+    QVERIFY(op.motion.has_value());
+    QCOMPARE(view->configuration(), op.q);
+    QCOMPARE(view->velocities(), op.v);
+    double mass = 0, Fz = 0;
+    for (int i = 1; i < m->nbodies; ++i) mass += m->mass[static_cast<size_t>(i)];
+    for (const auto& c : view->tireContacts()) {
+      QVERIFY(c.in_contact);
+      Fz += c.Fz;
+      // straight at 25 m/s: the fronts roll (drag, Fx < 0), the rears drive (Fx > 0), 20 to 200 N
+      const bool rear = c.name == "tire_rl" || c.name == "tire_rr";
+      QVERIFY2((rear ? c.Fx : -c.Fx) > 20 && std::abs(c.Fx) < 200, qPrintable(QString::fromStdString(c.name)));
+    }
+    const double mg = mass * m->gravity.norm();
+    QVERIFY2(std::abs(Fz - mg) < 1e-6 * mg, qPrintable(QString::number(Fz, 'g', 12)));
+    // a short run from the operating point (the file's study: the run starts there), played back
+    SimulateView* sv = w->simulateView();
+    w->analysisTabs()->setCurrentWidget(sv);
+    sv->endTimeSpin()->setValue(0.05);
+    QSignalSpy finished(sv, &SimulateView::runFinished);
+    QTest::mouseClick(sv->runButton(), Qt::LeftButton);
+    QVERIFY(waitFor([&] { return finished.count() == 1; }, 120000));
+    const auto r = sv->result();
+    QVERIFY(r && r->completed && r->samples() > 3);
+    w->playbackSlider()->setValue(2);
+    QCOMPARE(w->playbackTime(), r->t[2]);
+    QCOMPARE(view->configuration(), Eigen::VectorXd(r->q.row(2).transpose()));
+    QCOMPARE(view->velocities(), Eigen::VectorXd(r->v.row(2).transpose()));
+    QCOMPARE(view->tireContacts().size(), size_t(4));
+  }
+
   void undoRedoAndRenameUpdatesThePlantLists() {
     openCart();
     QUndoStack* undo = w->document()->undoStack();

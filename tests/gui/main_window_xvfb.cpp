@@ -15,6 +15,8 @@
 #include <QDoubleSpinBox>
 #include <QListWidget>
 #include <QPushButton>
+#include <QPlainTextEdit>
+#include <QScrollArea>
 #include <QScreen>
 #include <QLabel>
 #include <QSplitter>
@@ -412,6 +414,51 @@ class MainWindowXvfb : public QObject {
     sv->resultTabs()->setCurrentIndex(1);
     QTest::qWait(300);
     save(screenOfChild(&w, sv), "sweep_figure.png");
+    w.document()->undoStack()->setClean();
+  }
+
+  // the sedan of issue 39 in its steady 0.4 g left turn, set in the Linearize view's steady motion
+  // fields: the motion, the handling numbers, the modes, and the tire forces in the 3-D view
+  void sedanSteadyTurn() {
+    MainWindow w;
+    w.resize(1920, 1200);
+    w.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&w));
+    QVERIFY(w.openFile(QStringLiteral(CODYNA_EXAMPLES_DIR "/sedan.json")));
+    LinearizeView* lv = w.linearizeView();
+    w.analysisTabs()->setCurrentWidget(lv);
+    QCOMPARE(lv->steadySpeedSpin()->value(), 25.0);
+    lv->steadyTurnCombo()->setCurrentIndex(lv->steadyTurnCombo()->findData(QStringLiteral("lateral_acceleration")));
+    lv->steadyTurnValueSpin()->setValue(0.4 * 9.80665);
+    QCOMPARE(w.document()->spec().analysis.steady.lateral_acceleration.value_or(0), 0.4 * 9.80665);
+    QVERIFY(lv->linearize());
+    const auto* r = lv->result();
+    QVERIFY(r && r->op.motion && r->handling);
+    // the turn asked for: r V = a_y, and an understeering car
+    const auto& jm = r->op.motion->joints.at(0);
+    QVERIFY2(std::abs(jm.yaw_rate * jm.velocity.norm() - 0.4 * 9.80665) < 1e-6, qPrintable(QString::number(jm.yaw_rate)));
+    QVERIFY(r->handling->understeer_gradient > 0);
+    QCOMPARE(w.view3d()->velocities(), r->op.v);
+    QCOMPARE(w.view3d()->tireContacts().size(), std::size_t(4));
+    // the handling numbers' tab, and the steady motion's fields in sight in the settings column
+    QTabWidget* results = lv->resultTabs();
+    QVERIFY(results->isTabVisible(results->indexOf(lv->handlingText())));
+    results->setCurrentWidget(lv->handlingText());
+    QVERIFY(lv->handlingText()->toPlainText().contains("understeer gradient"));
+    auto* column = lv->findChild<QScrollArea*>();
+    QVERIFY(column);
+    w.view3d()->setShowFrames(false);
+    QTest::qWait(400);
+    column->ensureWidgetVisible(lv->steadyTurnValueSpin(), 10, 60);
+    QTest::qWait(100);
+    QPoint at = lv->steadyTurnValueSpin()->mapTo(column->viewport(), QPoint(0, 0));
+    QVERIFY2(column->viewport()->rect().contains(QRect(at, lv->steadyTurnValueSpin()->size())), "the turn's field is in sight");
+    at = lv->steadySpeedSpin()->mapTo(column->viewport(), QPoint(0, 0));
+    QVERIFY2(column->viewport()->rect().contains(QRect(at, lv->steadySpeedSpin()->size())), "the speed's field is in sight");
+    const QImage shot = screenOf(&w);
+    QVERIFY2(stats(screenOfChild(&w, w.view3d())).foreground > 0.02, "the car is drawn");
+    save(shot, "linearize_sedan_turn.png");
+    w.view3d()->setShowFrames(true);
     w.document()->undoStack()->setClean();
   }
 

@@ -8,12 +8,18 @@
 // reader), and the monkey did reach edits, undo steps and every element kind.
 // Built and run under ASan + UBSan by scripts/sanitize.sh as well.
 //
-// It works on a copy of the cart-pendulum in a scratch folder with a scratch
-// HOME, and the window's file questions answer "no file", so nothing outside
+// It works on a copy of the cart-pendulum (or of the sedan with its .tir file) in a scratch folder
+// with a scratch HOME, and the window's file questions answer "no file", so nothing outside
 // that folder can be written or deleted.
 //
 // CODYNA_MONKEY_EVENTS (default 4000) sets the events per seed; the seeds are 1..5 (the even ones
-// build a model from File > New, the odd ones edit the cart-pendulum).
+// build a model from File > New, the odd ones edit the cart-pendulum) and 6..7 on
+// examples/sedan.json (issue 39: 25 bodies, closed loops, Magic Formula tires from a .tir file, a
+// steady motion as its operating point), half as many events each (every edit compiles the car);
+// the sedan is linearized when it is opened (and opened afresh from examples/ now and then), and
+// the Linearize, Simulate and Tire tabs come to the front now and then, Linearize pressed, so that
+// the steady operating point, its handling numbers, its tire forces and the tire curves are in
+// the monkey's reach.
 #include <QAbstractItemView>
 #include <QAction>
 #include <QAbstractSpinBox>
@@ -31,17 +37,21 @@
 #include <QPushButton>
 #include <QRandomGenerator>
 #include <QSet>
+#include <QTabWidget>
 #include <QTemporaryDir>
 #include <QTest>
 #include <QTimer>
 #include <QTreeView>
 #include <QUndoStack>
 #include <QWheelEvent>
+#include <algorithm>
 #include <nlohmann/json.hpp>
 
+#include "gui/linearize_view.hpp"
 #include "gui/main_window.hpp"
 #include "gui/property_editor.hpp"
 #include "gui/simulate_view.hpp"
+#include "gui/tire_view.hpp"
 #include "io/model_file.hpp"
 
 using namespace codyna;
@@ -50,6 +60,9 @@ using namespace codyna::gui;
 namespace {
 
 const QString kCart = QStringLiteral(CODYNA_EXAMPLES_DIR "/cart_pendulum.json");
+const QString kSedan = QStringLiteral(CODYNA_EXAMPLES_DIR "/sedan.json");
+constexpr quint32 kSedanSeeds[] = {6, 7};
+bool onSedan(quint32 seed) { return std::find(std::begin(kSedanSeeds), std::end(kSedanSeeds), seed) != std::end(kSedanSeeds); }
 
 const char* const kTexts[] = {"1",    "-2.5", "0",     "inf",    "nan",  "1e400", "abc",   "1, 2", "",
                               "0.1 0 0", "body", "ground", "rod", "cart", "3; 4", "{}",   "[1]",  "-1e-9",
@@ -96,10 +109,24 @@ class MonkeyTest : public QObject {
     QVERIFY(scratch_.isValid());
     const QString dir = scratch_.filePath(QStringLiteral("seed%1").arg(seed));
     QVERIFY(QDir().mkpath(dir));
-    const QString model = dir + "/cart_pendulum.json";
+    const bool sedan = onSedan(seed);
+    const QString model = dir + (sedan ? "/sedan.json" : "/cart_pendulum.json");
     QFile::remove(model);
-    QVERIFY(QFile::copy(kCart, model));
+    QVERIFY(QFile::copy(sedan ? kSedan : kCart, model));
     QFile::setPermissions(model, QFile::ReadOwner | QFile::WriteOwner);
+    // the sedan as it is in examples/ (the monkey may have saved over its copy)
+    const auto freshSedan = [&] {
+      QFile::remove(model);
+      return QFile::copy(kSedan, model) && QFile::setPermissions(model, QFile::ReadOwner | QFile::WriteOwner);
+    };
+    if (sedan) {
+      // its tires read tires/MagicFormula61_Paramerters.tir beside it
+      QVERIFY(QDir().mkpath(dir + "/tires"));
+      const QString tir = dir + "/tires/MagicFormula61_Paramerters.tir";
+      QFile::remove(tir);
+      QVERIFY(QFile::copy(QStringLiteral(CODYNA_EXAMPLES_DIR "/tires/MagicFormula61_Paramerters.tir"), tir));
+      QFile::setPermissions(tir, QFile::ReadOwner | QFile::WriteOwner);
+    }
     QDir::setCurrent(dir);
 
     QRandomGenerator rng(seed);
@@ -119,13 +146,24 @@ class MonkeyTest : public QObject {
     // even seeds build from File > New, as a newcomer does (the model does not compile for a while,
     // its Issues list grows and shrinks, the Add bar and the tree's context menu are in reach);
     // odd seeds work on the finished cart-pendulum
-    const bool from_empty = seed % 2 == 0;
+    const bool from_empty = !sedan && seed % 2 == 0;
     if (from_empty) QVERIFY(w->newModel());
     else QVERIFY(w->openFile(model));
     Closer closer;
 
-    int spec_changes = 0;
+    int spec_changes = 0, linearized = 0, tire_tab = 0;
     connect(w->document(), &Document::specChanged, w.get(), [&] { ++spec_changes; });
+    connect(w->linearizeView(), &LinearizeView::linearized, w.get(), [&] { ++linearized; });
+    // the sedan opened as in examples/ is linearized first, as a person would: the steady motion at
+    // 25 m/s, its handling numbers and its tire forces in the 3-D view, which the events then meet
+    const auto linearizeSedan = [&] {
+      w->analysisTabs()->setCurrentWidget(w->linearizeView());
+      QTest::mouseClick(w->linearizeView()->linearizeButton(), Qt::LeftButton);
+    };
+    if (sedan) {
+      linearizeSedan();
+      QCOMPARE(linearized, 1);
+    }
     QSet<QString> classes;
     QSet<int> kinds_edited;
     int max_undo = 0;
@@ -136,8 +174,21 @@ class MonkeyTest : public QObject {
       if (e % 500 == 250) {
         // a person opens the model again now and then (every kind of element comes back)
         w->document()->undoStack()->setClean();
+        if (sedan) QVERIFY(freshSedan());
         if (from_empty) QVERIFY(w->newModel());
         else QVERIFY(w->openFile(model));
+        if (sedan) linearizeSedan();
+      }
+      if (sedan && e % 40 == 20) {
+        // a person looks at another analysis now and then: Linearize (pressed: the steady motion,
+        // the handling numbers, the tires' forces in the 3-D view), Simulate or the tire's curves
+        QTabWidget* tabs = w->analysisTabs();
+        QWidget* pages[] = {w->linearizeView(), w->simulateView(), w->tireView()};
+        QWidget* page = pages[rng.bounded(3)];
+        tabs->setCurrentWidget(page);
+        if (page == w->tireView()) ++tire_tab;
+        if (page == w->linearizeView() && rng.bounded(2) == 0 && w->linearizeView()->linearizeButton()->isEnabled())
+          QTest::mouseClick(w->linearizeView()->linearizeButton(), Qt::LeftButton);
       }
       if (from_empty && e % 10 == 5) {
         // building: an element of any kind added now and then (the Add bar's and Edit > Add's
@@ -224,8 +275,11 @@ class MonkeyTest : public QObject {
       QFAIL(qPrintable(QString("the document's spec no longer reads back: %1").arg(ex.what())));
     }
     // the monkey did reach the editing paths
-    qInfo("seed %u: %d events, %d spec changes, undo stack up to %d, %lld widget classes, %lld element kinds selected",
-          seed, events, spec_changes, max_undo, qlonglong(classes.size()), qlonglong(kinds_edited.size()));
+    qInfo("seed %u (%s): %d events, %d spec changes, undo stack up to %d, %lld widget classes, %lld element kinds selected, "
+          "%d linearizations, the Tire tab shown %d times",
+          seed, sedan ? "sedan" : from_empty ? "from File > New" : "cart-pendulum", events, spec_changes, max_undo,
+          qlonglong(classes.size()), qlonglong(kinds_edited.size()), linearized, tire_tab);
+    if (sedan) QVERIFY(tire_tab > 0);
     QVERIFY(spec_changes > events / 100);
     QVERIFY(kinds_edited.size() >= 4);  // the property editor of most element kinds was open
     QVERIFY(classes.contains("QComboBox"));
@@ -252,13 +306,14 @@ class MonkeyTest : public QObject {
   void randomEvents_data() {
     QTest::addColumn<quint32>("seed");
     for (quint32 s = 1; s <= 5; ++s) QTest::newRow(qPrintable(QStringLiteral("seed %1").arg(s))) << s;
+    for (quint32 s : kSedanSeeds) QTest::newRow(qPrintable(QStringLiteral("seed %1 sedan").arg(s))) << s;
   }
   void randomEvents() {
     QFETCH(quint32, seed);
     bool ok = false;
     int events = qEnvironmentVariableIntValue("CODYNA_MONKEY_EVENTS", &ok);
     if (!ok || events <= 0) events = 4000;
-    runSeed(seed, events);
+    runSeed(seed, onSedan(seed) ? events / 2 : events);
   }
 };
 

@@ -3,6 +3,7 @@
 #include <QApplication>
 #include <QDir>
 #include <QLabel>
+#include <QSet>
 #include <QSignalSpy>
 #include <QtTest>
 #include <cmath>
@@ -12,6 +13,8 @@
 #include "dynamics/kinematics.hpp"
 #include "io/model_file.hpp"
 #include "dynamics/prepare.hpp"
+#include "study/files.hpp"
+#include "study/workflow.hpp"
 
 using codyna::gui::Camera;
 using codyna::gui::ItemKind;
@@ -670,6 +673,107 @@ class View3DTest : public QObject {
     QVERIFY(((Lb / sb) - R).cwiseAbs().maxCoeff() < 1e-12);
     EXPECT_NEAR3(tail(items[2].world), Eigen::Vector3d(0, 0, 1.2));
     EXPECT_NEAR3(tip(items[2].world), p);
+  }
+
+  // the sedan in its steady 0.4 g left turn (examples/sedan.json): one load arrow and one in-plane
+  // arrow per tire from its contact point. Against the car's balance, from the kinematics alone
+  // (the tires and gravity are its only external forces; every centre of mass turns at the yaw
+  // rate r on its circle, a_i = r ez x v_i): the arrows, read back as forces through the legend's
+  // scale, sum to m a - m g
+  void tireForcesOfTheSedanInATurn() {
+    const std::string path = QDir(CODYNA_EXAMPLES_DIR).filePath("sedan.json").toStdString();
+    codyna::ModelSpec spec = codyna::study_read_model(path);
+    spec.analysis.steady.lateral_acceleration = 0.4 * 9.80665;
+    auto m = std::make_shared<const codyna::Model>(codyna::study_model(spec, path));
+    const codyna::OperatingPoint op = codyna::study_operating_point(*m);
+    QVERIFY(op.motion.has_value());
+    const double r = op.motion->joints.at(0).yaw_rate;
+    QVERIFY(r > 0.1);
+
+    View3D view;
+    view.resize(640, 480);
+    view.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&view));
+    view.setModel(m);
+    view.setState(op.q, op.v);
+    QCOMPARE(view.velocities(), op.v);
+    const Scene& scene = view.scene();
+    const double scale = scene.tireForceScale();
+    // a round scale: 1, 2 or 5 times a power of ten metres per kN, a tire's share of the weight
+    // between 0.4 and 1 of a quarter of the car's size
+    const double per_kN = scale * 1000, decade = std::pow(10.0, std::floor(std::log10(per_kN) + 1e-9));
+    const double mantissa = per_kN / decade;
+    QVERIFY2(std::abs(mantissa - 1) < 1e-9 || std::abs(mantissa - 2) < 1e-9 || std::abs(mantissa - 5) < 1e-9,
+             qPrintable(QString::number(per_kN)));
+    double mass = 0;
+    for (int i = 1; i < m->nbodies; ++i) mass += m->mass[static_cast<size_t>(i)];
+    const double share_len = mass * m->gravity.norm() / 4 * scale;
+    QVERIFY2(share_len > 0.4 * 0.25 * scene.length() && share_len <= 0.25 * scene.length() * (1 + 1e-12),
+             qPrintable(QString("%1 m for a quarter of %2 m").arg(share_len).arg(scene.length())));
+    const QString legend = view.tireForceLegend();
+    QVERIFY2(legend.contains(QString("1 kN = %1 m").arg(per_kN, 0, 'g', 3)), qPrintable(legend));
+    QVERIFY(view.findChild<QLabel*>("view3dTireLegend")->isVisible());
+
+    int loads = 0, in_plane = 0;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    QSet<QString> tires;
+    for (const auto& it : scene.items()) {
+      if (it.kind != ItemKind::TireLoad && it.kind != ItemKind::TireInPlane) continue;
+      QCOMPARE(it.prim, Prim::Arrow);
+      const Eigen::Vector3d a = tail(it.world), b = tip(it.world), F = (b - a) / scale;
+      // from the contact point, on the road (z = 0)
+      QVERIFY2(std::abs(a.z()) < 1e-12, qPrintable(str(a)));
+      sum += F;
+      tires.insert(QString::fromStdString(it.element));
+      if (it.kind == ItemKind::TireLoad) {
+        ++loads;
+        // straight up, a tire's share of the weight within a factor 2 (the outer ones carry more)
+        QVERIFY2(F.head<2>().norm() < 1e-12 * F.z(), qPrintable(str(F)));
+        QVERIFY(F.z() > 0.4 * mass * m->gravity.norm() / 4 && F.z() < 1.8 * mass * m->gravity.norm() / 4);
+      } else {
+        ++in_plane;
+        QVERIFY2(std::abs(F.z()) < 1e-9 * F.norm(), qPrintable(str(F)));  // in the road plane
+      }
+    }
+    QCOMPARE(loads, 4);
+    QCOMPARE(in_plane, 4);
+    QCOMPARE(tires, (QSet<QString>{"tire_fl", "tire_fr", "tire_rl", "tire_rr"}));
+    // the balance
+    codyna::Data d(*m);
+    codyna::forward_kinematics(*m, d, op.q, op.v);
+    Eigen::Vector3d ma = Eigen::Vector3d::Zero(), W = Eigen::Vector3d::Zero();
+    for (int i = 1; i < m->nbodies; ++i) {
+      const double mi = m->mass[static_cast<size_t>(i)];
+      ma += mi * r * Eigen::Vector3d::UnitZ().cross(codyna::point_velocity<double>(d, i, m->com[static_cast<size_t>(i)]));
+      W += mi * m->gravity;
+    }
+    QVERIFY2((sum + W - ma).norm() < 1e-6 * W.norm(), qPrintable(str(sum) + " vs " + str(Eigen::Vector3d(ma - W))));
+    // the lateral force pulls to the centre of the turn, 0.4 g of the car's mass
+    QVERIFY(std::abs(sum.head<2>().norm() - 0.4 * W.norm()) < 0.02 * W.norm());
+
+    // hidden and shown again; the arrows and the legend with them
+    view.setShowTireForces(false);
+    QVERIFY(itemsOf(scene, ItemKind::TireLoad, "tire_fl").empty());
+    QVERIFY(view.tireContacts().empty());
+    QVERIFY(view.tireForceLegend().isEmpty());
+    view.setShowTireForces(true);
+    QCOMPARE(itemsOf(scene, ItemKind::TireLoad, "tire_fl").size(), size_t(1));
+    // the car a metre up: no contact, no arrow, no legend
+    Eigen::VectorXd up = op.q;
+    up[m->joints[static_cast<size_t>(m->find_body("chassis"))].idx_q + 2] += 1.0;
+    view.setConfiguration(up);
+    QCOMPARE(view.tireContacts().size(), size_t(4));
+    for (const auto& c : view.tireContacts()) QVERIFY(!c.in_contact);
+    QVERIFY(itemsOf(scene, ItemKind::TireLoad, "tire_fl").empty());
+    QVERIFY(view.tireForceLegend().isEmpty());
+    // a state of the wrong size changes nothing
+    view.setState(op.q, Eigen::VectorXd::Zero(m->nv + 1));
+    QCOMPARE(view.configuration(), up);
+    // a model without tires has no arrows and no legend
+    view.setModel(loadExample("cart_pendulum.json"));
+    QVERIFY(view.tireContacts().empty());
+    QCOMPARE(scene.tireForceScale(), 0.0);
+    QVERIFY(view.tireForceLegend().isEmpty());
   }
 
   // an edited model (same file and name) keeps the camera; another model is framed anew

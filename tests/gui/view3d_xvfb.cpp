@@ -15,6 +15,8 @@
 #include "gui/view3d.hpp"
 #include "io/model_file.hpp"
 #include "dynamics/prepare.hpp"
+#include "study/files.hpp"
+#include "study/workflow.hpp"
 
 using codyna::gui::View3D;
 
@@ -130,8 +132,9 @@ class View3DXvfb : public QObject {
     QVERIFY2(colors >= 8, qPrintable(QString("%1 colours").arg(colors)));
 
     // where picking finds a body, GL drew something, and the highlight changes it
-    // (frames off: a triad may lie over the body's centre)
+    // (frames and tire forces off: a triad or a tire's load arrow may lie over the body's centre)
     view.setShowFrames(false);
+    view.setShowTireForces(false);
     const QImage plain = grabOf(view);
     for (int i = 1; i < m->nbodies; ++i) {
       const QString body = QString::fromStdString(m->body_names[static_cast<size_t>(i)]);
@@ -147,6 +150,7 @@ class View3DXvfb : public QObject {
       view.setHighlight("");
     }
     view.setShowFrames(true);
+    view.setShowTireForces(true);
 
     // the largest body's highlight is plainly visible and orange-ish
     QString biggest;
@@ -236,6 +240,66 @@ class View3DXvfb : public QObject {
     QCOMPARE(spy.count(), 2);
     QCOMPARE(spy.at(0).at(0).toString(), QStringLiteral("rod"));
     QCOMPARE(spy.at(1).at(0).toString(), QString());
+  }
+
+  // the sedan in its steady 0.4 g left turn with its tires' contact forces (the picture in
+  // docs/vehicles.md): blue load arrows and teal in-plane arrows where the tires touch the road,
+  // gone with View > Show tire forces off; the legend over the picture
+  void sedanTireForces() {
+    const std::string path = QDir(CODYNA_EXAMPLES_DIR).filePath("sedan.json").toStdString();
+    codyna::ModelSpec spec = codyna::study_read_model(path);
+    spec.analysis.steady.lateral_acceleration = 0.4 * 9.80665;
+    auto m = std::make_shared<const codyna::Model>(codyna::study_model(spec, path));
+    const codyna::OperatingPoint op = codyna::study_operating_point(*m);
+    View3D view;
+    view.setWindowTitle("sedan");
+    view.resize(1000, 640);
+    view.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&view));
+    view.setModel(m);
+    view.setState(op.q, op.v);
+    view.setShowFrames(false);  // the car and its forces, not its 25 body frames
+    // seen from behind (a drag of 209 px turns the default yaw, 0.45 rad, to -pi/2 + 0.35), a little
+    // lower than the default: the loads up, the lateral forces to the left, into the turn
+    QTest::mousePress(&view, Qt::LeftButton, {}, QPoint(400, 300));
+    QTest::mouseMove(&view, QPoint(500, 300));
+    QTest::mouseMove(&view, QPoint(609, 288));
+    QTest::mouseRelease(&view, Qt::LeftButton, {}, QPoint(609, 288));
+    QVERIFY(std::abs(view.camera().yaw - (-M_PI / 2 + 0.35)) < 0.01);
+    view.fitView();
+    QApplication::processEvents();
+    const QImage with = grabOf(view);
+    QVERIFY(with.save(QDir(CODYNA_SCREENSHOT_DIR).filePath("view3d_sedan_tire_forces.png")));
+    view.setShowTireForces(false);
+    QApplication::processEvents();
+    const QImage without = grabOf(view);
+    // shaded blue (the loads: blue over green over red) and teal (green and blue over red)
+    const auto count = [](const QImage& img, bool blue) {
+      int n = 0;
+      for (int y = 0; y < img.height(); ++y)
+        for (int x = 0; x < img.width(); ++x) {
+          const QRgb c = img.pixel(x, y);
+          const int r = qRed(c), g = qGreen(c), b = qBlue(c);
+          n += blue ? (b > g + 50 && g > r + 25) : (g > r + 60 && b > r + 50 && std::abs(g - b) < 40);
+        }
+      return n;
+    };
+    const int blue = count(with, true), teal = count(with, false);
+    qInfo("sedan in a 0.4 g turn: %d blue and %d teal pixels with the tire forces, %d and %d without", blue, teal,
+          count(without, true), count(without, false));
+    QVERIFY2(blue > 2000, qPrintable(QString::number(blue)));
+    QVERIFY2(teal > 600, qPrintable(QString::number(teal)));
+    QVERIFY(count(without, true) < blue / 50);
+    QVERIFY(count(without, false) < teal / 50);
+    // the legend is in the picture (bottom left): dark text on its light box
+    const QString legend = view.tireForceLegend();
+    QVERIFY(legend.isEmpty());  // hidden with the forces
+    view.setShowTireForces(true);
+    QVERIFY(view.tireForceLegend().contains("1 kN = "));
+    int dark = 0;
+    for (int y = with.height() - 60; y < with.height(); ++y)
+      for (int x = 0; x < 300; ++x) dark += qGray(with.pixel(x, y)) < 90;
+    QVERIFY2(dark > 200, qPrintable(QString::number(dark)));
   }
 
   // docking moves the view to another window and so to another GL context

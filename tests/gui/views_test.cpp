@@ -28,6 +28,8 @@
 #include <QTableView>
 #include <QTableWidget>
 #include <QTemporaryDir>
+#include <QPlainTextEdit>
+#include <QTabWidget>
 #include <QTest>
 #include <QThread>
 #include <QUndoStack>
@@ -216,6 +218,52 @@ class ViewsTest : public QObject {
     const StudyLinearization direct = study_linearize(*doc.model());
     QCOMPARE(view.result()->handling->understeer_gradient, direct.handling->understeer_gradient);
     QCOMPARE(view.result()->op.u, direct.op.u);
+    // every handling number in the Handling tab, as codyna linearize prints them; the tab goes with
+    // a result that has none
+    QTabWidget* tabs = view.resultTabs();
+    const int handling = tabs->indexOf(view.handlingText());
+    QVERIFY(tabs->isTabVisible(handling));
+    QCOMPARE(view.handlingText()->toPlainText(), QString::fromStdString(study_handling_text(*direct.handling)));
+    QVERIFY(view.handlingText()->toPlainText().contains("characteristic speed"));
+    QVERIFY(doc.load(QStringLiteral(CODYNA_EXAMPLES_DIR "/cart_pendulum.json")));
+    QVERIFY(!tabs->isTabVisible(handling));
+    QVERIFY(view.handlingText()->toPlainText().isEmpty());
+    QVERIFY(view.linearize());
+    QVERIFY(!view.result()->handling.has_value());
+    QVERIFY(!tabs->isTabVisible(handling));
+  }
+
+  // the steady motion's fields keep what the study says to the last digit: a lateral acceleration
+  // of 3.92266 m/s^2 (0.4 g) and a yaw rate of 0.00012345 rad/s are shown and written back as they
+  // are when another field of the steady motion changes (four decimals made them 3.9227 and 0.0001)
+  void steadyFieldsKeepEveryDigit() {
+    Document doc;
+    QVERIFY(doc.load(QStringLiteral(CODYNA_EXAMPLES_DIR "/single_track_car.json")));
+    StudySpec study = doc.spec().analysis;
+    study.steady.lateral_acceleration = 3.92266;
+    QVERIFY(doc.setStudy(study));
+    LinearizeView view(&doc);
+    view.show();
+    QCOMPARE(view.steadyTurnValueSpin()->value(), 3.92266);
+    QCOMPARE(view.steadyTurnValueSpin()->text(), QString("3.92266"));
+    view.steadySpeedSpin()->setValue(31.25);
+    QCOMPARE(doc.spec().analysis.steady.speed.value_or(0), 31.25);
+    QCOMPARE(view.steadySpeedSpin()->text(), QString("31.25 m/s"));
+    QCOMPARE(doc.spec().analysis.steady.lateral_acceleration.value_or(0), 3.92266);
+    study = doc.spec().analysis;
+    study.steady.lateral_acceleration.reset();
+    study.steady.yaw_rate = 0.00012345;
+    QVERIFY(doc.setStudy(study));
+    QCOMPARE(view.steadyTurnValueSpin()->text(), QString("0.00012345"));
+    view.steadySpeedSpin()->setValue(30);
+    QCOMPARE(doc.spec().analysis.steady.yaw_rate.value_or(0), 0.00012345);
+    // typed, as a person does
+    QDoubleSpinBox* value = view.steadyTurnValueSpin();
+    value->setFocus();
+    value->selectAll();
+    QTest::keyClicks(value, "0.000123456");
+    QTest::keyClick(value, Qt::Key_Return);
+    QCOMPARE(doc.spec().analysis.steady.yaw_rate.value_or(0), 0.000123456);
   }
 
   void controllabilityAsTheCommandLineSaysIt() {
