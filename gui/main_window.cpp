@@ -944,7 +944,10 @@ void MainWindow::setPlaybackTime(double t) {
   const auto model = doc_->model();
   if (model && result_->q.cols() == model->nq) {
     if (result_->v.cols() == model->nv && result_->v.rows() == result_->q.rows())
-      view_->setState(result_->q.row(k).transpose(), result_->v.row(k).transpose());
+      view_->setState(result_->q.row(k).transpose(), result_->v.row(k).transpose(),
+                      result_->s.cols() == model->ns && result_->s.rows() == result_->q.rows()
+                          ? Eigen::VectorXd(result_->s.row(k).transpose())
+                          : Eigen::VectorXd());
     else
       view_->setConfiguration(result_->q.row(k).transpose());
   }

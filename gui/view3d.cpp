@@ -472,6 +472,7 @@ void View3D::setModel(std::shared_ptr<const codyna::Model> model) {
   model_ = std::move(model);
   poses_ = model_ ? std::make_unique<codyna::StudyPoses>(*model_) : nullptr;
   q_ = model_ ? model_->q0 : Eigen::VectorXd();
+  s_.resize(0);
   v_ = model_ ? model_->v0 : Eigen::VectorXd();
   scene_.build(model_.get());
   if (model_ && q_.size() == model_->nq) {
@@ -492,6 +493,11 @@ void View3D::setModel(std::shared_ptr<const codyna::Model> model) {
 }
 
 void View3D::setConfiguration(const Eigen::VectorXd& q) {
+  s_.resize(0);  // a pose alone: the deflections at rest there
+  applyConfiguration(q);
+}
+
+void View3D::applyConfiguration(const Eigen::VectorXd& q) {
   if (!model_ || q.size() != model_->nq) return;
   q_ = q;
   if (v_.size() != model_->nv) v_ = Eigen::VectorXd::Zero(model_->nv);
@@ -500,10 +506,11 @@ void View3D::setConfiguration(const Eigen::VectorXd& q) {
   requestPaint();
 }
 
-void View3D::setState(const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
+void View3D::setState(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& s) {
   if (!model_ || q.size() != model_->nq || v.size() != model_->nv) return;
   v_ = v;
-  setConfiguration(q);
+  s_ = s.size() == model_->ns ? s : Eigen::VectorXd();
+  applyConfiguration(q);
 }
 
 void View3D::setShowTireForces(bool on) {
@@ -521,7 +528,7 @@ void View3D::updateTireForces() {
   contacts_.clear();
   if (model_ && show_tire_forces_ && !model_->tires.empty() && q_.size() == model_->nq && v_.size() == model_->nv) {
     try {
-      contacts_ = codyna::study_tire_contacts(*model_, q_, v_);
+      contacts_ = codyna::study_tire_contacts(*model_, q_, v_, s_.size() == model_->ns ? s_ : Eigen::VectorXd());
     } catch (const std::exception&) {
       contacts_.clear();  // a state the model cannot hold: nothing to draw
     }

@@ -68,7 +68,8 @@ class View3D : public QWidget {
   void setConfiguration(const Eigen::VectorXd& q);
   // the state (nq and nv values): the mechanism at q and the tires' contact forces at (q, v).
   // Wrong sizes are ignored.
-  void setState(const Eigen::VectorXd& q, const Eigen::VectorXd& v);
+  // s: the effect states (a tire's deflections) of a simulation's sample; empty: at rest at (q, v)
+  void setState(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& s = {});
   const Eigen::VectorXd& configuration() const { return q_; }
   const Eigen::VectorXd& velocities() const { return v_; }
   // the tires' contacts drawn now (empty: a model without tires, or the tire forces hidden)
@@ -124,11 +125,12 @@ class View3D : public QWidget {
   void syncViewport();
   void updateSceneRadius();
   void requestPaint();
+  void applyConfiguration(const Eigen::VectorXd& q);  // q_, the scene's poses, the tire forces
   void updateTireForces();  // contacts_ and the scene's arrows at (q_, v_), the legend
 
   std::shared_ptr<const codyna::Model> model_;
   std::unique_ptr<codyna::StudyPoses> poses_;  // the body poses at q_
-  Eigen::VectorXd q_, v_;
+  Eigen::VectorXd q_, v_, s_;
   std::vector<codyna::TireContactReport> contacts_;
   Scene scene_;
   Camera camera_;

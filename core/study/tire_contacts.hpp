@@ -31,9 +31,11 @@ struct TireContactReport {
   double penetration = 0;                           // tire deflection, m
 };
 
-// One report per tire of the model (Model::tires' order). q, v: nq and nv values; other sizes
-// throw std::invalid_argument.
+// One report per tire of the model (Model::tires' order). q, v: nq and nv values; s: the effect
+// states (Model::ns: the tires' deflections of their transient slip; a simulation's sample), or
+// empty for those at rest at (q, v), as an operating point has them; other sizes throw
+// std::invalid_argument.
 std::vector<TireContactReport> study_tire_contacts(const Model& model, const Eigen::VectorXd& q,
-                                                  const Eigen::VectorXd& v);
+                                                  const Eigen::VectorXd& v, const Eigen::VectorXd& s = {});
 
 }  // namespace codyna

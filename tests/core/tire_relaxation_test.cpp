@@ -30,6 +30,7 @@
 #include "model/errors.hpp"
 #include "simulation/simulator.hpp"
 #include "study/files.hpp"
+#include "study/tire_contacts.hpp"
 #include "study/workflow.hpp"
 #include "test_util.hpp"
 #include "vehicle/magic_formula_relaxation.hpp"
@@ -452,4 +453,26 @@ TEST(TireRelaxation, TheTirFilesLengthsAreTheFormulasWithTheFilesNumbers) {
   std::printf("[ TireRelaxation ] .tir lengths: book file 0.16 / 0.48 m at 4000 N; MF 5.2 the PTX/PTY formulas; MF 6.1 "
               "MFeval's Kxk, Kya over the carcass stiffnesses at %d loads and cambers: %.2e relative\n",
               checked, worst);
+}
+
+// What the 3-D view draws (study_tire_contacts): the force the deflections carry, at rest by
+// default; a sample's deflections move it (none: no side force), as the simulation applies it
+TEST(TireRelaxation, TheContactsShownCarryTheDeflections) {
+  const Model mod = study_model(single_track_with_lag(0.6));
+  Eigen::VectorXd v0 = mod.v0;
+  v0[mod.joints[static_cast<std::size_t>(mod.find_joint("body"))].idx_v + 1] = 0.3;  // sideslip
+  const std::vector<TireContactReport> rest = study_tire_contacts(mod, mod.q0, v0);
+  Data d(mod);
+  const Eigen::VectorXd s = effect_states_steady(mod, d, mod.q0, v0);
+  const std::vector<TireContactReport> given = study_tire_contacts(mod, mod.q0, v0, s);
+  const std::vector<TireContactReport> none = study_tire_contacts(mod, mod.q0, v0, Eigen::VectorXd::Zero(mod.ns));
+  ASSERT_EQ(rest.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    // at rest: the steady tire's force, -C alpha with tan(alpha) = 0.3 / 30
+    EXPECT_NEAR(rest[k].Fy, -160000 * std::atan(0.3 / 30), 1e-9 * 1600) << k;
+    EXPECT_EQ(given[k].Fy, rest[k].Fy) << k;
+    EXPECT_EQ(none[k].Fy, 0.0) << k;
+    EXPECT_EQ(none[k].alpha, 0.0) << k;
+  }
+  EXPECT_THROW(study_tire_contacts(mod, mod.q0, v0, Eigen::VectorXd::Zero(3)), std::invalid_argument);
 }
