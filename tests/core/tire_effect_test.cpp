@@ -24,7 +24,9 @@
 #include "dynamics/kinematics.hpp"
 #include "dynamics/tire_effect.hpp"
 #include "model/errors.hpp"
+#include "simulation/simulator.hpp"
 #include "study/files.hpp"
+#include "study/tire_contacts.hpp"
 #include "study/workflow.hpp"
 #include "jacobian_check.hpp"
 #include "test_util.hpp"
@@ -379,6 +381,68 @@ TEST(TireEffect, TheExactJacobianOfACarWithTiresEqualsCentralDifferencesAndAutod
     std::printf("[ TireEffect ] car %s: |exact - central| / max|J| = %.2e (worst column, own scale: %.2e), max|J| = %.3g\n",
                 k.label, worst, worst_column, scale);
   }
+}
+
+// A car on the road with its dampers and its tires' slip forces off (no slip stiffness, no
+// vertical damping) keeps its energy: the chassis on a free joint heaves and pitches on the four
+// tires' vertical springs at 20 m/s, the wheels spinning; the energy is the kinetic and
+// gravitational one plus the tires' k pen^2 / 2 (pen from study_tire_contacts). Upright wheels (no
+// roll: the motion stays in the car's plane of symmetry) make the contact force along the road's
+// normal the gradient of that potential (a cambered wheel's is not: docs/tires.md).
+TEST(TireEffect, ACarOnTheRoadKeepsItsEnergyWithItsDampersAndSlipsOff) {
+  const double k = 250000, U = 20, R0 = 0.3;
+  char text[6000];
+  std::snprintf(text, sizeof text, R"({"name": "car",
+    "bodies": [{"name": "chassis", "mass": 1200, "inertia": [400, 1500, 1700]},
+               {"name": "fl", "mass": 15, "inertia": [0.4, 0.8, 0.4]}, {"name": "fr", "mass": 15, "inertia": [0.4, 0.8, 0.4]},
+               {"name": "rl", "mass": 15, "inertia": [0.4, 0.8, 0.4]}, {"name": "rr", "mass": 15, "inertia": [0.4, 0.8, 0.4]}],
+    "joints": [{"name": "body", "type": "free", "parent": "ground", "child": "chassis",
+                "q0": [0, 0, 0.29, 1, 0, 0, 0], "v0": [0, 0.2, 0, %.17g, 0, 0.1]},
+               {"name": "spin_fl", "type": "revolute", "parent": "chassis", "child": "fl", "axis": [0, 1, 0],
+                "parent_frame": {"position": [1.2, 0.8, 0]}, "v0": %.17g},
+               {"name": "spin_fr", "type": "revolute", "parent": "chassis", "child": "fr", "axis": [0, 1, 0],
+                "parent_frame": {"position": [1.2, -0.8, 0]}, "v0": %.17g},
+               {"name": "spin_rl", "type": "revolute", "parent": "chassis", "child": "rl", "axis": [0, 1, 0],
+                "parent_frame": {"position": [-1.5, 0.8, 0]}, "v0": %.17g},
+               {"name": "spin_rr", "type": "revolute", "parent": "chassis", "child": "rr", "axis": [0, 1, 0],
+                "parent_frame": {"position": [-1.5, -0.8, 0]}, "v0": %.17g}],
+    "effects": [{"name": "gravity", "type": "gravity", "g": [0, 0, -9.81]},
+      {"name": "tire_fl", "type": "tire", "body": "fl", "unloaded_radius": 0.3, "law": "linear", "vertical_stiffness": %.17g},
+      {"name": "tire_fr", "type": "tire", "body": "fr", "unloaded_radius": 0.3, "law": "linear", "vertical_stiffness": %.17g},
+      {"name": "tire_rl", "type": "tire", "body": "rl", "unloaded_radius": 0.3, "law": "linear", "vertical_stiffness": %.17g},
+      {"name": "tire_rr", "type": "tire", "body": "rr", "unloaded_radius": 0.3, "law": "linear", "vertical_stiffness": %.17g}],
+    "analysis": {"operating_point": "initial"}})",
+                U, U / R0, U / R0, U / R0, U / R0, k, k, k, k);
+  const Model mod = study_model(study_parse_model_text(text, "car.json"));
+  SimulationOptions so;
+  so.t_end = 3.0;
+  so.output_step = 0.01;
+  so.integrator.method = "cvode-bdf";
+  so.integrator.rtol = 1e-11;
+  so.integrator.atol = 1e-12;
+  const SimulationResult r = simulate(mod, nullptr, nullptr, so);
+  ASSERT_TRUE(r.completed) << r.failure;
+  double E0 = 0, drift = 0, tire_low = 1e300, tire_high = 0;
+  for (int i = 0; i < r.samples(); ++i) {
+    double tire = 0;
+    for (const TireContactReport& c : study_tire_contacts(mod, r.q.row(i).transpose(), r.v.row(i).transpose())) {
+      if (c.in_contact) tire += 0.5 * k * c.penetration * c.penetration;
+      EXPECT_EQ(c.Fx, 0.0);  // no slip force
+      EXPECT_EQ(c.Fy, 0.0);
+      EXPECT_LT(std::abs(c.gamma), 1e-12);  // upright
+    }
+    const double E = r.kinetic_energy[static_cast<std::size_t>(i)] + r.potential_energy[static_cast<std::size_t>(i)] + tire;
+    if (i == 0) E0 = E;
+    drift = std::max(drift, std::abs(E - E0));
+    tire_low = std::min(tire_low, tire);
+    tire_high = std::max(tire_high, tire);
+  }
+  // the tires' energy swings (the car heaves and pitches on them) while the total stays
+  EXPECT_GT(tire_high - tire_low, 10.0);
+  EXPECT_LT(drift, 1e-6 * (tire_high - tire_low));
+  std::printf("[ TireEffect ] car with dampers and slips off, 3 s at 20 m/s: the tires' energy swings %.4g J, the total "
+              "drifts %.2e J\n",
+              tire_high - tire_low, drift);
 }
 
 // a Magic Formula tire on the ground and a Fiala tire on a road carried by a moving platform (a
