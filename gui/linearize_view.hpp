@@ -13,8 +13,8 @@
 // refuses what the core refuses, with its message; one undo step; spin boxes merge while they are
 // stepped), and the widgets follow the Document (undo, redo, load).
 //
-// "Linearize" calls study_linearize() on the document's model, as
-// `codyna linearize` does, and shows the operating point, A, B, C, D with their
+// "Linearize" runs study_linearize_job() on the document's model, the job
+// `codyna linearize` runs, and shows the operating point, A, B, C, D with their
 // names, the offsets x0, u0, y0, xdot0, the modes (ModeTableModel) and the
 // pole map. A mode selected in the table or on the pole map (kept in sync)
 // is announced by modeSelected() for the 3-D view. "Export…" (and exportTo())

@@ -1,6 +1,6 @@
-// SimWorker: runs one study simulation (study/workflow.hpp: study_simulation,
-// then study_simulate, the same calls as `codyna simulate`) on its own QThread,
-// so the GUI thread never waits for the integrator.
+// SimWorker: runs one simulate job (study/jobs.hpp: study_simulate_job, the job `codyna simulate`
+// and Python run, whose report the window shows) on its own QThread, so the GUI thread never
+// waits for the integrator.
 //
 // Threading contract
 //   - start(), cancel(), isRunning() and every signal belong to the thread that
@@ -11,8 +11,8 @@
 //   - Samples are batched: at most one samples() + progress() emission every
 //     batchIntervalMs() (50 ms), never one queued call per integrator sample.
 //     The last batch always arrives before finished().
-//   - cancel() is cooperative (an atomic flag the integrator loop polls between
-//     output times); the partial result comes with finished() (cancelled = true).
+//   - cancel() is cooperative (an atomic flag the simulator hands the integrators: they stop
+//     inside their step); the partial result comes with finished() (cancelled = true).
 //   - A setup that throws (unknown controller file, no equilibrium for the LQR,
 //     wrong weights, ...) or a run that throws is reported by failed(text); then
 //     finished() is not emitted. isRunning() is false before either signal.
