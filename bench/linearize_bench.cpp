@@ -221,11 +221,8 @@ BENCHMARK(SedanDynamics)->ArgName("tires")->Arg(1)->Arg(0)->Unit(benchmark::kMic
 
 void SedanSimulate1s(benchmark::State& state) {
   const SedanBench& b = sedan_bench();
-  Model run = b.with;
-  for (std::size_t k = 0; k < run.actuators.size(); ++k) run.actuators[k].u0 = b.op.u[static_cast<Eigen::Index>(k)];
   SimulationOptions so;
-  so.q0 = b.op.q;
-  so.v0 = b.op.v;
+  const Model run = held_at(b.with, b.op, so);
   so.t_end = 1.0;
   so.output_step = 0.01;
   long steps = 0;

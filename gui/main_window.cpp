@@ -945,7 +945,7 @@ void MainWindow::setPlaybackTime(double t) {
   if (model && result_->q.cols() == model->nq) {
     if (result_->v.cols() == model->nv && result_->v.rows() == result_->q.rows())
       view_->setState(result_->q.row(k).transpose(), result_->v.row(k).transpose(),
-                      result_->s.cols() == model->ns && result_->s.rows() == result_->q.rows()
+                      model->ns > 0 && result_->s.cols() == model->ns && result_->s.rows() == result_->q.rows()
                           ? Eigen::VectorXd(result_->s.row(k).transpose())
                           : Eigen::VectorXd());
     else

@@ -131,6 +131,21 @@ void main() {
 
 Eigen::Matrix4f toGL(const Eigen::Matrix4d& m) { return m.cast<float>(); }
 
+// a note drawn over the 3-D view (the draft's, the tire forces' legend): its own colours, clicks
+// pass through it to the view
+QLabel* overlay_label(QWidget* parent, const QString& name, const QColor& window, const QColor& text) {
+  auto* label = new QLabel(parent);
+  label->setObjectName(name);
+  label->setAutoFillBackground(true);
+  label->setMargin(4);
+  label->setAttribute(Qt::WA_TransparentForMouseEvents);
+  QPalette pal = label->palette();
+  pal.setColor(QPalette::Window, window);
+  pal.setColor(QPalette::WindowText, text);
+  label->setPalette(pal);
+  return label;
+}
+
 }  // namespace
 
 // ---- the OpenGL canvas (only made when openGLAvailable()) ----
@@ -444,16 +459,8 @@ void View3D::setDraft(std::shared_ptr<const codyna::Model> draft, const QString&
     if (canvas_) canvas_->gridChanged();
   }
   if (!draft_note_) {
-    draft_note_ = new QLabel(this);
-    draft_note_->setObjectName(QStringLiteral("view3dDraftNote"));
+    draft_note_ = overlay_label(this, QStringLiteral("view3dDraftNote"), QColor(255, 244, 214), QColor(90, 60, 0));
     draft_note_->setWordWrap(true);
-    draft_note_->setAutoFillBackground(true);
-    draft_note_->setMargin(4);
-    draft_note_->setAttribute(Qt::WA_TransparentForMouseEvents);
-    QPalette pal = draft_note_->palette();
-    pal.setColor(QPalette::Window, QColor(255, 244, 214));
-    pal.setColor(QPalette::WindowText, QColor(90, 60, 0));
-    draft_note_->setPalette(pal);
   }
   draft_note_->setText(note);
   draft_note_->setMaximumWidth(std::max(160, width() - 16));
@@ -542,16 +549,8 @@ void View3D::updateTireForces() {
     return;
   }
   if (!tire_legend_) {
-    tire_legend_ = new QLabel(this);
-    tire_legend_->setObjectName(QStringLiteral("view3dTireLegend"));
+    tire_legend_ = overlay_label(this, QStringLiteral("view3dTireLegend"), QColor(250, 250, 252), QColor(40, 44, 52));
     tire_legend_->setTextFormat(Qt::RichText);
-    tire_legend_->setAutoFillBackground(true);
-    tire_legend_->setMargin(4);
-    tire_legend_->setAttribute(Qt::WA_TransparentForMouseEvents);
-    QPalette pal = tire_legend_->palette();
-    pal.setColor(QPalette::Window, QColor(250, 250, 252));
-    pal.setColor(QPalette::WindowText, QColor(40, 44, 52));
-    tire_legend_->setPalette(pal);
   }
   const QString s = QString::fromStdString(scale);
   tire_legend_->setProperty("plainText",

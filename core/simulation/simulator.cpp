@@ -158,6 +158,17 @@ std::vector<Eigen::VectorXd> linear_run(const Model& model, const Controller* ct
 
 }  // namespace
 
+Model held_at(const Model& model, const OperatingPoint& op, SimulationOptions& options) {
+  if (op.q.size() != model.nq || op.v.size() != model.nv || op.u.size() != model.nu())
+    throw std::invalid_argument("held_at: the operating point does not belong to the model");
+  Model run = model;
+  for (std::size_t k = 0; k < run.actuators.size(); ++k) run.actuators[k].u0 = op.u[static_cast<Eigen::Index>(k)];
+  options.q0 = op.q;
+  options.v0 = op.v;
+  options.s0 = op.s;
+  return run;
+}
+
 SimulationResult simulate(const Model& model, const Controller* controller, const LinearPlant* plant,
                           const SimulationOptions& o, const SimulationCallbacks& cb) {
   if (!std::isfinite(o.t0) || !std::isfinite(o.t_end) || !(o.t_end > o.t0))

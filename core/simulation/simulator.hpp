@@ -74,6 +74,11 @@ struct LinearPlant {
 SimulationResult simulate(const Model& model, const Controller* controller, const LinearPlant* plant,
                           const SimulationOptions& options, const SimulationCallbacks& callbacks = {});
 
+// A run that starts at an operating point with every actuator held at its value there (a steady
+// motion's steer and drive, which the search solved): the model with those nominal inputs, and
+// options' initial state set to the point's (its effect states at rest there, as always).
+Model held_at(const Model& model, const OperatingPoint& op, SimulationOptions& options);
+
 // Actuators that sat at a limit during a run: how long (summed over the output samples
 // at the limit, each counting one output interval) and from when. Empty when none did.
 struct Saturation {

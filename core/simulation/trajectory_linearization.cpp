@@ -15,7 +15,8 @@ std::vector<Linearization> linearize_along(const Model& model, const SimulationR
   for (int k = 0; k < r.samples(); k += stride) {
     OperatingPoint op = snapshot_point(model, r.t[k], r.q.row(k).transpose(), r.v.row(k).transpose(),
                                        r.u.row(k).transpose());
-    if (r.s.cols() == model.ns && r.s.rows() == r.samples()) op.s = r.s.row(k).transpose();  // the run's effect states
+    // the run's effect states (a matrix without columns has no rows to take: none then)
+    if (model.ns > 0 && r.s.cols() == model.ns && r.s.rows() == r.samples()) op.s = r.s.row(k).transpose();
     try {
       out.push_back(linearizer.linearize(op, options));
     } catch (const std::invalid_argument& e) {

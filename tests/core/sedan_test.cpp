@@ -117,11 +117,8 @@ TEST(Sedan, ASteadyTurnIsTheSameMotionAllAlongAndASimulationStaysOnIt) {
 
   // a run started on the turn (its state, the steer and drive it holds) stays on it: the chassis'
   // yaw rate, speed and roll stay, its path is the circle
-  Model run = mod;
-  for (std::size_t k = 0; k < run.actuators.size(); ++k) run.actuators[k].u0 = sl.op.u[static_cast<Eigen::Index>(k)];
   SimulationOptions so;
-  so.q0 = sl.op.q;
-  so.v0 = sl.op.v;
+  const Model run = held_at(mod, sl.op, so);
   so.t_end = 2.0;
   so.output_step = 0.1;
   so.integrator.rtol = 1e-9;

@@ -213,12 +213,8 @@ TEST(TireRelaxation, ARunStartedOnASteadyTurnStaysOnItWithTheDeflectionsSteady) 
   // the deflections at the turn: steady and not zero (the tires carry the turn's side forces)
   const Eigen::VectorXd s_turn = sl.lin.system.x0.tail(2);
   EXPECT_GT(s_turn.cwiseAbs().minCoeff(), 1e-4);
-  // the same deflections a steady-tire linearization's slip angles give: u = sigma tan(alpha)
-  Model run = mod;
-  for (std::size_t k = 0; k < run.actuators.size(); ++k) run.actuators[k].u0 = sl.op.u[static_cast<Eigen::Index>(k)];
   SimulationOptions so;
-  so.q0 = sl.op.q;
-  so.v0 = sl.op.v;
+  const Model run = held_at(mod, sl.op, so);
   so.t_end = 2.0;
   so.output_step = 0.1;
   so.integrator.rtol = 1e-10;
