@@ -8,10 +8,6 @@
 
 namespace codyna::gui {
 
-namespace {
-constexpr double kMaxSamples = 1e6;
-}  // namespace
-
 SimWorker::SimWorker(QObject* parent) : QObject(parent) {
   qRegisterMetaType<codyna::gui::SampleBatch>("codyna::gui::SampleBatch");
   qRegisterMetaType<std::shared_ptr<const codyna::SimulationResult>>("std::shared_ptr<const codyna::SimulationResult>");
@@ -87,9 +83,8 @@ void SimWorker::runJob(const codyna::ModelSpec& spec, const std::string& file) {
   // command line says of it (notes, warnings, saturation), decided there, shown here
   codyna::SimulateRequest request;
   request.model = file.empty() ? std::string("untitled.json") : file;
-  // the window keeps a run several times (plots, the signal list, runs kept for comparison):
-  // it records at most kMaxSamples samples; longer records are the command line's (codyna simulate)
-  request.max_samples = kMaxSamples;
+  // a run shown live: the study's limit for it (kShownRunMaxSamples)
+  request.max_samples = codyna::kShownRunMaxSamples;
   codyna::SimulationCallbacks cb;
   cb.cancel = &cancel_;
   // record() in the simulator calls on_sample, then progress, for every output time

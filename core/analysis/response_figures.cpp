@@ -36,4 +36,28 @@ void response_figures(const std::vector<double>& t, const Eigen::MatrixXd& e, Ei
   }
 }
 
+LinearGap linear_gap(const std::vector<double>& t, const Eigen::MatrixXd& y, const Eigen::MatrixXd& y_linear) {
+  LinearGap g;
+  const Eigen::Index N = y.rows();
+  if (N == 0 || y_linear.rows() != N || y_linear.cols() != y.cols()) return g;
+  const Eigen::Index ny = y.cols();
+  g.largest.resize(ny);
+  g.percent.resize(ny);
+  g.from.resize(ny);
+  for (Eigen::Index k = 0; k < ny; ++k) {
+    const Eigen::VectorXd d = (y.col(k) - y_linear.col(k)).cwiseAbs();
+    const double range = std::max((y.col(k).array() - y(N - 1, k)).abs().maxCoeff(), 1e-12);
+    Eigen::Index first = -1;
+    for (Eigen::Index i = 0; i < N; ++i)
+      if (d[i] > 0.01 * range) {
+        first = i;
+        break;
+      }
+    g.largest[k] = d.maxCoeff();
+    g.percent[k] = 100 * d.maxCoeff() / range;
+    g.from[k] = first < 0 ? -1.0 : t[static_cast<std::size_t>(first)];
+  }
+  return g;
+}
+
 }  // namespace codyna

@@ -1,4 +1,5 @@
 #include "study/jobs.hpp"
+#include "analysis/response_figures.hpp"
 
 #include "analysis/stability.hpp"
 
@@ -589,23 +590,10 @@ SimulateJob simulate_job(const SimulateRequest& a, const ModelSpec& file_spec, c
     }
   }
   if (r.y_linear.rows() == N && N > 0) {
-    const auto ny = r.y.cols();
-    job.linear_gap.resize(ny);
-    job.linear_gap_percent.resize(ny);
-    job.linear_gap_from.resize(ny);
-    for (Eigen::Index k = 0; k < ny; ++k) {
-      const Eigen::VectorXd d = (r.y.col(k) - r.y_linear.col(k)).cwiseAbs();
-      const double range = std::max((r.y.col(k).array() - r.y(N - 1, k)).abs().maxCoeff(), 1e-12);
-      int first = -1;
-      for (int i = 0; i < N; ++i)
-        if (d[i] > 0.01 * range) {
-          first = i;
-          break;
-        }
-      job.linear_gap[k] = d.maxCoeff();
-      job.linear_gap_percent[k] = 100 * d.maxCoeff() / range;
-      job.linear_gap_from[k] = first < 0 ? -1.0 : r.t[first];
-    }
+    const LinearGap gap = linear_gap(r.t, r.y, r.y_linear);
+    job.linear_gap = gap.largest;
+    job.linear_gap_percent = gap.percent;
+    job.linear_gap_from = gap.from;
   }
   if (plant) {
     // how far the run went from the point the linear parts are about

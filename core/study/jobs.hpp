@@ -116,6 +116,11 @@ struct SimulateRequest {
   std::optional<double> t_end, rtol, atol, max_step, output_step, max_samples, divergence_bound;
 };
 
+// The sample limit of a run shown live in a window, which keeps each run several times (plots, the
+// signal list, runs kept for comparison); longer records are the command line's (codyna simulate,
+// whose limit is SimulationOptions::max_samples).
+constexpr double kShownRunMaxSamples = 1e6;
+
 struct SimulateJob {
   Model model;
   std::vector<std::string> notes, warnings;  // each in order (the ready callback sees those before the run)

@@ -14,6 +14,7 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 #include <iterator>
 #include <limits>
@@ -107,18 +108,16 @@ long long sweep_shard_size(long long n, long long index, long long count) {
 }
 
 namespace {
-SweepJob sweep_job(const SweepRequest& r, const StudyMessages& tell, const SweepProgress& progress, bool merging) {
+
+using SweepNote = std::function<void(const std::string&)>;
+
+// the request's options and its output files, checked before any work (a shard writes its own file
+// only; an MPI rank's slice, `memory`, checks the whole study's)
+void check_sweep_request(const SweepRequest& r, bool shard, bool memory) {
   const Names opt{r.style};
-  SweepJob job;
-  const auto note = [&](const std::string& text) {
-    job.notes.push_back(text);
-    if (tell) tell({StudyMessage::Note, text});
-  };
   if (r.redesign != "" && r.redesign != "lqr")
     throw std::invalid_argument(opt("redesign") + " " + r.redesign + ": expected lqr");
   if (r.threads < 0) throw std::invalid_argument(opt("threads") + ": expected 1 or more (0: every core)");
-  const bool shard = r.shard_count > 0;
-  const bool memory = shard && r.journal_in_memory;  // an MPI rank's slice: the whole study's outputs checked below
   if (shard) {
     if (r.shard_index < 0 || r.shard_index >= r.shard_count)
       throw std::invalid_argument(opt("shard") + " " + std::to_string(r.shard_index) + "/" + std::to_string(r.shard_count) +
@@ -156,21 +155,13 @@ SweepJob sweep_job(const SweepRequest& r, const StudyMessages& tell, const Sweep
     study_guard_output(r.mat, OutputKind::PlantMat, {r.model});
     study_guard_output((p.parent_path() / (p.stem().string() + ".m")).string(), OutputKind::PlantScript, {r.model});
   }
-  // errors name the file and the field
-  const ModelSpec nominal_spec = r.model_text.empty() ? study_read_model(r.model) : study_parse_model_text(r.model_text, r.model);
-  for (const std::string& n : nominal_spec.notes) note(n);
-  std::string model_bytes = r.model_text;
-  if (model_bytes.empty()) {
-    std::ifstream in(r.model, std::ios::binary);
-    model_bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  }
-  const nlohmann::json file = nlohmann::json::parse(model_bytes);
-  job.plan = study_sweep_plan(r, file);
-  job.model_file = r.model;
-  job.model_name = nominal_spec.name;
+}
 
-  // the nominal model: its linearization and controller must work, or there is no study
-  Context c;
+// the nominal model's linearization and controller (they must work, or there is no study): what
+// every variant shares (c) and the job's nominal figures; true when the study's controller is a file
+bool sweep_nominal(Context& c, std::optional<Model>& structure, SweepJob& job, const SweepRequest& r,
+                   const nlohmann::json& file, const ModelSpec& nominal_spec, const SweepNote& note) {
+  const Names opt{r.style};
   c.request = &r;
   c.plan = &job.plan;
   c.file = &file;
@@ -182,7 +173,6 @@ SweepJob sweep_job(const SweepRequest& r, const StudyMessages& tell, const Sweep
   c.linearize.modes = false;  // a variant records its poles and uncontrollable modes only
   const LinearizeJob nominal = study_linearize_job(c.linearize, nominal_spec);
   const Model& m = nominal.model;
-  std::optional<Model> structure;
   if (const std::optional<NumbersChanged> what = numbers_changed(job.plan.vary); what && !c.whole_file) {
     structure = study_linearize_structure(c.linearize, nominal_spec);
     c.structure = &*structure;
@@ -241,33 +231,34 @@ SweepJob sweep_job(const SweepRequest& r, const StudyMessages& tell, const Sweep
       c.controller_point = model_controller ? m.spec.controller.operating_point : s.operating_point;
     }
   }
+  return s.controller == "file";
+}
 
-  // the variants
+// the journal of the study's variants: those an interrupted run of this very study finished (have)
+// and the file every finished variant is appended to
+struct SweepJournalFile {
+  std::vector<char> have;
+  std::ofstream out;
+  std::string path;
+};
+
+void open_sweep_journal(SweepJournalFile& jf, SweepJob& job, const SweepRequest& r, const std::string& model_bytes,
+                        bool shard, bool memory, bool merging, const SweepNote& note) {
   const long long n = job.plan.count;
-  job.variants.resize(static_cast<std::size_t>(n));
-  unsigned threads = r.threads > 0 ? static_cast<unsigned>(r.threads) : std::max(1u, std::thread::hardware_concurrency());
-  if (s.controller == "file" && threads > 1) {
-    // the controller file is read again with every variant's model (matio, HDF5 for v7.3: not thread-safe)
-    note("the study's controller is a file: variants run on one thread");
-    threads = 1;
-  }
-  threads = static_cast<unsigned>(std::min<long long>(threads, n));
-  // the journal: the variants an interrupted run of this very study finished
-  std::vector<char> have(static_cast<std::size_t>(n), 0);
-  std::ofstream journal;
+  jf.have.assign(static_cast<std::size_t>(n), 0);
   job.shard_index = shard ? r.shard_index : 0;
   job.shard_count = shard ? r.shard_count : 0;
-  const std::string journal_path =
+  jf.path =
       memory ? r.journal_file : r.out.empty() ? std::string() : shard ? r.out : study_sweep_journal_path(r.out);
   if (memory) job.journal = journal_head(r, model_bytes, n) + journal_request(r);
-  if (!journal_path.empty()) {
+  if (!jf.path.empty()) {
     const std::string head = journal_head(r, model_bytes, n), request_line = journal_request(r);
     std::error_code ec;
-    if (r.resume && std::filesystem::exists(journal_path, ec)) {
-      std::ifstream in(journal_path, std::ios::binary);
+    if (r.resume && std::filesystem::exists(jf.path, ec)) {
+      std::ifstream in(jf.path, std::ios::binary);
       std::string line;
       if (!std::getline(in, line) || line + "\n" != head)
-        throw std::invalid_argument(journal_path + ": the journal of another study (other model file contents or options) "
+        throw std::invalid_argument(jf.path + ": the journal of another study (other model file contents or options) "
                                     "is in the way: remove it to start afresh");
       std::string kept = head + request_line;
       while (std::getline(in, line)) {
@@ -276,11 +267,11 @@ SweepJob sweep_job(const SweepRequest& r, const StudyMessages& tell, const Sweep
         try {
           const nlohmann::json j = nlohmann::json::parse(line);
           const long long i = j.at("i").get<long long>();
-          if (i < 0 || i >= n || have[static_cast<std::size_t>(i)] || !job.in_shard(i)) continue;
+          if (i < 0 || i >= n || jf.have[static_cast<std::size_t>(i)] || !job.in_shard(i)) continue;
           SweepVariant v = sweep_journal_variant(j);
           if (v.values != job.plan.values(i)) continue;
           job.variants[static_cast<std::size_t>(i)] = std::move(v);
-          have[static_cast<std::size_t>(i)] = 1;
+          jf.have[static_cast<std::size_t>(i)] = 1;
           ++job.resumed;
           kept += line + "\n";
           if (memory) job.journal += line + "\n";
@@ -289,24 +280,31 @@ SweepJob sweep_job(const SweepRequest& r, const StudyMessages& tell, const Sweep
         }
       }
       in.close();
-      write_file_atomically(journal_path, kept);  // without the damaged lines, then appended to
+      write_file_atomically(jf.path, kept);  // without the damaged lines, then appended to
       if (job.resumed > 0 && !shard && !merging)
         note("resuming: " + std::to_string(job.resumed) + " of " + std::to_string(n) + " variants were done (" +
-             journal_path + ")");
+             jf.path + ")");
       if (job.resumed > 0 && shard) {
         const long long slice = sweep_shard_size(n, r.shard_index, r.shard_count);
         note("resuming: " + std::to_string(job.resumed) + " of the " + std::to_string(slice) + " variants of slice " +
-             std::to_string(r.shard_index) + "/" + std::to_string(r.shard_count) + " were done (" + journal_path + ")");
+             std::to_string(r.shard_index) + "/" + std::to_string(r.shard_count) + " were done (" + jf.path + ")");
       }
     } else {
-      if (!is_sweep_journal(journal_path))
-        throw std::invalid_argument(journal_path + ": exists and is not the journal of a codyna sweep; codyna never "
+      if (!is_sweep_journal(jf.path))
+        throw std::invalid_argument(jf.path + ": exists and is not the journal of a codyna sweep; codyna never "
                                     "replaces a file it did not write: remove it or choose another --out");
-      write_file_atomically(journal_path, head + request_line);
+      write_file_atomically(jf.path, head + request_line);
     }
-    journal.open(journal_path, std::ios::binary | std::ios::app);
-    if (!journal) throw std::runtime_error(journal_path + ": cannot append to the journal");
+    jf.out.open(jf.path, std::ios::binary | std::ios::app);
+    if (!jf.out) throw std::runtime_error(jf.path + ": cannot append to the journal");
   }
+}
+
+// the variants not done yet, on `threads` threads, each appended to the journal as it finishes
+void run_sweep_variants(const Context& c, SweepJob& job, SweepJournalFile& jf, unsigned threads, bool memory,
+                        const SweepProgress& progress) {
+  const SweepRequest& r = *c.request;
+  const long long n = job.plan.count;
   std::atomic<long long> next{0}, done{job.resumed};
   std::mutex report;
   std::exception_ptr fatal;
@@ -315,7 +313,7 @@ SweepJob sweep_job(const SweepRequest& r, const StudyMessages& tell, const Sweep
       if (progress.cancel && progress.cancel->load()) return;
       const long long i = next.fetch_add(1);
       if (i >= n) return;
-      if (have[static_cast<std::size_t>(i)] || !job.in_shard(i)) continue;
+      if (jf.have[static_cast<std::size_t>(i)] || !job.in_shard(i)) continue;
       SweepVariant& v = job.variants[static_cast<std::size_t>(i)];
       try {
         run_variant(c, i, v);
@@ -325,10 +323,10 @@ SweepJob sweep_job(const SweepRequest& r, const StudyMessages& tell, const Sweep
         next.store(n);
         return;
       }
-      const std::string line = journal.is_open() || memory ? sweep_journal_line(i, v) : std::string();
+      const std::string line = jf.out.is_open() || memory ? sweep_journal_line(i, v) : std::string();
       const long long d = done.fetch_add(1) + 1;
       const std::lock_guard<std::mutex> lock(report);
-      if (journal.is_open()) journal << line << std::flush;
+      if (jf.out.is_open()) jf.out << line << std::flush;
       if (memory) job.journal += line;
       if (progress.done) progress.done(d, n);
     }
@@ -345,9 +343,12 @@ SweepJob sweep_job(const SweepRequest& r, const StudyMessages& tell, const Sweep
   if (done.load() < expected) throw StudyCancelled("the sweep was cancelled after " + std::to_string(done.load()) + " of " +
                                             std::to_string(expected) + " variants");
 
-  // the summary: the worst case is the completed variant with the largest max real part (first on ties)
+}
+
+// the summary: the worst case is the completed variant with the largest max real part (first on ties)
+void count_sweep_variants(SweepJob& job) {
   double worst = -std::numeric_limits<double>::infinity();
-  for (long long i = 0; i < n; ++i) {
+  for (long long i = 0; i < job.plan.count; ++i) {
     if (!job.in_shard(i)) continue;
     const SweepVariant& v = job.variants[static_cast<std::size_t>(i)];
     if (v.status != SweepStatus::Ok) {
@@ -367,18 +368,22 @@ SweepJob sweep_job(const SweepRequest& r, const StudyMessages& tell, const Sweep
     }
   }
 
-  if (memory) return job;  // the journal in job.journal is the slice's result
+}
+
+// a shard's file, or the study's results, CSV and MAT files (the journal removed once they are written)
+void write_sweep_outputs(SweepJob& job, const SweepRequest& r, SweepJournalFile& jf, const std::string& model_bytes,
+                         bool shard) {
   if (shard) {  // the shard's journal is its result
-    journal.close();
-    if (!journal) throw std::runtime_error(r.out + ": cannot finish the shard's file");
+    jf.out.close();
+    if (!jf.out) throw std::runtime_error(r.out + ": cannot finish the shard's file");
     // written again in the variants' order (it was appended to as they finished): the same bytes
     // whatever the threads and the order they finished in
-    std::string text = journal_head(r, model_bytes, n) + journal_request(r);
-    for (long long i = 0; i < n; ++i)
+    std::string text = journal_head(r, model_bytes, job.plan.count) + journal_request(r);
+    for (long long i = 0; i < job.plan.count; ++i)
       if (job.in_shard(i)) text += sweep_journal_line(i, job.variants[static_cast<std::size_t>(i)]);
     write_file_atomically(r.out, text);
     job.written.push_back(r.out);
-    return job;
+    return;
   }
   if (!r.out.empty()) {
     study_write_sweep_hdf5(job, r.out);
@@ -394,11 +399,55 @@ SweepJob sweep_job(const SweepRequest& r, const StudyMessages& tell, const Sweep
     const std::filesystem::path p(r.mat);
     job.written.push_back((p.parent_path() / (p.stem().string() + ".m")).string());
   }
-  if (journal.is_open()) {
-    journal.close();
+  if (jf.out.is_open()) {
+    jf.out.close();
     std::error_code ec;
-    std::filesystem::remove(journal_path, ec);
+    std::filesystem::remove(jf.path, ec);
   }
+}
+
+SweepJob sweep_job(const SweepRequest& r, const StudyMessages& tell, const SweepProgress& progress, bool merging) {
+  SweepJob job;
+  const SweepNote note = [&](const std::string& text) {
+    job.notes.push_back(text);
+    if (tell) tell({StudyMessage::Note, text});
+  };
+  const bool shard = r.shard_count > 0;
+  const bool memory = shard && r.journal_in_memory;  // an MPI rank's slice: the whole study's outputs checked below
+  check_sweep_request(r, shard, memory);
+  // errors name the file and the field
+  const ModelSpec nominal_spec = r.model_text.empty() ? study_read_model(r.model) : study_parse_model_text(r.model_text, r.model);
+  for (const std::string& n : nominal_spec.notes) note(n);
+  std::string model_bytes = r.model_text;
+  if (model_bytes.empty()) {
+    std::ifstream in(r.model, std::ios::binary);
+    model_bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  const nlohmann::json file = nlohmann::json::parse(model_bytes);
+  job.plan = study_sweep_plan(r, file);
+  job.model_file = r.model;
+  job.model_name = nominal_spec.name;
+
+  Context c;
+  std::optional<Model> structure;
+  const bool controller_file = sweep_nominal(c, structure, job, r, file, nominal_spec, note);
+
+  // the variants
+  const long long n = job.plan.count;
+  job.variants.resize(static_cast<std::size_t>(n));
+  unsigned threads = r.threads > 0 ? static_cast<unsigned>(r.threads) : std::max(1u, std::thread::hardware_concurrency());
+  if (controller_file && threads > 1) {
+    // the controller file is read again with every variant's model (matio, HDF5 for v7.3: not thread-safe)
+    note("the study's controller is a file: variants run on one thread");
+    threads = 1;
+  }
+  threads = static_cast<unsigned>(std::min<long long>(threads, n));
+  SweepJournalFile jf;
+  open_sweep_journal(jf, job, r, model_bytes, shard, memory, merging, note);
+  run_sweep_variants(c, job, jf, threads, memory, progress);
+  count_sweep_variants(job);
+  if (memory) return job;  // the journal in job.journal is the slice's result
+  write_sweep_outputs(job, r, jf, model_bytes, shard);
   return job;
 }
 }  // namespace

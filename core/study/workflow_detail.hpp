@@ -1,5 +1,6 @@
 // Helpers the study's steps share (study/workflow.cpp: the model, the operating point, the
-// linearization and export; study/workflow_simulation.cpp: the closed-loop run). Internal to
+// linearization and export; study/workflow_handling.cpp: the handling numbers at a steady motion;
+// study/workflow_simulation.cpp: the closed-loop run). Internal to
 // study/: front ends use workflow.hpp.
 #pragma once
 
@@ -37,6 +38,8 @@ std::vector<HiddenMode> uncontrollable(const LinearSystem& sys);
 // errors at /analysis/FIELD[/NAME] (study/workflow.cpp)
 StudyInitialState set_coordinates(const Model& m, Eigen::VectorXd q, Eigen::VectorXd v,
                                   const std::vector<std::pair<std::string, double>>& pairs, const std::string& field);
+// the handling numbers of a linearization about a steady motion (study/workflow_handling.cpp)
+HandlingNumbers study_handling(const Model& m, const StudyLinearization& sl);
 // an LQR needs every mode that does not decay by itself to be movable: says which are not
 void require_stabilizable(const Model& m, const LinearSystem& sys);
 
