@@ -107,8 +107,7 @@ void print_setup(const SimulateJob& job, const SimulateArgs& a) {
     std::cout << std::setprecision(6) << "\n";
   }
   if (m.spec.analysis.start == "operating-point") {
-    const std::string kind = setup.start.substr(0, setup.start.find(" + "));
-    std::cout << "start            at the " << kind << " point";
+    std::cout << "start            at the " << setup.start_point << " point";
     if (m.spec.analysis.initial.empty()) std::cout << (plant ? " (x0 of the controller's linearization)" : " (the study's operating point)");
     else std::cout << " with the initial coordinates set: " << name_values(m.v_names, job.initial_coordinates, true, 10);
     std::cout << std::setprecision(6) << "\n";

@@ -525,9 +525,8 @@ bool PropertyEditor::applyText(const QString& field, const QString& text, QStrin
         break;
       } catch (const ModelError& e) {
         const std::string p = e.path();
-        const std::string missing = "missing required field \"";
-        if (p == ss(base) && e.detail().rfind(missing, 0) == 0) {
-          const std::string key = e.detail().substr(missing.size(), e.detail().find('"', missing.size()) - missing.size());
+        if (p == ss(base) && e.kind() == ModelError::Kind::MissingField) {
+          const std::string& key = e.field();
           json& element = j[json::json_pointer(p)];
           if (!element.is_object() || element.contains(key)) break;
           if (key.rfind("joint", 0) == 0) {
@@ -569,8 +568,7 @@ bool PropertyEditor::applyText(const QString& field, const QString& text, QStrin
         if (p.rfind(ss(base) + "/", 0) != 0) break;
         const std::string last = p.substr(p.rfind('/') + 1);
         // a field the new type does not know, or one of another tire law than the new one's
-        const bool unknown = e.detail().find("unknown field") != std::string::npos ||
-                             e.detail().find("belongs to the tire law") != std::string::npos;
+        const bool unknown = e.kind() == ModelError::Kind::UnknownField;
         const bool sized = last == "q0" || last == "v0" || last == "armature";
         if (!unknown && !sized) break;
         json& parent = j[json::json_pointer(p).parent_pointer()];

@@ -332,17 +332,13 @@ bool TireView::refresh() {
   TireJob lat, lon, comb;
   try {
     if (base.loads.empty() && base.tir.empty()) {
-      // a model's linear or Fiala tire has no nominal load: ask the job, and a Magic Formula tire
-      // takes its file's FNOMIN (0.5, 1, 1.5 times)
+      // the loads the job takes: a Magic Formula tire its file's FNOMIN (0.5, 1, 1.5 times), a
+      // linear or Fiala tire (no nominal load) the job's typical loads
       TireRequest probe = base;
-      try {
-        const TireJob j = study_tire_job(probe);
-        const int fz = tire_column(j, "Fz");
-        for (Eigen::Index i = 0; i < j.rows.rows(); ++i) base.loads.push_back(j.rows(i, fz));
-      } catch (const std::invalid_argument& e) {
-        if (std::string(e.what()).rfind("--load", 0) != 0) throw;
-        base.loads = {2000.0, 4000.0, 6000.0};
-      }
+      probe.typical_loads = true;
+      const TireJob j = study_tire_job(probe);
+      const int fz = tire_column(j, "Fz");
+      for (Eigen::Index i = 0; i < j.rows.rows(); ++i) base.loads.push_back(j.rows(i, fz));
     }
     TireRequest r = base;
     r.alpha = alphas;

@@ -80,6 +80,14 @@ class Node {
   Node member(const std::string& key) const { return Node(j_->at(key), path_ + "/" + pointer_token(key), *file_); }
 
   [[noreturn]] void fail(const std::string& detail) const { throw ModelError(*file_, path_, detail); }
+  // a field this element does not have (ModelError::Kind::UnknownField)
+  [[noreturn]] void fail_unknown(const std::string& detail) const {
+    throw ModelError(*file_, path_, detail, ModelError::Kind::UnknownField);
+  }
+  // a required field this element lacks (ModelError::Kind::MissingField)
+  [[noreturn]] void fail_missing(const std::string& key) const {
+    throw ModelError(*file_, path_, "missing required field " + quote(key), ModelError::Kind::MissingField, key);
+  }
   [[noreturn]] void expected(const std::string& what) const { fail("expected " + what + ", got " + describe(*j_)); }
 
  private:
@@ -98,7 +106,7 @@ class Object {
   void allow(const std::vector<std::string_view>& allowed, const std::string& owner = {}) const {
     for (const auto& item : n_.value().items()) {
       if (std::find(allowed.begin(), allowed.end(), item.key()) != allowed.end()) continue;
-      n_.member(item.key()).fail("unknown field " + quote(item.key()) + " (allowed" +
+      n_.member(item.key()).fail_unknown("unknown field " + quote(item.key()) + " (allowed" +
                                  (owner.empty() ? "" : " for " + owner) + ": " + join(allowed) + ")");
     }
   }
@@ -108,7 +116,7 @@ class Object {
   }
   Node need(const std::string& key) const {
     if (auto f = get(key)) return *f;
-    n_.fail("missing required field " + quote(key));
+    n_.fail_missing(key);
   }
 
  private:
@@ -586,7 +594,7 @@ S read_struct(const Node& n) {
     if (auto v = o.get(std::string(key)))
       f.read(*v, s);
     else if (f.need == Need::Required)
-      n.fail("missing required field " + quote(key));
+      n.fail_missing(std::string(key));
   }
   return s;
 }
@@ -838,7 +846,7 @@ Field<EffectSpec> tire_law_field(std::string_view key, T EffectSpec::*m, Read re
   return {key, Need::Optional,
           [key, m, read, laws, uses](const Node& n, EffectSpec& s) {
             if (!uses(s.law))
-              n.fail("field " + quote(key) + " belongs to the tire law" + (laws.size() > 1 ? "s " : " ") + join(laws) +
+              n.fail_unknown("field " + quote(key) + " belongs to the tire law" + (laws.size() > 1 ? "s " : " ") + join(laws) +
                      ", not to " + quote(s.law));
             s.*m = read(n);
           },
@@ -895,7 +903,7 @@ const Schema<EffectSpec>& schema<EffectSpec>() {
            {"side", Need::Optional,
             [](const Node& n, EffectSpec& s) {
               if (s.law != "magic_formula")
-                n.fail("field \"side\" belongs to the tire law magic_formula, not to " + quote(s.law));
+                n.fail_unknown("field \"side\" belongs to the tire law magic_formula, not to " + quote(s.law));
               s.side = read_string(n);
               if (s.side != "left" && s.side != "right") n.fail("unknown side " + quote(s.side) + " (expected one of: left, right)");
             },
@@ -914,7 +922,7 @@ const Schema<EffectSpec>& schema<EffectSpec>() {
            {"relaxation_from_file", Need::Optional,
             [](const Node& n, EffectSpec& s) {
               if (s.law != "magic_formula")
-                n.fail("field \"relaxation_from_file\" belongs to the tire law magic_formula, not to " + quote(s.law));
+                n.fail_unknown("field \"relaxation_from_file\" belongs to the tire law magic_formula, not to " + quote(s.law));
               s.relaxation_from_file = read_bool(n);
             },
             [](ojson& j, const EffectSpec& s) {

@@ -94,8 +94,13 @@ TireJob study_tire_job(const TireRequest& r) {
   }
   std::vector<double> loads = r.loads;
   if (loads.empty()) {
-    if (!t.mf) throw std::invalid_argument("--load: give the loads (N) for a " + std::string(t.law == TireLaw::Linear ? "linear" : "fiala") + " tire");
-    for (double f : {0.5, 1.0, 1.5}) loads.push_back(f * t.mf->FNOMIN);
+    if (t.mf) {
+      for (double f : {0.5, 1.0, 1.5}) loads.push_back(f * t.mf->FNOMIN);
+    } else if (r.typical_loads) {
+      loads = {2000.0, 4000.0, 6000.0};
+    } else {
+      throw std::invalid_argument("--load: give the loads (N) for a " + std::string(t.law == TireLaw::Linear ? "linear" : "fiala") + " tire");
+    }
   }
   for (double f : loads)
     if (!(f >= 0)) throw std::invalid_argument("--load: expected loads >= 0 N, got " + std::to_string(f));

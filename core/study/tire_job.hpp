@@ -28,6 +28,10 @@ struct TireRequest {
                                      // (its .tir files) and names it in messages ("" when unsaved)
   std::string side;                  // .tir: "" (as the file), "left" or "right"
   std::vector<double> loads, kappa, alpha, gamma;
+  // no loads given and the tire has no nominal load (a linear or Fiala tire; a .tir has FNOMIN):
+  // true: 2, 4 and 6 kN (a passenger car's corner, what a window draws first); false: refused
+  // (--load: give the loads)
+  bool typical_loads = false;
   double speed = 16.7;               // m/s
   std::string out;                   // the CSV file ("" = none: the job's rows only)
 };

@@ -127,6 +127,7 @@ struct StudySimulation {
   // study's initial coordinates), or the operating point's kind ("equilibrium", "trim", ...), with
   // " + study initial" when coordinates are set on it
   std::string start = "model";
+  std::string start_point;  // the operating point's kind when the run starts at it ("" otherwise)
   // a linear controller (state feedback, LQR, LTI; not PID, not open loop): the poles of the
   // linear closed loop about the operating point (close_loop of analysis/closed_loop_linear.hpp,
   // saturation left out), sorted by real part; `linear_unstable` when one has a real part

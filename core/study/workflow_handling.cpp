@@ -48,6 +48,135 @@ void steady_heading(const Model& m, const OperatingPoint& op, int body, Eigen::V
   speed = h.dot(point_velocity<double>(d, body, m.com[static_cast<std::size_t>(body)]));
 }
 
+// the wheelbase: between the foremost and the rearmost tire along the heading h
+double tire_wheelbase(const Model& m, const OperatingPoint& op, const Eigen::Vector3d& h) {
+  if (m.tires.empty()) workflow_fail(m, "handling/wheelbase", "the model has no tires to measure the wheelbase between: give it");
+  Data d(m);
+  forward_kinematics<double>(m, d, op.q, op.v);
+  double lo = 0, hi = 0;
+  for (std::size_t k = 0; k < m.tires.size(); ++k) {
+    const double x = h.dot(point_position<double>(d, m.tires[k].body, m.tires[k].center));
+    lo = k ? std::min(lo, x) : x;
+    hi = k ? std::max(hi, x) : x;
+  }
+  return hi - lo;
+}
+
+// a planar joint's velocities are the world's: in body axes, dv_b = Rz(-psi0) (dv - J v0 dpsi)
+// (J the quarter turn), the heading no longer reaches the velocities and a steady turn is steady;
+// T_axes: the change of the state (identity without a planar joint on the way)
+void planar_body_axes(const Model& m, const StudyLinearization& sl, LinearSystem* body_axes, Eigen::MatrixXd* T_axes) {
+  const LinearSystem& sys = sl.lin.system;
+  *body_axes = sys;
+  *T_axes = Eigen::MatrixXd::Identity(sys.nx(), sys.nx());
+  const CoordinatePartition& part = sl.lin.partition;
+  const std::vector<int> rates = part.rates();
+  const int nz = static_cast<int>(part.independent.size());
+  const auto pos = [&](const std::vector<int>& v, int iv) {
+    const auto it = std::find(v.begin(), v.end(), iv);
+    return it == v.end() ? -1 : static_cast<int>(it - v.begin());
+  };
+  Eigen::MatrixXd T = Eigen::MatrixXd::Identity(sys.nx(), sys.nx());
+  bool any = false;
+  for (int b = 1; b < m.nbodies; ++b) {
+    const JointModel& j = m.joints[static_cast<std::size_t>(b)];
+    if (j.type != JointType::Planar) continue;
+    const int ipsi = pos(part.independent, j.idx_v + 2), ivx = pos(rates, j.idx_v), ivy = pos(rates, j.idx_v + 1);
+    if (ipsi < 0 || ivx < 0 || ivy < 0) continue;
+    const double psi = sl.op.q[j.idx_q + 2];
+    const Eigen::Vector2d v0(sl.op.v[j.idx_v], sl.op.v[j.idx_v + 1]);
+    Eigen::Matrix2d Rt;
+    Rt << std::cos(psi), std::sin(psi), -std::sin(psi), std::cos(psi);  // Rz(-psi)
+    const Eigen::Vector2d Jv(-v0.y(), v0.x());
+    const int rx = nz + ivx, ry = nz + ivy;
+    T(rx, rx) = Rt(0, 0);
+    T(rx, ry) = Rt(0, 1);
+    T(ry, rx) = Rt(1, 0);
+    T(ry, ry) = Rt(1, 1);
+    const Eigen::Vector2d c = -Rt * Jv;
+    T(rx, ipsi) = c.x();
+    T(ry, ipsi) = c.y();
+    any = true;
+  }
+  if (any) {
+    *T_axes = T;
+    const Eigen::MatrixXd Ti = T.inverse();
+    body_axes->A = T * sys.A * Ti;
+    body_axes->B = T * sys.B;
+    body_axes->C = sys.C * Ti;
+  }
+}
+
+// the speed held by the steady motion's other free inputs (a drive torque): their B and D columns
+// (a linearization with them among the inputs, when they are not Plant/In) and the row of the
+// speed's change, v^ . (dv + dw x c) in the steady body's axes (v^ its centre of mass' velocity
+// direction, c the centre of mass from the joint's origin)
+SpeedHold steady_speed_hold(const Model& m, const StudyLinearization& sl, int steer, int body, const Eigen::MatrixXd& T_axes) {
+  const LinearSystem& sys = sl.lin.system;
+  SpeedHold hold;
+  std::vector<int> holders;
+  const int steer_act = m.plant_inputs[static_cast<std::size_t>(steer)];
+  for (const std::string& name : m.spec.analysis.free_inputs) {
+    const int k = m.find_actuator(name);
+    if (k >= 0 && k != steer_act) holders.push_back(k);
+  }
+  const JointModel& j = m.joints[static_cast<std::size_t>(body)];
+  const CoordinatePartition& part = sl.lin.partition;
+  const std::vector<int> rates = part.rates();
+  const int nz = static_cast<int>(part.independent.size());
+  const auto state_of = [&](int iv) {
+    const auto it = std::find(rates.begin(), rates.end(), iv);
+    return it == rates.end() ? -1 : nz + static_cast<int>(it - rates.begin());
+  };
+  Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(sys.nx());
+  bool row_ok = !holders.empty();
+  if (row_ok && j.type == JointType::Free) {
+    const Eigen::Vector3d w = sl.op.v.segment<3>(j.idx_v), vo = sl.op.v.segment<3>(j.idx_v + 3);
+    const Eigen::Vector3d c = j.X_CM.R.transpose() * (m.com[static_cast<std::size_t>(body)] - j.X_CM.p);
+    const Eigen::Vector3d vc = vo + w.cross(c);
+    const Eigen::Vector3d dir = vc / std::max(vc.norm(), 1e-300), cw = c.cross(dir);
+    for (int a = 0; a < 3; ++a) {
+      const int sv = state_of(j.idx_v + 3 + a), sw = state_of(j.idx_v + a);
+      row_ok = row_ok && sv >= 0 && sw >= 0;
+      if (sv >= 0) row[sv] = dir[a];
+      if (sw >= 0) row[sw] = cw[a];
+    }
+  } else if (row_ok && j.type == JointType::Planar) {
+    // body_axes' rows of the planar velocities are already in the body's axes
+    const double psi = sl.op.q[j.idx_q + 2];
+    const Eigen::Vector2d vw(sl.op.v[j.idx_v], sl.op.v[j.idx_v + 1]);
+    const Eigen::Vector2d vb(std::cos(psi) * vw.x() + std::sin(psi) * vw.y(), -std::sin(psi) * vw.x() + std::cos(psi) * vw.y());
+    const Eigen::Vector2d dir = vb / std::max(vb.norm(), 1e-300);
+    const int sx = state_of(j.idx_v), sy = state_of(j.idx_v + 1);
+    row_ok = sx >= 0 && sy >= 0;
+    if (row_ok) row[sx] = dir.x(), row[sy] = dir.y();
+  } else {
+    row_ok = false;
+  }
+  if (row_ok) {
+    Model with = m;
+    for (int k : holders)
+      if (std::find(with.plant_inputs.begin(), with.plant_inputs.end(), k) == with.plant_inputs.end()) with.plant_inputs.push_back(k);
+    LinearizeOptions o;
+    o.method = method_of_model(m);
+    o.independent = m.spec.analysis.independent;
+    const Linearization lw = linearize(with, sl.op, o);
+    if (lw.system.state_names == sys.state_names && lw.system.A.rows() == sys.A.rows()) {
+      hold.B.resize(sys.nx(), static_cast<Eigen::Index>(holders.size()));
+      hold.D.resize(sys.C.rows(), static_cast<Eigen::Index>(holders.size()));
+      for (std::size_t h = 0; h < holders.size(); ++h) {
+        const auto at = std::find(with.plant_inputs.begin(), with.plant_inputs.end(), holders[h]) - with.plant_inputs.begin();
+        hold.B.col(static_cast<Eigen::Index>(h)) = lw.system.B.col(at);
+        hold.D.col(static_cast<Eigen::Index>(h)) = lw.system.D.col(at);
+      }
+      // in the body's axes, as body_axes (the planar velocities turned by T; B's rows alike)
+      hold.B = T_axes * hold.B;
+      hold.speed = row;
+    }
+  }
+  return hold;
+}
+
 }  // namespace
 
 HandlingNumbers workflow_detail::study_handling(const Model& m, const StudyLinearization& sl) {
@@ -70,129 +199,11 @@ HandlingNumbers workflow_detail::study_handling(const Model& m, const StudyLinea
   Eigen::Vector3d h;
   double speed = 0;
   steady_heading(m, sl.op, body, h, speed);
-  double L = hs.wheelbase.value_or(0.0);
-  if (!hs.wheelbase) {
-    // the foremost and the rearmost tire along the heading
-    if (m.tires.empty()) workflow_fail(m, "handling/wheelbase", "the model has no tires to measure the wheelbase between: give it");
-    Data d(m);
-    forward_kinematics<double>(m, d, sl.op.q, sl.op.v);
-    double lo = 0, hi = 0;
-    for (std::size_t k = 0; k < m.tires.size(); ++k) {
-      const double x = h.dot(point_position<double>(d, m.tires[k].body, m.tires[k].center));
-      lo = k ? std::min(lo, x) : x;
-      hi = k ? std::max(hi, x) : x;
-    }
-    L = hi - lo;
-  }
-  // a planar joint's velocities are the world's: in body axes, dv_b = Rz(-psi0) (dv - J v0 dpsi)
-  // (J the quarter turn), the heading no longer reaches the velocities and a steady turn is steady
-  LinearSystem body_axes = sys;
-  Eigen::MatrixXd T_axes = Eigen::MatrixXd::Identity(sys.nx(), sys.nx());
-  {
-    const CoordinatePartition& part = sl.lin.partition;
-    const std::vector<int> rates = part.rates();
-    const int nz = static_cast<int>(part.independent.size());
-    const auto pos = [&](const std::vector<int>& v, int iv) {
-      const auto it = std::find(v.begin(), v.end(), iv);
-      return it == v.end() ? -1 : static_cast<int>(it - v.begin());
-    };
-    Eigen::MatrixXd T = Eigen::MatrixXd::Identity(sys.nx(), sys.nx());
-    bool any = false;
-    for (int b = 1; b < m.nbodies; ++b) {
-      const JointModel& j = m.joints[static_cast<std::size_t>(b)];
-      if (j.type != JointType::Planar) continue;
-      const int ipsi = pos(part.independent, j.idx_v + 2), ivx = pos(rates, j.idx_v), ivy = pos(rates, j.idx_v + 1);
-      if (ipsi < 0 || ivx < 0 || ivy < 0) continue;
-      const double psi = sl.op.q[j.idx_q + 2];
-      const Eigen::Vector2d v0(sl.op.v[j.idx_v], sl.op.v[j.idx_v + 1]);
-      Eigen::Matrix2d Rt;
-      Rt << std::cos(psi), std::sin(psi), -std::sin(psi), std::cos(psi);  // Rz(-psi)
-      const Eigen::Vector2d Jv(-v0.y(), v0.x());
-      const int rx = nz + ivx, ry = nz + ivy;
-      T(rx, rx) = Rt(0, 0);
-      T(rx, ry) = Rt(0, 1);
-      T(ry, rx) = Rt(1, 0);
-      T(ry, ry) = Rt(1, 1);
-      const Eigen::Vector2d c = -Rt * Jv;
-      T(rx, ipsi) = c.x();
-      T(ry, ipsi) = c.y();
-      any = true;
-    }
-    if (any) {
-      T_axes = T;
-      const Eigen::MatrixXd Ti = T.inverse();
-      body_axes.A = T * sys.A * Ti;
-      body_axes.B = T * sys.B;
-      body_axes.C = sys.C * Ti;
-    }
-  }
-  // the speed held by the steady motion's other free inputs (a drive torque): their B and D columns
-  // (a linearization with them among the inputs, when they are not Plant/In) and the row of the
-  // speed's change, v^ . (dv + dw x c) in the steady body's axes (v^ its centre of mass' velocity
-  // direction, c the centre of mass from the joint's origin)
-  SpeedHold hold;
-  {
-    std::vector<int> holders;
-    const int steer_act = m.plant_inputs[static_cast<std::size_t>(steer)];
-    for (const std::string& name : m.spec.analysis.free_inputs) {
-      const int k = m.find_actuator(name);
-      if (k >= 0 && k != steer_act) holders.push_back(k);
-    }
-    const JointModel& j = m.joints[static_cast<std::size_t>(body)];
-    const CoordinatePartition& part = sl.lin.partition;
-    const std::vector<int> rates = part.rates();
-    const int nz = static_cast<int>(part.independent.size());
-    const auto state_of = [&](int iv) {
-      const auto it = std::find(rates.begin(), rates.end(), iv);
-      return it == rates.end() ? -1 : nz + static_cast<int>(it - rates.begin());
-    };
-    Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(sys.nx());
-    bool row_ok = !holders.empty();
-    if (row_ok && j.type == JointType::Free) {
-      const Eigen::Vector3d w = sl.op.v.segment<3>(j.idx_v), vo = sl.op.v.segment<3>(j.idx_v + 3);
-      const Eigen::Vector3d c = j.X_CM.R.transpose() * (m.com[static_cast<std::size_t>(body)] - j.X_CM.p);
-      const Eigen::Vector3d vc = vo + w.cross(c);
-      const Eigen::Vector3d dir = vc / std::max(vc.norm(), 1e-300), cw = c.cross(dir);
-      for (int a = 0; a < 3; ++a) {
-        const int sv = state_of(j.idx_v + 3 + a), sw = state_of(j.idx_v + a);
-        row_ok = row_ok && sv >= 0 && sw >= 0;
-        if (sv >= 0) row[sv] = dir[a];
-        if (sw >= 0) row[sw] = cw[a];
-      }
-    } else if (row_ok && j.type == JointType::Planar) {
-      // body_axes' rows of the planar velocities are already in the body's axes
-      const double psi = sl.op.q[j.idx_q + 2];
-      const Eigen::Vector2d vw(sl.op.v[j.idx_v], sl.op.v[j.idx_v + 1]);
-      const Eigen::Vector2d vb(std::cos(psi) * vw.x() + std::sin(psi) * vw.y(), -std::sin(psi) * vw.x() + std::cos(psi) * vw.y());
-      const Eigen::Vector2d dir = vb / std::max(vb.norm(), 1e-300);
-      const int sx = state_of(j.idx_v), sy = state_of(j.idx_v + 1);
-      row_ok = sx >= 0 && sy >= 0;
-      if (row_ok) row[sx] = dir.x(), row[sy] = dir.y();
-    } else {
-      row_ok = false;
-    }
-    if (row_ok) {
-      Model with = m;
-      for (int k : holders)
-        if (std::find(with.plant_inputs.begin(), with.plant_inputs.end(), k) == with.plant_inputs.end()) with.plant_inputs.push_back(k);
-      LinearizeOptions o;
-      o.method = method_of_model(m);
-      o.independent = m.spec.analysis.independent;
-      const Linearization lw = linearize(with, sl.op, o);
-      if (lw.system.state_names == sys.state_names && lw.system.A.rows() == sys.A.rows()) {
-        hold.B.resize(sys.nx(), static_cast<Eigen::Index>(holders.size()));
-        hold.D.resize(sys.C.rows(), static_cast<Eigen::Index>(holders.size()));
-        for (std::size_t h = 0; h < holders.size(); ++h) {
-          const auto at = std::find(with.plant_inputs.begin(), with.plant_inputs.end(), holders[h]) - with.plant_inputs.begin();
-          hold.B.col(static_cast<Eigen::Index>(h)) = lw.system.B.col(at);
-          hold.D.col(static_cast<Eigen::Index>(h)) = lw.system.D.col(at);
-        }
-        // in the body's axes, as body_axes (the planar velocities turned by T; B's rows alike)
-        hold.B = T_axes * hold.B;
-        hold.speed = row;
-      }
-    }
-  }
+  const double L = hs.wheelbase ? *hs.wheelbase : tire_wheelbase(m, sl.op, h);
+  LinearSystem body_axes;
+  Eigen::MatrixXd T_axes;
+  planar_body_axes(m, sl, &body_axes, &T_axes);
+  const SpeedHold hold = steady_speed_hold(m, sl, steer, body, T_axes);
   try {
     HandlingNumbers out = handling_numbers(body_axes, steer, yaw, ay, beta, speed, L, hs.steering_ratio.value_or(1.0),
                                            hold.B.cols() > 0 ? &hold : nullptr);
@@ -203,7 +214,6 @@ HandlingNumbers workflow_detail::study_handling(const Model& m, const StudyLinea
     workflow_fail(m, "handling", e.what());
   }
 }
-
 
 std::string study_motion_text(const Model& m, const OperatingPoint& op) {
   if (!op.motion) return "";

@@ -306,6 +306,7 @@ StudySimulation study_simulation(const Model& m, const std::atomic<bool>* cancel
     out.options.q0 = op.q;
     out.options.v0 = op.v;
     out.start = op.kind;
+    out.start_point = op.kind;
     if (!s.initial.empty()) {
       const StudyInitialState start = set_coordinates(m, op.q, op.v, s.initial, "initial");
       out.options.q0 = start.q;

@@ -1140,5 +1140,47 @@ TEST(ModelFile, OneElementReadAgainEqualsTheWholeFileRead) {
   EXPECT_FALSE(parse_model_element(spec, "bodies", 7, rod, cart));
 }
 
+// The kind of a fault, for a front end that acts on it without reading the message's words (the
+// GUI's property editor drops the fields an element's old type had and fills a new type's
+// required ones): an unknown field and a field of another tire law are UnknownField at the
+// field's path; a missing required field is MissingField at the element's path, naming the field;
+// a bad value is neither.
+ModelError model_error_of(const std::string& text) {
+  try {
+    parse_model_spec_text(text, "kinds.json");
+  } catch (const ModelError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "no error for the model";
+  return ModelError("", "", "");
+}
+std::string pendulum_with(const std::string& from, const std::string& to) {
+  std::string s = kPendulum;
+  const std::size_t at = s.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return s.replace(at, from.size(), to);
+}
+
+TEST(ModelFile, ErrorsSayTheirKind) {
+  const ModelError unknown = model_error_of(pendulum_with(R"("mass": 2.0,)", R"("mass": 2.0, "colour": 1,)"));
+  EXPECT_EQ(unknown.kind(), ModelError::Kind::UnknownField);
+  EXPECT_EQ(unknown.path(), "/bodies/0/colour");
+  const ModelError missing = model_error_of(pendulum_with(R"("child": "link",)", ""));
+  EXPECT_EQ(missing.kind(), ModelError::Kind::MissingField);
+  EXPECT_EQ(missing.path(), "/joints/0");
+  EXPECT_EQ(missing.field(), "child");
+  EXPECT_EQ(missing.detail(), "missing required field \"child\"");
+  const ModelError law = model_error_of(pendulum_with(
+      R"({"name": "gravity", "type": "gravity"})",
+      R"({"name": "gravity", "type": "gravity"}, {"name": "tire", "type": "tire", "body": "link", "law": "linear",
+          "unloaded_radius": 0.3, "vertical_stiffness": 2e5, "side": "left"})"));
+  EXPECT_EQ(law.kind(), ModelError::Kind::UnknownField);
+  EXPECT_EQ(law.path(), "/effects/1/side");
+  const ModelError value = model_error_of(pendulum_with(R"("mass": 2.0,)", R"("mass": -2.0,)"));
+  EXPECT_EQ(value.kind(), ModelError::Kind::Other);
+  EXPECT_EQ(value.in_file("other.json").kind(), ModelError::Kind::Other);
+  EXPECT_EQ(missing.in_file("other.json").field(), "child");
+}
+
 }  // namespace
 }  // namespace codyna

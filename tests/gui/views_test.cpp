@@ -170,10 +170,6 @@ class ViewsTest : public QObject {
     QCOMPARE(view.methodCombo()->currentData().toString(), QString("exact"));
   }
 
-  // The Linearize view says controllability and observability as codyna linearize prints them
-  // (the same job): the heavy top about its initial state has modes its support's inputs cannot
-  // move and its outputs cannot see (the CLI's text pinned in tests/data/pinned_outputs.json,
-  // lin_initial_heavy_top); the cart-pendulum is controllable and observable
   // operating point steady on the single-track car: a turn set in the view's fields (typed, as a
   // person does), the drive force freed by its check box; the result says the motion and the
   // handling numbers, the same as the study's
@@ -266,6 +262,10 @@ class ViewsTest : public QObject {
     QCOMPARE(doc.spec().analysis.steady.yaw_rate.value_or(0), 0.000123456);
   }
 
+  // The Linearize view says controllability and observability as codyna linearize prints them
+  // (the same job): the heavy top about its initial state has modes its support's inputs cannot
+  // move and its outputs cannot see (the CLI's text pinned in tests/data/pinned_outputs.json,
+  // lin_initial_heavy_top); the cart-pendulum is controllable and observable
   void controllabilityAsTheCommandLineSaysIt() {
     Document doc;
     QVERIFY(doc.load(QStringLiteral(CODYNA_EXAMPLES_DIR "/heavy_top.json")));
