@@ -14,11 +14,19 @@
 // The pure-Python package (python/codyna/__init__.py) gives Study its keyword signatures and
 // docstrings and calls the functions registered here with a dict of the keywords given.
 #include "bind_common.hpp"
+#include "model/model_spec.hpp"
 
 PYBIND11_MODULE(_codyna, m) {
   using namespace codyna::python;
   m.doc() = "The C++ half of codyna's Python module: bindings of core/study (import codyna, not this).";
   m.attr("__version__") = CODYNA_VERSION;
+  // the integrators simulate() takes: the core's list (model_spec.hpp), which the CLI's help and the
+  // GUI's combo show too
+  {
+    pybind11::list names;
+    for (const char* name : codyna::kIntegratorNames) names.append(name);
+    m.attr("integrators") = pybind11::tuple(names);
+  }
 
   register_errors(m);
   register_model(m);

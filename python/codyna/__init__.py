@@ -31,6 +31,7 @@ from ._codyna import (  # noqa: F401  (the public names)
     Simulation,
     Sweep,
     __version__,
+    integrators,
     lqr,
     place,
 )
@@ -47,6 +48,7 @@ __all__ = [
     "lqr",
     "place",
     "sweep_merge",
+    "integrators",
     "__version__",
 ]
 
@@ -242,7 +244,7 @@ class Study:
         (or None) keeps the model file's choice (its "solver" and "analysis" sections):
 
         t_end             end time, s
-        integrator        "auto", "ida", "cvode-bdf", "cvode-adams", "arkode" or "rk4"
+        integrator        one of codyna.integrators: @INTEGRATORS@
         rtol, atol        tolerances
         max_step          largest step, s (rk4: its fixed step)
         output_step       output interval, s
@@ -366,3 +368,7 @@ def sweep_merge(shards, *, out, csv=None, mat=None):
     would replace an input; TypeError for a wrong type.
     """
     return _codyna._sweep_merge(shards, _given(dict(out=out, csv=csv, mat=mat)))
+
+
+# the integrators' names in simulate()'s docstring, from the core's one list
+Study.simulate.__doc__ = Study.simulate.__doc__.replace("@INTEGRATORS@", ", ".join(f'"{n}"' for n in integrators))

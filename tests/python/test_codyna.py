@@ -987,3 +987,21 @@ def test_a_steady_turn_and_its_handling_numbers_as_the_command_gives_them(tmp_pa
     assert any("linearized about the motion" in n for n in turn.notes), turn.notes
     with pytest.raises(codyna.ModelError, match="radius"):
         codyna.Study(car).linearize(radius=0.0)
+
+
+def test_the_integrators_are_the_cores_one_list():
+    """simulate()'s docstring and its refusal of an unknown integrator name the core's list, which
+    the command line's help shows too (one list: core/model/model_spec.hpp's kIntegratorNames)."""
+    names = codyna.integrators
+    assert names[0] == "auto" and len(names) >= 6
+    doc = codyna.Study.simulate.__doc__
+    assert "@INTEGRATORS@" not in doc
+    line = next(l for l in doc.splitlines() if l.strip().startswith("integrator "))
+    assert line.split(":", 1)[1].strip() == ", ".join(f'"{n}"' for n in names)
+    help_text, _ = cli("simulate", "--help")
+    assert " | ".join(names) in help_text
+    with pytest.raises(ValueError) as e:
+        codyna.Study(CART).simulate(integrator="euler", t_end=0.1)
+    assert "euler" in str(e.value)
+    for n in names[1:]:
+        assert n in str(e.value)
