@@ -13,7 +13,8 @@
 // These are the steps; the front ends (the CLI, codyna-gui, Python) do not call them one by
 // one: each runs a job (study/jobs.hpp), which applies its request to the model file's
 // "analysis" section and calls these in order. The steps live in workflow.cpp (model, operating
-// point, linearization, export) and workflow_simulation.cpp (the closed-loop run). Bad choices
+// point, linearization, export), workflow_handling.cpp (the handling numbers and the text about a
+// steady motion) and workflow_simulation.cpp (the closed-loop run). Bad choices
 // throw ModelError naming the file and the field ("/analysis/operating_point"), which a job
 // says of the flag or keyword when its request gave the value, or std::invalid_argument.
 #pragma once
