@@ -212,12 +212,15 @@ ManeuverReport mnv_open_loop(const ManeuverRequest& r, const ModelSpec& spec, bo
   const double t0 = r.steer_time ? *r.steer_time : 0.5;
   if (!(t0 >= 0) || !std::isfinite(t0)) throw std::invalid_argument(flag("steer-time") + ": expected a time >= 0");
   SteerProfile profile;
+  std::vector<double> stops;
   double t_end = 0, t_ref = 0;
   if (sine) {
     const double f = mnv_positive(flag, r.frequency, 0.7, "frequency");
     const double dwell = r.dwell ? *r.dwell : 0.5;
     if (!(dwell >= 0)) throw std::invalid_argument(flag("dwell") + ": expected a time >= 0");
     profile = mnv_sine_dwell(amplitude, t0, f, dwell);
+    // the steer's acceleration jumps there: the run stops and the integrator starts again
+    stops = {t0, t0 + 0.75 / f, t0 + 0.75 / f + dwell, t0 + 1.0 / f + dwell};
     rep.steer_start = t0;
     rep.steer_end = t0 + 1.0 / f + dwell;
     t_end = r.t_end ? *r.t_end : rep.steer_end + 2.0;
@@ -227,6 +230,7 @@ ManeuverReport mnv_open_loop(const ManeuverRequest& r, const ModelSpec& spec, bo
   } else {
     const double ramp = mnv_positive(flag, r.ramp, 0.05, "ramp");
     profile = mnv_ramp(amplitude, t0, ramp);
+    stops = {t0, t0 + ramp};
     t_ref = t0 + ramp / 2;
     t_end = r.t_end ? *r.t_end : t0 + ramp + 4.0;
     if (!(t_end > t0 + ramp + 0.5))
@@ -246,6 +250,7 @@ ManeuverReport mnv_open_loop(const ManeuverRequest& r, const ModelSpec& spec, bo
   o.disturbance = [one, profile](double t) { return one(profile.value(t)); };
   o.disturbance_rate = [one, profile](double t) { return one(profile.rate(t)); };
   o.disturbance_acceleration = [one, profile](double t) { return one(profile.acceleration(t)); };
+  o.rate_jumps = stops;
   rep.result = simulate(run, nullptr, nullptr, o);
   mnv_check_run(rep, rep.result, run, body);
 
@@ -513,8 +518,8 @@ ManeuverReport mnv_constant_radius(const ManeuverRequest& r, const ModelSpec& sp
     m.v0 = op.v;
     for (std::size_t k = 0; k < m.actuators.size(); ++k) m.actuators[k].u0 = op.u[static_cast<Eigen::Index>(k)];
     const BodyState b = mnv_body_state(m, d, body, op.q, op.v);
-    const double speed = b.v_body.norm();
-    rep.cr_speed.push_back(speed);
+    const double speed = b.v_body.norm();  // the centre of mass's: a_y = V^2 / R on its circle
+    rep.cr_speed.push_back(b.v_body.x());   // along the heading, as the search sets it
     rep.cr_lateral_acceleration.push_back((rep.radius > 0 ? 1.0 : -1.0) * speed * speed / std::abs(rep.radius));
     rep.cr_steer.push_back(op.u[ks]);
     rep.cr_road_wheel.push_back(op.u[ks] / ratio);
@@ -557,10 +562,12 @@ ManeuverReport study_maneuver_job(const ManeuverRequest& r, const ModelSpec& spe
   for (const std::string& f : {r.out, r.csv})
     if (!f.empty()) study_guard_output(f, f == r.out ? OutputKind::ResultsHdf5 : (r.type == "constant-radius" ? OutputKind::CurvesCsv : OutputKind::ResultsCsv), {r.model});
   ManeuverReport rep;
-  if (r.type == "step-steer") rep = mnv_open_loop(r, spec, false);
-  else if (r.type == "sine-with-dwell") rep = mnv_open_loop(r, spec, true);
-  else if (r.type == "double-lane-change") rep = mnv_lane_change(r, spec);
-  else if (r.type == "constant-radius") rep = mnv_constant_radius(r, spec);
+  ModelSpec given = spec;
+  if (r.free_inputs) given.analysis.free_inputs = *r.free_inputs;
+  if (r.type == "step-steer") rep = mnv_open_loop(r, given, false);
+  else if (r.type == "sine-with-dwell") rep = mnv_open_loop(r, given, true);
+  else if (r.type == "double-lane-change") rep = mnv_lane_change(r, given);
+  else if (r.type == "constant-radius") rep = mnv_constant_radius(r, given);
   else throw std::invalid_argument(flag("type") + ": unknown maneuver \"" + r.type + "\" (expected one of " + known + ")");
   if (tell) {
     for (const std::string& n : rep.notes) tell({StudyMessage::Note, n});

@@ -50,6 +50,9 @@ struct ManeuverRequest {
   std::optional<double> radius;                // constant radius, m
   std::optional<double> speed_min, speed_max;  // constant radius, m/s
   std::optional<int> points;                   // constant radius (default 8)
+  // the steady motion's free inputs (StudySpec::free_inputs; a turn needs the drive that holds
+  // the speed besides the steer): each given replaces the file's list
+  std::optional<std::vector<std::string>> free_inputs;
   // the driver (double lane change)
   std::optional<double> width, length, preview, lateral_gain, speed_kp, speed_ki, sample_time;
   std::optional<std::string> x, y, yaw, speed_output, drive;  // Plant/Out / Plant/In names
