@@ -519,7 +519,7 @@ ManeuverReport mnv_constant_radius(const ManeuverRequest& r, const ModelSpec& sp
     for (std::size_t k = 0; k < m.actuators.size(); ++k) m.actuators[k].u0 = op.u[static_cast<Eigen::Index>(k)];
     const BodyState b = mnv_body_state(m, d, body, op.q, op.v);
     const double speed = b.v_body.norm();  // the centre of mass's: a_y = V^2 / R on its circle
-    rep.cr_speed.push_back(b.v_body.x());   // along the heading, as the search sets it
+    rep.cr_speed.push_back(U);              // along the heading in the road plane, as the search sets it
     rep.cr_lateral_acceleration.push_back((rep.radius > 0 ? 1.0 : -1.0) * speed * speed / std::abs(rep.radius));
     rep.cr_steer.push_back(op.u[ks]);
     rep.cr_road_wheel.push_back(op.u[ks] / ratio);

@@ -26,7 +26,7 @@ driver="$src/tests/data/single_track_car_driver.json"
 grep -q "understeer gradient at the lowest a_y" out.txt || fail "constant radius: $(cat out.txt)"
 while IFS=, read -r speed ay steer rest; do
   [ "$speed" = speed ] && continue
-  "$codyna" linearize "$car" --radius 120 --speed "$speed" --free-input steer,drive > lin.txt 2>&1 ||
+  "$codyna" linearize "$car" --radius 120 --speed "$speed" --free-input steer,drive --out lin > lin.txt 2>&1 ||
     fail "linearize at $speed: $(cat lin.txt)"
   lin=$(sed -n 's/^ *steer = \([-0-9.e+]*\).*/\1/p' lin.txt | head -1)
   $py -c "import sys; a, b = float('$steer'), float('$lin'); sys.exit(0 if abs(a - b) <= 1e-5 * abs(b) else 1)" ||
@@ -47,7 +47,7 @@ grep -q "wrote step.h5" out.txt || fail "step steer: $(cat out.txt)"
 grep -q "yaw-rate ratio at 1.00 s" out.txt || fail "sine with dwell: $(cat out.txt)"
 
 # the lane change driven by the driver of the model file
-"$codyna" maneuver "$driver" --type double-lane-change > out.txt 2> err.txt || fail "lane change: exit $?: $(cat err.txt)"
+"$codyna" maneuver "$driver" --type double-lane-change --speed 22.2 --preview 6 > out.txt 2> err.txt || fail "lane change: exit $?: $(cat err.txt)"
 grep -q "cones            none hit" out.txt || fail "lane change: $(cat out.txt)"
 
 # bad input: named, exit 1, nothing written
@@ -60,7 +60,19 @@ expect 1 '--yaw: the driver needs the Plant/Out "heading"' "$codyna" maneuver "$
 expect 1 '--radius: the constant-radius maneuver needs a radius' "$codyna" maneuver "$car" --type constant-radius
 expect 1 '--radius: expected a radius other than 0' "$codyna" maneuver "$car" --type constant-radius --radius 0
 sed 's/"preview": 15/"preview": -1/' "$driver" > neg.json
-expect 1 'neg.json: /controller/preview: expected a number > 0, got -1' "$codyna" maneuver neg.json --type double-lane-change
+expect 1 'neg.json: /controller/preview: expected a number > 0, got number -1' "$codyna" maneuver neg.json --type double-lane-change
+
+# the sedan: two constant-radius points on 1000 m, each codyna linearize's steer at its speed
+"$codyna" maneuver "$src/examples/sedan.json" --type constant-radius --radius 1000 --speed-min 25 --speed-max 26 \
+  --points 2 --csv sedan_cr.csv > out.txt 2> err.txt || fail "sedan constant radius: exit $?: $(cat err.txt)"
+while IFS=, read -r speed ay steer rest; do
+  [ "$speed" = speed ] && continue
+  "$codyna" linearize "$src/examples/sedan.json" --radius 1000 --speed "$speed" --out lin > lin.txt 2>&1 ||
+    fail "sedan linearize at $speed: $(cat lin.txt)"
+  lin=$(sed -n 's/^ *steer = \([-0-9.e+]*\).*/\1/p' lin.txt | head -1)
+  $py -c "import sys; a, b = float('$steer'), float('$lin'); sys.exit(0 if abs(a - b) <= 1e-5 * abs(b) else 1)" ||
+    fail "sedan constant radius at $speed m/s: steer $steer, linearize $lin"
+done < sedan_cr.csv
 
 [ "$fails" -eq 0 ] && echo "maneuver: all passed"
 exit $((fails > 0))

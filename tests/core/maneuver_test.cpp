@@ -52,12 +52,12 @@ TEST(ManeuverMetrics, SecondOrderStepMatchesTheClosedForms) {
       return 1 - std::exp(-zeta * wn * s) * (std::cos(wd * s) + zeta / std::sqrt(1 - zeta * zeta) * std::sin(wd * s));
     };
     std::vector<double> t, v;
-    for (int k = 0; k <= 12000; ++k) {
+    for (int k = 0; k <= 20000; ++k) {
       t.push_back(k * h);
       v.push_back(2.5 * y(k * h));  // a step of 2 with gain 1.25
     }
     const StepMetrics m = step_response_metrics(t, v, t0, 2.0);
-    EXPECT_NEAR(m.gain, 1.25, 1e-9) << zeta;
+    EXPECT_NEAR(m.gain, 1.25, 1e-9) << zeta;  // settled to e^(-zeta wn 19.75 s) < 1e-10
     EXPECT_NEAR(m.overshoot_percent, 100 * std::exp(-kPiManeuverTest * zeta / std::sqrt(1 - zeta * zeta)), 1e-4) << zeta;
     EXPECT_NEAR(m.peak_time, kPiManeuverTest / wd, 1e-5) << zeta;  // the parabola through the peak's samples
     double lo = 0, hi = kPiManeuverTest / wd;
@@ -142,16 +142,20 @@ TEST(Maneuver, StepSteerOnTheSingleTrackCarIsItsLinearModelsResponse) {
   }
   const StepMetrics ly = step_response_metrics(t, yaw, t0 + T / 2, a);
   const StepMetrics la = step_response_metrics(t, ay, t0 + T / 2, a);
-  // the linear model's steady gain is the handling number; the run's, at 3 s, the same to 1e-4
+  // The linear model's steady gain is the handling number. The run's differ by what a steer of 1e-3
+  // rad adds: the front tire's force has a component sin(delta) against the motion (the car slows
+  // by 2e-5 of its speed in 2.8 s): measured 5.7e-6 (yaw-rate gain), 2.4e-5 (lateral acceleration
+  // gain), 1e-5 and 5e-5 of the response times, 0.0005 and 0.0018 percentage points of overshoot.
   EXPECT_NEAR(ly.gain, lin.handling->yaw_rate_gain, 1e-6 * lin.handling->yaw_rate_gain);
-  EXPECT_NEAR(rep.yaw_rate.gain, ly.gain, 1e-3 * ly.gain);
-  EXPECT_NEAR(rep.yaw_rate.response_time, ly.response_time, 1e-3 * ly.response_time);
-  EXPECT_NEAR(rep.yaw_rate.peak_time, ly.peak_time, 1e-3 * ly.peak_time);
-  EXPECT_NEAR(rep.yaw_rate.overshoot_percent, ly.overshoot_percent, 0.01 * std::max(ly.overshoot_percent, 1.0));
+  EXPECT_NEAR(rep.yaw_rate.gain, ly.gain, 1e-4 * ly.gain);
+  EXPECT_NEAR(rep.yaw_rate.response_time, ly.response_time, 2e-4 * ly.response_time);
+  EXPECT_NEAR(rep.yaw_rate.peak_time, ly.peak_time, 2e-4 * ly.peak_time);
+  EXPECT_NEAR(rep.yaw_rate.overshoot_percent, ly.overshoot_percent, 0.005);
   ASSERT_TRUE(rep.has_lateral_acceleration);
-  EXPECT_NEAR(rep.lateral_acceleration.gain, la.gain, 1e-3 * la.gain);
-  EXPECT_NEAR(rep.lateral_acceleration.response_time, la.response_time, 1e-3 * la.response_time);
-  EXPECT_NEAR(rep.lateral_acceleration.peak_time, la.peak_time, 1e-3 * la.peak_time);
+  EXPECT_NEAR(rep.lateral_acceleration.gain, la.gain, 1e-4 * la.gain);
+  EXPECT_NEAR(rep.lateral_acceleration.response_time, la.response_time, 2e-4 * la.response_time);
+  EXPECT_NEAR(rep.lateral_acceleration.peak_time, la.peak_time, 2e-4 * la.peak_time);
+  EXPECT_NEAR(rep.lateral_acceleration.overshoot_percent, la.overshoot_percent, 0.005);
   std::cout << "yaw rate: gain " << rep.yaw_rate.gain << " (linear " << ly.gain << "), response time "
             << rep.yaw_rate.response_time << " (" << ly.response_time << "), peak time " << rep.yaw_rate.peak_time
             << " (" << ly.peak_time << "), overshoot " << rep.yaw_rate.overshoot_percent << " % ("
@@ -163,7 +167,9 @@ TEST(Maneuver, StepSteerOnTheSingleTrackCarIsItsLinearModelsResponse) {
 }
 
 // The driver steers the single-track car from the straight run onto a circle of 120 m at 30 m/s:
-// after settling the lateral error is below 1e-4 m, and its steer and drive are the steady turn's.
+// after settling the lateral error is below 1e-5 m (1.1e-6 measured over the last 5 of 40 s), its
+// steer the steady turn's to 1e-6 of it (the integral's convergence; the sampled steer is constant
+// in the steady state, so the turn is exactly the search's), its drive to 1e-3 (8e-5 measured).
 TEST(Maneuver, TheDriverHoldsTheSingleTrackCarOnACircleWithTheSteadyTurnsSteer) {
   const std::string file = maneuver_data("single_track_car_driver.json");
   const ModelSpec spec = study_read_model(file);
@@ -198,7 +204,7 @@ TEST(Maneuver, TheDriverHoldsTheSingleTrackCarOnACircleWithTheSteadyTurnsSteer) 
   const OperatingPoint top = study_operating_point(mt, "steady");
   std::cout << "lateral error over the last 5 s " << late_error << " m; steer " << u[0] << " (steady turn "
             << top.u[0] << "), drive " << u[1] << " N (" << top.u[1] << "), speed " << in.y[5] << "\n";
-  EXPECT_LT(late_error, 1e-4);
+  EXPECT_LT(late_error, 1e-5);
   EXPECT_NEAR(in.y[5], 30.0, 1e-5);
   EXPECT_NEAR(u[0], top.u[0], 1e-6 * std::abs(top.u[0]) + 1e-8);
   EXPECT_NEAR(u[1], top.u[1], 1e-3 * std::abs(top.u[1]) + 1e-3);
@@ -274,7 +280,7 @@ TEST(Maneuver, BadInputIsRefusedNamingTheFieldOrFlag) {
   nlohmann::json j = study_model_json(drv);
   j["controller"]["preview"] = -1;
   const std::string e3 = maneuver_error([&] { study_parse_model(j, "sedan.json"); });
-  EXPECT_NE(e3.find("sedan.json: /controller/preview: expected a number > 0, got -1"), std::string::npos) << e3;
+  EXPECT_NE(e3.find("sedan.json: /controller/preview: expected a number > 0, got number -1"), std::string::npos) << e3;
   j["controller"]["preview"] = 10;
   j["controller"]["path"] = "figure_eight";
   EXPECT_NE(maneuver_error([&] { study_parse_model(j, "car.json"); }).find("car.json: /controller/path: unknown driver path \"figure_eight\""),
