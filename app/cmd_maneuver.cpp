@@ -11,7 +11,7 @@ namespace codyna::cli {
 namespace {
 
 struct ManeuverArgs {
-  std::string model, type, out, csv, x, y, yaw, speed_output, drive;
+  std::string model, type, out, csv, x, y, yaw, speed_output, drive, integrator;
   std::vector<std::string> free_inputs;
   double speed = 0, steer = 0, steer_time = 0, ramp = 0, frequency = 0, dwell = 0, t_end = 0, output_step = 0;
   double radius = 0, speed_min = 0, speed_max = 0, width = 0, length = 0, preview = 0, lateral_gain = 0;
@@ -52,6 +52,7 @@ void run_maneuver(const ManeuverArgs& a, const CLI::App* cmd) {
   if (given(cmd, "--yaw")) r.yaw = a.yaw;
   if (given(cmd, "--speed-output")) r.speed_output = a.speed_output;
   if (given(cmd, "--drive")) r.drive = a.drive;
+  if (given(cmd, "--integrator")) r.integrator = a.integrator;
   if (given(cmd, "--free-input")) r.free_inputs = a.free_inputs;
   const ModelSpec spec = load_spec(a.model);
   const ManeuverReport rep = study_maneuver_job(r, spec, print_message);
@@ -92,6 +93,7 @@ void add_maneuver(CLI::App& app) {
   cmd->add_option("--yaw", a->yaw, "the Plant/Out output of its heading (default yaw)");
   cmd->add_option("--speed-output", a->speed_output, "the Plant/Out output of its forward speed (default speed)");
   cmd->add_option("--drive", a->drive, "the Plant/In input the speed controller drives (default: none)");
+  cmd->add_option("--integrator", a->integrator, "the runs' integrator (default: the model file's; cvode-bdf where tires saturate)");
   cmd->add_option("--free-input", a->free_inputs, "the steady motion's free inputs (a turn: steer,drive)")->delimiter(',');
   cmd->callback([a, cmd] { set_exit_code(run_guarded([&] { run_maneuver(*a, cmd); })); });
 }

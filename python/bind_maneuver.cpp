@@ -44,6 +44,7 @@ py::dict do_maneuver(const Study& s, const py::dict& options) {
   r.yaw = k.text("yaw");
   r.speed_output = k.text("speed_output");
   r.drive = k.text("drive");
+  r.integrator = k.text("integrator");
   r.free_inputs = k.names("free_inputs", "free_input");
   k.finish();
   ManeuverReport rep;

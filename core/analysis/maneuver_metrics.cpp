@@ -109,14 +109,25 @@ StepMetrics step_response_metrics(const std::vector<double>& t, const std::vecto
 
 SineWithDwellMetrics sine_with_dwell_metrics(const std::vector<double>& t, const std::vector<double>& yaw_rate,
                                              const std::vector<double>& lateral, double t_start, double t_end,
-                                             double first_sign) {
+                                             double peak_sign, double peak_from) {
   check_signal(t, yaw_rate, 3, "sine with dwell: yaw rate");
   check_signal(t, lateral, 3, "sine with dwell: lateral position");
   if (t.back() < t_end + 1.75)
     throw std::invalid_argument("sine with dwell: the run ends at " + std::to_string(t.back()) +
                                 " s, before 1.75 s after the steer ends (" + std::to_string(t_end + 1.75) + " s)");
   SineWithDwellMetrics m;
-  const SampledPeak p = sampled_peak(t, yaw_rate, first_sign > 0 ? 1.0 : -1.0, t_start, t.back(), true);
+  // the first local peak of at least half the largest excursion in that direction until the steer
+  // ends (a ripple is not the peak)
+  const double sign = peak_sign > 0 ? 1.0 : -1.0;
+  const SampledPeak largest = sampled_peak(t, yaw_rate, sign, peak_from, t_end);
+  if (largest.index < 0 || !(sign * largest.value > 0))
+    throw std::invalid_argument("sine with dwell: the yaw rate has no first peak");
+  SampledPeak p;
+  for (double from = peak_from;;) {
+    p = sampled_peak(t, yaw_rate, sign, from, t.back(), true);
+    if (p.index < 0 || sign * p.value >= 0.5 * sign * largest.value) break;
+    from = t[static_cast<std::size_t>(p.index) + 1];
+  }
   if (p.index < 0) throw std::invalid_argument("sine with dwell: the yaw rate has no first peak");
   m.peak_yaw_rate = p.value;
   m.peak_time = p.t;

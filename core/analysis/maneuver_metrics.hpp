@@ -8,7 +8,9 @@
 //                           in %, and the steady-state gain (steady - initial) / input step. The
 //                           steady value is the mean over the last `steady_window` seconds.
 //   sine_with_dwell_metrics FMVSS 126 / ISO 19365: the first peak of the yaw rate after the steer
-//                           starts (its sign the steer's first half wave's), the yaw-rate ratios
+//                           changes sign (at peak_from; in the second half wave's direction,
+//                           peak_sign; the first local peak of at least half the largest until the
+//                           steer ends, so a ripple is not taken for it), the yaw-rate ratios
 //                           r(t_end + 1.0) / r_peak and r(t_end + 1.75) / r_peak in %, and the
 //                           lateral displacement at t_start + 1.07 s (from the start's position,
 //                           perpendicular to the start's heading).
@@ -39,14 +41,14 @@ StepMetrics step_response_metrics(const std::vector<double>& t, const std::vecto
                                   double step, double steady_window = 0.5);
 
 struct SineWithDwellMetrics {
-  double peak_yaw_rate = 0, peak_time = 0;       // the first peak (rad/s, s)
+  double peak_yaw_rate = 0, peak_time = 0;       // the first peak after the steer changes sign (rad/s, s)
   double yrr_1_00 = 0, yrr_1_75 = 0;             // % of the peak
   double lateral_displacement = 0;               // m at t_start + 1.07 s
   bool passes_fmvss126 = false;                  // yrr_1_00 <= 35, yrr_1_75 <= 20, |displacement| >= 1.83
 };
 SineWithDwellMetrics sine_with_dwell_metrics(const std::vector<double>& t, const std::vector<double>& yaw_rate,
                                              const std::vector<double>& lateral, double t_start, double t_end,
-                                             double first_sign);
+                                             double peak_sign, double peak_from);
 
 struct PathErrorMetrics {
   double max_abs = 0, rms = 0;

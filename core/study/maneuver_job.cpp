@@ -135,6 +135,12 @@ IntegratorSettings mnv_integrator(const Model& m) {
 
 // the study's straight steady run at the request's speed
 ModelSpec mnv_straight_spec(const ManeuverRequest& r, ModelSpec spec) {
+  if (r.integrator) {
+    if (!is_integrator_name(*r.integrator))
+      throw std::invalid_argument(option_name(r.style, "integrator") + ": unknown integrator \"" + *r.integrator +
+                                  "\" (expected one of " + integrator_names() + ")");
+    spec.solver.integrator = *r.integrator;
+  }
   spec.analysis.operating_point = "steady";
   if (r.speed) spec.analysis.steady.speed = *r.speed;
   spec.analysis.steady.yaw_rate.reset();
@@ -265,7 +271,9 @@ ManeuverReport mnv_open_loop(const ManeuverRequest& r, const ModelSpec& spec, bo
         lateral[static_cast<std::size_t>(k)] = n.dot((s.p - s0.p).head<2>());
       }
       try {
-        rep.sine = sine_with_dwell_metrics(rep.result.t, yaw, lateral, rep.steer_start, rep.steer_end, amplitude);
+        // FMVSS 126: the peak after the steer changes sign (its second half wave's direction)
+        rep.sine = sine_with_dwell_metrics(rep.result.t, yaw, lateral, rep.steer_start, rep.steer_end, -amplitude,
+                                           rep.steer_start + 0.5 / mnv_positive(flag, r.frequency, 0.7, "frequency"));
       } catch (const std::invalid_argument& e) {
         rep.valid = false;
         if (rep.invalid_reason.empty()) rep.invalid_reason = e.what();
@@ -615,7 +623,7 @@ std::string study_maneuver_text(const ManeuverReport& r) {
     if (r.has_lateral_acceleration) line("lateral acceleration", r.lateral_acceleration, "m/s^2");
   } else if (r.type == "sine-with-dwell") {
     os << "steer amplitude  " << r.steer << " (steer from " << r.steer_start << " s to " << r.steer_end << " s)\n"
-       << "first yaw-rate peak         " << r.sine.peak_yaw_rate << " rad/s at " << r.sine.peak_time << " s\n"
+       << "yaw-rate peak (2nd half)    " << r.sine.peak_yaw_rate << " rad/s at " << r.sine.peak_time << " s\n"
        << "yaw-rate ratio at 1.00 s    " << r.sine.yrr_1_00 << " % (FMVSS 126: at most 35 %)\n"
        << "yaw-rate ratio at 1.75 s    " << r.sine.yrr_1_75 << " % (at most 20 %)\n"
        << "lateral displacement        " << r.sine.lateral_displacement << " m at 1.07 s (at least 1.83 m)\n"

@@ -47,6 +47,7 @@ struct ManeuverRequest {
   std::optional<double> steer_time, ramp;      // s: when the steer starts (default 0.5), its ramp (0.05)
   std::optional<double> frequency, dwell;      // sine with dwell: Hz (0.7), s (0.5)
   std::optional<double> t_end, output_step;    // s
+  std::optional<std::string> integrator;       // the runs' (default the model file's solver)
   std::optional<double> radius;                // constant radius, m
   std::optional<double> speed_min, speed_max;  // constant radius, m/s
   std::optional<int> points;                   // constant radius (default 8)

@@ -67,21 +67,24 @@ TEST(ManeuverMetrics, SecondOrderStepMatchesTheClosedForms) {
 }
 
 TEST(ManeuverMetrics, SineWithDwellRatiosAndDisplacementAreReadAtTheirTimes) {
-  // a yaw rate whose first peak is 0.3 at t = 1 and that is linear after 2 s; a lateral position t^2
+  // a yaw rate whose peak after the steer changes sign (at 0.5 s) is 0.3 at t = 1 (a sine's crest,
+  // sampled on it), with a ripple at 0.6 s (a local peak of 0.12, below half the largest: not the
+  // peak), falling linearly after 1.5 s; a lateral position t^2
   std::vector<double> t, r, lat;
   for (int k = 0; k <= 600; ++k) {
     const double s = k * 0.01;
     t.push_back(s);
-    r.push_back(s <= 2 ? 0.3 * std::sin(kPiManeuverTest * s / 2) : 0.3 - 0.05 * (s - 2) * 2);
+    const double base = s < 0.5 ? 0.0 : s <= 1.5 ? 0.3 * std::sin(kPiManeuverTest * (s - 0.5)) : -0.02 * (s - 1.5);
+    r.push_back(base + 0.03 * std::exp(-std::pow((s - 0.6) / 0.01, 2)));
     lat.push_back(s * s);
   }
-  const SineWithDwellMetrics m = sine_with_dwell_metrics(t, r, lat, 0.5, 2.5, 1.0);
+  const SineWithDwellMetrics m = sine_with_dwell_metrics(t, r, lat, 0.5, 2.5, 1.0, 0.5);
   EXPECT_NEAR(m.peak_yaw_rate, 0.3, 1e-12);
-  EXPECT_NEAR(m.peak_time, 1.0, 1e-12);
-  EXPECT_NEAR(m.yrr_1_00, (0.3 - 0.1 * 1.5) / 0.3 * 100, 1e-9);
-  EXPECT_NEAR(m.yrr_1_75, (0.3 - 0.1 * 2.25) / 0.3 * 100, 1e-9);
+  EXPECT_NEAR(m.peak_time, 1.0, 1e-9);
+  EXPECT_NEAR(m.yrr_1_00, -0.02 * 2.0 / 0.3 * 100, 1e-9);
+  EXPECT_NEAR(m.yrr_1_75, -0.02 * 2.75 / 0.3 * 100, 1e-9);
   EXPECT_NEAR(m.lateral_displacement, 1.57 * 1.57, 1e-4);  // t^2 linearly interpolated: h^2 / 4
-  EXPECT_THROW(sine_with_dwell_metrics(t, r, lat, 0.5, 5.0, 1.0), std::invalid_argument);  // ends too early
+  EXPECT_THROW(sine_with_dwell_metrics(t, r, lat, 0.5, 5.0, 1.0, 0.5), std::invalid_argument);  // ends too early
 }
 
 // The step steer's metrics on the nonlinear single-track car at a small steer equal the same metrics
