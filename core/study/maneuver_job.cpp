@@ -69,6 +69,7 @@ int mnv_steady_body(const Model& m) {
 struct BodyState {
   Eigen::Vector3d p, v_body;
   double heading = 0, roll = 0;
+  double speed_along_heading = 0, yaw_rate = 0;  // in the road plane (world x, y), about world z
 };
 BodyState mnv_body_state(const Model& m, Data& d, int body, const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
   forward_kinematics<double>(m, d, q, v);
@@ -80,6 +81,9 @@ BodyState mnv_body_state(const Model& m, Data& d, int body, const Eigen::VectorX
   s.v_body = V.tail<3>() + V.head<3>().cross(c);
   s.heading = std::atan2(X.R(1, 0), X.R(0, 0));
   s.roll = std::atan2(X.R(2, 1), X.R(2, 2));
+  const Eigen::Vector3d v_world = X.R * s.v_body, w_world = X.R * V.head<3>();
+  s.speed_along_heading = std::cos(s.heading) * v_world.x() + std::sin(s.heading) * v_world.y();
+  s.yaw_rate = w_world.z();
   return s;
 }
 
@@ -259,6 +263,12 @@ ManeuverReport mnv_open_loop(const ManeuverRequest& r, const ModelSpec& spec, bo
   o.rate_jumps = stops;
   rep.result = simulate(run, nullptr, nullptr, o);
   mnv_check_run(rep, rep.result, run, body);
+  if (rep.result.samples() > 0) {
+    const int last = rep.result.samples() - 1;
+    const BodyState e = mnv_body_state(run, d, body, rep.result.q.row(last).transpose(), rep.result.v.row(last).transpose());
+    rep.end_speed = e.speed_along_heading;
+    rep.end_yaw_rate = e.yaw_rate;
+  }
 
   if (rep.result.samples() >= 3) {
     const std::vector<double> yaw = mnv_column(rep.result, iy);

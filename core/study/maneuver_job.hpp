@@ -62,6 +62,9 @@ struct ManeuverRequest {
 struct ManeuverReport {
   std::string type, model_name;
   double speed = 0;                      // m/s at the start
+  // open loop: at the run's end, the steady body's speed along its heading in the road plane and
+  // its yaw rate about the road's normal (what the steady-motion search takes)
+  double end_speed = 0, end_yaw_rate = 0;
   std::vector<std::string> notes, warnings;
   bool valid = true;
   std::string invalid_reason;            // why the metrics are not to be trusted

@@ -169,6 +169,37 @@ TEST(Maneuver, StepSteerOnTheSingleTrackCarIsItsLinearModelsResponse) {
             << rep.lateral_acceleration.overshoot_percent << " % (" << la.overshoot_percent << ")\n";
 }
 
+// The sedan's step steer settles on the steady turn of its steer: the steady-motion search at the
+// run's final speed and yaw rate, the steer and drive solved, finds the steer the run applied.
+TEST(Maneuver, TheSedansStepSteerSettlesOnTheSteadyTurnOfItsSteer) {
+  const std::string file = maneuver_example("sedan.json");
+  const ModelSpec spec = study_read_model(file);
+  ManeuverRequest r;
+  r.model = file;
+  r.type = "step-steer";
+  r.steer = 0.3;  // at the steering wheel: 1.07 deg at the road wheels, 0.33 g
+  r.t_end = 4.0;
+  r.output_step = 0.01;
+  const ManeuverReport rep = study_maneuver_job(r, spec);
+  ASSERT_TRUE(rep.valid) << rep.invalid_reason;
+  ModelSpec turn = spec;
+  turn.analysis.steady.speed = rep.end_speed;
+  turn.analysis.steady.yaw_rate = rep.end_yaw_rate;
+  const Model m = study_model(turn, file);
+  const OperatingPoint op = study_operating_point(m, "steady");
+  const Model straight = study_model(spec, file);
+  const OperatingPoint op0 = study_operating_point(straight, "steady");
+  int ks = -1;
+  for (std::size_t k = 0; k < m.actuators.size(); ++k)
+    if (m.actuators[k].name == "steer") ks = static_cast<int>(k);
+  ASSERT_GE(ks, 0);
+  const double applied = op0.u[ks] + 0.3;
+  std::cout << "end speed " << rep.end_speed << " m/s, yaw rate " << rep.end_yaw_rate << " rad/s; steady turn's steer "
+            << op.u[ks] << ", applied " << applied << "; yaw-rate gain " << rep.yaw_rate.gain << ", response time "
+            << rep.yaw_rate.response_time << " s, overshoot " << rep.yaw_rate.overshoot_percent << " %\n";
+  EXPECT_NEAR(op.u[ks], applied, 1e-3 * 0.3);
+}
+
 // The driver steers the single-track car from the straight run onto a circle of 120 m at 30 m/s:
 // after settling the lateral error is below 1e-5 m (1.1e-6 measured over the last 5 of 40 s), its
 // steer the steady turn's to 1e-6 of it (the integral's convergence; the sampled steer is constant
