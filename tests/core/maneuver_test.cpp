@@ -170,14 +170,17 @@ TEST(Maneuver, StepSteerOnTheSingleTrackCarIsItsLinearModelsResponse) {
 }
 
 // The sedan's step steer settles on the steady turn of its steer: the steady-motion search at the
-// run's final speed and yaw rate, the steer and drive solved, finds the steer the run applied.
+// run's final speed and yaw rate, the steer and drive solved, finds the steer the run applied. The
+// run holds the drive torque of the straight run, so a turn slows the car (the tires' drag, of the
+// order of the steer squared) and its end is a turn only as far as that deceleration is small:
+// measured 9e-5 of the step at 0.03 rad, 0.9 % at 0.3 rad (0.06 m/s^2 of deceleration).
 TEST(Maneuver, TheSedansStepSteerSettlesOnTheSteadyTurnOfItsSteer) {
   const std::string file = maneuver_example("sedan.json");
   const ModelSpec spec = study_read_model(file);
   ManeuverRequest r;
   r.model = file;
   r.type = "step-steer";
-  r.steer = 0.3;  // at the steering wheel: 1.07 deg at the road wheels, 0.33 g
+  r.steer = 0.03;  // at the steering wheel: 0.107 deg at the road wheels, 0.034 g
   r.t_end = 4.0;
   r.output_step = 0.01;
   const ManeuverReport rep = study_maneuver_job(r, spec);
@@ -193,11 +196,11 @@ TEST(Maneuver, TheSedansStepSteerSettlesOnTheSteadyTurnOfItsSteer) {
   for (std::size_t k = 0; k < m.actuators.size(); ++k)
     if (m.actuators[k].name == "steer") ks = static_cast<int>(k);
   ASSERT_GE(ks, 0);
-  const double applied = op0.u[ks] + 0.3;
+  const double applied = op0.u[ks] + *r.steer;
   std::cout << "end speed " << rep.end_speed << " m/s, yaw rate " << rep.end_yaw_rate << " rad/s; steady turn's steer "
             << op.u[ks] << ", applied " << applied << "; yaw-rate gain " << rep.yaw_rate.gain << ", response time "
             << rep.yaw_rate.response_time << " s, overshoot " << rep.yaw_rate.overshoot_percent << " %\n";
-  EXPECT_NEAR(op.u[ks], applied, 1e-3 * 0.3);
+  EXPECT_NEAR(op.u[ks], applied, 1e-3 * *r.steer);
 }
 
 // The driver steers the single-track car from the straight run onto a circle of 120 m at 30 m/s:
