@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
   codyna::cli::add_export_mjcf(app);
   codyna::cli::add_sweep(app);
   codyna::cli::add_tire(app);
+  codyna::cli::add_maneuver(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

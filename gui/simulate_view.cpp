@@ -101,6 +101,12 @@ QString describeController(const ModelSpec& s) {
       return QObject::tr("LQR designed on the plant linearized %1; Q = diag(%2), R = diag(%3).")
           .arg(at, c.q_weights.empty() ? QObject::tr("1 ... 1") : joinNumbers(c.q_weights),
                c.r_weights.empty() ? QObject::tr("1 ... 1") : joinNumbers(c.r_weights));
+    case ControllerType::Driver:
+      return QObject::tr("Driver: pure pursuit on a %1 path (preview %2 m) steering %3%4, sampled every %5 s; "
+                         "its maneuvers run from the command line (codyna maneuver).")
+          .arg(qs(c.path), simNumber(c.preview), qs(c.steer),
+               c.drive.empty() ? QString() : QObject::tr(", a PI on speed driving %1").arg(qs(c.drive)),
+               simNumber(c.sample_time));
   }
   return {};
 }

@@ -126,5 +126,6 @@ void register_linearize(py::module_& m);  // bind_linearize.cpp: _linearize, Clo
 void register_simulate(py::module_& m);   // bind_simulate.cpp: _simulate, Simulation
 void register_sweep(py::module_& m);      // bind_sweep.cpp: _sweep, _sweep_merge, Sweep
 void register_tools(py::module_& m);      // bind_tools.cpp: lqr, place
+void register_maneuver(py::module_& m);   // bind_maneuver.cpp: _maneuver
 
 }  // namespace codyna::python

@@ -1073,6 +1073,30 @@ void expect_size_of_kp(const Node& n, const Eigen::MatrixXd& m, const Controller
   expect_size(n, m, c.kp.rows(), c.kp.cols(), "the size of kp");
 }
 
+std::string read_word(const Node& n, const std::vector<std::string>& words, const char* what);  // below
+
+// the driver's numbers (simulation/driver.hpp)
+double read_driver_positive(const Node& n) {
+  const double x = read_number(n);
+  if (!(x > 0)) n.expected("a number > 0");
+  return x;
+}
+double read_driver_nonnegative(const Node& n) {
+  const double x = read_number(n);
+  if (!(x >= 0)) n.expected("a number >= 0");
+  return x;
+}
+double read_driver_nonzero(const Node& n) {
+  const double x = read_number(n);
+  if (!(x != 0)) n.expected("a number other than 0");
+  return x;
+}
+double read_driver_radius(const Node& n) {
+  const double x = read_number(n);
+  if (!(x != 0)) n.expected("a radius other than 0 (m, > 0 turns left)");
+  return x;
+}
+
 template <>
 const Schema<ControllerSpec>& schema<ControllerSpec>() {
   using C = ControllerSpec;
@@ -1115,6 +1139,36 @@ const Schema<ControllerSpec>& schema<ControllerSpec>() {
           field("q_weights", &C::q_weights, [](const Node& n) { return read_weights(n, false); }),
           field("r_weights", &C::r_weights, [](const Node& n) { return read_weights(n, true); }),
           field("operating_point", &C::operating_point, read_operating_point),
+          // the driver (simulation/driver.hpp)
+          field("path", &C::path,
+                [](const Node& n) { return read_word(n, {"straight", "circle", "double_lane_change", "table"}, "driver path"); }),
+          field("radius", &C::radius, read_driver_radius),
+          field("path_length", &C::path_length, read_driver_positive),
+          field("vehicle_width", &C::vehicle_width, read_driver_positive),
+          field("path_heading", &C::path_heading, read_number),
+          field("path_start", &C::path_start, [](const Node& n) { return Eigen::Vector2d(read_numbers(n, 2)); }),
+          matrix_field("path_points", &C::path_points, Need::Optional,
+                       [](const Node& n, const C& c) {
+                         if (c.path_points.cols() != 2 || c.path_points.rows() < 2)
+                           n.fail("expected a table of at least 2 points [x, y] (N x 2), got " + size_of(c.path_points));
+                         for (Eigen::Index k = 1; k < c.path_points.rows(); ++k)
+                           if (c.path_points.row(k) == c.path_points.row(k - 1))
+                             n.fail("point " + std::to_string(k) + " is the same as the one before it");
+                       }),
+          field("preview", &C::preview, read_driver_positive),
+          field("wheelbase", &C::wheelbase, read_driver_positive),
+          field("steering_ratio", &C::steering_ratio, read_driver_nonzero),
+          field("lateral_gain", &C::lateral_gain, read_driver_nonnegative),
+          field("speed", &C::speed, read_driver_nonnegative),
+          field("speed_kp", &C::speed_kp, read_driver_nonnegative),
+          field("speed_ki", &C::speed_ki, read_driver_nonnegative),
+          field("sample_time", &C::sample_time, read_driver_positive),
+          field("x", &C::x, read_string),
+          field("y", &C::y, read_string),
+          field("yaw", &C::yaw, read_string),
+          field("forward_speed", &C::forward_speed, read_string),
+          field("steer", &C::steer, read_string),
+          field("drive", &C::drive, read_string),
       },
       "controller",
       [](const C& c) -> std::vector<std::string_view> {
@@ -1124,6 +1178,10 @@ const Schema<ControllerSpec>& schema<ControllerSpec>() {
           case ControllerType::StateFeedback: return {"type", "K", "operating_point"};
           case ControllerType::Lti: return {"type", "Ac", "Bc", "Cc", "Dc", "Ts", "operating_point"};
           case ControllerType::Lqr: return {"type", "q_weights", "r_weights", "operating_point"};
+          case ControllerType::Driver:
+            return {"type", "path", "radius", "path_length", "vehicle_width", "path_heading", "path_start", "path_points",
+                    "preview", "wheelbase", "steering_ratio", "lateral_gain", "speed", "speed_kp", "speed_ki",
+                    "sample_time", "x", "y", "yaw", "forward_speed", "steer", "drive", "operating_point"};
         }
         return {"type"};
       }};

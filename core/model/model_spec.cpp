@@ -73,12 +73,13 @@ constexpr std::array<std::pair<ShapeType, const char*>, 3> kShapes{{
     {ShapeType::Cylinder, "cylinder"},
     {ShapeType::Sphere, "sphere"},
 }};
-constexpr std::array<std::pair<ControllerType, const char*>, 5> kControllers{{
+constexpr std::array<std::pair<ControllerType, const char*>, 6> kControllers{{
     {ControllerType::None, "none"},
     {ControllerType::Pid, "pid"},
     {ControllerType::StateFeedback, "state_feedback"},
     {ControllerType::Lti, "lti"},
     {ControllerType::Lqr, "lqr"},
+    {ControllerType::Driver, "driver"},
 }};
 }  // namespace
 

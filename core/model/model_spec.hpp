@@ -291,7 +291,7 @@ struct PlantSpec {
 //   lqr             K = lqr(A, B, Q, R) of the linearized plant, then as state_feedback
 // Reading a model file checks only that the matrices fit each other; their
 // sizes against the plant (nu, ny, nx) are checked when a simulation uses them.
-enum class ControllerType { None, Pid, StateFeedback, Lti, Lqr };
+enum class ControllerType { None, Pid, StateFeedback, Lti, Lqr, Driver };
 
 struct ControllerSpec {
   ControllerType type = ControllerType::None;
@@ -308,6 +308,17 @@ struct ControllerSpec {
   std::vector<double> q_weights, r_weights;
   // where the plant is linearized for the controller's offsets/state order: "initial", "equilibrium", "trim"
   std::string operating_point = "equilibrium";
+  // driver (simulation/driver.hpp): pure pursuit on a path with integral action on the lateral
+  // error, and a PI on forward speed. path: straight | circle | double_lane_change | table
+  // (path_points, N x 2), from path_start (x, y) along path_heading (rad); the Plant/Out outputs
+  // and Plant/In inputs it uses, by name (drive "" = the speed is not held)
+  std::string path = "straight";
+  double radius = 0, path_length = 1000, vehicle_width = 1.8, path_heading = 0;
+  Eigen::Vector2d path_start = Eigen::Vector2d::Zero();
+  Eigen::MatrixXd path_points;
+  double preview = 10, wheelbase = 2.7, steering_ratio = 1, lateral_gain = 0.05;
+  double speed = 0, speed_kp = 0, speed_ki = 0, sample_time = 0.01;
+  std::string x = "x", y = "y", yaw = "yaw", forward_speed = "speed", steer = "steer", drive;
 };
 
 // Every integrator a run can name, "auto" first (chosen per model at the start of a run,

@@ -5,6 +5,7 @@
 #include "analysis/operating_point.hpp"
 #include "control/lqr.hpp"
 #include "model/errors.hpp"
+#include "simulation/driver.hpp"
 
 namespace codyna {
 
@@ -66,6 +67,10 @@ std::unique_ptr<Controller> make_model_controller(const Model& m, const LinearPl
       check_gain_size(m, "Cc", c.Cc, nu, n);
       check_gain_size(m, "Dc", c.Dc, nu, ny);
       return make_lti(c.Ac, c.Bc, c.Cc, c.Dc, c.Ts, s.y0, s.u0);
+    }
+    case ControllerType::Driver: {
+      const std::string where = (m.source_file.empty() ? std::string() : m.source_file + ": ") + "/controller";
+      return make_driver(model_driver_settings(m, s.u0), where);
     }
     case ControllerType::Lqr: {
       const LqrResult d = lqr(s.A, s.B, weights(m, "q_weights", c.q_weights, static_cast<int>(nx)),

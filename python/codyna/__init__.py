@@ -192,6 +192,19 @@ class Study:
         """
         return _codyna._linearize(self._study, _given(locals()))
 
+    def maneuver(self, type, **options):
+        """A standard handling maneuver with its metrics (codyna maneuver; docs/maneuvers.md).
+
+        type: "step-steer", "sine-with-dwell", "double-lane-change" or "constant-radius"; the
+        keywords are codyna maneuver's flags with underscores (speed, steer, steer_time, ramp,
+        frequency, dwell, t_end, output_step, radius, speed_min, speed_max, points, width, length,
+        preview, lateral_gain, speed_kp, speed_ki, sample_time, x, y, yaw, speed_output, drive, out,
+        csv). Returns a dict: the metrics, "valid" and "invalid_reason", "text" (the command's
+        report), and the run's "t", "outputs", "output_names".
+        """
+        options["type"] = type
+        return _codyna._maneuver(self._study, _given(options))
+
     def simulate(
         self,
         *,

@@ -927,7 +927,7 @@ void expect_controller_error(const std::string& controller, const std::string& p
 
 TEST(ModelFileErrors, UnknownControllerType) {
   expect_controller_error(R"({"type": "mpc"})", "/controller/type",
-                          "unknown controller type \"mpc\" (expected one of: none, pid, state_feedback, lti, lqr)");
+                          "unknown controller type \"mpc\" (expected one of: none, pid, state_feedback, lti, lqr, driver)");
   expect_controller_error(R"({"kp": 1})", "/controller", "missing required field \"type\"");
   expect_model_error(with_controller("[1]"), "/controller", "expected an object, got an array of 1 element");
 }

@@ -1005,3 +1005,22 @@ def test_the_integrators_are_the_cores_one_list():
     assert "euler" in str(e.value)
     for n in names[1:]:
         assert n in str(e.value)
+
+
+def test_maneuver_is_the_command_lines():
+    """Study.maneuver runs codyna maneuver's job: the same report text; bad keywords name themselves."""
+    car = os.path.join(SOURCE_DIR, "examples", "single_track_car.json")
+    stdout, _ = cli("maneuver", car, "--type", "step-steer", "--steer", "0.001")
+    r = codyna.Study(car).maneuver("step-steer", steer=0.001)
+    assert r["text"] == stdout
+    assert r["valid"] and abs(r["yaw_rate"]["gain"] - 7.03443) < 1e-3 * 7.03443
+    assert r["output_names"] == ["yaw_rate", "lateral_velocity", "lateral_acceleration"]
+    assert len(r["t"]) == r["outputs"].shape[0]
+    cr = codyna.Study(car).maneuver("constant-radius", radius=120, speed_min=10, speed_max=30, points=3,
+                                    free_inputs=["steer", "drive"])
+    assert list(cr["speed"]) == [10, 20, 30]
+    with pytest.raises(ValueError, match="^preview: expected a number > 0"):
+        codyna.Study(os.path.join(SOURCE_DIR, "tests", "data", "single_track_car_driver.json")).maneuver(
+            "double-lane-change", preview=-1)
+    with pytest.raises(ValueError, match="^type: unknown maneuver"):
+        codyna.Study(car).maneuver("slalom")

@@ -1,0 +1,101 @@
+// codyna maneuver: the standard handling maneuvers with their metrics (study/maneuver_job.hpp).
+#include <iostream>
+#include <memory>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "study/maneuver_job.hpp"
+
+namespace codyna::cli {
+
+namespace {
+
+struct ManeuverArgs {
+  std::string model, type, out, csv, x, y, yaw, speed_output, drive, integrator;
+  std::vector<std::string> free_inputs;
+  double speed = 0, steer = 0, steer_time = 0, ramp = 0, frequency = 0, dwell = 0, t_end = 0, output_step = 0;
+  double radius = 0, speed_min = 0, speed_max = 0, width = 0, length = 0, preview = 0, lateral_gain = 0;
+  double speed_kp = 0, speed_ki = 0, sample_time = 0;
+  int points = 0;
+};
+
+void run_maneuver(const ManeuverArgs& a, const CLI::App* cmd) {
+  ManeuverRequest r;
+  r.model = a.model;
+  r.type = a.type;
+  r.out = a.out;
+  r.csv = a.csv;
+  const auto num = [cmd](const char* flag, double v, std::optional<double>& into) {
+    if (given(cmd, flag)) into = v;
+  };
+  num("--speed", a.speed, r.speed);
+  num("--steer", a.steer, r.steer);
+  num("--steer-time", a.steer_time, r.steer_time);
+  num("--ramp", a.ramp, r.ramp);
+  num("--frequency", a.frequency, r.frequency);
+  num("--dwell", a.dwell, r.dwell);
+  num("--t-end", a.t_end, r.t_end);
+  num("--output-step", a.output_step, r.output_step);
+  num("--radius", a.radius, r.radius);
+  num("--speed-min", a.speed_min, r.speed_min);
+  num("--speed-max", a.speed_max, r.speed_max);
+  num("--width", a.width, r.width);
+  num("--length", a.length, r.length);
+  num("--preview", a.preview, r.preview);
+  num("--lateral-gain", a.lateral_gain, r.lateral_gain);
+  num("--speed-kp", a.speed_kp, r.speed_kp);
+  num("--speed-ki", a.speed_ki, r.speed_ki);
+  num("--sample-time", a.sample_time, r.sample_time);
+  if (given(cmd, "--points")) r.points = a.points;
+  if (given(cmd, "--x")) r.x = a.x;
+  if (given(cmd, "--y")) r.y = a.y;
+  if (given(cmd, "--yaw")) r.yaw = a.yaw;
+  if (given(cmd, "--speed-output")) r.speed_output = a.speed_output;
+  if (given(cmd, "--drive")) r.drive = a.drive;
+  if (given(cmd, "--integrator")) r.integrator = a.integrator;
+  if (given(cmd, "--free-input")) r.free_inputs = a.free_inputs;
+  const ModelSpec spec = load_spec(a.model);
+  const ManeuverReport rep = study_maneuver_job(r, spec, print_message);
+  std::cout << study_maneuver_text(rep);
+  if (!rep.valid) throw std::runtime_error("the metrics are invalid: " + rep.invalid_reason);
+}
+
+}  // namespace
+
+void add_maneuver(CLI::App& app) {
+  auto a = std::make_shared<ManeuverArgs>();
+  auto* cmd = app.add_subcommand("maneuver", "Run a standard handling maneuver (step steer, sine with dwell, double lane change, constant radius) and print its metrics");
+  cmd->add_option("model", a->model, "model file (JSON)")->required();
+  cmd->add_option("--type", a->type, "step-steer | sine-with-dwell | double-lane-change | constant-radius")->required();
+  cmd->add_option("--out", a->out, "the run as an HDF5 results file");
+  cmd->add_option("--csv", a->csv, "the run as CSV (constant radius: its table)");
+  cmd->add_option("--speed", a->speed, "m/s, the straight run's speed (default: the model file's steady motion)");
+  cmd->add_option("--steer", a->steer, "steer amplitude in the steer input's units (step: 0.01, sine: 0.05)");
+  cmd->add_option("--steer-time", a->steer_time, "s, when the steer starts (default 0.5)");
+  cmd->add_option("--ramp", a->ramp, "s, the step's ramp (half cosine; default 0.05)");
+  cmd->add_option("--frequency", a->frequency, "Hz, sine with dwell (default 0.7)");
+  cmd->add_option("--dwell", a->dwell, "s, sine with dwell (default 0.5)");
+  cmd->add_option("--t-end", a->t_end, "s, the run's length");
+  cmd->add_option("--output-step", a->output_step, "s, open-loop runs' output step (default 0.005)");
+  cmd->add_option("--radius", a->radius, "m, constant radius (> 0 left)");
+  cmd->add_option("--speed-min", a->speed_min, "m/s, constant radius's first speed (default 5)");
+  cmd->add_option("--speed-max", a->speed_max, "m/s, its last (default the speed of 0.6 g)");
+  cmd->add_option("--points", a->points, "constant radius: the number of speeds (default 8)");
+  cmd->add_option("--width", a->width, "m, vehicle width for the ISO 3888-1 lane (default 1.8)");
+  cmd->add_option("--length", a->length, "m, vehicle length for the cones (default 4.5)");
+  cmd->add_option("--preview", a->preview, "m, the driver's look-ahead distance");
+  cmd->add_option("--lateral-gain", a->lateral_gain, "rad/(m s), the driver's integral gain on the lateral error");
+  cmd->add_option("--speed-kp", a->speed_kp, "the driver's speed PI: drive input per m/s");
+  cmd->add_option("--speed-ki", a->speed_ki, "the driver's speed PI: drive input per m");
+  cmd->add_option("--sample-time", a->sample_time, "s, the driver's sample time (default 0.01)");
+  cmd->add_option("--x", a->x, "the Plant/Out output of the car's x position (default x)");
+  cmd->add_option("--y", a->y, "the Plant/Out output of its y position (default y)");
+  cmd->add_option("--yaw", a->yaw, "the Plant/Out output of its heading (default yaw)");
+  cmd->add_option("--speed-output", a->speed_output, "the Plant/Out output of its forward speed (default speed)");
+  cmd->add_option("--drive", a->drive, "the Plant/In input the speed controller drives (default: none)");
+  cmd->add_option("--integrator", a->integrator, "the runs' integrator (default: the model file's; cvode-bdf where tires saturate)");
+  cmd->add_option("--free-input", a->free_inputs, "the steady motion's free inputs (a turn: steer,drive)")->delimiter(',');
+  cmd->callback([a, cmd] { set_exit_code(run_guarded([&] { run_maneuver(*a, cmd); })); });
+}
+
+}  // namespace codyna::cli

@@ -1,0 +1,652 @@
+#include "study/maneuver_job.hpp"
+
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+
+#include "dynamics/data.hpp"
+#include "dynamics/energy.hpp"
+#include "dynamics/kinematics.hpp"
+#include "io/atomic_file.hpp"
+#include "model/errors.hpp"
+#include "simulation/driver.hpp"
+#include "simulation/simulator.hpp"
+#include "simulation/stepper.hpp"
+#include "study/files.hpp"
+
+namespace codyna {
+
+namespace {
+
+constexpr double kManeuverPi = 3.14159265358979323846;
+
+struct ManeuverFlags {
+  OptionStyle style;
+  std::string operator()(const std::string& dashed) const { return option_name(style, dashed); }
+};
+
+double mnv_positive(const ManeuverFlags& flag, const std::optional<double>& v, double fallback, const char* name) {
+  if (!v) return fallback;
+  if (!(*v > 0) || !std::isfinite(*v)) {
+    std::ostringstream os;
+    os << flag(name) << ": expected a number > 0, got " << *v;
+    throw std::invalid_argument(os.str());
+  }
+  return *v;
+}
+
+int mnv_actuator(const Model& m, const std::string& name, const std::string& field) {
+  for (std::size_t k = 0; k < m.actuators.size(); ++k)
+    if (m.actuators[k].name == name) return static_cast<int>(k);
+  throw ModelError(m.source_file, field, "the maneuver needs the actuator \"" + name + "\", which the model does not have");
+}
+
+int mnv_output(const Model& m, const std::string& name, const std::string& field, bool required) {
+  for (std::size_t k = 0; k < m.plant_outputs.size(); ++k)
+    if (m.sensors[static_cast<std::size_t>(m.plant_outputs[k])].name == name) return static_cast<int>(k);
+  if (!required) return -1;
+  std::string have;
+  for (int k : m.plant_outputs) have += (have.empty() ? "" : ", ") + m.sensors[static_cast<std::size_t>(k)].name;
+  throw ModelError(m.source_file, field,
+                   "the maneuver needs the Plant/Out output \"" + name + "\" (Plant/Out: " + (have.empty() ? "none" : have) + ")");
+}
+
+// the body whose motion the steady search sets (study.steady.body, or the first on a free or
+// planar joint to ground)
+int mnv_steady_body(const Model& m) {
+  const std::string& name = m.spec.analysis.steady.body;
+  for (int b = 1; b < m.nbodies; ++b) {
+    const JointModel& j = m.joints[static_cast<std::size_t>(b)];
+    if (!name.empty() ? m.body_names[static_cast<std::size_t>(b)] == name
+                      : j.parent == 0 && (j.type == JointType::Free || j.type == JointType::Planar))
+      return b;
+  }
+  throw ModelError(m.source_file, "/analysis/steady/body", "the maneuver needs a body on a free or planar joint to ground");
+}
+
+// the steady body's centre of mass in the world, its heading, roll, and its velocity in its own axes
+struct BodyState {
+  Eigen::Vector3d p, v_body;
+  double heading = 0, roll = 0;
+  double speed_along_heading = 0, yaw_rate = 0;  // in the road plane (world x, y), about world z
+};
+BodyState mnv_body_state(const Model& m, Data& d, int body, const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
+  forward_kinematics<double>(m, d, q, v);
+  const SE3& X = d.oMi[static_cast<std::size_t>(body)];
+  const Eigen::Vector3d c = m.com[static_cast<std::size_t>(body)];
+  BodyState s;
+  s.p = X.act_point(c);
+  const Vec6T<double>& V = d.v[static_cast<std::size_t>(body)];
+  s.v_body = V.tail<3>() + V.head<3>().cross(c);
+  s.heading = std::atan2(X.R(1, 0), X.R(0, 0));
+  s.roll = std::atan2(X.R(2, 1), X.R(2, 2));
+  const Eigen::Vector3d v_world = X.R * s.v_body, w_world = X.R * V.head<3>();
+  s.speed_along_heading = std::cos(s.heading) * v_world.x() + std::sin(s.heading) * v_world.y();
+  s.yaw_rate = w_world.z();
+  return s;
+}
+
+// one steer profile: value, rate and acceleration at t
+struct SteerProfile {
+  std::function<double(double)> value, rate, acceleration;
+};
+
+SteerProfile mnv_ramp(double amplitude, double t0, double T) {
+  const double w = kManeuverPi / T;
+  SteerProfile p;
+  p.value = [=](double t) { return t < t0 ? 0.0 : t > t0 + T ? amplitude : amplitude * 0.5 * (1 - std::cos(w * (t - t0))); };
+  p.rate = [=](double t) { return t < t0 || t > t0 + T ? 0.0 : amplitude * 0.5 * w * std::sin(w * (t - t0)); };
+  p.acceleration = [=](double t) { return t < t0 || t > t0 + T ? 0.0 : amplitude * 0.5 * w * w * std::cos(w * (t - t0)); };
+  return p;
+}
+
+// one period of a sine of frequency f, held at its second peak (-amplitude) for `dwell`
+SteerProfile mnv_sine_dwell(double amplitude, double t0, double f, double dwell) {
+  const double w = 2 * kManeuverPi * f, t_peak = 0.75 / f, t_end = 1.0 / f + dwell;
+  // the sine's phase time at t (the dwell removed), or -1 outside the steer, or -2 in the dwell
+  const auto phase = [=](double t) {
+    const double tau = t - t0;
+    if (tau < 0 || tau > t_end) return -1.0;
+    if (tau < t_peak) return tau;
+    if (tau < t_peak + dwell) return -2.0;
+    return tau - dwell;
+  };
+  SteerProfile p;
+  p.value = [=](double t) {
+    const double s = phase(t);
+    return s == -1.0 ? 0.0 : s == -2.0 ? -amplitude : amplitude * std::sin(w * s);
+  };
+  p.rate = [=](double t) {
+    const double s = phase(t);
+    return s < 0 ? 0.0 : amplitude * w * std::cos(w * s);
+  };
+  p.acceleration = [=](double t) {
+    const double s = phase(t);
+    return s < 0 ? 0.0 : -amplitude * w * w * std::sin(w * s);
+  };
+  return p;
+}
+
+IntegratorSettings mnv_integrator(const Model& m) {
+  IntegratorSettings is;
+  is.method = m.spec.solver.integrator;
+  is.rtol = m.spec.solver.rtol;
+  is.atol = m.spec.solver.atol;
+  is.max_step = m.spec.solver.max_step;
+  return is;
+}
+
+// the study's straight steady run at the request's speed
+ModelSpec mnv_straight_spec(const ManeuverRequest& r, ModelSpec spec) {
+  if (r.integrator) {
+    if (!is_integrator_name(*r.integrator))
+      throw std::invalid_argument(option_name(r.style, "integrator") + ": unknown integrator \"" + *r.integrator +
+                                  "\" (expected one of " + integrator_names() + ")");
+    spec.solver.integrator = *r.integrator;
+  }
+  spec.analysis.operating_point = "steady";
+  if (r.speed) spec.analysis.steady.speed = *r.speed;
+  spec.analysis.steady.yaw_rate.reset();
+  spec.analysis.steady.radius.reset();
+  spec.analysis.steady.lateral_acceleration.reset();
+  return spec;
+}
+
+// a run that left the road, or spun
+void mnv_check_run(ManeuverReport& rep, const SimulationResult& res, const Model& m, int body) {
+  if (!res.completed) {
+    rep.valid = false;
+    rep.invalid_reason = "the run did not complete: " + (res.failure.empty() ? std::string("cancelled") : res.failure);
+    return;
+  }
+  Data d(m);
+  double worst = 0, at = 0;
+  for (int k = 0; k < res.samples(); ++k) {
+    const BodyState s = mnv_body_state(m, d, body, res.q.row(k).transpose(), res.v.row(k).transpose());
+    const double beta = std::atan2(s.v_body.y(), std::abs(s.v_body.x()));
+    if (std::abs(beta) > worst) {
+      worst = std::abs(beta);
+      at = res.t[static_cast<std::size_t>(k)];
+    }
+  }
+  if (worst > 20 * kManeuverPi / 180) {
+    std::ostringstream os;
+    os << "the car spun out: its sideslip reached " << worst * 180 / kManeuverPi << " deg at t = " << at << " s";
+    rep.valid = false;
+    rep.invalid_reason = os.str();
+  }
+}
+
+std::vector<double> mnv_column(const SimulationResult& r, int k) {
+  std::vector<double> c(static_cast<std::size_t>(r.samples()));
+  for (int i = 0; i < r.samples(); ++i) c[static_cast<std::size_t>(i)] = r.y(i, k);
+  return c;
+}
+
+void mnv_write(ManeuverReport& rep, const ManeuverRequest& r) {
+  if (!r.out.empty()) {
+    study_write_results_hdf5(rep.result, r.out);
+    rep.written.push_back(r.out);
+  }
+  if (!r.csv.empty()) {
+    study_write_results_csv(rep.result, r.csv);
+    rep.written.push_back(r.csv);
+  }
+}
+
+ManeuverReport mnv_open_loop(const ManeuverRequest& r, const ModelSpec& spec, bool sine) {
+  const ManeuverFlags flag{r.style};
+  ManeuverReport rep;
+  rep.type = r.type;
+  const Model m = study_model(mnv_straight_spec(r, spec), r.model);
+  rep.model_name = m.name;
+  const HandlingSpec& h = m.spec.analysis.handling;
+  if (h.steer.empty())
+    throw ModelError(m.source_file, "/analysis/handling/steer", "the maneuver needs the steer input named here");
+  if (h.yaw_rate.empty())
+    throw ModelError(m.source_file, "/analysis/handling/yaw_rate", "the maneuver needs the yaw-rate output named here");
+  const int ks = mnv_actuator(m, h.steer, "/analysis/handling/steer");
+  const int iy = mnv_output(m, h.yaw_rate, "/analysis/handling/yaw_rate", true);
+  const int ia = h.lateral_acceleration.empty() ? -1 : mnv_output(m, h.lateral_acceleration, "/analysis/handling/lateral_acceleration", false);
+  const int body = mnv_steady_body(m);
+  const OperatingPoint op = study_operating_point(m, "steady");
+  Data d(m);
+  const BodyState s0 = mnv_body_state(m, d, body, op.q, op.v);
+  rep.speed = s0.v_body.norm();
+
+  const double amplitude = r.steer ? *r.steer : (sine ? 0.05 : 0.01);
+  if (!std::isfinite(amplitude) || amplitude == 0)
+    throw std::invalid_argument(flag("steer") + ": expected a steer amplitude other than 0");
+  rep.steer = amplitude;
+  const double t0 = r.steer_time ? *r.steer_time : 0.5;
+  if (!(t0 >= 0) || !std::isfinite(t0)) throw std::invalid_argument(flag("steer-time") + ": expected a time >= 0");
+  SteerProfile profile;
+  std::vector<double> stops;
+  double t_end = 0, t_ref = 0;
+  if (sine) {
+    const double f = mnv_positive(flag, r.frequency, 0.7, "frequency");
+    const double dwell = r.dwell ? *r.dwell : 0.5;
+    if (!(dwell >= 0)) throw std::invalid_argument(flag("dwell") + ": expected a time >= 0");
+    profile = mnv_sine_dwell(amplitude, t0, f, dwell);
+    // the steer's acceleration jumps there: the run stops and the integrator starts again
+    stops = {t0, t0 + 0.75 / f, t0 + 0.75 / f + dwell, t0 + 1.0 / f + dwell};
+    rep.steer_start = t0;
+    rep.steer_end = t0 + 1.0 / f + dwell;
+    t_end = r.t_end ? *r.t_end : rep.steer_end + 2.0;
+    if (t_end < rep.steer_end + 1.75)
+      throw std::invalid_argument(flag("t-end") + ": the run must last 1.75 s past the steer's end (" +
+                                  std::to_string(rep.steer_end + 1.75) + " s)");
+  } else {
+    const double ramp = mnv_positive(flag, r.ramp, 0.05, "ramp");
+    profile = mnv_ramp(amplitude, t0, ramp);
+    stops = {t0, t0 + ramp};
+    t_ref = t0 + ramp / 2;
+    t_end = r.t_end ? *r.t_end : t0 + ramp + 4.0;
+    if (!(t_end > t0 + ramp + 0.5))
+      throw std::invalid_argument(flag("t-end") + ": the run must last at least 0.5 s past the ramp's end");
+  }
+  SimulationOptions o;
+  o.integrator = mnv_integrator(m);
+  o.t_end = t_end;
+  o.output_step = mnv_positive(flag, r.output_step, 0.005, "output-step");
+  const Model run = held_at(m, op, o);
+  const Eigen::Index nu = run.nu();
+  const auto one = [nu, ks](double x) {
+    Eigen::VectorXd v = Eigen::VectorXd::Zero(nu);
+    v[ks] = x;
+    return v;
+  };
+  o.disturbance = [one, profile](double t) { return one(profile.value(t)); };
+  o.disturbance_rate = [one, profile](double t) { return one(profile.rate(t)); };
+  o.disturbance_acceleration = [one, profile](double t) { return one(profile.acceleration(t)); };
+  o.rate_jumps = stops;
+  rep.result = simulate(run, nullptr, nullptr, o);
+  mnv_check_run(rep, rep.result, run, body);
+  if (rep.result.samples() > 0) {
+    const int last = rep.result.samples() - 1;
+    const BodyState e = mnv_body_state(run, d, body, rep.result.q.row(last).transpose(), rep.result.v.row(last).transpose());
+    rep.end_speed = e.speed_along_heading;
+    rep.end_yaw_rate = e.yaw_rate;
+  }
+
+  if (rep.result.samples() >= 3) {
+    const std::vector<double> yaw = mnv_column(rep.result, iy);
+    if (sine) {
+      // the lateral displacement from the start, perpendicular to the start's heading
+      std::vector<double> lateral(yaw.size());
+      const Eigen::Vector2d n(-std::sin(s0.heading), std::cos(s0.heading));
+      for (int k = 0; k < rep.result.samples(); ++k) {
+        const BodyState s = mnv_body_state(run, d, body, rep.result.q.row(k).transpose(), rep.result.v.row(k).transpose());
+        lateral[static_cast<std::size_t>(k)] = n.dot((s.p - s0.p).head<2>());
+      }
+      try {
+        // FMVSS 126: the peak after the steer changes sign (its second half wave's direction)
+        rep.sine = sine_with_dwell_metrics(rep.result.t, yaw, lateral, rep.steer_start, rep.steer_end, -amplitude,
+                                           rep.steer_start + 0.5 / mnv_positive(flag, r.frequency, 0.7, "frequency"));
+      } catch (const std::invalid_argument& e) {
+        rep.valid = false;
+        if (rep.invalid_reason.empty()) rep.invalid_reason = e.what();
+      }
+    } else {
+      try {
+        rep.yaw_rate = step_response_metrics(rep.result.t, yaw, t_ref, amplitude);
+        if (ia >= 0) {
+          rep.lateral_acceleration = step_response_metrics(rep.result.t, mnv_column(rep.result, ia), t_ref, amplitude);
+          rep.has_lateral_acceleration = true;
+        }
+      } catch (const std::invalid_argument& e) {
+        rep.valid = false;
+        if (rep.invalid_reason.empty()) rep.invalid_reason = e.what();
+      }
+    }
+  }
+  mnv_write(rep, r);
+  return rep;
+}
+
+ManeuverReport mnv_lane_change(const ManeuverRequest& r, const ModelSpec& spec) {
+  const ManeuverFlags flag{r.style};
+  ManeuverReport rep;
+  rep.type = r.type;
+  const Model m = study_model(mnv_straight_spec(r, spec), r.model);
+  rep.model_name = m.name;
+  const bool from_file = m.spec.controller.type == ControllerType::Driver;
+  const ControllerSpec& c = m.spec.controller;
+  DriverSignals names;
+  if (from_file) names = DriverSignals{c.x, c.y, c.yaw, c.forward_speed, c.steer, c.drive};
+  else if (!m.spec.analysis.handling.steer.empty()) names.steer = m.spec.analysis.handling.steer;
+  if (r.x) names.x = *r.x;
+  if (r.y) names.y = *r.y;
+  if (r.yaw) names.yaw = *r.yaw;
+  if (r.speed_output) names.speed = *r.speed_output;
+  if (r.drive) names.drive = *r.drive;
+  const int body = mnv_steady_body(m);
+  const OperatingPoint op = study_operating_point(m, "steady");
+  Data d(m);
+  const BodyState s0 = mnv_body_state(m, d, body, op.q, op.v);
+  rep.speed = s0.v_body.norm();
+
+  DriverSettings ds;
+  std::vector<std::string> outputs, inputs;
+  for (int k : m.plant_outputs) outputs.push_back(m.sensors[static_cast<std::size_t>(k)].name);
+  for (int k : m.plant_inputs) inputs.push_back(m.actuators[static_cast<std::size_t>(k)].name);
+  Eigen::VectorXd u0(static_cast<Eigen::Index>(inputs.size()));
+  for (std::size_t k = 0; k < m.plant_inputs.size(); ++k) u0[static_cast<Eigen::Index>(k)] = op.u[m.plant_inputs[k]];
+  ds.u0 = u0;
+  // the names: refused naming the flag when the request gave them, else the file's field
+  try {
+    resolve_driver_signals(ds, names, outputs, inputs, (m.source_file.empty() ? "" : m.source_file + ": ") + "/controller");
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    for (const auto& [given, field, key] : {std::tuple{r.x.has_value(), "/x", "x"}, {r.y.has_value(), "/y", "y"},
+                                            {r.yaw.has_value(), "/yaw", "yaw"},
+                                            {r.speed_output.has_value(), "/forward_speed", "speed-output"},
+                                            {r.drive.has_value(), "/drive", "drive"}})
+      if (given && what.find(std::string("/controller") + field + ":") != std::string::npos)
+        throw std::invalid_argument(flag(key) + what.substr(what.find(':', what.find("/controller")) ));
+    throw;
+  }
+  // the output names were resolved: their values at the start
+  SimulationOptions o;
+  const Model run = held_at(m, op, o);
+  Stepper st(run, mnv_integrator(run));
+  st.reset(0, o.q0, o.v0);
+  const Eigen::VectorXd y0 = st.outputs();
+  const double yaw0 = y0[ds.out_yaw];
+  if (std::abs(yaw0) > 1e-9)
+    rep.notes.push_back("the lane is laid out along the car's heading at the start");
+  const double width = mnv_positive(flag, r.width, from_file ? c.vehicle_width : 1.8, "width");
+  const double length = mnv_positive(flag, r.length, 4.5, "length");
+  ds.path = path_double_lane_change(Eigen::Vector2d(0, 0), width);
+  // into the world: rotated by the start's heading about the start's position
+  const Eigen::Vector2d start(y0[ds.out_x], y0[ds.out_y]);
+  const Eigen::Rotation2Dd rot(yaw0);
+  DriverPath local = ds.path;
+  for (Eigen::Vector2d& p : ds.path.points) p = start + rot * p;
+  ds.preview = mnv_positive(flag, r.preview, from_file ? c.preview : std::max(5.0, 0.5 * rep.speed), "preview");
+  ds.wheelbase = from_file ? c.wheelbase : (m.spec.analysis.handling.wheelbase ? *m.spec.analysis.handling.wheelbase : 2.7);
+  ds.steering_ratio = from_file ? c.steering_ratio : (m.spec.analysis.handling.steering_ratio ? *m.spec.analysis.handling.steering_ratio : 1.0);
+  ds.lateral_gain = from_file ? c.lateral_gain : 0.05;
+  if (r.lateral_gain) {
+    if (!(*r.lateral_gain >= 0)) throw std::invalid_argument(flag("lateral-gain") + ": expected a number >= 0");
+    ds.lateral_gain = *r.lateral_gain;
+  }
+  ds.speed = rep.speed;
+  ds.speed_kp = r.speed_kp ? *r.speed_kp : from_file ? c.speed_kp : 0.0;
+  ds.speed_ki = r.speed_ki ? *r.speed_ki : from_file ? c.speed_ki : 0.0;
+  ds.sample_time = mnv_positive(flag, r.sample_time, from_file ? c.sample_time : 0.01, "sample-time");
+  if (r.speed_kp && !(*r.speed_kp >= 0)) throw std::invalid_argument(flag("speed-kp") + ": expected a number >= 0");
+  if (r.speed_ki && !(*r.speed_ki >= 0)) throw std::invalid_argument(flag("speed-ki") + ": expected a number >= 0");
+  const std::unique_ptr<Controller> driver = make_driver(ds, flag("driver"));
+
+  // the run: sampled driver, zero-order hold on the plant (simulation/stepper.hpp)
+  const double lane_end = local.gate_end.back() + 20;
+  const double t_end = r.t_end ? *r.t_end : (lane_end) / std::max(rep.speed, 1.0);
+  const int steps = static_cast<int>(std::ceil(t_end / ds.sample_time));
+  if (steps > 2000000) throw std::invalid_argument(flag("t-end") + ": too many driver samples");
+  SimulationResult& res = rep.result;
+  res.q.resize(steps + 1, run.nq);
+  res.v.resize(steps + 1, run.nv);
+  res.u.resize(steps + 1, run.nu());
+  res.y.resize(steps + 1, static_cast<Eigen::Index>(outputs.size()));
+  res.xc.resize(steps + 1, 2);
+  Eigen::VectorXd xc = Eigen::VectorXd::Zero(2);
+  std::vector<double> lateral;
+  ControllerInput in;
+  int done = 0;
+  res.completed = true;
+  for (int k = 0; k <= steps; ++k) {
+    in.t = st.time();
+    in.y = st.outputs();
+    const Eigen::VectorXd u = driver->output(in, xc);
+    res.t.push_back(in.t);
+    res.q.row(k) = st.q().transpose();
+    res.v.row(k) = st.v().transpose();
+    Eigen::VectorXd ua = run.nu() ? Eigen::VectorXd(op.u) : Eigen::VectorXd();
+    for (std::size_t i = 0; i < m.plant_inputs.size(); ++i) ua[m.plant_inputs[i]] = u[static_cast<Eigen::Index>(i)];
+    res.u.row(k) = ua.transpose();
+    res.y.row(k) = in.y.transpose();
+    res.xc.row(k) = xc.transpose();
+    res.kinetic_energy.push_back(kinetic_energy<double>(run, d, st.q(), st.v()));
+    res.potential_energy.push_back(std::nan(""));
+    res.constraint_violation.push_back(0);
+    res.velocity_violation.push_back(0);
+    lateral.push_back(project_on_path(ds.path, Eigen::Vector2d(in.y[ds.out_x], in.y[ds.out_y])).lateral);
+    rep.max_steer = std::max(rep.max_steer, std::abs(u[ds.in_steer]));
+    done = k + 1;
+    if (k == steps) break;
+    xc = driver->update(in, xc);
+    try {
+      st.step(u, ds.sample_time);
+    } catch (const std::exception& e) {
+      res.completed = false;
+      res.failure = e.what();
+      break;
+    }
+  }
+  res.q.conservativeResize(done, Eigen::NoChange);
+  res.v.conservativeResize(done, Eigen::NoChange);
+  res.u.conservativeResize(done, Eigen::NoChange);
+  res.y.conservativeResize(done, Eigen::NoChange);
+  res.xc.conservativeResize(done, Eigen::NoChange);
+  res.q_names = run.q_names;
+  res.v_names = run.rate_names;
+  for (const ActuatorModel& a : run.actuators) {
+    res.input_names.push_back(a.name);
+    res.input_units.push_back(a.unit);
+  }
+  for (int k : run.plant_outputs) {
+    res.output_names.push_back(run.sensors[static_cast<std::size_t>(k)].name);
+    res.output_units.push_back(run.sensors[static_cast<std::size_t>(k)].unit);
+  }
+  res.controller_state_names = driver->state_names();
+  res.controller = driver->describe();
+  res.model_name = run.name;
+  res.model_file = r.model;
+  res.codyna_version = CODYNA_VERSION;
+  res.stats = st.stats();
+  mnv_check_run(rep, res, run, body);
+
+  // the lateral error from the start of section 1 to the end of section 6, and the cones: the
+  // rectangle's corners in the lane's frame against each section's lines
+  const double gate_from = local.gate_start.front(), gate_to = local.gate_end.back();
+  std::vector<double> tin, ein;
+  std::vector<bool> hit(local.gate_start.size(), false);
+  for (int k = 0; k < done; ++k) {
+    const Eigen::Vector2d p = rot.inverse() * (Eigen::Vector2d(res.y(k, ds.out_x), res.y(k, ds.out_y)) - start);
+    const double psi = res.y(k, ds.out_yaw) - yaw0;
+    if (p.x() >= gate_from && p.x() <= gate_to) {
+      tin.push_back(res.t[static_cast<std::size_t>(k)]);
+      ein.push_back(lateral[static_cast<std::size_t>(k)]);
+    }
+    const Eigen::Rotation2Dd body_rot(psi);
+    for (const double a : {-0.5, 0.5})
+      for (const double b : {-0.5, 0.5}) {
+        const Eigen::Vector2d corner = p + body_rot * Eigen::Vector2d(a * length, b * width);
+        for (std::size_t g = 0; g < hit.size(); ++g)
+          if (!hit[g] && corner.x() >= local.gate_start[g] && corner.x() <= local.gate_end[g] &&
+              std::abs(corner.y() - local.gate_center[g]) > local.gate_width[g] / 2) {
+            hit[g] = true;
+            std::ostringstream os;
+            os << "section " << (g == 0 ? 1 : g == 1 ? 3 : 5) << " (" << local.gate_width[g] << " m wide) at x = "
+               << std::setprecision(4) << corner.x() - local.gate_start.front() << " m, t = " << res.t[static_cast<std::size_t>(k)] << " s";
+            rep.cones_hit.push_back(os.str());
+          }
+      }
+  }
+  if (tin.empty()) {
+    rep.valid = false;
+    if (rep.invalid_reason.empty()) rep.invalid_reason = "the run ended before the lane (raise " + flag("t-end") + ")";
+  } else {
+    rep.path = path_error_metrics(tin, ein);
+  }
+  mnv_write(rep, r);
+  return rep;
+}
+
+ManeuverReport mnv_constant_radius(const ManeuverRequest& r, const ModelSpec& spec) {
+  const ManeuverFlags flag{r.style};
+  ManeuverReport rep;
+  rep.type = r.type;
+  if (!r.radius) throw std::invalid_argument(flag("radius") + ": the constant-radius maneuver needs a radius (m)");
+  if (!(*r.radius != 0) || !std::isfinite(*r.radius))
+    throw std::invalid_argument(flag("radius") + ": expected a radius other than 0 (m, > 0 turns left)");
+  rep.radius = *r.radius;
+  const double u_min = mnv_positive(flag, r.speed_min, 5.0, "speed-min");
+  const double u_max = mnv_positive(flag, r.speed_max, std::sqrt(0.6 * 9.81 * std::abs(rep.radius)), "speed-max");
+  if (!(u_max > u_min)) throw std::invalid_argument(flag("speed-max") + ": expected a speed above " + flag("speed-min"));
+  const int n = r.points ? *r.points : 8;
+  if (n < 2 || n > 1000) throw std::invalid_argument(flag("points") + ": expected 2 to 1000 points");
+  ModelSpec s = spec;
+  s.analysis.operating_point = "steady";
+  s.analysis.steady.yaw_rate.reset();
+  s.analysis.steady.lateral_acceleration.reset();
+  s.analysis.steady.radius = rep.radius;
+  s.analysis.steady.speed = u_min;
+  Model m = study_model(s, r.model);
+  rep.model_name = m.name;
+  const HandlingSpec& h = m.spec.analysis.handling;
+  if (h.steer.empty())
+    throw ModelError(m.source_file, "/analysis/handling/steer", "the maneuver needs the steer input named here");
+  const int ks = mnv_actuator(m, h.steer, "/analysis/handling/steer");
+  const double ratio = h.steering_ratio ? *h.steering_ratio : 1.0;
+  const int body = mnv_steady_body(m);
+  Data d(m);
+  const Eigen::VectorXd q_start = m.q0, v_start = m.v0;
+  std::vector<double> u0_start;
+  for (const ActuatorModel& a : m.actuators) u0_start.push_back(a.u0);
+  rep.cr_has_roll = m.joints[static_cast<std::size_t>(body)].type == JointType::Free;
+  for (int i = 0; i < n; ++i) {
+    const double U = u_min + (u_max - u_min) * i / (n - 1);
+    m.spec.analysis.steady.speed = U;
+    OperatingPoint op;
+    try {
+      op = study_operating_point(m, "steady");
+    } catch (const std::exception& e) {
+      rep.valid = false;
+      std::ostringstream os;
+      os << "no steady turn at " << U << " m/s on the " << rep.radius << " m radius (a_y " << U * U / std::abs(rep.radius)
+         << " m/s^2): " << e.what();
+      rep.invalid_reason = os.str();
+      break;
+    }
+    // the next search starts here (a continuation in speed)
+    m.q0 = op.q;
+    m.v0 = op.v;
+    for (std::size_t k = 0; k < m.actuators.size(); ++k) m.actuators[k].u0 = op.u[static_cast<Eigen::Index>(k)];
+    const BodyState b = mnv_body_state(m, d, body, op.q, op.v);
+    const double speed = b.v_body.norm();  // the centre of mass's: a_y = V^2 / R on its circle
+    rep.cr_speed.push_back(U);              // along the heading in the road plane, as the search sets it
+    rep.cr_lateral_acceleration.push_back((rep.radius > 0 ? 1.0 : -1.0) * speed * speed / std::abs(rep.radius));
+    rep.cr_steer.push_back(op.u[ks]);
+    rep.cr_road_wheel.push_back(op.u[ks] / ratio);
+    rep.cr_sideslip.push_back(std::atan2(b.v_body.y(), b.v_body.x()));
+    rep.cr_roll.push_back(rep.cr_has_roll ? b.roll : 0.0);
+  }
+  if (rep.cr_speed.size() >= 2) rep.cr_gradient = understeer_diagram(rep.cr_lateral_acceleration, rep.cr_road_wheel);
+  // the linear model's understeer gradient, straight ahead at the first speed
+  try {
+    ModelSpec ls = mnv_straight_spec(r, spec);
+    ls.analysis.steady.speed = u_min;
+    const Model lm = study_model(ls, r.model);
+    const StudyLinearization lin = study_linearize(lm);
+    if (lin.handling) rep.linear_gradient = lin.handling->understeer_gradient;
+  } catch (const std::exception& e) {
+    rep.notes.push_back(std::string("no linear understeer gradient to compare with: ") + e.what());
+  }
+  rep.speed = u_min;
+  if (!r.csv.empty()) {
+    study_guard_output(r.csv, OutputKind::CurvesCsv, {r.model});
+    std::ostringstream os;
+    os << std::setprecision(17) << "speed,lateral_acceleration,steer,road_wheel_angle,sideslip,roll,understeer_gradient\n";
+    for (std::size_t k = 0; k < rep.cr_speed.size(); ++k)
+      os << rep.cr_speed[k] << "," << rep.cr_lateral_acceleration[k] << "," << rep.cr_steer[k] << ","
+         << rep.cr_road_wheel[k] << "," << rep.cr_sideslip[k] << "," << rep.cr_roll[k] << ","
+         << (k < rep.cr_gradient.size() ? rep.cr_gradient[k] : std::nan("")) << "\n";
+    write_file_atomically(r.csv, os.str());
+    rep.written.push_back(r.csv);
+  }
+  return rep;
+}
+
+}  // namespace
+
+ManeuverReport study_maneuver_job(const ManeuverRequest& r, const ModelSpec& spec, const StudyMessages& tell) {
+  const ManeuverFlags flag{r.style};
+  std::string known;
+  for (const char* t : kManeuverTypes) known += (known.empty() ? "" : ", ") + std::string(t);
+  if (r.type.empty()) throw std::invalid_argument(flag("type") + ": expected one of " + known);
+  for (const std::string& f : {r.out, r.csv})
+    if (!f.empty()) study_guard_output(f, f == r.out ? OutputKind::ResultsHdf5 : (r.type == "constant-radius" ? OutputKind::CurvesCsv : OutputKind::ResultsCsv), {r.model});
+  ManeuverReport rep;
+  ModelSpec given = spec;
+  if (r.free_inputs) given.analysis.free_inputs = *r.free_inputs;
+  if (r.type == "step-steer") rep = mnv_open_loop(r, given, false);
+  else if (r.type == "sine-with-dwell") rep = mnv_open_loop(r, given, true);
+  else if (r.type == "double-lane-change") rep = mnv_lane_change(r, given);
+  else if (r.type == "constant-radius") rep = mnv_constant_radius(r, given);
+  else throw std::invalid_argument(flag("type") + ": unknown maneuver \"" + r.type + "\" (expected one of " + known + ")");
+  if (tell) {
+    for (const std::string& n : rep.notes) tell({StudyMessage::Note, n});
+    for (const std::string& w : rep.warnings) tell({StudyMessage::Warning, w});
+  }
+  return rep;
+}
+
+std::string study_maneuver_text(const ManeuverReport& r) {
+  std::ostringstream os;
+  os << std::setprecision(6);
+  const double deg = 180 / kManeuverPi;
+  os << "maneuver         " << r.type << "\n";
+  os << "model            " << r.model_name << "\n";
+  if (r.type == "constant-radius") {
+    os << "radius           " << r.radius << " m\n";
+    os << "  speed (m/s)   a_y (m/s^2)   steer        road wheel (deg)  sideslip (deg)  roll (deg)  K (deg/g)\n";
+    for (std::size_t k = 0; k < r.cr_speed.size(); ++k) {
+      os << "  " << std::setw(12) << r.cr_speed[k] << "  " << std::setw(12) << r.cr_lateral_acceleration[k] << "  "
+         << std::setw(11) << r.cr_steer[k] << "  " << std::setw(16) << r.cr_road_wheel[k] * deg << "  " << std::setw(14)
+         << r.cr_sideslip[k] * deg << "  " << std::setw(10) << r.cr_roll[k] * deg << "  "
+         << (k < r.cr_gradient.size() ? r.cr_gradient[k] * deg * 9.80665 : std::nan("")) << "\n";
+    }
+    if (!r.cr_gradient.empty()) {
+      os << "understeer gradient at the lowest a_y   " << r.cr_gradient.front() << " rad/(m/s^2) = "
+         << r.cr_gradient.front() * deg * 9.80665 << " deg/g\n";
+      if (r.linear_gradient)
+        os << "linear model (straight at " << r.speed << " m/s)   " << *r.linear_gradient << " rad/(m/s^2) = "
+           << *r.linear_gradient * deg * 9.80665 << " deg/g (difference "
+           << std::abs(r.cr_gradient.front() - *r.linear_gradient) / std::abs(*r.linear_gradient) * 100 << " %)\n";
+    }
+  } else {
+    os << "speed            " << r.speed << " m/s\n";
+  }
+  if (r.type == "step-steer") {
+    os << "steer step       " << r.steer << "\n";
+    const auto line = [&os](const char* name, const StepMetrics& m, const char* unit) {
+      os << name << "\n"
+         << "  steady-state gain     " << m.gain << " " << unit << " per steer\n"
+         << "  response time (90 %)  " << m.response_time << " s\n"
+         << "  peak response time    " << m.peak_time << " s\n"
+         << "  overshoot             " << m.overshoot_percent << " %\n";
+    };
+    line("yaw rate", r.yaw_rate, "1/s");
+    if (r.has_lateral_acceleration) line("lateral acceleration", r.lateral_acceleration, "m/s^2");
+  } else if (r.type == "sine-with-dwell") {
+    os << "steer amplitude  " << r.steer << " (steer from " << r.steer_start << " s to " << r.steer_end << " s)\n"
+       << "yaw-rate peak (2nd half)    " << r.sine.peak_yaw_rate << " rad/s at " << r.sine.peak_time << " s\n"
+       << "yaw-rate ratio at 1.00 s    " << r.sine.yrr_1_00 << " % (FMVSS 126: at most 35 %)\n"
+       << "yaw-rate ratio at 1.75 s    " << r.sine.yrr_1_75 << " % (at most 20 %)\n"
+       << "lateral displacement        " << r.sine.lateral_displacement << " m at 1.07 s (at least 1.83 m)\n"
+       << "FMVSS 126                   " << (r.sine.passes_fmvss126 ? "passes" : "fails") << "\n";
+  } else if (r.type == "double-lane-change") {
+    os << "path error       max " << r.path.max_abs << " m at " << r.path.at << " s, RMS " << r.path.rms << " m\n"
+       << "largest steer    " << r.max_steer << "\n"
+       << "cones            " << (r.cones_hit.empty() ? "none hit" : std::to_string(r.cones_hit.size()) + " section(s) hit") << "\n";
+    for (const std::string& c : r.cones_hit) os << "  hit: " << c << "\n";
+  }
+  if (!r.valid) os << "metrics INVALID: " << r.invalid_reason << "\n";
+  for (const std::string& w : r.written) os << "wrote " << w << "\n";
+  return os.str();
+}
+
+}  // namespace codyna

@@ -1,0 +1,98 @@
+// Standard handling maneuvers with their metrics (codyna maneuver, Python codyna.maneuver):
+//
+//   step-steer          ISO 7401: from the steady straight run (the study's steady motion at
+//                       --speed), the steer input ramps by --steer over --ramp s (a half cosine:
+//                       its rate and acceleration exact, so a motion input takes it) starting at
+//                       --steer-time; yaw-rate and lateral-acceleration response times (to 90 %),
+//                       peak response times, overshoots and steady-state gains (analysis/
+//                       maneuver_metrics.hpp), times from the steer's 50 % point.
+//   sine-with-dwell     ISO 19365 / FMVSS 126: one period of a --frequency (0.7 Hz) sine of
+//                       amplitude --steer with a --dwell (0.5 s) at its second peak; the yaw-rate
+//                       ratios 1.0 and 1.75 s after the steer ends, the lateral displacement of the
+//                       steady body's centre of mass 1.07 s after the steer starts.
+//   double-lane-change  ISO 3888-1, driven by the driver (simulation/driver.hpp) on the lane's
+//                       centre line for a car of --width: the lateral error (max, RMS), and the
+//                       cones hit (a --width x --length rectangle about the position outputs).
+//   constant-radius     ISO 4138 style: steady turns on one --radius at --points speeds rising from
+//                       --speed-min to --speed-max, each the steady motion's search (the file's
+//                       study, its free inputs) started from the one before; steer, road-wheel
+//                       angle, sideslip and roll over lateral acceleration, the understeer gradient
+//                       d(delta)/d(a_y) over a_y, against the linear model's (handling numbers at
+//                       the straight run at the first speed).
+// A run that leaves the road (the integrator fails, the speed or yaw rate runs away) is reported
+// with its metrics marked invalid and the reason. Files: the run as HDF5 / CSV (--out, --csv;
+// the constant radius: --csv, its table).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "analysis/maneuver_metrics.hpp"
+#include "study/jobs.hpp"
+
+namespace codyna {
+
+// the maneuver types, in the order the help lists them
+inline constexpr const char* kManeuverTypes[] = {"step-steer", "sine-with-dwell", "double-lane-change",
+                                                 "constant-radius"};
+
+struct ManeuverRequest {
+  OptionStyle style = OptionStyle::Flag;
+  std::string model;      // the model file
+  std::string type;       // one of kManeuverTypes
+  std::string out, csv;   // results ("" = not written)
+  std::optional<double> speed;                 // m/s (the steady motion's; default the file's)
+  std::optional<double> steer;                 // steer input amplitude (step, sine)
+  std::optional<double> steer_time, ramp;      // s: when the steer starts (default 0.5), its ramp (0.05)
+  std::optional<double> frequency, dwell;      // sine with dwell: Hz (0.7), s (0.5)
+  std::optional<double> t_end, output_step;    // s
+  std::optional<std::string> integrator;       // the runs' (default the model file's solver)
+  std::optional<double> radius;                // constant radius, m
+  std::optional<double> speed_min, speed_max;  // constant radius, m/s
+  std::optional<int> points;                   // constant radius (default 8)
+  // the steady motion's free inputs (StudySpec::free_inputs; a turn needs the drive that holds
+  // the speed besides the steer): each given replaces the file's list
+  std::optional<std::vector<std::string>> free_inputs;
+  // the driver (double lane change)
+  std::optional<double> width, length, preview, lateral_gain, speed_kp, speed_ki, sample_time;
+  std::optional<std::string> x, y, yaw, speed_output, drive;  // Plant/Out / Plant/In names
+};
+
+struct ManeuverReport {
+  std::string type, model_name;
+  double speed = 0;                      // m/s at the start
+  // open loop: at the run's end, the steady body's speed along its heading in the road plane and
+  // its yaw rate about the road's normal (what the steady-motion search takes)
+  double end_speed = 0, end_yaw_rate = 0;
+  std::vector<std::string> notes, warnings;
+  bool valid = true;
+  std::string invalid_reason;            // why the metrics are not to be trusted
+  // step steer
+  double steer = 0;                      // the step (steer input units)
+  StepMetrics yaw_rate, lateral_acceleration;
+  bool has_lateral_acceleration = false;
+  // sine with dwell
+  SineWithDwellMetrics sine;
+  double steer_start = 0, steer_end = 0;
+  // double lane change
+  PathErrorMetrics path;
+  std::vector<std::string> cones_hit;    // "section 3 at x = 81.2 m" (empty: none)
+  double max_steer = 0;
+  // constant radius: one entry per point
+  double radius = 0;
+  std::vector<double> cr_speed, cr_lateral_acceleration, cr_steer, cr_road_wheel, cr_sideslip, cr_roll, cr_gradient;
+  bool cr_has_roll = false;
+  std::optional<double> linear_gradient;  // rad per m/s^2, at the first speed, straight
+  // the run (time series; not for the constant radius)
+  SimulationResult result;
+  std::vector<std::string> written;
+};
+
+// The whole `codyna maneuver`. Refusals name the flag or keyword (style) or the model file's field.
+ManeuverReport study_maneuver_job(const ManeuverRequest& r, const ModelSpec& spec, const StudyMessages& tell = {});
+
+// the report as `codyna maneuver` prints it
+std::string study_maneuver_text(const ManeuverReport& r);
+
+}  // namespace codyna

@@ -1,0 +1,97 @@
+// _codyna._maneuver: study_maneuver_job (study/maneuver_job.hpp) with the keywords given, its
+// report as a dict of plain values. Conversion only.
+#include "bind_common.hpp"
+#include "study/maneuver_job.hpp"
+
+namespace codyna::python {
+
+namespace {
+
+py::dict maneuver_step_of(const StepMetrics& m) {
+  return py::dict("initial"_a = m.initial, "steady"_a = m.steady, "gain"_a = m.gain, "response_time"_a = m.response_time,
+                  "peak_time"_a = m.peak_time, "peak"_a = m.peak, "overshoot_percent"_a = m.overshoot_percent);
+}
+
+py::dict do_maneuver(const Study& s, const py::dict& options) {
+  Keywords k(options, "maneuver");
+  ManeuverRequest r;
+  r.style = OptionStyle::Keyword;
+  r.model = s.file;
+  r.type = k.text("type").value_or("");
+  r.out = k.path("out").value_or("");
+  r.csv = k.path("csv").value_or("");
+  r.speed = k.number("speed");
+  r.steer = k.number("steer");
+  r.steer_time = k.number("steer_time");
+  r.ramp = k.number("ramp");
+  r.frequency = k.number("frequency");
+  r.dwell = k.number("dwell");
+  r.t_end = k.number("t_end");
+  r.output_step = k.number("output_step");
+  r.radius = k.number("radius");
+  r.speed_min = k.number("speed_min");
+  r.speed_max = k.number("speed_max");
+  if (const auto n = k.whole("points", 2, 1000)) r.points = static_cast<int>(*n);
+  r.width = k.number("width");
+  r.length = k.number("length");
+  r.preview = k.number("preview");
+  r.lateral_gain = k.number("lateral_gain");
+  r.speed_kp = k.number("speed_kp");
+  r.speed_ki = k.number("speed_ki");
+  r.sample_time = k.number("sample_time");
+  r.x = k.text("x");
+  r.y = k.text("y");
+  r.yaw = k.text("yaw");
+  r.speed_output = k.text("speed_output");
+  r.drive = k.text("drive");
+  r.integrator = k.text("integrator");
+  r.free_inputs = k.names("free_inputs", "free_input");
+  k.finish();
+  ManeuverReport rep;
+  {
+    py::gil_scoped_release release;
+    rep = study_maneuver_job(r, *s.spec);
+  }
+  py::dict d("type"_a = rep.type, "model"_a = rep.model_name, "speed"_a = rep.speed, "valid"_a = rep.valid,
+             "invalid_reason"_a = rep.invalid_reason, "notes"_a = rep.notes, "written"_a = rep.written,
+             "text"_a = study_maneuver_text(rep));
+  if (rep.type == "step-steer") {
+    d["yaw_rate"] = maneuver_step_of(rep.yaw_rate);
+    if (rep.has_lateral_acceleration) d["lateral_acceleration"] = maneuver_step_of(rep.lateral_acceleration);
+  } else if (rep.type == "sine-with-dwell") {
+    d["peak_yaw_rate"] = rep.sine.peak_yaw_rate;
+    d["yaw_rate_ratio_1_00"] = rep.sine.yrr_1_00;
+    d["yaw_rate_ratio_1_75"] = rep.sine.yrr_1_75;
+    d["lateral_displacement"] = rep.sine.lateral_displacement;
+    d["passes_fmvss126"] = rep.sine.passes_fmvss126;
+  } else if (rep.type == "double-lane-change") {
+    d["path_error_max"] = rep.path.max_abs;
+    d["path_error_rms"] = rep.path.rms;
+    d["cones_hit"] = rep.cones_hit;
+  } else if (rep.type == "constant-radius") {
+    d["radius"] = rep.radius;
+    d["speed"] = vector_of(rep.cr_speed);
+    d["lateral_acceleration"] = vector_of(rep.cr_lateral_acceleration);
+    d["steer"] = vector_of(rep.cr_steer);
+    d["road_wheel_angle"] = vector_of(rep.cr_road_wheel);
+    d["sideslip"] = vector_of(rep.cr_sideslip);
+    d["roll"] = vector_of(rep.cr_roll);
+    d["understeer_gradient"] = vector_of(rep.cr_gradient);
+    if (rep.linear_gradient) d["linear_understeer_gradient"] = *rep.linear_gradient;
+  }
+  if (rep.type != "constant-radius") {
+    d["t"] = vector_of(rep.result.t);
+    d["outputs"] = rep.result.y;
+    d["output_names"] = rep.result.output_names;
+  }
+  return d;
+}
+
+}  // namespace
+
+void register_maneuver(py::module_& m) {
+  m.def("_maneuver", &do_maneuver, "study"_a, "options"_a,
+        "study_maneuver_job with the keywords given (a dict); codyna.Study.maneuver documents them.");
+}
+
+}  // namespace codyna::python
