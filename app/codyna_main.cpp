@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
   codyna::cli::add_sweep(app);
   codyna::cli::add_tire(app);
   codyna::cli::add_maneuver(app);
+  codyna::cli::add_freqresp(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -14,6 +14,7 @@ void add_export_mjcf(CLI::App& app);
 void add_sweep(CLI::App& app);
 void add_tire(CLI::App& app);
 void add_maneuver(CLI::App& app);
+void add_freqresp(CLI::App& app);
 int exit_code();
 void set_exit_code(int code);
 

@@ -45,6 +45,8 @@ bool written_by_codyna(const std::string& path, OutputKind k) {
       return starts_with(h, "variant,status");  // io/sweep_files.hpp's kSweepCsvHead
     case OutputKind::TireCsv:
       return starts_with(h, "Fx,Fy,Fz,");
+    case OutputKind::FrequencyResponseCsv:
+      return starts_with(h, "w_rad_s,f_Hz,");
   }
   return false;
 }
@@ -69,6 +71,7 @@ const char* describe(OutputKind k) {
     case OutputKind::Mjcf: return "an MJCF export";
     case OutputKind::SweepCsv: return "a sweep CSV";
     case OutputKind::TireCsv: return "a tire CSV";
+    case OutputKind::FrequencyResponseCsv: return "a frequency-response CSV";
   }
   return "an output";
 }

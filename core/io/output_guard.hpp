@@ -23,6 +23,7 @@ enum class OutputKind {
   Mjcf,         // a model exported as MJCF (io/export_mjcf.hpp; its first line says codyna wrote it)
   SweepCsv,     // a parameter study's table (io/sweep_files.hpp; it begins "variant,status")
   TireCsv,      // a tire test rig's table (study/tire_job.hpp; it begins "Fx,Fy,Fz,")
+  FrequencyResponseCsv,  // a nonlinear plant's frequency response (study/freqresp_job.hpp; it begins "w_rad_s,")
 };
 
 const char* describe(OutputKind k);  // "an HDF5 results file", ...

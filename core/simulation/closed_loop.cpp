@@ -130,7 +130,8 @@ Eigen::VectorXd ClosedLoopSystem::saturate(Eigen::VectorXd u) const {
 Eigen::VectorXd ClosedLoopSystem::inputs(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
                                          const Eigen::VectorXd& xc) const {
   Eigen::VectorXd u = u_nominal_;
-  if (disturbance_) u += disturbance_(t);
+  const Eigen::VectorXd d = disturbance_ ? disturbance_(t) : Eigen::VectorXd();
+  if (d.size()) u += d;
   Eigen::VectorXd up;
   if (!controller_ || controller_->sample_time() > 0) {
     // held values: a discrete controller's last output, or inputs set from outside (co-simulation)
@@ -139,7 +140,12 @@ Eigen::VectorXd ClosedLoopSystem::inputs(double t, const Eigen::VectorXd& q, con
   } else {
     up = controller_->output(measure(t, q, v), xc);
   }
-  for (std::size_t k = 0; k < model_.plant_inputs.size(); ++k) u[model_.plant_inputs[k]] = up[k];
+  // a disturbance on a Plant/In input adds to what the controller asks (an excitation at the
+  // plant's input: codyna freqresp; a study's disturbances are on other actuators)
+  for (std::size_t k = 0; k < model_.plant_inputs.size(); ++k) {
+    const int a = model_.plant_inputs[k];
+    u[a] = up[k] + (d.size() ? d[a] : 0.0);
+  }
   return saturate(u);
 }
 

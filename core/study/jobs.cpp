@@ -509,10 +509,8 @@ ModelSpec simulate_spec(const SimulateRequest& a, ModelSpec spec) {
 namespace {
 SimulateJob simulate_job(const SimulateRequest& a, const ModelSpec& file_spec, const SimulationCallbacks& cb,
                          const std::function<void(const SimulateJob&)>& ready, const StudyMessages& tell);
-}  // namespace
 
-SimulateJob study_simulate_job(const SimulateRequest& a, const ModelSpec& file_spec, const SimulationCallbacks& cb,
-                               const std::function<void(const SimulateJob&)>& ready, const StudyMessages& tell) {
+GivenFields simulate_fields(const SimulateRequest& a) {
   GivenFields g(Names{a.style});
   add_point_fields(g, a.point);
   g.add(a.q_weights.has_value(), "/analysis/q_weights", "q-weights");
@@ -525,7 +523,23 @@ SimulateJob study_simulate_job(const SimulateRequest& a, const ModelSpec& file_s
   g.add(a.max_step.has_value(), "/solver/max_step", "max-step");
   g.add(a.t_end.has_value(), "/solver/t_end", "t-end");
   g.add(a.output_step.has_value(), "/solver/output_step", "output-step");
-  return g.run([&] { return simulate_job(a, file_spec, cb, ready, tell); });
+  return g;
+}
+}  // namespace
+
+SimulateJob study_simulate_job(const SimulateRequest& a, const ModelSpec& file_spec, const SimulationCallbacks& cb,
+                               const std::function<void(const SimulateJob&)>& ready, const StudyMessages& tell) {
+  return simulate_fields(a).run([&] { return simulate_job(a, file_spec, cb, ready, tell); });
+}
+
+SimulateSetup study_simulate_setup(const SimulateRequest& a, const ModelSpec& file_spec, bool linearize,
+                                   const std::atomic<bool>* cancel) {
+  return simulate_fields(a).run([&] {
+    SimulateSetup out{study_model(simulate_spec(a, file_spec), a.model), {}, std::nullopt};
+    out.setup = study_simulation(out.model, cancel);
+    if (linearize && !out.setup.plant) out.linearization = study_linearize(out.model);
+    return out;
+  });
 }
 
 namespace {

@@ -154,6 +154,19 @@ SimulateJob study_simulate_job(const SimulateRequest& r, const ModelSpec& spec, 
                                const std::function<void(const SimulateJob&)>& ready = {},
                                const StudyMessages& tell = {});
 
+// What a simulate request sets up before a run, as study_simulate_job does (the request over the
+// model file's study and solver sections, the model, the controller and the plant it is designed
+// on), and, with `linearize` and no plant (open loop), the study's linearization about its
+// operating point: what a job that runs the study several times (codyna freqresp) starts from.
+// Refusals name the request's options, as study_simulate_job's.
+struct SimulateSetup {
+  Model model;
+  StudySimulation setup;
+  std::optional<StudyLinearization> linearization;  // `linearize` and no setup.plant
+};
+SimulateSetup study_simulate_setup(const SimulateRequest& r, const ModelSpec& spec, bool linearize,
+                                   const std::atomic<bool>* cancel = nullptr);
+
 // The Control view's analysis (codyna-gui's Analyse): the plant linearized about the study's
 // operating point with its modes and its step and frequency responses on the grids the closed
 // loop uses (the core's defaults from the plant's poles), and the study's closed loop
