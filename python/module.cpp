@@ -36,4 +36,5 @@ PYBIND11_MODULE(_codyna, m) {
   for (const char* name : {"ClosedLoop", "Linearization", "Simulation", "Sweep"}) m.attr(name).attr("__module__") = "codyna";
   register_tools(m);
   register_maneuver(m);
+  register_freqresp(m);
 }

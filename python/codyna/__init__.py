@@ -192,6 +192,27 @@ class Study:
         """
         return _codyna._linearize(self._study, _given(locals()))
 
+    def freqresp(self, frequencies, **options):
+        """The frequency response of the nonlinear plant against the linear model's (codyna
+        freqresp; docs/frequency-response.md).
+
+        frequencies: rad/s (a sequence). Each Plant/In is excited in turn by a sine about the
+        operating point, the model run with the study's controller (an unstable plant is measured
+        in closed loop), and G(jw) from every Plant/In to every Plant/Out estimated. Keywords:
+        amplitude (one number or one per Plant/In, input units; default 0.01), settle_periods,
+        periods, samples_per_period, harmonics, csv, and codyna simulate's point, plant,
+        controller and solver keywords (operating_point, hold, speed, radius, lqr, open_loop,
+        controller, integrator, rtol, atol, ...). Returns a dict: "w", "G" and "G_linear"
+        (complex, frequencies x outputs x inputs), "gap" (|G - G_linear| relative to the linear
+        response), "distortion" (the harmonics' share), the names and units, "largest_gap",
+        "notes", "warnings" and "text" (the command's report).
+        """
+        options["frequencies"] = [float(w) for w in frequencies]
+        a = options.get("amplitude")
+        if a is not None and not hasattr(a, "__len__"):
+            options["amplitude"] = [float(a)]
+        return _codyna._freqresp(self._study, _given(options))
+
     def maneuver(self, type, **options):
         """A standard handling maneuver with its metrics (codyna maneuver; docs/maneuvers.md).
 

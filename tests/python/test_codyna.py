@@ -1024,3 +1024,21 @@ def test_maneuver_is_the_command_lines():
             "double-lane-change", preview=-1)
     with pytest.raises(ValueError, match="^type: unknown maneuver"):
         codyna.Study(car).maneuver("slalom")
+
+
+def test_freqresp_is_the_command_lines(tmp_path):
+    """Study.freqresp runs codyna freqresp's job: the same text and CSV; G equals the linear
+    response at a small amplitude; a bad keyword names itself."""
+    car = os.path.join(SOURCE_DIR, "examples", "single_track_car.json")
+    stdout, _ = cli("freqresp", car, "--frequencies", "0.5,3,20", "--amplitude", "1e-4", "--csv", tmp_path / "cli.csv")
+    r = codyna.Study(car).freqresp([0.5, 3, 20], amplitude=1e-4, csv=str(tmp_path / "py.csv"))
+    assert r["text"] + "wrote %s\n" % (tmp_path / "cli.csv") == stdout
+    assert (tmp_path / "py.csv").read_text() == (tmp_path / "cli.csv").read_text()
+    assert r["G"].shape == (3, 3, 1) and r["G"].dtype == complex
+    assert np.max(np.abs(r["G"] - r["G_linear"]) / np.abs(r["G_linear"])) < 3e-5
+    assert r["largest_gap"] == pytest.approx(np.max(r["gap"]), rel=1e-15)
+    assert r["input_names"] == ["steer"] and r["operating_point"] == "steady"
+    with pytest.raises(ValueError, match="^amplitude 0: expected an amplitude other than 0"):
+        codyna.Study(car).freqresp([1], amplitude=0)
+    with pytest.raises(TypeError):
+        codyna.Study(car).freqresp([1], amplitudes=1)
