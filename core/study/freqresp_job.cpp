@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cstdio>
 #include <cmath>
@@ -66,6 +67,34 @@ double slowest_decay(const Eigen::VectorXcd& poles, double tol, const std::strin
   return decay;
 }
 
+// The plant's poles an excitation of its inputs shows in its outputs: a decaying mode whose share
+// of the response, |C v| |w^H B| / (|w^H v| |p|) (v, w its right and left eigenvectors, each the
+// null vector of A - p I from its SVD, robust where A has repeated eigenvalues elsewhere), is below
+// 1e-9 of the largest is left out (a car's speed, which a steer does not move to first order,
+// decays in hours: waiting for it would measure nothing).
+Eigen::VectorXcd plant_poles_seen(const LinearSystem& sys) {
+  const Eigen::VectorXcd p = Eigen::EigenSolver<Eigen::MatrixXd>(sys.A, false).eigenvalues();
+  const double tol = stability_tolerance(sys.A);
+  const Eigen::Index n = sys.A.rows();
+  const Eigen::MatrixXcd Ac = sys.A.cast<std::complex<double>>(), Bc = sys.B.cast<std::complex<double>>(),
+                         Cc = sys.C.cast<std::complex<double>>();
+  Eigen::VectorXd share = Eigen::VectorXd::Zero(p.size());
+  for (Eigen::Index k = 0; k < p.size(); ++k) {
+    if (classify_pole(p[k], false, tol) != Stability::Stable) continue;
+    const Eigen::JacobiSVD<Eigen::MatrixXcd> svd(Ac - p[k] * Eigen::MatrixXcd::Identity(n, n), Eigen::ComputeFullU | Eigen::ComputeFullV);
+    const Eigen::VectorXcd v = svd.matrixV().col(n - 1), w = svd.matrixU().col(n - 1);
+    const double overlap = std::abs(w.dot(v));  // w^H v
+    share[k] = overlap > 0 ? (Cc * v).norm() * (w.adjoint() * Bc).norm() / (overlap * std::abs(p[k]))
+                           : std::numeric_limits<double>::infinity();
+  }
+  double top = 0;  // over the modes with a share (a repeated eigenvalue's has none: it is kept)
+  for (double x : share) top = std::isfinite(x) ? std::max(top, x) : top;
+  std::vector<std::complex<double>> kept;
+  for (Eigen::Index k = 0; k < p.size(); ++k)
+    if (classify_pole(p[k], false, tol) != Stability::Stable || share[k] >= 1e-9 * top) kept.push_back(p[k]);
+  return Eigen::Map<Eigen::VectorXcd>(kept.data(), static_cast<Eigen::Index>(kept.size()));
+}
+
 }  // namespace
 
 FreqRespJob study_freqresp_job(const FreqRespRequest& r, const ModelSpec& spec, const SimulationCallbacks& cb,
@@ -108,14 +137,16 @@ FreqRespJob study_freqresp_job(const FreqRespRequest& r, const ModelSpec& spec, 
   // how long the loop takes to settle: its linear poles (the closed loop's with a linear controller)
   const bool closed = setup.controller != nullptr;
   double decay = std::numeric_limits<double>::infinity();
-  if (!closed || setup.linear_poles.size()) {
-    const Eigen::VectorXcd poles = closed ? setup.linear_poles : Eigen::VectorXcd(Eigen::EigenSolver<Eigen::MatrixXd>(sys.A).eigenvalues());
-    decay = slowest_decay(poles, stability_tolerance(sys.A), closed ? "the closed loop" : "the plant");
+  if (closed && setup.linear_poles.size()) {
+    decay = slowest_decay(setup.linear_poles, stability_tolerance(sys.A), "the closed loop");
+  } else if (!closed) {
+    decay = slowest_decay(plant_poles_seen(sys), stability_tolerance(sys.A), "the plant");
   } else {
     note("the controller has no linear closed loop to read a settling time from: the runs settle for " +
          std::to_string(r.settle_periods) + " periods (" + opt("settle-periods") + ")");
   }
 
+  job.decay_rate = std::isfinite(decay) ? decay : 0.0;
   const std::vector<double> ws = r.frequencies;
   const FrequencyResponse linear = frequency_response(sys, ws);
   for (std::size_t iw = 0; iw < ws.size(); ++iw) {
@@ -236,6 +267,15 @@ std::vector<double> study_frequency_grid(const std::string& text, const std::str
   return log_grid(v.front(), v.back(), static_cast<int>(v.size()));
 }
 
+namespace {
+// a phase in degrees in (-180, 180], a half turn shown as 180 whatever the sign of a zero
+// imaginary part
+double shown_phase(std::complex<double> g) {
+  const double p = std::arg(g) * 180 / std::numbers::pi;
+  return p < -179.9995 ? p + 360 : p;
+}
+}  // namespace
+
 std::string study_freqresp_text(const FreqRespJob& job) {
   std::ostringstream os;
   os.precision(6);
@@ -245,7 +285,9 @@ std::string study_freqresp_text(const FreqRespJob& job) {
   for (std::size_t j = 0; j < job.input_names.size(); ++j)
     os << (j ? ", " : "") << job.input_names[j] << " " << job.amplitudes[static_cast<Eigen::Index>(j)]
        << (job.input_units[j].empty() ? "" : " " + job.input_units[j]);
-  os << "\n\n";
+  os << "\n";
+  if (job.decay_rate > 0) os << "settling        " << 8 / job.decay_rate << " s (8 / the slowest decay rate the outputs see, " << job.decay_rate << " 1/s)\n";
+  os << "\n";
   char line[256];
   std::snprintf(line, sizeof line, "%-12s %-28s %12s %10s %12s %10s %9s %9s\n", "w (rad/s)", "output/input", "gain",
                 "phase", "gain linear", "phase lin", "gap", "harmonics");
@@ -255,8 +297,8 @@ std::string study_freqresp_text(const FreqRespJob& job) {
       for (Eigen::Index j = 0; j < p.G.cols(); ++j) {
         const std::string pair = job.output_names[static_cast<std::size_t>(i)] + "/" + job.input_names[static_cast<std::size_t>(j)];
         std::snprintf(line, sizeof line, "%-12.6g %-28s %12.6g %10.4g %12.6g %10.4g %8.3g%% %8.3g%%\n", p.w, pair.c_str(),
-                      std::abs(p.G(i, j)), std::arg(p.G(i, j)) * 180 / std::numbers::pi, std::abs(p.G_linear(i, j)),
-                      std::arg(p.G_linear(i, j)) * 180 / std::numbers::pi, 100 * p.gap(i, j), 100 * p.distortion(i, j));
+                      std::abs(p.G(i, j)), shown_phase(p.G(i, j)), std::abs(p.G_linear(i, j)), shown_phase(p.G_linear(i, j)),
+                      100 * p.gap(i, j), 100 * p.distortion(i, j));
         os << line;
       }
   if (job.gap_point >= 0) {

@@ -47,6 +47,8 @@ struct FreqRespJob {
   std::string operating_point, controller;   // the point's kind; "none" or where the controller comes from
   std::vector<std::string> input_names, output_names, input_units, output_units;
   Eigen::VectorXd amplitudes;                // per Plant/In
+  double decay_rate = 0;                     // the slowest the outputs see (1/s; 0: not known), which
+                                             // sets the settling: 8 / decay_rate
   std::vector<FreqRespPoint> points;         // in the request's order
   // the largest gap: its value, frequency index, output and input
   double largest_gap = 0;
