@@ -813,11 +813,9 @@ bool LinearizeView::exportTo(const QString& dir, QString* error) {
   };
   if (isStale() && !linearize()) return fail(tr("the model could not be linearized"));
   try {
-    std::string target = ss(dir);
     // the document's model now: the same linearization, with the export name and folder as they are now
     const Model& now = doc_->model() && result_model_ != doc_->model() ? *doc_->model() : *result_model_;
-    if (!target.empty()) target = study_path(now, target);  // relative: to the model file
-    const ExportPaths p = study_export(now, result_->system, target);
+    const ExportPaths p = study_export_linearization(now, result_->system, ss(dir));  // relative: to the model file
     const QString mat = qs(p.mat_file), m = qs(p.m_file);
     emit exported(mat, m);
     return true;

@@ -506,6 +506,17 @@ ModelSpec simulate_spec(const SimulateRequest& a, ModelSpec spec) {
 
 }  // namespace
 
+ExportPaths study_export_linearization(const Model& m, const LinearSystem& system, const std::string& dir) {
+  const std::string target = dir.empty() ? std::string() : study_path(m, dir);
+  const std::string folder = target.empty() ? study_path(m, m.spec.analysis.export_dir) : target;
+  if (!folder.empty()) {  // (no folder at all: study_export says so)
+    const std::filesystem::path base = std::filesystem::path(folder) / study_export_name(m);
+    guard_output(base.string() + ".mat", OutputKind::PlantMat, {m.source_file});
+    guard_output(base.string() + ".m", OutputKind::PlantScript, {m.source_file});
+  }
+  return study_export(m, system, target);
+}
+
 namespace {
 SimulateJob simulate_job(const SimulateRequest& a, const ModelSpec& file_spec, const SimulationCallbacks& cb,
                          const std::function<void(const SimulateJob&)>& ready, const StudyMessages& tell);

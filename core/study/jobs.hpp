@@ -154,6 +154,12 @@ SimulateJob study_simulate_job(const SimulateRequest& r, const ModelSpec& spec, 
                                const std::function<void(const SimulateJob&)>& ready = {},
                                const StudyMessages& tell = {});
 
+// The export of a linearization already made (codyna-gui's Export after Linearize): NAME.mat and
+// NAME.m of `system` in `dir` (relative to the model file's folder; "" = the study's export_dir),
+// named and in the MAT version of `m`'s study as it is now, each output guarded as the linearize
+// job's (never the model file, never a file codyna did not write).
+ExportPaths study_export_linearization(const Model& m, const LinearSystem& system, const std::string& dir);
+
 // What a simulate request sets up before a run, as study_simulate_job does (the request over the
 // model file's study and solver sections, the model, the controller and the plant it is designed
 // on), and, with `linearize` and no plant (open loop), the study's linearization about its

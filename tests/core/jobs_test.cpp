@@ -8,6 +8,9 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 
 #include "analysis/stability.hpp"
 #include "control/lqr.hpp"
@@ -214,4 +217,30 @@ TEST(Jobs, RefusalsNameTheOptionAsWritten) {
   sr.model = path;
   sr.point.initial = {"cart=0.1"};
   EXPECT_INVALID_ARGUMENT_WITH(study_simulate_job(sr, spec), "--initial cart: unknown coordinate");
+}
+
+// An export of a linearization already made (the GUI's Export after Linearize) writes the same
+// NAME.mat and NAME.m as the job with `out`, and never over a file codyna did not write
+TEST(Jobs, ExportOfALinearizationIsTheJobsAndGuarded) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "codyna_jobs_export";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir / "job");
+  LinearizeRequest r;
+  r.model = test::example_path("cart_pendulum.json");
+  r.out = (dir / "job").string();
+  const LinearizeJob job = study_linearize_job(r, jobs_spec("cart_pendulum.json"));
+  ASSERT_EQ(job.written.size(), 2u);
+  const ExportPaths p = study_export_linearization(job.model, job.linearization.system, (dir / "again").string());
+  const auto bytes = [](const std::string& f) {
+    std::ifstream in(f, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  };
+  EXPECT_EQ(bytes(p.m_file), bytes(job.written[1]));
+  EXPECT_EQ(std::filesystem::file_size(p.mat_file), std::filesystem::file_size(job.written[0]));
+  std::filesystem::create_directories(dir / "mine");
+  const std::string foreign = (dir / "mine" / std::filesystem::path(p.mat_file).filename()).string();
+  std::ofstream(foreign) << "my notes";
+  EXPECT_THROW(study_export_linearization(job.model, job.linearization.system, (dir / "mine").string()), std::invalid_argument);
+  EXPECT_EQ(bytes(foreign), "my notes");
+  std::filesystem::remove_all(dir);
 }
