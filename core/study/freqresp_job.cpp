@@ -5,6 +5,7 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cstdio>
+#include <functional>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -95,6 +96,97 @@ Eigen::VectorXcd plant_poles_seen(const LinearSystem& sys) {
   return Eigen::Map<Eigen::VectorXcd>(kept.data(), static_cast<Eigen::Index>(kept.size()));
 }
 
+// One run of a frequency: input j excited by its sine from the point; the fundamentals of the
+// plant's inputs (column j of U) and outputs (of Y), the outputs' harmonics' share (of pt.distortion)
+struct FreqRespRun {
+  const FreqRespRequest& r;
+  const Model& m;
+  const StudySimulation& setup;
+  const OperatingPoint& op;
+  const SimulationCallbacks& cb;
+  FreqRespJob& job;
+  const std::function<void(const std::string&)>& warn;
+};
+
+void run_excited(const FreqRespRun& c, int j, double w, int n_settle, FreqRespPoint& pt, Eigen::MatrixXcd& U,
+                 Eigen::MatrixXcd& Y) {
+  const FreqRespRequest& r = c.r;
+  const Model& m = c.m;
+  const StudySimulation& setup = c.setup;
+  const FreqRespJob& job = c.job;
+  const auto& warn = c.warn;
+  const OperatingPoint& op = c.op;
+  const SimulationCallbacks& cb = c.cb;
+  const int nu = static_cast<int>(U.rows()), ny = static_cast<int>(Y.rows());
+  const double T = 2 * std::numbers::pi / w;
+  SimulationOptions o = setup.options;
+  const Model held = held_at(m, op, o);  // the point's state, every actuator at its value there
+  o.compare_linear = false;
+  o.t0 = 0;
+  o.t_end = pt.run_time;
+  o.output_step = T / r.samples_per_period;
+  const int actuator = m.plant_inputs[static_cast<std::size_t>(j)];
+  const double a = job.amplitudes[j];
+  const int nact = m.nu();
+  o.disturbance = [=](double t) {
+    Eigen::VectorXd d = Eigen::VectorXd::Zero(nact);
+    d[actuator] = a * std::sin(w * t);
+    return d;
+  };
+  o.disturbance_rate = nullptr;
+  o.disturbance_acceleration = nullptr;
+  const SimulationResult res = simulate(held, setup.controller.get(), setup.plant.get(), o, cb);
+  const std::string where = "at " + freq_text(w) + " rad/s, exciting " + job.input_names[static_cast<std::size_t>(j)];
+  if (res.cancelled) throw StudyCancelled("the frequency response was cancelled " + where);
+  if (!res.completed) throw std::runtime_error(where + ": the run failed: " + res.failure);
+  const Eigen::Index i0 = static_cast<Eigen::Index>(n_settle) * r.samples_per_period;
+  const Eigen::Index n = static_cast<Eigen::Index>(r.periods) * r.samples_per_period;
+  if (res.samples() < i0 + n) throw std::runtime_error(where + ": the run recorded fewer samples than its window");
+  Eigen::VectorXd t(n);
+  Eigen::MatrixXd X(n, nu + ny);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    t[i] = res.t[static_cast<std::size_t>(i0 + i)];
+    for (int k = 0; k < nu; ++k) X(i, k) = res.u(i0 + i, m.plant_inputs[static_cast<std::size_t>(k)]);
+    X.row(i).tail(ny) = res.y.row(i0 + i);
+  }
+  const std::vector<HarmonicFit> fits = fit_harmonics(t, X, w, r.harmonics);
+  for (int k = 0; k < nu; ++k) U(k, j) = fits[static_cast<std::size_t>(k)].harmonics[0];
+  for (int k = 0; k < ny; ++k) {
+    const HarmonicFit& f = fits[static_cast<std::size_t>(nu + k)];
+    Y(k, j) = f.harmonics[0];
+    pt.distortion(k, j) = f.distortion();
+    const double fundamental = std::abs(f.harmonics[0]);
+    if (fundamental > 0 && f.residual_rms > 0.05 * fundamental)
+      warn(where + ": " + job.output_names[static_cast<std::size_t>(k)] + " is not periodic at this frequency (what " +
+           "the fit leaves is " + freq_text(100 * f.residual_rms / fundamental) + " % of the response): not settled, " +
+           "or not a response to the excitation");
+  }
+}
+
+// the gap, relative to the linear response's size for that pair (at least 1e-3 of its largest
+// over the frequencies, so that a notch does not make a small difference look large; a pair
+// the linear model does not connect at all: the absolute difference), and the largest
+void set_gaps(FreqRespJob& job) {
+  const auto ny = static_cast<Eigen::Index>(job.output_names.size()), nu = static_cast<Eigen::Index>(job.input_names.size());
+  Eigen::MatrixXd scale = Eigen::MatrixXd::Zero(ny, nu);
+  for (const FreqRespPoint& p : job.points) scale = scale.cwiseMax(p.G_linear.cwiseAbs());
+  for (std::size_t iw = 0; iw < job.points.size(); ++iw) {
+    FreqRespPoint& p = job.points[iw];
+    p.gap.resize(ny, nu);
+    for (int i = 0; i < ny; ++i)
+      for (int j = 0; j < nu; ++j) {
+        const double s = scale(i, j) > 0 ? std::max(std::abs(p.G_linear(i, j)), 1e-3 * scale(i, j)) : 1.0;
+        p.gap(i, j) = std::abs(p.G(i, j) - p.G_linear(i, j)) / s;
+        if (job.gap_point < 0 || p.gap(i, j) > job.largest_gap) {
+          job.largest_gap = p.gap(i, j);
+          job.gap_point = static_cast<int>(iw);
+          job.gap_output = i;
+          job.gap_input = j;
+        }
+      }
+  }
+}
+
 }  // namespace
 
 FreqRespJob study_freqresp_job(const FreqRespRequest& r, const ModelSpec& spec, const SimulationCallbacks& cb,
@@ -149,6 +241,8 @@ FreqRespJob study_freqresp_job(const FreqRespRequest& r, const ModelSpec& spec, 
   job.decay_rate = std::isfinite(decay) ? decay : 0.0;
   const std::vector<double> ws = r.frequencies;
   const FrequencyResponse linear = frequency_response(sys, ws);
+  const std::function<void(const std::string&)> warn_fn = warn;
+  const FreqRespRun run{r, m, setup, op, cb, job, warn_fn};
   for (std::size_t iw = 0; iw < ws.size(); ++iw) {
     const double w = ws[iw], T = 2 * std::numbers::pi / w;
     FreqRespPoint pt;
@@ -158,50 +252,7 @@ FreqRespJob study_freqresp_job(const FreqRespRequest& r, const ModelSpec& spec, 
     pt.run_time = (n_settle + r.periods) * T;
     Eigen::MatrixXcd U(nu, nu), Y(ny, nu);
     pt.distortion.resize(ny, nu);
-    for (int j = 0; j < nu; ++j) {
-      SimulationOptions o = setup.options;
-      const Model held = held_at(m, op, o);  // the point's state, every actuator at its value there
-      o.compare_linear = false;
-      o.t0 = 0;
-      o.t_end = pt.run_time;
-      o.output_step = T / r.samples_per_period;
-      const int actuator = m.plant_inputs[static_cast<std::size_t>(j)];
-      const double a = job.amplitudes[j];
-      const int nact = m.nu();
-      o.disturbance = [=](double t) {
-        Eigen::VectorXd d = Eigen::VectorXd::Zero(nact);
-        d[actuator] = a * std::sin(w * t);
-        return d;
-      };
-      o.disturbance_rate = nullptr;
-      o.disturbance_acceleration = nullptr;
-      const SimulationResult res = simulate(held, setup.controller.get(), setup.plant.get(), o, cb);
-      const std::string where = "at " + freq_text(w) + " rad/s, exciting " + job.input_names[static_cast<std::size_t>(j)];
-      if (res.cancelled) throw StudyCancelled("the frequency response was cancelled " + where);
-      if (!res.completed) throw std::runtime_error(where + ": the run failed: " + res.failure);
-      const Eigen::Index i0 = static_cast<Eigen::Index>(n_settle) * r.samples_per_period;
-      const Eigen::Index n = static_cast<Eigen::Index>(r.periods) * r.samples_per_period;
-      if (res.samples() < i0 + n) throw std::runtime_error(where + ": the run recorded fewer samples than its window");
-      Eigen::VectorXd t(n);
-      Eigen::MatrixXd X(n, nu + ny);
-      for (Eigen::Index i = 0; i < n; ++i) {
-        t[i] = res.t[static_cast<std::size_t>(i0 + i)];
-        for (int k = 0; k < nu; ++k) X(i, k) = res.u(i0 + i, m.plant_inputs[static_cast<std::size_t>(k)]);
-        X.row(i).tail(ny) = res.y.row(i0 + i);
-      }
-      const std::vector<HarmonicFit> fits = fit_harmonics(t, X, w, r.harmonics);
-      for (int k = 0; k < nu; ++k) U(k, j) = fits[static_cast<std::size_t>(k)].harmonics[0];
-      for (int k = 0; k < ny; ++k) {
-        const HarmonicFit& f = fits[static_cast<std::size_t>(nu + k)];
-        Y(k, j) = f.harmonics[0];
-        pt.distortion(k, j) = f.distortion();
-        const double fundamental = std::abs(f.harmonics[0]);
-        if (fundamental > 0 && f.residual_rms > 0.05 * fundamental)
-          warn(where + ": " + job.output_names[static_cast<std::size_t>(k)] + " is not periodic at this frequency (what " +
-               "the fit leaves is " + freq_text(100 * f.residual_rms / fundamental) + " % of the response): not settled, " +
-               "or not a response to the excitation");
-      }
-    }
+    for (int j = 0; j < nu; ++j) run_excited(run, j, w, n_settle, pt, U, Y);
     const Eigen::PartialPivLU<Eigen::MatrixXcd> lu(U);
     if (!(std::abs(lu.determinant()) > 0))
       throw std::runtime_error("at " + freq_text(w) + " rad/s the inputs did not move independently (a saturated input?)");
@@ -210,26 +261,7 @@ FreqRespJob study_freqresp_job(const FreqRespRequest& r, const ModelSpec& spec, 
     job.points.push_back(std::move(pt));
   }
 
-  // the gap, relative to the linear response's size for that pair (at least 1e-3 of its largest
-  // over the frequencies, so that a notch does not make a small difference look large; a pair
-  // the linear model does not connect at all: the absolute difference)
-  Eigen::MatrixXd scale = Eigen::MatrixXd::Zero(ny, nu);
-  for (const FreqRespPoint& p : job.points) scale = scale.cwiseMax(p.G_linear.cwiseAbs());
-  for (std::size_t iw = 0; iw < job.points.size(); ++iw) {
-    FreqRespPoint& p = job.points[iw];
-    p.gap.resize(ny, nu);
-    for (int i = 0; i < ny; ++i)
-      for (int j = 0; j < nu; ++j) {
-        const double s = scale(i, j) > 0 ? std::max(std::abs(p.G_linear(i, j)), 1e-3 * scale(i, j)) : 1.0;
-        p.gap(i, j) = std::abs(p.G(i, j) - p.G_linear(i, j)) / s;
-        if (job.gap_point < 0 || p.gap(i, j) > job.largest_gap) {
-          job.largest_gap = p.gap(i, j);
-          job.gap_point = static_cast<int>(iw);
-          job.gap_output = i;
-          job.gap_input = j;
-        }
-      }
-  }
+  set_gaps(job);
   if (!r.csv.empty()) {
     study_write_freqresp_csv(job, r.csv);
     job.written.push_back(r.csv);
