@@ -305,13 +305,93 @@ ManeuverReport mnv_open_loop(const ManeuverRequest& r, const ModelSpec& spec, bo
   return rep;
 }
 
-ManeuverReport mnv_lane_change(const ManeuverRequest& r, const ModelSpec& spec) {
-  const ManeuverFlags flag{r.style};
-  ManeuverReport rep;
-  rep.type = r.type;
-  const Model m = study_model(mnv_straight_spec(r, spec), r.model);
-  rep.model_name = m.name;
-  const bool from_file = m.spec.controller.type == ControllerType::Driver;
+// a stepped run's names, units and provenance, as a simulation's result carries them
+void mnv_name_result(SimulationResult& res, const Model& run, const ManeuverRequest& r, const Controller& driver,
+                     const Stepper& st) {
+  res.q_names = run.q_names;
+  res.v_names = run.rate_names;
+  for (const ActuatorModel& a : run.actuators) {
+    res.input_names.push_back(a.name);
+    res.input_units.push_back(a.unit);
+  }
+  for (int k : run.plant_outputs) {
+    res.output_names.push_back(run.sensors[static_cast<std::size_t>(k)].name);
+    res.output_units.push_back(run.sensors[static_cast<std::size_t>(k)].unit);
+  }
+  res.controller_state_names = driver.state_names();
+  res.controller = driver.describe();
+  res.model_name = run.name;
+  res.model_file = r.model;
+  res.codyna_version = CODYNA_VERSION;
+  res.stats = st.stats();
+}
+
+// the lateral error from the start of section 1 to the end of section 6, and the cones: the
+// rectangle's corners (width x length about the position outputs) in the lane's frame against
+// each section's lines; `local` the lane in its own frame, placed at `start` turned by yaw0
+void mnv_lane_metrics(ManeuverReport& rep, const ManeuverFlags& flag, const DriverPath& local, const DriverSettings& ds,
+                      const Eigen::Vector2d& start, double yaw0, const std::vector<double>& lateral, double width,
+                      double length) {
+  const SimulationResult& res = rep.result;
+  const Eigen::Rotation2Dd rot(yaw0);
+  const int done = static_cast<int>(res.t.size());
+  const double gate_from = local.gate_start.front(), gate_to = local.gate_end.back();
+  std::vector<double> tin, ein;
+  std::vector<bool> hit(local.gate_start.size(), false);
+  for (int k = 0; k < done; ++k) {
+    const Eigen::Vector2d p = rot.inverse() * (Eigen::Vector2d(res.y(k, ds.out_x), res.y(k, ds.out_y)) - start);
+    const double psi = res.y(k, ds.out_yaw) - yaw0;
+    if (p.x() >= gate_from && p.x() <= gate_to) {
+      tin.push_back(res.t[static_cast<std::size_t>(k)]);
+      ein.push_back(lateral[static_cast<std::size_t>(k)]);
+    }
+    const Eigen::Rotation2Dd body_rot(psi);
+    for (const double a : {-0.5, 0.5})
+      for (const double b : {-0.5, 0.5}) {
+        const Eigen::Vector2d corner = p + body_rot * Eigen::Vector2d(a * length, b * width);
+        for (std::size_t g = 0; g < hit.size(); ++g)
+          if (!hit[g] && corner.x() >= local.gate_start[g] && corner.x() <= local.gate_end[g] &&
+              std::abs(corner.y() - local.gate_center[g]) > local.gate_width[g] / 2) {
+            hit[g] = true;
+            std::ostringstream os;
+            os << "section " << (g == 0 ? 1 : g == 1 ? 3 : 5) << " (" << local.gate_width[g] << " m wide) at x = "
+               << std::setprecision(4) << corner.x() - local.gate_start.front() << " m, t = " << res.t[static_cast<std::size_t>(k)] << " s";
+            rep.cones_hit.push_back(os.str());
+          }
+      }
+  }
+  if (tin.empty()) {
+    rep.valid = false;
+    if (rep.invalid_reason.empty()) rep.invalid_reason = "the run ended before the lane (raise " + flag("t-end") + ")";
+  } else {
+    rep.path = path_error_metrics(tin, ein);
+  }
+}
+
+// the driver's gains: the request's, else the model file's driver controller's (from_file), else
+// defaults for the car (preview half a second of travel, at least 5 m)
+void mnv_driver_gains(DriverSettings& ds, const ManeuverRequest& r, const ManeuverFlags& flag, const Model& m,
+                      bool from_file, double speed) {
+  const ControllerSpec& c = m.spec.controller;
+  ds.preview = mnv_positive(flag, r.preview, from_file ? c.preview : std::max(5.0, 0.5 * speed), "preview");
+  ds.wheelbase = from_file ? c.wheelbase : (m.spec.analysis.handling.wheelbase ? *m.spec.analysis.handling.wheelbase : 2.7);
+  ds.steering_ratio = from_file ? c.steering_ratio : (m.spec.analysis.handling.steering_ratio ? *m.spec.analysis.handling.steering_ratio : 1.0);
+  ds.lateral_gain = from_file ? c.lateral_gain : 0.05;
+  if (r.lateral_gain) {
+    if (!(*r.lateral_gain >= 0)) throw std::invalid_argument(flag("lateral-gain") + ": expected a number >= 0");
+    ds.lateral_gain = *r.lateral_gain;
+  }
+  ds.speed = speed;
+  ds.speed_kp = r.speed_kp ? *r.speed_kp : from_file ? c.speed_kp : 0.0;
+  ds.speed_ki = r.speed_ki ? *r.speed_ki : from_file ? c.speed_ki : 0.0;
+  ds.sample_time = mnv_positive(flag, r.sample_time, from_file ? c.sample_time : 0.01, "sample-time");
+  if (r.speed_kp && !(*r.speed_kp >= 0)) throw std::invalid_argument(flag("speed-kp") + ": expected a number >= 0");
+  if (r.speed_ki && !(*r.speed_ki >= 0)) throw std::invalid_argument(flag("speed-ki") + ": expected a number >= 0");
+}
+
+// the driver's signals by name: the request's, else the model file's driver controller's, else
+// the study's handling steer
+DriverSignals mnv_driver_names(const ManeuverRequest& r, const Model& m, bool from_file) {
   const ControllerSpec& c = m.spec.controller;
   DriverSignals names;
   if (from_file) names = DriverSignals{c.x, c.y, c.yaw, c.forward_speed, c.steer, c.drive};
@@ -321,6 +401,18 @@ ManeuverReport mnv_lane_change(const ManeuverRequest& r, const ModelSpec& spec) 
   if (r.yaw) names.yaw = *r.yaw;
   if (r.speed_output) names.speed = *r.speed_output;
   if (r.drive) names.drive = *r.drive;
+  return names;
+}
+
+ManeuverReport mnv_lane_change(const ManeuverRequest& r, const ModelSpec& spec) {
+  const ManeuverFlags flag{r.style};
+  ManeuverReport rep;
+  rep.type = r.type;
+  const Model m = study_model(mnv_straight_spec(r, spec), r.model);
+  rep.model_name = m.name;
+  const bool from_file = m.spec.controller.type == ControllerType::Driver;
+  const ControllerSpec& c = m.spec.controller;
+  const DriverSignals names = mnv_driver_names(r, m, from_file);
   const int body = mnv_steady_body(m);
   const OperatingPoint op = study_operating_point(m, "steady");
   Data d(m);
@@ -364,20 +456,7 @@ ManeuverReport mnv_lane_change(const ManeuverRequest& r, const ModelSpec& spec) 
   const Eigen::Rotation2Dd rot(yaw0);
   DriverPath local = ds.path;
   for (Eigen::Vector2d& p : ds.path.points) p = start + rot * p;
-  ds.preview = mnv_positive(flag, r.preview, from_file ? c.preview : std::max(5.0, 0.5 * rep.speed), "preview");
-  ds.wheelbase = from_file ? c.wheelbase : (m.spec.analysis.handling.wheelbase ? *m.spec.analysis.handling.wheelbase : 2.7);
-  ds.steering_ratio = from_file ? c.steering_ratio : (m.spec.analysis.handling.steering_ratio ? *m.spec.analysis.handling.steering_ratio : 1.0);
-  ds.lateral_gain = from_file ? c.lateral_gain : 0.05;
-  if (r.lateral_gain) {
-    if (!(*r.lateral_gain >= 0)) throw std::invalid_argument(flag("lateral-gain") + ": expected a number >= 0");
-    ds.lateral_gain = *r.lateral_gain;
-  }
-  ds.speed = rep.speed;
-  ds.speed_kp = r.speed_kp ? *r.speed_kp : from_file ? c.speed_kp : 0.0;
-  ds.speed_ki = r.speed_ki ? *r.speed_ki : from_file ? c.speed_ki : 0.0;
-  ds.sample_time = mnv_positive(flag, r.sample_time, from_file ? c.sample_time : 0.01, "sample-time");
-  if (r.speed_kp && !(*r.speed_kp >= 0)) throw std::invalid_argument(flag("speed-kp") + ": expected a number >= 0");
-  if (r.speed_ki && !(*r.speed_ki >= 0)) throw std::invalid_argument(flag("speed-ki") + ": expected a number >= 0");
+  mnv_driver_gains(ds, r, flag, m, from_file, rep.speed);
   const std::unique_ptr<Controller> driver = make_driver(ds, flag("driver"));
 
   // the run: sampled driver, zero-order hold on the plant (simulation/stepper.hpp)
@@ -430,57 +509,10 @@ ManeuverReport mnv_lane_change(const ManeuverRequest& r, const ModelSpec& spec) 
   res.u.conservativeResize(done, Eigen::NoChange);
   res.y.conservativeResize(done, Eigen::NoChange);
   res.xc.conservativeResize(done, Eigen::NoChange);
-  res.q_names = run.q_names;
-  res.v_names = run.rate_names;
-  for (const ActuatorModel& a : run.actuators) {
-    res.input_names.push_back(a.name);
-    res.input_units.push_back(a.unit);
-  }
-  for (int k : run.plant_outputs) {
-    res.output_names.push_back(run.sensors[static_cast<std::size_t>(k)].name);
-    res.output_units.push_back(run.sensors[static_cast<std::size_t>(k)].unit);
-  }
-  res.controller_state_names = driver->state_names();
-  res.controller = driver->describe();
-  res.model_name = run.name;
-  res.model_file = r.model;
-  res.codyna_version = CODYNA_VERSION;
-  res.stats = st.stats();
+  mnv_name_result(res, run, r, *driver, st);
   mnv_check_run(rep, res, run, body);
 
-  // the lateral error from the start of section 1 to the end of section 6, and the cones: the
-  // rectangle's corners in the lane's frame against each section's lines
-  const double gate_from = local.gate_start.front(), gate_to = local.gate_end.back();
-  std::vector<double> tin, ein;
-  std::vector<bool> hit(local.gate_start.size(), false);
-  for (int k = 0; k < done; ++k) {
-    const Eigen::Vector2d p = rot.inverse() * (Eigen::Vector2d(res.y(k, ds.out_x), res.y(k, ds.out_y)) - start);
-    const double psi = res.y(k, ds.out_yaw) - yaw0;
-    if (p.x() >= gate_from && p.x() <= gate_to) {
-      tin.push_back(res.t[static_cast<std::size_t>(k)]);
-      ein.push_back(lateral[static_cast<std::size_t>(k)]);
-    }
-    const Eigen::Rotation2Dd body_rot(psi);
-    for (const double a : {-0.5, 0.5})
-      for (const double b : {-0.5, 0.5}) {
-        const Eigen::Vector2d corner = p + body_rot * Eigen::Vector2d(a * length, b * width);
-        for (std::size_t g = 0; g < hit.size(); ++g)
-          if (!hit[g] && corner.x() >= local.gate_start[g] && corner.x() <= local.gate_end[g] &&
-              std::abs(corner.y() - local.gate_center[g]) > local.gate_width[g] / 2) {
-            hit[g] = true;
-            std::ostringstream os;
-            os << "section " << (g == 0 ? 1 : g == 1 ? 3 : 5) << " (" << local.gate_width[g] << " m wide) at x = "
-               << std::setprecision(4) << corner.x() - local.gate_start.front() << " m, t = " << res.t[static_cast<std::size_t>(k)] << " s";
-            rep.cones_hit.push_back(os.str());
-          }
-      }
-  }
-  if (tin.empty()) {
-    rep.valid = false;
-    if (rep.invalid_reason.empty()) rep.invalid_reason = "the run ended before the lane (raise " + flag("t-end") + ")";
-  } else {
-    rep.path = path_error_metrics(tin, ein);
-  }
+  mnv_lane_metrics(rep, flag, local, ds, start, yaw0, lateral, width, length);
   mnv_write(rep, r);
   return rep;
 }
