@@ -198,11 +198,17 @@ DriverLaw driver_law(const DriverSettings& s, double x, double y, double yaw) {
 
 void resolve_driver_signals(DriverSettings& s, const DriverSignals& names, const std::vector<std::string>& outputs,
                             const std::vector<std::string>& inputs, const std::string& where) {
+  resolve_driver_signals(s, names, outputs, inputs, [&](const std::string& field) { return where + "/" + field; });
+}
+
+void resolve_driver_signals(DriverSettings& s, const DriverSignals& names, const std::vector<std::string>& outputs,
+                            const std::vector<std::string>& inputs,
+                            const std::function<std::string(const std::string& field)>& label) {
   const auto find = [&](const std::vector<std::string>& list, const std::string& name, const std::string& field,
                         const char* kind) {
     for (std::size_t k = 0; k < list.size(); ++k)
       if (list[k] == name) return static_cast<int>(k);
-    throw std::invalid_argument(where + "/" + field + ": the driver needs the " + kind + " \"" + name +
+    throw std::invalid_argument(label(field) + ": the driver needs the " + kind + " \"" + name +
                                 "\", which the plant does not have (" + kind + ": " + driver_name_list(list) + ")");
   };
   s.out_x = find(outputs, names.x, "x", "Plant/Out");

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -89,6 +90,11 @@ struct DriverSignals {
 };
 void resolve_driver_signals(DriverSettings& s, const DriverSignals& names, const std::vector<std::string>& outputs,
                             const std::vector<std::string>& inputs, const std::string& where);
+// the same, each field named in a refusal by `label(field)` (the flag a request gave it by, or the
+// file's field path), the field as a model file writes it (x, y, yaw, forward_speed, steer, drive)
+void resolve_driver_signals(DriverSettings& s, const DriverSignals& names, const std::vector<std::string>& outputs,
+                            const std::vector<std::string>& inputs,
+                            const std::function<std::string(const std::string& field)>& label);
 // the same for each field name as a model file writes it (x, y, yaw, forward_speed, steer, drive)
 
 // checks the settings (std::invalid_argument naming the field as `where` + "/preview" ...)

@@ -427,18 +427,15 @@ ManeuverReport mnv_lane_change(const ManeuverRequest& r, const ModelSpec& spec) 
   for (std::size_t k = 0; k < m.plant_inputs.size(); ++k) u0[static_cast<Eigen::Index>(k)] = op.u[m.plant_inputs[k]];
   ds.u0 = u0;
   // the names: refused naming the flag when the request gave them, else the file's field
-  try {
-    resolve_driver_signals(ds, names, outputs, inputs, (m.source_file.empty() ? "" : m.source_file + ": ") + "/controller");
-  } catch (const std::invalid_argument& e) {
-    const std::string what = e.what();
-    for (const auto& [given, field, key] : {std::tuple{r.x.has_value(), "/x", "x"}, {r.y.has_value(), "/y", "y"},
-                                            {r.yaw.has_value(), "/yaw", "yaw"},
-                                            {r.speed_output.has_value(), "/forward_speed", "speed-output"},
-                                            {r.drive.has_value(), "/drive", "drive"}})
-      if (given && what.find(std::string("/controller") + field + ":") != std::string::npos)
-        throw std::invalid_argument(flag(key) + what.substr(what.find(':', what.find("/controller")) ));
-    throw;
-  }
+  const std::string file_field = (m.source_file.empty() ? "" : m.source_file + ": ") + "/controller/";
+  resolve_driver_signals(ds, names, outputs, inputs, [&](const std::string& field) {
+    for (const auto& [given, name, key] : {std::tuple{r.x.has_value(), "x", "x"}, {r.y.has_value(), "y", "y"},
+                                           {r.yaw.has_value(), "yaw", "yaw"},
+                                           {r.speed_output.has_value(), "forward_speed", "speed-output"},
+                                           {r.drive.has_value(), "drive", "drive"}})
+      if (given && field == name) return flag(key);
+    return file_field + field;
+  });
   // the output names were resolved: their values at the start
   SimulationOptions o;
   const Model run = held_at(m, op, o);
