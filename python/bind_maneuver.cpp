@@ -77,7 +77,9 @@ py::dict do_maneuver(const Study& s, const py::dict& options) {
     d["sideslip"] = vector_of(rep.cr_sideslip);
     d["roll"] = vector_of(rep.cr_roll);
     d["understeer_gradient"] = vector_of(rep.cr_gradient);
+    if (!rep.cr_linear_steer.empty()) d["linear_steer"] = vector_of(rep.cr_linear_steer);
     if (rep.linear_gradient) d["linear_understeer_gradient"] = *rep.linear_gradient;
+    if (rep.handling_gradient) d["handling_understeer_gradient"] = *rep.handling_gradient;
   }
   if (rep.type != "constant-radius") {
     d["t"] = vector_of(rep.result.t);

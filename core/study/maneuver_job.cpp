@@ -514,6 +514,55 @@ ManeuverReport mnv_lane_change(const ManeuverRequest& r, const ModelSpec& spec) 
   return rep;
 }
 
+// The linear model's prediction of the constant-radius diagram: at each point's speed U the
+// linearization about the straight run gives its steer s0(U) and constant-speed yaw-rate gain G(U),
+// so the turn of yaw rate r takes s0 + r / G; the gradient on the same a_y is the diagram's linear
+// counterpart (it holds what changes with speed, dK/dU, and the steering's own ratio, which the
+// handling number K at one speed does not).
+void mnv_linear_diagram(ManeuverReport& rep, const ManeuverRequest& r, const ModelSpec& spec, int ks, double ratio,
+                        const std::vector<double>& yaw_rates) {
+  try {
+    for (std::size_t k = 0; k < rep.cr_speed.size(); ++k) {
+      ModelSpec ls = mnv_straight_spec(r, spec);
+      ls.analysis.steady.speed = rep.cr_speed[k];
+      const StudyLinearization lin = study_linearize(study_model(ls, r.model));
+      if (!lin.handling || !(lin.handling->yaw_rate_gain != 0)) {
+        rep.notes.push_back("no linear understeer gradient to compare with: the straight run at " +
+                            std::to_string(rep.cr_speed[k]) + " m/s has no yaw-rate gain (analysis.handling)");
+        rep.cr_linear_steer.clear();
+        return;
+      }
+      if (k == 0) rep.handling_gradient = lin.handling->understeer_gradient;
+      rep.cr_linear_steer.push_back(lin.op.u[ks] + yaw_rates[k] / lin.handling->yaw_rate_gain);
+    }
+  } catch (const std::exception& e) {
+    rep.notes.push_back(std::string("no linear understeer gradient to compare with: ") + e.what());
+    rep.cr_linear_steer.clear();
+    return;
+  }
+  if (rep.cr_linear_steer.size() < 2) return;
+  std::vector<double> road_wheel;
+  for (double s : rep.cr_linear_steer) road_wheel.push_back(s / ratio);
+  rep.cr_linear_gradient = understeer_diagram(rep.cr_lateral_acceleration, road_wheel);
+  rep.linear_gradient = rep.cr_linear_gradient.front();
+}
+
+// the constant-radius table as CSV (--csv)
+void mnv_write_diagram(ManeuverReport& rep, const ManeuverRequest& r) {
+  study_guard_output(r.csv, OutputKind::CurvesCsv, {r.model});
+  const auto at = [](const std::vector<double>& v, std::size_t k) { return k < v.size() ? v[k] : std::nan(""); };
+  std::ostringstream os;
+  os << std::setprecision(17)
+     << "speed,lateral_acceleration,steer,road_wheel_angle,sideslip,roll,understeer_gradient,linear_steer,"
+        "linear_understeer_gradient\n";
+  for (std::size_t k = 0; k < rep.cr_speed.size(); ++k)
+    os << rep.cr_speed[k] << "," << rep.cr_lateral_acceleration[k] << "," << rep.cr_steer[k] << ","
+       << rep.cr_road_wheel[k] << "," << rep.cr_sideslip[k] << "," << rep.cr_roll[k] << "," << at(rep.cr_gradient, k)
+       << "," << at(rep.cr_linear_steer, k) << "," << at(rep.cr_linear_gradient, k) << "\n";
+  write_file_atomically(r.csv, os.str());
+  rep.written.push_back(r.csv);
+}
+
 ManeuverReport mnv_constant_radius(const ManeuverRequest& r, const ModelSpec& spec) {
   const ManeuverFlags flag{r.style};
   ManeuverReport rep;
@@ -546,6 +595,7 @@ ManeuverReport mnv_constant_radius(const ManeuverRequest& r, const ModelSpec& sp
   std::vector<double> u0_start;
   for (const ActuatorModel& a : m.actuators) u0_start.push_back(a.u0);
   rep.cr_has_roll = m.joints[static_cast<std::size_t>(body)].type == JointType::Free;
+  std::vector<double> yaw_rates;  // of each turn, about the road's normal
   for (int i = 0; i < n; ++i) {
     const double U = u_min + (u_max - u_min) * i / (n - 1);
     m.spec.analysis.steady.speed = U;
@@ -572,30 +622,12 @@ ManeuverReport mnv_constant_radius(const ManeuverRequest& r, const ModelSpec& sp
     rep.cr_road_wheel.push_back(op.u[ks] / ratio);
     rep.cr_sideslip.push_back(std::atan2(b.v_body.y(), b.v_body.x()));
     rep.cr_roll.push_back(rep.cr_has_roll ? b.roll : 0.0);
+    yaw_rates.push_back(b.yaw_rate);
   }
   if (rep.cr_speed.size() >= 2) rep.cr_gradient = understeer_diagram(rep.cr_lateral_acceleration, rep.cr_road_wheel);
-  // the linear model's understeer gradient, straight ahead at the first speed
-  try {
-    ModelSpec ls = mnv_straight_spec(r, spec);
-    ls.analysis.steady.speed = u_min;
-    const Model lm = study_model(ls, r.model);
-    const StudyLinearization lin = study_linearize(lm);
-    if (lin.handling) rep.linear_gradient = lin.handling->understeer_gradient;
-  } catch (const std::exception& e) {
-    rep.notes.push_back(std::string("no linear understeer gradient to compare with: ") + e.what());
-  }
+  mnv_linear_diagram(rep, r, spec, ks, ratio, yaw_rates);
   rep.speed = u_min;
-  if (!r.csv.empty()) {
-    study_guard_output(r.csv, OutputKind::CurvesCsv, {r.model});
-    std::ostringstream os;
-    os << std::setprecision(17) << "speed,lateral_acceleration,steer,road_wheel_angle,sideslip,roll,understeer_gradient\n";
-    for (std::size_t k = 0; k < rep.cr_speed.size(); ++k)
-      os << rep.cr_speed[k] << "," << rep.cr_lateral_acceleration[k] << "," << rep.cr_steer[k] << ","
-         << rep.cr_road_wheel[k] << "," << rep.cr_sideslip[k] << "," << rep.cr_roll[k] << ","
-         << (k < rep.cr_gradient.size() ? rep.cr_gradient[k] : std::nan("")) << "\n";
-    write_file_atomically(r.csv, os.str());
-    rep.written.push_back(r.csv);
-  }
+  if (!r.csv.empty()) mnv_write_diagram(rep, r);
   return rep;
 }
 
@@ -631,20 +663,35 @@ std::string study_maneuver_text(const ManeuverReport& r) {
   os << "model            " << r.model_name << "\n";
   if (r.type == "constant-radius") {
     os << "radius           " << r.radius << " m\n";
-    os << "  speed (m/s)   a_y (m/s^2)   steer        road wheel (deg)  sideslip (deg)  roll (deg)  K (deg/g)\n";
+    const bool lin = r.cr_linear_steer.size() == r.cr_speed.size();
+    os << "  speed (m/s)   a_y (m/s^2)   steer        " << (lin ? "linear steer  " : "")
+       << "road wheel (deg)  sideslip (deg)  roll (deg)  K (deg/g)\n";
     for (std::size_t k = 0; k < r.cr_speed.size(); ++k) {
       os << "  " << std::setw(12) << r.cr_speed[k] << "  " << std::setw(12) << r.cr_lateral_acceleration[k] << "  "
-         << std::setw(11) << r.cr_steer[k] << "  " << std::setw(16) << r.cr_road_wheel[k] * deg << "  " << std::setw(14)
-         << r.cr_sideslip[k] * deg << "  " << std::setw(10) << r.cr_roll[k] * deg << "  "
+         << std::setw(11) << r.cr_steer[k] << "  ";
+      if (lin) os << std::setw(12) << r.cr_linear_steer[k] << "  ";
+      os << std::setw(16) << r.cr_road_wheel[k] * deg << "  " << std::setw(14) << r.cr_sideslip[k] * deg << "  "
+         << std::setw(10) << r.cr_roll[k] * deg << "  "
          << (k < r.cr_gradient.size() ? r.cr_gradient[k] * deg * 9.80665 : std::nan("")) << "\n";
     }
+    const auto gradient = [&os, deg](double K) { os << K << " rad/(m/s^2) = " << K * deg * 9.80665 << " deg/g"; };
     if (!r.cr_gradient.empty()) {
-      os << "understeer gradient at the lowest a_y   " << r.cr_gradient.front() << " rad/(m/s^2) = "
-         << r.cr_gradient.front() * deg * 9.80665 << " deg/g\n";
-      if (r.linear_gradient)
-        os << "linear model (straight at " << r.speed << " m/s)   " << *r.linear_gradient << " rad/(m/s^2) = "
-           << *r.linear_gradient * deg * 9.80665 << " deg/g (difference "
-           << std::abs(r.cr_gradient.front() - *r.linear_gradient) / std::abs(*r.linear_gradient) * 100 << " %)\n";
+      os << "understeer gradient at the lowest a_y   ";
+      gradient(r.cr_gradient.front());
+      os << "\n";
+      if (r.linear_gradient) {
+        os << "linear model's, same speeds and a_y     ";
+        gradient(*r.linear_gradient);
+        os << " (difference " << std::abs(r.cr_gradient.front() - *r.linear_gradient) / std::abs(*r.linear_gradient) * 100
+           << " %)\n";
+      }
+      if (r.handling_gradient) {
+        std::ostringstream label;
+        label << std::setprecision(6) << "handling number K at " << r.speed << " m/s";
+        os << std::left << std::setw(40) << label.str() << std::right;
+        gradient(*r.handling_gradient);
+        os << " (constant speed: without dK/dU)\n";
+      }
     }
   } else {
     os << "speed            " << r.speed << " m/s\n";

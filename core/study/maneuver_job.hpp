@@ -17,8 +17,11 @@
 //                       --speed-min to --speed-max, each the steady motion's search (the file's
 //                       study, its free inputs) started from the one before; steer, road-wheel
 //                       angle, sideslip and roll over lateral acceleration, the understeer gradient
-//                       d(delta)/d(a_y) over a_y, against the linear model's (handling numbers at
-//                       the straight run at the first speed).
+//                       d(delta)/d(a_y) over a_y, against the linear model's prediction of the
+//                       same diagram: at each speed, the linearization about the straight run
+//                       (its steer s0(U) and constant-speed yaw-rate gain G(U)) gives the turn's
+//                       steer s0 + r / G; its gradient on the same a_y (and, for reference, the
+//                       handling number K at the first speed, a constant-speed gradient).
 // A run that leaves the road (the integrator fails, the speed or yaw rate runs away) is reported
 // with its metrics marked invalid and the reason. Files: the run as HDF5 / CSV (--out, --csv;
 // the constant radius: --csv, its table).
@@ -83,7 +86,11 @@ struct ManeuverReport {
   double radius = 0;
   std::vector<double> cr_speed, cr_lateral_acceleration, cr_steer, cr_road_wheel, cr_sideslip, cr_roll, cr_gradient;
   bool cr_has_roll = false;
-  std::optional<double> linear_gradient;  // rad per m/s^2, at the first speed, straight
+  // the linear model's prediction at each speed (straight-run linearizations: s0(U) + r / G(U)),
+  // its understeer diagram on the same a_y (empty when the study has no handling numbers)
+  std::vector<double> cr_linear_steer, cr_linear_gradient;
+  std::optional<double> linear_gradient;   // cr_linear_gradient's first: the linear model's, rad per m/s^2
+  std::optional<double> handling_gradient; // the handling number K at the first speed (constant speed)
   // the run (time series; not for the constant radius)
   SimulationResult result;
   std::vector<std::string> written;
