@@ -63,4 +63,11 @@ IntegratorChoice choose_integrator(ClosedLoopSystem& sys, double t, const Eigen:
   return c;
 }
 
+std::string auto_fallback_note(const std::string& failed, double t_failed, const std::string& why, double t_from) {
+  std::ostringstream os;
+  os << "; " << failed << " failed at t = " << t_failed << " s (" << why << "): " << kAutoFallbackIntegrator
+     << " from t = " << t_from << " s on";
+  return os.str();
+}
+
 }  // namespace codyna

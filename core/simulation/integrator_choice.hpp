@@ -28,6 +28,12 @@ struct IntegratorChoice {
 
 constexpr int kMaxAnalysed = 600;
 
+// What "auto" does when the method it chose fails during the run (a run that turns stiff after
+// its start, e.g. tires that begin to slide): it goes on from the last state reached with this
+// stiff method, and the run's integrator_choice says so (auto_fallback_note).
+inline constexpr const char* kAutoFallbackIntegrator = "cvode-bdf";
+std::string auto_fallback_note(const std::string& failed, double t_failed, const std::string& why, double t_from);
+
 // y: the ODE-layout state [q; v; xc] at time t (on the constraints); span: the run's length
 IntegratorChoice choose_integrator(ClosedLoopSystem& sys, double t, const Eigen::VectorXd& y, double span);
 

@@ -22,6 +22,7 @@ struct SolverStats {
   long restarts = 0;               // re-initializations at controller samples / projections
   double wall_time = 0;            // seconds
   std::string integrator_choice;   // when "auto" was asked: what was chosen and why (simulation/integrator_choice.hpp)
+  bool integrator_fell_back = false;  // auto's choice failed and the run went on with kAutoFallbackIntegrator
 };
 
 struct SimulationResult {

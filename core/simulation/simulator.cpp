@@ -282,7 +282,8 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
 
   SimulationResult r;
   IntegratorSettings settings = o.integrator;
-  if (settings.method == "auto") {  // the default: chosen from the closed loop at the initial state
+  const bool chosen = settings.method == "auto";
+  if (chosen) {  // the default: chosen from the closed loop at the initial state
     const IntegratorChoice choice = choose_integrator(sys, o.t0, y, o.t_end - o.t0);
     settings.method = choice.method;
     r.stats.integrator_choice = choice.reason;
@@ -358,6 +359,19 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
       if (cb.cancel && cb.cancel->load()) {  // stopped inside the step (ClosedLoopSystem::set_cancel)
         r.cancelled = true;
         break;
+      }
+      if (chosen && settings.method != kAutoFallbackIntegrator) {
+        // auto chose from the initial state; the run became stiff (tires sliding, a contact):
+        // on from the last state reached with the stiff method, and the log says so
+        r.stats.integrator_choice += auto_fallback_note(settings.method, f.time(), f.what(), t);
+        integrator->add_stats(r.stats);
+        settings.method = kAutoFallbackIntegrator;
+        r.stats.integrator = settings.method;
+        r.stats.integrator_fell_back = true;
+        integrator = make_integrator(sys, settings);
+        integrator->reset(t, y);
+        ++r.stats.restarts;
+        continue;
       }
       std::ostringstream os;
       os << "t = " << f.time() << " s: " << f.what();

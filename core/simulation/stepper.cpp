@@ -13,14 +13,15 @@ Stepper::Stepper(const Model& model, const IntegratorSettings& settings, double 
     : model_(model), projection_tolerance_(projection_tolerance),
       sys_(model, nullptr, nullptr, Eigen::VectorXd(), model.u_nominal()) {
   set_state(0.0, {}, {});
-  IntegratorSettings s = settings;
-  if (s.method == "auto") {  // chosen at the model's initial state; a stepped run has no length: 1 s
+  settings_ = settings;
+  chosen_ = settings.method == "auto";
+  if (chosen_) {  // chosen at the model's initial state; a stepped run has no length: 1 s
     const IntegratorChoice choice = choose_integrator(sys_, t_, y_, 1.0);
-    s.method = choice.method;
+    settings_.method = choice.method;
     extra_.integrator_choice = choice.reason;
   }
-  integrator_ = make_integrator(sys_, s);
-  extra_.integrator = s.method;
+  integrator_ = make_integrator(sys_, settings_);
+  extra_.integrator = settings_.method;
   extra_.rtol = settings.rtol;
   extra_.atol = settings.atol;
   extra_.max_step = settings.max_step;
@@ -70,7 +71,20 @@ const Eigen::VectorXd& Stepper::step(const Eigen::VectorXd& u, double dt) {
   sys_.set_held(u);
   integrator_->reset(t_, y_);  // the inputs jump: a discontinuity for the integrator
   ++extra_.restarts;
-  integrator_->advance(t_ + dt);
+  try {
+    integrator_->advance(t_ + dt);
+  } catch (const IntegratorFailure& f) {
+    if (!chosen_ || settings_.method == kAutoFallbackIntegrator) throw;
+    // auto's choice failed as the run turned stiff: this step again from its start, stiff
+    extra_.integrator_choice += auto_fallback_note(settings_.method, f.time(), f.what(), t_);
+    integrator_->add_stats(extra_);
+    settings_.method = kAutoFallbackIntegrator;
+    extra_.integrator = settings_.method;
+    extra_.integrator_fell_back = true;
+    integrator_ = make_integrator(sys_, settings_);
+    integrator_->reset(t_, y_);
+    integrator_->advance(t_ + dt);
+  }
   t_ += dt;
   y_ = integrator_->state();
   if (model_.nc && !integrator_->projects() && sys_.project(y_, projection_tolerance_, t_)) ++extra_.projections;

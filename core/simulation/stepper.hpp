@@ -40,6 +40,8 @@ class Stepper {
   double projection_tolerance_;
   ClosedLoopSystem sys_;
   std::unique_ptr<Integrator> integrator_;
+  IntegratorSettings settings_;  // the method in use (auto's choice, then its fallback)
+  bool chosen_ = false;          // by auto
   Eigen::VectorXd y_, out_;
   double t_ = 0;
   SolverStats extra_;

@@ -155,6 +155,7 @@ ModelSpec mnv_straight_spec(const ManeuverRequest& r, ModelSpec spec) {
 
 // a run that left the road, or spun
 void mnv_check_run(ManeuverReport& rep, const SimulationResult& res, const Model& m, int body) {
+  if (res.stats.integrator_fell_back) rep.notes.push_back("integrator " + res.stats.integrator_choice);
   if (!res.completed) {
     rep.valid = false;
     rep.invalid_reason = "the run did not complete: " + (res.failure.empty() ? std::string("cancelled") : res.failure);

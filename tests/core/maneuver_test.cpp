@@ -331,6 +331,38 @@ TEST(Maneuver, TheSedansConstantRadiusGradientIsItsLinearModelsPrediction) {
   EXPECT_NEAR(*rep.linear_gradient, slope, 1e-3 * K1) << K1;
 }
 
+// auto chooses an explicit method for the sedan at the straight run; in a sine with dwell of 3 rad
+// the tires slide and it fails where the dwell ends. auto then goes on from the last state reached
+// with cvode-bdf, says so, and the metrics are those of a run with cvode-bdf from the start.
+TEST(Maneuver, AutoGoesOnStiffWhereItsChoiceFailsInTheSedansSineWithDwell) {
+  const std::string file = maneuver_example("sedan.json");
+  const ModelSpec spec = study_read_model(file);
+  ManeuverRequest r;
+  r.model = file;
+  r.type = "sine-with-dwell";
+  r.steer = 3;
+  r.speed = 22.2;
+  r.integrator = "auto";
+  const ManeuverReport a = study_maneuver_job(r, spec);
+  r.integrator = "cvode-bdf";
+  const ManeuverReport b = study_maneuver_job(r, spec);
+  ASSERT_TRUE(a.valid) << a.invalid_reason;
+  ASSERT_TRUE(b.valid) << b.invalid_reason;
+  const std::string& choice = a.result.stats.integrator_choice;
+  EXPECT_NE(choice.find("arkode failed at t = "), std::string::npos) << choice;
+  EXPECT_NE(choice.find("cvode-bdf from t = "), std::string::npos) << choice;
+  EXPECT_EQ(a.result.stats.integrator, "cvode-bdf");
+  EXPECT_TRUE(a.result.stats.integrator_fell_back);
+  EXPECT_FALSE(b.result.stats.integrator_fell_back);
+  EXPECT_NE(std::find(a.notes.begin(), a.notes.end(), "integrator " + choice), a.notes.end());
+  EXPECT_NEAR(a.sine.yrr_1_00, b.sine.yrr_1_00, 1e-3);  // percent
+  EXPECT_NEAR(a.sine.yrr_1_75, b.sine.yrr_1_75, 1e-3);
+  EXPECT_NEAR(a.sine.lateral_displacement, b.sine.lateral_displacement, 1e-5);
+  EXPECT_NEAR(a.sine.peak_yaw_rate, b.sine.peak_yaw_rate, 1e-6);
+  std::cout << choice << "\nratios " << a.sine.yrr_1_00 << " / " << b.sine.yrr_1_00 << ", " << a.sine.yrr_1_75 << " / "
+            << b.sine.yrr_1_75 << "\n";
+}
+
 TEST(Maneuver, BadInputIsRefusedNamingTheFieldOrFlag) {
   const std::string file = maneuver_example("single_track_car.json");
   const ModelSpec spec = study_read_model(file);
