@@ -14,87 +14,15 @@
 #include "simulation/simulator.hpp"
 #include "simulation/stepper.hpp"
 #include "study/files.hpp"
+#include "study/maneuver_detail.hpp"
 
 namespace codyna {
 
 namespace {
 
-constexpr double kManeuverPi = 3.14159265358979323846;
-
-struct ManeuverFlags {
-  OptionStyle style;
-  std::string operator()(const std::string& dashed) const { return option_name(style, dashed); }
-};
-
-double mnv_positive(const ManeuverFlags& flag, const std::optional<double>& v, double fallback, const char* name) {
-  if (!v) return fallback;
-  if (!(*v > 0) || !std::isfinite(*v)) {
-    std::ostringstream os;
-    os << flag(name) << ": expected a number > 0, got " << *v;
-    throw std::invalid_argument(os.str());
-  }
-  return *v;
-}
-
-int mnv_actuator(const Model& m, const std::string& name, const std::string& field) {
-  for (std::size_t k = 0; k < m.actuators.size(); ++k)
-    if (m.actuators[k].name == name) return static_cast<int>(k);
-  throw ModelError(m.source_file, field, "the maneuver needs the actuator \"" + name + "\", which the model does not have");
-}
-
-int mnv_output(const Model& m, const std::string& name, const std::string& field, bool required) {
-  for (std::size_t k = 0; k < m.plant_outputs.size(); ++k)
-    if (m.sensors[static_cast<std::size_t>(m.plant_outputs[k])].name == name) return static_cast<int>(k);
-  if (!required) return -1;
-  std::string have;
-  for (int k : m.plant_outputs) have += (have.empty() ? "" : ", ") + m.sensors[static_cast<std::size_t>(k)].name;
-  throw ModelError(m.source_file, field,
-                   "the maneuver needs the Plant/Out output \"" + name + "\" (Plant/Out: " + (have.empty() ? "none" : have) + ")");
-}
-
-// the body whose motion the steady search sets (study.steady.body, or the first on a free or
-// planar joint to ground)
-int mnv_steady_body(const Model& m) {
-  const std::string& name = m.spec.analysis.steady.body;
-  for (int b = 1; b < m.nbodies; ++b) {
-    const JointModel& j = m.joints[static_cast<std::size_t>(b)];
-    if (!name.empty() ? m.body_names[static_cast<std::size_t>(b)] == name
-                      : j.parent == 0 && (j.type == JointType::Free || j.type == JointType::Planar))
-      return b;
-  }
-  throw ModelError(m.source_file, "/analysis/steady/body", "the maneuver needs a body on a free or planar joint to ground");
-}
-
-// the steady body's centre of mass in the world, its heading, roll, and its velocity in its own axes
-struct BodyState {
-  Eigen::Vector3d p, v_body;
-  double heading = 0, roll = 0;
-  double speed_along_heading = 0, yaw_rate = 0;  // in the road plane (world x, y), about world z
-};
-BodyState mnv_body_state(const Model& m, Data& d, int body, const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
-  forward_kinematics<double>(m, d, q, v);
-  const SE3& X = d.oMi[static_cast<std::size_t>(body)];
-  const Eigen::Vector3d c = m.com[static_cast<std::size_t>(body)];
-  BodyState s;
-  s.p = X.act_point(c);
-  const Vec6T<double>& V = d.v[static_cast<std::size_t>(body)];
-  s.v_body = V.tail<3>() + V.head<3>().cross(c);
-  s.heading = std::atan2(X.R(1, 0), X.R(0, 0));
-  s.roll = std::atan2(X.R(2, 1), X.R(2, 2));
-  const Eigen::Vector3d v_world = X.R * s.v_body, w_world = X.R * V.head<3>();
-  s.speed_along_heading = std::cos(s.heading) * v_world.x() + std::sin(s.heading) * v_world.y();
-  s.yaw_rate = w_world.z();
-  return s;
-}
-
-// one steer profile: value, rate and acceleration at t
-struct SteerProfile {
-  std::function<double(double)> value, rate, acceleration;
-};
-
-SteerProfile mnv_ramp(double amplitude, double t0, double T) {
-  const double w = kManeuverPi / T;
-  SteerProfile p;
+mnv::SteerProfile mnv_ramp(double amplitude, double t0, double T) {
+  const double w = mnv::kPi / T;
+  mnv::SteerProfile p;
   p.value = [=](double t) { return t < t0 ? 0.0 : t > t0 + T ? amplitude : amplitude * 0.5 * (1 - std::cos(w * (t - t0))); };
   p.rate = [=](double t) { return t < t0 || t > t0 + T ? 0.0 : amplitude * 0.5 * w * std::sin(w * (t - t0)); };
   p.acceleration = [=](double t) { return t < t0 || t > t0 + T ? 0.0 : amplitude * 0.5 * w * w * std::cos(w * (t - t0)); };
@@ -102,8 +30,8 @@ SteerProfile mnv_ramp(double amplitude, double t0, double T) {
 }
 
 // one period of a sine of frequency f, held at its second peak (-amplitude) for `dwell`
-SteerProfile mnv_sine_dwell(double amplitude, double t0, double f, double dwell) {
-  const double w = 2 * kManeuverPi * f, t_peak = 0.75 / f, t_end = 1.0 / f + dwell;
+mnv::SteerProfile mnv_sine_dwell(double amplitude, double t0, double f, double dwell) {
+  const double w = 2 * mnv::kPi * f, t_peak = 0.75 / f, t_end = 1.0 / f + dwell;
   // the sine's phase time at t (the dwell removed), or -1 outside the steer, or -2 in the dwell
   const auto phase = [=](double t) {
     const double tau = t - t0;
@@ -112,7 +40,7 @@ SteerProfile mnv_sine_dwell(double amplitude, double t0, double f, double dwell)
     if (tau < t_peak + dwell) return -2.0;
     return tau - dwell;
   };
-  SteerProfile p;
+  mnv::SteerProfile p;
   p.value = [=](double t) {
     const double s = phase(t);
     return s == -1.0 ? 0.0 : s == -2.0 ? -amplitude : amplitude * std::sin(w * s);
@@ -128,93 +56,15 @@ SteerProfile mnv_sine_dwell(double amplitude, double t0, double f, double dwell)
   return p;
 }
 
-IntegratorSettings mnv_integrator(const Model& m) {
-  IntegratorSettings is;
-  is.method = m.spec.solver.integrator;
-  is.rtol = m.spec.solver.rtol;
-  is.atol = m.spec.solver.atol;
-  is.max_step = m.spec.solver.max_step;
-  return is;
-}
-
-// the study's straight steady run at the request's speed
-ModelSpec mnv_straight_spec(const ManeuverRequest& r, ModelSpec spec) {
-  if (r.integrator) {
-    if (!is_integrator_name(*r.integrator))
-      throw std::invalid_argument(option_name(r.style, "integrator") + ": unknown integrator \"" + *r.integrator +
-                                  "\" (expected one of " + integrator_names() + ")");
-    spec.solver.integrator = *r.integrator;
-  }
-  spec.analysis.operating_point = "steady";
-  if (r.speed) spec.analysis.steady.speed = *r.speed;
-  spec.analysis.steady.yaw_rate.reset();
-  spec.analysis.steady.radius.reset();
-  spec.analysis.steady.lateral_acceleration.reset();
-  return spec;
-}
-
-// a run that left the road, or spun
-void mnv_check_run(ManeuverReport& rep, const SimulationResult& res, const Model& m, int body) {
-  if (res.stats.integrator_fell_back) rep.notes.push_back("integrator " + res.stats.integrator_choice);
-  if (!res.completed) {
-    rep.valid = false;
-    rep.invalid_reason = "the run did not complete: " + (res.failure.empty() ? std::string("cancelled") : res.failure);
-    return;
-  }
-  Data d(m);
-  double worst = 0, at = 0;
-  for (int k = 0; k < res.samples(); ++k) {
-    const BodyState s = mnv_body_state(m, d, body, res.q.row(k).transpose(), res.v.row(k).transpose());
-    const double beta = std::atan2(s.v_body.y(), std::abs(s.v_body.x()));
-    if (std::abs(beta) > worst) {
-      worst = std::abs(beta);
-      at = res.t[static_cast<std::size_t>(k)];
-    }
-  }
-  if (worst > 20 * kManeuverPi / 180) {
-    std::ostringstream os;
-    os << "the car spun out: its sideslip reached " << worst * 180 / kManeuverPi << " deg at t = " << at << " s";
-    rep.valid = false;
-    rep.invalid_reason = os.str();
-  }
-}
-
-std::vector<double> mnv_column(const SimulationResult& r, int k) {
-  std::vector<double> c(static_cast<std::size_t>(r.samples()));
-  for (int i = 0; i < r.samples(); ++i) c[static_cast<std::size_t>(i)] = r.y(i, k);
-  return c;
-}
-
-void mnv_write(ManeuverReport& rep, const ManeuverRequest& r) {
-  if (!r.out.empty()) {
-    study_write_results_hdf5(rep.result, r.out);
-    rep.written.push_back(r.out);
-  }
-  if (!r.csv.empty()) {
-    study_write_results_csv(rep.result, r.csv);
-    rep.written.push_back(r.csv);
-  }
-}
-
 ManeuverReport mnv_open_loop(const ManeuverRequest& r, const ModelSpec& spec, bool sine) {
-  const ManeuverFlags flag{r.style};
+  const mnv::Flags flag{r.style};
   ManeuverReport rep;
   rep.type = r.type;
-  const Model m = study_model(mnv_straight_spec(r, spec), r.model);
-  rep.model_name = m.name;
-  const HandlingSpec& h = m.spec.analysis.handling;
-  if (h.steer.empty())
-    throw ModelError(m.source_file, "/analysis/handling/steer", "the maneuver needs the steer input named here");
-  if (h.yaw_rate.empty())
-    throw ModelError(m.source_file, "/analysis/handling/yaw_rate", "the maneuver needs the yaw-rate output named here");
-  const int ks = mnv_actuator(m, h.steer, "/analysis/handling/steer");
-  const int iy = mnv_output(m, h.yaw_rate, "/analysis/handling/yaw_rate", true);
-  const int ia = h.lateral_acceleration.empty() ? -1 : mnv_output(m, h.lateral_acceleration, "/analysis/handling/lateral_acceleration", false);
-  const int body = mnv_steady_body(m);
-  const OperatingPoint op = study_operating_point(m, "steady");
-  Data d(m);
-  const BodyState s0 = mnv_body_state(m, d, body, op.q, op.v);
-  rep.speed = s0.v_body.norm();
+  const mnv::OpenLoop ol = mnv::open_loop_setup(r, spec);
+  rep.model_name = ol.model.name;
+  rep.speed = ol.start.v_body.norm();
+  const int iy = ol.yaw_rate, ia = ol.lateral_acceleration;
+  const mnv::BodyState& s0 = ol.start;
 
   const double amplitude = r.steer ? *r.steer : (sine ? 0.05 : 0.01);
   if (!std::isfinite(amplitude) || amplitude == 0)
@@ -222,11 +72,11 @@ ManeuverReport mnv_open_loop(const ManeuverRequest& r, const ModelSpec& spec, bo
   rep.steer = amplitude;
   const double t0 = r.steer_time ? *r.steer_time : 0.5;
   if (!(t0 >= 0) || !std::isfinite(t0)) throw std::invalid_argument(flag("steer-time") + ": expected a time >= 0");
-  SteerProfile profile;
+  mnv::SteerProfile profile;
   std::vector<double> stops;
   double t_end = 0, t_ref = 0;
   if (sine) {
-    const double f = mnv_positive(flag, r.frequency, 0.7, "frequency");
+    const double f = mnv::positive(flag, r.frequency, 0.7, "frequency");
     const double dwell = r.dwell ? *r.dwell : 0.5;
     if (!(dwell >= 0)) throw std::invalid_argument(flag("dwell") + ": expected a time >= 0");
     profile = mnv_sine_dwell(amplitude, t0, f, dwell);
@@ -239,7 +89,7 @@ ManeuverReport mnv_open_loop(const ManeuverRequest& r, const ModelSpec& spec, bo
       throw std::invalid_argument(flag("t-end") + ": the run must last 1.75 s past the steer's end (" +
                                   std::to_string(rep.steer_end + 1.75) + " s)");
   } else {
-    const double ramp = mnv_positive(flag, r.ramp, 0.05, "ramp");
+    const double ramp = mnv::positive(flag, r.ramp, 0.05, "ramp");
     profile = mnv_ramp(amplitude, t0, ramp);
     stops = {t0, t0 + ramp};
     t_ref = t0 + ramp / 2;
@@ -247,44 +97,23 @@ ManeuverReport mnv_open_loop(const ManeuverRequest& r, const ModelSpec& spec, bo
     if (!(t_end > t0 + ramp + 0.5))
       throw std::invalid_argument(flag("t-end") + ": the run must last at least 0.5 s past the ramp's end");
   }
-  SimulationOptions o;
-  o.integrator = mnv_integrator(m);
-  o.t_end = t_end;
-  o.output_step = mnv_positive(flag, r.output_step, 0.005, "output-step");
-  const Model run = held_at(m, op, o);
-  const Eigen::Index nu = run.nu();
-  const auto one = [nu, ks](double x) {
-    Eigen::VectorXd v = Eigen::VectorXd::Zero(nu);
-    v[ks] = x;
-    return v;
-  };
-  o.disturbance = [one, profile](double t) { return one(profile.value(t)); };
-  o.disturbance_rate = [one, profile](double t) { return one(profile.rate(t)); };
-  o.disturbance_acceleration = [one, profile](double t) { return one(profile.acceleration(t)); };
-  o.rate_jumps = stops;
-  rep.result = simulate(run, nullptr, nullptr, o);
-  mnv_check_run(rep, rep.result, run, body);
-  if (rep.result.samples() > 0) {
-    const int last = rep.result.samples() - 1;
-    const BodyState e = mnv_body_state(run, d, body, rep.result.q.row(last).transpose(), rep.result.v.row(last).transpose());
-    rep.end_speed = e.speed_along_heading;
-    rep.end_yaw_rate = e.yaw_rate;
-  }
+  const Model run = mnv::open_loop_run(rep, r, ol, profile, stops, t_end);
+  Data d(run);
 
   if (rep.result.samples() >= 3) {
-    const std::vector<double> yaw = mnv_column(rep.result, iy);
+    const std::vector<double> yaw = mnv::column(rep.result, iy);
     if (sine) {
       // the lateral displacement from the start, perpendicular to the start's heading
       std::vector<double> lateral(yaw.size());
       const Eigen::Vector2d n(-std::sin(s0.heading), std::cos(s0.heading));
       for (int k = 0; k < rep.result.samples(); ++k) {
-        const BodyState s = mnv_body_state(run, d, body, rep.result.q.row(k).transpose(), rep.result.v.row(k).transpose());
+        const mnv::BodyState s = mnv::body_state(run, d, ol.body, rep.result.q.row(k).transpose(), rep.result.v.row(k).transpose());
         lateral[static_cast<std::size_t>(k)] = n.dot((s.p - s0.p).head<2>());
       }
       try {
         // FMVSS 126: the peak after the steer changes sign (its second half wave's direction)
         rep.sine = sine_with_dwell_metrics(rep.result.t, yaw, lateral, rep.steer_start, rep.steer_end, -amplitude,
-                                           rep.steer_start + 0.5 / mnv_positive(flag, r.frequency, 0.7, "frequency"));
+                                           rep.steer_start + 0.5 / mnv::positive(flag, r.frequency, 0.7, "frequency"));
       } catch (const std::invalid_argument& e) {
         rep.valid = false;
         if (rep.invalid_reason.empty()) rep.invalid_reason = e.what();
@@ -293,7 +122,7 @@ ManeuverReport mnv_open_loop(const ManeuverRequest& r, const ModelSpec& spec, bo
       try {
         rep.yaw_rate = step_response_metrics(rep.result.t, yaw, t_ref, amplitude);
         if (ia >= 0) {
-          rep.lateral_acceleration = step_response_metrics(rep.result.t, mnv_column(rep.result, ia), t_ref, amplitude);
+          rep.lateral_acceleration = step_response_metrics(rep.result.t, mnv::column(rep.result, ia), t_ref, amplitude);
           rep.has_lateral_acceleration = true;
         }
       } catch (const std::invalid_argument& e) {
@@ -302,7 +131,7 @@ ManeuverReport mnv_open_loop(const ManeuverRequest& r, const ModelSpec& spec, bo
       }
     }
   }
-  mnv_write(rep, r);
+  mnv::write(rep, r);
   return rep;
 }
 
@@ -330,7 +159,7 @@ void mnv_name_result(SimulationResult& res, const Model& run, const ManeuverRequ
 // the lateral error from the start of section 1 to the end of section 6, and the cones: the
 // rectangle's corners (width x length about the position outputs) in the lane's frame against
 // each section's lines; `local` the lane in its own frame, placed at `start` turned by yaw0
-void mnv_lane_metrics(ManeuverReport& rep, const ManeuverFlags& flag, const DriverPath& local, const DriverSettings& ds,
+void mnv_lane_metrics(ManeuverReport& rep, const mnv::Flags& flag, const DriverPath& local, const DriverSettings& ds,
                       const Eigen::Vector2d& start, double yaw0, const std::vector<double>& lateral, double width,
                       double length) {
   const SimulationResult& res = rep.result;
@@ -371,10 +200,10 @@ void mnv_lane_metrics(ManeuverReport& rep, const ManeuverFlags& flag, const Driv
 
 // the driver's gains: the request's, else the model file's driver controller's (from_file), else
 // defaults for the car (preview half a second of travel, at least 5 m)
-void mnv_driver_gains(DriverSettings& ds, const ManeuverRequest& r, const ManeuverFlags& flag, const Model& m,
+void mnv_driver_gains(DriverSettings& ds, const ManeuverRequest& r, const mnv::Flags& flag, const Model& m,
                       bool from_file, double speed) {
   const ControllerSpec& c = m.spec.controller;
-  ds.preview = mnv_positive(flag, r.preview, from_file ? c.preview : std::max(5.0, 0.5 * speed), "preview");
+  ds.preview = mnv::positive(flag, r.preview, from_file ? c.preview : std::max(5.0, 0.5 * speed), "preview");
   ds.wheelbase = from_file ? c.wheelbase : (m.spec.analysis.handling.wheelbase ? *m.spec.analysis.handling.wheelbase : 2.7);
   ds.steering_ratio = from_file ? c.steering_ratio : (m.spec.analysis.handling.steering_ratio ? *m.spec.analysis.handling.steering_ratio : 1.0);
   ds.lateral_gain = from_file ? c.lateral_gain : 0.05;
@@ -385,7 +214,7 @@ void mnv_driver_gains(DriverSettings& ds, const ManeuverRequest& r, const Maneuv
   ds.speed = speed;
   ds.speed_kp = r.speed_kp ? *r.speed_kp : from_file ? c.speed_kp : 0.0;
   ds.speed_ki = r.speed_ki ? *r.speed_ki : from_file ? c.speed_ki : 0.0;
-  ds.sample_time = mnv_positive(flag, r.sample_time, from_file ? c.sample_time : 0.01, "sample-time");
+  ds.sample_time = mnv::positive(flag, r.sample_time, from_file ? c.sample_time : 0.01, "sample-time");
   if (r.speed_kp && !(*r.speed_kp >= 0)) throw std::invalid_argument(flag("speed-kp") + ": expected a number >= 0");
   if (r.speed_ki && !(*r.speed_ki >= 0)) throw std::invalid_argument(flag("speed-ki") + ": expected a number >= 0");
 }
@@ -406,18 +235,18 @@ DriverSignals mnv_driver_names(const ManeuverRequest& r, const Model& m, bool fr
 }
 
 ManeuverReport mnv_lane_change(const ManeuverRequest& r, const ModelSpec& spec) {
-  const ManeuverFlags flag{r.style};
+  const mnv::Flags flag{r.style};
   ManeuverReport rep;
   rep.type = r.type;
-  const Model m = study_model(mnv_straight_spec(r, spec), r.model);
+  const Model m = study_model(mnv::straight_spec(r, spec), r.model);
   rep.model_name = m.name;
   const bool from_file = m.spec.controller.type == ControllerType::Driver;
   const ControllerSpec& c = m.spec.controller;
   const DriverSignals names = mnv_driver_names(r, m, from_file);
-  const int body = mnv_steady_body(m);
+  const int body = mnv::steady_body(m);
   const OperatingPoint op = study_operating_point(m, "steady");
   Data d(m);
-  const BodyState s0 = mnv_body_state(m, d, body, op.q, op.v);
+  const mnv::BodyState s0 = mnv::body_state(m, d, body, op.q, op.v);
   rep.speed = s0.v_body.norm();
 
   DriverSettings ds;
@@ -440,14 +269,14 @@ ManeuverReport mnv_lane_change(const ManeuverRequest& r, const ModelSpec& spec) 
   // the output names were resolved: their values at the start
   SimulationOptions o;
   const Model run = held_at(m, op, o);
-  Stepper st(run, mnv_integrator(run));
+  Stepper st(run, mnv::integrator(run));
   st.reset(0, o.q0, o.v0);
   const Eigen::VectorXd y0 = st.outputs();
   const double yaw0 = y0[ds.out_yaw];
   if (std::abs(yaw0) > 1e-9)
     rep.notes.push_back("the lane is laid out along the car's heading at the start");
-  const double width = mnv_positive(flag, r.width, from_file ? c.vehicle_width : 1.8, "width");
-  const double length = mnv_positive(flag, r.length, 4.5, "length");
+  const double width = mnv::positive(flag, r.width, from_file ? c.vehicle_width : 1.8, "width");
+  const double length = mnv::positive(flag, r.length, 4.5, "length");
   ds.path = path_double_lane_change(Eigen::Vector2d(0, 0), width);
   // into the world: rotated by the start's heading about the start's position
   const Eigen::Vector2d start(y0[ds.out_x], y0[ds.out_y]);
@@ -508,10 +337,10 @@ ManeuverReport mnv_lane_change(const ManeuverRequest& r, const ModelSpec& spec) 
   res.y.conservativeResize(done, Eigen::NoChange);
   res.xc.conservativeResize(done, Eigen::NoChange);
   mnv_name_result(res, run, r, *driver, st);
-  mnv_check_run(rep, res, run, body);
+  mnv::check_run(rep, res, run, body);
 
   mnv_lane_metrics(rep, flag, local, ds, start, yaw0, lateral, width, length);
-  mnv_write(rep, r);
+  mnv::write(rep, r);
   return rep;
 }
 
@@ -524,7 +353,7 @@ void mnv_linear_diagram(ManeuverReport& rep, const ManeuverRequest& r, const Mod
                         const std::vector<double>& yaw_rates) {
   try {
     for (std::size_t k = 0; k < rep.cr_speed.size(); ++k) {
-      ModelSpec ls = mnv_straight_spec(r, spec);
+      ModelSpec ls = mnv::straight_spec(r, spec);
       ls.analysis.steady.speed = rep.cr_speed[k];
       const StudyLinearization lin = study_linearize(study_model(ls, r.model));
       if (!lin.handling || !(lin.handling->yaw_rate_gain != 0)) {
@@ -565,15 +394,15 @@ void mnv_write_diagram(ManeuverReport& rep, const ManeuverRequest& r) {
 }
 
 ManeuverReport mnv_constant_radius(const ManeuverRequest& r, const ModelSpec& spec) {
-  const ManeuverFlags flag{r.style};
+  const mnv::Flags flag{r.style};
   ManeuverReport rep;
   rep.type = r.type;
   if (!r.radius) throw std::invalid_argument(flag("radius") + ": the constant-radius maneuver needs a radius (m)");
   if (!(*r.radius != 0) || !std::isfinite(*r.radius))
     throw std::invalid_argument(flag("radius") + ": expected a radius other than 0 (m, > 0 turns left)");
   rep.radius = *r.radius;
-  const double u_min = mnv_positive(flag, r.speed_min, 5.0, "speed-min");
-  const double u_max = mnv_positive(flag, r.speed_max, std::sqrt(0.6 * 9.81 * std::abs(rep.radius)), "speed-max");
+  const double u_min = mnv::positive(flag, r.speed_min, 5.0, "speed-min");
+  const double u_max = mnv::positive(flag, r.speed_max, std::sqrt(0.6 * 9.81 * std::abs(rep.radius)), "speed-max");
   if (!(u_max > u_min)) throw std::invalid_argument(flag("speed-max") + ": expected a speed above " + flag("speed-min"));
   const int n = r.points ? *r.points : 8;
   if (n < 2 || n > 1000) throw std::invalid_argument(flag("points") + ": expected 2 to 1000 points");
@@ -588,9 +417,9 @@ ManeuverReport mnv_constant_radius(const ManeuverRequest& r, const ModelSpec& sp
   const HandlingSpec& h = m.spec.analysis.handling;
   if (h.steer.empty())
     throw ModelError(m.source_file, "/analysis/handling/steer", "the maneuver needs the steer input named here");
-  const int ks = mnv_actuator(m, h.steer, "/analysis/handling/steer");
+  const int ks = mnv::actuator(m, h.steer, "/analysis/handling/steer");
   const double ratio = h.steering_ratio ? *h.steering_ratio : 1.0;
-  const int body = mnv_steady_body(m);
+  const int body = mnv::steady_body(m);
   Data d(m);
   const Eigen::VectorXd q_start = m.q0, v_start = m.v0;
   std::vector<double> u0_start;
@@ -615,7 +444,7 @@ ManeuverReport mnv_constant_radius(const ManeuverRequest& r, const ModelSpec& sp
     m.q0 = op.q;
     m.v0 = op.v;
     for (std::size_t k = 0; k < m.actuators.size(); ++k) m.actuators[k].u0 = op.u[static_cast<Eigen::Index>(k)];
-    const BodyState b = mnv_body_state(m, d, body, op.q, op.v);
+    const mnv::BodyState b = mnv::body_state(m, d, body, op.q, op.v);
     const double speed = b.v_body.norm();  // the centre of mass's: a_y = V^2 / R on its circle
     rep.cr_speed.push_back(U);              // along the heading in the road plane, as the search sets it
     rep.cr_lateral_acceleration.push_back((rep.radius > 0 ? 1.0 : -1.0) * speed * speed / std::abs(rep.radius));
@@ -635,7 +464,7 @@ ManeuverReport mnv_constant_radius(const ManeuverRequest& r, const ModelSpec& sp
 }  // namespace
 
 ManeuverReport study_maneuver_job(const ManeuverRequest& r, const ModelSpec& spec, const StudyMessages& tell) {
-  const ManeuverFlags flag{r.style};
+  const mnv::Flags flag{r.style};
   std::string known;
   for (const char* t : kManeuverTypes) known += (known.empty() ? "" : ", ") + std::string(t);
   if (r.type.empty()) throw std::invalid_argument(flag("type") + ": expected one of " + known);
@@ -659,7 +488,7 @@ ManeuverReport study_maneuver_job(const ManeuverRequest& r, const ModelSpec& spe
 std::string study_maneuver_text(const ManeuverReport& r) {
   std::ostringstream os;
   os << std::setprecision(6);
-  const double deg = 180 / kManeuverPi;
+  const double deg = 180 / mnv::kPi;
   os << "maneuver         " << r.type << "\n";
   os << "model            " << r.model_name << "\n";
   if (r.type == "constant-radius") {

@@ -1,0 +1,190 @@
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "dynamics/kinematics.hpp"
+#include "model/errors.hpp"
+#include "simulation/simulator.hpp"
+#include "study/files.hpp"
+#include "study/workflow.hpp"
+#include "study/maneuver_detail.hpp"
+
+namespace codyna::mnv {
+
+
+double positive(const Flags& flag, const std::optional<double>& v, double fallback, const char* name) {
+  if (!v) return fallback;
+  if (!(*v > 0) || !std::isfinite(*v)) {
+    std::ostringstream os;
+    os << flag(name) << ": expected a number > 0, got " << *v;
+    throw std::invalid_argument(os.str());
+  }
+  return *v;
+}
+
+int actuator(const Model& m, const std::string& name, const std::string& field) {
+  for (std::size_t k = 0; k < m.actuators.size(); ++k)
+    if (m.actuators[k].name == name) return static_cast<int>(k);
+  throw ModelError(m.source_file, field, "the maneuver needs the actuator \"" + name + "\", which the model does not have");
+}
+
+int output(const Model& m, const std::string& name, const std::string& field, bool required) {
+  for (std::size_t k = 0; k < m.plant_outputs.size(); ++k)
+    if (m.sensors[static_cast<std::size_t>(m.plant_outputs[k])].name == name) return static_cast<int>(k);
+  if (!required) return -1;
+  std::string have;
+  for (int k : m.plant_outputs) have += (have.empty() ? "" : ", ") + m.sensors[static_cast<std::size_t>(k)].name;
+  throw ModelError(m.source_file, field,
+                   "the maneuver needs the Plant/Out output \"" + name + "\" (Plant/Out: " + (have.empty() ? "none" : have) + ")");
+}
+
+// the body whose motion the steady search sets (study.steady.body, or the first on a free or
+// planar joint to ground)
+int steady_body(const Model& m) {
+  const std::string& name = m.spec.analysis.steady.body;
+  for (int b = 1; b < m.nbodies; ++b) {
+    const JointModel& j = m.joints[static_cast<std::size_t>(b)];
+    if (!name.empty() ? m.body_names[static_cast<std::size_t>(b)] == name
+                      : j.parent == 0 && (j.type == JointType::Free || j.type == JointType::Planar))
+      return b;
+  }
+  throw ModelError(m.source_file, "/analysis/steady/body", "the maneuver needs a body on a free or planar joint to ground");
+}
+
+// the steady body's centre of mass in the world, its heading, roll, and its velocity in its own axes
+BodyState body_state(const Model& m, Data& d, int body, const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
+  forward_kinematics<double>(m, d, q, v);
+  const SE3& X = d.oMi[static_cast<std::size_t>(body)];
+  const Eigen::Vector3d c = m.com[static_cast<std::size_t>(body)];
+  BodyState s;
+  s.p = X.act_point(c);
+  const Vec6T<double>& V = d.v[static_cast<std::size_t>(body)];
+  s.v_body = V.tail<3>() + V.head<3>().cross(c);
+  s.heading = std::atan2(X.R(1, 0), X.R(0, 0));
+  s.roll = std::atan2(X.R(2, 1), X.R(2, 2));
+  const Eigen::Vector3d v_world = X.R * s.v_body, w_world = X.R * V.head<3>();
+  s.speed_along_heading = std::cos(s.heading) * v_world.x() + std::sin(s.heading) * v_world.y();
+  s.yaw_rate = w_world.z();
+  return s;
+}
+
+IntegratorSettings integrator(const Model& m) {
+  IntegratorSettings is;
+  is.method = m.spec.solver.integrator;
+  is.rtol = m.spec.solver.rtol;
+  is.atol = m.spec.solver.atol;
+  is.max_step = m.spec.solver.max_step;
+  return is;
+}
+
+// the study's straight steady run at the request's speed
+ModelSpec straight_spec(const ManeuverRequest& r, ModelSpec spec) {
+  if (r.integrator) {
+    if (!is_integrator_name(*r.integrator))
+      throw std::invalid_argument(option_name(r.style, "integrator") + ": unknown integrator \"" + *r.integrator +
+                                  "\" (expected one of " + integrator_names() + ")");
+    spec.solver.integrator = *r.integrator;
+  }
+  spec.analysis.operating_point = "steady";
+  if (r.speed) spec.analysis.steady.speed = *r.speed;
+  spec.analysis.steady.yaw_rate.reset();
+  spec.analysis.steady.radius.reset();
+  spec.analysis.steady.lateral_acceleration.reset();
+  return spec;
+}
+
+// a run that left the road, or spun
+void check_run(ManeuverReport& rep, const SimulationResult& res, const Model& m, int body) {
+  if (res.stats.integrator_fell_back) rep.notes.push_back("integrator " + res.stats.integrator_choice);
+  if (!res.completed) {
+    rep.valid = false;
+    rep.invalid_reason = "the run did not complete: " + (res.failure.empty() ? std::string("cancelled") : res.failure);
+    return;
+  }
+  Data d(m);
+  double worst = 0, at = 0;
+  for (int k = 0; k < res.samples(); ++k) {
+    const BodyState s = body_state(m, d, body, res.q.row(k).transpose(), res.v.row(k).transpose());
+    const double beta = std::atan2(s.v_body.y(), std::abs(s.v_body.x()));
+    if (std::abs(beta) > worst) {
+      worst = std::abs(beta);
+      at = res.t[static_cast<std::size_t>(k)];
+    }
+  }
+  if (worst > 20 * kPi / 180) {
+    std::ostringstream os;
+    os << "the car spun out: its sideslip reached " << worst * 180 / kPi << " deg at t = " << at << " s";
+    rep.valid = false;
+    rep.invalid_reason = os.str();
+  }
+}
+
+std::vector<double> column(const SimulationResult& r, int k) {
+  std::vector<double> c(static_cast<std::size_t>(r.samples()));
+  for (int i = 0; i < r.samples(); ++i) c[static_cast<std::size_t>(i)] = r.y(i, k);
+  return c;
+}
+
+void write(ManeuverReport& rep, const ManeuverRequest& r) {
+  if (!r.out.empty()) {
+    study_write_results_hdf5(rep.result, r.out);
+    rep.written.push_back(r.out);
+  }
+  if (!r.csv.empty()) {
+    study_write_results_csv(rep.result, r.csv);
+    rep.written.push_back(r.csv);
+  }
+}
+
+
+OpenLoop open_loop_setup(const ManeuverRequest& r, const ModelSpec& spec) {
+  OpenLoop ol{study_model(straight_spec(r, spec), r.model), {}, -1, -1, -1, -1, {}};
+  const Model& m = ol.model;
+  const HandlingSpec& h = m.spec.analysis.handling;
+  if (h.steer.empty())
+    throw ModelError(m.source_file, "/analysis/handling/steer", "the maneuver needs the steer input named here");
+  if (h.yaw_rate.empty())
+    throw ModelError(m.source_file, "/analysis/handling/yaw_rate", "the maneuver needs the yaw-rate output named here");
+  ol.steer = actuator(m, h.steer, "/analysis/handling/steer");
+  ol.yaw_rate = output(m, h.yaw_rate, "/analysis/handling/yaw_rate", true);
+  ol.lateral_acceleration =
+      h.lateral_acceleration.empty() ? -1 : output(m, h.lateral_acceleration, "/analysis/handling/lateral_acceleration", false);
+  ol.body = steady_body(m);
+  ol.op = study_operating_point(m, "steady");
+  Data d(m);
+  ol.start = body_state(m, d, ol.body, ol.op.q, ol.op.v);
+  return ol;
+}
+
+Model open_loop_run(ManeuverReport& rep, const ManeuverRequest& r, const OpenLoop& ol, const SteerProfile& profile,
+                    const std::vector<double>& stops, double t_end) {
+  const Flags flag{r.style};
+  SimulationOptions o;
+  o.integrator = integrator(ol.model);
+  o.t_end = t_end;
+  o.output_step = positive(flag, r.output_step, 0.005, "output-step");
+  Model run = held_at(ol.model, ol.op, o);
+  const Eigen::Index nu = run.nu();
+  const int ks = ol.steer;
+  const auto one = [nu, ks](double x) {
+    Eigen::VectorXd v = Eigen::VectorXd::Zero(nu);
+    v[ks] = x;
+    return v;
+  };
+  o.disturbance = [one, profile](double t) { return one(profile.value(t)); };
+  o.disturbance_rate = [one, profile](double t) { return one(profile.rate(t)); };
+  o.disturbance_acceleration = [one, profile](double t) { return one(profile.acceleration(t)); };
+  o.rate_jumps = stops;
+  rep.result = simulate(run, nullptr, nullptr, o);
+  check_run(rep, rep.result, run, ol.body);
+  if (rep.result.samples() > 0) {
+    Data d(run);
+    const int last = rep.result.samples() - 1;
+    const BodyState e = body_state(run, d, ol.body, rep.result.q.row(last).transpose(), rep.result.v.row(last).transpose());
+    rep.end_speed = e.speed_along_heading;
+    rep.end_yaw_rate = e.yaw_rate;
+  }
+  return run;
+}
+
+}  // namespace codyna::mnv

@@ -1,0 +1,75 @@
+// What the maneuvers of study/maneuver_job.hpp share (not an interface: maneuver_*.cpp only):
+// the request's checks, the steady body's state, the straight run, the open-loop steer run.
+#pragma once
+
+#include <Eigen/Core>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "analysis/operating_point.hpp"
+#include "dynamics/data.hpp"
+#include "model/model.hpp"
+#include "simulation/integrator.hpp"
+#include "simulation/result.hpp"
+#include "study/maneuver_job.hpp"
+
+namespace codyna::mnv {
+
+inline constexpr double kPi = 3.14159265358979323846;
+
+struct Flags {
+  OptionStyle style;
+  std::string operator()(const std::string& dashed) const { return option_name(style, dashed); }
+};
+
+// v when given (refused unless finite and > 0, naming the flag), else fallback
+double positive(const Flags& flag, const std::optional<double>& v, double fallback, const char* name);
+// the actuator / Plant/Out index of name, refused naming the model file's field
+int actuator(const Model& m, const std::string& name, const std::string& field);
+int output(const Model& m, const std::string& name, const std::string& field, bool required);
+// the body whose motion the steady search sets (study.steady.body, or the first on a free or
+// planar joint to ground)
+int steady_body(const Model& m);
+
+// the steady body's centre of mass in the world, its heading, roll, and its velocity in its own axes
+struct BodyState {
+  Eigen::Vector3d p, v_body;
+  double heading = 0, roll = 0;
+  double speed_along_heading = 0, yaw_rate = 0;  // in the road plane (world x, y), about world z
+};
+BodyState body_state(const Model& m, Data& d, int body, const Eigen::VectorXd& q, const Eigen::VectorXd& v);
+
+// one steer profile: value, rate and acceleration at t
+struct SteerProfile {
+  std::function<double(double)> value, rate, acceleration;
+};
+
+IntegratorSettings integrator(const Model& m);
+// the study's straight steady run at the request's speed (its integrator checked)
+ModelSpec straight_spec(const ManeuverRequest& r, ModelSpec spec);
+// a run that did not complete, or spun (sideslip past 20 deg): rep invalid with the reason; a
+// note when auto's integrator fell back
+void check_run(ManeuverReport& rep, const SimulationResult& res, const Model& m, int body);
+std::vector<double> column(const SimulationResult& r, int k);
+// the run as --out / --csv
+void write(ManeuverReport& rep, const ManeuverRequest& r);
+
+// An open-loop steer run from the straight steady run: the model at its steady motion, the steer
+// input (analysis.handling.steer), the yaw-rate and lateral-acceleration outputs (-1: none).
+struct OpenLoop {
+  Model model;
+  OperatingPoint op;
+  int steer = -1, yaw_rate = -1, lateral_acceleration = -1, body = -1;
+  BodyState start;
+};
+OpenLoop open_loop_setup(const ManeuverRequest& r, const ModelSpec& spec);
+// Runs it to t_end with the steer's deviation from the steady run following `profile` (its rate
+// and acceleration exact: a motion input takes it), stopping at `stops` (where the steer's
+// acceleration jumps); fills rep.result, checks it (check_run), end_speed, end_yaw_rate. Returns
+// the run's model (the steady one held at the point: the result's q, v are its).
+Model open_loop_run(ManeuverReport& rep, const ManeuverRequest& r, const OpenLoop& ol, const SteerProfile& profile,
+                    const std::vector<double>& stops, double t_end);
+
+}  // namespace codyna::mnv
