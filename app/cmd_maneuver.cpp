@@ -14,6 +14,7 @@ struct ManeuverArgs {
   std::string model, type, out, csv, x, y, yaw, speed_output, drive, integrator;
   std::vector<std::string> free_inputs;
   double speed = 0, steer = 0, steer_time = 0, ramp = 0, frequency = 0, dwell = 0, t_end = 0, output_step = 0;
+  double frequency_min = 0, frequency_max = 0, sweep_time = 0;
   double radius = 0, speed_min = 0, speed_max = 0, width = 0, length = 0, preview = 0, lateral_gain = 0;
   double speed_kp = 0, speed_ki = 0, sample_time = 0;
   int points = 0;
@@ -34,6 +35,9 @@ void run_maneuver(const ManeuverArgs& a, const CLI::App* cmd) {
   num("--ramp", a.ramp, r.ramp);
   num("--frequency", a.frequency, r.frequency);
   num("--dwell", a.dwell, r.dwell);
+  num("--frequency-min", a.frequency_min, r.frequency_min);
+  num("--frequency-max", a.frequency_max, r.frequency_max);
+  num("--sweep-time", a.sweep_time, r.sweep_time);
   num("--t-end", a.t_end, r.t_end);
   num("--output-step", a.output_step, r.output_step);
   num("--radius", a.radius, r.radius);
@@ -64,9 +68,9 @@ void run_maneuver(const ManeuverArgs& a, const CLI::App* cmd) {
 
 void add_maneuver(CLI::App& app) {
   auto a = std::make_shared<ManeuverArgs>();
-  auto* cmd = app.add_subcommand("maneuver", "Run a standard handling maneuver (step steer, sine with dwell, double lane change, constant radius) and print its metrics");
+  auto* cmd = app.add_subcommand("maneuver", "Run a standard handling maneuver (step steer, sine with dwell, swept sine, double lane change, constant radius) and print its metrics");
   cmd->add_option("model", a->model, "model file (JSON)")->required();
-  cmd->add_option("--type", a->type, "step-steer | sine-with-dwell | double-lane-change | constant-radius")->required();
+  cmd->add_option("--type", a->type, "step-steer | sine-with-dwell | swept-sine | double-lane-change | constant-radius")->required();
   cmd->add_option("--out", a->out, "the run as an HDF5 results file");
   cmd->add_option("--csv", a->csv, "the run as CSV (constant radius: its table)");
   cmd->add_option("--speed", a->speed, "m/s, the straight run's speed (default: the model file's steady motion)");
@@ -75,12 +79,15 @@ void add_maneuver(CLI::App& app) {
   cmd->add_option("--ramp", a->ramp, "s, the step's ramp (half cosine; default 0.05)");
   cmd->add_option("--frequency", a->frequency, "Hz, sine with dwell (default 0.7)");
   cmd->add_option("--dwell", a->dwell, "s, sine with dwell (default 0.5)");
+  cmd->add_option("--frequency-min", a->frequency_min, "Hz, swept sine's first frequency (default 0.1)");
+  cmd->add_option("--frequency-max", a->frequency_max, "Hz, swept sine's last (default 2)");
+  cmd->add_option("--sweep-time", a->sweep_time, "s, swept sine's sweep (default 30; 5 s at rest follow)");
   cmd->add_option("--t-end", a->t_end, "s, the run's length");
   cmd->add_option("--output-step", a->output_step, "s, open-loop runs' output step (default 0.005)");
   cmd->add_option("--radius", a->radius, "m, constant radius (> 0 left)");
   cmd->add_option("--speed-min", a->speed_min, "m/s, constant radius's first speed (default 5)");
   cmd->add_option("--speed-max", a->speed_max, "m/s, its last (default the speed of 0.6 g)");
-  cmd->add_option("--points", a->points, "constant radius: the number of speeds (default 8)");
+  cmd->add_option("--points", a->points, "constant radius: the number of speeds (default 8); swept sine: of the table's frequencies (12)");
   cmd->add_option("--width", a->width, "m, vehicle width for the ISO 3888-1 lane (default 1.8)");
   cmd->add_option("--length", a->length, "m, vehicle length for the cones (default 4.5)");
   cmd->add_option("--preview", a->preview, "m, the driver's look-ahead distance");
@@ -93,7 +100,7 @@ void add_maneuver(CLI::App& app) {
   cmd->add_option("--yaw", a->yaw, "the Plant/Out output of its heading (default yaw)");
   cmd->add_option("--speed-output", a->speed_output, "the Plant/Out output of its forward speed (default speed)");
   cmd->add_option("--drive", a->drive, "the Plant/In input the speed controller drives (default: none)");
-  cmd->add_option("--integrator", a->integrator, "the runs' integrator (default: the model file's; cvode-bdf where tires saturate)");
+  cmd->add_option("--integrator", a->integrator, "the runs' integrator (default: the model file's)");
   cmd->add_option("--free-input", a->free_inputs, "the steady motion's free inputs (a turn: steer,drive)")->delimiter(',');
   cmd->callback([a, cmd] { set_exit_code(run_guarded([&] { run_maneuver(*a, cmd); })); });
 }

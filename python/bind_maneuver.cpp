@@ -12,6 +12,19 @@ py::dict maneuver_step_of(const StepMetrics& m) {
                   "peak_time"_a = m.peak_time, "peak"_a = m.peak, "overshoot_percent"_a = m.overshoot_percent);
 }
 
+py::dict swept_characteristics_of(const SweptSineCharacteristics& c) {
+  return py::dict("yaw_gain_low"_a = c.yaw_gain_low, "resonance_hz"_a = c.resonance_hz, "peak_ratio"_a = c.peak_ratio,
+                  "yaw_phase_1hz"_a = c.yaw_phase_1hz, "lateral_gain_low"_a = c.lateral_gain_low,
+                  "lateral_phase_1hz"_a = c.lateral_phase_1hz);
+}
+
+py::array_t<std::complex<double>> complex_array(const std::vector<std::complex<double>>& v) {
+  py::array_t<std::complex<double>> a(static_cast<py::ssize_t>(v.size()));
+  auto m = a.mutable_unchecked<1>();
+  for (std::size_t k = 0; k < v.size(); ++k) m(static_cast<py::ssize_t>(k)) = v[k];
+  return a;
+}
+
 py::dict do_maneuver(const Study& s, const py::dict& options) {
   Keywords k(options, "maneuver");
   ManeuverRequest r;
@@ -26,6 +39,9 @@ py::dict do_maneuver(const Study& s, const py::dict& options) {
   r.ramp = k.number("ramp");
   r.frequency = k.number("frequency");
   r.dwell = k.number("dwell");
+  r.frequency_min = k.number("frequency_min");
+  r.frequency_max = k.number("frequency_max");
+  r.sweep_time = k.number("sweep_time");
   r.t_end = k.number("t_end");
   r.output_step = k.number("output_step");
   r.radius = k.number("radius");
@@ -64,6 +80,19 @@ py::dict do_maneuver(const Study& s, const py::dict& options) {
     d["yaw_rate_ratio_1_75"] = rep.sine.yrr_1_75;
     d["lateral_displacement"] = rep.sine.lateral_displacement;
     d["passes_fmvss126"] = rep.sine.passes_fmvss126;
+  } else if (rep.type == "swept-sine") {
+    d["frequency_hz"] = vector_of(rep.sw_frequency);
+    d["input_share"] = vector_of(rep.sw_input_share);
+    d["yaw_rate_response"] = complex_array(rep.sw_yaw);
+    d["lateral_acceleration_response"] = complex_array(rep.sw_lateral);
+    d["characteristics"] = swept_characteristics_of(rep.sw_metrics);
+    if (rep.sw_has_linear) {
+      d["yaw_rate_response_linear"] = complex_array(rep.sw_yaw_linear);
+      d["lateral_acceleration_response_linear"] = complex_array(rep.sw_lateral_linear);
+      d["characteristics_linear"] = swept_characteristics_of(rep.sw_metrics_linear);
+      d["largest_gap_yaw_rate"] = py::make_tuple(rep.sw_gap_yaw, rep.sw_gap_yaw_hz);
+      d["largest_gap_lateral_acceleration"] = py::make_tuple(rep.sw_gap_lateral, rep.sw_gap_lateral_hz);
+    }
   } else if (rep.type == "double-lane-change") {
     d["path_error_max"] = rep.path.max_abs;
     d["path_error_rms"] = rep.path.rms;

@@ -1,6 +1,7 @@
 #include "analysis/frequency_estimate.hpp"
 
 #include <Eigen/QR>
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -46,6 +47,30 @@ std::vector<HarmonicFit> fit_harmonics(const Eigen::VectorXd& t, const Eigen::Ma
 
 HarmonicFit fit_harmonics(const Eigen::VectorXd& t, const Eigen::VectorXd& x, double w, int K) {
   return fit_harmonics(t, Eigen::MatrixXd(x), w, K)[0];
+}
+
+TransformRatio transform_ratio(const std::vector<double>& t, const std::vector<double>& du,
+                               const std::vector<double>& dy, const std::vector<double>& w) {
+  if (t.size() < 2 || du.size() != t.size() || dy.size() != t.size())
+    throw std::invalid_argument("transform_ratio: expected at least 2 samples of the time, the input and the output");
+  TransformRatio r;
+  std::vector<std::complex<double>> U(w.size());
+  const std::size_t n = t.size();
+  for (std::size_t i = 0; i < w.size(); ++i) {
+    std::complex<double> su = 0, sy = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+      const double h = 0.5 * ((k + 1 < n ? t[k + 1] - t[k] : 0.0) + (k > 0 ? t[k] - t[k - 1] : 0.0));
+      const std::complex<double> e = std::polar(h, -w[i] * t[k]);
+      su += du[k] * e;
+      sy += dy[k] * e;
+    }
+    U[i] = su;
+    r.H.push_back(su != 0.0 ? sy / su : std::complex<double>(std::nan(""), std::nan("")));
+  }
+  double largest = 0;
+  for (const auto& u : U) largest = std::max(largest, std::abs(u));
+  for (const auto& u : U) r.input_share.push_back(largest > 0 ? std::abs(u) / largest : 0.0);
+  return r;
 }
 
 }  // namespace codyna

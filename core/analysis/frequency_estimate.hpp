@@ -32,4 +32,17 @@ HarmonicFit fit_harmonics(const Eigen::VectorXd& t, const Eigen::VectorXd& x, do
 // Every column of X (samples x signals) at once (one factorization).
 std::vector<HarmonicFit> fit_harmonics(const Eigen::VectorXd& t, const Eigen::MatrixXd& X, double w, int K);
 
+// The frequency response of a transient run (a swept sine, a step): the ratio of the Fourier
+// transforms Y(w) / U(w) of the output's and the input's deviations, each by the trapezoid rule
+// over the samples, at each w (rad/s). Exact for a linear plant when the run starts at rest and
+// has settled by its end (both deviations then vanish at the ends), to the quadrature's error on
+// the samples; where |U(w)| is small the ratio is not to be trusted (share: |U(w)| over the
+// largest |U| of the ws). Throws std::invalid_argument for fewer than 2 samples or unequal sizes.
+struct TransformRatio {
+  std::vector<std::complex<double>> H;
+  std::vector<double> input_share;
+};
+TransformRatio transform_ratio(const std::vector<double>& t, const std::vector<double>& du,
+                               const std::vector<double>& dy, const std::vector<double>& w);
+
 }  // namespace codyna

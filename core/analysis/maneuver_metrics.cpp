@@ -170,4 +170,55 @@ std::vector<double> understeer_diagram(const std::vector<double>& ay, const std:
   return K;
 }
 
+namespace {
+
+// the unwrapped phase (deg) of H over the grid, each step taken the short way
+std::vector<double> unwrapped_phase_deg(const std::vector<std::complex<double>>& H) {
+  std::vector<double> p(H.size());
+  constexpr double deg = 180 / 3.14159265358979323846;
+  for (std::size_t k = 0; k < H.size(); ++k) {
+    p[k] = std::arg(H[k]) * deg;
+    if (k > 0) p[k] -= 360 * std::round((p[k] - p[k - 1]) / 360);
+  }
+  return p;
+}
+
+double at_one_hz(const std::vector<double>& f, const std::vector<double>& v) {
+  for (std::size_t k = 0; k + 1 < f.size(); ++k)
+    if (f[k] <= 1.0 && f[k + 1] >= 1.0) return v[k] + (v[k + 1] - v[k]) * (1.0 - f[k]) / (f[k + 1] - f[k]);
+  return std::nan("");
+}
+
+}  // namespace
+
+SweptSineCharacteristics swept_sine_characteristics(const std::vector<double>& f,
+                                                    const std::vector<std::complex<double>>& yaw_rate,
+                                                    const std::vector<std::complex<double>>& lateral) {
+  if (f.size() < 3 || yaw_rate.size() != f.size() || (!lateral.empty() && lateral.size() != f.size()))
+    throw std::invalid_argument("swept_sine_characteristics: expected at least 3 frequencies and a response at each");
+  for (std::size_t k = 0; k + 1 < f.size(); ++k)
+    if (!(f[k] > 0 && f[k + 1] > f[k])) throw std::invalid_argument("swept_sine_characteristics: the frequencies must rise from above 0");
+  SweptSineCharacteristics c;
+  c.yaw_gain_low = std::abs(yaw_rate.front());
+  std::size_t top = 0;
+  for (std::size_t k = 1; k < f.size(); ++k)
+    if (std::abs(yaw_rate[k]) > std::abs(yaw_rate[top])) top = k;
+  double peak = std::abs(yaw_rate[top]);
+  if (top > 0 && top + 1 < f.size()) {
+    // the parabola through the three samples in x = log f
+    const double x0 = std::log(f[top - 1]), x1 = std::log(f[top]), x2 = std::log(f[top + 1]);
+    const double y0 = std::abs(yaw_rate[top - 1]), y1 = peak, y2 = std::abs(yaw_rate[top + 1]);
+    const double d01 = (y1 - y0) / (x1 - x0), d12 = (y2 - y1) / (x2 - x1), a = (d12 - d01) / (x2 - x0);
+    const double b = d01 - a * (x0 + x1);
+    const double xm = a < 0 ? -b / (2 * a) : x1;
+    c.resonance_hz = std::exp(xm);
+    peak = std::max(peak, y0 + (xm - x0) * (d01 + a * (xm - x1)));
+  }
+  c.peak_ratio = c.yaw_gain_low > 0 ? peak / c.yaw_gain_low : std::nan("");
+  c.yaw_phase_1hz = at_one_hz(f, unwrapped_phase_deg(yaw_rate));
+  c.lateral_gain_low = lateral.empty() ? std::nan("") : std::abs(lateral.front());
+  c.lateral_phase_1hz = lateral.empty() ? std::nan("") : at_one_hz(f, unwrapped_phase_deg(lateral));
+  return c;
+}
+
 }  // namespace codyna

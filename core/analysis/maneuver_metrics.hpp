@@ -21,6 +21,7 @@
 // Cost O(N). Everything throws std::invalid_argument on signals too short for the metric.
 #pragma once
 
+#include <complex>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,20 @@ std::vector<double> understeer_diagram(const std::vector<double>& ay, const std:
 
 // the time and value of the sampled maximum of sign * y on [from, to], refined by a parabola
 // through the sample and its neighbours
+// ISO 7401's frequency-response characteristic values from a yaw-rate (and lateral-acceleration)
+// response to steer on a frequency grid f (Hz, rising): the gain at the grid's lowest frequency
+// (standing for the steady state), the resonance (the largest yaw-rate gain inside the grid, found
+// by a parabola through the largest sample and its neighbours in log f; 0 when the largest is at an
+// end), the peak ratio (largest gain / lowest-frequency gain), and the phases at 1 Hz (deg, by
+// linear interpolation of the unwrapped phase; NaN when 1 Hz is outside the grid).
+struct SweptSineCharacteristics {
+  double yaw_gain_low = 0, resonance_hz = 0, peak_ratio = 0, yaw_phase_1hz = 0;
+  double lateral_gain_low = 0, lateral_phase_1hz = 0;  // NaN without a lateral acceleration
+};
+SweptSineCharacteristics swept_sine_characteristics(const std::vector<double>& f,
+                                                    const std::vector<std::complex<double>>& yaw_rate,
+                                                    const std::vector<std::complex<double>>& lateral = {});
+
 struct SampledPeak {
   double t = 0, value = 0;
   int index = -1;

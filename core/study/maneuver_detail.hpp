@@ -72,4 +72,7 @@ OpenLoop open_loop_setup(const ManeuverRequest& r, const ModelSpec& spec);
 Model open_loop_run(ManeuverReport& rep, const ManeuverRequest& r, const OpenLoop& ol, const SteerProfile& profile,
                     const std::vector<double>& stops, double t_end);
 
+// the maneuvers in their own files
+ManeuverReport swept_sine(const ManeuverRequest& r, const ModelSpec& spec);  // maneuver_swept.cpp
+
 }  // namespace codyna::mnv

@@ -475,6 +475,7 @@ ManeuverReport study_maneuver_job(const ManeuverRequest& r, const ModelSpec& spe
   if (r.free_inputs) given.analysis.free_inputs = *r.free_inputs;
   if (r.type == "step-steer") rep = mnv_open_loop(r, given, false);
   else if (r.type == "sine-with-dwell") rep = mnv_open_loop(r, given, true);
+  else if (r.type == "swept-sine") rep = mnv::swept_sine(r, given);
   else if (r.type == "double-lane-change") rep = mnv_lane_change(r, given);
   else if (r.type == "constant-radius") rep = mnv_constant_radius(r, given);
   else throw std::invalid_argument(flag("type") + ": unknown maneuver \"" + r.type + "\" (expected one of " + known + ")");
@@ -484,6 +485,45 @@ ManeuverReport study_maneuver_job(const ManeuverRequest& r, const ModelSpec& spe
   }
   return rep;
 }
+
+namespace {
+
+// the swept sine's table and characteristic values
+void mnv_swept_text(std::ostream& os, const ManeuverReport& r) {
+  const double deg = 180 / mnv::kPi;
+  os << "steer amplitude  " << r.steer << " (swept from " << r.steer_start << " s to " << r.steer_end << " s)\n";
+  if (r.sw_frequency.empty()) return;
+  const bool lin = r.sw_has_linear, lat = !r.sw_lateral.empty();
+  os << "yaw rate per steer" << (lat ? " / lateral acceleration per steer" : "") << (lin ? " (the linear model's beside)" : "")
+     << "\n  f (Hz)      gain        phase (deg)" << (lin ? "  linear gain  phase (deg)" : "")
+     << (lat ? "  a_y gain     phase (deg)" : "") << (lat && lin ? "  linear gain  phase (deg)" : "") << "\n";
+  const auto pair = [&os, deg](std::complex<double> h) {
+    os << "  " << std::setw(11) << std::abs(h) << "  " << std::setw(11) << std::arg(h) * deg;
+  };
+  for (std::size_t k = 0; k < r.sw_frequency.size(); ++k) {
+    os << "  " << std::setw(8) << r.sw_frequency[k];
+    pair(r.sw_yaw[k]);
+    if (lin) pair(r.sw_yaw_linear[k]);
+    if (lat) pair(r.sw_lateral[k]);
+    if (lat && lin) pair(r.sw_lateral_linear[k]);
+    os << "\n";
+  }
+  const auto metrics = [&os, lat](const char* who, const SweptSineCharacteristics& m) {
+    os << who << "steady gain " << m.yaw_gain_low << " 1/s, resonance " << m.resonance_hz << " Hz, peak ratio "
+       << m.peak_ratio << ", yaw-rate phase at 1 Hz " << m.yaw_phase_1hz << " deg";
+    if (lat) os << ", a_y phase at 1 Hz " << m.lateral_phase_1hz << " deg";
+    os << "\n";
+  };
+  os << "ISO 7401 (the steady gain: at " << r.sw_frequency.front() << " Hz)\n";
+  metrics("  run:     ", r.sw_metrics);
+  if (!lin) return;
+  metrics("  linear:  ", r.sw_metrics_linear);
+  os << "largest gap  yaw rate " << r.sw_gap_yaw * 100 << " % at " << r.sw_gap_yaw_hz << " Hz";
+  if (lat) os << ", lateral acceleration " << r.sw_gap_lateral * 100 << " % at " << r.sw_gap_lateral_hz << " Hz";
+  os << " (of the linear response's largest)\n";
+}
+
+}  // namespace
 
 std::string study_maneuver_text(const ManeuverReport& r) {
   std::ostringstream os;
@@ -544,6 +584,8 @@ std::string study_maneuver_text(const ManeuverReport& r) {
        << "yaw-rate ratio at 1.75 s    " << r.sine.yrr_1_75 << " % (at most 20 %)\n"
        << "lateral displacement        " << r.sine.lateral_displacement << " m at 1.07 s (at least 1.83 m)\n"
        << "FMVSS 126                   " << (r.sine.passes_fmvss126 ? "passes" : "fails") << "\n";
+  } else if (r.type == "swept-sine") {
+    mnv_swept_text(os, r);
   } else if (r.type == "double-lane-change") {
     os << "path error       max " << r.path.max_abs << " m at " << r.path.at << " s, RMS " << r.path.rms << " m\n"
        << "largest steer    " << r.max_steer << "\n"

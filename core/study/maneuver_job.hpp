@@ -10,6 +10,14 @@
 //                       amplitude --steer with a --dwell (0.5 s) at its second peak; the yaw-rate
 //                       ratios 1.0 and 1.75 s after the steer ends, the lateral displacement of the
 //                       steady body's centre of mass 1.07 s after the steer starts.
+//   swept-sine          ISO 7401 frequency response: a sine of amplitude --steer whose frequency
+//                       rises exponentially over --sweep-time s through the band from
+//                       --frequency-min to --frequency-max (Hz; the sweep starts and ends 1.25
+//                       times beyond, its first and last twentieth tapered by half cosines), then
+//                       5 s at rest; the yaw-rate and lateral-acceleration responses to steer by the
+//                       ratio of the transforms (analysis/frequency_estimate.hpp), against the
+//                       linearization's; ISO 7401's characteristic values (steady gain, resonance,
+//                       peak ratio, phases at 1 Hz) of both.
 //   double-lane-change  ISO 3888-1, driven by the driver (simulation/driver.hpp) on the lane's
 //                       centre line for a car of --width: the lateral error (max, RMS), and the
 //                       cones hit (a --width x --length rectangle about the position outputs).
@@ -27,6 +35,7 @@
 // the constant radius: --csv, its table).
 #pragma once
 
+#include <complex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -37,7 +46,7 @@
 namespace codyna {
 
 // the maneuver types, in the order the help lists them
-inline constexpr const char* kManeuverTypes[] = {"step-steer", "sine-with-dwell", "double-lane-change",
+inline constexpr const char* kManeuverTypes[] = {"step-steer", "sine-with-dwell", "swept-sine", "double-lane-change",
                                                  "constant-radius"};
 
 struct ManeuverRequest {
@@ -49,11 +58,12 @@ struct ManeuverRequest {
   std::optional<double> steer;                 // steer input amplitude (step, sine)
   std::optional<double> steer_time, ramp;      // s: when the steer starts (default 0.5), its ramp (0.05)
   std::optional<double> frequency, dwell;      // sine with dwell: Hz (0.7), s (0.5)
+  std::optional<double> frequency_min, frequency_max, sweep_time;  // swept sine: Hz (0.1, 2), s (30)
   std::optional<double> t_end, output_step;    // s
   std::optional<std::string> integrator;       // the runs' (default the model file's solver)
   std::optional<double> radius;                // constant radius, m
   std::optional<double> speed_min, speed_max;  // constant radius, m/s
-  std::optional<int> points;                   // constant radius (default 8)
+  std::optional<int> points;                   // constant radius (default 8); swept sine: the table's frequencies (12)
   // the steady motion's free inputs (StudySpec::free_inputs; a turn needs the drive that holds
   // the speed besides the steer): each given replaces the file's list
   std::optional<std::vector<std::string>> free_inputs;
@@ -82,6 +92,15 @@ struct ManeuverReport {
   PathErrorMetrics path;
   std::vector<std::string> cones_hit;    // "section 3 at x = 81.2 m" (empty: none)
   double max_steer = 0;
+  // swept sine: the frequency responses to steer on the table's frequencies (Hz), estimated from
+  // the run (the ratio of the transforms) and the linear model's (straight-run linearization);
+  // ISO 7401's characteristic values of both (on a grid of 200), the largest gaps |H - H_lin| over
+  // the linear response's largest |H_lin| and where (Hz)
+  std::vector<double> sw_frequency, sw_input_share;
+  std::vector<std::complex<double>> sw_yaw, sw_yaw_linear, sw_lateral, sw_lateral_linear;
+  SweptSineCharacteristics sw_metrics, sw_metrics_linear;
+  bool sw_has_linear = false;
+  double sw_gap_yaw = 0, sw_gap_yaw_hz = 0, sw_gap_lateral = 0, sw_gap_lateral_hz = 0;
   // constant radius: one entry per point
   double radius = 0;
   std::vector<double> cr_speed, cr_lateral_acceleration, cr_steer, cr_road_wheel, cr_sideslip, cr_roll, cr_gradient;
