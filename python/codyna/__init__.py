@@ -216,12 +216,16 @@ class Study:
     def maneuver(self, type, **options):
         """A standard handling maneuver with its metrics (codyna maneuver; docs/maneuvers.md).
 
-        type: "step-steer", "sine-with-dwell", "double-lane-change" or "constant-radius"; the
-        keywords are codyna maneuver's flags with underscores (speed, steer, steer_time, ramp,
-        frequency, dwell, t_end, output_step, radius, speed_min, speed_max, points, width, length,
-        preview, lateral_gain, speed_kp, speed_ki, sample_time, x, y, yaw, speed_output, drive, out,
-        csv). Returns a dict: the metrics, "valid" and "invalid_reason", "text" (the command's
-        report), and the run's "t", "outputs", "output_names".
+        type: "step-steer", "sine-with-dwell", "swept-sine", "double-lane-change" or
+        "constant-radius"; the keywords are codyna maneuver's flags with underscores (speed, steer,
+        steer_time, ramp, frequency, dwell, frequency_min, frequency_max, sweep_time, t_end,
+        output_step, radius, speed_min, speed_max, points, width, length, preview, lateral_gain,
+        speed_kp, speed_ki, sample_time, x, y, yaw, speed_output, drive, integrator, free_inputs,
+        out, csv). Returns a dict: the metrics, "valid" and "invalid_reason", "text" (the command's
+        report), and the run's "t", "outputs", "output_names". The swept sine adds
+        "frequency_hz" and the complex responses "yaw_rate_response",
+        "lateral_acceleration_response" (and their "..._linear"), "characteristics" (ISO 7401's
+        values; "characteristics_linear") and the largest gaps as (gap, Hz).
         """
         options["type"] = type
         return _codyna._maneuver(self._study, _given(options))

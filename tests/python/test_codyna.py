@@ -1024,6 +1024,16 @@ def test_maneuver_is_the_command_lines():
             "double-lane-change", preview=-1)
     with pytest.raises(ValueError, match="^type: unknown maneuver"):
         codyna.Study(car).maneuver("slalom")
+    # the swept sine: the command line's text; the responses as complex arrays beside the linear ones
+    stdout, _ = cli("maneuver", car, "--type", "swept-sine", "--steer", "0.001", "--points", "5")
+    sw = codyna.Study(car).maneuver("swept-sine", steer=0.001, points=5)
+    assert sw["text"] == stdout
+    assert sw["yaw_rate_response"].dtype == complex and sw["yaw_rate_response"].shape == (5,)
+    assert np.max(np.abs(sw["yaw_rate_response"] - sw["yaw_rate_response_linear"])
+                  / np.abs(sw["yaw_rate_response_linear"])) < 1e-3
+    assert sw["characteristics"]["resonance_hz"] == pytest.approx(sw["characteristics_linear"]["resonance_hz"], rel=1e-3)
+    with pytest.raises(ValueError, match="^frequency_max: expected a frequency above frequency_min"):
+        codyna.Study(car).maneuver("swept-sine", frequency_max=0.05)
 
 
 def test_freqresp_is_the_command_lines(tmp_path):
