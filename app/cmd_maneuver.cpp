@@ -14,7 +14,7 @@ struct ManeuverArgs {
   std::string model, type, out, csv, x, y, yaw, speed_output, drive, integrator;
   std::vector<std::string> free_inputs;
   double speed = 0, steer = 0, steer_time = 0, ramp = 0, frequency = 0, dwell = 0, t_end = 0, output_step = 0;
-  double frequency_min = 0, frequency_max = 0, sweep_time = 0;
+  double frequency_min = 0, frequency_max = 0, sweep_time = 0, ay_min = 0, ay_max = 0;
   double radius = 0, speed_min = 0, speed_max = 0, width = 0, length = 0, preview = 0, lateral_gain = 0;
   double speed_kp = 0, speed_ki = 0, sample_time = 0;
   int points = 0;
@@ -43,6 +43,8 @@ void run_maneuver(const ManeuverArgs& a, const CLI::App* cmd) {
   num("--radius", a.radius, r.radius);
   num("--speed-min", a.speed_min, r.speed_min);
   num("--speed-max", a.speed_max, r.speed_max);
+  num("--ay-min", a.ay_min, r.ay_min);
+  num("--ay-max", a.ay_max, r.ay_max);
   num("--width", a.width, r.width);
   num("--length", a.length, r.length);
   num("--preview", a.preview, r.preview);
@@ -68,11 +70,11 @@ void run_maneuver(const ManeuverArgs& a, const CLI::App* cmd) {
 
 void add_maneuver(CLI::App& app) {
   auto a = std::make_shared<ManeuverArgs>();
-  auto* cmd = app.add_subcommand("maneuver", "Run a standard handling maneuver (step steer, sine with dwell, swept sine, double lane change, constant radius) and print its metrics");
+  auto* cmd = app.add_subcommand("maneuver", "Run a standard handling maneuver (step steer, sine with dwell, swept sine, double lane change, constant radius, constant speed) and print its metrics");
   cmd->add_option("model", a->model, "model file (JSON)")->required();
-  cmd->add_option("--type", a->type, "step-steer | sine-with-dwell | swept-sine | double-lane-change | constant-radius")->required();
+  cmd->add_option("--type", a->type, "step-steer | sine-with-dwell | swept-sine | double-lane-change | constant-radius | constant-speed")->required();
   cmd->add_option("--out", a->out, "the run as an HDF5 results file");
-  cmd->add_option("--csv", a->csv, "the run as CSV (constant radius: its table)");
+  cmd->add_option("--csv", a->csv, "the run as CSV (constant radius, constant speed: the table)");
   cmd->add_option("--speed", a->speed, "m/s, the straight run's speed (default: the model file's steady motion)");
   cmd->add_option("--steer", a->steer, "steer amplitude in the steer input's units (step: 0.01, sine: 0.05)");
   cmd->add_option("--steer-time", a->steer_time, "s, when the steer starts (default 0.5)");
@@ -87,7 +89,9 @@ void add_maneuver(CLI::App& app) {
   cmd->add_option("--radius", a->radius, "m, constant radius (> 0 left)");
   cmd->add_option("--speed-min", a->speed_min, "m/s, constant radius's first speed (default 5)");
   cmd->add_option("--speed-max", a->speed_max, "m/s, its last (default the speed of 0.6 g)");
-  cmd->add_option("--points", a->points, "constant radius: the number of speeds (default 8); swept sine: of the table's frequencies (12)");
+  cmd->add_option("--ay-min", a->ay_min, "m/s^2, constant speed's first lateral acceleration (default 0.5; > 0 left)");
+  cmd->add_option("--ay-max", a->ay_max, "m/s^2, its last (default 0.6 g)");
+  cmd->add_option("--points", a->points, "constant radius, constant speed: the number of turns (default 8); swept sine: of the table's frequencies (12)");
   cmd->add_option("--width", a->width, "m, vehicle width for the ISO 3888-1 lane (default 1.8)");
   cmd->add_option("--length", a->length, "m, vehicle length for the cones (default 4.5)");
   cmd->add_option("--preview", a->preview, "m, the driver's look-ahead distance");

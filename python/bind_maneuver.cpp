@@ -47,6 +47,8 @@ py::dict do_maneuver(const Study& s, const py::dict& options) {
   r.radius = k.number("radius");
   r.speed_min = k.number("speed_min");
   r.speed_max = k.number("speed_max");
+  r.ay_min = k.number("ay_min");
+  r.ay_max = k.number("ay_max");
   if (const auto n = k.whole("points", 2, 1000)) r.points = static_cast<int>(*n);
   r.width = k.number("width");
   r.length = k.number("length");
@@ -97,7 +99,7 @@ py::dict do_maneuver(const Study& s, const py::dict& options) {
     d["path_error_max"] = rep.path.max_abs;
     d["path_error_rms"] = rep.path.rms;
     d["cones_hit"] = rep.cones_hit;
-  } else if (rep.type == "constant-radius") {
+  } else if (rep.type == "constant-radius" || rep.type == "constant-speed") {
     d["radius"] = rep.radius;
     d["speed"] = vector_of(rep.cr_speed);
     d["lateral_acceleration"] = vector_of(rep.cr_lateral_acceleration);
@@ -110,7 +112,7 @@ py::dict do_maneuver(const Study& s, const py::dict& options) {
     if (rep.linear_gradient) d["linear_understeer_gradient"] = *rep.linear_gradient;
     if (rep.handling_gradient) d["handling_understeer_gradient"] = *rep.handling_gradient;
   }
-  if (rep.type != "constant-radius") {
+  if (rep.type != "constant-radius" && rep.type != "constant-speed") {
     d["t"] = vector_of(rep.result.t);
     d["outputs"] = rep.result.y;
     d["output_names"] = rep.result.output_names;

@@ -73,6 +73,8 @@ Model open_loop_run(ManeuverReport& rep, const ManeuverRequest& r, const OpenLoo
                     const std::vector<double>& stops, double t_end);
 
 // the maneuvers in their own files
-ManeuverReport swept_sine(const ManeuverRequest& r, const ModelSpec& spec);  // maneuver_swept.cpp
+ManeuverReport swept_sine(const ManeuverRequest& r, const ModelSpec& spec);       // maneuver_swept.cpp
+ManeuverReport constant_radius(const ManeuverRequest& r, const ModelSpec& spec);  // maneuver_steady.cpp
+ManeuverReport constant_speed(const ManeuverRequest& r, const ModelSpec& spec);   // maneuver_steady.cpp
 
 }  // namespace codyna::mnv

@@ -344,123 +344,6 @@ ManeuverReport mnv_lane_change(const ManeuverRequest& r, const ModelSpec& spec) 
   return rep;
 }
 
-// The linear model's prediction of the constant-radius diagram: at each point's speed U the
-// linearization about the straight run gives its steer s0(U) and constant-speed yaw-rate gain G(U),
-// so the turn of yaw rate r takes s0 + r / G; the gradient on the same a_y is the diagram's linear
-// counterpart (it holds what changes with speed, dK/dU, and the steering's own ratio, which the
-// handling number K at one speed does not).
-void mnv_linear_diagram(ManeuverReport& rep, const ManeuverRequest& r, const ModelSpec& spec, int ks, double ratio,
-                        const std::vector<double>& yaw_rates) {
-  try {
-    for (std::size_t k = 0; k < rep.cr_speed.size(); ++k) {
-      ModelSpec ls = mnv::straight_spec(r, spec);
-      ls.analysis.steady.speed = rep.cr_speed[k];
-      const StudyLinearization lin = study_linearize(study_model(ls, r.model));
-      if (!lin.handling || !(lin.handling->yaw_rate_gain != 0)) {
-        rep.notes.push_back("no linear understeer gradient to compare with: the straight run at " +
-                            std::to_string(rep.cr_speed[k]) + " m/s has no yaw-rate gain (analysis.handling)");
-        rep.cr_linear_steer.clear();
-        return;
-      }
-      if (k == 0) rep.handling_gradient = lin.handling->understeer_gradient;
-      rep.cr_linear_steer.push_back(lin.op.u[ks] + yaw_rates[k] / lin.handling->yaw_rate_gain);
-    }
-  } catch (const std::exception& e) {
-    rep.notes.push_back(std::string("no linear understeer gradient to compare with: ") + e.what());
-    rep.cr_linear_steer.clear();
-    return;
-  }
-  if (rep.cr_linear_steer.size() < 2) return;
-  std::vector<double> road_wheel;
-  for (double s : rep.cr_linear_steer) road_wheel.push_back(s / ratio);
-  rep.cr_linear_gradient = understeer_diagram(rep.cr_lateral_acceleration, road_wheel);
-  rep.linear_gradient = rep.cr_linear_gradient.front();
-}
-
-// the constant-radius table as CSV (--csv)
-void mnv_write_diagram(ManeuverReport& rep, const ManeuverRequest& r) {
-  study_guard_output(r.csv, OutputKind::CurvesCsv, {r.model});
-  const auto at = [](const std::vector<double>& v, std::size_t k) { return k < v.size() ? v[k] : std::nan(""); };
-  std::ostringstream os;
-  os << std::setprecision(17)
-     << "speed,lateral_acceleration,steer,road_wheel_angle,sideslip,roll,understeer_gradient,linear_steer,"
-        "linear_understeer_gradient\n";
-  for (std::size_t k = 0; k < rep.cr_speed.size(); ++k)
-    os << rep.cr_speed[k] << "," << rep.cr_lateral_acceleration[k] << "," << rep.cr_steer[k] << ","
-       << rep.cr_road_wheel[k] << "," << rep.cr_sideslip[k] << "," << rep.cr_roll[k] << "," << at(rep.cr_gradient, k)
-       << "," << at(rep.cr_linear_steer, k) << "," << at(rep.cr_linear_gradient, k) << "\n";
-  write_file_atomically(r.csv, os.str());
-  rep.written.push_back(r.csv);
-}
-
-ManeuverReport mnv_constant_radius(const ManeuverRequest& r, const ModelSpec& spec) {
-  const mnv::Flags flag{r.style};
-  ManeuverReport rep;
-  rep.type = r.type;
-  if (!r.radius) throw std::invalid_argument(flag("radius") + ": the constant-radius maneuver needs a radius (m)");
-  if (!(*r.radius != 0) || !std::isfinite(*r.radius))
-    throw std::invalid_argument(flag("radius") + ": expected a radius other than 0 (m, > 0 turns left)");
-  rep.radius = *r.radius;
-  const double u_min = mnv::positive(flag, r.speed_min, 5.0, "speed-min");
-  const double u_max = mnv::positive(flag, r.speed_max, std::sqrt(0.6 * 9.81 * std::abs(rep.radius)), "speed-max");
-  if (!(u_max > u_min)) throw std::invalid_argument(flag("speed-max") + ": expected a speed above " + flag("speed-min"));
-  const int n = r.points ? *r.points : 8;
-  if (n < 2 || n > 1000) throw std::invalid_argument(flag("points") + ": expected 2 to 1000 points");
-  ModelSpec s = spec;
-  s.analysis.operating_point = "steady";
-  s.analysis.steady.yaw_rate.reset();
-  s.analysis.steady.lateral_acceleration.reset();
-  s.analysis.steady.radius = rep.radius;
-  s.analysis.steady.speed = u_min;
-  Model m = study_model(s, r.model);
-  rep.model_name = m.name;
-  const HandlingSpec& h = m.spec.analysis.handling;
-  if (h.steer.empty())
-    throw ModelError(m.source_file, "/analysis/handling/steer", "the maneuver needs the steer input named here");
-  const int ks = mnv::actuator(m, h.steer, "/analysis/handling/steer");
-  const double ratio = h.steering_ratio ? *h.steering_ratio : 1.0;
-  const int body = mnv::steady_body(m);
-  Data d(m);
-  const Eigen::VectorXd q_start = m.q0, v_start = m.v0;
-  std::vector<double> u0_start;
-  for (const ActuatorModel& a : m.actuators) u0_start.push_back(a.u0);
-  rep.cr_has_roll = m.joints[static_cast<std::size_t>(body)].type == JointType::Free;
-  std::vector<double> yaw_rates;  // of each turn, about the road's normal
-  for (int i = 0; i < n; ++i) {
-    const double U = u_min + (u_max - u_min) * i / (n - 1);
-    m.spec.analysis.steady.speed = U;
-    OperatingPoint op;
-    try {
-      op = study_operating_point(m, "steady");
-    } catch (const std::exception& e) {
-      rep.valid = false;
-      std::ostringstream os;
-      os << "no steady turn at " << U << " m/s on the " << rep.radius << " m radius (a_y " << U * U / std::abs(rep.radius)
-         << " m/s^2): " << e.what();
-      rep.invalid_reason = os.str();
-      break;
-    }
-    // the next search starts here (a continuation in speed)
-    m.q0 = op.q;
-    m.v0 = op.v;
-    for (std::size_t k = 0; k < m.actuators.size(); ++k) m.actuators[k].u0 = op.u[static_cast<Eigen::Index>(k)];
-    const mnv::BodyState b = mnv::body_state(m, d, body, op.q, op.v);
-    const double speed = b.v_body.norm();  // the centre of mass's: a_y = V^2 / R on its circle
-    rep.cr_speed.push_back(U);              // along the heading in the road plane, as the search sets it
-    rep.cr_lateral_acceleration.push_back((rep.radius > 0 ? 1.0 : -1.0) * speed * speed / std::abs(rep.radius));
-    rep.cr_steer.push_back(op.u[ks]);
-    rep.cr_road_wheel.push_back(op.u[ks] / ratio);
-    rep.cr_sideslip.push_back(std::atan2(b.v_body.y(), b.v_body.x()));
-    rep.cr_roll.push_back(rep.cr_has_roll ? b.roll : 0.0);
-    yaw_rates.push_back(b.yaw_rate);
-  }
-  if (rep.cr_speed.size() >= 2) rep.cr_gradient = understeer_diagram(rep.cr_lateral_acceleration, rep.cr_road_wheel);
-  mnv_linear_diagram(rep, r, spec, ks, ratio, yaw_rates);
-  rep.speed = u_min;
-  if (!r.csv.empty()) mnv_write_diagram(rep, r);
-  return rep;
-}
-
 }  // namespace
 
 ManeuverReport study_maneuver_job(const ManeuverRequest& r, const ModelSpec& spec, const StudyMessages& tell) {
@@ -469,7 +352,7 @@ ManeuverReport study_maneuver_job(const ManeuverRequest& r, const ModelSpec& spe
   for (const char* t : kManeuverTypes) known += (known.empty() ? "" : ", ") + std::string(t);
   if (r.type.empty()) throw std::invalid_argument(flag("type") + ": expected one of " + known);
   for (const std::string& f : {r.out, r.csv})
-    if (!f.empty()) study_guard_output(f, f == r.out ? OutputKind::ResultsHdf5 : (r.type == "constant-radius" ? OutputKind::CurvesCsv : OutputKind::ResultsCsv), {r.model});
+    if (!f.empty()) study_guard_output(f, f == r.out ? OutputKind::ResultsHdf5 : (r.type == "constant-radius" || r.type == "constant-speed" ? OutputKind::CurvesCsv : OutputKind::ResultsCsv), {r.model});
   ManeuverReport rep;
   ModelSpec given = spec;
   if (r.free_inputs) given.analysis.free_inputs = *r.free_inputs;
@@ -477,7 +360,8 @@ ManeuverReport study_maneuver_job(const ManeuverRequest& r, const ModelSpec& spe
   else if (r.type == "sine-with-dwell") rep = mnv_open_loop(r, given, true);
   else if (r.type == "swept-sine") rep = mnv::swept_sine(r, given);
   else if (r.type == "double-lane-change") rep = mnv_lane_change(r, given);
-  else if (r.type == "constant-radius") rep = mnv_constant_radius(r, given);
+  else if (r.type == "constant-radius") rep = mnv::constant_radius(r, given);
+  else if (r.type == "constant-speed") rep = mnv::constant_speed(r, given);
   else throw std::invalid_argument(flag("type") + ": unknown maneuver \"" + r.type + "\" (expected one of " + known + ")");
   if (tell) {
     for (const std::string& n : rep.notes) tell({StudyMessage::Note, n});
@@ -531,8 +415,9 @@ std::string study_maneuver_text(const ManeuverReport& r) {
   const double deg = 180 / mnv::kPi;
   os << "maneuver         " << r.type << "\n";
   os << "model            " << r.model_name << "\n";
-  if (r.type == "constant-radius") {
-    os << "radius           " << r.radius << " m\n";
+  if (r.type == "constant-radius" || r.type == "constant-speed") {
+    if (r.type == "constant-radius") os << "radius           " << r.radius << " m\n";
+    else os << "speed            " << r.speed << " m/s\n";
     const bool lin = r.cr_linear_steer.size() == r.cr_speed.size();
     os << "  speed (m/s)   a_y (m/s^2)   steer        " << (lin ? "linear steer  " : "")
        << "road wheel (deg)  sideslip (deg)  roll (deg)  K (deg/g)\n";
@@ -550,7 +435,7 @@ std::string study_maneuver_text(const ManeuverReport& r) {
       gradient(r.cr_gradient.front());
       os << "\n";
       if (r.linear_gradient) {
-        os << "linear model's, same speeds and a_y     ";
+        os << (r.type == "constant-radius" ? "linear model's, same speeds and a_y     " : "linear model's, same a_y                ");
         gradient(*r.linear_gradient);
         os << " (difference " << std::abs(r.cr_gradient.front() - *r.linear_gradient) / std::abs(*r.linear_gradient) * 100
            << " %)\n";
@@ -560,7 +445,9 @@ std::string study_maneuver_text(const ManeuverReport& r) {
         label << std::setprecision(6) << "handling number K at " << r.speed << " m/s";
         os << std::left << std::setw(40) << label.str() << std::right;
         gradient(*r.handling_gradient);
-        os << " (constant speed: without dK/dU)\n";
+        if (r.type == "constant-radius") os << " (constant speed: without dK/dU)";
+        else os << " (difference " << std::abs(r.cr_gradient.front() - *r.handling_gradient) / std::abs(*r.handling_gradient) * 100 << " %)";
+        os << "\n";
       }
     }
   } else {

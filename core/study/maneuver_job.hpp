@@ -30,6 +30,10 @@
 //                       (its steer s0(U) and constant-speed yaw-rate gain G(U)) gives the turn's
 //                       steer s0 + r / G; its gradient on the same a_y (and, for reference, the
 //                       handling number K at the first speed, a constant-speed gradient).
+//   constant-speed      ISO 4138 style at one speed (--speed): steady turns at --points lateral
+//                       accelerations from --ay-min to --ay-max; the same table, the understeer
+//                       gradient d(delta)/d(a_y) - L / U^2, against the linear model's (the handling
+//                       number K at that speed, and its prediction of each turn's steer).
 // A run that leaves the road (the integrator fails, the speed or yaw rate runs away) is reported
 // with its metrics marked invalid and the reason. Files: the run as HDF5 / CSV (--out, --csv;
 // the constant radius: --csv, its table).
@@ -47,7 +51,7 @@ namespace codyna {
 
 // the maneuver types, in the order the help lists them
 inline constexpr const char* kManeuverTypes[] = {"step-steer", "sine-with-dwell", "swept-sine", "double-lane-change",
-                                                 "constant-radius"};
+                                                 "constant-radius", "constant-speed"};
 
 struct ManeuverRequest {
   OptionStyle style = OptionStyle::Flag;
@@ -63,6 +67,7 @@ struct ManeuverRequest {
   std::optional<std::string> integrator;       // the runs' (default the model file's solver)
   std::optional<double> radius;                // constant radius, m
   std::optional<double> speed_min, speed_max;  // constant radius, m/s
+  std::optional<double> ay_min, ay_max;        // constant speed, m/s^2 (0.5, 0.6 g; > 0 turns left)
   std::optional<int> points;                   // constant radius (default 8); swept sine: the table's frequencies (12)
   // the steady motion's free inputs (StudySpec::free_inputs; a turn needs the drive that holds
   // the speed besides the steer): each given replaces the file's list
@@ -101,7 +106,8 @@ struct ManeuverReport {
   SweptSineCharacteristics sw_metrics, sw_metrics_linear;
   bool sw_has_linear = false;
   double sw_gap_yaw = 0, sw_gap_yaw_hz = 0, sw_gap_lateral = 0, sw_gap_lateral_hz = 0;
-  // constant radius: one entry per point
+  // constant radius and constant speed: one entry per point (cr_gradient: constant radius
+  // d(delta)/d(a_y), constant speed d(delta)/d(a_y) - L / U^2; so the linear ones)
   double radius = 0;
   std::vector<double> cr_speed, cr_lateral_acceleration, cr_steer, cr_road_wheel, cr_sideslip, cr_roll, cr_gradient;
   bool cr_has_roll = false;

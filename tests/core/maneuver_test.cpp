@@ -363,6 +363,43 @@ TEST(Maneuver, AutoGoesOnStiffWhereItsChoiceFailsInTheSedansSineWithDwell) {
             << b.sine.yrr_1_75 << "\n";
 }
 
+// At one speed (ISO 4138's constant-speed method) the understeer gradient d(delta)/d(a_y) - L / U^2
+// at low a_y is the handling number K of the linearization at that speed: the sedan's to 1e-3
+// (measured 4e-4 turning left, 6.7e-4 right: the car is not symmetric), the single-track car's
+// closed form to 2e-4 (measured 8e-5, at 0.1 .. 2.1 m/s^2)
+TEST(Maneuver, ConstantSpeedGradientIsTheHandlingNumber) {
+  const auto run = [](const std::string& name, double a0, double a1, int n) {
+    const std::string file = maneuver_example(name);
+    ModelSpec spec = study_read_model(file);
+    spec.analysis.free_inputs = {"steer", "drive"};
+    ManeuverRequest r;
+    r.model = file;
+    r.type = "constant-speed";
+    r.ay_min = a0;
+    r.ay_max = a1;
+    r.points = n;
+    return study_maneuver_job(r, spec);
+  };
+  for (double sign : {1.0, -1.0}) {
+    const ManeuverReport rep = run("sedan.json", sign * 0.01, sign * 0.02, 3);
+    ASSERT_TRUE(rep.valid) << rep.invalid_reason;
+    ASSERT_TRUE(rep.handling_gradient && rep.linear_gradient);
+    EXPECT_EQ(rep.speed, 25.0);
+    EXPECT_NEAR(rep.cr_gradient.front(), *rep.handling_gradient, 1e-3 * *rep.handling_gradient) << sign;
+    EXPECT_NEAR(*rep.linear_gradient, *rep.handling_gradient, 2e-4 * *rep.handling_gradient) << sign;
+    EXPECT_NEAR(rep.cr_lateral_acceleration.front(), sign * 0.01, 1e-9);
+  }
+  const ManeuverReport bike = run("single_track_car.json", 0.1, 6, 4);
+  ASSERT_TRUE(bike.valid) << bike.invalid_reason;
+  const double K = 1573 / 2.68 * (1.58 / 160000.0 - 1.1 / 160000.0);
+  EXPECT_NEAR(bike.cr_gradient.front(), K, 2e-4 * K);
+  EXPECT_NEAR(*bike.handling_gradient, K, 1e-9 * K);
+  EXPECT_EQ(maneuver_error([&] { run("single_track_car.json", 0, 2, 3); }),
+            "--ay-min: expected a lateral acceleration other than 0 (m/s^2, > 0 turns left)");
+  EXPECT_EQ(maneuver_error([&] { run("single_track_car.json", 1, -2, 3); }),
+            "--ay-max: expected a lateral acceleration beyond --ay-min, on its side");
+}
+
 TEST(Maneuver, BadInputIsRefusedNamingTheFieldOrFlag) {
   const std::string file = maneuver_example("single_track_car.json");
   const ModelSpec spec = study_read_model(file);
