@@ -175,7 +175,11 @@ Model open_loop_run(ManeuverReport& rep, const ManeuverRequest& r, const OpenLoo
   o.disturbance_rate = [one, profile](double t) { return one(profile.rate(t)); };
   o.disturbance_acceleration = [one, profile](double t) { return one(profile.acceleration(t)); };
   o.rate_jumps = stops;
-  rep.result = simulate(run, nullptr, nullptr, o);
+  SimulationCallbacks cb;
+  cb.cancel = r.cancel;
+  cb.progress = r.progress;
+  rep.result = simulate(run, nullptr, nullptr, o, cb);
+  if (rep.result.cancelled) throw StudyCancelled("the maneuver was cancelled");
   check_run(rep, rep.result, run, ol.body);
   if (rep.result.samples() > 0) {
     Data d(run);

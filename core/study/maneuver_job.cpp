@@ -322,6 +322,8 @@ ManeuverReport mnv_lane_change(const ManeuverRequest& r, const ModelSpec& spec) 
     rep.max_steer = std::max(rep.max_steer, std::abs(u[ds.in_steer]));
     done = k + 1;
     if (k == steps) break;
+    if (r.cancel && r.cancel->load()) throw StudyCancelled("the maneuver was cancelled");
+    if (r.progress) r.progress(res.t.back(), t_end);
     xc = driver->update(in, xc);
     try {
       st.step(u, ds.sample_time);

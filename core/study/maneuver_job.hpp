@@ -39,7 +39,9 @@
 // the constant radius: --csv, its table).
 #pragma once
 
+#include <atomic>
 #include <complex>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -75,6 +77,10 @@ struct ManeuverRequest {
   // the driver (double lane change)
   std::optional<double> width, length, preview, lateral_gain, speed_kp, speed_ki, sample_time;
   std::optional<std::string> x, y, yaw, speed_output, drive;  // Plant/Out / Plant/In names
+  // a front end's Cancel (not owned; null: none): the job then throws StudyCancelled
+  const std::atomic<bool>* cancel = nullptr;
+  // the run's progress (t, t_end), called from the job's thread (runs only, not the steady turns)
+  std::function<void(double, double)> progress;
 };
 
 struct ManeuverReport {

@@ -49,11 +49,13 @@ SteadyTurns steady_setup(const ManeuverRequest& r, const ModelSpec& spec, const 
 
 // Each turn asked in order, each search started from the one before (a continuation); the table's
 // rows; a turn the search does not find ends the table (rep invalid with the reason).
-void steady_turns(ManeuverReport& rep, SteadyTurns& st, const std::vector<TurnAsked>& turns, bool a_from_radius) {
+void steady_turns(ManeuverReport& rep, SteadyTurns& st, const std::vector<TurnAsked>& turns, bool a_from_radius,
+                  const std::atomic<bool>* r_cancel) {
   Model& m = st.model;
   Data d(m);
   rep.cr_has_roll = m.joints[static_cast<std::size_t>(st.body)].type == JointType::Free;
   for (const TurnAsked& t : turns) {
+    if (r_cancel && r_cancel->load()) throw StudyCancelled("the maneuver was cancelled");
     m.spec.analysis.steady.speed = t.speed;
     if (a_from_radius) m.spec.analysis.steady.radius = t.radius;
     else m.spec.analysis.steady.lateral_acceleration = t.lateral_acceleration;
@@ -166,7 +168,7 @@ ManeuverReport constant_radius(const ManeuverRequest& r, const ModelSpec& spec) 
   for (int i = 0; i < n; ++i) turns.push_back({u_min + (u_max - u_min) * i / (n - 1), rep.radius, 0});
   SteadyTurns st = steady_setup(r, spec, turns.front());
   rep.model_name = st.model.name;
-  steady_turns(rep, st, turns, true);
+  steady_turns(rep, st, turns, true, r.cancel);
   if (rep.cr_speed.size() >= 2) rep.cr_gradient = understeer_diagram(rep.cr_lateral_acceleration, rep.cr_road_wheel);
   linear_diagram(rep, r, spec, st);
   if (!rep.cr_linear_gradient.empty()) rep.linear_gradient = rep.cr_linear_gradient.front();
@@ -192,7 +194,7 @@ ManeuverReport constant_speed(const ManeuverRequest& r, const ModelSpec& spec) {
   SteadyTurns st = steady_setup(r, spec, turns.front());
   rep.model_name = st.model.name;
   rep.speed = U;
-  steady_turns(rep, st, turns, false);
+  steady_turns(rep, st, turns, false, r.cancel);
   const double L = linear_diagram(rep, r, spec, st);
   // the understeer gradient at one speed: d(delta)/d(a_y) - L / U^2 (the kinematic steer's share)
   if (rep.cr_speed.size() >= 2 && L > 0) {
