@@ -10,8 +10,10 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include "vehicle/magic_formula_relaxation.hpp"
+#include "vehicle/road.hpp"
 #include "vehicle/tir_file.hpp"
 
 
@@ -731,7 +733,157 @@ class Compiler {
       t.relaxation_x = sx;
       t.relaxation_y = sy;
     }
+    build_tire_road(e.road, p + "/road", t);
     return t;
+  }
+
+  // a road of heights (vehicle/road.hpp, docs/roads.md) and the friction regions: tires whose roads
+  // read the same CSV file or generate the same ISO 8608 road, with the same regions, share one surface
+  void build_tire_road(const RoadSpec& r, const std::string& p, TireModel& t) const {
+    const int kinds = int(r.grid.has_value()) + int(r.profile.has_value()) + int(r.iso8608.has_value());
+    if (kinds > 1) fail(p, "expected one road surface of grid, profile, iso8608, got " + std::to_string(kinds));
+    if (kinds == 0 && r.friction.empty()) return;
+    if (kinds == 1 && (r.point != Eigen::Vector3d::Zero() || r.normal != Eigen::Vector3d::UnitZ()))
+      fail(p + (r.point != Eigen::Vector3d::Zero() ? "/point" : "/normal"),
+           "a road surface lies in the road body's frame: point and normal belong to the plane road; leave them out");
+    std::ostringstream key;
+    key.precision(17);
+    RoadSurface road;
+    if (kinds == 0) {
+      // a plane with friction regions: the plane as heights (z = 0 below the road body's x, y)
+      if (r.point != Eigen::Vector3d::Zero() || r.normal != Eigen::Vector3d::UnitZ())
+        fail(p + "/friction", "friction regions lie on a road in the road body's x, y: leave out point and normal, or the regions");
+      road = road_tracks({0.0, 1.0}, {0.0, 0.0}, {}, 0.0, 0.0);
+      key << "plane";
+    } else if (r.grid) {
+      road = build_road_grid(*r.grid, p + "/grid", key);
+    } else if (r.profile) {
+      road = build_road_profile(*r.profile, p + "/profile", key);
+    } else {
+      road = build_road_iso8608(*r.iso8608, p + "/iso8608", key);
+    }
+    for (std::size_t k = 0; k < r.friction.size(); ++k) {
+      const RoadFrictionSpec& f = r.friction[k];
+      const std::string q = p + "/friction/" + std::to_string(k);
+      RoadFrictionRegion region;
+      for (const auto& [v, lo, hi, name] : {std::tuple{&f.x, &region.x_min, &region.x_max, "/x"}, std::tuple{&f.y, &region.y_min, &region.y_max, "/y"}}) {
+        if (v->empty()) continue;
+        if (v->size() != 2 || !((*v)[0] <= (*v)[1])) fail(q + name, "expected [min, max] with min <= max");
+        *lo = (*v)[0];
+        *hi = (*v)[1];
+      }
+      if (!std::isfinite(f.scale) || !(f.scale >= 0)) fail(q + "/scale", "expected a friction scale >= 0, got " + compile_number(f.scale));
+      if (t.law == TireLaw::Linear && !(t.friction > 0))
+        fail(q, "a linear tire without friction (its \"friction\" 0: no limit) has no friction to scale; give the tire a friction");
+      region.scale = f.scale;
+      road.friction.push_back(region);
+      key << ";f" << region.x_min << "," << region.x_max << "," << region.y_min << "," << region.y_max << "," << region.scale;
+    }
+    std::shared_ptr<const RoadSurface>& shared = roads_[key.str()];
+    if (!shared || key.str().rfind("inline", 0) == 0) shared = std::make_shared<const RoadSurface>(std::move(road));
+    t.road = shared;
+    if (t.law == TireLaw::MagicFormula)
+      for (const RoadFrictionRegion& region : t.road->friction) {
+        auto scaled = std::make_shared<MagicFormulaParameters>(*t.mf);
+        scaled->LMUX *= region.scale;
+        scaled->LMUY *= region.scale;
+        t.mf_regions.push_back(std::move(scaled));
+      }
+  }
+
+  std::string road_file(const std::string& file) const {
+    std::filesystem::path path(file);
+    if (path.is_relative() && !file_.empty()) path = std::filesystem::path(file_).parent_path() / path;
+    return path.string();
+  }
+
+  RoadSurface build_road_grid(const RoadGridSpec& g, const std::string& p, std::ostringstream& key) const {
+    RoadTable table;
+    if (!g.file.empty()) {
+      if (!g.x.empty() || !g.y.empty() || g.z.size()) fail(p, "expected the grid from a file or inline (x, y, z), not both");
+      try {
+        table = read_road_grid_csv(road_file(g.file));
+      } catch (const std::exception& x) {
+        fail(p + "/file", x.what());
+      }
+      key << "grid:" << road_file(g.file);
+    } else {
+      if (g.x.empty() || g.y.empty() || !g.z.size()) fail(p, "expected a \"file\", or the nodes \"x\", \"y\" and the heights \"z\" (one row per y)");
+      table.x = g.x;
+      table.y = g.y;
+      table.z.assign(static_cast<std::size_t>(g.z.rows()), std::vector<double>());
+      for (Eigen::Index j = 0; j < g.z.rows(); ++j)
+        for (Eigen::Index i = 0; i < g.z.cols(); ++i) table.z[static_cast<std::size_t>(j)].push_back(g.z(j, i));
+      key << "inline";
+    }
+    try {
+      return road_grid(table.x, table.y, table.z);
+    } catch (const std::exception& x) {
+      fail(p + (g.file.empty() ? "" : "/file"), (g.file.empty() ? std::string() : road_file(g.file) + ": ") + x.what());
+    }
+  }
+
+  // the tracks' y: both given for two tracks (left above right), none for one
+  void road_track_ys(const std::optional<double>& left_y, const std::optional<double>& right_y, bool two, const std::string& p) const {
+    if (!two) {
+      if (left_y || right_y) fail(p + (left_y ? "/left_y" : "/right_y"), "one track has no y: leave the field out");
+      return;
+    }
+    if (!left_y) fail(p, "missing required field \"left_y\" (the left track's y in the road body's frame)");
+    if (!right_y) fail(p, "missing required field \"right_y\" (the right track's y in the road body's frame)");
+    if (!(*left_y > *right_y)) fail(p + "/left_y", "expected the left track's y above the right track's, got " + compile_number(*left_y) + " and " + compile_number(*right_y));
+  }
+
+  RoadSurface build_road_profile(const RoadProfileSpec& r, const std::string& p, std::ostringstream& key) const {
+    RoadTable table;
+    if (!r.file.empty()) {
+      if (!r.s.empty() || !r.left.empty() || !r.right.empty()) fail(p, "expected the profile from a file or inline (s, left, right), not both");
+      try {
+        table = read_road_profile_csv(road_file(r.file));
+      } catch (const std::exception& x) {
+        fail(p + "/file", x.what());
+      }
+      key << "profile:" << road_file(r.file) << ":" << r.left_y.value_or(0) << ":" << r.right_y.value_or(0);
+    } else {
+      if (r.s.empty() || r.left.empty()) fail(p, "expected a \"file\", or \"s\" and \"left\" (and \"right\" for two tracks)");
+      table.x = r.s;
+      table.z = {r.left};
+      if (!r.right.empty()) table.z.push_back(r.right);
+      key << "inline";
+    }
+    const bool two = table.z.size() == 2;
+    road_track_ys(r.left_y, r.right_y, two, p);
+    try {
+      return road_tracks(table.x, table.z[0], two ? table.z[1] : std::vector<double>(), r.left_y.value_or(0), r.right_y.value_or(0));
+    } catch (const std::exception& x) {
+      fail(p + (r.file.empty() ? "" : "/file"), (r.file.empty() ? std::string() : road_file(r.file) + ": ") + x.what());
+    }
+  }
+
+  RoadSurface build_road_iso8608(const RoadIso8608Spec& r, const std::string& p, std::ostringstream& key) const {
+    Iso8608Spec iso;
+    iso.road_class = iso8608_class(r.road_class);
+    if (iso.road_class < 0) fail(p + "/class", "unknown ISO 8608 class " + quote(r.road_class) + " (expected one of: A, B, C, D, E, F, G, H)");
+    if (r.band.size() != 2 || !(r.band[0] > 0) || !(r.band[1] > r.band[0]))
+      fail(p + "/band", "expected [n_min, n_max] with 0 < n_min < n_max (cycle/m)");
+    iso.length = r.length;
+    iso.n_min = r.band[0];
+    iso.n_max = r.band[1];
+    iso.spacing = r.spacing;
+    iso.seed = static_cast<std::uint64_t>(static_cast<std::int64_t>(r.seed));
+    road_track_ys(r.left_y, r.right_y, true, p);
+    std::vector<std::vector<double>> tracks;
+    try {
+      tracks = iso8608_tracks(iso);
+    } catch (const std::exception& x) {
+      fail(p, x.what());
+    }
+    const std::size_t n = tracks[0].size();
+    std::vector<double> s(n);
+    for (std::size_t i = 0; i < n; ++i) s[i] = r.start + r.length * static_cast<double>(i) / static_cast<double>(n - 1);
+    key << "iso8608:" << iso.road_class << "," << iso.length << "," << iso.n_min << "," << iso.n_max << "," << iso.spacing << ","
+        << r.start << "," << iso.seed << "," << *r.left_y << "," << *r.right_y;
+    return road_tracks(s, tracks[0], tracks[1], *r.left_y, *r.right_y);
   }
 
   // the transient slip's states of tire t (its contact's deflections), after the others
@@ -1027,6 +1179,7 @@ class Compiler {
   const ModelSpec& spec_;
   std::string file_;
   Model m_;
+  mutable std::map<std::string, std::shared_ptr<const RoadSurface>> roads_;  // build_tire_road: the roads made
   std::map<std::string, int> body_index_spec_;
   std::map<std::string, int> compiled_;
 };
