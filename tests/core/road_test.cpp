@@ -19,6 +19,7 @@
 #include "dynamics/data.hpp"
 #include "dynamics/kinematics.hpp"
 #include "dynamics/tire_effect.hpp"
+#include "io/model_file.hpp"
 #include "model/errors.hpp"
 #include "simulation/simulator.hpp"
 #include "study/files.hpp"
@@ -421,6 +422,29 @@ TEST(Road, TheExactJacobianOnGridRoadsEqualsCentralDifferencesAndAutodiff) {
   EXPECT_GT(test::expect_analytic_equals_autodiff(f, x, up, "tires on grid roads", 1e-12), 1.0);
   // the grids' slopes are in it: the same model on the flat roads differs
   std::printf("[ Road ] tires on grid roads: |exact - central| / max|J| = %.2e, max|J| = %.3g\n", worst, scale);
+}
+
+// the road fields written by the model file's writer read back the same, and compile to the same road
+TEST(Road, RoadFieldsRoundTripThroughTheModelFile) {
+  const std::string roads[] = {
+      R"({"grid": {"x": [0, 0.5, 1], "y": [-1, 1], "z": [[0, 0.01, 0.02], [0.005, 0, 0.03]]}, "friction": [{"x": [0, 0.6], "scale": 0.4}]})",
+      R"({"body": "ground", "profile": {"s": [0, 1, 2], "left": [0, 0.01, 0], "right": [0, 0, 0.02], "left_y": 0.8, "right_y": -0.7}})",
+      R"({"iso8608": {"class": "D", "length": 50, "start": -5, "band": [0.05, 2], "spacing": 0.1, "seed": 3, "left_y": 0.8, "right_y": -0.8},
+          "friction": [{"y": [0, 5], "scale": 0.2}]})"};
+  for (const std::string& road : roads) {
+    const ModelSpec a = parse_model_spec_text(road_test_wheel(road_test_fiala, road), "a.json");
+    const std::string written = to_json(a).dump();
+    const ModelSpec b = parse_model_spec_text(written, "b.json");
+    EXPECT_EQ(to_json(b).dump(), written);
+    const Model ma = study_model(a), mb = study_model(b);
+    const RoadSurface &ra = *ma.tires[0].road, &rb = *mb.tires[0].road;
+    EXPECT_EQ(ra.z, rb.z) << road;
+    EXPECT_EQ(ra.left, rb.left) << road;
+    EXPECT_EQ(ra.right, rb.right) << road;
+    EXPECT_EQ(ra.friction.size(), rb.friction.size()) << road;
+    for (const double x : {0.1, 0.35, 0.8})
+      EXPECT_EQ(ra.height(x, 0.2).z, rb.height(x, 0.2).z) << road;
+  }
 }
 
 // the message of compiling `text` (as `file`), or "" when it compiles
