@@ -112,7 +112,8 @@ TEST(Road, AGridSamplingATiltedPlaneGivesThePlaneRoadsContact) {
   for (int k = 0; k < 12; ++k) {
     const Eigen::Quaterniond qr(Eigen::AngleAxisd(0.3 * k, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(0.03 * (k % 3 - 1), Eigen::Vector3d::UnitX()));
     Eigen::VectorXd q(7), v(6);
-    const double x = -3.7 + 0.61 * k, y = -2.5 + 0.43 * k;  // inside and on cell edges alike
+    // every fourth wheel centre on a node (cell edges both ways), the others inside cells
+    const double x = k % 4 == 0 ? -3.0 + 0.5 * k : -3.7 + 0.61 * k, y = k % 4 == 0 ? -2.25 + 0.1875 * k : -2.5 + 0.43 * k;
     q << x, y, plane(x, y) + 0.29 - 0.002 * (k % 4), qr.w(), qr.x(), qr.y(), qr.z();
     v << 0.3 - 0.05 * k, 12 + k, 0.2, 2 + 0.5 * k, 0.1 * k - 0.4, 0.02 * k;
     bool on_flat = false, on_grid = false;
@@ -265,7 +266,7 @@ TEST(Road, AQuarterCarOnASinusoidalTrackHasTheClosedFormHeaveAmplitude) {
   const Eigen::Vector3d c = B.colPivHouseholderQr().solve(z);
   const double amplitude = std::hypot(c[1], c[2]), expected = A * road_test_quarter_car_gain(ms, mu, ks, cs, kt, ct, w);
   const double residual = (B * c - z).cwiseAbs().maxCoeff();
-  EXPECT_NEAR(amplitude, expected, 1e-3 * expected);
+  EXPECT_NEAR(amplitude, expected, 1e-5 * expected);  // (the brief asks 1e-3; the equivalent plane's error is O(slope^2))
   EXPECT_LT(residual, 1e-3 * amplitude);
   std::printf("[ Road ] quarter car at %.0f m/s over a %.0f m, %.0f mm sine (w = %.4f rad/s): heave amplitude %.6e m, closed form "
               "%.6e m (relative %.1e), fit residual %.1e m\n",
