@@ -45,6 +45,7 @@ struct RoadCell {
 RoadCell road_cell(double x, double x0, double dx, int n) {
   RoadCell c;
   double u = (x - x0) / dx;
+  if (std::isnan(u)) u = 0;  // a failed state: the first cell, never an undefined cast to int
   if (u <= 0) {
     c.clamped = u < 0;
     u = 0;
@@ -316,8 +317,9 @@ std::vector<std::vector<double>> iso8608_tracks(const Iso8608Spec& spec) {
     throw std::invalid_argument("expected a band [n_min, n_max] with 0 < n_min < n_max (cycle/m)");
   if (!(spec.spacing > 0)) throw std::invalid_argument("expected a spacing > 0 (m)");
   const double L = spec.length;
+  if (!(L / spec.spacing <= 2e7)) throw std::invalid_argument("expected at most 2e7 samples (length / spacing)");
+  if (!(spec.n_max * L < 1e7)) throw std::invalid_argument("expected a spacing below 1 / (2 n_max) (Nyquist)");
   const long samples = std::max(2L, std::lround(std::ceil(L / spec.spacing)));
-  if (samples > 20000000L) throw std::invalid_argument("expected at most 2e7 samples (length / spacing)");
   const long k1 = std::max(1L, std::lround(std::ceil(spec.n_min * L))), k2 = std::lround(std::floor(spec.n_max * L));
   if (k2 < k1) throw std::invalid_argument("expected a band holding at least one frequency k / length");
   if (2 * k2 >= samples) throw std::invalid_argument("expected a spacing below 1 / (2 n_max) (Nyquist)");

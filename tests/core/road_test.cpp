@@ -188,6 +188,7 @@ TEST(Road, CatmullRomReproducesQuadraticsAndIsC1AcrossCellEdges) {
   EXPECT_EQ(out.z, edge.z);
   EXPECT_EQ(out.zx, 0.0);
   EXPECT_EQ(out.zy, edge.zy);
+  EXPECT_TRUE(std::isfinite(rough.height(std::nan(""), 0.6).z));  // a failed state: no undefined cast
   // tracks: a wheel on a track sees exactly its profile; between them the straight cross-section
   std::vector<double> s, left, right;
   for (int i = 0; i < 40; ++i) {
@@ -481,6 +482,8 @@ TEST(Road, BadRoadsAreRefusedNamingTheFileAndTheField) {
        "unknown ISO 8608 class \"Z\""},
       {R"({"iso8608": {"class": "C", "length": 100, "band": [0.011, 30], "left_y": 0.8, "right_y": -0.8}})", "/effects/1/road/iso8608",
        "below 1 / (2 n_max)"},
+      {R"({"iso8608": {"class": "C", "length": 100, "spacing": 1e-300, "left_y": 0.8, "right_y": -0.8}})", "/effects/1/road/iso8608",
+       "expected at most 2e7 samples"},
       {R"({"grid": {"x": [0, 1], "y": [0, 1], "z": [[0, 0], [0, 0]]}, "profile": {"s": [0, 1], "left": [0, 0]}})", "/effects/1/road",
        "expected one road surface"},
       {R"({"normal": [0, 0.1, 1], "grid": {"x": [0, 1], "y": [0, 1], "z": [[0, 0], [0, 0]]}})", "/effects/1/road/normal",
