@@ -738,30 +738,21 @@ class Compiler {
   }
 
   // a road of heights (vehicle/road.hpp, docs/roads.md) and the friction regions: tires whose roads
-  // read the same CSV file or generate the same ISO 8608 road, with the same regions, share one surface
+  // read the same CSV file or generate the same ISO 8608 road, with the same regions, share one
+  // surface, read or generated once
   void build_tire_road(const RoadSpec& r, const std::string& p, TireModel& t) const {
     const int kinds = int(r.grid.has_value()) + int(r.profile.has_value()) + int(r.iso8608.has_value());
     if (kinds > 1) fail(p, "expected one road surface of grid, profile, iso8608, got " + std::to_string(kinds));
     if (kinds == 0 && r.friction.empty()) return;
-    if (kinds == 1 && (r.point != Eigen::Vector3d::Zero() || r.normal != Eigen::Vector3d::UnitZ()))
+    const bool plane_given = r.point != Eigen::Vector3d::Zero() || r.normal != Eigen::Vector3d::UnitZ();
+    if (kinds == 1 && plane_given)
       fail(p + (r.point != Eigen::Vector3d::Zero() ? "/point" : "/normal"),
            "a road surface lies in the road body's frame: point and normal belong to the plane road; leave them out");
-    std::ostringstream key;
-    key.precision(17);
-    RoadSurface road;
-    if (kinds == 0) {
-      // a plane with friction regions: the plane as heights (z = 0 below the road body's x, y)
-      if (r.point != Eigen::Vector3d::Zero() || r.normal != Eigen::Vector3d::UnitZ())
-        fail(p + "/friction", "friction regions lie on a road in the road body's x, y: leave out point and normal, or the regions");
-      road = road_tracks({0.0, 1.0}, {0.0, 0.0}, {}, 0.0, 0.0);
-      key << "plane";
-    } else if (r.grid) {
-      road = build_road_grid(*r.grid, p + "/grid", key);
-    } else if (r.profile) {
-      road = build_road_profile(*r.profile, p + "/profile", key);
-    } else {
-      road = build_road_iso8608(*r.iso8608, p + "/iso8608", key);
-    }
+    if (kinds == 0 && plane_given)
+      fail(p + "/friction", "friction regions lie on a road in the road body's x, y: leave out point and normal, or the regions");
+    std::vector<RoadFrictionRegion> regions;
+    std::ostringstream suffix;
+    suffix.precision(17);
     for (std::size_t k = 0; k < r.friction.size(); ++k) {
       const RoadFrictionSpec& f = r.friction[k];
       const std::string q = p + "/friction/" + std::to_string(k);
@@ -776,12 +767,22 @@ class Compiler {
       if (t.law == TireLaw::Linear && !(t.friction > 0))
         fail(q, "a linear tire without friction (its \"friction\" 0: no limit) has no friction to scale; give the tire a friction");
       region.scale = f.scale;
-      road.friction.push_back(region);
-      key << ";f" << region.x_min << "," << region.x_max << "," << region.y_min << "," << region.y_max << "," << region.scale;
+      regions.push_back(region);
+      suffix << ";f" << region.x_min << "," << region.x_max << "," << region.y_min << "," << region.y_max << "," << region.scale;
     }
-    std::shared_ptr<const RoadSurface>& shared = roads_[key.str()];
-    if (!shared || key.str().rfind("inline", 0) == 0) shared = std::make_shared<const RoadSurface>(std::move(road));
-    t.road = shared;
+    const std::string key = road_key(r);  // empty: made per tire
+    std::shared_ptr<const RoadSurface>* slot = key.empty() ? nullptr : &roads_[key + suffix.str()];
+    if (slot && *slot) {
+      t.road = *slot;
+    } else {
+      RoadSurface road = kinds == 0 ? road_tracks({0.0, 1.0}, {0.0, 0.0}, {}, 0.0, 0.0)  // the plane z = 0 as heights
+                         : r.grid   ? build_road_grid(*r.grid, p + "/grid")
+                         : r.profile ? build_road_profile(*r.profile, p + "/profile")
+                                     : build_road_iso8608(*r.iso8608, p + "/iso8608");
+      road.friction = regions;
+      t.road = std::make_shared<const RoadSurface>(std::move(road));
+      if (slot) *slot = t.road;
+    }
     if (t.law == TireLaw::MagicFormula)
       for (const RoadFrictionRegion& region : t.road->friction) {
         auto scaled = std::make_shared<MagicFormulaParameters>(*t.mf);
@@ -791,13 +792,37 @@ class Compiler {
       }
   }
 
+  // what makes two roads the same surface: the CSV file (and the tracks' y), the ISO 8608 road's
+  // fields, the plane; empty for inline heights (made per tire)
+  std::string road_key(const RoadSpec& r) const {
+    std::ostringstream key;
+    key.precision(17);
+    if (r.grid) {
+      if (r.grid->file.empty() || !r.grid->x.empty() || !r.grid->y.empty() || r.grid->z.size()) return "";
+      key << "grid:" << road_file(r.grid->file);
+    } else if (r.profile) {
+      if (r.profile->file.empty() || !r.profile->s.empty() || !r.profile->left.empty() || !r.profile->right.empty()) return "";
+      key << "profile:" << road_file(r.profile->file) << ":" << r.profile->left_y.value_or(0) << ":" << r.profile->right_y.value_or(0)
+          << ":" << r.profile->left_y.has_value() << r.profile->right_y.has_value();
+    } else if (r.iso8608) {
+      const RoadIso8608Spec& i = *r.iso8608;
+      key << "iso8608:" << i.road_class << "," << i.length << ",";
+      for (double b : i.band) key << b << ",";
+      key << i.spacing << "," << i.start << "," << i.seed << "," << i.left_y.value_or(0) << "," << i.right_y.value_or(0) << ","
+          << i.left_y.has_value() << i.right_y.has_value();
+    } else {
+      key << "plane";
+    }
+    return key.str();
+  }
+
   std::string road_file(const std::string& file) const {
     std::filesystem::path path(file);
     if (path.is_relative() && !file_.empty()) path = std::filesystem::path(file_).parent_path() / path;
     return path.string();
   }
 
-  RoadSurface build_road_grid(const RoadGridSpec& g, const std::string& p, std::ostringstream& key) const {
+  RoadSurface build_road_grid(const RoadGridSpec& g, const std::string& p) const {
     RoadTable table;
     if (!g.file.empty()) {
       if (!g.x.empty() || !g.y.empty() || g.z.size()) fail(p, "expected the grid from a file or inline (x, y, z), not both");
@@ -806,7 +831,6 @@ class Compiler {
       } catch (const std::exception& x) {
         fail(p + "/file", x.what());
       }
-      key << "grid:" << road_file(g.file);
     } else {
       if (g.x.empty() || g.y.empty() || !g.z.size()) fail(p, "expected a \"file\", or the nodes \"x\", \"y\" and the heights \"z\" (one row per y)");
       table.x = g.x;
@@ -814,7 +838,6 @@ class Compiler {
       table.z.assign(static_cast<std::size_t>(g.z.rows()), std::vector<double>());
       for (Eigen::Index j = 0; j < g.z.rows(); ++j)
         for (Eigen::Index i = 0; i < g.z.cols(); ++i) table.z[static_cast<std::size_t>(j)].push_back(g.z(j, i));
-      key << "inline";
     }
     try {
       return road_grid(table.x, table.y, table.z);
@@ -834,7 +857,7 @@ class Compiler {
     if (!(*left_y > *right_y)) fail(p + "/left_y", "expected the left track's y above the right track's, got " + compile_number(*left_y) + " and " + compile_number(*right_y));
   }
 
-  RoadSurface build_road_profile(const RoadProfileSpec& r, const std::string& p, std::ostringstream& key) const {
+  RoadSurface build_road_profile(const RoadProfileSpec& r, const std::string& p) const {
     RoadTable table;
     if (!r.file.empty()) {
       if (!r.s.empty() || !r.left.empty() || !r.right.empty()) fail(p, "expected the profile from a file or inline (s, left, right), not both");
@@ -843,13 +866,11 @@ class Compiler {
       } catch (const std::exception& x) {
         fail(p + "/file", x.what());
       }
-      key << "profile:" << road_file(r.file) << ":" << r.left_y.value_or(0) << ":" << r.right_y.value_or(0);
     } else {
       if (r.s.empty() || r.left.empty()) fail(p, "expected a \"file\", or \"s\" and \"left\" (and \"right\" for two tracks)");
       table.x = r.s;
       table.z = {r.left};
       if (!r.right.empty()) table.z.push_back(r.right);
-      key << "inline";
     }
     const bool two = table.z.size() == 2;
     road_track_ys(r.left_y, r.right_y, two, p);
@@ -860,7 +881,7 @@ class Compiler {
     }
   }
 
-  RoadSurface build_road_iso8608(const RoadIso8608Spec& r, const std::string& p, std::ostringstream& key) const {
+  RoadSurface build_road_iso8608(const RoadIso8608Spec& r, const std::string& p) const {
     Iso8608Spec iso;
     iso.road_class = iso8608_class(r.road_class);
     if (iso.road_class < 0) fail(p + "/class", "unknown ISO 8608 class " + quote(r.road_class) + " (expected one of: A, B, C, D, E, F, G, H)");
@@ -881,8 +902,6 @@ class Compiler {
     const std::size_t n = tracks[0].size();
     std::vector<double> s(n);
     for (std::size_t i = 0; i < n; ++i) s[i] = r.start + r.length * static_cast<double>(i) / static_cast<double>(n - 1);
-    key << "iso8608:" << iso.road_class << "," << iso.length << "," << iso.n_min << "," << iso.n_max << "," << iso.spacing << ","
-        << r.start << "," << iso.seed << "," << *r.left_y << "," << *r.right_y;
     return road_tracks(s, tracks[0], tracks[1], *r.left_y, *r.right_y);
   }
 

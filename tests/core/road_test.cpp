@@ -449,6 +449,37 @@ TEST(Road, RoadFieldsRoundTripThroughTheModelFile) {
   }
 }
 
+// tires with the same generated road or CSV file share one surface; inline heights, another seed or
+// other friction regions make their own
+TEST(Road, TiresWithTheSameRoadShareOneSurface) {
+  const std::string iso = R"({"iso8608": {"class": "B", "length": 40, "seed": 5, "left_y": 0.8, "right_y": -0.8}})";
+  const std::string iso_seed6 = R"({"iso8608": {"class": "B", "length": 40, "seed": 6, "left_y": 0.8, "right_y": -0.8}})";
+  const std::string iso_mu = R"({"iso8608": {"class": "B", "length": 40, "seed": 5, "left_y": 0.8, "right_y": -0.8},
+                                  "friction": [{"x": [0, 10], "scale": 0.5}]})";
+  const std::string inline_grid = R"({"grid": {"x": [0, 1], "y": [0, 1], "z": [[0, 0], [0, 0]]}})";
+  const std::string roads[] = {iso, iso, iso_seed6, iso_mu, inline_grid, inline_grid};
+  std::string bodies, joints, tires;
+  for (int k = 0; k < 6; ++k) {
+    const std::string w = "w" + std::to_string(k);
+    bodies += std::string(k ? ", " : "") + R"({"name": ")" + w + R"(", "mass": 20, "inertia": [0.5, 0.9, 0.5]})";
+    joints += std::string(k ? ", " : "") + R"({"name": "j)" + std::to_string(k) + R"(", "type": "free", "parent": "ground", "child": ")" + w + R"("})";
+    tires += R"(, {"name": "t)" + std::to_string(k) + R"(", "type": "tire", "body": ")" + w + R"(", )" + road_test_fiala +
+             R"(, "road": )" + roads[k] + "}";
+  }
+  const Model mod = study_model(study_parse_model_text(R"({"name": "shared", "bodies": [)" + bodies + R"(], "joints": [)" + joints +
+                                                           R"(], "effects": [{"name": "gravity", "type": "gravity", "g": [0, 0, -9.81]})" +
+                                                           tires + "]}",
+                                                       "shared.json"));
+  ASSERT_EQ(mod.tires.size(), 6u);
+  EXPECT_EQ(mod.tires[0].road, mod.tires[1].road);
+  EXPECT_NE(mod.tires[0].road, mod.tires[2].road);
+  EXPECT_NE(mod.tires[0].road->left, mod.tires[2].road->left);
+  EXPECT_NE(mod.tires[0].road, mod.tires[3].road);
+  EXPECT_EQ(mod.tires[0].road->left, mod.tires[3].road->left);
+  EXPECT_EQ(mod.tires[3].road->friction.size(), 1u);
+  EXPECT_NE(mod.tires[4].road, mod.tires[5].road);
+}
+
 // the message of compiling `text` (as `file`), or "" when it compiles
 std::string road_test_refusal(const std::string& text, const std::string& file) {
   try {
