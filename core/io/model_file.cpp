@@ -896,10 +896,23 @@ const Schema<RoadSpec>& schema<RoadSpec>() {
       field("body", &RoadSpec::body, read_string),
       field("point", &RoadSpec::point, read_vec3),
       field("normal", &RoadSpec::normal, read_direction),
+      field("surface", &RoadSpec::surface, read_string),
       optional_struct_field("grid", &RoadSpec::grid),
       optional_struct_field("profile", &RoadSpec::profile),
       optional_struct_field("iso8608", &RoadSpec::iso8608),
       list_field("friction", &RoadSpec::friction),
+  }};
+  return s;
+}
+
+template <>
+const Schema<NamedRoadSpec>& schema<NamedRoadSpec>() {
+  static const Schema<NamedRoadSpec> s{{
+      name_field<NamedRoadSpec>(),
+      optional_struct_field("grid", &NamedRoadSpec::grid),
+      optional_struct_field("profile", &NamedRoadSpec::profile),
+      optional_struct_field("iso8608", &NamedRoadSpec::iso8608),
+      list_field("friction", &NamedRoadSpec::friction),
   }};
   return s;
 }
@@ -1564,6 +1577,7 @@ const Schema<ModelSpec>& schema<ModelSpec>() {
       list_field("effects", &ModelSpec::effects),
       list_field("actuators", &ModelSpec::actuators),
       list_field("sensors", &ModelSpec::sensors),
+      list_field("roads", &ModelSpec::roads),
       struct_field("plant", &ModelSpec::plant),
       field("controller", &ModelSpec::controller, read_struct<ControllerSpec>, write_controller),
       struct_field("solver", &ModelSpec::solver),

@@ -152,6 +152,7 @@ class Compiler {
     unique_names(spec_.effects, "effects", "effect");
     unique_names(spec_.actuators, "actuators", "actuator");
     unique_names(spec_.sensors, "sensors", "sensor");
+    unique_names(spec_.roads, "roads", "road");
     for (std::size_t i = 0; i < spec_.bodies.size(); ++i)
       if (spec_.bodies[i].name == kGroundName) fail(at("bodies", i) + "/name", "\"ground\" is reserved for the fixed world body");
   }
@@ -740,7 +741,33 @@ class Compiler {
   // a road of heights (vehicle/road.hpp, docs/roads.md) and the friction regions: tires whose roads
   // read the same CSV file or generate the same ISO 8608 road, with the same regions, share one
   // surface, read or generated once
-  void build_tire_road(const RoadSpec& r, const std::string& p, TireModel& t) const {
+  void build_tire_road(const RoadSpec& given, const std::string& given_path, TireModel& t) const {
+    RoadSpec r = given;
+    std::string p = given_path;
+    if (!given.surface.empty()) {
+      // a road of the model's `roads`: its surface and regions; its fields' errors at /roads/K
+      if (given.grid || given.profile || given.iso8608 || !given.friction.empty())
+        fail(given_path + "/surface", "a named road gives the surface and the friction regions: leave out grid, profile, "
+                                      "iso8608 and friction, or the name");
+      if (given.point != Eigen::Vector3d::Zero() || given.normal != Eigen::Vector3d::UnitZ())
+        fail(given_path + (given.point != Eigen::Vector3d::Zero() ? "/point" : "/normal"),
+             "a named road lies in the road body's frame: point and normal belong to the plane road; leave them out");
+      std::string names;
+      std::size_t k = 0;
+      for (; k < spec_.roads.size() && spec_.roads[k].name != given.surface; ++k)
+        names += (names.empty() ? "" : ", ") + spec_.roads[k].name;
+      if (k == spec_.roads.size())
+        fail(given_path + "/surface", "unknown road " + quote(given.surface) + " (expected one of the model's roads: " +
+                                          (names.empty() ? "none defined" : names) + ")");
+      const NamedRoadSpec& named = spec_.roads[k];
+      r.grid = named.grid;
+      r.profile = named.profile;
+      r.iso8608 = named.iso8608;
+      r.friction = named.friction;
+      p = at("roads", k);
+      if (!r.grid && !r.profile && !r.iso8608 && r.friction.empty())
+        fail(p, "expected a road surface (grid, profile, iso8608) or friction regions");
+    }
     const int kinds = int(r.grid.has_value()) + int(r.profile.has_value()) + int(r.iso8608.has_value());
     if (kinds > 1) fail(p, "expected one road surface of grid, profile, iso8608, got " + std::to_string(kinds));
     if (kinds == 0 && r.friction.empty()) return;
@@ -770,7 +797,7 @@ class Compiler {
       regions.push_back(region);
       suffix << ";f" << region.x_min << "," << region.x_max << "," << region.y_min << "," << region.y_max << "," << region.scale;
     }
-    const std::string key = road_key(r);  // empty: made per tire
+    const std::string key = given.surface.empty() ? road_key(r) : "named:" + p;  // empty: made per tire
     std::shared_ptr<const RoadSurface>* slot = key.empty() ? nullptr : &roads_[key + suffix.str()];
     if (slot && *slot) {
       t.road = *slot;

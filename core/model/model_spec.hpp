@@ -156,11 +156,23 @@ struct RoadFrictionSpec {
 
 // A tire's road: the plane through `point` with normal `normal` (both in `body`'s coordinates; the
 // ground by default), the wheel on the side the normal points to; or one surface of heights (grid,
-// profile, iso8608) in `body`'s frame; friction regions on either.
+// profile, iso8608) in `body`'s frame; friction regions on either; or `surface`, the name of a road
+// of the model's `roads` (its surface and regions, in `body`'s frame).
 struct RoadSpec {
   std::string body = kGroundName;
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  std::string surface;
+  std::optional<RoadGridSpec> grid;
+  std::optional<RoadProfileSpec> profile;
+  std::optional<RoadIso8608Spec> iso8608;
+  std::vector<RoadFrictionSpec> friction;
+};
+
+// A road of the model's top-level `roads`, defined once and named by tires (RoadSpec::surface):
+// one surface (grid, profile or iso8608) and friction regions, as a tire's road object holds them.
+struct NamedRoadSpec {
+  std::string name;
   std::optional<RoadGridSpec> grid;
   std::optional<RoadProfileSpec> profile;
   std::optional<RoadIso8608Spec> iso8608;
@@ -382,6 +394,7 @@ struct ModelSpec {
   std::vector<EffectSpec> effects;
   std::vector<ActuatorSpec> actuators;
   std::vector<SensorSpec> sensors;
+  std::vector<NamedRoadSpec> roads;  // roads the tires name (docs/roads.md)
   PlantSpec plant;
   ControllerSpec controller;  // type None: no controller
   SolverSpec solver;

@@ -73,6 +73,16 @@ TireContact<double> road_test_contact(const Model& mod, const Eigen::VectorXd& q
   return c;
 }
 
+// the message of compiling `text` (as `file`), or "" when it compiles
+std::string road_test_refusal(const std::string& text, const std::string& file) {
+  try {
+    study_model(study_parse_model_text(text, file), file);
+  } catch (const ModelError& e) {
+    return e.what();
+  }
+  return "";
+}
+
 // a JSON array of numbers
 std::string road_test_array(const std::vector<double>& v) {
   std::string s = "[";
@@ -480,15 +490,55 @@ TEST(Road, TiresWithTheSameRoadShareOneSurface) {
   EXPECT_NE(mod.tires[4].road, mod.tires[5].road);
 }
 
-// the message of compiling `text` (as `file`), or "" when it compiles
-std::string road_test_refusal(const std::string& text, const std::string& file) {
-  try {
-    study_model(study_parse_model_text(text, file), file);
-  } catch (const ModelError& e) {
-    return e.what();
+// a road defined once in the model's `roads` and named by tires: one surface, the same contact as the
+// road written in the tire; bad names and mixed fields refused at the field
+TEST(Road, ARoadOfTheModelsRoadsIsNamedByTires) {
+  const std::string grid = road_test_grid(-2, 0.5, 9, -1, 0.5, 5, [](double x, double y) { return 0.01 * std::sin(x) * std::cos(y); });
+  const auto model = [&](const std::string& roads, const std::string& road_a, const std::string& road_b) {
+    return R"({"name": "named",
+      "bodies": [{"name": "a", "mass": 20, "inertia": [0.5, 0.9, 0.5]}, {"name": "b", "mass": 20, "inertia": [0.5, 0.9, 0.5]}],
+      "joints": [{"name": "ja", "type": "free", "parent": "ground", "child": "a"}, {"name": "jb", "type": "free", "parent": "ground", "child": "b"}],
+      "roads": )" + roads + R"(,
+      "effects": [{"name": "ta", "type": "tire", "body": "a", )" + road_test_fiala + R"(, "road": )" + road_a + R"(},
+                  {"name": "tb", "type": "tire", "body": "b", )" + road_test_fiala + R"(, "road": )" + road_b + "}]}";
+  };
+  const std::string roads = R"([{"name": "bumpy", "grid": )" + grid + R"(, "friction": [{"x": [0, 1], "scale": 0.5}]}])";
+  const Model named = study_model(study_parse_model_text(model(roads, R"({"surface": "bumpy"})", R"({"body": "ground", "surface": "bumpy"})"), "n.json"));
+  EXPECT_EQ(named.tires[0].road, named.tires[1].road);
+  EXPECT_EQ(named.tires[0].road->friction.size(), 1u);
+  const std::string inline_road = R"({"grid": )" + grid + R"(, "friction": [{"x": [0, 1], "scale": 0.5}]})";
+  const Model written = study_model(study_parse_model_text(model("[]", inline_road, inline_road), "w.json"));
+  Eigen::VectorXd q(7), v(6);
+  q << 0.3, 0.2, 0.29, 1, 0, 0, 0;
+  v << 0, 8, 0, 2, 0.1, 0;
+  const TireContact<double> a = road_test_contact(named, q, v), b = road_test_contact(written, q, v);
+  EXPECT_EQ(a.force, b.force);
+  EXPECT_EQ(a.moment, b.moment);
+  EXPECT_GT(a.force.norm(), 100.0);
+  // written back: the roads and the names
+  const nlohmann::json j = to_json(parse_model_spec_text(model(roads, R"({"surface": "bumpy"})", R"({"surface": "bumpy"})"), "n.json"));
+  EXPECT_EQ(j.at("roads").at(0).at("name"), "bumpy");
+  EXPECT_EQ(j.at("roads").at(0).at("grid").at("x").size(), 9u);
+  EXPECT_EQ(j.at("effects").at(1).at("road").at("surface"), "bumpy");
+  const struct {
+    std::string roads, road, field, phrase;
+  } bad[] = {
+      {roads, R"({"surface": "smooth"})", "/effects/0/road/surface", "unknown road \"smooth\" (expected one of the model's roads: bumpy)"},
+      {roads, R"({"surface": "bumpy", "friction": [{"scale": 0.2}]})", "/effects/0/road/surface", "a named road gives the surface"},
+      {roads, R"({"surface": "bumpy", "point": [0, 0, 1]})", "/effects/0/road/point", "point and normal belong to the plane road"},
+      {R"([{"name": "bumpy", "grid": {"x": [0, 1, 3], "y": [0, 1], "z": [[0, 0, 0], [0, 0, 0]]}}])", R"({"surface": "bumpy"})",
+       "/roads/0/grid", "expected uniformly spaced x"},
+      {R"([{"name": "bumpy"}])", R"({"surface": "bumpy"})", "/roads/0", "expected a road surface"},
+  };
+  for (const auto& c : bad) {
+    const std::string message = road_test_refusal(model(c.roads, c.road, "{}"), "named.json");
+    EXPECT_NE(message.find("named.json: " + c.field + ": "), std::string::npos) << c.road << "\n -> " << message;
+    EXPECT_NE(message.find(c.phrase), std::string::npos) << c.road << "\n -> " << message;
   }
-  return "";
+  const std::string twice = R"([{"name": "bumpy", "grid": )" + grid + R"(}, {"name": "bumpy", "grid": )" + grid + "}]";
+  EXPECT_NE(road_test_refusal(model(twice, "{}", "{}"), "named.json").find("named.json: /roads/1/name: duplicate road name"), std::string::npos);
 }
+
 
 TEST(Road, BadRoadsAreRefusedNamingTheFileAndTheField) {
   const std::string dir = road_test_dir(), file = dir + "/car.json";
