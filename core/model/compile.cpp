@@ -741,33 +741,37 @@ class Compiler {
   // a road of heights (vehicle/road.hpp, docs/roads.md) and the friction regions: tires whose roads
   // read the same CSV file or generate the same ISO 8608 road, with the same regions, share one
   // surface, read or generated once
-  void build_tire_road(const RoadSpec& given, const std::string& given_path, TireModel& t) const {
+  // a tire's road as written, or with the surface and regions of the model's road it names (then p,
+  // where its fields' errors are, becomes /roads/K)
+  RoadSpec resolve_road(const RoadSpec& given, const std::string& given_path, std::string& p) const {
+    p = given_path;
+    if (given.surface.empty()) return given;
+    if (given.grid || given.profile || given.iso8608 || !given.friction.empty())
+      fail(given_path + "/surface", "a named road gives the surface and the friction regions: leave out grid, profile, "
+                                    "iso8608 and friction, or the name");
+    if (given.point != Eigen::Vector3d::Zero() || given.normal != Eigen::Vector3d::UnitZ())
+      fail(given_path + (given.point != Eigen::Vector3d::Zero() ? "/point" : "/normal"),
+           "a named road lies in the road body's frame: point and normal belong to the plane road; leave them out");
+    std::string names;
+    std::size_t k = 0;
+    for (; k < spec_.roads.size() && spec_.roads[k].name != given.surface; ++k) names += (names.empty() ? "" : ", ") + spec_.roads[k].name;
+    if (k == spec_.roads.size())
+      fail(given_path + "/surface", "unknown road " + quote(given.surface) + " (expected one of the model's roads: " +
+                                        (names.empty() ? "none defined" : names) + ")");
+    const NamedRoadSpec& named = spec_.roads[k];
     RoadSpec r = given;
-    std::string p = given_path;
-    if (!given.surface.empty()) {
-      // a road of the model's `roads`: its surface and regions; its fields' errors at /roads/K
-      if (given.grid || given.profile || given.iso8608 || !given.friction.empty())
-        fail(given_path + "/surface", "a named road gives the surface and the friction regions: leave out grid, profile, "
-                                      "iso8608 and friction, or the name");
-      if (given.point != Eigen::Vector3d::Zero() || given.normal != Eigen::Vector3d::UnitZ())
-        fail(given_path + (given.point != Eigen::Vector3d::Zero() ? "/point" : "/normal"),
-             "a named road lies in the road body's frame: point and normal belong to the plane road; leave them out");
-      std::string names;
-      std::size_t k = 0;
-      for (; k < spec_.roads.size() && spec_.roads[k].name != given.surface; ++k)
-        names += (names.empty() ? "" : ", ") + spec_.roads[k].name;
-      if (k == spec_.roads.size())
-        fail(given_path + "/surface", "unknown road " + quote(given.surface) + " (expected one of the model's roads: " +
-                                          (names.empty() ? "none defined" : names) + ")");
-      const NamedRoadSpec& named = spec_.roads[k];
-      r.grid = named.grid;
-      r.profile = named.profile;
-      r.iso8608 = named.iso8608;
-      r.friction = named.friction;
-      p = at("roads", k);
-      if (!r.grid && !r.profile && !r.iso8608 && r.friction.empty())
-        fail(p, "expected a road surface (grid, profile, iso8608) or friction regions");
-    }
+    r.grid = named.grid;
+    r.profile = named.profile;
+    r.iso8608 = named.iso8608;
+    r.friction = named.friction;
+    p = at("roads", k);
+    if (!r.grid && !r.profile && !r.iso8608 && r.friction.empty()) fail(p, "expected a road surface (grid, profile, iso8608) or friction regions");
+    return r;
+  }
+
+  void build_tire_road(const RoadSpec& given, const std::string& given_path, TireModel& t) const {
+    std::string p;
+    const RoadSpec r = resolve_road(given, given_path, p);
     const int kinds = int(r.grid.has_value()) + int(r.profile.has_value()) + int(r.iso8608.has_value());
     if (kinds > 1) fail(p, "expected one road surface of grid, profile, iso8608, got " + std::to_string(kinds));
     if (kinds == 0 && r.friction.empty()) return;
