@@ -40,6 +40,7 @@
 #include "vehicle/linear_tire.hpp"
 #include "vehicle/magic_formula.hpp"
 #include "vehicle/magic_formula_relaxation.hpp"
+#include "vehicle/road.hpp"
 
 namespace codyna {
 
@@ -79,16 +80,19 @@ inline MagicFormulaOptions tire_effect_mf_options(const TireModel& t) {
   return options;
 }
 
-// The tire's force law at one contact state.
+// The tire's force law at one contact state; region: the road's friction region at the contact
+// (t.road->friction; -1: none), whose scale multiplies the law's friction (linear: mu; fiala: mu_max
+// and mu_min; magic_formula: LMUX and LMUY, t.mf_regions)
 template <class S>
-TireForces<S> tire_effect_law(const TireModel& t, const TireInput<S>& in) {
+TireForces<S> tire_effect_law(const TireModel& t, const TireInput<S>& in, int region = -1) {
+  const double scale = region >= 0 ? t.road->friction[static_cast<std::size_t>(region)].scale : 1.0;
   switch (t.law) {
     case TireLaw::Linear: {
       LinearTireParameters p;
       p.C_kappa = t.C_kappa;
       p.C_alpha = t.C_alpha;
       p.C_gamma = t.C_gamma;
-      p.mu = t.friction;
+      p.mu = region >= 0 ? t.friction * scale : t.friction;
       p.trail = t.trail;
       p.unloaded_radius = t.unloaded_radius;
       return linear_tire<S>(p, in);
@@ -97,8 +101,8 @@ TireForces<S> tire_effect_law(const TireModel& t, const TireInput<S>& in) {
       FialaParameters p;
       p.C_kappa = t.C_kappa;
       p.C_alpha = t.C_alpha;
-      p.mu_max = t.friction;
-      p.mu_min = t.sliding_friction;
+      p.mu_max = region >= 0 ? t.friction * scale : t.friction;
+      p.mu_min = region >= 0 ? t.sliding_friction * scale : t.sliding_friction;
       p.width = t.width;
       p.rolling_resistance = t.rolling_resistance;
       p.unloaded_radius = t.unloaded_radius;
@@ -106,7 +110,54 @@ TireForces<S> tire_effect_law(const TireModel& t, const TireInput<S>& in) {
     }
     case TireLaw::MagicFormula: break;
   }
+  if (region >= 0) return magic_formula<S>(*t.mf_regions[static_cast<std::size_t>(region)], in, tire_effect_mf_options(t));
   return magic_formula<S>(*t.mf, in, tire_effect_mf_options(t));
+}
+
+// The road's height and gradient at (x, y) (road body coordinates) on the scalar S: the surface's
+// values, and for an automatic-differentiation scalar the derivatives by the chain rule through the
+// surface's second derivatives.
+template <class S>
+struct TireRoadPoint {
+  S z, zx, zy;
+};
+inline TireRoadPoint<double> tire_effect_road(const RoadSurface& road, double x, double y) {
+  const RoadHeight h = road.height(x, y);
+  return {h.z, h.zx, h.zy};
+}
+template <class D>
+TireRoadPoint<Eigen::AutoDiffScalar<D>> tire_effect_road(const RoadSurface& road, const Eigen::AutoDiffScalar<D>& x,
+                                                         const Eigen::AutoDiffScalar<D>& y) {
+  using A = Eigen::AutoDiffScalar<D>;
+  const RoadHeight h = road.height(x.value(), y.value());
+  const auto chain = [&](double fx, double fy) {
+    // x and y carry the same derivatives' size, except a constant's (size 0 when dynamic)
+    if (y.derivatives().size() == 0) return D(x.derivatives() * fx);
+    if (x.derivatives().size() == 0) return D(y.derivatives() * fy);
+    return D(x.derivatives() * fx + y.derivatives() * fy);
+  };
+  return {A(h.z, chain(h.zx, h.zy)), A(h.zx, chain(h.zxx, h.zxy)), A(h.zy, chain(h.zxy, h.zyy))};
+}
+
+// The road below the wheel centre c as a plane (world axes): its unit normal n and a point r0. A
+// road of heights gives its tangent plane at the centre's x, y in the road body's frame (the
+// "equivalent plane" of a point follower, docs/roads.md), and the friction region there.
+template <class S>
+void tire_effect_plane(const TireModel& t, const Mat3T<S>& Rr, const Vec3T<S>& pr, const Vec3T<S>& c, Vec3T<S>& n, Vec3T<S>& r0,
+                       int& region) {
+  using std::sqrt;
+  region = -1;
+  if (!t.road) {
+    n = Rr * t.road_normal.cast<S>();
+    r0 = Rr * t.road_point.cast<S>() + pr;
+    return;
+  }
+  const Vec3T<S> cl = Rr.transpose() * Vec3T<S>(c - pr);
+  const TireRoadPoint<S> h = tire_effect_road(*t.road, cl[0], cl[1]);
+  const S inv = 1.0 / S(sqrt(h.zx * h.zx + h.zy * h.zy + 1.0));
+  n = Rr * Vec3T<S>(S(-h.zx * inv), S(-h.zy * inv), inv);
+  r0 = Rr * Vec3T<S>(cl[0], cl[1], h.z) + pr;
+  region = t.road->region(tire_value(cl[0]), tire_value(cl[1]));
 }
 
 // The contact of tire t: wheel pose (R, p), angular velocity w and velocity v of its origin, the road
@@ -127,8 +178,9 @@ bool tire_contact(const TireModel& t, const Mat3T<S>& Rw, const Vec3T<S>& pw, co
   c.rate_y = lag_y ? S((*states)[t.state_y] * (-0.5 * t.low_speed / t.relaxation_y)) : zero;
   const Vec3T<S> a = Rw * t.axis.cast<S>();
   c.center = Rw * t.center.cast<S>() + pw;
-  const Vec3T<S> n = Rr * t.road_normal.cast<S>();
-  const Vec3T<S> r0 = Rr * t.road_point.cast<S>() + pr;
+  Vec3T<S> n, r0;
+  int region = -1;
+  tire_effect_plane<S>(t, Rr, pr, c.center, n, r0, region);
   const S na = n.dot(a);
   const Vec3T<S> e = n - a * na;
   const S ce2 = e.squaredNorm();
@@ -194,7 +246,7 @@ bool tire_contact(const TireModel& t, const Mat3T<S>& Rw, const Vec3T<S>& pw, co
   c.input.Vx = c.Vx;
   c.input.phit = zero;
   c.input.pressure = zero;
-  c.out = tire_effect_law<S>(t, c.input);
+  c.out = tire_effect_law<S>(t, c.input, region);
   c.force = c.ex * c.out.Fx + c.ey * c.out.Fy + c.ez * Fz;
   c.moment = c.ex * c.out.Mx + c.ey * c.out.My + c.ez * c.out.Mz;
   return true;

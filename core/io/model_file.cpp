@@ -820,12 +820,99 @@ const Schema<ConstraintSpec>& schema<ConstraintSpec>() {
   return s;
 }
 
+// roads of heights (docs/roads.md): the numbers as written; compile_model reads the CSV files and
+// checks the grids
+std::vector<double> read_road_numbers(const Node& n) {
+  const Eigen::VectorXd v = read_vector(n);
+  return std::vector<double>(v.data(), v.data() + v.size());
+}
+
+std::vector<double> read_road_interval(const Node& n) {
+  const std::vector<double> v = read_road_numbers(n);
+  if (v.size() != 2 || !(v[0] <= v[1])) n.expected("[min, max] with min <= max");
+  return v;
+}
+
+std::optional<double> read_road_track_y(const Node& n) { return read_number(n); }
+
+template <class S, class T>
+Field<S> optional_struct_field(std::string_view key, std::optional<T> S::*m) {
+  return field(key, m, [](const Node& n) { return std::optional<T>(read_struct<T>(n)); },
+               [](const std::optional<T>& v) { return v ? write_struct(*v) : ojson(); });
+}
+
+template <>
+const Schema<RoadGridSpec>& schema<RoadGridSpec>() {
+  static const Schema<RoadGridSpec> s{{
+      field("file", &RoadGridSpec::file, read_string),
+      field("x", &RoadGridSpec::x, read_road_numbers),
+      field("y", &RoadGridSpec::y, read_road_numbers),
+      field("z", &RoadGridSpec::z, read_matrix, [](const Eigen::MatrixXd& z) { return z.size() ? encode_matrix(z) : ojson(); }),
+  }};
+  return s;
+}
+
+template <>
+const Schema<RoadProfileSpec>& schema<RoadProfileSpec>() {
+  static const Schema<RoadProfileSpec> s{{
+      field("file", &RoadProfileSpec::file, read_string),
+      field("s", &RoadProfileSpec::s, read_road_numbers),
+      field("left", &RoadProfileSpec::left, read_road_numbers),
+      field("right", &RoadProfileSpec::right, read_road_numbers),
+      field("left_y", &RoadProfileSpec::left_y, read_road_track_y),
+      field("right_y", &RoadProfileSpec::right_y, read_road_track_y),
+  }};
+  return s;
+}
+
+template <>
+const Schema<RoadIso8608Spec>& schema<RoadIso8608Spec>() {
+  static const Schema<RoadIso8608Spec> s{{
+      field("class", &RoadIso8608Spec::road_class, read_string, Need::Required),
+      field("length", &RoadIso8608Spec::length, read_positive_length, Need::Required),
+      field("band", &RoadIso8608Spec::band, read_road_interval),
+      field("spacing", &RoadIso8608Spec::spacing, read_positive_length),
+      field("start", &RoadIso8608Spec::start, read_number),
+      field("seed", &RoadIso8608Spec::seed, read_integer),
+      field("left_y", &RoadIso8608Spec::left_y, read_road_track_y),
+      field("right_y", &RoadIso8608Spec::right_y, read_road_track_y),
+  }};
+  return s;
+}
+
+template <>
+const Schema<RoadFrictionSpec>& schema<RoadFrictionSpec>() {
+  static const Schema<RoadFrictionSpec> s{{
+      field("x", &RoadFrictionSpec::x, read_road_interval),
+      field("y", &RoadFrictionSpec::y, read_road_interval),
+      field("scale", &RoadFrictionSpec::scale, read_coefficient, Need::Required),
+  }};
+  return s;
+}
+
 template <>
 const Schema<RoadSpec>& schema<RoadSpec>() {
   static const Schema<RoadSpec> s{{
       field("body", &RoadSpec::body, read_string),
       field("point", &RoadSpec::point, read_vec3),
       field("normal", &RoadSpec::normal, read_direction),
+      field("surface", &RoadSpec::surface, read_string),
+      optional_struct_field("grid", &RoadSpec::grid),
+      optional_struct_field("profile", &RoadSpec::profile),
+      optional_struct_field("iso8608", &RoadSpec::iso8608),
+      list_field("friction", &RoadSpec::friction),
+  }};
+  return s;
+}
+
+template <>
+const Schema<NamedRoadSpec>& schema<NamedRoadSpec>() {
+  static const Schema<NamedRoadSpec> s{{
+      name_field<NamedRoadSpec>(),
+      optional_struct_field("grid", &NamedRoadSpec::grid),
+      optional_struct_field("profile", &NamedRoadSpec::profile),
+      optional_struct_field("iso8608", &NamedRoadSpec::iso8608),
+      list_field("friction", &NamedRoadSpec::friction),
   }};
   return s;
 }
@@ -1490,6 +1577,7 @@ const Schema<ModelSpec>& schema<ModelSpec>() {
       list_field("effects", &ModelSpec::effects),
       list_field("actuators", &ModelSpec::actuators),
       list_field("sensors", &ModelSpec::sensors),
+      list_field("roads", &ModelSpec::roads),
       struct_field("plant", &ModelSpec::plant),
       field("controller", &ModelSpec::controller, read_struct<ControllerSpec>, write_controller),
       struct_field("solver", &ModelSpec::solver),

@@ -10,8 +10,10 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include "vehicle/magic_formula_relaxation.hpp"
+#include "vehicle/road.hpp"
 #include "vehicle/tir_file.hpp"
 
 
@@ -150,6 +152,7 @@ class Compiler {
     unique_names(spec_.effects, "effects", "effect");
     unique_names(spec_.actuators, "actuators", "actuator");
     unique_names(spec_.sensors, "sensors", "sensor");
+    unique_names(spec_.roads, "roads", "road");
     for (std::size_t i = 0; i < spec_.bodies.size(); ++i)
       if (spec_.bodies[i].name == kGroundName) fail(at("bodies", i) + "/name", "\"ground\" is reserved for the fixed world body");
   }
@@ -731,7 +734,206 @@ class Compiler {
       t.relaxation_x = sx;
       t.relaxation_y = sy;
     }
+    build_tire_road(e.road, p + "/road", t);
     return t;
+  }
+
+  // a road of heights (vehicle/road.hpp, docs/roads.md) and the friction regions: tires whose roads
+  // read the same CSV file or generate the same ISO 8608 road, with the same regions, share one
+  // surface, read or generated once
+  // a tire's road as written, or with the surface and regions of the model's road it names (then p,
+  // where its fields' errors are, becomes /roads/K)
+  RoadSpec resolve_road(const RoadSpec& given, const std::string& given_path, std::string& p) const {
+    p = given_path;
+    if (given.surface.empty()) return given;
+    if (given.grid || given.profile || given.iso8608 || !given.friction.empty())
+      fail(given_path + "/surface", "a named road gives the surface and the friction regions: leave out grid, profile, "
+                                    "iso8608 and friction, or the name");
+    if (given.point != Eigen::Vector3d::Zero() || given.normal != Eigen::Vector3d::UnitZ())
+      fail(given_path + (given.point != Eigen::Vector3d::Zero() ? "/point" : "/normal"),
+           "a named road lies in the road body's frame: point and normal belong to the plane road; leave them out");
+    std::string names;
+    std::size_t k = 0;
+    for (; k < spec_.roads.size() && spec_.roads[k].name != given.surface; ++k) names += (names.empty() ? "" : ", ") + spec_.roads[k].name;
+    if (k == spec_.roads.size())
+      fail(given_path + "/surface", "unknown road " + quote(given.surface) + " (expected one of the model's roads: " +
+                                        (names.empty() ? "none defined" : names) + ")");
+    const NamedRoadSpec& named = spec_.roads[k];
+    RoadSpec r = given;
+    r.grid = named.grid;
+    r.profile = named.profile;
+    r.iso8608 = named.iso8608;
+    r.friction = named.friction;
+    p = at("roads", k);
+    if (!r.grid && !r.profile && !r.iso8608 && r.friction.empty()) fail(p, "expected a road surface (grid, profile, iso8608) or friction regions");
+    return r;
+  }
+
+  void build_tire_road(const RoadSpec& given, const std::string& given_path, TireModel& t) const {
+    std::string p;
+    const RoadSpec r = resolve_road(given, given_path, p);
+    const int kinds = int(r.grid.has_value()) + int(r.profile.has_value()) + int(r.iso8608.has_value());
+    if (kinds > 1) fail(p, "expected one road surface of grid, profile, iso8608, got " + std::to_string(kinds));
+    if (kinds == 0 && r.friction.empty()) return;
+    const bool plane_given = r.point != Eigen::Vector3d::Zero() || r.normal != Eigen::Vector3d::UnitZ();
+    if (kinds == 1 && plane_given)
+      fail(p + (r.point != Eigen::Vector3d::Zero() ? "/point" : "/normal"),
+           "a road surface lies in the road body's frame: point and normal belong to the plane road; leave them out");
+    if (kinds == 0 && plane_given)
+      fail(p + "/friction", "friction regions lie on a road in the road body's x, y: leave out point and normal, or the regions");
+    std::vector<RoadFrictionRegion> regions;
+    std::ostringstream suffix;
+    suffix.precision(17);
+    for (std::size_t k = 0; k < r.friction.size(); ++k) {
+      const RoadFrictionSpec& f = r.friction[k];
+      const std::string q = p + "/friction/" + std::to_string(k);
+      RoadFrictionRegion region;
+      for (const auto& [v, lo, hi, name] : {std::tuple{&f.x, &region.x_min, &region.x_max, "/x"}, std::tuple{&f.y, &region.y_min, &region.y_max, "/y"}}) {
+        if (v->empty()) continue;
+        if (v->size() != 2 || !((*v)[0] <= (*v)[1])) fail(q + name, "expected [min, max] with min <= max");
+        *lo = (*v)[0];
+        *hi = (*v)[1];
+      }
+      if (!std::isfinite(f.scale) || !(f.scale >= 0)) fail(q + "/scale", "expected a friction scale >= 0, got " + compile_number(f.scale));
+      if (t.law == TireLaw::Linear && !(t.friction > 0))
+        fail(q, "a linear tire without friction (its \"friction\" 0: no limit) has no friction to scale; give the tire a friction");
+      region.scale = f.scale;
+      regions.push_back(region);
+      suffix << ";f" << region.x_min << "," << region.x_max << "," << region.y_min << "," << region.y_max << "," << region.scale;
+    }
+    const std::string key = given.surface.empty() ? road_key(r) : "named:" + p;  // empty: made per tire
+    std::shared_ptr<const RoadSurface>* slot = key.empty() ? nullptr : &roads_[key + suffix.str()];
+    if (slot && *slot) {
+      t.road = *slot;
+    } else {
+      RoadSurface road = kinds == 0 ? road_tracks({0.0, 1.0}, {0.0, 0.0}, {}, 0.0, 0.0)  // the plane z = 0 as heights
+                         : r.grid   ? build_road_grid(*r.grid, p + "/grid")
+                         : r.profile ? build_road_profile(*r.profile, p + "/profile")
+                                     : build_road_iso8608(*r.iso8608, p + "/iso8608");
+      road.friction = regions;
+      t.road = std::make_shared<const RoadSurface>(std::move(road));
+      if (slot) *slot = t.road;
+    }
+    if (t.law == TireLaw::MagicFormula)
+      for (const RoadFrictionRegion& region : t.road->friction) {
+        auto scaled = std::make_shared<MagicFormulaParameters>(*t.mf);
+        scaled->LMUX *= region.scale;
+        scaled->LMUY *= region.scale;
+        t.mf_regions.push_back(std::move(scaled));
+      }
+  }
+
+  // what makes two roads the same surface: the CSV file (and the tracks' y), the ISO 8608 road's
+  // fields, the plane; empty for inline heights (made per tire)
+  std::string road_key(const RoadSpec& r) const {
+    std::ostringstream key;
+    key.precision(17);
+    if (r.grid) {
+      if (r.grid->file.empty() || !r.grid->x.empty() || !r.grid->y.empty() || r.grid->z.size()) return "";
+      key << "grid:" << road_file(r.grid->file);
+    } else if (r.profile) {
+      if (r.profile->file.empty() || !r.profile->s.empty() || !r.profile->left.empty() || !r.profile->right.empty()) return "";
+      key << "profile:" << road_file(r.profile->file) << ":" << r.profile->left_y.value_or(0) << ":" << r.profile->right_y.value_or(0)
+          << ":" << r.profile->left_y.has_value() << r.profile->right_y.has_value();
+    } else if (r.iso8608) {
+      const RoadIso8608Spec& i = *r.iso8608;
+      key << "iso8608:" << i.road_class << "," << i.length << ",";
+      for (double b : i.band) key << b << ",";
+      key << i.spacing << "," << i.start << "," << i.seed << "," << i.left_y.value_or(0) << "," << i.right_y.value_or(0) << ","
+          << i.left_y.has_value() << i.right_y.has_value();
+    } else {
+      key << "plane";
+    }
+    return key.str();
+  }
+
+  std::string road_file(const std::string& file) const {
+    std::filesystem::path path(file);
+    if (path.is_relative() && !file_.empty()) path = std::filesystem::path(file_).parent_path() / path;
+    return path.string();
+  }
+
+  RoadSurface build_road_grid(const RoadGridSpec& g, const std::string& p) const {
+    RoadTable table;
+    if (!g.file.empty()) {
+      if (!g.x.empty() || !g.y.empty() || g.z.size()) fail(p, "expected the grid from a file or inline (x, y, z), not both");
+      try {
+        table = read_road_grid_csv(road_file(g.file));
+      } catch (const std::exception& x) {
+        fail(p + "/file", x.what());
+      }
+    } else {
+      if (g.x.empty() || g.y.empty() || !g.z.size()) fail(p, "expected a \"file\", or the nodes \"x\", \"y\" and the heights \"z\" (one row per y)");
+      table.x = g.x;
+      table.y = g.y;
+      table.z.assign(static_cast<std::size_t>(g.z.rows()), std::vector<double>());
+      for (Eigen::Index j = 0; j < g.z.rows(); ++j)
+        for (Eigen::Index i = 0; i < g.z.cols(); ++i) table.z[static_cast<std::size_t>(j)].push_back(g.z(j, i));
+    }
+    try {
+      return road_grid(table.x, table.y, table.z);
+    } catch (const std::exception& x) {
+      fail(p + (g.file.empty() ? "" : "/file"), (g.file.empty() ? std::string() : road_file(g.file) + ": ") + x.what());
+    }
+  }
+
+  // the tracks' y: both given for two tracks (left above right), none for one
+  void road_track_ys(const std::optional<double>& left_y, const std::optional<double>& right_y, bool two, const std::string& p) const {
+    if (!two) {
+      if (left_y || right_y) fail(p + (left_y ? "/left_y" : "/right_y"), "one track has no y: leave the field out");
+      return;
+    }
+    if (!left_y) fail(p, "missing required field \"left_y\" (the left track's y in the road body's frame)");
+    if (!right_y) fail(p, "missing required field \"right_y\" (the right track's y in the road body's frame)");
+    if (!(*left_y > *right_y)) fail(p + "/left_y", "expected the left track's y above the right track's, got " + compile_number(*left_y) + " and " + compile_number(*right_y));
+  }
+
+  RoadSurface build_road_profile(const RoadProfileSpec& r, const std::string& p) const {
+    RoadTable table;
+    if (!r.file.empty()) {
+      if (!r.s.empty() || !r.left.empty() || !r.right.empty()) fail(p, "expected the profile from a file or inline (s, left, right), not both");
+      try {
+        table = read_road_profile_csv(road_file(r.file));
+      } catch (const std::exception& x) {
+        fail(p + "/file", x.what());
+      }
+    } else {
+      if (r.s.empty() || r.left.empty()) fail(p, "expected a \"file\", or \"s\" and \"left\" (and \"right\" for two tracks)");
+      table.x = r.s;
+      table.z = {r.left};
+      if (!r.right.empty()) table.z.push_back(r.right);
+    }
+    const bool two = table.z.size() == 2;
+    road_track_ys(r.left_y, r.right_y, two, p);
+    try {
+      return road_tracks(table.x, table.z[0], two ? table.z[1] : std::vector<double>(), r.left_y.value_or(0), r.right_y.value_or(0));
+    } catch (const std::exception& x) {
+      fail(p + (r.file.empty() ? "" : "/file"), (r.file.empty() ? std::string() : road_file(r.file) + ": ") + x.what());
+    }
+  }
+
+  RoadSurface build_road_iso8608(const RoadIso8608Spec& r, const std::string& p) const {
+    Iso8608Spec iso;
+    iso.road_class = iso8608_class(r.road_class);
+    if (iso.road_class < 0) fail(p + "/class", "unknown ISO 8608 class " + quote(r.road_class) + " (expected one of: A, B, C, D, E, F, G, H)");
+    if (r.band.size() != 2 || !(r.band[0] > 0) || !(r.band[1] > r.band[0]))
+      fail(p + "/band", "expected [n_min, n_max] with 0 < n_min < n_max (cycle/m)");
+    iso.length = r.length;
+    iso.n_min = r.band[0];
+    iso.n_max = r.band[1];
+    iso.spacing = r.spacing;
+    iso.seed = static_cast<std::uint64_t>(static_cast<std::int64_t>(r.seed));
+    road_track_ys(r.left_y, r.right_y, true, p);
+    std::vector<std::vector<double>> tracks;
+    try {
+      tracks = iso8608_tracks(iso);
+    } catch (const std::exception& x) {
+      fail(p, x.what());
+    }
+    const std::size_t n = tracks[0].size();
+    std::vector<double> s(n);
+    for (std::size_t i = 0; i < n; ++i) s[i] = r.start + r.length * static_cast<double>(i) / static_cast<double>(n - 1);
+    return road_tracks(s, tracks[0], tracks[1], *r.left_y, *r.right_y);
   }
 
   // the transient slip's states of tire t (its contact's deflections), after the others
@@ -1027,6 +1229,7 @@ class Compiler {
   const ModelSpec& spec_;
   std::string file_;
   Model m_;
+  mutable std::map<std::string, std::shared_ptr<const RoadSurface>> roads_;  // build_tire_road: the roads made
   std::map<std::string, int> body_index_spec_;
   std::map<std::string, int> compiled_;
 };

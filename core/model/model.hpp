@@ -80,6 +80,7 @@ struct BushingModel {
 };
 
 struct MagicFormulaParameters;  // vehicle/tir_file.hpp
+struct RoadSurface;             // vehicle/road.hpp
 
 enum class TireLaw { Linear, Fiala, MagicFormula };
 
@@ -94,6 +95,12 @@ struct TireModel {
   int road_body = 0;
   Eigen::Vector3d road_point = Eigen::Vector3d::Zero();   // road body coordinates
   Eigen::Vector3d road_normal = Eigen::Vector3d::UnitZ(); // unit, road body coordinates
+  // a road of heights in road_body's frame (road_point, road_normal then unused; null: the plane),
+  // shared by the tires that name the same road; its friction regions scale the law's friction
+  std::shared_ptr<const RoadSurface> road;
+  // magic_formula on a road with friction regions: the .tir parameters with LMUX, LMUY scaled, one
+  // per region of road->friction
+  std::vector<std::shared_ptr<const MagicFormulaParameters>> mf_regions;
   double vertical_stiffness = 0, vertical_damping = 0;    // N/m, N s/m
   double low_speed = 0.1;                                 // m/s
   TireLaw law = TireLaw::Linear;

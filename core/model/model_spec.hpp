@@ -124,12 +124,59 @@ enum class EffectType {
                      // (linear, fiala, magic_formula from a .tir file); docs/tires.md
 };
 
+// A road surface of heights (docs/roads.md; vehicle/road.hpp), in the road body's x, y, z:
+// a grid of heights (a CSV `file` relative to the model file, or the nodes `x`, `y` and the rows
+// `z` inline), per-track profiles (a CSV `file` with s,z or s,left,right, or `s`, `left`, `right`
+// inline; the tracks at `left_y`, `right_y`), or a generated ISO 8608 road of a class.
+struct RoadGridSpec {
+  std::string file;
+  std::vector<double> x, y;
+  Eigen::MatrixXd z;  // rows: y, columns: x
+};
+struct RoadProfileSpec {
+  std::string file;
+  std::vector<double> s, left, right;
+  std::optional<double> left_y, right_y;
+};
+struct RoadIso8608Spec {
+  std::string road_class;                      // "A" .. "H"
+  double length = 0;                           // m
+  std::vector<double> band{0.011, 2.83};       // cycle/m
+  double spacing = 0.05;                       // m
+  double start = 0;                            // m: x of the profile's s = 0
+  int seed = 1;
+  std::optional<double> left_y, right_y;
+};
+// a friction region: a box in the road body's x, y (each bound optional: unbounded) scaling the
+// tire law's friction by `scale`
+struct RoadFrictionSpec {
+  std::vector<double> x, y;  // [min, max] or empty
+  double scale = 1.0;
+};
+
 // A tire's road: the plane through `point` with normal `normal` (both in `body`'s coordinates; the
-// ground by default), the wheel on the side the normal points to.
+// ground by default), the wheel on the side the normal points to; or one surface of heights (grid,
+// profile, iso8608) in `body`'s frame; friction regions on either; or `surface`, the name of a road
+// of the model's `roads` (its surface and regions, in `body`'s frame).
 struct RoadSpec {
   std::string body = kGroundName;
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  std::string surface;
+  std::optional<RoadGridSpec> grid;
+  std::optional<RoadProfileSpec> profile;
+  std::optional<RoadIso8608Spec> iso8608;
+  std::vector<RoadFrictionSpec> friction;
+};
+
+// A road of the model's top-level `roads`, defined once and named by tires (RoadSpec::surface):
+// one surface (grid, profile or iso8608) and friction regions, as a tire's road object holds them.
+struct NamedRoadSpec {
+  std::string name;
+  std::optional<RoadGridSpec> grid;
+  std::optional<RoadProfileSpec> profile;
+  std::optional<RoadIso8608Spec> iso8608;
+  std::vector<RoadFrictionSpec> friction;
 };
 
 // The tire force laws an effect of type tire may name, as written in a model file.
@@ -347,6 +394,7 @@ struct ModelSpec {
   std::vector<EffectSpec> effects;
   std::vector<ActuatorSpec> actuators;
   std::vector<SensorSpec> sensors;
+  std::vector<NamedRoadSpec> roads;  // roads the tires name (docs/roads.md)
   PlantSpec plant;
   ControllerSpec controller;  // type None: no controller
   SolverSpec solver;
