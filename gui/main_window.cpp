@@ -41,6 +41,7 @@
 #include "gui/autosave.hpp"
 #include "gui/control_view.hpp"
 #include "gui/sweep_view.hpp"
+#include "gui/maneuver_view.hpp"
 #include "gui/tire_view.hpp"
 #include "gui/linearize_view.hpp"
 #include "gui/plant_panel.hpp"
@@ -112,6 +113,10 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
   tabs_->addTab(tire_view_, tr("Tire"));
   tabs_->setTabToolTip(4, tr("The tire test rig: Fy, Fx and Mz over the slips at several loads, and combined slip, for a "
                              "tire of the model or a .tir file (codyna tire)"));
+  maneuver_view_ = new ManeuverView(doc_, this);
+  tabs_->addTab(maneuver_view_, tr("Maneuvers"));
+  tabs_->setTabToolTip(5, tr("Standard handling maneuvers on the car: step steer, sine with dwell, swept sine, double "
+                             "lane change, constant radius and constant speed, with their metrics (codyna maneuver)"));
   auto* centre = new QSplitter(Qt::Vertical, this);
   centre->setObjectName("centreSplitter");
   centre->addWidget(top);
@@ -263,6 +268,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
   connect(control_view_, &ControlView::message, this, [this](const QString& m) { message(m); });
   connect(sweep_view_, &SweepView::message, this, [this](const QString& m) { message(m); });
   connect(tire_view_, &TireView::message, this, [this](const QString& m) { message(m); });
+  connect(maneuver_view_, &ManeuverView::message, this, [this](const QString& m) { message(m); });
   connect(props_, &PropertyEditor::varyRequested, this, [this](const QString& pointer) {
     sweep_view_->addField(pointer);
     tabs_->setCurrentWidget(sweep_view_);

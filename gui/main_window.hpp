@@ -42,6 +42,7 @@ class SimulateView;
 class ControlView;
 class SweepView;
 class TireView;
+class ManeuverView;
 class Autosave;
 class IssuesPanel;
 
@@ -63,6 +64,7 @@ class MainWindow : public QMainWindow {
   ControlView* controlView() { return control_view_; }
   SweepView* sweepView() { return sweep_view_; }
   TireView* tireView() { return tire_view_; }
+  ManeuverView* maneuverView() { return maneuver_view_; }
   QTabWidget* analysisTabs() { return tabs_; }
   QPlainTextEdit* messages() { return messages_; }
   IssuesPanel* issuesPanel() { return issues_; }
@@ -154,6 +156,7 @@ class MainWindow : public QMainWindow {
   ControlView* control_view_ = nullptr;
   SweepView* sweep_view_ = nullptr;
   TireView* tire_view_ = nullptr;
+  ManeuverView* maneuver_view_ = nullptr;
   Autosave* autosave_ = nullptr;
   QTabWidget* tabs_;
   QPlainTextEdit* messages_;

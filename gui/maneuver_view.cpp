@@ -1,0 +1,392 @@
+#include "gui/maneuver_view.hpp"
+
+#include <QChart>
+#include <QComboBox>
+#include <QFileInfo>
+#include <QFormLayout>
+#include <QHBoxLayout>
+#include <QLabel>
+#include <QLineEdit>
+#include <QLineSeries>
+#include <QLocale>
+#include <QPlainTextEdit>
+#include <QProgressBar>
+#include <QPushButton>
+#include <QThread>
+#include <QTimer>
+#include <QVBoxLayout>
+#include <QValueAxis>
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include "gui/chart_view.hpp"
+#include "gui/document.hpp"
+#include "gui/result_plots.hpp"
+#include "study/workflow.hpp"
+
+namespace codyna::gui {
+
+namespace {
+
+QString mq(const std::string& s) { return QString::fromStdString(s); }
+
+// a parameter: its flag's name, its label, what an empty field means, the maneuvers it is for
+struct ManeuverField {
+  const char* key;
+  const char* label;
+  const char* empty;
+  QStringList types;
+};
+
+const QList<ManeuverField>& maneuver_fields() {
+  static const QList<ManeuverField> f = {
+      {"speed", "speed (m/s)", "the model's steady speed",
+       {"step-steer", "sine-with-dwell", "swept-sine", "double-lane-change", "constant-speed"}},
+      {"steer", "steer amplitude", "0.01 (sine: 0.05)", {"step-steer", "sine-with-dwell", "swept-sine"}},
+      {"frequency", "frequency (Hz)", "0.7", {"sine-with-dwell"}},
+      {"dwell", "dwell (s)", "0.5", {"sine-with-dwell"}},
+      {"frequency-min", "lowest frequency (Hz)", "0.1", {"swept-sine"}},
+      {"frequency-max", "highest frequency (Hz)", "2", {"swept-sine"}},
+      {"sweep-time", "sweep time (s)", "30", {"swept-sine"}},
+      {"radius", "radius (m, > 0 left)", "required", {"constant-radius"}},
+      {"speed-min", "lowest speed (m/s)", "5", {"constant-radius"}},
+      {"speed-max", "highest speed (m/s)", "the speed of 0.6 g", {"constant-radius"}},
+      {"ay-min", "lowest a_y (m/s^2)", "0.5", {"constant-speed"}},
+      {"ay-max", "highest a_y (m/s^2)", "0.6 g", {"constant-speed"}},
+      {"points", "points", "8 (swept sine: 12)", {"constant-radius", "constant-speed", "swept-sine"}},
+      {"width", "vehicle width (m)", "1.8", {"double-lane-change"}},
+      {"preview", "driver preview (m)", "the model's", {"double-lane-change"}},
+      {"integrator", "integrator", "the model's", {"step-steer", "sine-with-dwell", "swept-sine", "double-lane-change"}},
+      {"free-input", "free inputs", "the model's (a turn: steer,drive)",
+       {"step-steer", "sine-with-dwell", "swept-sine", "constant-radius", "constant-speed"}},
+  };
+  return f;
+}
+
+// a line series on the chart's two axes
+QLineSeries* maneuver_series(QChart* c, const QString& name, const QList<QPointF>& points) {
+  auto* s = new QLineSeries;
+  s->setName(name);
+  s->append(points);
+  c->addSeries(s);
+  s->attachAxis(c->axes(Qt::Horizontal).value(0));
+  s->attachAxis(c->axes(Qt::Vertical).value(0));
+  return s;
+}
+
+void maneuver_axes(QChart* c, const QString& x_title, const QString& y_title) {
+  double xlo = INFINITY, xhi = -INFINITY, ylo = INFINITY, yhi = -INFINITY;
+  for (QAbstractSeries* s : c->series())
+    if (auto* l = qobject_cast<QLineSeries*>(s))
+      for (const QPointF& p : l->points()) {
+        xlo = std::min(xlo, p.x()), xhi = std::max(xhi, p.x());
+        ylo = std::min(ylo, p.y()), yhi = std::max(yhi, p.y());
+      }
+  if (!(xlo < xhi)) xlo -= 1, xhi += 1;
+  if (!(ylo < yhi)) ylo -= 1, yhi += 1;
+  auto* x = qobject_cast<QValueAxis*>(c->axes(Qt::Horizontal).value(0));
+  auto* y = qobject_cast<QValueAxis*>(c->axes(Qt::Vertical).value(0));
+  if (!x || !y) return;
+  x->setTitleText(x_title);
+  y->setTitleText(y_title);
+  const NiceRange rx = niceRange(xlo, xhi, 6), ry = niceRange(ylo, yhi, 6);
+  setAxisRange(x, rx.min, rx.max, rx.step);
+  setAxisRange(y, ry.min, ry.max, ry.step);
+}
+
+}  // namespace
+
+ManeuverView::ManeuverView(Document* doc, QWidget* parent) : QWidget(parent), doc_(doc) {
+  buildUi();
+  timer_ = new QTimer(this);
+  timer_->setInterval(100);
+  connect(timer_, &QTimer::timeout, this, [this] {
+    const double t = t_.load(), te = t_end_.load();
+    if (te > 0) {
+      progress_->setRange(0, 1000);
+      progress_->setValue(static_cast<int>(std::clamp(t / te, 0.0, 1.0) * 1000));
+      progress_->setFormat(tr("t = %1 of %2 s").arg(t, 0, 'f', 2).arg(te, 0, 'f', 2));
+    }
+  });
+  connect(doc_, &Document::replaced, this, [this] {
+    if (running_) drop_result_ = true;  // the running job's result belongs to the old model
+    report_.reset();
+    report_view_->clear();
+    chart_->chart()->removeAllSeries();
+    setStatus(QString(), false);
+  });
+  typeChosen();
+  updateButtons();
+}
+
+ManeuverView::~ManeuverView() {
+  if (thread_) {
+    cancel_.store(true);
+    thread_->wait();  // what it posted to this object is dropped with it
+    delete thread_;
+  }
+}
+
+void ManeuverView::buildUi() {
+  auto* outer = new QHBoxLayout(this);
+  outer->setContentsMargins(4, 4, 4, 4);
+  auto* left = new QVBoxLayout;
+  auto* form = new QFormLayout;
+  type_ = new QComboBox(this);
+  type_->setObjectName("maneuverType");
+  for (const char* t : kManeuverTypes) type_->addItem(mq(t), mq(t));
+  form->addRow(tr("maneuver"), type_);
+  for (const ManeuverField& f : maneuver_fields()) {
+    auto* e = new QLineEdit(this);
+    e->setObjectName(QStringLiteral("maneuver_%1").arg(f.key));
+    e->setPlaceholderText(tr(f.empty));
+    auto* l = new QLabel(tr(f.label), this);
+    l->setBuddy(e);
+    form->addRow(l, e);
+    fields_.insert(f.key, e);
+    labels_.insert(f.key, l);
+  }
+  left->addLayout(form);
+  auto* buttons = new QHBoxLayout;
+  run_ = new QPushButton(tr("Run"), this);
+  run_->setObjectName("maneuverRun");
+  cancel_button_ = new QPushButton(tr("Cancel"), this);
+  cancel_button_->setObjectName("maneuverCancel");
+  buttons->addWidget(run_);
+  buttons->addWidget(cancel_button_);
+  left->addLayout(buttons);
+  progress_ = new QProgressBar(this);
+  progress_->setObjectName("maneuverProgress");
+  progress_->setTextVisible(true);
+  progress_->setFormat(QString());
+  left->addWidget(progress_);
+  status_ = new QLabel(this);
+  status_->setObjectName("maneuverStatus");
+  status_->setWordWrap(true);
+  status_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  left->addWidget(status_);
+  left->addStretch(1);
+  auto* right = new QVBoxLayout;
+  QChart* chart = ChartView::compactChart(QString());
+  chart->addAxis(new QValueAxis, Qt::AlignBottom);
+  chart->addAxis(new QValueAxis, Qt::AlignLeft);
+  chart_ = new ChartView(chart, this);
+  chart_->setObjectName("maneuverChart");
+  chart_->setMinimumHeight(260);
+  report_view_ = new QPlainTextEdit(this);
+  report_view_->setObjectName("maneuverReport");
+  report_view_->setReadOnly(true);
+  report_view_->setLineWrapMode(QPlainTextEdit::NoWrap);
+  QFont mono(QStringLiteral("monospace"));
+  mono.setStyleHint(QFont::Monospace);
+  report_view_->setFont(mono);
+  right->addWidget(chart_, 3);
+  right->addWidget(report_view_, 2);
+  outer->addLayout(left, 0);
+  outer->addLayout(right, 1);
+  connect(type_, &QComboBox::currentIndexChanged, this, [this] { typeChosen(); });
+  connect(run_, &QPushButton::clicked, this, [this] { run(); });
+  connect(cancel_button_, &QPushButton::clicked, this, [this] { cancel(); });
+  for (QLineEdit* e : fields_) connect(e, &QLineEdit::returnPressed, this, [this] { run(); });
+}
+
+void ManeuverView::typeChosen() {
+  const QString t = type_->currentData().toString();
+  for (const ManeuverField& f : maneuver_fields()) {
+    const bool on = f.types.contains(t);
+    fields_[f.key]->setVisible(on);
+    labels_[f.key]->setVisible(on);
+  }
+}
+
+QString ManeuverView::statusText() const { return status_->text(); }
+
+void ManeuverView::setStatus(const QString& text, bool error) {
+  status_->setText(text);
+  status_->setStyleSheet(error ? QStringLiteral("color: #b00020;") : QString());
+}
+
+void ManeuverView::updateButtons() {
+  run_->setEnabled(!running_);
+  cancel_button_->setEnabled(running_);
+  type_->setEnabled(!running_);
+}
+
+// the request of the fields shown; a field that does not read is refused naming its label
+ManeuverRequest ManeuverView::request() const {
+  ManeuverRequest r;
+  r.style = OptionStyle::Keyword;
+  r.type = type_->currentData().toString().toStdString();
+  r.model = doc_->filePath().isEmpty() ? std::string("untitled.json") : doc_->filePath().toStdString();
+  const auto number = [this](const char* key) -> std::optional<double> {
+    const QLineEdit* e = fields_.value(key);
+    if (!e || e->isHidden() || e->text().trimmed().isEmpty()) return std::nullopt;
+    bool ok = false;
+    const double x = QLocale::c().toDouble(e->text().trimmed(), &ok);
+    if (!ok || !std::isfinite(x))
+      throw std::invalid_argument(QStringLiteral("%1: \"%2\" is not a number").arg(QString::fromUtf8(key), e->text()).toStdString());
+    return x;
+  };
+  r.speed = number("speed");
+  r.steer = number("steer");
+  r.frequency = number("frequency");
+  r.dwell = number("dwell");
+  r.frequency_min = number("frequency-min");
+  r.frequency_max = number("frequency-max");
+  r.sweep_time = number("sweep-time");
+  r.radius = number("radius");
+  r.speed_min = number("speed-min");
+  r.speed_max = number("speed-max");
+  r.ay_min = number("ay-min");
+  r.ay_max = number("ay-max");
+  r.width = number("width");
+  r.preview = number("preview");
+  if (const auto p = number("points")) {
+    if (*p != std::floor(*p) || std::abs(*p) > 1e6) throw std::invalid_argument("points: expected a whole number");
+    r.points = static_cast<int>(*p);
+  }
+  const QLineEdit* free = fields_.value("free-input");
+  if (!free->isHidden() && !free->text().trimmed().isEmpty()) {
+    std::vector<std::string> names;
+    for (const QString& n : free->text().split(',', Qt::SkipEmptyParts)) names.push_back(n.trimmed().toStdString());
+    r.free_inputs = names;
+  }
+  const QLineEdit* integ = fields_.value("integrator");
+  if (!integ->isHidden() && !integ->text().trimmed().isEmpty()) r.integrator = integ->text().trimmed().toStdString();
+  return r;
+}
+
+bool ManeuverView::run() {
+  if (running_) return false;
+  ManeuverRequest r;
+  try {
+    r = request();
+  } catch (const std::exception& e) {
+    setStatus(mq(e.what()), true);
+    emit message(tr("Maneuver: %1").arg(mq(e.what())));
+    return false;
+  }
+  if (thread_) {
+    thread_->wait();
+    delete thread_;
+    thread_ = nullptr;
+  }
+  cancel_.store(false);
+  t_.store(0);
+  t_end_.store(0);
+  r.cancel = &cancel_;
+  r.progress = [this](double t, double t_end) {
+    t_.store(t);
+    t_end_.store(t_end);
+  };
+  running_ = true;
+  report_.reset();
+  progress_->setRange(0, 0);  // busy until the run reports its time
+  progress_->setFormat(tr("searching the steady motion..."));
+  setStatus(tr("Running %1...").arg(mq(r.type)), false);
+  updateButtons();
+  const ModelSpec spec = doc_->spec();
+  thread_ = QThread::create([this, r, spec] {
+    QStringList notes;
+    const StudyMessages tell = [&notes](const StudyMessage& m) {
+      notes << (m.kind == StudyMessage::Warning ? QStringLiteral("warning: ") : QString()) + mq(m.text);
+    };
+    std::shared_ptr<const ManeuverReport> rep;
+    QString error;
+    bool cancelled = false;
+    try {
+      rep = std::make_shared<const ManeuverReport>(study_maneuver_job(r, spec, tell));
+    } catch (const StudyCancelled&) {
+      cancelled = true;
+    } catch (const std::exception& e) {
+      error = mq(e.what());
+    } catch (...) {
+      error = QStringLiteral("the maneuver failed (unknown error)");
+    }
+    QMetaObject::invokeMethod(
+        this, [this, rep, error, notes, cancelled] { onFinished(rep, error, notes, cancelled); }, Qt::QueuedConnection);
+  });
+  thread_->setObjectName(QStringLiteral("codyna-maneuver"));
+  timer_->start();
+  thread_->start();
+  return true;
+}
+
+void ManeuverView::cancel() {
+  if (running_) cancel_.store(true);
+}
+
+void ManeuverView::onFinished(std::shared_ptr<const ManeuverReport> report, const QString& error, const QStringList& notes,
+                              bool cancelled) {
+  running_ = false;
+  timer_->stop();
+  progress_->setRange(0, 1);
+  progress_->setValue(cancelled || !error.isEmpty() ? 0 : 1);
+  progress_->setFormat(QString());
+  updateButtons();
+  if (drop_result_) {
+    drop_result_ = false;
+    setStatus(tr("The maneuver of the previous model was stopped"), false);
+    emit finished();
+    return;
+  }
+  for (const QString& n : notes) emit message(tr("Maneuver: %1").arg(n));
+  if (cancelled) {
+    setStatus(tr("Cancelled"), false);
+  } else if (!report) {
+    setStatus(error, true);
+    emit message(tr("Maneuver: %1").arg(error));
+  } else {
+    report_ = std::move(report);
+    report_view_->setPlainText(mq(study_maneuver_text(*report_)));
+    showCurve();
+    if (report_->valid) setStatus(tr("Done"), false);
+    else setStatus(tr("The metrics are invalid: %1").arg(mq(report_->invalid_reason)), true);
+  }
+  emit finished();
+}
+
+void ManeuverView::showCurve() {
+  QChart* c = chart_->chart();
+  c->removeAllSeries();
+  const ManeuverReport& r = *report_;
+  constexpr double deg = 180 / std::numbers::pi;
+  if (r.type == "constant-radius" || r.type == "constant-speed") {
+    QList<QPointF> run, lin;
+    for (std::size_t k = 0; k < r.cr_lateral_acceleration.size(); ++k) {
+      run << QPointF(r.cr_lateral_acceleration[k], r.cr_road_wheel[k] * deg);
+      if (k < r.cr_linear_steer.size() && r.cr_steer[k] != 0)
+        lin << QPointF(r.cr_lateral_acceleration[k], r.cr_linear_steer[k] / r.cr_steer[k] * r.cr_road_wheel[k] * deg);
+    }
+    maneuver_series(c, tr("steady turns"), run);
+    if (!lin.isEmpty()) maneuver_series(c, tr("linear model"), lin);
+    c->setTitle(tr("Understeer diagram"));
+    maneuver_axes(c, tr("lateral acceleration [m/s^2]"), tr("road-wheel angle [deg]"));
+  } else if (r.type == "swept-sine") {
+    QList<QPointF> run, lin;
+    for (std::size_t k = 0; k < r.sw_frequency.size(); ++k) {
+      run << QPointF(r.sw_frequency[k], std::abs(r.sw_yaw[k]));
+      if (k < r.sw_yaw_linear.size()) lin << QPointF(r.sw_frequency[k], std::abs(r.sw_yaw_linear[k]));
+    }
+    maneuver_series(c, tr("run"), run);
+    if (!lin.isEmpty()) maneuver_series(c, tr("linear model"), lin);
+    c->setTitle(tr("Yaw rate per steer"));
+    maneuver_axes(c, tr("frequency [Hz]"), tr("gain [1/s]"));
+  } else {
+    const auto& names = r.result.output_names;
+    const std::string wanted = doc_->spec().analysis.handling.yaw_rate;
+    const auto it = std::find(names.begin(), names.end(), wanted);
+    const int k = it != names.end() ? static_cast<int>(it - names.begin()) : (names.empty() ? -1 : 0);
+    if (k >= 0 && r.result.samples() > 0) {
+      QList<QPointF> pts;
+      for (int i = 0; i < r.result.samples(); ++i) pts << QPointF(r.result.t[static_cast<std::size_t>(i)], r.result.y(i, k));
+      maneuver_series(c, mq(names[static_cast<std::size_t>(k)]), pts);
+    }
+    c->setTitle(tr("Response over time"));
+    maneuver_axes(c, tr("t [s]"), k >= 0 ? mq(names[static_cast<std::size_t>(k)]) : QString());
+  }
+}
+
+}  // namespace codyna::gui

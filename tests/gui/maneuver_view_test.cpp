@@ -1,0 +1,198 @@
+// The Maneuvers tab (gui/maneuver_view.hpp), driven as a person does: the tab clicked, the maneuver
+// picked from its list with the mouse, numbers typed into the fields, Run clicked. What it shows is
+// the job's (study_maneuver_job with the same request): the report's text equal to what codyna
+// maneuver prints, the curve's points equal to the report's numbers. A field that does not read and
+// a refusal of the job are shown naming the field, and nothing runs; Cancel stops a long run (the
+// sedan's swept sine) within a second, the window alive.
+#include <QApplication>
+#include <QChart>
+#include <QComboBox>
+#include <QLabel>
+#include <QLineEdit>
+#include <QLineSeries>
+#include <QPlainTextEdit>
+#include <QPushButton>
+#include <QTabBar>
+#include <QTabWidget>
+#include <QTest>
+#include <cmath>
+#include <numbers>
+
+#include "drive.hpp"
+#include "gui/chart_view.hpp"
+#include "gui/main_window.hpp"
+#include "gui/maneuver_view.hpp"
+#include "study/files.hpp"
+#include "study/maneuver_job.hpp"
+
+using namespace codyna;
+using namespace codyna::gui;
+
+namespace {
+
+const QString kCar = QStringLiteral(CODYNA_EXAMPLES_DIR "/single_track_car.json");
+const QString kSedan = QStringLiteral(CODYNA_EXAMPLES_DIR "/sedan.json");
+
+QLineSeries* maneuver_series_named(ChartView* view, const QString& name) {
+  for (QAbstractSeries* s : view->chart()->series())
+    if (s->name() == name) return qobject_cast<QLineSeries*>(s);
+  return nullptr;
+}
+
+}  // namespace
+
+class ManeuverViewTest : public QObject {
+  Q_OBJECT
+ private:
+  std::unique_ptr<MainWindow> w;
+
+  ManeuverView* view() { return w->maneuverView(); }
+
+  void openTab() {
+    auto* tabs = w->findChild<QTabWidget*>();
+    QVERIFY(tabs);
+    const int i = tabs->indexOf(view());
+    QVERIFY(i >= 0);
+    QTest::mouseClick(tabs->tabBar(), Qt::LeftButton, {}, tabs->tabBar()->tabRect(i).center());
+    QTRY_COMPARE(tabs->currentWidget(), view());
+  }
+
+  void type(const QString& key, const QString& text) {
+    QLineEdit* e = view()->field(key);
+    QVERIFY2(e && e->isVisible(), qPrintable(key));
+    QTest::mouseClick(e, Qt::LeftButton);
+    e->selectAll();
+    QTest::keyClick(e, Qt::Key_Backspace);
+    QTest::keyClicks(e, text);
+  }
+
+  void runAndWait(int ms = 60000) {
+    QTest::mouseClick(view()->runButton(), Qt::LeftButton);
+    QTRY_VERIFY_WITH_TIMEOUT(!view()->isRunning(), ms);
+  }
+
+  // the job run directly with the request the fields mean (the command line's)
+  ManeuverReport job(const QString& file, ManeuverRequest r) {
+    r.model = file.toStdString();
+    return study_maneuver_job(r, study_read_model(r.model));
+  }
+
+ private slots:
+  void init() {
+    w = std::make_unique<MainWindow>();
+    w->resize(1400, 900);
+    w->show();
+    QVERIFY(QTest::qWaitForWindowExposed(w.get()));
+  }
+  void cleanup() { w.reset(); }
+
+  void stepSteerIsTheJobsReport() {
+    QVERIFY(w->openFile(kCar));
+    openTab();
+    QVERIFY(drive::pickWithMouse(view()->typeBox(), "step-steer"));
+    QVERIFY(!view()->field("radius")->isVisible());
+    type("steer", "0.001");
+    runAndWait();
+    QCOMPARE(view()->statusText(), QStringLiteral("Done"));
+    ManeuverRequest r;
+    r.type = "step-steer";
+    r.steer = 0.001;
+    const ManeuverReport rep = job(kCar, r);
+    QCOMPARE(view()->reportView()->toPlainText(), QString::fromStdString(study_maneuver_text(rep)));
+    QLineSeries* s = maneuver_series_named(view()->chartView(), "yaw_rate");
+    QVERIFY(s);
+    QCOMPARE(s->count(), rep.result.samples());
+    for (int i = 0; i < s->count(); i += 97) {
+      QCOMPARE(s->at(i).x(), rep.result.t[static_cast<std::size_t>(i)]);
+      QCOMPARE(s->at(i).y(), rep.result.y(i, 0));
+    }
+  }
+
+  void badFieldsAndRefusalsNameTheField() {
+    QVERIFY(w->openFile(kCar));
+    openTab();
+    QVERIFY(drive::pickWithMouse(view()->typeBox(), "constant-radius"));
+    QVERIFY(view()->field("radius")->isVisible());
+    QVERIFY(!view()->field("steer")->isVisible());
+    runAndWait();  // no radius: the job's refusal
+    QCOMPARE(view()->statusText(), QStringLiteral("radius: the constant-radius maneuver needs a radius (m)"));
+    QVERIFY(!view()->report());
+    type("radius", "12o");
+    QTest::mouseClick(view()->runButton(), Qt::LeftButton);
+    QVERIFY(!view()->isRunning());
+    QCOMPARE(view()->statusText(), QStringLiteral("radius: \"12o\" is not a number"));
+    // then the turns, the free inputs typed as the command line's --free-input
+    type("radius", "500");
+    type("speed-min", "2");
+    type("speed-max", "30");
+    type("points", "4");
+    type("free-input", "steer, drive");
+    runAndWait();
+    QCOMPARE(view()->statusText(), QStringLiteral("Done"));
+    ManeuverRequest r;
+    r.type = "constant-radius";
+    r.radius = 500;
+    r.speed_min = 2;
+    r.speed_max = 30;
+    r.points = 4;
+    r.free_inputs = std::vector<std::string>{"steer", "drive"};
+    const ManeuverReport rep = job(kCar, r);
+    QCOMPARE(view()->reportView()->toPlainText(), QString::fromStdString(study_maneuver_text(rep)));
+    QLineSeries* turns = maneuver_series_named(view()->chartView(), "steady turns");
+    QLineSeries* lin = maneuver_series_named(view()->chartView(), "linear model");
+    QVERIFY(turns && lin);
+    QCOMPARE(turns->count(), 4);
+    QCOMPARE(lin->count(), 4);
+    for (int k = 0; k < 4; ++k) {
+      QCOMPARE(turns->at(k).x(), rep.cr_lateral_acceleration[static_cast<std::size_t>(k)]);
+      QCOMPARE(turns->at(k).y(), rep.cr_road_wheel[static_cast<std::size_t>(k)] * 180 / std::numbers::pi);
+      // the linear model's steer (a ratio of 1 on this car)
+      QVERIFY(std::abs(lin->at(k).y() - rep.cr_linear_steer[static_cast<std::size_t>(k)] * 180 / std::numbers::pi) < 1e-12);
+    }
+  }
+
+  void sweptSineShowsTheGainsBesideTheLinearOnes() {
+    QVERIFY(w->openFile(kCar));
+    openTab();
+    QVERIFY(drive::pickWithMouse(view()->typeBox(), "swept-sine"));
+    type("steer", "0.001");
+    type("points", "6");
+    runAndWait();
+    QCOMPARE(view()->statusText(), QStringLiteral("Done"));
+    ManeuverRequest r;
+    r.type = "swept-sine";
+    r.steer = 0.001;
+    r.points = 6;
+    const ManeuverReport rep = job(kCar, r);
+    QCOMPARE(view()->reportView()->toPlainText(), QString::fromStdString(study_maneuver_text(rep)));
+    QLineSeries* run = maneuver_series_named(view()->chartView(), "run");
+    QLineSeries* lin = maneuver_series_named(view()->chartView(), "linear model");
+    QVERIFY(run && lin);
+    QCOMPARE(run->count(), 6);
+    for (int k = 0; k < 6; ++k) {
+      QCOMPARE(run->at(k).y(), std::abs(rep.sw_yaw[static_cast<std::size_t>(k)]));
+      QVERIFY(std::abs(run->at(k).y() - lin->at(k).y()) < 1e-3 * lin->at(k).y());
+    }
+  }
+
+  void cancelStopsALongRun() {
+    QVERIFY(w->openFile(kSedan));
+    openTab();
+    QVERIFY(drive::pickWithMouse(view()->typeBox(), "swept-sine"));
+    type("steer", "0.02");
+    QTest::mouseClick(view()->runButton(), Qt::LeftButton);
+    QVERIFY(view()->isRunning());
+    QVERIFY(!view()->runButton()->isEnabled());
+    QTest::qWait(1500);  // the run under way
+    QVERIFY(view()->isRunning());
+    QTest::mouseClick(view()->cancelButton(), Qt::LeftButton);
+    QTRY_VERIFY_WITH_TIMEOUT(!view()->isRunning(), 5000);
+    QCOMPARE(view()->statusText(), QStringLiteral("Cancelled"));
+    QVERIFY(!view()->report());
+    QVERIFY(view()->runButton()->isEnabled());
+    QVERIFY(w->isVisible());
+  }
+};
+
+QTEST_MAIN(ManeuverViewTest)
+#include "maneuver_view_test.moc"
