@@ -43,6 +43,7 @@
 #include "gui/property_editor.hpp"
 #include "gui/chart_view.hpp"
 #include "gui/sweep_view.hpp"
+#include "gui/maneuver_view.hpp"
 #include "gui/tire_view.hpp"
 #include "gui/view3d.hpp"
 #include "simulation/result.hpp"
@@ -482,6 +483,29 @@ class MainWindowXvfb : public QObject {
     }
     save(screenOf(&w), "tire_view.png");
     save(screenOfChild(&w, tv), "tire_curves.png");
+    w.document()->undoStack()->setClean();
+  }
+
+  // the Maneuvers tab of issue 40: the sedan's understeer diagram at 25 m/s (constant speed)
+  void maneuverView() {
+    MainWindow w;
+    w.resize(1600, 1000);
+    w.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&w));
+    QVERIFY(w.openFile(QStringLiteral(CODYNA_EXAMPLES_DIR "/sedan.json")));
+    ManeuverView* mv = w.maneuverView();
+    w.analysisTabs()->setCurrentWidget(mv);
+    w.findChild<QSplitter*>("centreSplitter")->setSizes({200, 740});
+    mv->typeBox()->setCurrentIndex(mv->typeBox()->findData(QStringLiteral("constant-speed")));
+    mv->field("ay-min")->setText(QStringLiteral("0.2"));
+    mv->field("ay-max")->setText(QStringLiteral("7"));
+    mv->field("points")->setText(QStringLiteral("12"));
+    QVERIFY(mv->run());
+    QTRY_VERIFY_WITH_TIMEOUT(!mv->isRunning(), 60000);
+    QCOMPARE(mv->statusText(), QStringLiteral("Done"));
+    QTest::qWait(300);
+    QVERIFY2(stats(screenOfChild(&w, mv->chartView())).foreground > 0.003, "the understeer diagram is drawn");
+    save(screenOf(&w), "maneuver_view.png");
     w.document()->undoStack()->setClean();
   }
 };
