@@ -76,26 +76,6 @@ QLineSeries* maneuver_series(QChart* c, const QString& name, const QList<QPointF
   return s;
 }
 
-void maneuver_axes(QChart* c, const QString& x_title, const QString& y_title) {
-  double xlo = INFINITY, xhi = -INFINITY, ylo = INFINITY, yhi = -INFINITY;
-  for (QAbstractSeries* s : c->series())
-    if (auto* l = qobject_cast<QLineSeries*>(s))
-      for (const QPointF& p : l->points()) {
-        xlo = std::min(xlo, p.x()), xhi = std::max(xhi, p.x());
-        ylo = std::min(ylo, p.y()), yhi = std::max(yhi, p.y());
-      }
-  if (!(xlo < xhi)) xlo -= 1, xhi += 1;
-  if (!(ylo < yhi)) ylo -= 1, yhi += 1;
-  auto* x = qobject_cast<QValueAxis*>(c->axes(Qt::Horizontal).value(0));
-  auto* y = qobject_cast<QValueAxis*>(c->axes(Qt::Vertical).value(0));
-  if (!x || !y) return;
-  x->setTitleText(x_title);
-  y->setTitleText(y_title);
-  const NiceRange rx = niceRange(xlo, xhi, 6), ry = niceRange(ylo, yhi, 6);
-  setAxisRange(x, rx.min, rx.max, rx.step);
-  setAxisRange(y, ry.min, ry.max, ry.step);
-}
-
 }  // namespace
 
 ManeuverView::ManeuverView(Document* doc, QWidget* parent) : QWidget(parent), doc_(doc) {
@@ -363,7 +343,7 @@ void ManeuverView::showCurve() {
     maneuver_series(c, tr("steady turns"), run);
     if (!lin.isEmpty()) maneuver_series(c, tr("linear model"), lin);
     c->setTitle(tr("Understeer diagram"));
-    maneuver_axes(c, tr("lateral acceleration [m/s^2]"), tr("road-wheel angle [deg]"));
+    fitAxesToLines(c, tr("lateral acceleration [m/s^2]"), tr("road-wheel angle [deg]"));
   } else if (r.type == "swept-sine") {
     QList<QPointF> run, lin;
     for (std::size_t k = 0; k < r.sw_frequency.size(); ++k) {
@@ -373,7 +353,7 @@ void ManeuverView::showCurve() {
     maneuver_series(c, tr("run"), run);
     if (!lin.isEmpty()) maneuver_series(c, tr("linear model"), lin);
     c->setTitle(tr("Yaw rate per steer"));
-    maneuver_axes(c, tr("frequency [Hz]"), tr("gain [1/s]"));
+    fitAxesToLines(c, tr("frequency [Hz]"), tr("gain [1/s]"));
   } else {
     const auto& names = r.result.output_names;
     const std::string wanted = doc_->spec().analysis.handling.yaw_rate;
@@ -385,7 +365,7 @@ void ManeuverView::showCurve() {
       maneuver_series(c, mq(names[static_cast<std::size_t>(k)]), pts);
     }
     c->setTitle(tr("Response over time"));
-    maneuver_axes(c, tr("t [s]"), k >= 0 ? mq(names[static_cast<std::size_t>(k)]) : QString());
+    fitAxesToLines(c, tr("t [s]"), k >= 0 ? mq(names[static_cast<std::size_t>(k)]) : QString());
   }
 }
 

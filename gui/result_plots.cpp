@@ -64,6 +64,35 @@ void setAxisRange(QValueAxis* axis, double min, double max, double step) {
   axis->setTickInterval(step);
 }
 
+void fitAxesToLines(QChart* c, const QString& x_title, const QString& y_title) {
+  double xlo = INFINITY, xhi = -INFINITY, ylo = INFINITY, yhi = -INFINITY;
+  for (QAbstractSeries* s : c->series())
+    if (auto* l = qobject_cast<QLineSeries*>(s))
+      for (const QPointF& p : l->points()) {
+        xlo = std::min(xlo, p.x()), xhi = std::max(xhi, p.x());
+        ylo = std::min(ylo, p.y()), yhi = std::max(yhi, p.y());
+      }
+  auto* x = qobject_cast<QValueAxis*>(c->axes(Qt::Horizontal).value(0));
+  auto* y = qobject_cast<QValueAxis*>(c->axes(Qt::Vertical).value(0));
+  if (!x || !y) return;
+  x->setTitleText(x_title);
+  y->setTitleText(y_title);
+  if (!(xlo <= xhi)) xlo = -1, xhi = 1;
+  if (!(ylo <= yhi)) ylo = -1, yhi = 1;
+  const NiceRange rx = niceRange(xlo, xhi, 6), ry = niceRange(ylo, yhi, 6);
+  // the ticks' labels with the step's decimals: Qt adds the step to the first tick, so a tick at 0
+  // after -0.3 + 3 x 0.1 is 5.6e-17, which "%g" would print as such
+  for (auto [a, r] : {std::pair{x, rx}, std::pair{y, ry}}) {
+    const double big = std::max(std::abs(r.min), std::abs(r.max));
+    // as many decimals as the step has (0.625: 3), so that no label is rounded
+    int decimals = 0;
+    for (double m = r.step; decimals < 6 && std::abs(m - std::round(m)) > 1e-6 * m; m *= 10) ++decimals;
+    if (r.step >= 1e-4 && big < 1e7) a->setLabelFormat(QStringLiteral("%.%1f").arg(decimals));
+    else a->setLabelFormat("%.4g");
+    setAxisRange(a, r.min, r.max, r.step);
+  }
+}
+
 QString nameWithUnit(const QString& name, const QString& unit) {
   return unit.trimmed().isEmpty() ? name : QStringLiteral("%1 [%2]").arg(name, unit.trimmed());
 }

@@ -49,6 +49,10 @@ NiceRange niceRange(double lo, double hi, int ticks = 5);
 // thousands of tick items).
 void setAxisRange(QValueAxis* axis, double min, double max, double step);
 
+// The chart's first horizontal and vertical value axes titled and ranged about its line series'
+// points (round steps; the labels with the step's decimals).
+void fitAxesToLines(QChart* chart, const QString& x_title, const QString& y_title);
+
 // "theta [rad]", or "theta" when the unit is empty.
 QString nameWithUnit(const QString& name, const QString& unit);
 

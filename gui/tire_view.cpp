@@ -54,33 +54,6 @@ QChart* tire_chart(const QString& title) {
   return c;
 }
 
-// x and y axes' titles, and their ranges around the curves (round steps)
-void tire_fit_axes(QChart* c, const QString& x_title, const QString& y_title) {
-  double xlo = INFINITY, xhi = -INFINITY, ylo = INFINITY, yhi = -INFINITY;
-  for (QAbstractSeries* s : c->series())
-    if (auto* l = qobject_cast<QLineSeries*>(s))
-      for (const QPointF& p : l->points()) {
-        xlo = std::min(xlo, p.x()), xhi = std::max(xhi, p.x());
-        ylo = std::min(ylo, p.y()), yhi = std::max(yhi, p.y());
-      }
-  auto* x = qobject_cast<QValueAxis*>(c->axes(Qt::Horizontal).value(0));
-  auto* y = qobject_cast<QValueAxis*>(c->axes(Qt::Vertical).value(0));
-  if (!x || !y) return;
-  x->setTitleText(x_title);
-  y->setTitleText(y_title);
-  if (!(xlo <= xhi)) xlo = -1, xhi = 1;
-  if (!(ylo <= yhi)) ylo = -1, yhi = 1;
-  const NiceRange rx = niceRange(xlo, xhi, 6), ry = niceRange(ylo, yhi, 6);
-  // the ticks' labels with the step's decimals: Qt adds the step to the first tick, so a tick at 0
-  // after -0.3 + 3 x 0.1 is 5.6e-17, which "%g" would print as such
-  for (auto [a, r] : {std::pair{x, rx}, std::pair{y, ry}}) {
-    const double big = std::max(std::abs(r.min), std::abs(r.max));
-    if (r.step >= 1e-4 && big < 1e7) a->setLabelFormat(QStringLiteral("%.%1f").arg(std::max(0, int(std::ceil(-std::log10(r.step) - 1e-9)))));
-    else a->setLabelFormat("%.4g");
-    setAxisRange(a, r.min, r.max, r.step);
-  }
-}
-
 QLineSeries* tire_series(QChart* c, const QString& name) {
   auto* s = new QLineSeries;
   s->setName(name);
@@ -403,10 +376,10 @@ bool TireView::refresh() {
     s->replace(p);
   }
   combined_->chart()->setTitle(tr("Combined slip at %1, kappa swept").arg(tire_load_text(base.loads[base.loads.size() / 2])));
-  tire_fit_axes(lateral_->chart(), tr("slip angle alpha [deg]"), tr("Fy [N]"));
-  tire_fit_axes(longitudinal_->chart(), tr("longitudinal slip kappa [%]"), tr("Fx [N]"));
-  tire_fit_axes(aligning_->chart(), tr("slip angle alpha [deg]"), tr("Mz [N m]"));
-  tire_fit_axes(combined_->chart(), tr("Fx [N]"), tr("Fy [N]"));
+  fitAxesToLines(lateral_->chart(), tr("slip angle alpha [deg]"), tr("Fy [N]"));
+  fitAxesToLines(longitudinal_->chart(), tr("longitudinal slip kappa [%]"), tr("Fx [N]"));
+  fitAxesToLines(aligning_->chart(), tr("slip angle alpha [deg]"), tr("Mz [N m]"));
+  fitAxesToLines(combined_->chart(), tr("Fx [N]"), tr("Fy [N]"));
   return true;
 }
 
