@@ -14,7 +14,7 @@ struct ManeuverArgs {
   std::string model, type, out, csv, x, y, yaw, speed_output, drive, integrator;
   std::vector<std::string> free_inputs;
   double speed = 0, steer = 0, steer_time = 0, ramp = 0, frequency = 0, dwell = 0, t_end = 0, output_step = 0;
-  double frequency_min = 0, frequency_max = 0, sweep_time = 0, ay_min = 0, ay_max = 0;
+  double steer_scale = 0, frequency_min = 0, frequency_max = 0, sweep_time = 0, ay_min = 0, ay_max = 0;
   double radius = 0, speed_min = 0, speed_max = 0, width = 0, length = 0, preview = 0, lateral_gain = 0;
   double speed_kp = 0, speed_ki = 0, sample_time = 0;
   int points = 0;
@@ -35,6 +35,7 @@ void run_maneuver(const ManeuverArgs& a, const CLI::App* cmd) {
   num("--ramp", a.ramp, r.ramp);
   num("--frequency", a.frequency, r.frequency);
   num("--dwell", a.dwell, r.dwell);
+  num("--steer-scale", a.steer_scale, r.steer_scale);
   num("--frequency-min", a.frequency_min, r.frequency_min);
   num("--frequency-max", a.frequency_max, r.frequency_max);
   num("--sweep-time", a.sweep_time, r.sweep_time);
@@ -81,6 +82,7 @@ void add_maneuver(CLI::App& app) {
   cmd->add_option("--ramp", a->ramp, "s, the step's ramp (half cosine; default 0.05)");
   cmd->add_option("--frequency", a->frequency, "Hz, sine with dwell (default 0.7)");
   cmd->add_option("--dwell", a->dwell, "s, sine with dwell (default 0.5)");
+  cmd->add_option("--steer-scale", a->steer_scale, "sine with dwell: the amplitude as a multiple of the steady steer at 0.3 g (FMVSS 126: 5 .. 6.5)");
   cmd->add_option("--frequency-min", a->frequency_min, "Hz, swept sine's first frequency (default 0.1)");
   cmd->add_option("--frequency-max", a->frequency_max, "Hz, swept sine's last (default 2)");
   cmd->add_option("--sweep-time", a->sweep_time, "s, swept sine's sweep (default 30; 5 s at rest follow)");

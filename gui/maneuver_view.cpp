@@ -45,6 +45,7 @@ const QList<ManeuverField>& maneuver_fields() {
       {"speed", "speed (m/s)", "the model's steady speed",
        {"step-steer", "sine-with-dwell", "swept-sine", "double-lane-change", "constant-speed"}},
       {"steer", "steer amplitude", "0.01 (sine: 0.05)", {"step-steer", "sine-with-dwell", "swept-sine"}},
+      {"steer-scale", "or x steer at 0.3 g", "FMVSS 126: 1.5 .. 6.5", {"sine-with-dwell"}},
       {"frequency", "frequency (Hz)", "0.7", {"sine-with-dwell"}},
       {"dwell", "dwell (s)", "0.5", {"sine-with-dwell"}},
       {"frequency-min", "lowest frequency (Hz)", "0.1", {"swept-sine"}},
@@ -213,6 +214,7 @@ ManeuverRequest ManeuverView::request() const {
   r.steer = number("steer");
   r.frequency = number("frequency");
   r.dwell = number("dwell");
+  r.steer_scale = number("steer-scale");
   r.frequency_min = number("frequency-min");
   r.frequency_max = number("frequency-max");
   r.sweep_time = number("sweep-time");

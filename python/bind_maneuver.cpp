@@ -39,6 +39,7 @@ py::dict do_maneuver(const Study& s, const py::dict& options) {
   r.ramp = k.number("ramp");
   r.frequency = k.number("frequency");
   r.dwell = k.number("dwell");
+  r.steer_scale = k.number("steer_scale");
   r.frequency_min = k.number("frequency_min");
   r.frequency_max = k.number("frequency_max");
   r.sweep_time = k.number("sweep_time");
@@ -82,6 +83,8 @@ py::dict do_maneuver(const Study& s, const py::dict& options) {
     d["yaw_rate_ratio_1_75"] = rep.sine.yrr_1_75;
     d["lateral_displacement"] = rep.sine.lateral_displacement;
     d["passes_fmvss126"] = rep.sine.passes_fmvss126;
+    d["steer_at_0_3g"] = rep.steer_03g;
+    d["displacement_applies"] = rep.displacement_applies;
   } else if (rep.type == "swept-sine") {
     d["frequency_hz"] = vector_of(rep.sw_frequency);
     d["input_share"] = vector_of(rep.sw_input_share);

@@ -156,6 +156,15 @@ OpenLoop open_loop_setup(const ManeuverRequest& r, const ModelSpec& spec) {
   return ol;
 }
 
+double steady_steer_at(const ManeuverRequest& r, const ModelSpec& spec, const OpenLoop& ol, double a_y) {
+  ModelSpec s = straight_spec(r, spec);
+  s.analysis.steady.speed = ol.start.speed_along_heading;
+  s.analysis.steady.lateral_acceleration = a_y;
+  const Model m = study_model(s, r.model);
+  const OperatingPoint op = study_operating_point(m, "steady");
+  return op.u[ol.steer] - ol.op.u[ol.steer];
+}
+
 Model open_loop_run(ManeuverReport& rep, const ManeuverRequest& r, const OpenLoop& ol, const SteerProfile& profile,
                     const std::vector<double>& stops, double t_end) {
   const Flags flag{r.style};

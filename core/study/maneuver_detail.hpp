@@ -65,6 +65,10 @@ struct OpenLoop {
   BodyState start;
 };
 OpenLoop open_loop_setup(const ManeuverRequest& r, const ModelSpec& spec);
+// The steer (less the straight run's) of the steady turn at lateral acceleration a_y (m/s^2, > 0
+// left) at the straight run's speed, by the steady-motion search with the study's free inputs;
+// throws what the search throws.
+double steady_steer_at(const ManeuverRequest& r, const ModelSpec& spec, const OpenLoop& ol, double a_y);
 // Runs it to t_end with the steer's deviation from the steady run following `profile` (its rate
 // and acceleration exact: a motion input takes it), stopping at `stops` (where the steer's
 // acceleration jumps); fills rep.result, checks it (check_run), end_speed, end_yaw_rate. Returns

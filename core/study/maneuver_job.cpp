@@ -56,6 +56,19 @@ mnv::SteerProfile mnv_sine_dwell(double amplitude, double t0, double f, double d
   return p;
 }
 
+// FMVSS 126's reference steer: the steady turns' at 0.3 g at the run's speed, left and right
+// averaged (the standard finds it in slowly increasing steer, both ways; the steady search is that
+// test's limit)
+void mnv_steer_03g(ManeuverReport& rep, const ManeuverRequest& r, const ModelSpec& spec, const mnv::OpenLoop& ol) {
+  const double g03 = 0.3 * 9.80665;
+  try {
+    rep.steer_03g = 0.5 * (std::abs(mnv::steady_steer_at(r, spec, ol, g03)) + std::abs(mnv::steady_steer_at(r, spec, ol, -g03)));
+  } catch (const std::exception& e) {
+    rep.notes.push_back(std::string("no steer at 0.3 g (the steady turn at the run's speed): ") + e.what() +
+                        "; the lateral displacement is asked at any amplitude");
+  }
+}
+
 ManeuverReport mnv_open_loop(const ManeuverRequest& r, const ModelSpec& spec, bool sine) {
   const mnv::Flags flag{r.style};
   ManeuverReport rep;
@@ -66,7 +79,16 @@ ManeuverReport mnv_open_loop(const ManeuverRequest& r, const ModelSpec& spec, bo
   const int iy = ol.yaw_rate, ia = ol.lateral_acceleration;
   const mnv::BodyState& s0 = ol.start;
 
-  const double amplitude = r.steer ? *r.steer : (sine ? 0.05 : 0.01);
+  if (sine) mnv_steer_03g(rep, r, spec, ol);
+  double amplitude = r.steer ? *r.steer : (sine ? 0.05 : 0.01);
+  if (sine && r.steer_scale) {
+    if (r.steer) throw std::invalid_argument(flag("steer-scale") + ": give the amplitude or its scale, not both (" + flag("steer") + ")");
+    if (!std::isfinite(*r.steer_scale) || *r.steer_scale == 0)
+      throw std::invalid_argument(flag("steer-scale") + ": expected a multiple of the steer at 0.3 g other than 0");
+    if (!std::isfinite(rep.steer_03g))
+      throw std::invalid_argument(flag("steer-scale") + ": " + rep.notes.back());
+    amplitude = *r.steer_scale * rep.steer_03g;
+  }
   if (!std::isfinite(amplitude) || amplitude == 0)
     throw std::invalid_argument(flag("steer") + ": expected a steer amplitude other than 0");
   rep.steer = amplitude;
@@ -114,6 +136,10 @@ ManeuverReport mnv_open_loop(const ManeuverRequest& r, const ModelSpec& spec, bo
         // FMVSS 126: the peak after the steer changes sign (its second half wave's direction)
         rep.sine = sine_with_dwell_metrics(rep.result.t, yaw, lateral, rep.steer_start, rep.steer_end, -amplitude,
                                            rep.steer_start + 0.5 / mnv::positive(flag, r.frequency, 0.7, "frequency"));
+        // FMVSS 126 S5.2.3: the displacement only of runs at 5 x the steer at 0.3 g or more
+        rep.displacement_applies = !std::isfinite(rep.steer_03g) || std::abs(amplitude) >= 5 * rep.steer_03g * (1 - 1e-12);
+        rep.sine.passes_fmvss126 = rep.sine.yrr_1_00 <= 35.0 && rep.sine.yrr_1_75 <= 20.0 &&
+                                   (!rep.displacement_applies || std::abs(rep.sine.lateral_displacement) >= 1.83);
       } catch (const std::invalid_argument& e) {
         rep.valid = false;
         if (rep.invalid_reason.empty()) rep.invalid_reason = e.what();
@@ -471,8 +497,12 @@ std::string study_maneuver_text(const ManeuverReport& r) {
        << "yaw-rate peak (2nd half)    " << r.sine.peak_yaw_rate << " rad/s at " << r.sine.peak_time << " s\n"
        << "yaw-rate ratio at 1.00 s    " << r.sine.yrr_1_00 << " % (FMVSS 126: at most 35 %)\n"
        << "yaw-rate ratio at 1.75 s    " << r.sine.yrr_1_75 << " % (at most 20 %)\n"
-       << "lateral displacement        " << r.sine.lateral_displacement << " m at 1.07 s (at least 1.83 m)\n"
-       << "FMVSS 126                   " << (r.sine.passes_fmvss126 ? "passes" : "fails") << "\n";
+       << "lateral displacement        " << r.sine.lateral_displacement << " m at 1.07 s (at least 1.83 m"
+       << (r.displacement_applies ? "" : "; not asked below 5 x the steer at 0.3 g") << ")\n";
+    if (std::isfinite(r.steer_03g))
+      os << "steer at 0.3 g              " << r.steer_03g << " (steady turns, left and right); amplitude "
+         << std::abs(r.steer) / r.steer_03g << " x\n";
+    os << "FMVSS 126                   " << (r.sine.passes_fmvss126 ? "passes" : "fails") << "\n";
   } else if (r.type == "swept-sine") {
     mnv_swept_text(os, r);
   } else if (r.type == "double-lane-change") {

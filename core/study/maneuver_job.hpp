@@ -40,6 +40,7 @@
 #pragma once
 
 #include <atomic>
+#include <cmath>
 #include <complex>
 #include <functional>
 #include <optional>
@@ -64,6 +65,9 @@ struct ManeuverRequest {
   std::optional<double> steer;                 // steer input amplitude (step, sine)
   std::optional<double> steer_time, ramp;      // s: when the steer starts (default 0.5), its ramp (0.05)
   std::optional<double> frequency, dwell;      // sine with dwell: Hz (0.7), s (0.5)
+  // sine with dwell: the amplitude as a multiple of the steer of the steady turn at 0.3 g at the
+  // run's speed (FMVSS 126's 5 .. 6.5 x delta_0.3g); not with steer
+  std::optional<double> steer_scale;
   std::optional<double> frequency_min, frequency_max, sweep_time;  // swept sine: Hz (0.1, 2), s (30)
   std::optional<double> t_end, output_step;    // s
   std::optional<std::string> integrator;       // the runs' (default the model file's solver)
@@ -98,6 +102,11 @@ struct ManeuverReport {
   bool has_lateral_acceleration = false;
   // sine with dwell
   SineWithDwellMetrics sine;
+  // the steer (from the straight run's) of the steady turn at 0.3 g at the run's speed, turning the
+  // way the sine starts (NaN: not found; a note says why); FMVSS 126 asks the lateral displacement
+  // only of runs at 5 times it or more (sine.passes_fmvss126 then counts it, else not)
+  double steer_03g = std::nan("");
+  bool displacement_applies = true;
   double steer_start = 0, steer_end = 0;
   // double lane change
   PathErrorMetrics path;

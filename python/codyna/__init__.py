@@ -218,7 +218,7 @@ class Study:
 
         type: "step-steer", "sine-with-dwell", "swept-sine", "double-lane-change",
         "constant-radius" or "constant-speed"; the keywords are codyna maneuver's flags with underscores (speed, steer,
-        steer_time, ramp, frequency, dwell, frequency_min, frequency_max, sweep_time, t_end,
+        steer_time, ramp, frequency, dwell, steer_scale, frequency_min, frequency_max, sweep_time, t_end,
         output_step, radius, speed_min, speed_max, ay_min, ay_max, points, width, length, preview, lateral_gain,
         speed_kp, speed_ki, sample_time, x, y, yaw, speed_output, drive, integrator, free_inputs,
         out, csv). Returns a dict: the metrics, "valid" and "invalid_reason", "text" (the command's

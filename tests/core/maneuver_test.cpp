@@ -400,6 +400,42 @@ TEST(Maneuver, ConstantSpeedGradientIsTheHandlingNumber) {
             "--ay-max: expected a lateral acceleration beyond --ay-min, on its side");
 }
 
+// FMVSS 126's amplitudes are multiples of the steer at 0.3 g: the sedan's is the steady turns' at
+// +-0.3 g at the run's speed (the search directly, averaged), the amplitude that times the scale;
+// at 1 x the lateral displacement is not asked (the verdict counts the yaw-rate ratios only)
+TEST(Maneuver, SineWithDwellScalesItsAmplitudeByTheSteerAtPoint3g) {
+  const std::string file = maneuver_example("sedan.json");
+  const ModelSpec spec = study_read_model(file);
+  ManeuverRequest r;
+  r.model = file;
+  r.type = "sine-with-dwell";
+  r.speed = 22.2;
+  r.steer_scale = 1;
+  r.integrator = "cvode-bdf";
+  const ManeuverReport rep = study_maneuver_job(r, spec);
+  ASSERT_TRUE(rep.valid) << rep.invalid_reason;
+  double turns[2];
+  for (int k = 0; k < 2; ++k) {
+    ModelSpec s = spec;
+    s.analysis.operating_point = "steady";
+    s.analysis.steady.speed = 22.2;
+    s.analysis.steady.lateral_acceleration = (k == 0 ? 1 : -1) * 0.3 * 9.80665;
+    ModelSpec straight = spec;
+    straight.analysis.steady.speed = 22.2;
+    const double s0 = study_operating_point(study_model(straight, file), "steady").u[0];
+    turns[k] = std::abs(study_operating_point(study_model(s, file), "steady").u[0] - s0);
+  }
+  EXPECT_NEAR(rep.steer_03g, 0.5 * (turns[0] + turns[1]), 1e-6 * rep.steer_03g);
+  EXPECT_NEAR(turns[0], turns[1], 0.01 * turns[0]);  // nearly symmetric
+  EXPECT_EQ(rep.steer, rep.steer_03g);
+  EXPECT_FALSE(rep.displacement_applies);
+  EXPECT_LT(std::abs(rep.sine.lateral_displacement), 1.83);  // small at 1 x, and not asked
+  EXPECT_EQ(rep.sine.passes_fmvss126, rep.sine.yrr_1_00 <= 35 && rep.sine.yrr_1_75 <= 20);
+  r.steer = 1;
+  EXPECT_EQ(maneuver_error([&] { study_maneuver_job(r, spec); }),
+            "--steer-scale: give the amplitude or its scale, not both (--steer)");
+}
+
 TEST(Maneuver, BadInputIsRefusedNamingTheFieldOrFlag) {
   const std::string file = maneuver_example("single_track_car.json");
   const ModelSpec spec = study_read_model(file);
