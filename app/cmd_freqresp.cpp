@@ -12,7 +12,7 @@ namespace codyna::cli {
 namespace {
 
 struct FreqRespArgs {
-  std::string model, csv, frequencies, controller, integrator;
+  std::string model, csv, out, frequencies, controller, integrator;
   std::vector<double> amplitudes;
   bool open_loop = false;
   LqrFlags lqr;
@@ -44,6 +44,7 @@ void run_freqresp(const FreqRespArgs& a) {
   r.samples_per_period = a.samples_per_period;
   r.harmonics = a.harmonics;
   r.csv = a.csv;
+  r.out = a.out;
   const ModelSpec spec = load_spec(a.model);
   const FreqRespJob job = study_freqresp_job(r, spec, {}, print_message);
   std::cout << study_freqresp_text(job);
@@ -64,6 +65,7 @@ void add_freqresp(CLI::App& app) {
   cmd->add_option("--samples-per-period", a->samples_per_period, "output samples per period")->capture_default_str();
   cmd->add_option("--harmonics", a->harmonics, "harmonics fitted (the first is the response)")->capture_default_str();
   cmd->add_option("--csv", a->csv, "write the table as CSV");
+  cmd->add_option("--out", a->out, "write the responses as HDF5 (G, the linear G, gaps, distortion per frequency)");
   cmd->add_option("--controller", a->controller, "controller .mat (default: the model file's controller, if any)");
   cmd->add_flag("--open-loop", a->open_loop, "ignore the model's controller: the plant alone (it must be stable)");
   add_lqr_flags(cmd, a->lqr, "close the loop with an LQR designed on the linearized plant (an unstable plant's response is measured in closed loop)",

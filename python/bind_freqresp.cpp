@@ -57,6 +57,7 @@ py::dict do_freqresp(const Study& s, const py::dict& options) {
   if (const auto n = k.whole("samples_per_period", 1, 1000000)) r.samples_per_period = static_cast<int>(*n);
   if (const auto n = k.whole("harmonics", 1, 1000)) r.harmonics = static_cast<int>(*n);
   r.csv = k.path("csv").value_or("");
+  r.out = k.path("out").value_or("");
   k.finish();
   FreqRespJob job;
   {

@@ -30,6 +30,7 @@
 #include "io/atomic_file.hpp"
 #include "io/hdf5_handle.hpp"
 #include "io/hdf5_quiet.hpp"
+#include "io/hdf5_write.hpp"
 #include "io/mat_export.hpp"
 #include "io/output_guard.hpp"
 
@@ -242,72 +243,6 @@ namespace {
 
 using FileError = Hdf5Error;
 using Handle = Hdf5Handle;
-void check(herr_t rc, const std::string& what) { hdf5_check(rc, what); }
-
-// no modification times in the object headers: the same study gives the same bytes
-Handle untimed(hid_t cls, const std::string& what) {
-  Handle p(H5Pcreate(cls), H5Pclose, what);
-  check(H5Pset_obj_track_times(p, 0), what);
-  return p;
-}
-
-void create_group(hid_t file, const std::string& name) {
-  const std::string what = "cannot create group " + name;
-  const Handle gcpl = untimed(H5P_GROUP_CREATE, what);
-  Handle g(H5Gcreate2(file, name.c_str(), H5P_DEFAULT, gcpl, H5P_DEFAULT), H5Gclose, what);
-}
-
-void write_dataset(hid_t file, const std::string& name, hid_t file_type, hid_t memory_type, const std::vector<hsize_t>& dims,
-                   const void* data) {
-  const std::string what = "cannot write " + name;
-  Handle space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), H5Sclose, what);
-  const Handle dcpl = untimed(H5P_DATASET_CREATE, what);
-  Handle d(H5Dcreate2(file, name.c_str(), file_type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT), H5Dclose, what);
-  std::size_t count = 1;
-  for (hsize_t x : dims) count *= static_cast<std::size_t>(x);
-  if (count > 0) check(H5Dwrite(d, memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), what);
-}
-
-void write_doubles(hid_t file, const std::string& name, const std::vector<hsize_t>& dims, const std::vector<double>& v) {
-  write_dataset(file, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, dims, v.data());
-}
-
-void write_ints(hid_t file, const std::string& name, const std::vector<int>& v) {
-  write_dataset(file, name, H5T_STD_I32LE, H5T_NATIVE_INT, {v.size()}, v.data());
-}
-
-void write_strings(hid_t file, const std::string& name, const std::vector<std::string>& list) {
-  std::size_t width = 1;
-  for (const std::string& s : list) width = std::max(width, s.size());
-  std::vector<char> packed(list.size() * width, '\0');
-  for (std::size_t i = 0; i < list.size(); ++i) std::memcpy(packed.data() + i * width, list[i].data(), list[i].size());
-  const std::string what = "cannot write " + name;
-  Handle type(H5Tcopy(H5T_C_S1), H5Tclose, what);
-  check(H5Tset_size(type, width), what);
-  check(H5Tset_strpad(type, H5T_STR_NULLPAD), what);
-  write_dataset(file, name, type, type, {list.size()}, packed.data());
-}
-
-void write_attribute(hid_t file, const char* object, const char* name, hid_t ftype, hid_t mtype, const void* value) {
-  const std::string what = std::string("cannot write attribute ") + name + " of " + object;
-  Handle space(H5Screate(H5S_SCALAR), H5Sclose, what);
-  Handle a(H5Acreate_by_name(file, object, name, ftype, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Aclose, what);
-  check(H5Awrite(a, mtype, value), what);
-}
-void write_attribute(hid_t file, const char* object, const char* name, const std::string& value) {
-  const std::string what = std::string("cannot write attribute ") + name;
-  Handle type(H5Tcopy(H5T_C_S1), H5Tclose, what);
-  check(H5Tset_size(type, H5T_VARIABLE), what);
-  check(H5Tset_cset(type, H5T_CSET_UTF8), what);
-  const char* text = value.c_str();
-  write_attribute(file, object, name, type, type, &text);
-}
-void write_attribute(hid_t file, const char* object, const char* name, long long value) {
-  write_attribute(file, object, name, H5T_STD_I64LE, H5T_NATIVE_LLONG, &value);
-}
-void write_attribute_u64(hid_t file, const char* object, const char* name, std::uint64_t value) {
-  write_attribute(file, object, name, H5T_STD_U64LE, H5T_NATIVE_UINT64, &value);
-}
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
@@ -348,9 +283,9 @@ void write_poles(hid_t file, const std::string& group, const std::vector<SweepVa
     }
     mr[i] = vs[i].*maxr;
   }
-  write_doubles(file, group + "/poles_real", {vs.size(), static_cast<hsize_t>(n)}, re);
-  write_doubles(file, group + "/poles_imag", {vs.size(), static_cast<hsize_t>(n)}, im);
-  write_doubles(file, group + "/max_real", {vs.size()}, mr);
+  h5::write_doubles(file, group + "/poles_real", {vs.size(), static_cast<hsize_t>(n)}, re);
+  h5::write_doubles(file, group + "/poles_imag", {vs.size(), static_cast<hsize_t>(n)}, im);
+  h5::write_doubles(file, group + "/max_real", {vs.size()}, mr);
 }
 
 void write_contents(hid_t file, const SweepJob& job) {
@@ -358,20 +293,20 @@ void write_contents(hid_t file, const SweepJob& job) {
   const std::size_t n = vs.size(), nv = job.plan.vary.size();
   const Eigen::Index nx = static_cast<Eigen::Index>(job.state_names.size()), nu = static_cast<Eigen::Index>(job.input_names.size()),
                      ny = static_cast<Eigen::Index>(job.output_names.size());
-  write_attribute(file, "/", "format", std::string("codyna sweep"));
-  write_attribute(file, "/", "format_version", static_cast<long long>(kFormatVersion));
-  write_attribute(file, "/", "model_file", job.model_file);
-  write_attribute(file, "/", "model_name", job.model_name);
-  write_attribute(file, "/", "codyna_version", std::string(CODYNA_VERSION));
-  write_attribute(file, "/", "design", std::string(job.plan.random ? "random" : "grid"));
-  write_attribute(file, "/", "variants", static_cast<long long>(n));
-  if (job.plan.random) write_attribute_u64(file, "/", "seed", job.plan.seed);
-  write_attribute(file, "/", "operating_point", job.operating_point);
-  write_attribute(file, "/", "method", job.method);
-  write_attribute(file, "/", "controller", job.controller);
-  write_attribute(file, "/", "gain", std::string(!job.closed_loop ? "none" : job.redesigned ? "redesigned" : "fixed"));
+  h5::write_attribute(file, "/", "format", std::string("codyna sweep"));
+  h5::write_attribute(file, "/", "format_version", static_cast<long long>(kFormatVersion));
+  h5::write_attribute(file, "/", "model_file", job.model_file);
+  h5::write_attribute(file, "/", "model_name", job.model_name);
+  h5::write_attribute(file, "/", "codyna_version", std::string(CODYNA_VERSION));
+  h5::write_attribute(file, "/", "design", std::string(job.plan.random ? "random" : "grid"));
+  h5::write_attribute(file, "/", "variants", static_cast<long long>(n));
+  if (job.plan.random) h5::write_attribute_u64(file, "/", "seed", job.plan.seed);
+  h5::write_attribute(file, "/", "operating_point", job.operating_point);
+  h5::write_attribute(file, "/", "method", job.method);
+  h5::write_attribute(file, "/", "controller", job.controller);
+  h5::write_attribute(file, "/", "gain", std::string(!job.closed_loop ? "none" : job.redesigned ? "redesigned" : "fixed"));
 
-  create_group(file, "/parameters");
+  h5::create_group(file, "/parameters");
   std::vector<std::string> fields, specs;
   std::vector<double> nominal, values(n * nv, kNaN);
   for (const SweepVary& v : job.plan.vary) {
@@ -381,44 +316,44 @@ void write_contents(hid_t file, const SweepJob& job) {
   }
   for (std::size_t i = 0; i < n; ++i)
     for (std::size_t k = 0; k < nv && k < vs[i].values.size(); ++k) values[i * nv + k] = vs[i].values[k];
-  write_doubles(file, "/parameters/values", {n, nv}, values);
-  write_strings(file, "/parameters/fields", fields);
-  write_strings(file, "/parameters/specs", specs);
-  write_doubles(file, "/parameters/nominal", {nv}, nominal);
+  h5::write_doubles(file, "/parameters/values", {n, nv}, values);
+  h5::write_strings(file, "/parameters/fields", fields);
+  h5::write_strings(file, "/parameters/specs", specs);
+  h5::write_doubles(file, "/parameters/nominal", {nv}, nominal);
 
-  create_group(file, "/status");
+  h5::create_group(file, "/status");
   std::vector<int> codes;
   std::vector<std::string> reasons;
   for (const SweepVariant& v : vs) {
     codes.push_back(static_cast<int>(v.status));
     reasons.push_back(v.reason);
   }
-  write_ints(file, "/status/code", codes);
-  write_strings(file, "/status/reason", reasons);
-  write_attribute(file, "/status", "codes",
+  h5::write_ints(file, "/status/code", codes);
+  h5::write_strings(file, "/status/reason", reasons);
+  h5::write_attribute(file, "/status", "codes",
                   std::string("0 ok, 1 model error, 2 not converged, 3 refused, 4 failed, 5 sizes differ"));
 
-  create_group(file, "/names");
-  write_strings(file, "/names/states", job.state_names);
-  write_strings(file, "/names/inputs", job.input_names);
-  write_strings(file, "/names/outputs", job.output_names);
+  h5::create_group(file, "/names");
+  h5::write_strings(file, "/names/states", job.state_names);
+  h5::write_strings(file, "/names/inputs", job.input_names);
+  h5::write_strings(file, "/names/outputs", job.output_names);
 
-  create_group(file, "/linear");
-  write_doubles(file, "/linear/A", {n, static_cast<hsize_t>(nx), static_cast<hsize_t>(nx)}, stack(vs, &SweepVariant::A, nx, nx));
-  write_doubles(file, "/linear/B", {n, static_cast<hsize_t>(nx), static_cast<hsize_t>(nu)}, stack(vs, &SweepVariant::B, nx, nu));
-  write_doubles(file, "/linear/C", {n, static_cast<hsize_t>(ny), static_cast<hsize_t>(nx)}, stack(vs, &SweepVariant::C, ny, nx));
-  write_doubles(file, "/linear/D", {n, static_cast<hsize_t>(ny), static_cast<hsize_t>(nu)}, stack(vs, &SweepVariant::D, ny, nu));
+  h5::create_group(file, "/linear");
+  h5::write_doubles(file, "/linear/A", {n, static_cast<hsize_t>(nx), static_cast<hsize_t>(nx)}, stack(vs, &SweepVariant::A, nx, nx));
+  h5::write_doubles(file, "/linear/B", {n, static_cast<hsize_t>(nx), static_cast<hsize_t>(nu)}, stack(vs, &SweepVariant::B, nx, nu));
+  h5::write_doubles(file, "/linear/C", {n, static_cast<hsize_t>(ny), static_cast<hsize_t>(nx)}, stack(vs, &SweepVariant::C, ny, nx));
+  h5::write_doubles(file, "/linear/D", {n, static_cast<hsize_t>(ny), static_cast<hsize_t>(nu)}, stack(vs, &SweepVariant::D, ny, nu));
 
-  create_group(file, "/open_loop");
+  h5::create_group(file, "/open_loop");
   write_poles(file, "/open_loop", vs, &SweepVariant::open_poles, &SweepVariant::open_max_real, nx);
   std::vector<int> unc, stable;
   for (const SweepVariant& v : vs) {
     unc.push_back(v.status == SweepStatus::Ok ? v.uncontrollable : -1);
     stable.push_back(v.stable ? 1 : 0);
   }
-  write_ints(file, "/open_loop/uncontrollable", unc);
+  h5::write_ints(file, "/open_loop/uncontrollable", unc);
   if (job.simulated) {
-    create_group(file, "/simulation");
+    h5::create_group(file, "/simulation");
     std::vector<int> st;
     std::vector<std::string> why;
     std::vector<double> reached(n, kNaN), err(n, kNaN);
@@ -431,33 +366,33 @@ void write_contents(hid_t file, const SweepJob& job) {
         err[i] = v.final_error;
       }
     }
-    write_ints(file, "/simulation/status", st);
-    write_strings(file, "/simulation/reason", why);
-    write_doubles(file, "/simulation/t_reached", {n}, reached);
-    write_doubles(file, "/simulation/peak_input", {n, static_cast<hsize_t>(nu)}, rows(vs, &SweepVariant::peak_input, nu));
-    write_doubles(file, "/simulation/final_error", {n}, err);
-    write_doubles(file, "/simulation/overshoot", {n, static_cast<hsize_t>(ny)}, rows(vs, &SweepVariant::overshoot, ny));
-    write_doubles(file, "/simulation/settling_time", {n, static_cast<hsize_t>(ny)}, rows(vs, &SweepVariant::settling_time, ny));
-    write_doubles(file, "/simulation/saturation_time", {n, static_cast<hsize_t>(nu)},
+    h5::write_ints(file, "/simulation/status", st);
+    h5::write_strings(file, "/simulation/reason", why);
+    h5::write_doubles(file, "/simulation/t_reached", {n}, reached);
+    h5::write_doubles(file, "/simulation/peak_input", {n, static_cast<hsize_t>(nu)}, rows(vs, &SweepVariant::peak_input, nu));
+    h5::write_doubles(file, "/simulation/final_error", {n}, err);
+    h5::write_doubles(file, "/simulation/overshoot", {n, static_cast<hsize_t>(ny)}, rows(vs, &SweepVariant::overshoot, ny));
+    h5::write_doubles(file, "/simulation/settling_time", {n, static_cast<hsize_t>(ny)}, rows(vs, &SweepVariant::settling_time, ny));
+    h5::write_doubles(file, "/simulation/saturation_time", {n, static_cast<hsize_t>(nu)},
                   rows(vs, &SweepVariant::saturation_time, nu));
-    write_attribute(file, "/simulation", "status_codes",
+    h5::write_attribute(file, "/simulation", "status_codes",
                     std::string("-1 not run (the variant failed), 0 reached t_end, 1 the run failed, 2 it could not be set up"));
   }
   if (!job.closed_loop) {
-    write_ints(file, "/open_loop/stable", stable);
+    h5::write_ints(file, "/open_loop/stable", stable);
     return;
   }
-  create_group(file, "/closed_loop");
+  h5::create_group(file, "/closed_loop");
   if (job.redesigned) {
-    write_doubles(file, "/closed_loop/K", {n, static_cast<hsize_t>(nu), static_cast<hsize_t>(nx)}, stack(vs, &SweepVariant::K, nu, nx));
+    h5::write_doubles(file, "/closed_loop/K", {n, static_cast<hsize_t>(nu), static_cast<hsize_t>(nx)}, stack(vs, &SweepVariant::K, nu, nx));
   } else {
     std::vector<double> k(static_cast<std::size_t>(nu * nx));
     for (Eigen::Index a = 0; a < nu; ++a)
       for (Eigen::Index b = 0; b < nx; ++b) k[static_cast<std::size_t>(a * nx + b)] = job.K(a, b);
-    write_doubles(file, "/closed_loop/K", {static_cast<hsize_t>(nu), static_cast<hsize_t>(nx)}, k);
+    h5::write_doubles(file, "/closed_loop/K", {static_cast<hsize_t>(nu), static_cast<hsize_t>(nx)}, k);
   }
   write_poles(file, "/closed_loop", vs, &SweepVariant::closed_poles, &SweepVariant::closed_max_real, nx);
-  write_ints(file, "/closed_loop/stable", stable);
+  h5::write_ints(file, "/closed_loop/stable", stable);
 }
 
 void append_number(std::string& line, double x) {

@@ -16,6 +16,8 @@
 #include "analysis/frequency_estimate.hpp"
 #include "analysis/stability.hpp"
 #include "io/atomic_file.hpp"
+#include "io/hdf5_quiet.hpp"
+#include "io/hdf5_write.hpp"
 #include "io/output_guard.hpp"
 #include "simulation/simulator.hpp"
 #include "study/tire_job.hpp"
@@ -194,6 +196,7 @@ FreqRespJob study_freqresp_job(const FreqRespRequest& r, const ModelSpec& spec, 
   check_freqresp_request(r);
   const auto opt = [&](const char* dashed) { return option_name(r.run.style, dashed); };
   if (!r.csv.empty()) guard_output(r.csv, OutputKind::FrequencyResponseCsv, {r.run.model});
+  if (!r.out.empty()) guard_output(r.out, OutputKind::ResultsHdf5, {r.run.model});
   FreqRespJob job;
   const auto note = [&](const std::string& s) {
     job.notes.push_back(s);
@@ -262,6 +265,10 @@ FreqRespJob study_freqresp_job(const FreqRespRequest& r, const ModelSpec& spec, 
   }
 
   set_gaps(job);
+  if (!r.out.empty()) {
+    study_write_freqresp_hdf5(job, r.out);
+    job.written.push_back(r.out);
+  }
   if (!r.csv.empty()) {
     study_write_freqresp_csv(job, r.csv);
     job.written.push_back(r.csv);
@@ -289,6 +296,54 @@ void study_write_freqresp_csv(const FreqRespJob& job, const std::string& path) {
     os << "\n";
   }
   write_file_atomically(path, os.str());
+}
+
+void study_write_freqresp_hdf5(const FreqRespJob& job, const std::string& path) {
+  guard_output(path, OutputKind::ResultsHdf5, {job.model.source_file});
+  const std::size_t nw = job.points.size(), ny = job.output_names.size(), nu = job.input_names.size();
+  // nw x ny x nu in C order
+  const auto cube = [&](const auto& value) {
+    std::vector<double> v;
+    v.reserve(nw * ny * nu);
+    for (const FreqRespPoint& p : job.points)
+      for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(ny); ++i)
+        for (Eigen::Index j = 0; j < static_cast<Eigen::Index>(nu); ++j) v.push_back(value(p, i, j));
+    return v;
+  };
+  std::vector<double> w, settle, run;
+  for (const FreqRespPoint& p : job.points) {
+    w.push_back(p.w);
+    settle.push_back(p.settle_time);
+    run.push_back(p.run_time);
+  }
+  AtomicFile out(path);
+  try {
+    const QuietHdf5 quiet;
+    Hdf5Handle file(H5Fcreate(out.temp_path().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose,
+                    "cannot create " + out.temp_path());
+    h5::write_attribute(file, "/", "codyna_version", std::string(CODYNA_VERSION));
+    h5::write_attribute(file, "/", "kind", std::string("frequency_response"));
+    h5::write_attribute(file, "/", "model", job.model.name);
+    h5::write_attribute(file, "/", "operating_point", job.operating_point);
+    h5::write_attribute(file, "/", "controller", job.controller);
+    h5::write_doubles(file, "w", {nw}, w);
+    h5::write_strings(file, "input_names", job.input_names);
+    h5::write_strings(file, "output_names", job.output_names);
+    h5::write_doubles(file, "amplitudes", {nu}, std::vector<double>(job.amplitudes.data(), job.amplitudes.data() + nu));
+    const std::vector<hsize_t> dims{nw, ny, nu};
+    h5::write_doubles(file, "G_real", dims, cube([](const FreqRespPoint& p, auto i, auto j) { return p.G(i, j).real(); }));
+    h5::write_doubles(file, "G_imag", dims, cube([](const FreqRespPoint& p, auto i, auto j) { return p.G(i, j).imag(); }));
+    h5::write_doubles(file, "G_linear_real", dims, cube([](const FreqRespPoint& p, auto i, auto j) { return p.G_linear(i, j).real(); }));
+    h5::write_doubles(file, "G_linear_imag", dims, cube([](const FreqRespPoint& p, auto i, auto j) { return p.G_linear(i, j).imag(); }));
+    h5::write_doubles(file, "gap", dims, cube([](const FreqRespPoint& p, auto i, auto j) { return p.gap(i, j); }));
+    h5::write_doubles(file, "distortion", dims, cube([](const FreqRespPoint& p, auto i, auto j) { return p.distortion(i, j); }));
+    h5::write_doubles(file, "settle_time", {nw}, settle);
+    h5::write_doubles(file, "run_time", {nw}, run);
+    file.close("cannot finish " + out.temp_path());
+  } catch (const Hdf5Error& e) {
+    throw std::runtime_error(path + ": " + e.what());
+  }
+  out.commit();
 }
 
 std::vector<double> study_frequency_grid(const std::string& text, const std::string& option) {

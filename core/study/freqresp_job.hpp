@@ -31,6 +31,7 @@ struct FreqRespRequest {
   int samples_per_period = 64;
   int harmonics = 5;                   // fitted (the first is the response)
   std::string csv;                     // the table ("" = none)
+  std::string out;                     // the responses as HDF5 ("" = none; study_write_freqresp_hdf5)
 };
 
 struct FreqRespPoint {
@@ -73,5 +74,11 @@ std::string study_freqresp_text(const FreqRespJob& job);
 // The table as CSV: w (rad/s), f (Hz), then per output and input OUT/IN: magnitude, phase (deg),
 // the linear model's magnitude and phase, the gap and the distortion.
 void study_write_freqresp_csv(const FreqRespJob& job, const std::string& path);
+
+// The responses as HDF5: attributes codyna_version, kind ("frequency_response"), model,
+// operating_point, controller on "/"; datasets w (rad/s), input_names, output_names, amplitudes,
+// and per frequency, output and input (nw x ny x nu, C order) G_real, G_imag, G_linear_real,
+// G_linear_imag, gap, distortion; settle_time, run_time (nw, s).
+void study_write_freqresp_hdf5(const FreqRespJob& job, const std::string& path);
 
 }  // namespace codyna

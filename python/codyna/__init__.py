@@ -200,7 +200,7 @@ class Study:
         operating point, the model run with the study's controller (an unstable plant is measured
         in closed loop), and G(jw) from every Plant/In to every Plant/Out estimated. Keywords:
         amplitude (one number or one per Plant/In, input units; default 0.01), settle_periods,
-        periods, samples_per_period, harmonics, csv, and codyna simulate's point, plant,
+        periods, samples_per_period, harmonics, csv, out (HDF5), and codyna simulate's point, plant,
         controller and solver keywords (operating_point, hold, speed, radius, lqr, open_loop,
         controller, integrator, rtol, atol, ...). Returns a dict: "w", "G" and "G_linear"
         (complex, frequencies x outputs x inputs), "gap" (|G - G_linear| relative to the linear

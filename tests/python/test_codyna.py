@@ -1047,6 +1047,15 @@ def test_freqresp_is_the_command_lines(tmp_path):
     assert r["G"].shape == (3, 3, 1) and r["G"].dtype == complex
     assert np.max(np.abs(r["G"] - r["G_linear"]) / np.abs(r["G_linear"])) < 3e-5
     assert r["largest_gap"] == pytest.approx(np.max(r["gap"]), rel=1e-15)
+    # the HDF5 file holds the same responses (nw x ny x nu), the names and the kind
+    h = codyna.Study(car).freqresp([0.5, 3], amplitude=1e-4, out=str(tmp_path / "fr.h5"))
+    with h5py.File(tmp_path / "fr.h5", "r") as f:
+        assert f.attrs["kind"] == "frequency_response"
+        assert np.array_equal(f["w"][()], [0.5, 3])
+        assert [n.decode() for n in f["output_names"][()]] == h["output_names"]
+        assert np.array_equal(f["G_real"][()] + 1j * f["G_imag"][()], h["G"])
+        assert np.array_equal(f["G_linear_real"][()] + 1j * f["G_linear_imag"][()], h["G_linear"])
+        assert np.array_equal(f["gap"][()], h["gap"])
     assert r["input_names"] == ["steer"] and r["operating_point"] == "steady"
     with pytest.raises(ValueError, match="^amplitude 0: expected an amplitude other than 0"):
         codyna.Study(car).freqresp([1], amplitude=0)
