@@ -356,8 +356,18 @@ void ManeuverView::showCurve() {
     if (!lin.isEmpty()) maneuver_series(c, tr("linear model"), lin);
     c->setTitle(tr("Yaw rate per steer"));
     fitAxesToLines(c, tr("frequency [Hz]"), tr("gain [1/s]"));
+  } else if (const auto& names = r.result.output_names;
+             r.type == "double-lane-change" && std::count(names.begin(), names.end(), "x") == 1 &&
+             std::count(names.begin(), names.end(), "y") == 1) {
+    // the car's path (the driver's x and y outputs)
+    const int ix = static_cast<int>(std::find(names.begin(), names.end(), "x") - names.begin());
+    const int iy = static_cast<int>(std::find(names.begin(), names.end(), "y") - names.begin());
+    QList<QPointF> pts;
+    for (int i = 0; i < r.result.samples(); ++i) pts << QPointF(r.result.y(i, ix), r.result.y(i, iy));
+    maneuver_series(c, tr("path"), pts);
+    c->setTitle(tr("The car's path"));
+    fitAxesToLines(c, tr("x [m]"), tr("y [m]"));
   } else {
-    const auto& names = r.result.output_names;
     const std::string wanted = doc_->spec().analysis.handling.yaw_rate;
     const auto it = std::find(names.begin(), names.end(), wanted);
     const int k = it != names.end() ? static_cast<int>(it - names.begin()) : (names.empty() ? -1 : 0);

@@ -2,7 +2,8 @@
 // the model being edited: the maneuver chosen from the core's list, its parameters typed (an empty
 // field keeps the job's default, shown greyed), Run on a worker thread with a progress bar and
 // Cancel, then the job's report (the text codyna maneuver prints) and its curve:
-//   step steer, sine with dwell, double lane change   the yaw rate over time;
+//   step steer, sine with dwell                       the yaw rate over time;
+//   double lane change                                the path (its x, y outputs), else the yaw rate;
 //   swept sine                                        the yaw-rate gain over frequency, run and linear;
 //   constant radius, constant speed                   the road-wheel angle over a_y, turns and linear.
 // Every number shown is the job's; the view computes nothing itself.

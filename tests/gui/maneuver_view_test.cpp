@@ -2,7 +2,8 @@
 // picked from its list with the mouse, numbers typed into the fields, Run clicked. What it shows is
 // the job's (study_maneuver_job with the same request): the report's text equal to what codyna
 // maneuver prints, the curve's points equal to the report's numbers. A field that does not read and
-// a refusal of the job are shown naming the field, and nothing runs; Cancel stops a long run (the
+// a refusal of the job are shown naming the field, and nothing runs; the lane change draws the
+// car's path (its x and y outputs); Cancel stops a long run (the
 // sedan's swept sine) within a step, the window alive.
 #include <QApplication>
 #include <QChart>
@@ -173,6 +174,33 @@ class ManeuverViewTest : public QObject {
     for (int k = 0; k < 6; ++k) {
       QCOMPARE(run->at(k).y(), std::abs(rep.sw_yaw[static_cast<std::size_t>(k)]));
       QVERIFY(std::abs(run->at(k).y() - lin->at(k).y()) < 1e-3 * lin->at(k).y());
+    }
+  }
+
+  void laneChangeShowsThePath() {
+    const QString file = QStringLiteral(CODYNA_TEST_DATA_DIR "/single_track_car_driver.json");
+    QVERIFY(w->openFile(file));
+    openTab();
+    QVERIFY(drive::pickWithMouse(view()->typeBox(), "double-lane-change"));
+    type("speed", "22.2");
+    type("preview", "6");
+    runAndWait();
+    QCOMPARE(view()->statusText(), QStringLiteral("Done"));
+    ManeuverRequest r;
+    r.type = "double-lane-change";
+    r.speed = 22.2;
+    r.preview = 6;
+    const ManeuverReport rep = job(file, r);
+    QCOMPARE(view()->reportView()->toPlainText(), QString::fromStdString(study_maneuver_text(rep)));
+    QLineSeries* path = maneuver_series_named(view()->chartView(), "path");
+    QVERIFY(path);
+    QCOMPARE(path->count(), rep.result.samples());
+    const auto& names = rep.result.output_names;
+    const int ix = static_cast<int>(std::find(names.begin(), names.end(), "x") - names.begin());
+    const int iy = static_cast<int>(std::find(names.begin(), names.end(), "y") - names.begin());
+    for (int i = 0; i < path->count(); i += 53) {
+      QCOMPARE(path->at(i).x(), rep.result.y(i, ix));
+      QCOMPARE(path->at(i).y(), rep.result.y(i, iy));
     }
   }
 
