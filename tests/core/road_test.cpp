@@ -508,9 +508,12 @@ TEST(Road, ARoadOfTheModelsRoadsIsNamedByTires) {
   EXPECT_EQ(named.tires[0].road->friction.size(), 1u);
   const std::string inline_road = R"({"grid": )" + grid + R"(, "friction": [{"x": [0, 1], "scale": 0.5}]})";
   const Model written = study_model(study_parse_model_text(model("[]", inline_road, inline_road), "w.json"));
-  Eigen::VectorXd q(7), v(6);
-  q << 0.3, 0.2, 0.29, 1, 0, 0, 0;
-  v << 0, 8, 0, 2, 0.1, 0;
+  // both free bodies' states (the model has two): a's as the contact needs it, b's at rest elsewhere
+  Eigen::VectorXd q(14), v(12);
+  q << 0.3, 0.2, 0.29, 1, 0, 0, 0, 5, 5, 0.29, 1, 0, 0, 0;
+  v << 0, 8, 0, 2, 0.1, 0, 0, 0, 0, 0, 0, 0;
+  ASSERT_EQ(q.size(), named.nq);
+  ASSERT_EQ(v.size(), named.nv);
   const TireContact<double> a = road_test_contact(named, q, v), b = road_test_contact(written, q, v);
   EXPECT_EQ(a.force, b.force);
   EXPECT_EQ(a.moment, b.moment);
