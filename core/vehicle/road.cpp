@@ -323,6 +323,15 @@ std::vector<std::vector<double>> iso8608_tracks(const Iso8608Spec& spec) {
   const long k1 = std::max(1L, std::lround(std::ceil(spec.n_min * L))), k2 = std::lround(std::floor(spec.n_max * L));
   if (k2 < k1) throw std::invalid_argument("expected a band holding at least one frequency k / length");
   if (2 * k2 >= samples) throw std::invalid_argument("expected a spacing below 1 / (2 n_max) (Nyquist)");
+  // the sum below costs (components x samples) cosines per track, about 1e8 a second: refused
+  // beyond 1e9 in all (10 s) rather than left to run for hours (a 10 km road at the defaults)
+  const double terms = 2.0 * static_cast<double>(k2 - k1 + 1) * static_cast<double>(samples + 1);
+  if (terms > 1e9) {
+    std::ostringstream os;
+    os << "the road would sum " << (k2 - k1 + 1) << " cosines at " << samples + 1 << " points per track (" << terms
+       << " terms); expected at most 1e9: a shorter length, a narrower band or a coarser spacing";
+    throw std::invalid_argument(os.str());
+  }
   std::mt19937_64 rng(spec.seed);
   const auto uniform = [&rng] { return static_cast<double>(rng() >> 11) * 0x1.0p-53; };  // [0, 1), 53 bits
   const double two_pi = 6.283185307179586476925286766559;

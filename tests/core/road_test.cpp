@@ -585,3 +585,13 @@ TEST(Road, BadRoadsAreRefusedNamingTheFileAndTheField) {
 
 }  // namespace
 }  // namespace codyna
+
+// A generated road whose sum would run for hours (here 1e5 m at the default band: 2.8e5 cosines
+// at 2e6 points per track) is refused at once, naming the field and what to change
+TEST(Road, AnIso8608RoadTooCostlyToSumIsRefusedAtOnce) {
+  const std::string message = road_test_refusal(
+      road_test_wheel(road_test_fiala, R"({"iso8608": {"class": "C", "length": 100000, "left_y": 0.8, "right_y": -0.8}})"), "long.json");
+  EXPECT_NE(message.find("long.json: /effects/1/road/iso8608: the road would sum "), std::string::npos) << message;
+  EXPECT_NE(message.find("expected at most 1e9: a shorter length, a narrower band or a coarser spacing"), std::string::npos)
+      << message;
+}
