@@ -186,9 +186,9 @@ ManeuverReport constant_speed(const ManeuverRequest& r, const ModelSpec& spec) {
   if (!std::isfinite(a_max) || !(std::abs(a_max) > std::abs(a_min)) || a_max * a_min < 0)
     throw std::invalid_argument(flag("ay-max") + ": expected a lateral acceleration beyond " + flag("ay-min") + ", on its side");
   const int n = diagram_points(flag, r);
-  const Model probe = study_model(straight_spec(r, spec), r.model);
-  const double U = probe.spec.analysis.steady.speed ? *probe.spec.analysis.steady.speed : 0.0;
-  if (!(U > 0)) throw ModelError(probe.source_file, "/analysis/steady/speed", "the constant-speed maneuver needs a speed (--speed)");
+  const std::optional<double> speed = straight_spec(r, spec).analysis.steady.speed;  // the request's, else the file's
+  const double U = speed ? *speed : 0.0;
+  if (!(U > 0)) throw ModelError(r.model, "/analysis/steady/speed", "the constant-speed maneuver needs a speed (--speed)");
   std::vector<TurnAsked> turns;
   for (int i = 0; i < n; ++i) turns.push_back({U, 0, a_min + (a_max - a_min) * i / (n - 1)});
   SteadyTurns st = steady_setup(r, spec, turns.front());
