@@ -17,7 +17,9 @@ struct ManeuverArgs {
   double steer_scale = 0, frequency_min = 0, frequency_max = 0, sweep_time = 0, ay_min = 0, ay_max = 0;
   double radius = 0, speed_min = 0, speed_max = 0, width = 0, length = 0, preview = 0, lateral_gain = 0;
   double speed_kp = 0, speed_ki = 0, sample_time = 0;
+  double friction = 0;
   int points = 0;
+  bool open_loop = false;
 };
 
 void run_maneuver(const ManeuverArgs& a, const CLI::App* cmd) {
@@ -53,6 +55,8 @@ void run_maneuver(const ManeuverArgs& a, const CLI::App* cmd) {
   num("--speed-kp", a.speed_kp, r.speed_kp);
   num("--speed-ki", a.speed_ki, r.speed_ki);
   num("--sample-time", a.sample_time, r.sample_time);
+  num("--friction", a.friction, r.friction);
+  r.open_loop = a.open_loop;
   if (given(cmd, "--points")) r.points = a.points;
   if (given(cmd, "--x")) r.x = a.x;
   if (given(cmd, "--y")) r.y = a.y;
@@ -106,6 +110,8 @@ void add_maneuver(CLI::App& app) {
   cmd->add_option("--yaw", a->yaw, "the Plant/Out output of its heading (default yaw)");
   cmd->add_option("--speed-output", a->speed_output, "the Plant/Out output of its forward speed (default speed)");
   cmd->add_option("--drive", a->drive, "the Plant/In input the speed controller drives (default: none)");
+  cmd->add_flag("--open-loop", a->open_loop, "leave the model file's controller out (step steer and sine with dwell run it in the loop, on its Plant/In)");
+  cmd->add_option("--friction", a->friction, "the road friction the controller's yaw-rate reference is limited by (mu g / U; default 0.85)");
   cmd->add_option("--integrator", a->integrator, "the runs' integrator (default: the model file's)");
   cmd->add_option("--free-input", a->free_inputs, "the steady motion's free inputs (a turn: steer,drive)")->delimiter(',');
   cmd->callback([a, cmd] { set_exit_code(run_guarded([&] { run_maneuver(*a, cmd); })); });

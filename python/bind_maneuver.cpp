@@ -65,6 +65,8 @@ py::dict do_maneuver(const Study& s, const py::dict& options) {
   r.drive = k.text("drive");
   r.integrator = k.text("integrator");
   r.free_inputs = k.names("free_inputs", "free_input");
+  r.open_loop = k.flag("open_loop");
+  r.friction = k.number("friction");
   k.finish();
   ManeuverReport rep;
   {
@@ -74,6 +76,17 @@ py::dict do_maneuver(const Study& s, const py::dict& options) {
   py::dict d("type"_a = rep.type, "model"_a = rep.model_name, "speed"_a = rep.speed, "valid"_a = rep.valid,
              "invalid_reason"_a = rep.invalid_reason, "notes"_a = rep.notes, "written"_a = rep.written,
              "text"_a = study_maneuver_text(rep));
+  if (!rep.controller.empty()) {
+    d["controller"] = rep.controller;
+    d["reference_gain"] = rep.reference_gain;
+    d["reference_limit"] = rep.reference_limit;
+    d["controller_inputs"] = rep.controller_inputs;
+    d["controller_effort"] = vector_of(rep.controller_effort);
+  }
+  if (rep.type == "step-steer" || rep.type == "sine-with-dwell") {
+    d["max_sideslip"] = rep.max_sideslip;
+    d["max_sideslip_time"] = rep.max_sideslip_time;
+  }
   if (rep.type == "step-steer") {
     d["yaw_rate"] = maneuver_step_of(rep.yaw_rate);
     if (rep.has_lateral_acceleration) d["lateral_acceleration"] = maneuver_step_of(rep.lateral_acceleration);

@@ -6,9 +6,20 @@ chassis frame (x forward, y left, z up, origin at the sprung mass's centre of ma
 design position, and each body's frame is parallel to the chassis there, its origin at its
 joint, so a body's local point is the chassis point less the body's origin.
 Run: /usr/bin/python3 scripts/make_sedan.py > examples/sedan.json
+
+With --esc it writes examples/sedan_esc.json instead: the same car with a yaw-rate controller that
+brakes one front wheel (docs/vehicles.md, "A yaw-rate controller"): the front brakes are its
+Plant/In, limited to braking (-3000 .. 0 N m), and a P law on the yaw rate's error from the
+driver's intended yaw rate (codyna maneuver gives it as the reference) brakes the outer front wheel
+when the car yaws more than intended, the inner one when less. Its gain KP_ESC was designed on
+the linearized car at 25 m/s: the loop from the differential front brake torque to the yaw rate
+crosses over at 1 Hz (k = 1 / |G(j 2 pi)|, 7304 N m per rad/s, rounded; tests/core/yaw_control_test.cpp
+designs it again from the linearization and checks the file's value).
+Run: /usr/bin/python3 scripts/make_sedan.py --esc > examples/sedan_esc.json
 """
 import json
 import math
+import sys
 
 G = 9.81
 A_FRONT, B_REAR = 1.20, 1.50              # axles from the sprung centre of mass (m)
@@ -16,6 +27,8 @@ HALF_TRACK = 0.775
 TIR = "tires/MagicFormula61_Paramerters.tir"
 R0, KZ = 0.393581, 322913.0               # the .tir's UNLOADED_RADIUS and VERTICAL_STIFFNESS
 SPEED = 25.0
+KP_ESC = 7300.0                           # N m of brake torque per rad/s of yaw-rate error
+ESC = "--esc" in sys.argv[1:]
 
 M_CHASSIS = 1350.0
 FRONT_SPRING, REAR_SPRING = 75000.0, 45650.0
@@ -235,4 +248,17 @@ model = {
                  "handling": {"steer": "steer", "yaw_rate": "yaw_rate", "lateral_acceleration": "lateral_acceleration",
                               "steering_ratio": STEER_RATIO}},
 }
+if ESC:
+    for a in actuators:
+        if a["name"] in ("brake_fl", "brake_fr"):
+            a["min"], a["max"] = -3000.0, 0.0
+    model["name"] = "sedan_esc"
+    model["description"] = (
+        "The sedan of examples/sedan.json (docs/vehicles.md) with a yaw-rate controller, written by scripts/make_sedan.py --esc: "
+        "the front brakes are the Plant/In (limited to braking), a P law on the yaw rate's error from the driver's intended yaw "
+        "rate brakes the outer front wheel when the car yaws more than intended, the inner one when less. The gain was designed "
+        "on the car linearized at 25 m/s (the loop crosses over at 1 Hz). codyna maneuver runs it in the loop (--open-loop leaves "
+        "it out): codyna maneuver examples/sedan_esc.json --type sine-with-dwell --steer 3.")
+    model["plant"] = {"inputs": ["brake_fl", "brake_fr"], "outputs": ["yaw_rate", "lateral_acceleration", "roll_rate"]}
+    model["controller"] = {"type": "pid", "kp": [[-KP_ESC, 0, 0], [KP_ESC, 0, 0]], "operating_point": "steady"}
 print(json.dumps(model, indent=1))

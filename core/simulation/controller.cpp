@@ -29,6 +29,10 @@ class Pid final : public Controller {
   }
   int nxc() const override { return g_.Ki.size() ? static_cast<int>(g_.r.size()) : 0; }
   bool needs_rates() const override { return g_.Kd.size() > 0; }
+  bool reads_output(int k) const override {
+    const auto reads = [k](const Eigen::MatrixXd& G) { return G.size() > 0 && k < G.cols() && !G.col(k).isZero(0.0); };
+    return reads(g_.Kp) || reads(g_.Ki) || reads(g_.Kd);
+  }
   Eigen::VectorXd output(const ControllerInput& in, const Eigen::VectorXd& xc) const override {
     const Eigen::VectorXd& r = in.r.size() ? in.r : g_.r;
     Eigen::VectorXd u = g_.u0 + g_.Kp * (r - in.y);

@@ -56,6 +56,9 @@ class Controller {
   virtual double sample_time() const { return 0; }  // > 0: discrete (zero-order hold)
   virtual bool needs_state() const { return false; }
   virtual bool needs_rates() const { return false; }
+  // whether the law reads Plant/Out output k at all (a PID whose gains' column k is zero does not:
+  // an acceleration output there is only recorded, not an algebraic loop)
+  virtual bool reads_output(int k) const { return true; }
   // plant input values (before saturation) for controller state xc
   virtual Eigen::VectorXd output(const ControllerInput& in, const Eigen::VectorXd& xc) const = 0;
   // continuous: d xc/dt; discrete: xc at the next sample

@@ -208,8 +208,10 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
   if (controller && controller->needs_state() && !plant)
     throw std::invalid_argument("simulate: state feedback needs the linearized plant it was designed on");
   if (controller && !controller->needs_state())
-    for (int k : model.plant_outputs)
-      if (sensor_reads_accelerations(model.sensors[static_cast<std::size_t>(k)].type)) {
+    for (std::size_t i = 0; i < model.plant_outputs.size(); ++i) {
+      const int k = model.plant_outputs[i];
+      if (sensor_reads_accelerations(model.sensors[static_cast<std::size_t>(k)].type) &&
+          controller->reads_output(static_cast<int>(i))) {
         const bool reaction = model.sensors[static_cast<std::size_t>(k)].type == SensorType::MotionForce;
         throw std::invalid_argument("simulate: the controller measures \"" + model.sensors[static_cast<std::size_t>(k)].name +
                                     (reaction ? "\", a motion input's reaction force" : "\", an acceleration") +
@@ -217,6 +219,7 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
                                     "computes (an algebraic loop); feed back positions or velocities, or use state "
                                     "feedback (the " + (reaction ? "reaction" : "acceleration") + " is then recorded as an output)");
       }
+    }
   const auto wall0 = std::chrono::steady_clock::now();
 
   std::optional<PlantFunction> pf;

@@ -1,9 +1,12 @@
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 
 #include "dynamics/kinematics.hpp"
+#include "analysis/linearize.hpp"
 #include "model/errors.hpp"
+#include "simulation/model_controller.hpp"
 #include "simulation/simulator.hpp"
 #include "study/files.hpp"
 #include "study/workflow.hpp"
@@ -111,6 +114,8 @@ void check_run(ManeuverReport& rep, const SimulationResult& res, const Model& m,
       at = res.t[static_cast<std::size_t>(k)];
     }
   }
+  rep.max_sideslip = worst;
+  rep.max_sideslip_time = at;
   if (worst > 20 * kPi / 180) {
     std::ostringstream os;
     os << "the car spun out: its sideslip reached " << worst * 180 / kPi << " deg at t = " << at << " s";
@@ -137,8 +142,56 @@ void write(ManeuverReport& rep, const ManeuverRequest& r) {
 }
 
 
-OpenLoop open_loop_setup(const ManeuverRequest& r, const ModelSpec& spec) {
-  OpenLoop ol{study_model(straight_spec(r, spec), r.model), {}, -1, -1, -1, -1, {}};
+namespace {
+
+// The model file's controller about the straight run, and the driver's intended yaw rate as its
+// reference on the yaw-rate output (when that is a Plant/Out)
+void attach_controller(OpenLoop& ol, const ManeuverRequest& r, const ModelSpec& spec, bool controlled) {
+  const Model& m = ol.model;
+  const Flags flag{r.style};
+  const std::string kind = to_string(m.spec.controller.type);
+  if (!controlled)
+    throw std::invalid_argument(flag("open-loop") + ": the model file has a " + kind + " controller, and a " + r.type +
+                                " maneuver compares the run with the open-loop linear model: run it " + flag("open-loop") +
+                                " (the controller left out)");
+  const std::string& steer = m.spec.analysis.handling.steer;
+  for (int k : m.plant_inputs)
+    if (m.actuators[static_cast<std::size_t>(k)].name == steer)
+      throw ModelError(m.source_file, "/plant/inputs",
+                       "the maneuver drives the steer \"" + steer + "\", and the model file's " + kind +
+                           " controller acts on it too (a Plant/In): give the controller other inputs (brakes, a yaw "
+                           "moment, rear steer), or run the maneuver " + flag("open-loop"));
+  if (m.plant_inputs.empty()) throw ModelError(m.source_file, "/plant/inputs", "the model file's controller needs Plant/In actuators");
+  // about the straight run, wherever the file says its controller was designed: a maneuver starts there
+  auto plant = std::make_shared<LinearPlant>();
+  plant->op = ol.op;
+  LinearizeOptions lo;
+  lo.independent = m.spec.analysis.independent;
+  plant->lin = linearize(m, plant->op, lo);
+  ol.controller = make_model_controller(m, *plant);
+  ol.plant = plant;
+  ol.controller_text = "the model file's " + kind + " controller: " + ol.controller->describe();
+  if (ol.yaw_rate < 0) return;
+  // the intended yaw rate: the steady yaw rate of the linear car for the steer (its straight run,
+  // steer in, yaw rate out), limited to what the road holds at the run's speed
+  const double mu = positive(flag, r.friction, 0.85, "friction");
+  ModelSpec ls = straight_spec(r, spec);
+  ls.plant.inputs = {steer};
+  ls.controller = ControllerSpec{};
+  const StudyLinearization lin = study_linearize(study_model(ls, r.model));
+  if (!lin.handling || !(lin.handling->yaw_rate_gain != 0))
+    throw ModelError(m.source_file, "/analysis/handling",
+                     "the controller's yaw-rate reference needs the straight run's steady yaw-rate gain, which the "
+                     "linearization does not give; run the maneuver " + flag("open-loop"));
+  ol.reference_gain = lin.handling->yaw_rate_gain;
+  ol.reference_limit = mu * 9.80665 / std::max(ol.start.speed_along_heading, 1e-9);
+}
+
+}  // namespace
+
+OpenLoop open_loop_setup(const ManeuverRequest& r, const ModelSpec& spec, bool controlled) {
+  OpenLoop ol;
+  ol.model = study_model(straight_spec(r, spec), r.model);
   const Model& m = ol.model;
   const HandlingSpec& h = m.spec.analysis.handling;
   if (h.steer.empty())
@@ -153,6 +206,8 @@ OpenLoop open_loop_setup(const ManeuverRequest& r, const ModelSpec& spec) {
   ol.op = study_operating_point(m, "steady");
   Data d(m);
   ol.start = body_state(m, d, ol.body, ol.op.q, ol.op.v);
+  if (!r.open_loop && has_model_controller(m) && m.spec.controller.type != ControllerType::Driver)
+    attach_controller(ol, r, spec, controlled);
   return ol;
 }
 
@@ -187,7 +242,30 @@ Model open_loop_run(ManeuverReport& rep, const ManeuverRequest& r, const OpenLoo
   SimulationCallbacks cb;
   cb.cancel = r.cancel;
   cb.progress = r.progress;
-  rep.result = simulate(run, nullptr, nullptr, o, cb);
+  if (ol.controller) {
+    const Eigen::VectorXd y0 = ol.plant->lin.system.y0;
+    const int iy = ol.yaw_rate;
+    const double gain = ol.reference_gain, limit = ol.reference_limit;
+    if (iy >= 0)
+      o.reference = [y0, iy, gain, limit, profile](double t) {
+        Eigen::VectorXd ref = y0;
+        ref[iy] += std::clamp(gain * profile.value(t), -limit, limit);
+        return ref;
+      };
+    rep.controller = ol.controller_text;
+    rep.reference_gain = gain;
+    rep.reference_limit = iy >= 0 ? limit : 0.0;
+  }
+  rep.result = simulate(run, ol.controller.get(), ol.plant.get(), o, cb);
+  if (ol.controller && rep.result.samples() > 0) {
+    const Eigen::VectorXd& u0 = ol.plant->op.u;
+    for (int k : run.plant_inputs) {
+      double largest = 0;
+      for (int i = 0; i < rep.result.samples(); ++i) largest = std::max(largest, std::abs(rep.result.u(i, k) - u0[k]));
+      rep.controller_inputs.push_back(run.actuators[static_cast<std::size_t>(k)].name);
+      rep.controller_effort.push_back(largest);
+    }
+  }
   if (rep.result.cancelled) throw StudyCancelled("the maneuver was cancelled");
   check_run(rep, rep.result, run, ol.body);
   if (rep.result.samples() > 0) {

@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -11,7 +12,9 @@
 #include "analysis/operating_point.hpp"
 #include "dynamics/data.hpp"
 #include "model/model.hpp"
+#include "simulation/controller.hpp"
 #include "simulation/integrator.hpp"
+#include "simulation/simulator.hpp"
 #include "simulation/result.hpp"
 #include "study/maneuver_job.hpp"
 
@@ -63,8 +66,18 @@ struct OpenLoop {
   OperatingPoint op;
   int steer = -1, yaw_rate = -1, lateral_acceleration = -1, body = -1;
   BodyState start;
+  // the model file's controller in the loop (unless ManeuverRequest::open_loop), on its Plant/In
+  // (never the steer, which the maneuver drives), linearized about the straight run; its reference
+  // on the yaw-rate output is the driver's intended yaw rate: the straight run's steady yaw-rate
+  // gain times the steer's deviation, within +-mu g / U (yaw_rate_reference)
+  std::shared_ptr<const LinearPlant> plant;
+  std::shared_ptr<const Controller> controller;
+  std::string controller_text;
+  double reference_gain = 0, reference_limit = 0;  // 1/s (per steer unit), rad/s
 };
-OpenLoop open_loop_setup(const ManeuverRequest& r, const ModelSpec& spec);
+// controlled: the run may take the model file's controller (step steer, sine with dwell); a
+// maneuver that compares with the open-loop linear model refuses one (unless --open-loop)
+OpenLoop open_loop_setup(const ManeuverRequest& r, const ModelSpec& spec, bool controlled = false);
 // The steer (less the straight run's) of the steady turn at lateral acceleration a_y (m/s^2, > 0
 // left) at the straight run's speed, by the steady-motion search with the study's free inputs;
 // throws what the search throws.

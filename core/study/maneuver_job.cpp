@@ -73,7 +73,7 @@ ManeuverReport mnv_open_loop(const ManeuverRequest& r, const ModelSpec& spec, bo
   const mnv::Flags flag{r.style};
   ManeuverReport rep;
   rep.type = r.type;
-  const mnv::OpenLoop ol = mnv::open_loop_setup(r, spec);
+  const mnv::OpenLoop ol = mnv::open_loop_setup(r, spec, true);
   rep.model_name = ol.model.name;
   rep.speed = ol.start.v_body.norm();
   const int iy = ol.yaw_rate, ia = ol.lateral_acceleration;
@@ -481,6 +481,16 @@ std::string study_maneuver_text(const ManeuverReport& r) {
   } else {
     os << "speed            " << r.speed << " m/s\n";
   }
+  if (!r.controller.empty()) {
+    os << "controller       " << r.controller << "\n";
+    if (r.reference_limit > 0)
+      os << "  reference      yaw rate " << r.reference_gain << " 1/s x steer, within +-" << r.reference_limit
+         << " rad/s (the straight run's steady gain; mu g / U)\n";
+    for (std::size_t k = 0; k < r.controller_inputs.size(); ++k)
+      os << "  largest |u - u0| " << r.controller_inputs[k] << " " << r.controller_effort[k] << "\n";
+  }
+  if (r.type == "step-steer" || r.type == "sine-with-dwell")
+    os << "largest sideslip " << r.max_sideslip * deg << " deg at " << r.max_sideslip_time << " s\n";
   if (r.type == "step-steer") {
     os << "steer step       " << r.steer << "\n";
     const auto line = [&os](const char* name, const StepMetrics& m, const char* unit) {

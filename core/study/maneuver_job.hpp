@@ -81,6 +81,12 @@ struct ManeuverRequest {
   // the driver (double lane change)
   std::optional<double> width, length, preview, lateral_gain, speed_kp, speed_ki, sample_time;
   std::optional<std::string> x, y, yaw, speed_output, drive;  // Plant/Out / Plant/In names
+  // step steer and sine with dwell run the model file's controller in the loop (on its Plant/In,
+  // which must not hold the steer; about the straight run), unless open_loop; its reference on the
+  // yaw-rate output (when a Plant/Out) is the driver's intended yaw rate, the straight run's steady
+  // yaw-rate gain times the steer, within +-friction g / U (friction default 0.85)
+  bool open_loop = false;
+  std::optional<double> friction;
   // a front end's Cancel (not owned; null: none): the job then throws StudyCancelled
   const std::atomic<bool>* cancel = nullptr;
   // the run's progress (t, t_end), called from the job's thread (runs only, not the steady turns)
@@ -94,6 +100,16 @@ struct ManeuverReport {
   // its yaw rate about the road's normal (what the steady-motion search takes)
   double end_speed = 0, end_yaw_rate = 0;
   std::vector<std::string> notes, warnings;
+  // the controller in the loop ("" = none: open loop), and its yaw-rate reference: gain per steer
+  // unit (1/s) and limit (rad/s); 0 when the yaw rate is not a Plant/Out
+  std::string controller;
+  double reference_gain = 0, reference_limit = 0;
+  // per Plant/In of the controller: its name and the largest |u - u0| in the run
+  std::vector<std::string> controller_inputs;
+  std::vector<double> controller_effort;
+  // the steady body's largest sideslip (rad, atan of its lateral over its forward speed) and when
+  // (step steer, sine with dwell, swept sine)
+  double max_sideslip = 0, max_sideslip_time = 0;
   bool valid = true;
   std::string invalid_reason;            // why the metrics are not to be trusted
   // step steer

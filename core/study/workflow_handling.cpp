@@ -190,7 +190,21 @@ HandlingNumbers workflow_detail::study_handling(const Model& m, const StudyLinea
   };
   if (hs.steer.empty()) workflow_fail(m, "handling/steer", "name the steer input (a Plant/In) for the handling numbers");
   if (hs.yaw_rate.empty()) workflow_fail(m, "handling/yaw_rate", "name the yaw-rate output (a Plant/Out) for the handling numbers");
-  const int steer = index(sys.input_names, hs.steer, "steer", "a Plant/In input");
+  const int steer_actuator = m.find_actuator(hs.steer);
+  if (steer_actuator >= 0 && plant_position(sys.input_names, hs.steer) < 0) {
+    // the steer is not a Plant/In (a controller acts on brakes or a yaw moment, the steer is the
+    // driver's): the numbers are the steer's all the same, from the same point linearized with it
+    // as the first input
+    Model with = m;
+    with.plant_inputs.insert(with.plant_inputs.begin(), steer_actuator);
+    StudyLinearization sl_steer = sl;
+    LinearizeOptions o;
+    o.method = method_of_model(m);
+    o.independent = m.spec.analysis.independent;
+    sl_steer.lin = linearize(with, sl.op, o);
+    return study_handling(with, sl_steer);
+  }
+  const int steer = index(sys.input_names, hs.steer, "steer", "a Plant/In input or another actuator");
   const int yaw = index(sys.output_names, hs.yaw_rate, "yaw_rate", "a Plant/Out output");
   const int ay = index(sys.output_names, hs.lateral_acceleration, "lateral_acceleration", "a Plant/Out output");
   const int beta = index(sys.output_names, hs.sideslip, "sideslip", "a Plant/Out output");

@@ -221,8 +221,11 @@ class Study:
         steer_time, ramp, frequency, dwell, steer_scale, frequency_min, frequency_max, sweep_time, t_end,
         output_step, radius, speed_min, speed_max, ay_min, ay_max, points, width, length, preview, lateral_gain,
         speed_kp, speed_ki, sample_time, x, y, yaw, speed_output, drive, integrator, free_inputs,
-        out, csv). Returns a dict: the metrics, "valid" and "invalid_reason", "text" (the command's
-        report), and the run's "t", "outputs", "output_names". The swept sine adds
+        open_loop, friction, out, csv). Returns a dict: the metrics, "valid" and "invalid_reason",
+        "text" (the command's report), and the run's "t", "outputs", "output_names". Step steer and
+        sine with dwell add "max_sideslip" (rad) and "max_sideslip_time", and with the model file's
+        controller in the loop (open_loop=True leaves it out) "controller", "reference_gain",
+        "reference_limit", "controller_inputs" and "controller_effort" (largest |u - u0|). The swept sine adds
         "frequency_hz" and the complex responses "yaw_rate_response",
         "lateral_acceleration_response" (and their "..._linear"), "characteristics" (ISO 7401's
         values; "characteristics_linear") and the largest gaps as (gap, Hz).
