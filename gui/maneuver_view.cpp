@@ -6,6 +6,7 @@
 #include <QFormLayout>
 #include <QHBoxLayout>
 #include <QLabel>
+#include <QCheckBox>
 #include <QLineEdit>
 #include <QLineSeries>
 #include <QLocale>
@@ -59,6 +60,7 @@ const QList<ManeuverField>& maneuver_fields() {
       {"points", "points", "8 (swept sine: 12)", {"constant-radius", "constant-speed", "swept-sine"}},
       {"width", "vehicle width (m)", "1.8", {"double-lane-change"}},
       {"preview", "driver preview (m)", "the model's", {"double-lane-change"}},
+      {"friction", "friction (controller's reference)", "0.85", {"step-steer", "sine-with-dwell"}},
       {"integrator", "integrator", "the model's", {"step-steer", "sine-with-dwell", "swept-sine", "double-lane-change"}},
       {"free-input", "free inputs", "the model's (a turn: steer,drive)",
        {"step-steer", "sine-with-dwell", "swept-sine", "constant-radius", "constant-speed"}},
@@ -129,6 +131,11 @@ void ManeuverView::buildUi() {
     fields_.insert(f.key, e);
     labels_.insert(f.key, l);
   }
+  open_loop_ = new QCheckBox(tr("Open loop: leave the model file's controller out"), this);
+  open_loop_->setObjectName("maneuverOpenLoop");
+  open_loop_->setToolTip(tr("Step steer and sine with dwell run the model file's controller in the loop (on its Plant/In, never "
+                            "the steer); a swept sine needs it left out"));
+  form->addRow(open_loop_);
   left->addLayout(form);
   auto* buttons = new QHBoxLayout;
   run_ = new QPushButton(tr("Run"), this);
@@ -180,6 +187,7 @@ void ManeuverView::typeChosen() {
     fields_[f.key]->setVisible(on);
     labels_[f.key]->setVisible(on);
   }
+  open_loop_->setVisible(t == "step-steer" || t == "sine-with-dwell" || t == "swept-sine");
 }
 
 QString ManeuverView::statusText() const { return status_->text(); }
@@ -225,6 +233,8 @@ ManeuverRequest ManeuverView::request() const {
   r.ay_max = number("ay-max");
   r.width = number("width");
   r.preview = number("preview");
+  r.friction = number("friction");
+  r.open_loop = !open_loop_->isHidden() && open_loop_->isChecked();
   if (const auto p = number("points")) {
     if (*p != std::floor(*p) || std::abs(*p) > 1e6) throw std::invalid_argument("points: expected a whole number");
     r.points = static_cast<int>(*p);

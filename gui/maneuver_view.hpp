@@ -18,6 +18,7 @@
 
 class QComboBox;
 class QLabel;
+class QCheckBox;
 class QLineEdit;
 class QPlainTextEdit;
 class QProgressBar;
@@ -45,6 +46,7 @@ class ManeuverView : public QWidget {
   QComboBox* typeBox() const { return type_; }
   // the field of a parameter, by its flag's name ("speed", "steer", "radius", ...; null: none)
   QLineEdit* field(const QString& key) const { return fields_.value(key, nullptr); }
+  QCheckBox* openLoopBox() const { return open_loop_; }
   QPushButton* runButton() const { return run_; }
   QPushButton* cancelButton() const { return cancel_button_; }
   QPlainTextEdit* reportView() const { return report_view_; }
@@ -69,6 +71,7 @@ class ManeuverView : public QWidget {
 
   Document* doc_;
   QComboBox* type_ = nullptr;
+  QCheckBox* open_loop_ = nullptr;
   QMap<QString, QLineEdit*> fields_;
   QMap<QString, QWidget*> labels_;
   QPushButton *run_ = nullptr, *cancel_button_ = nullptr;

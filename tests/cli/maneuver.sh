@@ -74,5 +74,22 @@ while IFS=, read -r speed ay steer rest; do
     fail "sedan constant radius at $speed m/s: steer $steer, linearize $lin"
 done < sedan_cr.csv
 
+# the sedan with its yaw-rate controller: a swept sine refuses it (nothing written), --friction is
+# checked, and the refusal of a controller on the steer names the field
+esc="$src/examples/sedan_esc.json"
+expect 1 '--open-loop: the model file has a pid controller' "$codyna" maneuver "$esc" --type swept-sine --csv esc.csv
+[ -e esc.csv ] && fail "esc.csv written"
+expect 1 '--friction: expected a number > 0, got -0.5' "$codyna" maneuver "$esc" --type step-steer --friction -0.5
+$py - "$esc" "$src/examples" <<'PY' || fail "esc_steer.json not written"
+import json, sys
+m = json.load(open(sys.argv[1]))
+m["plant"]["inputs"] = ["steer", "brake_fr"]
+for e in m["effects"]:
+    if "file" in e:
+        e["file"] = sys.argv[2] + "/" + e["file"]
+json.dump(m, open("esc_steer.json", "w"))
+PY
+expect 1 'esc_steer.json: /plant/inputs: the maneuver drives the steer "steer"' "$codyna" maneuver esc_steer.json --type step-steer
+
 [ "$fails" -eq 0 ] && echo "maneuver: all passed"
 exit $((fails > 0))

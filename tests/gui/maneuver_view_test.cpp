@@ -7,6 +7,7 @@
 // sedan's swept sine) within a step, the window alive.
 #include <QApplication>
 #include <QChart>
+#include <QCheckBox>
 #include <QComboBox>
 #include <QLabel>
 #include <QLineEdit>
@@ -34,6 +35,7 @@ namespace {
 
 const QString kCar = QStringLiteral(CODYNA_EXAMPLES_DIR "/single_track_car.json");
 const QString kSedan = QStringLiteral(CODYNA_EXAMPLES_DIR "/sedan.json");
+const QString kSedanEsc = QStringLiteral(CODYNA_EXAMPLES_DIR "/sedan_esc.json");
 
 QLineSeries* maneuver_series_named(ChartView* view, const QString& name) {
   for (QAbstractSeries* s : view->chart()->series())
@@ -151,6 +153,40 @@ class ManeuverViewTest : public QObject {
       // the linear model's steer (a ratio of 1 on this car)
       QVERIFY(std::abs(lin->at(k).y() - rep.cr_linear_steer[static_cast<std::size_t>(k)] * 180 / std::numbers::pi) < 1e-12);
     }
+  }
+
+  // the sedan with its yaw-rate controller: a swept sine refuses it (the box unticked), the step
+  // steer runs it in the loop (the job's report, the controller named), and with "Open loop" ticked
+  // by a click the same step runs without it
+  void theModelsControllerRunsUnlessOpenLoopIsTicked() {
+    QVERIFY(w->openFile(kSedanEsc));
+    openTab();
+    QVERIFY(drive::pickWithMouse(view()->typeBox(), "swept-sine"));
+    QVERIFY(view()->openLoopBox()->isVisible());
+    QVERIFY(!view()->openLoopBox()->isChecked());
+    runAndWait();
+    QVERIFY2(view()->statusText().startsWith(QStringLiteral("open_loop: the model file has a pid controller")),
+             qPrintable(view()->statusText()));
+    QVERIFY(!view()->report());
+    QVERIFY(drive::pickWithMouse(view()->typeBox(), "constant-radius"));
+    QVERIFY(!view()->openLoopBox()->isVisible());
+    QVERIFY(drive::pickWithMouse(view()->typeBox(), "step-steer"));
+    type("steer", "0.01");
+    runAndWait();
+    QCOMPARE(view()->statusText(), QStringLiteral("Done"));
+    ManeuverRequest r;
+    r.type = "step-steer";
+    r.steer = 0.01;
+    const ManeuverReport rep = job(kSedanEsc, r);
+    QVERIFY(!rep.controller.empty());
+    QCOMPARE(view()->reportView()->toPlainText(), QString::fromStdString(study_maneuver_text(rep)));
+    QTest::mouseClick(view()->openLoopBox(), Qt::LeftButton);
+    QVERIFY(view()->openLoopBox()->isChecked());
+    runAndWait();
+    QCOMPARE(view()->statusText(), QStringLiteral("Done"));
+    QVERIFY(view()->report() && view()->report()->controller.empty());
+    QVERIFY(!view()->reportView()->toPlainText().contains(QStringLiteral("controller")));
+    QVERIFY(view()->reportView()->toPlainText().contains(QStringLiteral("largest sideslip")));
   }
 
   void sweptSineShowsTheGainsBesideTheLinearOnes() {
