@@ -1034,6 +1034,19 @@ def test_maneuver_is_the_command_lines():
     assert sw["characteristics"]["resonance_hz"] == pytest.approx(sw["characteristics_linear"]["resonance_hz"], rel=1e-3)
     with pytest.raises(ValueError, match="^frequency_max: expected a frequency above frequency_min"):
         codyna.Study(car).maneuver("swept-sine", frequency_max=0.05)
+    # the sedan with its yaw-rate controller: a swept sine refuses it, naming the keyword; a step
+    # steer runs it (its brakes, its reference) and open_loop=True leaves it out
+    esc = codyna.Study(os.path.join(SOURCE_DIR, "examples", "sedan_esc.json"))
+    with pytest.raises(ValueError, match="^open_loop: the model file has a pid controller"):
+        esc.maneuver("swept-sine")
+    with pytest.raises(ValueError, match="^friction: expected a number > 0"):
+        esc.maneuver("step-steer", friction=0)
+    on = esc.maneuver("step-steer", steer=0.01, t_end=1.2)
+    assert on["controller_inputs"] == ["brake_fl", "brake_fr"]
+    assert on["reference_limit"] == pytest.approx(0.85 * 9.80665 / 25, rel=1e-6)
+    assert 0 < max(on["controller_effort"]) <= 3000
+    off = esc.maneuver("step-steer", steer=0.01, t_end=1.2, open_loop=True)
+    assert "controller" not in off and off["max_sideslip"] > on["max_sideslip"] > 0
 
 
 def test_freqresp_is_the_command_lines(tmp_path):
