@@ -17,7 +17,7 @@ struct ManeuverArgs {
   double steer_scale = 0, frequency_min = 0, frequency_max = 0, sweep_time = 0, ay_min = 0, ay_max = 0;
   double radius = 0, speed_min = 0, speed_max = 0, width = 0, length = 0, preview = 0, lateral_gain = 0;
   double speed_kp = 0, speed_ki = 0, sample_time = 0;
-  double friction = 0;
+  double friction = 0, steer_rate = 0;
   int points = 0;
   bool open_loop = false;
 };
@@ -56,6 +56,7 @@ void run_maneuver(const ManeuverArgs& a, const CLI::App* cmd) {
   num("--speed-ki", a.speed_ki, r.speed_ki);
   num("--sample-time", a.sample_time, r.sample_time);
   num("--friction", a.friction, r.friction);
+  num("--steer-rate", a.steer_rate, r.steer_rate);
   r.open_loop = a.open_loop;
   if (given(cmd, "--points")) r.points = a.points;
   if (given(cmd, "--x")) r.x = a.x;
@@ -75,9 +76,9 @@ void run_maneuver(const ManeuverArgs& a, const CLI::App* cmd) {
 
 void add_maneuver(CLI::App& app) {
   auto a = std::make_shared<ManeuverArgs>();
-  auto* cmd = app.add_subcommand("maneuver", "Run a standard handling maneuver (step steer, sine with dwell, swept sine, double lane change, constant radius, constant speed) and print its metrics");
+  auto* cmd = app.add_subcommand("maneuver", "Run a standard handling maneuver (step steer, sine with dwell, swept sine, double lane change, constant radius, constant speed, slowly increasing steer, fishhook) and print its metrics");
   cmd->add_option("model", a->model, "model file (JSON)")->required();
-  cmd->add_option("--type", a->type, "step-steer | sine-with-dwell | swept-sine | double-lane-change | constant-radius | constant-speed")->required();
+  cmd->add_option("--type", a->type, "step-steer | sine-with-dwell | swept-sine | double-lane-change | constant-radius | constant-speed | slowly-increasing-steer | fishhook")->required();
   cmd->add_option("--out", a->out, "the run as an HDF5 results file");
   cmd->add_option("--csv", a->csv, "the run as CSV (constant radius, constant speed: the table)");
   cmd->add_option("--speed", a->speed, "m/s, the straight run's speed (default: the model file's steady motion)");
@@ -86,7 +87,8 @@ void add_maneuver(CLI::App& app) {
   cmd->add_option("--ramp", a->ramp, "s, the step's ramp (half cosine; default 0.05)");
   cmd->add_option("--frequency", a->frequency, "Hz, sine with dwell (default 0.7)");
   cmd->add_option("--dwell", a->dwell, "s, sine with dwell (default 0.5)");
-  cmd->add_option("--steer-scale", a->steer_scale, "sine with dwell: the amplitude as a multiple of the steady steer at 0.3 g (FMVSS 126: 5 .. 6.5)");
+  cmd->add_option("--steer-scale", a->steer_scale, "the amplitude as a multiple of the steady steer at 0.3 g (sine with dwell, FMVSS 126: 5 .. 6.5; slowly increasing steer: default 2.5; fishhook: 6.5)");
+  cmd->add_option("--steer-rate", a->steer_rate, "slowly increasing steer, fishhook: the steer's rate per s (13.5 deg/s, 720 deg/s, in rad)");
   cmd->add_option("--frequency-min", a->frequency_min, "Hz, swept sine's first frequency (default 0.1)");
   cmd->add_option("--frequency-max", a->frequency_max, "Hz, swept sine's last (default 2)");
   cmd->add_option("--sweep-time", a->sweep_time, "s, swept sine's sweep (default 30; 5 s at rest follow)");

@@ -67,6 +67,7 @@ py::dict do_maneuver(const Study& s, const py::dict& options) {
   r.free_inputs = k.names("free_inputs", "free_input");
   r.open_loop = k.flag("open_loop");
   r.friction = k.number("friction");
+  r.steer_rate = k.number("steer_rate");
   k.finish();
   ManeuverReport rep;
   {
@@ -83,7 +84,8 @@ py::dict do_maneuver(const Study& s, const py::dict& options) {
     d["controller_inputs"] = rep.controller_inputs;
     d["controller_effort"] = vector_of(rep.controller_effort);
   }
-  if (rep.type == "step-steer" || rep.type == "sine-with-dwell") {
+  if (rep.type == "step-steer" || rep.type == "sine-with-dwell" || rep.type == "slowly-increasing-steer" ||
+      rep.type == "fishhook") {
     d["max_sideslip"] = rep.max_sideslip;
     d["max_sideslip_time"] = rep.max_sideslip_time;
   }
@@ -111,6 +113,26 @@ py::dict do_maneuver(const Study& s, const py::dict& options) {
       d["largest_gap_yaw_rate"] = py::make_tuple(rep.sw_gap_yaw, rep.sw_gap_yaw_hz);
       d["largest_gap_lateral_acceleration"] = py::make_tuple(rep.sw_gap_lateral, rep.sw_gap_lateral_hz);
     }
+  } else if (rep.type == "slowly-increasing-steer") {
+    d["steer_at_0_3g"] = rep.sis_steer_03g;
+    d["time_at_0_3g"] = rep.sis_time_03g;
+    d["speed_at_0_3g"] = rep.sis_speed_03g;
+    d["steady_steer_at_0_3g"] = rep.sis_steady_steer_03g;
+    d["understeer_gradient"] = rep.sis_gradient;
+    d["steady_understeer_gradient"] = rep.sis_steady_gradient;
+    if (rep.handling_gradient) d["handling_understeer_gradient"] = *rep.handling_gradient;
+    d["max_lateral_acceleration"] = rep.sis_ay_max;
+    d["steer_at_max_lateral_acceleration"] = rep.sis_steer_at_ay_max;
+  } else if (rep.type == "fishhook") {
+    d["max_roll"] = rep.fh_max_roll;
+    d["max_roll_time"] = rep.fh_max_roll_time;
+    d["max_lateral_acceleration"] = rep.fh_ay_max;
+    d["tires"] = rep.fh_tires;
+    d["tire_sides"] = rep.fh_sides;
+    d["min_tire_load"] = vector_of(rep.fh_min_load);
+    d["min_tire_load_time"] = vector_of(rep.fh_min_load_time);
+    d["two_wheel_lift_time"] = rep.fh_lift_time;
+    d["two_wheel_lift_side"] = rep.fh_lift_side;
   } else if (rep.type == "double-lane-change") {
     d["path_error_max"] = rep.path.max_abs;
     d["path_error_rms"] = rep.path.rms;

@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -99,11 +100,6 @@ ModelSpec straight_spec(const ManeuverRequest& r, ModelSpec spec) {
 // a run that left the road, or spun
 void check_run(ManeuverReport& rep, const SimulationResult& res, const Model& m, int body) {
   if (res.stats.integrator_fell_back) rep.notes.push_back("integrator " + res.stats.integrator_choice);
-  if (!res.completed) {
-    rep.valid = false;
-    rep.invalid_reason = "the run did not complete: " + (res.failure.empty() ? std::string("cancelled") : res.failure);
-    return;
-  }
   Data d(m);
   double worst = 0, at = 0;
   for (int k = 0; k < res.samples(); ++k) {
@@ -116,7 +112,10 @@ void check_run(ManeuverReport& rep, const SimulationResult& res, const Model& m,
   }
   rep.max_sideslip = worst;
   rep.max_sideslip_time = at;
-  if (worst > 20 * kPi / 180) {
+  if (!res.completed) {
+    rep.valid = false;
+    rep.invalid_reason = "the run did not complete: " + (res.failure.empty() ? std::string("cancelled") : res.failure);
+  } else if (worst > 20 * kPi / 180) {
     std::ostringstream os;
     os << "the car spun out: its sideslip reached " << worst * 180 / kPi << " deg at t = " << at << " s";
     rep.valid = false;
@@ -211,13 +210,47 @@ OpenLoop open_loop_setup(const ManeuverRequest& r, const ModelSpec& spec, bool c
   return ol;
 }
 
-double steady_steer_at(const ManeuverRequest& r, const ModelSpec& spec, const OpenLoop& ol, double a_y) {
+double steady_steer_at(const ManeuverRequest& r, const ModelSpec& spec, const OpenLoop& ol, double a_y, double speed) {
   ModelSpec s = straight_spec(r, spec);
-  s.analysis.steady.speed = ol.start.speed_along_heading;
+  s.analysis.steady.speed = speed > 0 ? speed : ol.start.speed_along_heading;
   s.analysis.steady.lateral_acceleration = a_y;
   const Model m = study_model(s, r.model);
   const OperatingPoint op = study_operating_point(m, "steady");
   return op.u[ol.steer] - ol.op.u[ol.steer];
+}
+
+void steer_at_03g(ManeuverReport& rep, const ManeuverRequest& r, const ModelSpec& spec, const OpenLoop& ol,
+                  const std::string& otherwise) {
+  const double g03 = 0.3 * 9.80665;
+  try {
+    rep.steer_03g = 0.5 * (std::abs(steady_steer_at(r, spec, ol, g03)) + std::abs(steady_steer_at(r, spec, ol, -g03)));
+  } catch (const std::exception& e) {
+    rep.notes.push_back(std::string("no steer at 0.3 g (the steady turn at the run's speed): ") + e.what() + otherwise);
+  }
+}
+
+SteerProfile piecewise_linear(const std::vector<double>& t, const std::vector<double>& v) {
+  const auto segment = [t](double x) {  // the segment x lies in (right-continuous), -1 before, n-1 after
+    if (x < t.front()) return -1;
+    const auto it = std::upper_bound(t.begin(), t.end(), x);
+    return static_cast<int>(it - t.begin()) - 1;
+  };
+  SteerProfile p;
+  p.value = [t, v, segment](double x) {
+    const int k = segment(x);
+    if (k < 0) return v.front();
+    if (k >= static_cast<int>(t.size()) - 1) return v.back();
+    const std::size_t i = static_cast<std::size_t>(k);
+    return v[i] + (v[i + 1] - v[i]) * (x - t[i]) / (t[i + 1] - t[i]);
+  };
+  p.rate = [t, v, segment](double x) {
+    const int k = segment(x);
+    if (k < 0 || k >= static_cast<int>(t.size()) - 1) return 0.0;
+    const std::size_t i = static_cast<std::size_t>(k);
+    return (v[i + 1] - v[i]) / (t[i + 1] - t[i]);
+  };
+  p.acceleration = [](double) { return 0.0; };
+  return p;
 }
 
 Model open_loop_run(ManeuverReport& rep, const ManeuverRequest& r, const OpenLoop& ol, const SteerProfile& profile,
@@ -239,9 +272,6 @@ Model open_loop_run(ManeuverReport& rep, const ManeuverRequest& r, const OpenLoo
   o.disturbance_rate = [one, profile](double t) { return one(profile.rate(t)); };
   o.disturbance_acceleration = [one, profile](double t) { return one(profile.acceleration(t)); };
   o.rate_jumps = stops;
-  SimulationCallbacks cb;
-  cb.cancel = r.cancel;
-  cb.progress = r.progress;
   if (ol.controller) {
     const Eigen::VectorXd y0 = ol.plant->lin.system.y0;
     const int iy = ol.yaw_rate;
@@ -256,7 +286,32 @@ Model open_loop_run(ManeuverReport& rep, const ManeuverRequest& r, const OpenLoo
     rep.reference_gain = gain;
     rep.reference_limit = iy >= 0 ? limit : 0.0;
   }
+  // the run stops when the car rolls over (past kRolledOver: it does not come back, and a car on its
+  // side is no maneuver), or at the user's cancel, both seen at each output sample
+  std::atomic<bool> stop{false};
+  bool user_cancelled = false;
+  double rolled_at = -1, roll_reached = 0;
+  Data dk(run);
+  const int body = ol.body;
+  SimulationCallbacks cb;
+  cb.cancel = &stop;
+  cb.progress = r.progress;
+  cb.on_sample = [&](const Snapshot& sn) {
+    if (r.cancel && r.cancel->load()) {
+      user_cancelled = true;
+      stop.store(true);
+    }
+    forward_kinematics<double>(run, dk, sn.q, sn.v);
+    const SE3& X = dk.oMi[static_cast<std::size_t>(body)];
+    const double roll = std::atan2(X.R(2, 1), X.R(2, 2));
+    if (std::abs(roll) > kRolledOver && rolled_at < 0) {
+      rolled_at = sn.t;
+      roll_reached = roll;
+      stop.store(true);
+    }
+  };
   rep.result = simulate(run, ol.controller.get(), ol.plant.get(), o, cb);
+  if (user_cancelled || (rep.result.cancelled && rolled_at < 0)) throw StudyCancelled("the maneuver was cancelled");
   if (ol.controller && rep.result.samples() > 0) {
     const Eigen::VectorXd& u0 = ol.plant->op.u;
     for (int k : run.plant_inputs) {
@@ -266,8 +321,14 @@ Model open_loop_run(ManeuverReport& rep, const ManeuverRequest& r, const OpenLoo
       rep.controller_effort.push_back(largest);
     }
   }
-  if (rep.result.cancelled) throw StudyCancelled("the maneuver was cancelled");
   check_run(rep, rep.result, run, ol.body);
+  if (rolled_at >= 0) {
+    std::ostringstream os;
+    os << "the car rolled over: its roll reached " << std::abs(roll_reached) * 180 / kPi << " deg at t = " << rolled_at
+       << " s (the run stopped there)";
+    rep.valid = false;
+    rep.invalid_reason = os.str();
+  }
   if (rep.result.samples() > 0) {
     Data d(run);
     const int last = rep.result.samples() - 1;

@@ -21,6 +21,8 @@
 namespace codyna::mnv {
 
 inline constexpr double kPi = 3.14159265358979323846;
+// a roll past this (rad) is a rollover: the open-loop runs stop there, their metrics invalid
+inline constexpr double kRolledOver = 60 * kPi / 180;
 
 struct Flags {
   OptionStyle style;
@@ -79,9 +81,17 @@ struct OpenLoop {
 // maneuver that compares with the open-loop linear model refuses one (unless --open-loop)
 OpenLoop open_loop_setup(const ManeuverRequest& r, const ModelSpec& spec, bool controlled = false);
 // The steer (less the straight run's) of the steady turn at lateral acceleration a_y (m/s^2, > 0
-// left) at the straight run's speed, by the steady-motion search with the study's free inputs;
-// throws what the search throws.
-double steady_steer_at(const ManeuverRequest& r, const ModelSpec& spec, const OpenLoop& ol, double a_y);
+// left) at the straight run's speed (or at `speed` when > 0), by the steady-motion search with the
+// study's free inputs; throws what the search throws.
+double steady_steer_at(const ManeuverRequest& r, const ModelSpec& spec, const OpenLoop& ol, double a_y, double speed = 0);
+// FMVSS 126's reference steer into rep.steer_03g: the steady turns' at +-0.3 g at the run's speed,
+// averaged (the standard finds it in slowly increasing steer, both ways; the steady search is that
+// test's limit); when not found, a note: why, and `otherwise` (what that means for the maneuver)
+void steer_at_03g(ManeuverReport& rep, const ManeuverRequest& r, const ModelSpec& spec, const OpenLoop& ol,
+                  const std::string& otherwise);
+// a steer through the knots (t, v) (t rising), linear between them, v.front() before and v.back()
+// after: its rate jumps at the knots (where a run stops), its acceleration is zero between
+SteerProfile piecewise_linear(const std::vector<double>& t, const std::vector<double>& v);
 // Runs it to t_end with the steer's deviation from the steady run following `profile` (its rate
 // and acceleration exact: a motion input takes it), stopping at `stops` (where the steer's
 // acceleration jumps); fills rep.result, checks it (check_run), end_speed, end_yaw_rate. Returns
@@ -93,5 +103,7 @@ Model open_loop_run(ManeuverReport& rep, const ManeuverRequest& r, const OpenLoo
 ManeuverReport swept_sine(const ManeuverRequest& r, const ModelSpec& spec);       // maneuver_swept.cpp
 ManeuverReport constant_radius(const ManeuverRequest& r, const ModelSpec& spec);  // maneuver_steady.cpp
 ManeuverReport constant_speed(const ManeuverRequest& r, const ModelSpec& spec);   // maneuver_steady.cpp
+ManeuverReport slowly_increasing_steer(const ManeuverRequest& r, const ModelSpec& spec);  // maneuver_ramp.cpp
+ManeuverReport fishhook(const ManeuverRequest& r, const ModelSpec& spec);                 // maneuver_ramp.cpp
 
 }  // namespace codyna::mnv

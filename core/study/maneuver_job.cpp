@@ -56,19 +56,6 @@ mnv::SteerProfile mnv_sine_dwell(double amplitude, double t0, double f, double d
   return p;
 }
 
-// FMVSS 126's reference steer: the steady turns' at 0.3 g at the run's speed, left and right
-// averaged (the standard finds it in slowly increasing steer, both ways; the steady search is that
-// test's limit)
-void mnv_steer_03g(ManeuverReport& rep, const ManeuverRequest& r, const ModelSpec& spec, const mnv::OpenLoop& ol) {
-  const double g03 = 0.3 * 9.80665;
-  try {
-    rep.steer_03g = 0.5 * (std::abs(mnv::steady_steer_at(r, spec, ol, g03)) + std::abs(mnv::steady_steer_at(r, spec, ol, -g03)));
-  } catch (const std::exception& e) {
-    rep.notes.push_back(std::string("no steer at 0.3 g (the steady turn at the run's speed): ") + e.what() +
-                        "; the lateral displacement is asked at any amplitude");
-  }
-}
-
 ManeuverReport mnv_open_loop(const ManeuverRequest& r, const ModelSpec& spec, bool sine) {
   const mnv::Flags flag{r.style};
   ManeuverReport rep;
@@ -79,7 +66,7 @@ ManeuverReport mnv_open_loop(const ManeuverRequest& r, const ModelSpec& spec, bo
   const int iy = ol.yaw_rate, ia = ol.lateral_acceleration;
   const mnv::BodyState& s0 = ol.start;
 
-  if (sine) mnv_steer_03g(rep, r, spec, ol);
+  if (sine) mnv::steer_at_03g(rep, r, spec, ol, "; the lateral displacement is asked at any amplitude");
   double amplitude = r.steer ? *r.steer : (sine ? 0.05 : 0.01);
   if (sine && r.steer_scale) {
     if (r.steer) throw std::invalid_argument(flag("steer-scale") + ": give the amplitude or its scale, not both (" + flag("steer") + ")");
@@ -390,6 +377,8 @@ ManeuverReport study_maneuver_job(const ManeuverRequest& r, const ModelSpec& spe
   else if (r.type == "double-lane-change") rep = mnv_lane_change(r, given);
   else if (r.type == "constant-radius") rep = mnv::constant_radius(r, given);
   else if (r.type == "constant-speed") rep = mnv::constant_speed(r, given);
+  else if (r.type == "slowly-increasing-steer") rep = mnv::slowly_increasing_steer(r, given);
+  else if (r.type == "fishhook") rep = mnv::fishhook(r, given);
   else throw std::invalid_argument(flag("type") + ": unknown maneuver \"" + r.type + "\" (expected one of " + known + ")");
   if (tell) {
     for (const std::string& n : rep.notes) tell({StudyMessage::Note, n});
@@ -489,7 +478,7 @@ std::string study_maneuver_text(const ManeuverReport& r) {
     for (std::size_t k = 0; k < r.controller_inputs.size(); ++k)
       os << "  largest |u - u0| " << r.controller_inputs[k] << " " << r.controller_effort[k] << "\n";
   }
-  if (r.type == "step-steer" || r.type == "sine-with-dwell")
+  if (r.type == "step-steer" || r.type == "sine-with-dwell" || r.type == "slowly-increasing-steer" || r.type == "fishhook")
     os << "largest sideslip " << r.max_sideslip * deg << " deg at " << r.max_sideslip_time << " s\n";
   if (r.type == "step-steer") {
     os << "steer step       " << r.steer << "\n";
@@ -520,6 +509,39 @@ std::string study_maneuver_text(const ManeuverReport& r) {
        << "largest steer    " << r.max_steer << "\n"
        << "cones            " << (r.cones_hit.empty() ? "none hit" : std::to_string(r.cones_hit.size()) + " section(s) hit") << "\n";
     for (const std::string& c : r.cones_hit) os << "  hit: " << c << "\n";
+  } else if (r.type == "slowly-increasing-steer") {
+    const auto pct = [](double a, double b) { return std::abs(a - b) / std::abs(b) * 100; };
+    os << "steer ramp       to " << r.steer << " (from " << r.steer_start << " s to " << r.steer_end << " s)\n";
+    if (std::isfinite(r.sis_steer_03g)) {
+      os << "at 0.3 g         steer " << r.sis_steer_03g << " at " << r.sis_time_03g << " s, speed " << r.sis_speed_03g
+         << " m/s (a_y = U r)\n";
+      if (std::isfinite(r.sis_steady_steer_03g))
+        os << "  steady turn's  steer " << r.sis_steady_steer_03g << " (difference " << pct(r.sis_steer_03g, r.sis_steady_steer_03g)
+           << " %)\n";
+    }
+    if (std::isfinite(r.sis_gradient)) {
+      os << "understeer gradient (0.1 .. 0.3 g)  " << r.sis_gradient << " rad/(m/s^2) = " << r.sis_gradient * deg * 9.80665
+         << " deg/g (road-wheel angle)\n";
+      if (std::isfinite(r.sis_steady_gradient))
+        os << "  steady turns' (same a_y, speed)  " << r.sis_steady_gradient << " rad/(m/s^2) = "
+           << r.sis_steady_gradient * deg * 9.80665 << " deg/g (difference " << pct(r.sis_gradient, r.sis_steady_gradient) << " %)\n";
+      if (r.handling_gradient)
+        os << "  handling number K (low a_y)      " << *r.handling_gradient << " rad/(m/s^2) = "
+           << *r.handling_gradient * deg * 9.80665 << " deg/g (difference " << pct(r.sis_gradient, *r.handling_gradient) << " %)\n";
+    }
+    os << "largest a_y      " << r.sis_ay_max << " m/s^2 (" << r.sis_ay_max / 9.80665 << " g) at steer " << r.sis_steer_at_ay_max
+       << " (" << r.sis_time_ay_max << " s)\n";
+  } else if (r.type == "fishhook") {
+    os << "steer            +-" << std::abs(r.steer) << " (from " << r.steer_start << " s to " << r.steer_end << " s)\n"
+       << "largest roll     " << r.fh_max_roll * deg << " deg at " << r.fh_max_roll_time << " s\n"
+       << "largest a_y      " << r.fh_ay_max << " m/s^2 (" << r.fh_ay_max / 9.80665 << " g)\n"
+       << "smallest tire loads\n";
+    for (std::size_t k = 0; k < r.fh_tires.size(); ++k)
+      os << "  " << std::left << std::setw(14) << r.fh_tires[k] << std::setw(7) << r.fh_sides[k] << std::right << std::setw(12)
+         << r.fh_min_load[k] << " N at " << r.fh_min_load_time[k] << " s\n";
+    os << "two-wheel lift   " << (r.fh_lift_time < 0 ? std::string("none") : r.fh_lift_side + " side off the road at ");
+    if (r.fh_lift_time >= 0) os << r.fh_lift_time << " s";
+    os << "\n";
   }
   if (!r.valid) os << "metrics INVALID: " << r.invalid_reason << "\n";
   for (const std::string& w : r.written) os << "wrote " << w << "\n";

@@ -53,8 +53,9 @@
 namespace codyna {
 
 // the maneuver types, in the order the help lists them
-inline constexpr const char* kManeuverTypes[] = {"step-steer", "sine-with-dwell", "swept-sine", "double-lane-change",
-                                                 "constant-radius", "constant-speed"};
+inline constexpr const char* kManeuverTypes[] = {"step-steer",      "sine-with-dwell",         "swept-sine",
+                                                 "double-lane-change", "constant-radius",     "constant-speed",
+                                                 "slowly-increasing-steer", "fishhook"};
 
 struct ManeuverRequest {
   OptionStyle style = OptionStyle::Flag;
@@ -69,6 +70,10 @@ struct ManeuverRequest {
   // run's speed (FMVSS 126's 5 .. 6.5 x delta_0.3g); not with steer
   std::optional<double> steer_scale;
   std::optional<double> frequency_min, frequency_max, sweep_time;  // swept sine: Hz (0.1, 2), s (30)
+  // slowly increasing steer, fishhook: the steer's rate, steer units per s (13.5 deg/s, 720 deg/s:
+  // the standards' at the steering wheel); their amplitude --steer, or --steer-scale times the
+  // steady steer at 0.3 g (2.5, 6.5)
+  std::optional<double> steer_rate;
   std::optional<double> t_end, output_step;    // s
   std::optional<std::string> integrator;       // the runs' (default the model file's solver)
   std::optional<double> radius;                // constant radius, m
@@ -147,6 +152,26 @@ struct ManeuverReport {
   std::vector<double> cr_linear_steer, cr_linear_gradient;
   std::optional<double> linear_gradient;   // cr_linear_gradient's first: the linear model's, rad per m/s^2
   std::optional<double> handling_gradient; // the handling number K at the first speed (constant speed)
+  // slowly increasing steer (a_y = U r of the steady body): where |a_y| first reaches 0.3 g, the
+  // steer (less the straight run's), the time and the speed, against the steady turn's steer at
+  // 0.3 g the same way at that speed (its steer less the straight run's at the start); the understeer gradient from the run, the slope of
+  // delta / ratio - L r / U over a_y fitted between 0.1 and 0.3 g (rad per m/s^2, road-wheel angle;
+  // NaN when the run does not reach 0.3 g), beside the handling number K (handling_gradient); the
+  // largest |a_y| and the steer there
+  double sis_steer_03g = std::nan(""), sis_time_03g = std::nan(""), sis_speed_03g = std::nan("");
+  double sis_steady_steer_03g = std::nan(""), sis_gradient = std::nan("");
+  // the steady turns' gradient over the same range, at the run's speed at 0.3 g: the secant of
+  // delta / ratio - L / R between the turns at 0.1 and 0.3 g
+  double sis_steady_gradient = std::nan("");
+  double sis_ay_max = 0, sis_steer_at_ay_max = 0, sis_time_ay_max = 0;
+  // fishhook: the steady body's largest |roll| (rad) and when; per tire its name, side ("left" /
+  // "right" of the steady body at the start), smallest normal load (N) and when; the first sample
+  // at which both tires of one side are off the road (a two-wheel lift: -1 none) and that side;
+  // the largest |a_y| (the lateral-acceleration output's, or U r without one)
+  double fh_max_roll = 0, fh_max_roll_time = 0, fh_lift_time = -1, fh_ay_max = 0;
+  std::string fh_lift_side;
+  std::vector<std::string> fh_tires, fh_sides;
+  std::vector<double> fh_min_load, fh_min_load_time;
   // the run (time series; not for the constant radius)
   SimulationResult result;
   std::vector<std::string> written;

@@ -1,0 +1,206 @@
+// The maneuvers whose steer is a ramp at a set rate (study/maneuver_job.hpp): slowly increasing
+// steer (SAE J266, FMVSS 126 S5.1.2's characterization) and NHTSA's fishhook (fixed timing).
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "dynamics/kinematics.hpp"
+#include "model/errors.hpp"
+#include "study/maneuver_detail.hpp"
+#include "study/tire_contacts.hpp"
+#include "study/workflow.hpp"
+
+namespace codyna::mnv {
+
+namespace {
+
+constexpr double kG = 9.80665;
+
+// the amplitude: --steer, or --steer-scale times the steady steer at 0.3 g (scale_default when
+// neither is given); refused when neither can be had
+double ramp_amplitude(ManeuverReport& rep, const ManeuverRequest& r, const ModelSpec& spec, const OpenLoop& ol,
+                      double scale_default) {
+  const Flags flag{r.style};
+  if (r.steer && r.steer_scale)
+    throw std::invalid_argument(flag("steer-scale") + ": give the amplitude or its scale, not both (" + flag("steer") + ")");
+  if (r.steer) {
+    if (!std::isfinite(*r.steer) || *r.steer == 0) throw std::invalid_argument(flag("steer") + ": expected a steer other than 0");
+    return *r.steer;
+  }
+  const double scale = r.steer_scale ? *r.steer_scale : scale_default;
+  if (!std::isfinite(scale) || scale == 0)
+    throw std::invalid_argument(flag("steer-scale") + ": expected a multiple of the steer at 0.3 g other than 0");
+  steer_at_03g(rep, r, spec, ol, "");
+  if (!std::isfinite(rep.steer_03g))
+    throw std::invalid_argument(flag("steer") + ": give the amplitude; " + rep.notes.back());
+  return scale * rep.steer_03g;
+}
+
+double ramp_rate(const ManeuverRequest& r, double fallback) { return positive(Flags{r.style}, r.steer_rate, fallback, "steer-rate"); }
+
+// the steady body's state at every sample
+std::vector<BodyState> ramp_states(const Model& run, const ManeuverReport& rep, int body) {
+  Data d(run);
+  std::vector<BodyState> out;
+  out.reserve(static_cast<std::size_t>(rep.result.samples()));
+  for (int k = 0; k < rep.result.samples(); ++k)
+    out.push_back(body_state(run, d, body, rep.result.q.row(k).transpose(), rep.result.v.row(k).transpose()));
+  return out;
+}
+
+// the straight run's handling numbers with the steer as the input (its K, L and steering ratio)
+std::optional<HandlingNumbers> ramp_handling(ManeuverReport& rep, const ManeuverRequest& r, const ModelSpec& spec) {
+  try {
+    ModelSpec ls = straight_spec(r, spec);
+    ls.plant.inputs = {spec.analysis.handling.steer};
+    ls.controller = ControllerSpec{};
+    const StudyLinearization lin = study_linearize(study_model(ls, r.model));
+    if (lin.handling) return lin.handling;
+    rep.notes.push_back("no handling numbers to compare with (analysis.handling)");
+  } catch (const std::exception& e) {
+    rep.notes.push_back(std::string("no handling numbers to compare with: ") + e.what());
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+ManeuverReport slowly_increasing_steer(const ManeuverRequest& r, const ModelSpec& spec) {
+  const Flags flag{r.style};
+  ManeuverReport rep;
+  rep.type = r.type;
+  const OpenLoop ol = open_loop_setup(r, spec, true);
+  rep.model_name = ol.model.name;
+  rep.speed = ol.start.v_body.norm();
+  const double amplitude = ramp_amplitude(rep, r, spec, ol, 2.5);
+  rep.steer = amplitude;
+  const double rate = ramp_rate(r, 13.5 * kPi / 180);
+  const double t0 = r.steer_time ? *r.steer_time : 0.5;
+  if (!(t0 >= 0) || !std::isfinite(t0)) throw std::invalid_argument(flag("steer-time") + ": expected a time >= 0");
+  const double T = std::abs(amplitude) / rate;
+  rep.steer_start = t0;
+  rep.steer_end = t0 + T;
+  const double t_end = r.t_end ? *r.t_end : t0 + T;
+  if (!(t_end > t0) || !std::isfinite(t_end)) throw std::invalid_argument(flag("t-end") + ": expected a time past the steer's start");
+  const double sign = amplitude > 0 ? 1.0 : -1.0;
+  const std::optional<HandlingNumbers> h = ramp_handling(rep, r, spec);
+  if (h) rep.handling_gradient = h->understeer_gradient;
+  const Model run = open_loop_run(rep, r, ol, piecewise_linear({t0, t0 + T}, {0.0, amplitude}), {t0, t0 + T}, t_end);
+  if (rep.result.samples() < 3) return rep;
+  const std::vector<BodyState> st = ramp_states(run, rep, ol.body);
+  const std::vector<double>& t = rep.result.t;
+  const auto steer_at = [&](std::size_t k) { return rep.result.u(static_cast<Eigen::Index>(k), ol.steer) - ol.op.u[ol.steer]; };
+  const auto ay = [&](std::size_t k) { return st[k].speed_along_heading * st[k].yaw_rate; };
+  for (std::size_t k = 0; k < st.size(); ++k) {
+    if (std::abs(ay(k)) > rep.sis_ay_max) {
+      rep.sis_ay_max = std::abs(ay(k));
+      rep.sis_steer_at_ay_max = steer_at(k);
+      rep.sis_time_ay_max = t[k];
+    }
+    if (std::isnan(rep.sis_steer_03g) && k > 0 && std::abs(ay(k)) >= 0.3 * kG) {
+      // linear interpolation between the samples either side
+      const double a0 = std::abs(ay(k - 1)), a1 = std::abs(ay(k)), w = (0.3 * kG - a0) / (a1 - a0);
+      rep.sis_steer_03g = steer_at(k - 1) + w * (steer_at(k) - steer_at(k - 1));
+      rep.sis_time_03g = t[k - 1] + w * (t[k] - t[k - 1]);
+      rep.sis_speed_03g = st[k - 1].speed_along_heading + w * (st[k].speed_along_heading - st[k - 1].speed_along_heading);
+    }
+  }
+  if (std::isnan(rep.sis_steer_03g)) {
+    rep.notes.push_back("the run does not reach 0.3 g (largest |a_y| " + std::to_string(rep.sis_ay_max) +
+                        " m/s^2): raise the amplitude (" + flag("steer") + ")");
+  } else {
+    // the steady turns at the run's speed there: at 0.3 g, and at 0.1 g for the gradient's secant
+    try {
+      rep.sis_steady_steer_03g = steady_steer_at(r, spec, ol, sign * 0.3 * kG, rep.sis_speed_03g);
+      if (h && h->wheelbase > 0) {
+        const double s01 = steady_steer_at(r, spec, ol, sign * 0.1 * kG, rep.sis_speed_03g);
+        rep.sis_steady_gradient = sign * (rep.sis_steady_steer_03g - s01) / h->steering_ratio / (0.2 * kG) -
+                                  h->wheelbase / (rep.sis_speed_03g * rep.sis_speed_03g);
+      }
+    } catch (const std::exception& e) {
+      rep.notes.push_back(std::string("no steady turn to compare with: ") + e.what());
+    }
+  }
+  if (std::isfinite(rep.sis_steer_03g) && h && h->wheelbase > 0) {
+    // delta / ratio - L r / U = K a_y in every steady turn: its slope over a_y between 0.1 and 0.3 g
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    int n = 0;
+    for (std::size_t k = 0; k < st.size() && t[k] <= rep.sis_time_03g; ++k) {
+      const double a = std::abs(ay(k));
+      if (a < 0.1 * kG) continue;
+      const double x = sign * ay(k);
+      const double y = sign * (steer_at(k) / h->steering_ratio - h->wheelbase * st[k].yaw_rate / st[k].speed_along_heading);
+      sx += x, sy += y, sxx += x * x, sxy += x * y;
+      ++n;
+    }
+    if (n >= 3) rep.sis_gradient = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+  }
+  write(rep, r);
+  return rep;
+}
+
+ManeuverReport fishhook(const ManeuverRequest& r, const ModelSpec& spec) {
+  const Flags flag{r.style};
+  ManeuverReport rep;
+  rep.type = r.type;
+  const OpenLoop ol = open_loop_setup(r, spec, true);
+  rep.model_name = ol.model.name;
+  rep.speed = ol.start.v_body.norm();
+  if (ol.model.tires.empty())
+    throw ModelError(ol.model.source_file, "/effects", "the fishhook reads the tires' loads: the model has no tire");
+  const double A = ramp_amplitude(rep, r, spec, ol, 6.5);
+  rep.steer = A;
+  const double rate = ramp_rate(r, 720 * kPi / 180);
+  const double dwell = r.dwell ? *r.dwell : 0.25;
+  if (!(dwell >= 0) || !std::isfinite(dwell)) throw std::invalid_argument(flag("dwell") + ": expected a time >= 0");
+  const double t0 = r.steer_time ? *r.steer_time : 0.5;
+  if (!(t0 >= 0) || !std::isfinite(t0)) throw std::invalid_argument(flag("steer-time") + ": expected a time >= 0");
+  // to A, the dwell, through to -A at the same rate, held 3 s, back to zero over 2 s (NHTSA)
+  const double t1 = t0 + std::abs(A) / rate, t2 = t1 + dwell, t3 = t2 + 2 * std::abs(A) / rate, t4 = t3 + 3.0, t5 = t4 + 2.0;
+  std::vector<double> knots = {t0, t1}, values = {0.0, A};
+  if (dwell > 0) knots.push_back(t2), values.push_back(A);
+  for (const auto& [tk, vk] : {std::pair{t3, -A}, std::pair{t4, -A}, std::pair{t5, 0.0}}) knots.push_back(tk), values.push_back(vk);
+  rep.steer_start = t0;
+  rep.steer_end = t5;
+  const double t_end = r.t_end ? *r.t_end : t5 + 1.0;
+  if (!(t_end > t0) || !std::isfinite(t_end)) throw std::invalid_argument(flag("t-end") + ": expected a time past the steer's start");
+  const Model run = open_loop_run(rep, r, ol, piecewise_linear(knots, values), knots, t_end);
+  if (rep.result.samples() < 1) return rep;
+  const std::vector<BodyState> st = ramp_states(run, rep, ol.body);
+  const std::vector<double>& t = rep.result.t;
+  // each tire's side: its wheel centre in the steady body's axes at the start
+  const std::vector<TireContactReport> c0 = study_tire_contacts(run, ol.op.q, ol.op.v);
+  Data d(run);
+  forward_kinematics<double>(run, d, ol.op.q, ol.op.v);
+  const SE3& X = d.oMi[static_cast<std::size_t>(ol.body)];
+  for (const TireContactReport& c : c0) {
+    rep.fh_tires.push_back(c.name);
+    rep.fh_sides.push_back((X.R.transpose() * (c.center - X.p)).y() > 0 ? "left" : "right");
+    rep.fh_min_load.push_back(c.Fz);
+    rep.fh_min_load_time.push_back(t.front());
+  }
+  for (std::size_t k = 0; k < st.size(); ++k) {
+    if (std::abs(st[k].roll) > rep.fh_max_roll) rep.fh_max_roll = std::abs(st[k].roll), rep.fh_max_roll_time = t[k];
+    rep.fh_ay_max = std::max(rep.fh_ay_max, std::abs(ol.lateral_acceleration >= 0 ? rep.result.y(static_cast<Eigen::Index>(k), ol.lateral_acceleration)
+                                                                                   : st[k].speed_along_heading * st[k].yaw_rate));
+    const Eigen::Index i = static_cast<Eigen::Index>(k);
+    const Eigen::VectorXd s = rep.result.s.cols() ? Eigen::VectorXd(rep.result.s.row(i).transpose()) : Eigen::VectorXd();
+    const std::vector<TireContactReport> c = study_tire_contacts(run, rep.result.q.row(i).transpose(), rep.result.v.row(i).transpose(), s);
+    bool off_left = true, off_right = true, any_left = false, any_right = false;
+    for (std::size_t j = 0; j < c.size(); ++j) {
+      if (c[j].Fz < rep.fh_min_load[j]) rep.fh_min_load[j] = c[j].Fz, rep.fh_min_load_time[j] = t[k];
+      bool& off = rep.fh_sides[j] == "left" ? off_left : off_right;
+      (rep.fh_sides[j] == "left" ? any_left : any_right) = true;
+      off = off && !c[j].in_contact;
+    }
+    if (rep.fh_lift_time < 0 && ((any_left && off_left) || (any_right && off_right))) {
+      rep.fh_lift_time = t[k];
+      rep.fh_lift_side = any_left && off_left ? "left" : "right";
+    }
+  }
+  write(rep, r);
+  return rep;
+}
+
+}  // namespace codyna::mnv

@@ -1,0 +1,129 @@
+// Slowly increasing steer and the fishhook (study/maneuver_ramp.cpp), each against an independent
+// value: the single-track car's understeer gradient from a slow ramp against its handling number
+// (linear tires: K is the same at every a_y), its steer at 0.3 g against the steady turn's, the gap
+// the yaw response's lag (proportional to the steer's rate); the fishhook's tire loads against the
+// tire sensors of the same run, its two-wheel lift and rollover on a sedan whose centre of mass is
+// raised, where the run stops.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "study/files.hpp"
+#include "study/maneuver_job.hpp"
+#include "study/tire_contacts.hpp"
+#include "study/workflow.hpp"
+
+using namespace codyna;
+
+namespace {
+
+const double kPiRampTest = 3.14159265358979323846;
+
+std::string ramp_example(const std::string& name) { return std::string(CODYNA_EXAMPLES_DIR) + "/" + name; }
+
+ManeuverReport ramp_sis(double rate) {
+  const std::string file = ramp_example("single_track_car.json");
+  ManeuverRequest r;
+  r.model = file;
+  r.type = "slowly-increasing-steer";
+  r.steer_rate = rate;
+  r.output_step = 0.01;
+  r.free_inputs = std::vector<std::string>{"steer", "drive"};
+  return study_maneuver_job(r, study_read_model(file));
+}
+
+}  // namespace
+
+// The single-track car at 30 m/s (default amplitude: 2.5 x the steer at 0.3 g): from a ramp of
+// 0.002 rad/s the gradient over 0.1 .. 0.3 g is the handling number to 8e-4 (the steady turns'
+// secant to 6e-4); the steer at 0.3 g leads the steady turn's by the yaw response's lag, the same
+// time at two rates (0.0690 s and 0.0699 s measured), so the gap is the rate times it
+TEST(ManeuverRamp, SlowlyIncreasingSteerGivesTheHandlingNumberOfTheSingleTrackCar) {
+  const ManeuverReport slow = ramp_sis(0.002), fast = ramp_sis(0.01);
+  std::cout << study_maneuver_text(slow) << study_maneuver_text(fast);
+  for (const ManeuverReport* rep : {&slow, &fast}) {
+    ASSERT_TRUE(rep->valid) << rep->invalid_reason;
+    ASSERT_TRUE(std::isfinite(rep->sis_steer_03g));
+    ASSERT_TRUE(rep->handling_gradient);
+    EXPECT_GT(rep->sis_ay_max, 0.6 * 9.80665);
+  }
+  EXPECT_NEAR(slow.sis_gradient, *slow.handling_gradient, 2e-3 * *slow.handling_gradient);
+  EXPECT_NEAR(slow.sis_gradient, slow.sis_steady_gradient, 2e-3 * slow.sis_steady_gradient);
+  EXPECT_NEAR(fast.sis_gradient, *fast.handling_gradient, 6e-3 * *fast.handling_gradient);
+  const double lag_slow = (slow.sis_steer_03g - slow.sis_steady_steer_03g) / 0.002;
+  const double lag_fast = (fast.sis_steer_03g - fast.sis_steady_steer_03g) / 0.01;
+  EXPECT_GT(lag_slow, 0.05);
+  EXPECT_LT(lag_slow, 0.1);
+  EXPECT_NEAR(lag_fast, lag_slow, 0.03 * lag_slow);
+  // where the ramp's steer is: rate x (t - start)
+  EXPECT_NEAR(slow.sis_steer_03g, 0.002 * (slow.sis_time_03g - slow.steer_start), 1e-9);
+}
+
+// The sedan at 22.2 m/s (FMVSS 126's speed; 6.5 x the steer at 0.3 g, 720 deg/s): it stays on its
+// wheels; each tire's smallest load equals the smallest its Fz sensor recorded in the same run
+TEST(ManeuverRamp, TheSedansFishhookKeepsItsWheelsOnTheRoadAndItsLoadsAreItsSensors) {
+  const std::string file = ramp_example("sedan.json");
+  ModelSpec spec = study_read_model(file);
+  for (const char* t : {"fl", "fr", "rl", "rr"}) spec.plant.outputs.push_back(std::string("Fz_") + t);
+  ManeuverRequest r;
+  r.model = file;
+  r.type = "fishhook";
+  r.speed = 22.2;
+  r.output_step = 0.005;
+  const ManeuverReport rep = study_maneuver_job(r, spec);
+  std::cout << study_maneuver_text(rep);
+  ASSERT_TRUE(rep.valid) << rep.invalid_reason;
+  EXPECT_LT(rep.fh_lift_time, 0.0);
+  EXPECT_NEAR(rep.steer, 6.5 * rep.steer_03g, 1e-12);
+  EXPECT_GT(rep.fh_max_roll, 2 * kPiRampTest / 180);
+  EXPECT_LT(rep.fh_max_roll, 10 * kPiRampTest / 180);
+  ASSERT_EQ(rep.fh_tires.size(), 4u);
+  EXPECT_EQ(rep.fh_sides, (std::vector<std::string>{"left", "right", "left", "right"}));
+  for (std::size_t j = 0; j < 4; ++j) {
+    const Eigen::Index col = 3 + static_cast<Eigen::Index>(j);
+    ASSERT_EQ(rep.result.output_names[static_cast<std::size_t>(col)], "Fz_" + rep.fh_tires[j].substr(5));
+    const double sensor_min = rep.result.y.col(col).minCoeff();
+    EXPECT_NEAR(rep.fh_min_load[j], sensor_min, 1e-9 * 4000) << rep.fh_tires[j];
+    EXPECT_GT(rep.fh_min_load[j], 0.0);
+  }
+  // the steer's knots: to A at 720 deg/s, the dwell, to -A, held 3 s, back to zero over 2 s
+  const double A = rep.steer, rate = 720 * kPiRampTest / 180;
+  EXPECT_NEAR(rep.steer_end - rep.steer_start, A / rate + 0.25 + 2 * A / rate + 3 + 2, 1e-12);
+}
+
+// The same sedan with its chassis' centre of mass 0.5 m higher: the fishhook lifts both inner
+// (left) wheels in the first turn, and the car rolls over; the run stops at 60 deg of roll, its
+// metrics invalid saying so. At the lift both left tires are off the road, at the sample before not
+TEST(ManeuverRamp, ATallSedanLiftsItsInnerWheelsAndRollsOverAndTheRunStops) {
+  const std::string file = ramp_example("sedan.json");
+  ModelSpec spec = study_read_model(file);
+  spec.bodies[0].com = Eigen::Vector3d(0, 0, 0.5);
+  ManeuverRequest r;
+  r.model = file;
+  r.type = "fishhook";
+  r.speed = 22.2;
+  r.output_step = 0.005;
+  const ManeuverReport rep = study_maneuver_job(r, spec);
+  std::cout << study_maneuver_text(rep);
+  EXPECT_FALSE(rep.valid);
+  EXPECT_NE(rep.invalid_reason.find("rolled over"), std::string::npos) << rep.invalid_reason;
+  EXPECT_GT(rep.fh_max_roll, 60 * kPiRampTest / 180);
+  EXPECT_LT(rep.result.t.back(), rep.steer_end);
+  ASSERT_GT(rep.fh_lift_time, rep.steer_start);
+  EXPECT_EQ(rep.fh_lift_side, "left");
+  ModelSpec straight = spec;
+  straight.analysis.steady.speed = 22.2;
+  const Model m = study_model(straight, file);
+  ASSERT_EQ(m.nq, rep.result.q.cols());
+  std::size_t k = 0;
+  while (rep.result.t[k] < rep.fh_lift_time) ++k;
+  ASSERT_GT(k, 0u);
+  const auto left_off = [&](std::size_t i) {
+    const Eigen::Index row = static_cast<Eigen::Index>(i);
+    const std::vector<TireContactReport> c = study_tire_contacts(m, rep.result.q.row(row).transpose(), rep.result.v.row(row).transpose());
+    return !c[0].in_contact && !c[2].in_contact;  // tire_fl, tire_rl
+  };
+  EXPECT_TRUE(left_off(k));
+  EXPECT_FALSE(left_off(k - 1));
+}
