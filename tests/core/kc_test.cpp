@@ -292,3 +292,40 @@ TEST(KcJob, BadRequestsAreRefusedNamingTheOption) {
 
 }  // namespace
 }  // namespace codyna
+
+namespace codyna {
+namespace {
+
+// The sedan's left front corner in the full car (chassis on its free joint, held): an aligning
+// moment turns the upright about its kingpin against the steering column's torsion bushing (2000 N m/rad)
+// through the tie rod (0.12 m behind the kingpin, along y), the rack and the 16:1 pinion (0.0075 m of
+// rack per rad of shaft): the rack's stiffness is kc / p^2, so d toe / d Mz = -1 / (0.12^2 kc / p^2)
+// (toe-out for a moment to the left), the spring network's static solution. The front coil-overs'
+// rest lengths are set to their design lengths: with their preload the travel constraint's reaction
+// would add the kingpin's jacking (a geometric stiffness) to the network (1.2e-4 of it, measured).
+TEST(KcJob, AligningMomentComplianceOfTheSedanIsItsSteeringColumnsSpring) {
+  ModelSpec spec = study_read_model(CODYNA_EXAMPLES_DIR "/sedan.json");
+  int unloaded = 0;
+  for (EffectSpec& e : spec.effects)
+    if (e.name == "spring_fl" || e.name == "spring_fr") {
+      e.rest_length = std::sqrt(0.05 * 0.05 + 0.55 * 0.55);  // top [1.2, 0.55, 0.25], bottom [1.2, 0.60, -0.30]
+      ++unloaded;
+    }
+  ASSERT_EQ(unloaded, 2);
+  KcRequest r;
+  r.model = CODYNA_EXAMPLES_DIR "/sedan.json";
+  r.spec = &spec;
+  r.wheel = "tire_fl";
+  r.travel = KcRange{-0.01, 0.01, 3};
+  const KcReport rep = study_kc_job(r);
+  EXPECT_EQ(rep.held, "chassis");
+  EXPECT_EQ(rep.wheel, "wheel_fl");
+  const double pinion = 0.12 / 16, column = 2000, arm = 0.12;
+  const double rack_stiffness = column / (pinion * pinion);
+  const double toe_per_kNm = -1000 / (arm * arm * rack_stiffness) * kc_test_deg;
+  EXPECT_NEAR(rep.gradients.mz_steer, toe_per_kNm, 1e-7 * std::abs(toe_per_kNm)) << rep.gradients.mz_steer;
+  EXPECT_NEAR(rep.gradients.mz_camber, 0.0, 1e-9);
+}
+
+}  // namespace
+}  // namespace codyna
