@@ -48,7 +48,7 @@ bool written_by_codyna(const std::string& path, OutputKind k) {
     case OutputKind::FrequencyResponseCsv:
       return starts_with(h, "w_rad_s,f_Hz,");
     case OutputKind::KcCsv:
-      return starts_with(h, "sweep,travel_m,");
+      return starts_with(h, "sweep,wheel,travel_m,");
   }
   return false;
 }

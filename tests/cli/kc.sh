@@ -57,6 +57,22 @@ m = re.search(r'Fy compliance steer\s+(\S+) deg/kN\s+camber\s+(\S+) deg/kN', tex
 assert m and abs(float(m.group(1))) > 1e-3 and abs(float(m.group(2))) > 1e-3, m
 PY
 
+# the sedan's front axle (the chassis held on its free joint) rolled: the left wheel at +phi is the right one at -phi
+"$codyna" kc "$src/examples/sedan.json" --wheel tire_fl --wheel tire_fr --roll=-4:4:5 --csv axle.csv > out.txt 2> err.txt \
+  || fail "axle: exit $?: $(cat err.txt)"
+grep -q "axle roll centre" out.txt || fail "no axle roll centre: $(cat out.txt)"
+$py - axle.csv <<'PY' || fail "the sedan's axle is not symmetric in roll"
+import csv, sys
+rows = [r for r in csv.DictReader(open(sys.argv[1])) if r['sweep'] == 'roll']
+assert len(rows) == 10, len(rows)
+at = {(r['wheel'], float(r['roll_deg'])): r for r in rows}
+for phi in (-4, -2, 0, 2, 4):
+    l, r = at[('wheel_fl', phi)], at[('wheel_fr', -phi)]
+    for k in ('camber_deg', 'toe_deg', 'track_change_m'):
+        assert abs(float(l[k]) - float(r[k])) < 1e-9, (phi, k, l[k], r[k])
+assert abs(float(at[('wheel_fl', 4)]['camber_deg'])) > 0.1
+PY
+
 # bad input: named, exit 1, nothing written
 expect 1 "--wheel nope: no body or tire element of that name" "$codyna" kc corner.json --wheel nope --csv bad.csv
 expect 1 "--travel 0.05:-0.05:5: expected MIN < MAX" "$codyna" kc corner.json --travel=0.05:-0.05:5 --csv bad.csv
@@ -65,6 +81,7 @@ expect 1 "--fy 1:2: expected MIN:MAX:N" "$codyna" kc corner.json --fy 1:2 --csv 
 expect 1 "--steer nope: no motion input of that name (motion inputs: rack)" "$codyna" kc corner.json --steer nope --csv bad.csv
 expect 1 "--radius: expected a wheel radius > 0 m" "$codyna" kc corner.json --radius=-1 --csv bad.csv
 expect 1 "corner.json" "$codyna" kc corner.json --csv corner.json
+expect 1 "--roll: rolls an axle: give its two wheels" "$codyna" kc corner.json --roll=-2:2:3 --csv bad.csv
 expect 2 "--travel 0.6: the suspension cannot reach it" "$codyna" kc corner.json --travel 0:0.6:3 --csv bad.csv
 [ -e bad.csv ] && fail "bad.csv written on error"
 cmp -s corner.json "$src/examples/kc_double_wishbone.json" || fail "the model file was changed"

@@ -107,16 +107,17 @@ TEST(KcJob, CamberAndToeOverTravelEqualAnIndependentSolveOfTheLinkage) {
   r.model = CODYNA_EXAMPLES_DIR "/kc_double_wishbone.json";
   r.travel = KcRange{-0.08, 0.08, 9};
   const KcReport rep = study_kc_job(r);
-  EXPECT_EQ(rep.wheel, "wheel");
+  ASSERT_EQ(rep.wheels.size(), 1u);
+  EXPECT_EQ(rep.wheels[0].name, "wheel");
   EXPECT_EQ(rep.held, "chassis");
   EXPECT_EQ(rep.steer, "rack");
-  EXPECT_NEAR(rep.radius, 0.393581, 1e-15);
+  EXPECT_NEAR(rep.wheels[0].radius, 0.393581, 1e-15);
   ASSERT_EQ(rep.points.size(), 9u);
   // the design point: caster 0, kingpin atan(0.04 / 0.35), camber and toe 0 (the axle along y)
-  EXPECT_NEAR(rep.design.caster, 0.0, 1e-10);
-  EXPECT_NEAR(rep.design.kingpin, std::atan(0.04 / 0.35) * kc_test_deg, 1e-10);
-  EXPECT_NEAR(rep.design.camber, 0.0, 1e-10);
-  EXPECT_NEAR(rep.design.toe, 0.0, 1e-10);
+  EXPECT_NEAR(rep.wheels[0].design.caster, 0.0, 1e-10);
+  EXPECT_NEAR(rep.wheels[0].design.kingpin, std::atan(0.04 / 0.35) * kc_test_deg, 1e-10);
+  EXPECT_NEAR(rep.wheels[0].design.camber, 0.0, 1e-10);
+  EXPECT_NEAR(rep.wheels[0].design.toe, 0.0, 1e-10);
   Eigen::VectorXd x = kc_test_design(corner);
   double camber_span = 0, toe_span = 0;
   // from the design point up, then down: each from its neighbour
@@ -142,11 +143,11 @@ TEST(KcJob, CamberAndToeOverTravelEqualAnIndependentSolveOfTheLinkage) {
   // bump steer and camber at design: the table's central difference about design
   const KcPoint& up = rep.points[5];
   const KcPoint& down = rep.points[3];
-  EXPECT_NEAR(rep.gradients.bump_steer, (up.toe - down.toe) / 0.04, 0.02 * std::abs(rep.gradients.bump_steer) + 1e-6);
-  EXPECT_NEAR(rep.gradients.bump_camber, (up.camber - down.camber) / 0.04, 0.02 * std::abs(rep.gradients.bump_camber));
+  EXPECT_NEAR(rep.wheels[0].gradients.bump_steer, (up.toe - down.toe) / 0.04, 0.02 * std::abs(rep.wheels[0].gradients.bump_steer) + 1e-6);
+  EXPECT_NEAR(rep.wheels[0].gradients.bump_camber, (up.camber - down.camber) / 0.04, 0.02 * std::abs(rep.wheels[0].gradients.bump_camber));
   // a rigid linkage does not comply
-  EXPECT_NEAR(rep.gradients.fy_steer, 0.0, 1e-9);
-  EXPECT_NEAR(rep.gradients.fy_camber, 0.0, 1e-9);
+  EXPECT_NEAR(rep.wheels[0].gradients.fy_steer, 0.0, 1e-9);
+  EXPECT_NEAR(rep.wheels[0].gradients.fy_camber, 0.0, 1e-9);
 }
 
 TEST(KcJob, SteerSweepEqualsTheIndependentSolve) {
@@ -227,12 +228,12 @@ TEST(KcJob, LateralForceComplianceEqualsTheBushingsStaticSolution) {
   EXPECT_NEAR(rep.points[4].camber, -R * 3000 / kr.x() * kc_test_deg, 1e-3);
   EXPECT_GT(std::abs(rep.points[4].camber), 1.0);
   // the gradients at design: the spring's compliance K^-1, per kN (per kN m)
-  EXPECT_NEAR(rep.gradients.fy_camber, -R * 1000 / kr.x() * kc_test_deg, 1e-7);
-  EXPECT_NEAR(rep.gradients.fy_steer, 0.0, 1e-9);
-  EXPECT_NEAR(rep.gradients.mz_steer, -1000 / kr.z() * kc_test_deg, 1e-7);
-  EXPECT_NEAR(rep.gradients.mz_camber, 0.0, 1e-9);
-  EXPECT_NEAR(rep.gradients.fx_steer, 0.0, 1e-9);
-  EXPECT_NEAR(rep.gradients.fx_camber, 0.0, 1e-9);
+  EXPECT_NEAR(rep.wheels[0].gradients.fy_camber, -R * 1000 / kr.x() * kc_test_deg, 1e-7);
+  EXPECT_NEAR(rep.wheels[0].gradients.fy_steer, 0.0, 1e-9);
+  EXPECT_NEAR(rep.wheels[0].gradients.mz_steer, -1000 / kr.z() * kc_test_deg, 1e-7);
+  EXPECT_NEAR(rep.wheels[0].gradients.mz_camber, 0.0, 1e-9);
+  EXPECT_NEAR(rep.wheels[0].gradients.fx_steer, 0.0, 1e-9);
+  EXPECT_NEAR(rep.wheels[0].gradients.fx_camber, 0.0, 1e-9);
 }
 
 TEST(KcJob, TheBushingCornerCompliesWhereTheRigidOneDoesNot) {
@@ -240,11 +241,11 @@ TEST(KcJob, TheBushingCornerCompliesWhereTheRigidOneDoesNot) {
   r.model = CODYNA_EXAMPLES_DIR "/kc_double_wishbone_bushing.json";
   r.fy = KcRange{-2000, 2000, 3};
   const KcReport rep = study_kc_job(r);
-  EXPECT_GT(std::abs(rep.gradients.fy_steer), 1e-3);
-  EXPECT_GT(std::abs(rep.gradients.fy_camber), 1e-3);
+  EXPECT_GT(std::abs(rep.wheels[0].gradients.fy_steer), 1e-3);
+  EXPECT_GT(std::abs(rep.wheels[0].gradients.fy_camber), 1e-3);
   // the sweep's own central difference about design agrees with the gradient (small loads: near linear)
-  EXPECT_NEAR((rep.points[2].toe - rep.points[0].toe) / 4.0, rep.gradients.fy_steer, 0.05 * std::abs(rep.gradients.fy_steer));
-  EXPECT_NEAR((rep.points[2].camber - rep.points[0].camber) / 4.0, rep.gradients.fy_camber, 0.05 * std::abs(rep.gradients.fy_camber));
+  EXPECT_NEAR((rep.points[2].toe - rep.points[0].toe) / 4.0, rep.wheels[0].gradients.fy_steer, 0.05 * std::abs(rep.wheels[0].gradients.fy_steer));
+  EXPECT_NEAR((rep.points[2].camber - rep.points[0].camber) / 4.0, rep.wheels[0].gradients.fy_camber, 0.05 * std::abs(rep.wheels[0].gradients.fy_camber));
 }
 
 std::string kc_test_refusal(const KcRequest& r) {
@@ -259,9 +260,9 @@ std::string kc_test_refusal(const KcRequest& r) {
 TEST(KcJob, BadRequestsAreRefusedNamingTheOption) {
   KcRequest r;
   r.model = CODYNA_EXAMPLES_DIR "/kc_double_wishbone.json";
-  r.wheel = "wheel_fl";
+  r.wheels = {"wheel_fl"};
   EXPECT_NE(kc_test_refusal(r).find("--wheel wheel_fl: no body or tire element of that name in"), std::string::npos) << kc_test_refusal(r);
-  r.wheel = "";
+  r.wheels.clear();
   r.travel = KcRange{0.05, -0.05, 5};
   EXPECT_NE(kc_test_refusal(r).find("expected MIN < MAX"), std::string::npos) << kc_test_refusal(r);
   r.travel = KcRange{-0.05, 0.05, 1};
@@ -315,16 +316,113 @@ TEST(KcJob, AligningMomentComplianceOfTheSedanIsItsSteeringColumnsSpring) {
   KcRequest r;
   r.model = CODYNA_EXAMPLES_DIR "/sedan.json";
   r.spec = &spec;
-  r.wheel = "tire_fl";
+  r.wheels = {"tire_fl"};
   r.travel = KcRange{-0.01, 0.01, 3};
   const KcReport rep = study_kc_job(r);
   EXPECT_EQ(rep.held, "chassis");
-  EXPECT_EQ(rep.wheel, "wheel_fl");
+  EXPECT_EQ(rep.wheels[0].name, "wheel_fl");
   const double pinion = 0.12 / 16, column = 2000, arm = 0.12;
   const double rack_stiffness = column / (pinion * pinion);
   const double toe_per_kNm = -1000 / (arm * arm * rack_stiffness) * kc_test_deg;
-  EXPECT_NEAR(rep.gradients.mz_steer, toe_per_kNm, 1e-7 * std::abs(toe_per_kNm)) << rep.gradients.mz_steer;
-  EXPECT_NEAR(rep.gradients.mz_camber, 0.0, 1e-9);
+  EXPECT_NEAR(rep.wheels[0].gradients.mz_steer, toe_per_kNm, 1e-7 * std::abs(toe_per_kNm)) << rep.wheels[0].gradients.mz_steer;
+  EXPECT_NEAR(rep.wheels[0].gradients.mz_camber, 0.0, 1e-9);
+}
+
+}  // namespace
+}  // namespace codyna
+
+namespace codyna {
+namespace {
+
+// the corner mirrored to the right (y -> -y, names + "_r") on the same chassis and rack: an axle
+ModelSpec kc_test_axle() {
+  ModelSpec s = study_read_model(CODYNA_EXAMPLES_DIR "/kc_double_wishbone.json");
+  const auto shared = [](const std::string& n) { return n == "chassis" || n == "rack" || n == "ground"; };
+  const auto right = [&](const std::string& n) { return shared(n) ? n : n + "_r"; };
+  const auto mirror = [](Eigen::Vector3d p) {
+    p.y() = -p.y();
+    return p;
+  };
+  const ModelSpec left = s;
+  for (BodySpec b : left.bodies)
+    if (!shared(b.name)) {
+      b.name = right(b.name);
+      s.bodies.push_back(b);
+    }
+  for (JointSpec j : left.joints)
+    if (!shared(j.child)) {
+      j.name = j.name + "_r";
+      j.parent = right(j.parent);
+      j.child = right(j.child);
+      j.parent_frame.position = mirror(j.parent_frame.position);
+      j.child_frame.position = mirror(j.child_frame.position);
+      s.joints.push_back(j);
+    }
+  for (ConstraintSpec c : left.constraints) {
+    c.name += "_r";
+    c.body_a = right(c.body_a);
+    c.body_b = right(c.body_b);
+    c.point_a = mirror(c.point_a);
+    c.point_b = mirror(c.point_b);
+    s.constraints.push_back(c);
+  }
+  for (EffectSpec e : left.effects)
+    if (e.type != EffectType::Gravity) {
+      e.name += "_r";
+      e.body_a = right(e.body_a);
+      e.body_b = right(e.body_b);
+      e.point_a = mirror(e.point_a);
+      e.point_b = mirror(e.point_b);
+      s.effects.push_back(e);
+    }
+  return s;
+}
+
+// the left corner's independent solve at a travel, from design in ten steps
+Eigen::VectorXd kc_test_solve_from_design(const KcTestCorner& c, double travel) {
+  Eigen::VectorXd x = kc_test_design(c);
+  for (int k = 1; k <= 10; ++k) x = kc_test_solve(c, x, travel * k / 10, 0.0);
+  return x;
+}
+
+TEST(KcJob, AnAxlesRollMovesEachWheelAsTheIndependentSolveAtItsTravel) {
+  const KcTestCorner corner;
+  const ModelSpec axle = kc_test_axle();
+  KcRequest r;
+  r.model = "axle.json";
+  r.spec = &axle;
+  r.wheels = {"wheel", "tire_r"};
+  r.roll = KcRange{-4, 4, 5};
+  const KcReport rep = study_kc_job(r);
+  ASSERT_EQ(rep.wheels.size(), 2u);
+  EXPECT_EQ(rep.wheels[1].name, "wheel_r");
+  ASSERT_EQ(rep.points.size(), 10u);
+  const double half_track = 0.775;
+  for (const KcPoint& p : rep.points) {
+    EXPECT_EQ(p.sweep, "roll");
+    // body roll phi (left side up): the left wheel drops by y tan(phi) relative to the body, the right one rises
+    const double y = p.wheel == "wheel" ? half_track : -half_track;
+    const double travel = -y * std::tan(p.roll / kc_test_deg);
+    const KcTestPose pose = kc_test_pose(corner, kc_test_solve_from_design(corner, travel));
+    EXPECT_NEAR(p.camber, kc_test_camber(pose.axis), 1e-9) << p.wheel << " roll " << p.roll;
+    EXPECT_NEAR(p.toe, kc_test_toe(pose.axis), 1e-9) << p.wheel << " roll " << p.roll;
+    EXPECT_NEAR(p.wheel_centre.z(), corner.wheel.z() + travel, 1e-12) << p.wheel << " roll " << p.roll;
+  }
+  EXPECT_GT(std::abs(rep.points[0].camber), 0.1);  // 4 deg of roll: not zeros
+  // roll steer: -y times bump steer; the axle's roll centre on the centreline at the corners' height
+  const KcGradients& gl = rep.wheels[0].gradients;
+  const KcGradients& gr = rep.wheels[1].gradients;
+  EXPECT_NEAR(gl.roll_steer, -half_track * gl.bump_steer / kc_test_deg, 1e-6 * std::abs(gl.roll_steer));
+  EXPECT_NEAR(gr.roll_steer, -gl.roll_steer, 1e-6 * std::abs(gl.roll_steer));
+  EXPECT_NEAR(rep.roll_centre_y, 0.0, 1e-9);
+  EXPECT_NEAR(rep.roll_centre_z - rep.wheels[0].design.contact.z(), gl.roll_centre_height, 1e-9);
+  // refusals: a roll needs two wheels on opposite sides
+  KcRequest one = r;
+  one.wheels = {"wheel"};
+  EXPECT_NE(kc_test_refusal(one).find("--roll: rolls an axle: give its two wheels"), std::string::npos) << kc_test_refusal(one);
+  KcRequest same = r;
+  same.wheels = {"wheel", "wheel"};
+  EXPECT_NE(kc_test_refusal(same).find("the same wheel twice"), std::string::npos) << kc_test_refusal(same);
 }
 
 }  // namespace
