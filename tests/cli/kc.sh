@@ -18,7 +18,7 @@ expect() {
 }
 py=/usr/bin/python3
 cp "$src/examples/kc_double_wishbone.json" corner.json
-cp "$src/examples/kc_double_wishbone_bushing.json" bushing.json
+cp "$src/tests/data/kc_double_wishbone_bushing.json" bushing.json
 
 "$codyna" kc corner.json --travel=-0.08:0.08:9 --steer-range=-0.02:0.02:5 --csv kc.csv > out.txt 2> err.txt \
   || fail "kc: exit $?: $(cat err.txt)"

@@ -238,7 +238,7 @@ TEST(KcJob, LateralForceComplianceEqualsTheBushingsStaticSolution) {
 
 TEST(KcJob, TheBushingCornerCompliesWhereTheRigidOneDoesNot) {
   KcRequest r;
-  r.model = CODYNA_EXAMPLES_DIR "/kc_double_wishbone_bushing.json";
+  r.model = CODYNA_TEST_DATA_DIR "/kc_double_wishbone_bushing.json";
   r.fy = KcRange{-2000, 2000, 3};
   const KcReport rep = study_kc_job(r);
   EXPECT_GT(std::abs(rep.wheels[0].gradients.fy_steer), 1e-3);
