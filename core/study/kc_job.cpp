@@ -7,6 +7,7 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include "dynamics/constraints.hpp"
 #include "dynamics/effects.hpp"
@@ -44,6 +45,7 @@ struct KcWheelRig {
 
 // the rig: the compiled model (no gravity, no tires) and its wheels
 struct KcRig {
+  explicit KcRig(Model m) : model(std::move(m)) {}
   Model model;
   std::vector<KcWheelRig> wheels;
   int held = 0;
@@ -305,7 +307,7 @@ KcRig kc_make_rig(const KcRequest& r, const ModelSpec& spec_in, KcReport& report
   spec.plant = PlantSpec{};
   spec.controller = ControllerSpec{};
   spec.analysis = StudySpec{};
-  KcRig rig{study_model(spec, file)};
+  KcRig rig(study_model(spec, file));
   const Model& m = rig.model;
   // the held body: the root of the first wheel's tree, or the one named; every wheel hangs on it
   const int first = m.find_body(wheel_bodies[0]);
@@ -657,6 +659,13 @@ KcReport study_kc_job(const KcRequest& r) {
   return report;
 }
 
+namespace {
+
+// a value printed with 4 decimals: a round-off residue shows as 0, not -0.0000
+double kc_shown(double v) { return std::abs(v) < 5e-5 ? 0.0 : v; }
+
+}  // namespace
+
 std::string study_kc_text(const KcReport& r) {
   std::ostringstream os;
   char line[2048];
@@ -671,8 +680,9 @@ std::string study_kc_text(const KcReport& r) {
     std::snprintf(line, sizeof line,
                   "design%s%s wheel centre [%.4f, %.4f, %.4f] m, contact [%.4f, %.4f, %.4f] m\n"
                   "         camber %.4f deg, toe %.4f deg, caster %.4f deg, kingpin %.4f deg\n",
-                  axle ? " " : "", axle ? w.name.c_str() : "  ", d.wheel_centre.x(), d.wheel_centre.y(), d.wheel_centre.z(), d.contact.x(),
-                  d.contact.y(), d.contact.z(), d.camber, d.toe, d.caster, d.kingpin);
+                  axle ? " " : "", axle ? w.name.c_str() : "  ", kc_shown(d.wheel_centre.x()), kc_shown(d.wheel_centre.y()),
+                  kc_shown(d.wheel_centre.z()), kc_shown(d.contact.x()), kc_shown(d.contact.y()), kc_shown(d.contact.z()), kc_shown(d.camber),
+                  kc_shown(d.toe), kc_shown(d.caster), kc_shown(d.kingpin));
     os << line;
   }
   std::string sweep;
@@ -689,8 +699,8 @@ std::string study_kc_text(const KcReport& r) {
       std::snprintf(line, sizeof line, "%-10s ", p.wheel.c_str());
       os << line;
     }
-    std::snprintf(line, sizeof line, "%10.5g %9.4f %9.4f %9.4f %9.4f %11.4f %11.4f %10.5f\n", v, p.camber, p.toe, p.caster, p.kingpin,
-                  p.track_change * 1e3, p.wheelbase_change * 1e3, p.wheel_centre.z());
+    std::snprintf(line, sizeof line, "%10.5g %9.4f %9.4f %9.4f %9.4f %11.4f %11.4f %10.5f\n", v, kc_shown(p.camber), kc_shown(p.toe),
+                  kc_shown(p.caster), kc_shown(p.kingpin), kc_shown(p.track_change * 1e3), kc_shown(p.wheelbase_change * 1e3), p.wheel_centre.z());
     os << line;
   }
   for (const KcWheel& w : r.wheels) {
@@ -704,13 +714,15 @@ std::string study_kc_text(const KcReport& r) {
                   "  Fy compliance steer %10.4f deg/kN   camber        %10.4f deg/kN\n"
                   "  Fx compliance steer %10.4f deg/kN   camber        %10.4f deg/kN\n"
                   "  Mz compliance steer %10.4f deg/kN m camber        %10.4f deg/kN m\n",
-                  axle ? ", " : "", axle ? w.name.c_str() : "", g.bump_steer, g.bump_camber, g.track_per_travel, g.roll_centre_height,
-                  g.roll_steer, g.roll_camber, g.fy_steer, g.fy_camber, g.fx_steer, g.fx_camber, g.mz_steer, g.mz_camber);
+                  axle ? ", " : "", axle ? w.name.c_str() : "", kc_shown(g.bump_steer), kc_shown(g.bump_camber), kc_shown(g.track_per_travel),
+                  kc_shown(g.roll_centre_height), kc_shown(g.roll_steer), kc_shown(g.roll_camber), kc_shown(g.fy_steer), kc_shown(g.fy_camber),
+                  kc_shown(g.fx_steer), kc_shown(g.fx_camber), kc_shown(g.mz_steer), kc_shown(g.mz_camber));
     os << line;
   }
   if (axle) {
-    std::snprintf(line, sizeof line, "\naxle roll centre    y %.4f m, z %.4f m (held frame; %.4f m above the contacts' mean)\n", r.roll_centre_y,
-                  r.roll_centre_z, r.roll_centre_z - 0.5 * (r.wheels[0].design.contact.z() + r.wheels[1].design.contact.z()));
+    std::snprintf(line, sizeof line, "\naxle roll centre    y %.4f m, z %.4f m (held frame; %.4f m above the contacts' mean)\n",
+                  kc_shown(r.roll_centre_y), kc_shown(r.roll_centre_z),
+                  kc_shown(r.roll_centre_z - 0.5 * (r.wheels[0].design.contact.z() + r.wheels[1].design.contact.z())));
     os << line;
   }
   return os.str();
