@@ -145,6 +145,25 @@ TEST(KcJob, CamberAndToeOverTravelEqualAnIndependentSolveOfTheLinkage) {
   const KcPoint& down = rep.points[3];
   EXPECT_NEAR(rep.wheels[0].gradients.bump_steer, (up.toe - down.toe) / 0.04, 0.02 * std::abs(rep.wheels[0].gradients.bump_steer) + 1e-6);
   EXPECT_NEAR(rep.wheels[0].gradients.bump_camber, (up.camber - down.camber) / 0.04, 0.02 * std::abs(rep.wheels[0].gradients.bump_camber));
+  // the gradients against the independent solve's central differences (h = 1e-4 m: truncation ~1e-8)
+  {
+    const double h = 1e-4, R = 0.393581;
+    const KcTestPose up_pose = kc_test_pose(corner, kc_test_solve(corner, kc_test_design(corner), h, 0.0));
+    const KcTestPose down_pose = kc_test_pose(corner, kc_test_solve(corner, kc_test_design(corner), -h, 0.0));
+    const auto contact = [R](const KcTestPose& p) {
+      const Eigen::Vector3d ez = Eigen::Vector3d::UnitZ();
+      return Eigen::Vector3d(p.wheel - R * (ez - ez.dot(p.axis) * p.axis).normalized());
+    };
+    const double steer = (kc_test_toe(up_pose.axis) - kc_test_toe(down_pose.axis)) / (2 * h);
+    const double camber = (kc_test_camber(up_pose.axis) - kc_test_camber(down_pose.axis)) / (2 * h);
+    const Eigen::Vector3d dcontact = (contact(up_pose) - contact(down_pose)) / (2 * h);
+    const KcGradients& g = rep.wheels[0].gradients;
+    EXPECT_NEAR(g.bump_steer, steer, 1e-6 * std::abs(steer));
+    EXPECT_NEAR(g.bump_camber, camber, 1e-6 * std::abs(camber));
+    EXPECT_NEAR(g.track_per_travel, 2 * dcontact.y() / dcontact.z(), 1e-6);
+    EXPECT_NEAR(g.roll_centre_height, corner.wheel.y() * dcontact.y() / dcontact.z(), 1e-7);
+    EXPECT_NEAR(g.roll_steer, -corner.wheel.y() * steer / kc_test_deg, 1e-6 * std::abs(g.roll_steer));
+  }
   // a rigid linkage does not comply
   EXPECT_NEAR(rep.wheels[0].gradients.fy_steer, 0.0, 1e-9);
   EXPECT_NEAR(rep.wheels[0].gradients.fy_camber, 0.0, 1e-9);
