@@ -88,8 +88,12 @@ KcPoint kc_measure_at(const KcRig& rig, const KcWheelRig& w, const Data& d, cons
     if (k.z() < 0) k = -k;
     p.caster = std::atan2(-k.x(), k.z()) * kc_deg;
     p.kingpin = std::atan2(-w.outward * k.y(), k.z()) * kc_deg;
+    const Eigen::Vector3d a = rig.X_WH.inverse().act_point(X.act_point(w.ball_a));
+    const Eigen::Vector3d ground = a + k * ((g.contact.z() - a.z()) / k.z());
+    p.scrub_radius = w.outward * (g.contact.y() - ground.y());
+    p.caster_trail = ground.x() - g.contact.x();
   } else {
-    p.caster = p.kingpin = std::numeric_limits<double>::quiet_NaN();
+    p.caster = p.kingpin = p.scrub_radius = p.caster_trail = std::numeric_limits<double>::quiet_NaN();
   }
   p.track_change = 2 * w.outward * (g.contact.y() - design.contact.y());
   p.wheelbase_change = g.contact.x() - design.contact.x();
@@ -471,7 +475,8 @@ KcRange study_kc_range(const std::string& text, const std::string& option) {
 std::vector<std::string> study_kc_columns() {
   return {"sweep",       "wheel",       "travel_m",    "roll_deg",   "steer",       "Fx_N",           "Fy_N",
           "Mz_Nm",       "wheel_x_m",   "wheel_y_m",   "wheel_z_m",  "contact_x_m", "contact_y_m",    "contact_z_m",
-          "camber_deg",  "toe_deg",     "caster_deg",  "kingpin_deg", "track_change_m", "wheelbase_change_m"};
+          "camber_deg",  "toe_deg",     "caster_deg",  "kingpin_deg", "track_change_m", "wheelbase_change_m",
+          "scrub_radius_m", "caster_trail_m"};
 }
 
 KcReport study_kc_job(const KcRequest& r) {
@@ -651,7 +656,7 @@ KcReport study_kc_job(const KcRequest& r) {
       for (int k = 0; k < 3; ++k) os << "," << p.wheel_centre(k);
       for (int k = 0; k < 3; ++k) os << "," << p.contact(k);
       os << "," << p.camber << "," << p.toe << "," << p.caster << "," << p.kingpin << "," << p.track_change << ","
-         << p.wheelbase_change << "\n";
+         << p.wheelbase_change << "," << p.scrub_radius << "," << p.caster_trail << "\n";
     }
     write_file_atomically(r.csv, os.str());
     report.written = r.csv;
@@ -679,10 +684,11 @@ std::string study_kc_text(const KcReport& r) {
     const KcPoint& d = w.design;
     std::snprintf(line, sizeof line,
                   "design%s%s wheel centre [%.4f, %.4f, %.4f] m, contact [%.4f, %.4f, %.4f] m\n"
-                  "         camber %.4f deg, toe %.4f deg, caster %.4f deg, kingpin %.4f deg\n",
+                  "         camber %.4f deg, toe %.4f deg, caster %.4f deg, kingpin %.4f deg\n"
+                  "         scrub radius %.4f m, caster trail %.4f m\n",
                   axle ? " " : "", axle ? w.name.c_str() : "  ", kc_shown(d.wheel_centre.x()), kc_shown(d.wheel_centre.y()),
                   kc_shown(d.wheel_centre.z()), kc_shown(d.contact.x()), kc_shown(d.contact.y()), kc_shown(d.contact.z()), kc_shown(d.camber),
-                  kc_shown(d.toe), kc_shown(d.caster), kc_shown(d.kingpin));
+                  kc_shown(d.toe), kc_shown(d.caster), kc_shown(d.kingpin), kc_shown(d.scrub_radius), kc_shown(d.caster_trail));
     os << line;
   }
   std::string sweep;

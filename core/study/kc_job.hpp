@@ -65,6 +65,9 @@ struct KcPoint {
   double camber = 0, toe = 0, caster = 0, kingpin = 0;     // deg
   double track_change = 0;          // m: twice the contact's outward move (a symmetric axle's track)
   double wheelbase_change = 0;      // m: the contact's forward move
+  // where the kingpin meets the ground (the contact's height): the contact outboard of it
+  // (scrub radius, positive outboard) and behind it (caster trail, positive behind); m, NaN without a kingpin
+  double scrub_radius = 0, caster_trail = 0;
 };
 
 // a wheel's gradients at the design point (zero travel, roll, steer and loads)

@@ -118,6 +118,10 @@ TEST(KcJob, CamberAndToeOverTravelEqualAnIndependentSolveOfTheLinkage) {
   EXPECT_NEAR(rep.wheels[0].design.kingpin, std::atan(0.04 / 0.35) * kc_test_deg, 1e-10);
   EXPECT_NEAR(rep.wheels[0].design.camber, 0.0, 1e-10);
   EXPECT_NEAR(rep.wheels[0].design.toe, 0.0, 1e-10);
+  // the balls' line meets the contact's height zc at y = 0.70 + 0.04 (-0.30 - zc) / 0.35 (0.730 m): 45 mm of scrub
+  const double zc = rep.wheels[0].design.contact.z();
+  EXPECT_NEAR(rep.wheels[0].design.scrub_radius, 0.775 - (0.70 + 0.04 * (-0.30 - zc) / 0.35), 1e-12);
+  EXPECT_NEAR(rep.wheels[0].design.caster_trail, 0.0, 1e-12);
   Eigen::VectorXd x = kc_test_design(corner);
   double camber_span = 0, toe_span = 0;
   // from the design point up, then down: each from its neighbour
@@ -133,6 +137,15 @@ TEST(KcJob, CamberAndToeOverTravelEqualAnIndependentSolveOfTheLinkage) {
       EXPECT_NEAR(p.toe, kc_test_toe(pose.axis), 1e-9) << "travel " << p.travel;
       EXPECT_NEAR(p.kingpin, kc_test_kingpin(pose), 1e-9) << "travel " << p.travel;
       EXPECT_NEAR((p.wheel_centre - pose.wheel).lpNorm<Eigen::Infinity>(), 0.0, 1e-11) << "travel " << p.travel;
+      {
+        // the kingpin (the balls' line) at the contact's height: scrub radius and caster trail
+        const Eigen::Vector3d ez = Eigen::Vector3d::UnitZ();
+        const Eigen::Vector3d contact = pose.wheel - 0.393581 * (ez - ez.dot(pose.axis) * pose.axis).normalized();
+        const Eigen::Vector3d k = pose.ub - pose.lb;
+        const Eigen::Vector3d ground = pose.lb + k * ((contact.z() - pose.lb.z()) / k.z());
+        EXPECT_NEAR(p.scrub_radius, contact.y() - ground.y(), 1e-11) << "travel " << p.travel;
+        EXPECT_NEAR(p.caster_trail, ground.x() - contact.x(), 1e-11) << "travel " << p.travel;
+      }
       camber_span = std::max(camber_span, std::abs(p.camber));
       toe_span = std::max(toe_span, std::abs(p.toe));
     }
