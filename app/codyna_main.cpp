@@ -38,6 +38,7 @@ int main(int argc, char** argv) {
   codyna::cli::add_tire(app);
   codyna::cli::add_maneuver(app);
   codyna::cli::add_freqresp(app);
+  codyna::cli::add_kc(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

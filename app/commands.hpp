@@ -15,6 +15,7 @@ void add_sweep(CLI::App& app);
 void add_tire(CLI::App& app);
 void add_maneuver(CLI::App& app);
 void add_freqresp(CLI::App& app);
+void add_kc(CLI::App& app);
 int exit_code();
 void set_exit_code(int code);
 

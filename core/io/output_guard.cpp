@@ -47,6 +47,8 @@ bool written_by_codyna(const std::string& path, OutputKind k) {
       return starts_with(h, "Fx,Fy,Fz,");
     case OutputKind::FrequencyResponseCsv:
       return starts_with(h, "w_rad_s,f_Hz,");
+    case OutputKind::KcCsv:
+      return starts_with(h, "sweep,wheel,travel_m,");
   }
   return false;
 }
@@ -72,6 +74,7 @@ const char* describe(OutputKind k) {
     case OutputKind::SweepCsv: return "a sweep CSV";
     case OutputKind::TireCsv: return "a tire CSV";
     case OutputKind::FrequencyResponseCsv: return "a frequency-response CSV";
+    case OutputKind::KcCsv: return "a K&C rig CSV";
   }
   return "an output";
 }

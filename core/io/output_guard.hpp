@@ -24,6 +24,7 @@ enum class OutputKind {
   SweepCsv,     // a parameter study's table (io/sweep_files.hpp; it begins "variant,status")
   TireCsv,      // a tire test rig's table (study/tire_job.hpp; it begins "Fx,Fy,Fz,")
   FrequencyResponseCsv,  // a nonlinear plant's frequency response (study/freqresp_job.hpp; it begins "w_rad_s,")
+  KcCsv,        // a suspension K&C rig's table (study/kc_job.hpp; it begins "sweep,wheel,travel_m,")
 };
 
 const char* describe(OutputKind k);  // "an HDF5 results file", ...
