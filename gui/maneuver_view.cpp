@@ -44,11 +44,14 @@ struct ManeuverField {
 const QList<ManeuverField>& maneuver_fields() {
   static const QList<ManeuverField> f = {
       {"speed", "speed (m/s)", "the model's steady speed",
-       {"step-steer", "sine-with-dwell", "swept-sine", "double-lane-change", "constant-speed"}},
-      {"steer", "steer amplitude", "0.01 (sine: 0.05)", {"step-steer", "sine-with-dwell", "swept-sine"}},
-      {"steer-scale", "or x steer at 0.3 g", "FMVSS 126: 1.5 .. 6.5", {"sine-with-dwell"}},
+       {"step-steer", "sine-with-dwell", "swept-sine", "double-lane-change", "constant-speed", "slowly-increasing-steer",
+        "fishhook"}},
+      {"steer", "steer amplitude", "0.01 (sine: 0.05)", {"step-steer", "sine-with-dwell", "swept-sine", "slowly-increasing-steer", "fishhook"}},
+      {"steer-scale", "or x steer at 0.3 g", "FMVSS 126: 1.5 .. 6.5 (ramp 2.5, fishhook 6.5)",
+       {"sine-with-dwell", "slowly-increasing-steer", "fishhook"}},
+      {"steer-rate", "steer rate (per s)", "13.5 deg/s (fishhook 720 deg/s)", {"slowly-increasing-steer", "fishhook"}},
       {"frequency", "frequency (Hz)", "0.7", {"sine-with-dwell"}},
-      {"dwell", "dwell (s)", "0.5", {"sine-with-dwell"}},
+      {"dwell", "dwell (s)", "0.5 (fishhook 0.25)", {"sine-with-dwell", "fishhook"}},
       {"frequency-min", "lowest frequency (Hz)", "0.1", {"swept-sine"}},
       {"frequency-max", "highest frequency (Hz)", "2", {"swept-sine"}},
       {"sweep-time", "sweep time (s)", "30", {"swept-sine"}},
@@ -60,10 +63,11 @@ const QList<ManeuverField>& maneuver_fields() {
       {"points", "points", "8 (swept sine: 12)", {"constant-radius", "constant-speed", "swept-sine"}},
       {"width", "vehicle width (m)", "1.8", {"double-lane-change"}},
       {"preview", "driver preview (m)", "the model's", {"double-lane-change"}},
-      {"friction", "friction (controller's reference)", "0.85", {"step-steer", "sine-with-dwell"}},
-      {"integrator", "integrator", "the model's", {"step-steer", "sine-with-dwell", "swept-sine", "double-lane-change"}},
+      {"friction", "friction (controller's reference)", "0.85", {"step-steer", "sine-with-dwell", "slowly-increasing-steer", "fishhook"}},
+      {"integrator", "integrator", "the model's",
+       {"step-steer", "sine-with-dwell", "swept-sine", "double-lane-change", "slowly-increasing-steer", "fishhook"}},
       {"free-input", "free inputs", "the model's (a turn: steer,drive)",
-       {"step-steer", "sine-with-dwell", "swept-sine", "constant-radius", "constant-speed"}},
+       {"step-steer", "sine-with-dwell", "swept-sine", "constant-radius", "constant-speed", "slowly-increasing-steer", "fishhook"}},
   };
   return f;
 }
@@ -187,7 +191,8 @@ void ManeuverView::typeChosen() {
     fields_[f.key]->setVisible(on);
     labels_[f.key]->setVisible(on);
   }
-  open_loop_->setVisible(t == "step-steer" || t == "sine-with-dwell" || t == "swept-sine");
+  open_loop_->setVisible(t == "step-steer" || t == "sine-with-dwell" || t == "swept-sine" || t == "slowly-increasing-steer" ||
+                         t == "fishhook");
 }
 
 QString ManeuverView::statusText() const { return status_->text(); }
@@ -234,6 +239,7 @@ ManeuverRequest ManeuverView::request() const {
   r.width = number("width");
   r.preview = number("preview");
   r.friction = number("friction");
+  r.steer_rate = number("steer-rate");
   r.open_loop = !open_loop_->isHidden() && open_loop_->isChecked();
   if (const auto p = number("points")) {
     if (*p != std::floor(*p) || std::abs(*p) > 1e6) throw std::invalid_argument("points: expected a whole number");

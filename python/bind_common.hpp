@@ -127,6 +127,7 @@ void register_simulate(py::module_& m);   // bind_simulate.cpp: _simulate, Simul
 void register_sweep(py::module_& m);      // bind_sweep.cpp: _sweep, _sweep_merge, Sweep
 void register_tools(py::module_& m);      // bind_tools.cpp: lqr, place
 void register_maneuver(py::module_& m);   // bind_maneuver.cpp: _maneuver
+void register_kc(py::module_& m);         // bind_kc.cpp: _kc
 void register_freqresp(py::module_& m);   // bind_freqresp.cpp: _freqresp
 
 }  // namespace codyna::python

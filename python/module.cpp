@@ -36,5 +36,6 @@ PYBIND11_MODULE(_codyna, m) {
   for (const char* name : {"ClosedLoop", "Linearization", "Simulation", "Sweep"}) m.attr(name).attr("__module__") = "codyna";
   register_tools(m);
   register_maneuver(m);
+  register_kc(m);
   register_freqresp(m);
 }

@@ -34,6 +34,16 @@
 //                       accelerations from --ay-min to --ay-max; the same table, the understeer
 //                       gradient d(delta)/d(a_y) - L / U^2, against the linear model's (the handling
 //                       number K at that speed, and its prediction of each turn's steer).
+//   slowly-increasing-steer  SAE J266 / FMVSS 126 S5.1.2: the steer rises at --steer-rate (13.5
+//                       deg/s) to --steer (2.5 x the steer at 0.3 g); the steer at 0.3 g (a_y = U r)
+//                       against the steady turn's at the speed there, the understeer gradient fitted
+//                       over 0.1 .. 0.3 g against the steady turns' and the handling number
+//                       (maneuver_ramp.cpp).
+//   fishhook            NHTSA (fixed timing): to --steer (6.5 x the steer at 0.3 g) at --steer-rate
+//                       (720 deg/s), --dwell (0.25 s), to the opposite side, held 3 s, back over 2 s;
+//                       the largest roll, each tire's smallest load, the first two-wheel lift.
+// Step steer, sine with dwell, slowly increasing steer and fishhook run the model file's controller
+// in the loop (ManeuverRequest::open_loop). An open-loop run stops when the car rolls over (60 deg).
 // A run that leaves the road (the integrator fails, the speed or yaw rate runs away) is reported
 // with its metrics marked invalid and the reason. Files: the run as HDF5 / CSV (--out, --csv;
 // the constant radius: --csv, its table).

@@ -233,6 +233,22 @@ class Study:
         options["type"] = type
         return _codyna._maneuver(self._study, _given(options))
 
+    def kc(self, **options):
+        """The suspension K&C rig (codyna kc; docs/kc.md): a corner or an axle held at its body,
+        swept through wheel travel, roll, steer and contact-patch loads as static equilibria.
+
+        Keywords, as codyna kc's flags with underscores: wheels (one name, or two for an axle; also
+        wheel), held, steer, radius, travel, roll, steer_range, fx, fy, mz (each "MIN:MAX:N" or
+        (min, max, n)), csv. Returns a dict: "wheels" (each its "name", "radius", "design" point and
+        "gradients": bump_steer, bump_camber (deg/m), track_per_travel, roll_centre_height (m),
+        roll_steer, roll_camber (deg/deg), fy_/fx_steer and _camber (deg/kN), mz_steer, mz_camber
+        (deg/kN m)), "points" (each a dict: sweep, wheel, travel, roll, steer, fx, fy, mz,
+        wheel_centre, contact, camber, toe, caster, kingpin (deg), track_change, wheelbase_change,
+        scrub_radius, caster_trail (m)), "roll_centre" (y, z of an axle), "notes", "written" and
+        "text" (the command's report).
+        """
+        return _codyna._kc(self._study, _given(options))
+
     def simulate(
         self,
         *,

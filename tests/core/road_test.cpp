@@ -586,6 +586,8 @@ TEST(Road, BadRoadsAreRefusedNamingTheFileAndTheField) {
 }  // namespace
 }  // namespace codyna
 
+namespace codyna {
+
 // A generated road whose sum would run for hours (here 1e5 m at the default band: 2.8e5 cosines
 // at 2e6 points per track) is refused at once, naming the field and what to change
 TEST(Road, AnIso8608RoadTooCostlyToSumIsRefusedAtOnce) {
@@ -595,3 +597,5 @@ TEST(Road, AnIso8608RoadTooCostlyToSumIsRefusedAtOnce) {
   EXPECT_NE(message.find("expected at most 1e9: a shorter length, a narrower band or a coarser spacing"), std::string::npos)
       << message;
 }
+
+}  // namespace codyna

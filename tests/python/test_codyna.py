@@ -1049,6 +1049,26 @@ def test_maneuver_is_the_command_lines():
     assert "controller" not in off and off["max_sideslip"] > on["max_sideslip"] > 0
 
 
+def test_kc_is_the_command_lines(tmp_path):
+    """Study.kc runs codyna kc's job: the same text and CSV; a range as (min, max, n) is the same
+    as its text; the gradients are numbers of the report; a bad range names the keyword."""
+    corner = os.path.join(SOURCE_DIR, "examples", "kc_double_wishbone.json")
+    stdout, _ = cli("kc", corner, "--travel=-0.02:0.02:5", "--steer-range=-0.01:0.01:3", "--csv", tmp_path / "cli.csv")
+    study = codyna.Study(corner)
+    r = study.kc(travel="-0.02:0.02:5", steer_range=(-0.01, 0.01, 3), csv=str(tmp_path / "py.csv"))
+    assert r["text"] + "wrote %s\n" % (tmp_path / "cli.csv") == stdout
+    assert (tmp_path / "py.csv").read_text() == (tmp_path / "cli.csv").read_text()
+    g = r["wheels"][0]["gradients"]
+    assert "bump steer" in r["text"] and np.isfinite(g["bump_steer"]) and g["bump_steer"] != 0
+    travel = [p for p in r["points"] if p["sweep"] == "travel"]
+    assert [p["travel"] for p in travel] == pytest.approx([-0.02, -0.01, 0, 0.01, 0.02], abs=1e-15)
+    # bump steer is d(toe)/d(travel) at design: the table's central difference about it
+    mid = (travel[3]["toe"] - travel[1]["toe"]) / 0.02
+    assert mid == pytest.approx(g["bump_steer"], rel=1e-2)
+    with pytest.raises(ValueError, match="travel"):
+        study.kc(travel=(0.02, -0.02, 5))
+
+
 def test_freqresp_is_the_command_lines(tmp_path):
     """Study.freqresp runs codyna freqresp's job: the same text and CSV; G equals the linear
     response at a small amplitude; a bad keyword names itself."""
