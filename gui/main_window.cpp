@@ -41,6 +41,7 @@
 #include "gui/autosave.hpp"
 #include "gui/control_view.hpp"
 #include "gui/sweep_view.hpp"
+#include "gui/kc_view.hpp"
 #include "gui/maneuver_view.hpp"
 #include "gui/tire_view.hpp"
 #include "gui/linearize_view.hpp"
@@ -115,8 +116,14 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
                              "tire of the model or a .tir file (codyna tire)"));
   maneuver_view_ = new ManeuverView(doc_, this);
   tabs_->addTab(maneuver_view_, tr("Maneuvers"));
+  kc_view_ = new KcView(doc_, this);
+  kc_view_->setObjectName("kcView");
+  tabs_->addTab(kc_view_, tr("K&&C"));
   tabs_->setTabToolTip(5, tr("Standard handling maneuvers on the car: step steer, sine with dwell, swept sine, double "
-                             "lane change, constant radius and constant speed, with their metrics (codyna maneuver)"));
+                             "lane change, constant radius, constant speed, slowly increasing steer and the fishhook, "
+                             "with their metrics (codyna maneuver)"));
+  tabs_->setTabToolTip(6, tr("The suspension K&C rig: a corner or an axle held at its body, swept through wheel travel, "
+                             "steer, roll and contact-patch loads: camber, toe, kingpin, bump steer, compliance (codyna kc)"));
   auto* centre = new QSplitter(Qt::Vertical, this);
   centre->setObjectName("centreSplitter");
   centre->addWidget(top);
@@ -269,6 +276,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
   connect(sweep_view_, &SweepView::message, this, [this](const QString& m) { message(m); });
   connect(tire_view_, &TireView::message, this, [this](const QString& m) { message(m); });
   connect(maneuver_view_, &ManeuverView::message, this, [this](const QString& m) { message(m); });
+  connect(kc_view_, &KcView::message, this, [this](const QString& m) { message(m); });
   connect(props_, &PropertyEditor::varyRequested, this, [this](const QString& pointer) {
     sweep_view_->addField(pointer);
     tabs_->setCurrentWidget(sweep_view_);

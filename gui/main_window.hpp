@@ -42,6 +42,7 @@ class SimulateView;
 class ControlView;
 class SweepView;
 class TireView;
+class KcView;
 class ManeuverView;
 class Autosave;
 class IssuesPanel;
@@ -65,6 +66,7 @@ class MainWindow : public QMainWindow {
   SweepView* sweepView() { return sweep_view_; }
   TireView* tireView() { return tire_view_; }
   ManeuverView* maneuverView() { return maneuver_view_; }
+  KcView* kcView() { return kc_view_; }
   QTabWidget* analysisTabs() { return tabs_; }
   QPlainTextEdit* messages() { return messages_; }
   IssuesPanel* issuesPanel() { return issues_; }
@@ -157,6 +159,7 @@ class MainWindow : public QMainWindow {
   SweepView* sweep_view_ = nullptr;
   TireView* tire_view_ = nullptr;
   ManeuverView* maneuver_view_ = nullptr;
+  KcView* kc_view_ = nullptr;
   Autosave* autosave_ = nullptr;
   QTabWidget* tabs_;
   QPlainTextEdit* messages_;

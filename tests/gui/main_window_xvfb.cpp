@@ -43,6 +43,7 @@
 #include "gui/property_editor.hpp"
 #include "gui/chart_view.hpp"
 #include "gui/sweep_view.hpp"
+#include "gui/kc_view.hpp"
 #include "gui/maneuver_view.hpp"
 #include "gui/tire_view.hpp"
 #include "gui/view3d.hpp"
@@ -507,6 +508,24 @@ class MainWindowXvfb : public QObject {
     QVERIFY2(stats(screenOfChild(&w, mv->chartView())).foreground > 0.003, "the understeer diagram is drawn");
     save(screenOf(&w), "maneuver_view.png");
     w.document()->undoStack()->setClean();
+  }
+
+  // the K&C tab on the sedan's front corner: travel and steer swept, the curves and the report
+  void kcView() {
+    MainWindow w;
+    w.resize(1600, 1000);
+    w.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&w));
+    QVERIFY(w.openFile(QStringLiteral(CODYNA_EXAMPLES_DIR "/kc_double_wishbone.json")));
+    KcView* kc = w.kcView();
+    w.analysisTabs()->setCurrentWidget(kc);
+    w.findChild<QSplitter*>("centreSplitter")->setSizes({200, 740});
+    kc->field("travel")->setText(QStringLiteral("-0.08:0.08:17"));
+    kc->field("steer-range")->setText(QStringLiteral("-0.03:0.03:13"));
+    QVERIFY2(kc->run(), qPrintable(kc->errorText()));
+    QTest::qWait(300);
+    QVERIFY2(stats(screenOfChild(&w, kc->travelView())).foreground > 0.003, "the camber and toe curves are drawn");
+    save(screenOf(&w), "kc_view.png");
   }
 };
 

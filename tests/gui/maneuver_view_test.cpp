@@ -24,8 +24,10 @@
 #include "drive.hpp"
 #include "gui/chart_view.hpp"
 #include "gui/main_window.hpp"
+#include "gui/kc_view.hpp"
 #include "gui/maneuver_view.hpp"
 #include "study/files.hpp"
+#include "study/kc_job.hpp"
 #include "study/maneuver_job.hpp"
 
 using namespace codyna;
@@ -36,6 +38,7 @@ namespace {
 const QString kCar = QStringLiteral(CODYNA_EXAMPLES_DIR "/single_track_car.json");
 const QString kSedan = QStringLiteral(CODYNA_EXAMPLES_DIR "/sedan.json");
 const QString kSedanEsc = QStringLiteral(CODYNA_EXAMPLES_DIR "/sedan_esc.json");
+const QString kCorner = QStringLiteral(CODYNA_EXAMPLES_DIR "/kc_double_wishbone.json");
 
 QLineSeries* maneuver_series_named(ChartView* view, const QString& name) {
   for (QAbstractSeries* s : view->chart()->series())
@@ -187,6 +190,67 @@ class ManeuverViewTest : public QObject {
     QVERIFY(view()->report() && view()->report()->controller.empty());
     QVERIFY(!view()->reportView()->toPlainText().contains(QStringLiteral("controller")));
     QVERIFY(view()->reportView()->toPlainText().contains(QStringLiteral("largest sideslip")));
+  }
+
+  // The K&C tab (gui/kc_view.hpp) on the sedan's corner: ranges typed, Enter in a field runs it;
+  // the report is codyna kc's text for the same request, the curves its points; a range that does
+  // not read is shown naming it, and the last curves stay until a run succeeds
+  void kcTabIsTheJobsReportAndCurves() {
+    QVERIFY(w->openFile(kCorner));
+    KcView* kc = w->kcView();
+    auto* tabs = w->findChild<QTabWidget*>();
+    QVERIFY(tabs);
+    const int i = tabs->indexOf(kc);
+    QVERIFY(i >= 0);
+    QTest::mouseClick(tabs->tabBar(), Qt::LeftButton, {}, tabs->tabBar()->tabRect(i).center());
+    QTRY_COMPARE(tabs->currentWidget(), kc);
+    const auto typeInto = [](QLineEdit* e, const QString& text) {
+      QTest::mouseClick(e, Qt::LeftButton);
+      e->selectAll();
+      QTest::keyClick(e, Qt::Key_Backspace);
+      QTest::keyClicks(e, text);
+    };
+    typeInto(kc->field("travel"), "-0.03:0.03:7");
+    typeInto(kc->field("steer-range"), "-0.01:0.01:5");
+    QTest::keyClick(kc->field("steer-range"), Qt::Key_Return);
+    QVERIFY2(kc->errorText().isEmpty(), qPrintable(kc->errorText()));
+    QVERIFY(kc->report());
+    KcRequest r;
+    r.model = kCorner.toStdString();
+    r.travel = study_kc_range("-0.03:0.03:7", "travel");
+    r.steer_range = study_kc_range("-0.01:0.01:5", "steer range");
+    const ModelSpec spec = study_read_model(r.model);
+    r.spec = &spec;
+    const KcReport rep = study_kc_job(r);
+    QCOMPARE(kc->reportView()->toPlainText(), QString::fromStdString(study_kc_text(rep)));
+    QLineSeries* camber = maneuver_series_named(kc->travelView(), "camber");
+    QLineSeries* toe = maneuver_series_named(kc->travelView(), "toe");
+    QLineSeries* steer_toe = maneuver_series_named(kc->steerView(), "toe");
+    QVERIFY(camber && toe && steer_toe);
+    QCOMPARE(camber->count(), 7);
+    QCOMPARE(steer_toe->count(), 5);
+    int t = 0, st = 0;
+    for (const KcPoint& p : rep.points) {
+      if (p.sweep == "travel") {
+        QCOMPARE(camber->at(t).x(), p.travel * 1000);
+        QCOMPARE(camber->at(t).y(), p.camber);
+        QCOMPARE(toe->at(t++).y(), p.toe);
+      } else if (p.sweep == "steer") {
+        QCOMPARE(steer_toe->at(st).x(), p.steer);
+        QCOMPARE(steer_toe->at(st++).y(), p.toe);
+      }
+    }
+    QCOMPARE(t, 7);
+    // a range that does not read: the error names it, the curves stay
+    typeInto(kc->field("travel"), "0.03:-0.03:7");
+    QTest::mouseClick(kc->runButton(), Qt::LeftButton);
+    QVERIFY(kc->errorText().contains(QStringLiteral("travel")));
+    QCOMPARE(maneuver_series_named(kc->travelView(), "camber")->count(), 7);
+    // a wheel the model does not have
+    typeInto(kc->field("travel"), "-0.01:0.01:3");
+    typeInto(kc->field("wheel"), "wheel_rr");
+    QTest::keyClick(kc->field("wheel"), Qt::Key_Return);
+    QVERIFY2(kc->errorText().contains(QStringLiteral("wheel_rr")), qPrintable(kc->errorText()));
   }
 
   void sweptSineShowsTheGainsBesideTheLinearOnes() {
