@@ -7,16 +7,22 @@
 #include <QHBoxLayout>
 #include <QHeaderView>
 #include <QLabel>
+#include <QLineEdit>
 #include <QLineSeries>
 #include <QLogValueAxis>
+#include <QProgressBar>
 #include <QPushButton>
+#include <QScatterSeries>
 #include <QSplitter>
+#include <QThread>
+#include <QTimer>
 #include <QTabWidget>
 #include <QTableView>
 #include <QVBoxLayout>
 #include <QValueAxis>
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "gui/chart_view.hpp"
 #include "gui/document.hpp"
@@ -24,6 +30,7 @@
 #include "gui/matrix_view.hpp"
 #include "gui/pole_map.hpp"
 #include "gui/result_plots.hpp"
+#include "analysis/closed_loop_linear.hpp"
 #include "study/tools.hpp"
 
 namespace codyna::gui {
@@ -102,12 +109,34 @@ void decadeAxis(QLogValueAxis* a, double lo, double hi) {
 
 ControlView::ControlView(Document* doc, QWidget* parent) : QWidget(parent), doc_(doc) {
   buildUi();
-  connect(doc_, &Document::replaced, this, &ControlView::clearResult);
+  timer_ = new QTimer(this);
+  timer_->setInterval(100);
+  connect(timer_, &QTimer::timeout, this, [this] {
+    const int started = runs_started_.load();
+    const double t = run_t_.load(), te = run_t_end_.load();
+    if (started < 1 || runs_total_ < 1 || !freq_nu_) return;
+    const double done = (started - 1 + (te > 0 ? std::clamp(t / te, 0.0, 1.0) : 0.0)) / runs_total_;
+    estimate_progress_->setRange(0, 1000);
+    estimate_progress_->setValue(static_cast<int>(std::clamp(done, 0.0, 1.0) * 1000));
+    const int k = std::min(started, runs_total_) - 1;
+    estimate_progress_->setFormat(tr("frequency %1 of %2, input %3").arg(k / freq_nu_ + 1).arg(runs_total_ / freq_nu_).arg(k % freq_nu_ + 1));
+  });
+  connect(doc_, &Document::replaced, this, [this] {
+    if (estimating_) drop_estimate_ = true;  // the running estimate belongs to the model that left
+    clearResult();
+  });
   connect(doc_, &Document::modelChanged, this, &ControlView::updateStaleness);
   clearResult();
+  updateEstimateButtons();
 }
 
-ControlView::~ControlView() = default;
+ControlView::~ControlView() {
+  if (thread_) {
+    cancel_.store(true);
+    thread_->wait();  // what it posted to this object is dropped with it
+    delete thread_;
+  }
+}
 
 void ControlView::buildUi() {
   analyse_button_ = new QPushButton(tr("Analyse"), this);
@@ -205,8 +234,65 @@ void ControlView::buildUi() {
   bode->setObjectName("bodeView");
   bode->addWidget(view(mag_chart_, "bodeMagnitude"));
   bode->addWidget(view(phase_chart_, "bodePhase"));
+  // the nonlinear plant's points over the linear curves
+  mag_points_ = new QScatterSeries;
+  phase_points_ = new QScatterSeries;
+  for (auto [chart, line, points] : {std::tuple{mag_chart_, mag_series_, mag_points_}, std::tuple{phase_chart_, phase_series_, phase_points_}}) {
+    line->setName(tr("linear model"));
+    points->setName(tr("nonlinear plant"));
+    points->setMarkerShape(QScatterSeries::MarkerShapeCircle);
+    points->setMarkerSize(8);
+    points->setColor(QColor(0xc0, 0x30, 0x20));
+    points->setBorderColor(QColor(0x60, 0x10, 0x08));
+    chart->addSeries(points);
+    points->attachAxis(chart->axes(Qt::Horizontal).value(0));
+    points->attachAxis(chart->axes(Qt::Vertical).value(0));
+  }
+  // over the plot, not beside it: the two charts' frequency axes stay aligned
+  mag_chart_->legend()->setAlignment(Qt::AlignTop);
+  amplitude_edit_ = new QLineEdit(this);
+  amplitude_edit_->setObjectName("freqAmplitude");
+  amplitude_edit_->setPlaceholderText(QStringLiteral("0.01"));
+  amplitude_edit_->setToolTip(tr("The sine's amplitude on each Plant/In input in turn, in the input's units: one value for all, "
+                                 "or one per input separated by commas (codyna freqresp --amplitude)"));
+  frequencies_edit_ = new QLineEdit(this);
+  frequencies_edit_->setObjectName("freqFrequencies");
+  frequencies_edit_->setToolTip(tr("rad/s: W1,W2,... or A:B:N (N frequencies from A to B, log-spaced); empty: 10 over the middle "
+                                   "of the plot's range (codyna freqresp --frequencies)"));
+  estimate_button_ = new QPushButton(tr("Estimate"), this);
+  estimate_button_->setObjectName("freqEstimate");
+  estimate_button_->setToolTip(tr("Run the nonlinear model with a sine on each Plant/In input in turn, at each frequency, and draw "
+                                  "the gain and phase measured on each Plant/Out over the linear model's (codyna freqresp)"));
+  cancel_button_ = new QPushButton(tr("Cancel"), this);
+  cancel_button_->setObjectName("freqCancel");
+  estimate_progress_ = new QProgressBar(this);
+  estimate_progress_->setObjectName("freqProgress");
+  estimate_progress_->setTextVisible(true);
+  estimate_progress_->setFormat(QString());
+  estimate_progress_->setRange(0, 1);
+  estimate_progress_->setValue(0);
+  freq_status_ = new QLabel(this);
+  freq_status_->setObjectName("freqStatus");
+  freq_status_->setWordWrap(true);
+  freq_status_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  auto* est_row = new QHBoxLayout;
+  est_row->addWidget(new QLabel(tr("Nonlinear plant: amplitude"), this));
+  est_row->addWidget(amplitude_edit_);
+  est_row->addWidget(new QLabel(tr("frequencies"), this));
+  est_row->addWidget(frequencies_edit_, 1);
+  est_row->addWidget(estimate_button_);
+  est_row->addWidget(cancel_button_);
+  est_row->addWidget(estimate_progress_, 1);
+  auto* bode_page = new QWidget(this);
+  auto* bode_lay = new QVBoxLayout(bode_page);
+  bode_lay->setContentsMargins(0, 0, 0, 0);
+  bode_lay->addWidget(bode, 1);
+  bode_lay->addLayout(est_row);
+  bode_lay->addWidget(freq_status_);
+
   auto* plots = new QTabWidget(this);
-  plots->addTab(bode, tr("Bode"));
+  plots->setObjectName("controlPlots");
+  plots->addTab(bode_page, tr("Bode"));
   plots->addTab(view(step_chart_, "stepView"), tr("Step"));
   pz_map_ = new PoleMap(this);
   pz_map_->setObjectName("poleZeroMap");
@@ -234,6 +320,9 @@ void ControlView::buildUi() {
   });
   connect(input_combo_, &QComboBox::currentIndexChanged, this, [this] { redraw(); });
   connect(output_combo_, &QComboBox::currentIndexChanged, this, [this] { redraw(); });
+  connect(estimate_button_, &QPushButton::clicked, this, [this] { estimate(); });
+  connect(cancel_button_, &QPushButton::clicked, this, [this] { cancelEstimate(); });
+  for (QLineEdit* e : {amplitude_edit_, frequencies_edit_}) connect(e, &QLineEdit::returnPressed, this, [this] { estimate(); });
 }
 
 const LinearSystem* ControlView::system(System s) const {
@@ -258,6 +347,8 @@ bool ControlView::analyse() {
     emit message(tr("Analyse: the model does not compile: %1").arg(doc_->errorText()));
     return false;
   }
+  // an estimate of the same model stays
+  std::pair<std::shared_ptr<const FreqRespJob>, std::shared_ptr<const Model>> keep_freq{freq_, freq_model_};
   clearResult();
   try {
     ControlRequest request;
@@ -270,6 +361,10 @@ bool ControlView::analyse() {
     return false;
   }
   model_ = m;
+  if (keep_freq.second == m) {
+    freq_ = std::move(keep_freq.first);
+    freq_model_ = std::move(keep_freq.second);
+  }
   const ControlJob& job = *job_;
   const LinearSystem& plant = job.plant.system;
   QString text = tr("<b>Plant</b> about %1: %2 states, %3 inputs, %4 outputs.")
@@ -308,6 +403,9 @@ bool ControlView::analyse() {
 void ControlView::clearResult() {
   model_.reset();
   job_.reset();
+  freq_.reset();
+  freq_model_.reset();
+  if (!estimating_) setFreqStatus(QString(), false);
   gain_model_->clear();
   pole_model_->clear();
   status_->setText(tr("Not analysed yet: Analyse linearizes the plant and closes the loop with the study's controller."));
@@ -342,6 +440,9 @@ void ControlView::fillPairs() {
 void ControlView::redraw() {
   mag_series_->clear();
   phase_series_->clear();
+  mag_points_->clear();
+  phase_points_->clear();
+  mag_chart_->legend()->hide();
   for (QLineSeries* s : step_series_) {
     step_chart_->removeSeries(s);
     delete s;
@@ -399,8 +500,44 @@ void ControlView::redraw() {
   }
   mag_series_->replace(mag);
   phase_series_->replace(phase);
-  decadeAxis(mx, f->w.front(), f->w.back());
-  decadeAxis(px, f->w.front(), f->w.back());
+  // the nonlinear plant's points, over the open-loop plant's curves
+  double wlo = f->w.front(), whi = f->w.back();
+  QList<QPointF> nmag, nphase;
+  if (which == Plant && freq_ && freq_model_ == model_ && in < static_cast<int>(freq_->input_names.size()) &&
+      out < static_cast<int>(freq_->output_names.size()) && freq_->input_names[in] == sys->input_names[in] &&
+      freq_->output_names[out] == sys->output_names[out]) {
+    // the linear curve's (unwrapped) phase at w, interpolated over log w
+    const auto line_phase = [&](double w) {
+      const auto it = std::lower_bound(f->w.begin(), f->w.end(), w);
+      const std::size_t k = std::clamp<std::size_t>(it - f->w.begin(), 1, f->w.size() - 1);
+      const double w0 = f->w[k - 1], w1 = f->w[k];
+      const double p0 = f->phase_deg[k - 1](out, in), p1 = f->phase_deg[k](out, in);
+      if (f->w.size() < 2 || !(w1 > w0)) return p0;
+      const double a = std::clamp(std::log(w / w0) / std::log(w1 / w0), 0.0, 1.0);
+      return p0 + a * (p1 - p0);
+    };
+    for (const FreqRespPoint& p : freq_->points) {
+      const std::complex<double> g = p.G(out, in);
+      const double db = 20.0 * std::log10(std::abs(g));
+      double ph = std::arg(g) * 180 / std::numbers::pi;
+      const double ref = line_phase(p.w);
+      if (std::isfinite(ref)) ph += 360.0 * std::round((ref - ph) / 360.0);  // on the curve's branch
+      if (!std::isfinite(db) || !std::isfinite(ph)) continue;
+      nmag << QPointF(p.w, db);
+      nphase << QPointF(p.w, ph);
+      mlo = std::min(mlo, db);
+      mhi = std::max(mhi, db);
+      plo = std::min(plo, ph);
+      phi = std::max(phi, ph);
+      wlo = std::min(wlo, p.w);
+      whi = std::max(whi, p.w);
+    }
+  }
+  mag_points_->replace(nmag);
+  phase_points_->replace(nphase);
+  mag_chart_->legend()->setVisible(!nmag.isEmpty());
+  decadeAxis(mx, wlo, whi);
+  decadeAxis(px, wlo, whi);
   bodeAxis(my, mlo, mhi, {1, 2, 5, 10, 20, 40, 100, 200, 500});
   bodeAxis(py, plo, phi, {5, 15, 45, 90, 180, 360});
   mag_chart_->setTitle(tr("Magnitude, %1 to %2").arg(input_combo_->currentText(), output_combo_->currentText()));
@@ -448,6 +585,182 @@ void ControlView::redraw() {
 }
 
 QList<QPointF> ControlView::magnitudePoints() const { return mag_series_->points(); }
+QList<QPointF> ControlView::nonlinearMagnitudePoints() const { return mag_points_->points(); }
+QList<QPointF> ControlView::nonlinearPhasePoints() const { return phase_points_->points(); }
+
+std::vector<double> ControlView::defaultEstimateFrequencies() const {
+  if (!job_ || job_->plant_frequency.w.size() < 2) return {};
+  // the middle half of the plot's range in log w
+  const double a = std::log10(job_->plant_frequency.w.front()), b = std::log10(job_->plant_frequency.w.back());
+  return log_grid(std::pow(10.0, a + 0.25 * (b - a)), std::pow(10.0, b - 0.25 * (b - a)), 10);
+}
+
+namespace {
+// "0.01" or "0.01, 2" (one per Plant/In); throws std::invalid_argument naming the field
+std::vector<double> read_amplitudes(const QString& text) {
+  std::vector<double> v;
+  if (text.trimmed().isEmpty()) return v;
+  for (const QString& part : text.split(',')) {
+    bool ok = false;
+    const double a = part.trimmed().toDouble(&ok);
+    if (!ok || !std::isfinite(a) || !(a > 0))
+      throw std::invalid_argument("amplitude \"" + ss(part.trimmed()) + "\": expected a number > 0 (one, or one per Plant/In input)");
+    v.push_back(a);
+  }
+  return v;
+}
+}  // namespace
+
+bool ControlView::estimate() {
+  if (estimating_) return false;
+  FreqRespRequest r;
+  try {
+    r.amplitudes = read_amplitudes(amplitude_edit_->text());
+    if (!frequencies_edit_->text().trimmed().isEmpty())
+      r.frequencies = study_frequency_grid(ss(frequencies_edit_->text().trimmed()), "frequencies");
+  } catch (const std::exception& e) {
+    setFreqStatus(qs(e.what()), true);
+    emit message(tr("Estimate: %1").arg(qs(e.what())));
+    return false;
+  }
+  if (!job_ || isStale()) {
+    if (!analyse()) {
+      setFreqStatus(tr("The plant could not be analysed: see above"), true);
+      return false;
+    }
+  }
+  if (r.frequencies.empty()) r.frequencies = defaultEstimateFrequencies();
+  if (r.frequencies.empty()) {
+    setFreqStatus(tr("frequencies: none to estimate at"), true);
+    return false;
+  }
+  r.run.model = doc_->filePath().isEmpty() ? std::string("untitled.json") : ss(doc_->filePath());
+  if (thread_) {
+    thread_->wait();
+    delete thread_;
+    thread_ = nullptr;
+  }
+  freq_.reset();  // the points on screen are of the estimate that runs now
+  freq_model_.reset();
+  redraw();
+  cancel_.store(false);
+  runs_started_.store(0);
+  run_t_.store(0);
+  run_t_end_.store(0);
+  freq_nu_ = std::max<int>(1, static_cast<int>(job_->plant.system.nu()));
+  runs_total_ = static_cast<int>(r.frequencies.size()) * freq_nu_;
+  estimating_ = true;
+  drop_estimate_ = false;
+  estimate_progress_->setRange(0, 0);  // busy until the first run reports
+  estimate_progress_->setFormat(tr("setting up..."));
+  setFreqStatus(tr("Estimating at %1 frequencies...").arg(r.frequencies.size()), false);
+  updateEstimateButtons();
+  const ModelSpec spec = doc_->spec();
+  const std::shared_ptr<const Model> model = model_;
+  thread_ = QThread::create([this, r, spec, model] {
+    SimulationCallbacks cb;
+    cb.cancel = &cancel_;
+    double last = -1;
+    cb.progress = [this, &last](double t, double t_end) {
+      if (t < last || last < 0) runs_started_.fetch_add(1);  // a run starts again from 0
+      last = t;
+      run_t_.store(t);
+      run_t_end_.store(t_end);
+    };
+    QStringList notes;
+    const StudyMessages tell = [&notes](const StudyMessage& m) {
+      notes << (m.kind == StudyMessage::Warning ? QStringLiteral("warning: ") : QString()) + qs(m.text);
+    };
+    std::shared_ptr<const FreqRespJob> job;
+    QString error;
+    bool cancelled = false;
+    try {
+      job = std::make_shared<const FreqRespJob>(study_freqresp_job(r, spec, cb, tell));
+    } catch (const StudyCancelled&) {
+      cancelled = true;
+    } catch (const std::exception& e) {
+      error = qs(e.what());
+    } catch (...) {
+      error = QStringLiteral("the estimate failed (unknown error)");
+    }
+    QMetaObject::invokeMethod(
+        this, [this, job, error, notes, cancelled, model] {
+          if (job && !drop_estimate_) freq_model_ = model;
+          onEstimated(job, error, notes, cancelled);
+        },
+        Qt::QueuedConnection);
+  });
+  thread_->setObjectName(QStringLiteral("codyna-freqresp"));
+  timer_->start();
+  thread_->start();
+  return true;
+}
+
+void ControlView::cancelEstimate() {
+  if (estimating_) cancel_.store(true);
+}
+
+void ControlView::onEstimated(std::shared_ptr<const FreqRespJob> job, const QString& error, const QStringList& notes,
+                              bool cancelled) {
+  estimating_ = false;
+  timer_->stop();
+  estimate_progress_->setRange(0, 1);
+  estimate_progress_->setValue(cancelled || !error.isEmpty() || !job ? 0 : 1);
+  estimate_progress_->setFormat(QString());
+  updateEstimateButtons();
+  if (drop_estimate_) {
+    drop_estimate_ = false;
+    setFreqStatus(tr("The estimate of the previous model was stopped"), false);
+    emit estimateFinished();
+    return;
+  }
+  for (const QString& n : notes) emit message(tr("Estimate: %1").arg(n));
+  if (cancelled) {
+    setFreqStatus(tr("Cancelled"), false);
+  } else if (!job) {
+    setFreqStatus(error, true);
+    emit message(tr("Estimate: %1").arg(error));
+  } else {
+    freq_ = std::move(job);
+    const FreqRespJob& j = *freq_;
+    double harmonics = 0;
+    for (const FreqRespPoint& p : j.points) harmonics = std::max(harmonics, p.distortion.maxCoeff());
+    QString amps;
+    for (Eigen::Index k = 0; k < j.amplitudes.size(); ++k)
+      amps += (k ? QStringLiteral(", ") : QString()) + QStringLiteral("%1 %2").arg(qs(j.input_names[k])).arg(j.amplitudes[k], 0, 'g', 4) +
+              (j.input_units[k].empty() ? QString() : QStringLiteral(" ") + qs(j.input_units[k]));
+    QString text = tr("<b>Nonlinear plant</b> (%1, amplitude %2, %3 frequencies): largest gap <b>%4 %</b> of the linear "
+                      "response, %5/%6 at %7 rad/s; harmonics at most %8 % of a response.")
+                       .arg(qs(j.controller).toHtmlEscaped(), amps.toHtmlEscaped())
+                       .arg(j.points.size())
+                       .arg(100 * j.largest_gap, 0, 'g', 3)
+                       .arg(qs(j.output_names[j.gap_output]).toHtmlEscaped(), qs(j.input_names[j.gap_input]).toHtmlEscaped())
+                       .arg(j.points[j.gap_point].w, 0, 'g', 4)
+                       .arg(100 * harmonics, 0, 'g', 3);
+    if (!j.warnings.empty())
+      text += tr(" <span style='color:#b00000'>%1 warning(s): see Messages.</span>").arg(j.warnings.size());
+    freq_status_->setStyleSheet(QString());
+    freq_status_->setText(text);
+    // the points are the open-loop plant's
+    if (system_combo_->currentIndex() != Plant) {
+      system_combo_->setCurrentIndex(Plant);
+    } else {
+      redraw();
+    }
+    emit message(tr("Estimated the nonlinear plant's frequency response: largest gap %1 %").arg(100 * j.largest_gap, 0, 'g', 3));
+  }
+  emit estimateFinished();
+}
+
+void ControlView::setFreqStatus(const QString& text, bool error) {
+  freq_status_->setStyleSheet(error ? QStringLiteral("QLabel { color: #b00000; }") : QString());
+  freq_status_->setText(text.toHtmlEscaped());
+}
+
+void ControlView::updateEstimateButtons() {
+  estimate_button_->setEnabled(!estimating_);
+  cancel_button_->setEnabled(estimating_);
+}
 QList<QPointF> ControlView::phasePoints() const { return phase_series_->points(); }
 int ControlView::stepSeriesCount() const { return static_cast<int>(step_series_.size()); }
 QList<QPointF> ControlView::stepPoints(int output) const {

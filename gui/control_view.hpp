@@ -11,7 +11,11 @@
 //    poles (a table: eigenvalue, frequency, damping; unstable ones in red);
 //  - a Bode plot, magnitude in dB and phase in degrees over a logarithmic
 //    frequency axis, of one input-output pair of the open-loop plant or of
-//    the closed loop (chosen with three drop-downs);
+//    the closed loop (chosen with three drop-downs), and over the open-loop plant's, the
+//    frequency response of the nonlinear plant (Estimate: core's study_freqresp_job, the job
+//    `codyna freqresp` runs, at the amplitude and frequencies typed, on a worker thread with
+//    progress and Cancel): its gain and phase as points on the linear curves, and the largest
+//    gap, where, and the harmonics' share in a line under the plot;
 //  - the step response to a unit step on the chosen input of the outputs of
 //    the chosen output's group (exact at the samples: core's step_response).
 // Nothing is computed here: the curves, poles, zeros, the gain and the stability verdict are
@@ -20,9 +24,11 @@
 #pragma once
 
 #include <QWidget>
+#include <atomic>
 #include <memory>
 #include <optional>
 
+#include "study/freqresp_job.hpp"
 #include "study/jobs.hpp"
 
 QT_BEGIN_NAMESPACE
@@ -30,9 +36,14 @@ class QChart;
 class QChartView;
 class QComboBox;
 class QLabel;
+class QLineEdit;
 class QLineSeries;
+class QProgressBar;
 class QPushButton;
+class QScatterSeries;
 class QTableView;
+class QThread;
+class QTimer;
 QT_END_NAMESPACE
 
 namespace codyna::gui {
@@ -82,14 +93,44 @@ class ControlView : public QWidget {
   // the chosen system's poles and the chosen pair's transmission zeros
   PoleMap* poleZeroMap() const { return pz_map_; }
 
+  // The frequency response of the nonlinear plant (Estimate). Starts study_freqresp_job on the
+  // document's model (analysing first when there is no result or it is out of date) at the
+  // amplitude and frequencies typed (empty: the job's 0.01, and 10 frequencies over the middle
+  // of the Bode plot's range); false (the reason in freqStatusLabel(), red) when a field does not
+  // read, the model does not analyse, or an estimate is running. The job's own refusals and
+  // failures come with estimateFinished().
+  bool estimate();
+  void cancelEstimate();
+  bool isEstimating() const { return estimating_; }
+  // the last estimate (null before the first, while one runs, after one that failed or was
+  // cancelled, New and Open)
+  const codyna::FreqRespJob* freqResp() const { return freq_.get(); }
+  QLineEdit* amplitudeEdit() const { return amplitude_edit_; }
+  QLineEdit* frequenciesEdit() const { return frequencies_edit_; }
+  QPushButton* estimateButton() const { return estimate_button_; }
+  QPushButton* cancelEstimateButton() const { return cancel_button_; }
+  QProgressBar* estimateProgress() const { return estimate_progress_; }
+  QLabel* freqStatusLabel() const { return freq_status_; }
+  // the estimate's points drawn for the chosen pair: (w rad/s, |G| dB) and (w rad/s, phase deg,
+  // on the linear curve's branch); empty when the closed loop is shown or there is no estimate
+  QList<QPointF> nonlinearMagnitudePoints() const;
+  QList<QPointF> nonlinearPhasePoints() const;
+  // the frequencies Estimate uses when the field is empty (rad/s; empty before Analyse)
+  std::vector<double> defaultEstimateFrequencies() const;
+
  signals:
   void message(const QString& text);
+  void estimateFinished();
 
  private:
   void buildUi();
   void fillPairs();  // input and output names of the chosen system
   void redraw();     // the chosen pair's Bode and step curves, poles and zeros
   void updateStaleness();
+  void onEstimated(std::shared_ptr<const codyna::FreqRespJob> job, const QString& error, const QStringList& notes,
+                   bool cancelled);
+  void setFreqStatus(const QString& text, bool error);
+  void updateEstimateButtons();
 
   Document* doc_;
   std::shared_ptr<const codyna::Model> model_;  // the model the results belong to
@@ -113,6 +154,25 @@ class ControlView : public QWidget {
   QLineSeries* phase_series_ = nullptr;
   std::vector<QLineSeries*> step_series_;
   std::vector<int> step_outputs_;
+
+  // the nonlinear plant's frequency response
+  QLineEdit* amplitude_edit_ = nullptr;
+  QLineEdit* frequencies_edit_ = nullptr;
+  QPushButton* estimate_button_ = nullptr;
+  QPushButton* cancel_button_ = nullptr;
+  QProgressBar* estimate_progress_ = nullptr;
+  QLabel* freq_status_ = nullptr;
+  QScatterSeries* mag_points_ = nullptr;
+  QScatterSeries* phase_points_ = nullptr;
+  std::shared_ptr<const codyna::FreqRespJob> freq_;
+  std::shared_ptr<const codyna::Model> freq_model_;  // the model the estimate belongs to
+  QThread* thread_ = nullptr;
+  QTimer* timer_ = nullptr;
+  std::atomic<bool> cancel_{false};
+  std::atomic<int> runs_started_{0};
+  std::atomic<double> run_t_{0}, run_t_end_{0};
+  int runs_total_ = 0, freq_nu_ = 0;
+  bool estimating_ = false, drop_estimate_ = false;
 };
 
 }  // namespace codyna::gui

@@ -7,7 +7,10 @@
 #include <QLabel>
 #include <QMessageBox>
 #include <QProcess>
+#include <QLineEdit>
+#include <QProgressBar>
 #include <QPushButton>
+#include <QSignalSpy>
 #include <QTabWidget>
 #include <QTemporaryDir>
 #include <QTest>
@@ -46,6 +49,106 @@ class ControlViewTest : public QObject {
     QVERIFY(w->openFile(kCart));
   }
   void cleanup() { drive::close(w); }
+
+  // the nonlinear plant's frequency response over the linear Bode plot, as a person asks for it:
+  // the amplitude and frequencies typed, Enter; at a small force the points lie on the linear
+  // model's curve (the test's own C (jwI - A)^-1 B + D: gain to 1e-4, phase to 0.01 rad, on the
+  // curve's branch), at a large one the gap grows and the line under the plot says where; bad
+  // fields are named, and Cancel stops a long estimate with nothing drawn
+  void nonlinearPlantOverTheLinearBode() {
+    ControlView* cv = w->controlView();
+    w->analysisTabs()->setCurrentWidget(cv);
+    QTRY_VERIFY(cv->amplitudeEdit()->isVisible());
+    QSignalSpy done(cv, &ControlView::estimateFinished);
+    auto type = [](QLineEdit* e, const QString& text) {
+      e->setFocus();
+      e->selectAll();
+      QTest::keyClick(e, Qt::Key_Delete);
+      QTest::keyClicks(e, text);
+    };
+    type(cv->amplitudeEdit(), "0.01");
+    type(cv->frequenciesEdit(), "1:10:5");
+    QTest::keyClick(cv->frequenciesEdit(), Qt::Key_Return);  // analyses first: nothing was
+    QVERIFY(cv->isEstimating());
+    QVERIFY(!cv->estimateButton()->isEnabled());
+    QVERIFY(cv->cancelEstimateButton()->isEnabled());
+    QVERIFY(done.wait(60000));
+    QVERIFY2(cv->freqResp(), qPrintable(cv->freqStatusLabel()->text()));
+    QCOMPARE(cv->systemCombo()->currentIndex(), int(ControlView::Plant));
+    const LinearSystem& s = *cv->system(ControlView::Plant);
+    const FreqRespJob& job = *cv->freqResp();
+    QCOMPARE(int(job.points.size()), 5);
+    for (const char* out : {"h", "theta"}) {
+      cv->inputCombo()->setCurrentText("force");
+      cv->outputCombo()->setCurrentText(out);
+      const int i = cv->outputCombo()->currentIndex(), j = cv->inputCombo()->currentIndex();
+      const QList<QPointF> mag = cv->nonlinearMagnitudePoints(), phase = cv->nonlinearPhasePoints();
+      const QList<QPointF> line = cv->phasePoints();
+      QCOMPARE(mag.size(), 5);
+      QCOMPARE(phase.size(), 5);
+      for (int k = 0; k < 5; ++k) {
+        const double wk = std::pow(10.0, k / 4.0);
+        QVERIFY(std::abs(mag[k].x() - wk) < 1e-12 * wk);
+        const Eigen::MatrixXcd Z = std::complex<double>(0, wk) * Eigen::MatrixXcd::Identity(s.nx(), s.nx()) - s.A.cast<std::complex<double>>();
+        const std::complex<double> h = (s.C.cast<std::complex<double>>() * Z.partialPivLu().solve(s.B.cast<std::complex<double>>()))(i, j) + s.D(i, j);
+        const double gain = std::pow(10.0, mag[k].y() / 20);
+        QVERIFY2(std::abs(gain - std::abs(h)) <= 1e-4 * std::abs(h),
+                 qPrintable(QString("%1 at %2 rad/s: gain %3, linear %4").arg(out).arg(wk).arg(gain).arg(std::abs(h))));
+        const double dphi = std::remainder(phase[k].y() * std::numbers::pi / 180 - std::arg(h), 2 * std::numbers::pi);
+        QVERIFY2(std::abs(dphi) <= 0.01, qPrintable(QString("%1 at %2 rad/s: phase off by %3 rad").arg(out).arg(wk).arg(dphi)));
+        // on the drawn curve's branch: within a degree of the line between its neighbours
+        int n = 1;
+        while (n + 1 < line.size() && line[n].x() < wk) ++n;
+        const double a = std::log(wk / line[n - 1].x()) / std::log(line[n].x() / line[n - 1].x());
+        const double on_line = line[n - 1].y() + a * (line[n].y() - line[n - 1].y());
+        QVERIFY2(std::abs(phase[k].y() - on_line) < 1, qPrintable(QString("%1 at %2 rad/s: %3 deg, the curve %4").arg(out).arg(wk).arg(phase[k].y()).arg(on_line)));
+      }
+      // the closed loop's curves are not the plant's: no points there
+      cv->systemCombo()->setCurrentIndex(ControlView::ClosedLoop);
+      QCOMPARE(cv->nonlinearMagnitudePoints().size(), 0);
+      cv->systemCombo()->setCurrentIndex(ControlView::Plant);
+    }
+    QVERIFY2(job.largest_gap < 1e-4, qPrintable(QString::number(job.largest_gap)));
+    QVERIFY2(cv->freqStatusLabel()->text().contains("largest gap"), qPrintable(cv->freqStatusLabel()->text()));
+
+    // 200 N: the pendulum swings far, the gap grows (to several per cent) and is said with its pair
+    type(cv->amplitudeEdit(), "200");
+    QTest::mouseClick(cv->estimateButton(), Qt::LeftButton);
+    QVERIFY(done.wait(60000));
+    QVERIFY(cv->freqResp());
+    const FreqRespJob& big = *cv->freqResp();
+    QVERIFY2(big.largest_gap > 0.02, qPrintable(QString::number(big.largest_gap)));
+    const QString where = QString("%1 %").arg(100 * big.largest_gap, 0, 'g', 3);
+    const QString label = cv->freqStatusLabel()->text();
+    QVERIFY2(label.contains(where) && label.contains(QString::fromStdString(big.output_names[big.gap_output] + "/" + big.input_names[big.gap_input])),
+             qPrintable(label));
+    QCOMPARE(big.amplitudes[0], 200.0);
+
+    // bad fields: named, red, nothing started, the last estimate stays
+    for (auto [edit, text, name] : {std::tuple{cv->amplitudeEdit(), QString("-1"), QString("amplitude")},
+                                    std::tuple{cv->frequenciesEdit(), QString("abc"), QString("frequencies")}}) {
+      const QString keep = edit->text();
+      type(edit, text);
+      QTest::keyClick(edit, Qt::Key_Return);
+      QVERIFY(!cv->isEstimating());
+      QVERIFY2(cv->freqStatusLabel()->text().contains(name), qPrintable(cv->freqStatusLabel()->text()));
+      QVERIFY(cv->freqStatusLabel()->styleSheet().contains("b00000"));
+      QVERIFY(cv->freqResp());
+      type(edit, keep);
+    }
+
+    // Cancel: a long estimate (400 frequencies) stops, nothing drawn
+    done.clear();
+    type(cv->frequenciesEdit(), "0.5:60:400");
+    QTest::mouseClick(cv->estimateButton(), Qt::LeftButton);
+    QVERIFY(cv->isEstimating());
+    QTest::mouseClick(cv->cancelEstimateButton(), Qt::LeftButton);
+    QVERIFY(done.wait(60000));
+    QVERIFY(!cv->freqResp());
+    QCOMPARE(cv->freqStatusLabel()->text(), QString("Cancelled"));
+    QCOMPARE(cv->nonlinearMagnitudePoints().size(), 0);
+    QVERIFY(cv->estimateButton()->isEnabled());
+  }
 
   // the charts zoom by a dragged rectangle and back by a double click, read the value under the pointer,
   // and copy their curves as CSV

@@ -527,6 +527,30 @@ class MainWindowXvfb : public QObject {
     QVERIFY2(stats(screenOfChild(&w, kc->travelView())).foreground > 0.003, "the camber and toe curves are drawn");
     save(screenOf(&w), "kc_view.png");
   }
+  // the nonlinear plant's frequency response over the linear Bode plot: the cart-pendulum pushed
+  // with 200 N, the rod's angle parts from the linear model where it swings most
+  void frequencyResponseOverlay() {
+    MainWindow w;
+    w.resize(1600, 1000);
+    w.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&w));
+    QVERIFY(w.openFile(QStringLiteral(CODYNA_EXAMPLES_DIR "/cart_pendulum.json")));
+    ControlView* cv = w.controlView();
+    w.analysisTabs()->setCurrentWidget(cv);
+    w.findChild<QSplitter*>("centreSplitter")->setSizes({250, 690});
+    QVERIFY(cv->analyse());
+    cv->inputCombo()->setCurrentText("force");
+    cv->outputCombo()->setCurrentText("theta");
+    cv->amplitudeEdit()->setText(QStringLiteral("200"));
+    cv->frequenciesEdit()->setText(QStringLiteral("0.5:30:12"));
+    QSignalSpy done(cv, &ControlView::estimateFinished);
+    QVERIFY(cv->estimate());
+    QVERIFY(done.wait(60000));
+    QVERIFY2(cv->freqResp(), qPrintable(cv->freqStatusLabel()->text()));
+    QCOMPARE(cv->nonlinearMagnitudePoints().size(), 12);
+    QTest::qWait(300);
+    save(screenOf(&w), "bode_nonlinear.png");
+  }
 };
 
 QTEST_MAIN(MainWindowXvfb)
