@@ -51,6 +51,8 @@
 #include "gui/simulate_view.hpp"
 #include "gui/view3d.hpp"
 #include "gui/wheel_guard.hpp"
+#include "study/maneuver_job.hpp"
+#include "study/tools.hpp"
 #include "study/workflow.hpp"
 
 // the icon lives in codyna_gui, a static library: its resources must be registered by name
@@ -282,7 +284,13 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new Document
     tabs_->setCurrentWidget(sweep_view_);
   });
   connect(sim_view_, &SimulateView::runFinished, this, &MainWindow::onResult);
-  connect(sim_view_, &SimulateView::runStarted, this, [this] { animateMode(-1, {}); });
+  connect(sim_view_, &SimulateView::runStarted, this, [this] {
+    animateMode(-1, {});
+    // a maneuver's lane and track are not this run's
+    view_->setPaths({});
+    view_->setFollowBody(-1);
+  });
+  connect(maneuver_view_, &ManeuverView::finished, this, &MainWindow::onManeuverFinished);
 
   connect(slider_, &QSlider::valueChanged, this, [this](int k) {
     if (result_ && k >= 0 && k < result_->samples()) setPlaybackTime(result_->t[k]);
@@ -947,6 +955,50 @@ void MainWindow::onResult(std::shared_ptr<const SimulationResult> r) {
     slider_->setValue(n - 1);
     setPlaybackTime(result_->t.back());
   }
+}
+
+void MainWindow::onManeuverFinished() {
+  const std::shared_ptr<const ManeuverReport> rep = maneuver_view_->sharedReport();
+  const std::shared_ptr<const Model> model = doc_->model();
+  if (!rep || !model || rep->result.samples() < 2 || rep->result.q.cols() != model->nq) return;  // a steady diagram: no run
+  setPlaying(false);
+  animateMode(-1, {});
+  // the track of the body the maneuver reads (its centre of mass) and the lane, on the ground
+  std::vector<ScenePath> paths;
+  int body = -1;
+  try {
+    body = study_maneuver_body(*model);
+  } catch (const std::exception&) {
+    body = -1;
+  }
+  const double L = view_->scene().length();
+  if (!rep->lane_path.empty()) {
+    ScenePath lane{"lane", {}, Eigen::Vector3f(0.25f, 0.55f, 0.85f), 0.04 * L, false};
+    for (const Eigen::Vector2d& p : rep->lane_path) lane.points.emplace_back(p.x(), p.y(), 0.0);
+    paths.push_back(std::move(lane));
+    ScenePath cones{"cones", {}, Eigen::Vector3f(0.95f, 0.45f, 0.05f), 0.06 * L, true};
+    for (const Eigen::Vector2d& p : rep->lane_cones) cones.points.emplace_back(p.x(), p.y(), 0.0);
+    paths.push_back(std::move(cones));
+  }
+  if (body > 0) {
+    ScenePath track{"track", {}, Eigen::Vector3f(0.80f, 0.15f, 0.10f), 0.04 * L, false};
+    StudyPoses poses(*model);
+    const SimulationResult& r = rep->result;
+    const int n = r.samples(), stride = std::max(1, n / 4000);  // at most ~4000 points
+    const Eigen::Vector3d c = model->com[static_cast<std::size_t>(body)];
+    for (int k = 0; k < n; k += stride) track.points.push_back(poses.at(r.q.row(k).transpose())[static_cast<std::size_t>(body)].act_point(c));
+    if ((n - 1) % stride != 0) track.points.push_back(poses.at(r.q.row(n - 1).transpose())[static_cast<std::size_t>(body)].act_point(c));
+    paths.push_back(std::move(track));
+  }
+  // the run from its start, the camera following the car
+  view_->setPaths(std::move(paths));
+  onResult(std::shared_ptr<const SimulationResult>(rep, &rep->result));
+  setPlaybackTime(rep->result.t.front());
+  view_->setFollowBody(body);
+  view_->frameBody(body, 1.5 * L);  // the car and the lane about it
+  message(tr("The maneuver's run is in the 3-D view: Play (%1 s%2)")
+              .arg(rep->result.t.back() - rep->result.t.front(), 0, 'g', 4)
+              .arg(body > 0 ? tr(", the track of %1 drawn, the camera following it").arg(qs(model->body_names[static_cast<std::size_t>(body)])) : QString()));
 }
 
 void MainWindow::setPlaybackTime(double t) {

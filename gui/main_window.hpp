@@ -109,8 +109,12 @@ class MainWindow : public QMainWindow {
   // adds one element of kind k, set up by `setup` (its index given) in the same undo step, and selects it
   bool addElement(ElementKind k, const std::function<void(ModelSpec&, int)>& setup = {}, const QString& text = QString());
 
-  // playback of the last simulation result in the 3-D view
+  // playback of the last simulation result in the 3-D view (a Simulate run's, or a maneuver's:
+  // then with the lane and the track of the steady body drawn on the ground, the camera following
+  // that body)
   void setPlaybackTime(double t);
+  // the result playing (null: none)
+  const SimulationResult* playbackResult() const { return result_.get(); }
   double playbackTime() const { return play_t_; }
   void setPlaying(bool on);
   bool isPlaying() const;
@@ -139,6 +143,7 @@ class MainWindow : public QMainWindow {
   void rebuildRecentMenu();
   void onModelChanged();
   void onResult(std::shared_ptr<const SimulationResult> r);
+  void onManeuverFinished();  // its run to the playback, its track and lane to the 3-D view
   void stepAnimation();
   int ask(const QString& title, const QString& text, int buttons);
   // a report in a scrollable dialog (the question hook gets intro + "\n\n" + report)

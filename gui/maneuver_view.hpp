@@ -54,6 +54,7 @@ class ManeuverView : public QWidget {
   QString statusText() const;
   // the last report (null before the first, or after a refusal or a cancel)
   const ManeuverReport* report() const { return report_.get(); }
+  std::shared_ptr<const ManeuverReport> sharedReport() const { return report_; }
 
  signals:
   void message(const QString& text);

@@ -275,11 +275,14 @@ double intersect(Prim prim, const Eigen::Affine3d& world, const Ray& ray) {
 void Scene::build(const Model* model, const std::vector<int>& held) {
   model_ = model;
   items_.clear();
+  paths_.clear();
   up_ = Eigen::Vector3d::UnitY();
   length_ = 1.0;
   if (!model) {
     grid_center_.setZero();
     grid_half_ = 2.0, grid_step_ = 0.5;
+    base_grid_center_ = grid_center_;
+    base_grid_half_ = grid_half_, base_grid_step_ = grid_step_;
     return;
   }
   const Model& m = *model;
@@ -960,6 +963,72 @@ void Scene::placeGrid(const std::vector<SE3>& oMi) {
   const Eigen::Vector3d c = box.center();
   const double c1 = grid_step_ * std::round(c.dot(e1) / grid_step_), c2 = grid_step_ * std::round(c.dot(e2) / grid_step_);
   grid_center_ = c1 * e1 + c2 * e2 + height * up_;
+  base_grid_center_ = grid_center_;
+  base_grid_half_ = grid_half_;
+  base_grid_step_ = grid_step_;
+}
+
+void Scene::setPaths(std::vector<ScenePath> paths) {
+  paths_ = std::move(paths);
+  grid_center_ = base_grid_center_;
+  grid_half_ = base_grid_half_;
+  grid_step_ = base_grid_step_;
+  const Eigen::Vector3d e1 = frontFor(up_), e2 = up_.cross(e1);
+  double lo1 = grid_center_.dot(e1) - grid_half_, hi1 = grid_center_.dot(e1) + grid_half_;
+  double lo2 = grid_center_.dot(e2) - grid_half_, hi2 = grid_center_.dot(e2) + grid_half_;
+  bool grown = false;
+  for (const ScenePath& p : paths_)
+    for (const Eigen::Vector3d& x : p.points) {
+      if (!x.allFinite()) continue;
+      const double a = x.dot(e1), b = x.dot(e2), m = p.width;
+      if (a - m < lo1 || a + m > hi1 || b - m < lo2 || b + m > hi2) grown = true;
+      lo1 = std::min(lo1, a - m), hi1 = std::max(hi1, a + m);
+      lo2 = std::min(lo2, b - m), hi2 = std::max(hi2, b + m);
+    }
+  if (!grown) return;
+  // a square over both, a margin of a tenth, lines at most ~120 each way
+  const double half = 0.55 * std::max(hi1 - lo1, hi2 - lo2);
+  grid_step_ = std::max(grid_step_, niceStep(half / 60));
+  grid_half_ = grid_step_ * std::ceil(half / grid_step_);
+  const double c1 = grid_step_ * std::round(0.5 * (lo1 + hi1) / grid_step_), c2 = grid_step_ * std::round(0.5 * (lo2 + hi2) / grid_step_);
+  grid_center_ = c1 * e1 + c2 * e2 + grid_center_.dot(up_) * up_;
+}
+
+Mesh Scene::pathMesh() const {
+  Mesh mesh;
+  const double h = grid_center_.dot(up_) + 0.003 * length_;  // just over the grid
+  const auto onGround = [&](const Eigen::Vector3d& x) { return Eigen::Vector3d(x - (x.dot(up_) - h) * up_); };
+  const Eigen::Vector3f n = up_.cast<float>();
+  static const Mesh cone = unitCone(12);
+  for (const ScenePath& p : paths_) {
+    if (p.markers) {
+      for (const Eigen::Vector3d& x : p.points) {
+        if (!x.allFinite()) continue;
+        // the cone's z along up, its base p.width across and twice as tall
+        Eigen::Affine3f T = Eigen::Affine3f::Identity();
+        const Eigen::Vector3f e1 = frontFor(up_).cast<float>(), e2 = n.cross(e1);
+        T.linear().col(0) = e1 * float(0.5 * p.width);
+        T.linear().col(1) = e2 * float(0.5 * p.width);
+        T.linear().col(2) = n * float(2 * p.width);
+        T.translation() = onGround(x).cast<float>();
+        mesh.append(cone, T, p.color);
+      }
+      continue;
+    }
+    // a ribbon: each segment a quad, half the width either side of the line
+    for (std::size_t k = 1; k < p.points.size(); ++k) {
+      const Eigen::Vector3d a = onGround(p.points[k - 1]), b = onGround(p.points[k]);
+      if (!a.allFinite() || !b.allFinite()) continue;
+      const Eigen::Vector3d d = b - a;
+      if (d.norm() < 1e-12) continue;
+      const Eigen::Vector3f side = (0.5 * p.width * up_.cross(d).normalized()).cast<float>();
+      const Eigen::Vector3f fa = a.cast<float>(), fb = b.cast<float>();
+      for (const Eigen::Vector3f& v : {Eigen::Vector3f(fa - side), Eigen::Vector3f(fa + side), Eigen::Vector3f(fb + side),
+                                       Eigen::Vector3f(fa - side), Eigen::Vector3f(fb + side), Eigen::Vector3f(fb - side)})
+        mesh.addVertex(v, n, p.color);
+    }
+  }
+  return mesh;
 }
 
 std::vector<float> Scene::gridLines() const {

@@ -110,6 +110,17 @@ struct Ray {
 // distance along `ray` to the unit primitive under `world`, or a negative value on a miss
 double intersect(Prim prim, const Eigen::Affine3d& world, const Ray& ray);
 
+// A path drawn on the ground (a maneuver's target and the track a body left): world points,
+// dropped onto the grid's plane and drawn as a flat ribbon `width` wide; with `markers`, a cone
+// stands at each point instead (a lane's cones), `width` wide at its base
+struct ScenePath {
+  std::string name;
+  std::vector<Eigen::Vector3d> points;
+  Eigen::Vector3f color{0.2f, 0.2f, 0.2f};
+  double width = 0.1;
+  bool markers = false;
+};
+
 class Scene {
  public:
   // builds the items of `model` (nullptr: empty) and places them at model->q0
@@ -148,6 +159,13 @@ class Scene {
   // line vertices of the grid (x y z r g b pairs)
   std::vector<float> gridLines() const;
 
+  // the paths drawn on the ground (replaces them; empty: none). The grid grows to hold them, its
+  // lines at most about 120 each way (a coarser step over a long track); build() clears them.
+  void setPaths(std::vector<ScenePath> paths);
+  const std::vector<ScenePath>& paths() const { return paths_; }
+  // their triangles (ribbons and cones, with normals), in world coordinates on the grid's plane
+  Mesh pathMesh() const;
+
  private:
   void addDefaultLook(int body);
   void addElements(const std::vector<SE3>& oMi);
@@ -161,6 +179,10 @@ class Scene {
   double grid_half_ = 2.0, grid_step_ = 0.5;
   double tire_force_scale_ = 0.0;  // m per N
   double tire_force_unit_ = 1.0;   // N in the legend's unit (1 or 1000)
+  std::vector<ScenePath> paths_;
+  // the grid placeGrid() chose for the mechanism, before paths grew it
+  Eigen::Vector3d base_grid_center_ = Eigen::Vector3d::Zero();
+  double base_grid_half_ = 2.0, base_grid_step_ = 0.5;
 };
 
 // Orbit camera. Pixel coordinates are widget coordinates: x right, y down.

@@ -160,7 +160,7 @@ class GLCanvas : public QOpenGLWidget, protected QOpenGLExtraFunctions {
     disconnect(context_gone_);
     cleanup();
   }
-  void gridChanged() { grid_dirty_ = true; }
+  void gridChanged() { grid_dirty_ = paths_dirty_ = true; }
 
  protected:
   void initializeGL() override {
@@ -236,6 +236,15 @@ class GLCanvas : public QOpenGLWidget, protected QOpenGLExtraFunctions {
       }
       setTransform(PV, V, I3);
       draw(grid_, GL_LINES);
+    }
+    if (!scene.paths().empty() || paths_.count > 0) {
+      if (paths_dirty_) {
+        upload(paths_, scene.pathMesh().data, true);
+        paths_dirty_ = false;
+      }
+      setTransform(PV, V, V.topLeftCorner<3, 3>());
+      setLook(Eigen::Vector4f::Ones(), true, 0.0f);
+      draw(paths_, GL_TRIANGLES);
     }
 
     const int hl = owner_->highlight_body_;
@@ -368,6 +377,7 @@ class GLCanvas : public QOpenGLWidget, protected QOpenGLExtraFunctions {
     makeCurrent();
     for (auto& g : prims_) destroy(g);
     destroy(grid_);
+    destroy(paths_);
     destroy(background_);
     program_.reset();
     ready_ = false;
@@ -397,8 +407,8 @@ class GLCanvas : public QOpenGLWidget, protected QOpenGLExtraFunctions {
   std::unique_ptr<QOpenGLShaderProgram> program_;
   QMetaObject::Connection context_gone_;
   std::array<GpuMesh, 6> prims_;
-  GpuMesh grid_, background_;
-  bool grid_dirty_ = true, ready_ = false;
+  GpuMesh grid_, background_, paths_;
+  bool grid_dirty_ = true, paths_dirty_ = true, ready_ = false;
   int u_mvp_ = -1, u_mv_ = -1, u_nrm_ = -1, u_color_ = -1, u_lit_ = -1, u_hl_ = -1;
 };
 
@@ -473,8 +483,42 @@ void View3D::setDraft(std::shared_ptr<const codyna::Model> draft, const QString&
 
 QString View3D::draftNote() const { return draft_note_ && !draft_note_->isHidden() ? draft_note_->text() : QString(); }
 
+void View3D::setPaths(std::vector<ScenePath> paths) {
+  scene_.setPaths(std::move(paths));
+  updateSceneRadius();
+  if (canvas_) canvas_->gridChanged();
+  requestPaint();
+}
+
+void View3D::setFollowBody(int body) {
+  follow_body_ = model_ && body > 0 && body < model_->nbodies ? body : -1;
+  follow_at_ = Eigen::Vector3d::Constant(std::nan(""));
+  if (follow_body_ > 0 && q_.size() == model_->nq) follow_at_ = poses_->at(q_)[static_cast<std::size_t>(follow_body_)].p;
+}
+
+void View3D::frameBody(int body, double radius) {
+  if (!model_ || body <= 0 || body >= model_->nbodies || q_.size() != model_->nq || !(radius > 0)) return;
+  const Eigen::Vector3d at = poses_->at(q_)[static_cast<std::size_t>(body)].p, u = scene_.up();
+  const Eigen::Vector3d ground = at - (at.dot(u) - scene_.gridCenter().dot(u)) * u;
+  const Eigen::Vector3d e1 = camera_.front, e2 = u.cross(e1);
+  Eigen::AlignedBox3d box;
+  for (int i : {-1, 1})
+    for (int j : {-1, 1}) box.extend(ground + radius * (i * e1 + j * e2));
+  // as tall as the mechanism
+  const Eigen::AlignedBox3d b = scene_.bounds();
+  double top = 0;
+  for (int k = 0; k < 8; ++k) top = std::max(top, (b.corner(static_cast<Eigen::AlignedBox3d::CornerType>(k)) - ground).dot(u));
+  box.extend(ground + top * u);
+  syncViewport();
+  camera_.fit(box);
+  auto_fit_ = false;
+  updateSceneRadius();
+  requestPaint();
+}
+
 void View3D::setModel(std::shared_ptr<const codyna::Model> model) {
   if (draft_note_) draft_note_->hide();
+  follow_body_ = -1;
   poses_.reset();
   model_ = std::move(model);
   poses_ = model_ ? std::make_unique<codyna::StudyPoses>(*model_) : nullptr;
@@ -508,7 +552,16 @@ void View3D::applyConfiguration(const Eigen::VectorXd& q) {
   if (!model_ || q.size() != model_->nq) return;
   q_ = q;
   if (v_.size() != model_->nv) v_ = Eigen::VectorXd::Zero(model_->nv);
-  scene_.update(poses_->at(q_));
+  const std::vector<SE3>& oMi = poses_->at(q_);
+  scene_.update(oMi);
+  if (follow_body_ > 0 && follow_body_ < static_cast<int>(oMi.size())) {
+    const Eigen::Vector3d at = oMi[static_cast<std::size_t>(follow_body_)].p;
+    if (follow_at_.allFinite()) {
+      camera_.target += at - follow_at_;
+      updateSceneRadius();
+    }
+    follow_at_ = at;
+  }
   updateTireForces();
   requestPaint();
 }

@@ -87,6 +87,18 @@ class View3D : public QWidget {
   void setShowGrid(bool on);                   // ground grid, default on
   bool showGrid() const { return show_grid_; }
 
+  // paths on the ground (a maneuver's lane and the track the car left; Scene::setPaths): drawn
+  // with and without OpenGL's picking alike, cleared by setModel; the grid grows to hold them
+  void setPaths(std::vector<ScenePath> paths);
+  const std::vector<ScenePath>& paths() const { return scene_.paths(); }
+  // the camera follows this body (its origin's moves shift the camera's target; -1: none), as a
+  // maneuver's run plays; setModel stops it
+  void setFollowBody(int body);
+  int followBody() const { return follow_body_; }
+  // frames the ground `radius` around a body (its origin as drawn now; the grid's height), e.g. a
+  // car and the lane about it; no-op for an unknown body
+  void frameBody(int body, double radius);
+
   void fitView();    // frame the whole mechanism, keep the orbit angles
   void resetView();  // default orbit angles, then fit
 
@@ -139,6 +151,8 @@ class View3D : public QWidget {
   bool show_frames_ = true, show_grid_ = true, show_com_ = false, show_tire_forces_ = true;
   std::string fitted_for_;   // source file and name of the model the camera was fitted to
   bool auto_fit_ = true;      // refit on resize until the user moves the camera
+  int follow_body_ = -1;
+  Eigen::Vector3d follow_at_ = Eigen::Vector3d::Constant(std::nan(""));  // where the followed body was last drawn
 
   GLCanvas* canvas_ = nullptr;
   QLabel* placeholder_ = nullptr;

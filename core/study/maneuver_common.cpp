@@ -1,3 +1,4 @@
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -339,4 +340,26 @@ Model open_loop_run(ManeuverReport& rep, const ManeuverRequest& r, const OpenLoo
   return run;
 }
 
+void lane_layout(ManeuverReport& rep, const DriverPath& local, const Eigen::Vector2d& start, double heading) {
+  const Eigen::Rotation2Dd rot(heading);
+  rep.lane_path.clear();
+  rep.lane_cones.clear();
+  for (const Eigen::Vector2d& p : local.points) rep.lane_path.push_back(start + rot * p);
+  for (std::size_t g = 0; g < local.gate_start.size(); ++g) {
+    const double x0 = local.gate_start[g], x1 = local.gate_end[g];
+    const int n = std::max(2, static_cast<int>(std::ceil((x1 - x0) / 5.0)) + 1);
+    for (int k = 0; k < n; ++k)
+      for (const double side : {-0.5, 0.5}) {
+        const Eigen::Vector2d p(x0 + (x1 - x0) * k / (n - 1), local.gate_center[g] + side * local.gate_width[g]);
+        rep.lane_cones.push_back(start + rot * p);
+      }
+  }
+}
+
 }  // namespace codyna::mnv
+
+namespace codyna {
+
+int study_maneuver_body(const Model& m) { return mnv::steady_body(m); }
+
+}  // namespace codyna

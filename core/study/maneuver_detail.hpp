@@ -13,6 +13,7 @@
 #include "dynamics/data.hpp"
 #include "model/model.hpp"
 #include "simulation/controller.hpp"
+#include "simulation/driver.hpp"
 #include "simulation/integrator.hpp"
 #include "simulation/simulator.hpp"
 #include "simulation/result.hpp"
@@ -105,5 +106,9 @@ ManeuverReport constant_radius(const ManeuverRequest& r, const ModelSpec& spec);
 ManeuverReport constant_speed(const ManeuverRequest& r, const ModelSpec& spec);   // maneuver_steady.cpp
 ManeuverReport slowly_increasing_steer(const ManeuverRequest& r, const ModelSpec& spec);  // maneuver_ramp.cpp
 ManeuverReport fishhook(const ManeuverRequest& r, const ModelSpec& spec);                 // maneuver_ramp.cpp
+
+// the double lane change's path and cones into rep (lane_path, lane_cones): `local` is the lane
+// laid out from (0, 0) along +x, placed at `start` turned by `heading`
+void lane_layout(ManeuverReport& rep, const DriverPath& local, const Eigen::Vector2d& start, double heading);
 
 }  // namespace codyna::mnv

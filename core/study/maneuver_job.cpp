@@ -296,6 +296,7 @@ ManeuverReport mnv_lane_change(const ManeuverRequest& r, const ModelSpec& spec) 
   const Eigen::Rotation2Dd rot(yaw0);
   DriverPath local = ds.path;
   for (Eigen::Vector2d& p : ds.path.points) p = start + rot * p;
+  mnv::lane_layout(rep, local, start, yaw0);
   mnv_driver_gains(ds, r, flag, m, from_file, rep.speed);
   const std::unique_ptr<Controller> driver = make_driver(ds, flag("driver"));
 

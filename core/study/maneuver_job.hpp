@@ -182,6 +182,9 @@ struct ManeuverReport {
   std::string fh_lift_side;
   std::vector<std::string> fh_tires, fh_sides;
   std::vector<double> fh_min_load, fh_min_load_time;
+  // double lane change: the driver's path and the cones of its gates (at the lane's edges, about
+  // every 5 m of a gate), world x, y in the road plane, for a front end to draw
+  std::vector<Eigen::Vector2d> lane_path, lane_cones;
   // the run (time series; not for the constant radius)
   SimulationResult result;
   std::vector<std::string> written;
@@ -189,6 +192,10 @@ struct ManeuverReport {
 
 // The whole `codyna maneuver`. Refusals name the flag or keyword (style) or the model file's field.
 ManeuverReport study_maneuver_job(const ManeuverRequest& r, const ModelSpec& spec, const StudyMessages& tell = {});
+
+// The body whose motion a maneuver reads (the steady body: the study's analysis.steady.body, or
+// the first on a free or planar joint to ground): its index in m; throws ModelError without one.
+int study_maneuver_body(const Model& m);
 
 // the report as `codyna maneuver` prints it
 std::string study_maneuver_text(const ManeuverReport& r);

@@ -55,6 +55,7 @@ using namespace codyna::gui;
 namespace {
 
 const QString kShots = QStringLiteral(CODYNA_SCREENSHOT_DIR);
+const std::string kManeuverModel = CODYNA_TEST_DATA_DIR "/single_track_car_driver.json";
 
 // what a person sees: the X server's pixels of the window (GL content included)
 QImage screenOf(QWidget* w) {
@@ -550,6 +551,35 @@ class MainWindowXvfb : public QObject {
     QCOMPARE(cv->nonlinearMagnitudePoints().size(), 12);
     QTest::qWait(300);
     save(screenOf(&w), "bode_nonlinear.png");
+  }
+  // a maneuver's run played in the 3-D view: the double lane change of a car with a driver, at
+  // the second lane, its cones and the track it left drawn on the ground, the camera following it
+  void maneuverPlayback() {
+    MainWindow w;
+    w.resize(1600, 1000);
+    w.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&w));
+    QVERIFY(w.openFile(QString::fromStdString(kManeuverModel)));
+    ManeuverView* mv = w.maneuverView();
+    w.analysisTabs()->setCurrentWidget(mv);
+    w.findChild<QSplitter*>("centreSplitter")->setSizes({560, 380});
+    mv->typeBox()->setCurrentIndex(mv->typeBox()->findData(QStringLiteral("double-lane-change")));
+    mv->field("speed")->setText(QStringLiteral("16.7"));
+    QVERIFY(mv->run());
+    QTRY_VERIFY_WITH_TIMEOUT(!mv->isRunning(), 120000);
+    QCOMPARE(mv->statusText(), QStringLiteral("Done"));
+    const SimulationResult* r = w.playbackResult();
+    QVERIFY(r && r->samples() > 10);
+    // in the second lane, where the cones of section 3 stand beside the car
+    const auto& names = r->output_names;
+    const int ix = static_cast<int>(std::find(names.begin(), names.end(), "x") - names.begin());
+    QVERIFY(ix < static_cast<int>(names.size()));
+    int k = 0;
+    while (k + 1 < r->samples() && r->y(k, ix) < 50 + 15 + 30 + 6) ++k;
+    w.setPlaybackTime(r->t[k]);
+    QTest::qWait(400);
+    save(screenOf(&w), "maneuver_playback.png");
+    w.document()->undoStack()->setClean();
   }
 };
 

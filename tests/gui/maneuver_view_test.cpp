@@ -26,6 +26,7 @@
 #include "gui/main_window.hpp"
 #include "gui/kc_view.hpp"
 #include "gui/maneuver_view.hpp"
+#include "gui/view3d.hpp"
 #include "study/files.hpp"
 #include "study/kc_job.hpp"
 #include "study/maneuver_job.hpp"
@@ -304,6 +305,57 @@ class ManeuverViewTest : public QObject {
       QCOMPARE(path->at(i).x(), rep.result.y(i, ix));
       QCOMPARE(path->at(i).y(), rep.result.y(i, iy));
     }
+
+    // the 3-D view plays the run: the car at its start, the lane, its cones and the chassis' track
+    // on the ground, the camera following the car
+    const SimulationResult* played = w->playbackResult();
+    QVERIFY(played);
+    QCOMPARE(played->samples(), rep.result.samples());
+    QCOMPARE(w->playbackTime(), rep.result.t.front());
+    View3D* v3 = w->findChild<View3D*>();
+    QVERIFY(v3);
+    QCOMPARE(v3->followBody(), w->document()->model()->find_body("chassis"));
+    const auto named = [&](const std::string& name) -> const ScenePath* {
+      for (const ScenePath& p : v3->paths())
+        if (p.name == name) return &p;
+      return nullptr;
+    };
+    const ScenePath *lane = named("lane"), *cones = named("cones"), *track = named("track");
+    QVERIFY(lane && cones && track);
+    QCOMPARE(lane->points.size(), rep.lane_path.size());
+    // the chassis' centre (its planar joint's origin) through forward kinematics, against the x and
+    // y sensors of the same samples
+    QCOMPARE(int(track->points.size()), rep.result.samples());
+    double err = 0;
+    for (int i = 0; i < rep.result.samples(); ++i)
+      err = std::max({err, std::abs(track->points[i].x() - rep.result.y(i, ix)), std::abs(track->points[i].y() - rep.result.y(i, iy))});
+    QVERIFY2(err < 1e-9, qPrintable(QString("track off the sensors by %1 m").arg(err)));
+    // ISO 3888-1: the cones of section 1 (15 m from 50 m on) stand 1.1 w + 0.25 apart about the
+    // start's line (w = 1.8 m, the car's width here)
+    int first = 0;
+    for (const Eigen::Vector3d& c : cones->points)
+      if (c.x() > 50 - 1e-9 && c.x() < 65 + 1e-9) {
+        ++first;
+        QVERIFY2(std::abs(std::abs(c.y()) - (1.1 * 1.8 + 0.25) / 2) < 1e-9, qPrintable(QString::number(c.y())));
+      }
+    QVERIFY(first >= 4);
+    // the grid holds the whole track
+    const Scene& scene = v3->scene();
+    for (const Eigen::Vector3d& p : track->points)
+      QVERIFY(std::abs(p.x() - scene.gridCenter().x()) <= scene.gridHalf() && std::abs(p.y() - scene.gridCenter().y()) <= scene.gridHalf());
+    // the camera's target moves with the chassis
+    const int a = rep.result.samples() / 3, b = 2 * rep.result.samples() / 3;
+    w->setPlaybackTime(rep.result.t[a]);
+    const Eigen::Vector3d ta = v3->camera().target;
+    w->setPlaybackTime(rep.result.t[b]);
+    const Eigen::Vector3d moved = v3->camera().target - ta;
+    QVERIFY(std::abs(moved.x() - (rep.result.y(b, ix) - rep.result.y(a, ix))) < 1e-9);
+    QVERIFY(std::abs(moved.y() - (rep.result.y(b, iy) - rep.result.y(a, iy))) < 1e-9);
+    QVERIFY(moved.norm() > 50);  // it went far
+    // Play runs it
+    QTest::mouseClick(w->findChild<QPushButton*>("playButton"), Qt::LeftButton);
+    QVERIFY(w->isPlaying());
+    w->setPlaying(false);
   }
 
   void cancelStopsALongRun() {
