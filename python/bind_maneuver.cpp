@@ -137,6 +137,15 @@ py::dict do_maneuver(const Study& s, const py::dict& options) {
     d["path_error_max"] = rep.path.max_abs;
     d["path_error_rms"] = rep.path.rms;
     d["cones_hit"] = rep.cones_hit;
+    // the lane's centre line and its cones, n x 2 (x, y)
+    const auto points = [](const std::vector<Eigen::Vector2d>& v) {
+      py::array_t<double> a({static_cast<py::ssize_t>(v.size()), static_cast<py::ssize_t>(2)});
+      auto m = a.mutable_unchecked<2>();
+      for (std::size_t k = 0; k < v.size(); ++k) m(static_cast<py::ssize_t>(k), 0) = v[k].x(), m(static_cast<py::ssize_t>(k), 1) = v[k].y();
+      return a;
+    };
+    d["lane_path"] = points(rep.lane_path);
+    d["lane_cones"] = points(rep.lane_cones);
   } else if (rep.type == "constant-radius" || rep.type == "constant-speed") {
     d["radius"] = rep.radius;
     d["speed"] = vector_of(rep.cr_speed);

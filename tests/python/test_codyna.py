@@ -1022,6 +1022,15 @@ def test_maneuver_is_the_command_lines():
     with pytest.raises(ValueError, match="^preview: expected a number > 0"):
         codyna.Study(os.path.join(SOURCE_DIR, "tests", "data", "single_track_car_driver.json")).maneuver(
             "double-lane-change", preview=-1)
+    # the lane change: its lane and cones as arrays; ISO 3888-1's section 1 cones (15 m from 50 m)
+    # stand (1.1 w + 0.25) / 2 either side of the start's line (w = 1.8 m)
+    driver = os.path.join(SOURCE_DIR, "tests", "data", "single_track_car_driver.json")
+    dlc = codyna.Study(driver).maneuver("double-lane-change", speed=16.7)
+    assert dlc["lane_path"].shape[1] == 2 and dlc["lane_path"].shape[0] > 10
+    first = [c for c in dlc["lane_cones"] if 50 - 1e-9 <= c[0] <= 65 + 1e-9]
+    assert len(first) >= 4
+    assert all(abs(abs(c[1]) - (1.1 * 1.8 + 0.25) / 2) < 1e-9 for c in first)
+    assert len(dlc["cones_hit"]) == 1 and dlc["cones_hit"][0].startswith("section 5")
     with pytest.raises(ValueError, match="^type: unknown maneuver"):
         codyna.Study(car).maneuver("slalom")
     # the swept sine: the command line's text; the responses as complex arrays beside the linear ones
