@@ -47,7 +47,10 @@
 #include <algorithm>
 #include <nlohmann/json.hpp>
 
+#include "gui/control_view.hpp"
+#include "gui/kc_view.hpp"
 #include "gui/linearize_view.hpp"
+#include "gui/maneuver_view.hpp"
 #include "gui/main_window.hpp"
 #include "gui/property_editor.hpp"
 #include "gui/simulate_view.hpp"
@@ -151,7 +154,8 @@ class MonkeyTest : public QObject {
     else QVERIFY(w->openFile(model));
     Closer closer;
 
-    int spec_changes = 0, linearized = 0, tire_tab = 0;
+    int spec_changes = 0, linearized = 0, tire_tab = 0, maneuver_tab = 0, maneuver_runs = 0, maneuvers_done = 0;
+    connect(w->maneuverView(), &ManeuverView::finished, w.get(), [&] { ++maneuvers_done; });
     connect(w->document(), &Document::specChanged, w.get(), [&] { ++spec_changes; });
     connect(w->linearizeView(), &LinearizeView::linearized, w.get(), [&] { ++linearized; });
     // the sedan opened as in examples/ is linearized first, as a person would: the steady motion at
@@ -170,7 +174,12 @@ class MonkeyTest : public QObject {
 
     for (int e = 0; e < events; ++e) {
       if (!w->isVisible()) w->show();  // Quit answered "discard" closes it: reopen and go on
-      if (e % 300 == 299) w->simulateView()->cancel();  // as a person would stop a run that goes on too long
+      if (e % 300 == 299) {
+        // as a person would stop a run that goes on too long (a simulation, a maneuver, an estimate)
+        w->simulateView()->cancel();
+        w->maneuverView()->cancel();
+        w->controlView()->cancelEstimate();
+      }
       if (e % 500 == 250) {
         // a person opens the model again now and then (every kind of element comes back)
         w->document()->undoStack()->setClean();
@@ -181,12 +190,22 @@ class MonkeyTest : public QObject {
       }
       if (sedan && e % 40 == 20) {
         // a person looks at another analysis now and then: Linearize (pressed: the steady motion,
-        // the handling numbers, the tires' forces in the 3-D view), Simulate or the tire's curves
+        // the handling numbers, the tires' forces in the 3-D view), Simulate, the tire's curves,
+        // the maneuvers (whose Run the events may press: its run then plays in the 3-D view), the
+        // Control view (its Estimate too) or K&C
         QTabWidget* tabs = w->analysisTabs();
-        QWidget* pages[] = {w->linearizeView(), w->simulateView(), w->tireView()};
-        QWidget* page = pages[rng.bounded(3)];
+        QWidget* pages[] = {w->linearizeView(), w->simulateView(), w->tireView(), w->maneuverView(), w->controlView(), w->kcView()};
+        QWidget* page = pages[rng.bounded(6)];
         tabs->setCurrentWidget(page);
         if (page == w->tireView()) ++tire_tab;
+        if (page == w->maneuverView()) ++maneuver_tab;
+        // and presses Run there (the maneuver the events left picked: its run then plays in the 3-D
+        // view, and the events go on meanwhile), or Analyse in the Control view
+        if (page == w->maneuverView() && rng.bounded(2) == 0 && w->maneuverView()->runButton()->isEnabled()) {
+          QTest::mouseClick(w->maneuverView()->runButton(), Qt::LeftButton);
+          ++maneuver_runs;
+        }
+        if (page == w->controlView() && rng.bounded(2) == 0) QTest::mouseClick(w->controlView()->analyseButton(), Qt::LeftButton);
         if (page == w->linearizeView() && rng.bounded(2) == 0 && w->linearizeView()->linearizeButton()->isEnabled())
           QTest::mouseClick(w->linearizeView()->linearizeButton(), Qt::LeftButton);
       }
@@ -276,10 +295,10 @@ class MonkeyTest : public QObject {
     }
     // the monkey did reach the editing paths
     qInfo("seed %u (%s): %d events, %d spec changes, undo stack up to %d, %lld widget classes, %lld element kinds selected, "
-          "%d linearizations, the Tire tab shown %d times",
+          "%d linearizations, the Tire tab shown %d times, the Maneuvers tab %d times, %d maneuvers run (%d ended)",
           seed, sedan ? "sedan" : from_empty ? "from File > New" : "cart-pendulum", events, spec_changes, max_undo,
-          qlonglong(classes.size()), qlonglong(kinds_edited.size()), linearized, tire_tab);
-    if (sedan) QVERIFY(tire_tab > 0);
+          qlonglong(classes.size()), qlonglong(kinds_edited.size()), linearized, tire_tab, maneuver_tab, maneuver_runs, maneuvers_done);
+    if (sedan) QVERIFY(tire_tab > 0 && maneuver_tab > 0);
     QVERIFY(spec_changes > events / 100);
     QVERIFY(kinds_edited.size() >= 4);  // the property editor of most element kinds was open
     QVERIFY(classes.contains("QComboBox"));
@@ -288,9 +307,11 @@ class MonkeyTest : public QObject {
     // time=T pre-run the monkey may have set to hundreds of seconds) is not interruptible, and under
     // the sanitizers it can take minutes
     w->simulateView()->cancel();
+    w->maneuverView()->cancel();
+    w->controlView()->cancelEstimate();
     QElapsedTimer waited;
     waited.start();
-    QVERIFY(QTest::qWaitFor([&] { return !w->simulateView()->isRunning(); }, 600000));
+    QVERIFY(QTest::qWaitFor([&] { return !w->simulateView()->isRunning() && !w->maneuverView()->isRunning() && !w->controlView()->isEstimating(); }, 600000));
     if (waited.elapsed() > 5000) qInfo("seed %u: the last run took %lld ms to stop after Cancel", seed, qlonglong(waited.elapsed()));
     w->document()->undoStack()->setClean();
     w.reset();
