@@ -14,7 +14,6 @@
 #include <QPushButton>
 #include <QScatterSeries>
 #include <QSplitter>
-#include <QThread>
 #include <QTimer>
 #include <QTabWidget>
 #include <QTableView>
@@ -30,7 +29,6 @@
 #include "gui/matrix_view.hpp"
 #include "gui/pole_map.hpp"
 #include "gui/result_plots.hpp"
-#include "analysis/closed_loop_linear.hpp"
 #include "study/tools.hpp"
 
 namespace codyna::gui {
@@ -122,7 +120,7 @@ ControlView::ControlView(Document* doc, QWidget* parent) : QWidget(parent), doc_
     estimate_progress_->setFormat(tr("frequency %1 of %2, input %3").arg(k / freq_nu_ + 1).arg(runs_total_ / freq_nu_).arg(k % freq_nu_ + 1));
   });
   connect(doc_, &Document::replaced, this, [this] {
-    if (estimating_) drop_estimate_ = true;  // the running estimate belongs to the model that left
+    if (isEstimating()) drop_estimate_ = true;  // the running estimate belongs to the model that left
     clearResult();
   });
   connect(doc_, &Document::modelChanged, this, &ControlView::updateStaleness);
@@ -130,13 +128,7 @@ ControlView::ControlView(Document* doc, QWidget* parent) : QWidget(parent), doc_
   updateEstimateButtons();
 }
 
-ControlView::~ControlView() {
-  if (thread_) {
-    cancel_.store(true);
-    thread_->wait();  // what it posted to this object is dropped with it
-    delete thread_;
-  }
-}
+ControlView::~ControlView() = default;
 
 void ControlView::buildUi() {
   analyse_button_ = new QPushButton(tr("Analyse"), this);
@@ -405,7 +397,7 @@ void ControlView::clearResult() {
   job_.reset();
   freq_.reset();
   freq_model_.reset();
-  if (!estimating_) setFreqStatus(QString(), false);
+  if (!isEstimating()) setFreqStatus(QString(), false);
   gain_model_->clear();
   pole_model_->clear();
   status_->setText(tr("Not analysed yet: Analyse linearizes the plant and closes the loop with the study's controller."));
@@ -612,7 +604,7 @@ std::vector<double> read_amplitudes(const QString& text) {
 }  // namespace
 
 bool ControlView::estimate() {
-  if (estimating_) return false;
+  if (isEstimating()) return false;
   FreqRespRequest r;
   try {
     r.amplitudes = read_amplitudes(amplitude_edit_->text());
@@ -635,74 +627,48 @@ bool ControlView::estimate() {
     return false;
   }
   r.run.model = doc_->filePath().isEmpty() ? std::string("untitled.json") : ss(doc_->filePath());
-  if (thread_) {
-    thread_->wait();
-    delete thread_;
-    thread_ = nullptr;
-  }
   freq_.reset();  // the points on screen are of the estimate that runs now
   freq_model_.reset();
   redraw();
-  cancel_.store(false);
   runs_started_.store(0);
   run_t_.store(0);
   run_t_end_.store(0);
   freq_nu_ = std::max<int>(1, static_cast<int>(job_->plant.system.nu()));
   runs_total_ = static_cast<int>(r.frequencies.size()) * freq_nu_;
-  estimating_ = true;
   drop_estimate_ = false;
+  const ModelSpec spec = doc_->spec();
+  const std::shared_ptr<const Model> model = model_;
+  auto result = std::make_shared<std::shared_ptr<const FreqRespJob>>();
+  freq_job_.start(
+      [this, r, spec, result](const std::atomic<bool>& cancel, const StudyMessages& tell) {
+        SimulationCallbacks cb;
+        cb.cancel = &cancel;
+        double last = -1;
+        cb.progress = [this, &last](double t, double t_end) {  // on this thread: atomics only
+          if (t < last || last < 0) runs_started_.fetch_add(1);  // a run starts again from 0
+          last = t;
+          run_t_.store(t);
+          run_t_end_.store(t_end);
+        };
+        *result = std::make_shared<const FreqRespJob>(study_freqresp_job(r, spec, cb, tell));
+      },
+      [this, result, model](const JobOutcome& out) {
+        if (*result && !drop_estimate_) freq_model_ = model;
+        onEstimated(*result, out);
+      });
   estimate_progress_->setRange(0, 0);  // busy until the first run reports
   estimate_progress_->setFormat(tr("setting up..."));
   setFreqStatus(tr("Estimating at %1 frequencies...").arg(r.frequencies.size()), false);
   updateEstimateButtons();
-  const ModelSpec spec = doc_->spec();
-  const std::shared_ptr<const Model> model = model_;
-  thread_ = QThread::create([this, r, spec, model] {
-    SimulationCallbacks cb;
-    cb.cancel = &cancel_;
-    double last = -1;
-    cb.progress = [this, &last](double t, double t_end) {
-      if (t < last || last < 0) runs_started_.fetch_add(1);  // a run starts again from 0
-      last = t;
-      run_t_.store(t);
-      run_t_end_.store(t_end);
-    };
-    QStringList notes;
-    const StudyMessages tell = [&notes](const StudyMessage& m) {
-      notes << (m.kind == StudyMessage::Warning ? QStringLiteral("warning: ") : QString()) + qs(m.text);
-    };
-    std::shared_ptr<const FreqRespJob> job;
-    QString error;
-    bool cancelled = false;
-    try {
-      job = std::make_shared<const FreqRespJob>(study_freqresp_job(r, spec, cb, tell));
-    } catch (const StudyCancelled&) {
-      cancelled = true;
-    } catch (const std::exception& e) {
-      error = qs(e.what());
-    } catch (...) {
-      error = QStringLiteral("the estimate failed (unknown error)");
-    }
-    QMetaObject::invokeMethod(
-        this, [this, job, error, notes, cancelled, model] {
-          if (job && !drop_estimate_) freq_model_ = model;
-          onEstimated(job, error, notes, cancelled);
-        },
-        Qt::QueuedConnection);
-  });
-  thread_->setObjectName(QStringLiteral("codyna-freqresp"));
   timer_->start();
-  thread_->start();
   return true;
 }
 
-void ControlView::cancelEstimate() {
-  if (estimating_) cancel_.store(true);
-}
+void ControlView::cancelEstimate() { freq_job_.cancel(); }
 
-void ControlView::onEstimated(std::shared_ptr<const FreqRespJob> job, const QString& error, const QStringList& notes,
-                              bool cancelled) {
-  estimating_ = false;
+void ControlView::onEstimated(std::shared_ptr<const FreqRespJob> job, const JobOutcome& out) {
+  const QString& error = out.error;
+  const bool cancelled = out.cancelled;
   timer_->stop();
   estimate_progress_->setRange(0, 1);
   estimate_progress_->setValue(cancelled || !error.isEmpty() || !job ? 0 : 1);
@@ -714,7 +680,7 @@ void ControlView::onEstimated(std::shared_ptr<const FreqRespJob> job, const QStr
     emit estimateFinished();
     return;
   }
-  for (const QString& n : notes) emit message(tr("Estimate: %1").arg(n));
+  for (const QString& n : out.notes) emit message(tr("Estimate: %1").arg(n));
   if (cancelled) {
     setFreqStatus(tr("Cancelled"), false);
   } else if (!job) {
@@ -758,8 +724,8 @@ void ControlView::setFreqStatus(const QString& text, bool error) {
 }
 
 void ControlView::updateEstimateButtons() {
-  estimate_button_->setEnabled(!estimating_);
-  cancel_button_->setEnabled(estimating_);
+  estimate_button_->setEnabled(!isEstimating());
+  cancel_button_->setEnabled(isEstimating());
 }
 QList<QPointF> ControlView::phasePoints() const { return phase_series_->points(); }
 int ControlView::stepSeriesCount() const { return static_cast<int>(step_series_.size()); }

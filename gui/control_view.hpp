@@ -28,6 +28,7 @@
 #include <memory>
 #include <optional>
 
+#include "gui/job_thread.hpp"
 #include "study/freqresp_job.hpp"
 #include "study/jobs.hpp"
 
@@ -42,7 +43,6 @@ class QProgressBar;
 class QPushButton;
 class QScatterSeries;
 class QTableView;
-class QThread;
 class QTimer;
 QT_END_NAMESPACE
 
@@ -101,7 +101,7 @@ class ControlView : public QWidget {
   // failures come with estimateFinished().
   bool estimate();
   void cancelEstimate();
-  bool isEstimating() const { return estimating_; }
+  bool isEstimating() const { return freq_job_.isRunning(); }
   // the last estimate (null before the first, while one runs, after one that failed or was
   // cancelled, New and Open)
   const codyna::FreqRespJob* freqResp() const { return freq_.get(); }
@@ -127,8 +127,7 @@ class ControlView : public QWidget {
   void fillPairs();  // input and output names of the chosen system
   void redraw();     // the chosen pair's Bode and step curves, poles and zeros
   void updateStaleness();
-  void onEstimated(std::shared_ptr<const codyna::FreqRespJob> job, const QString& error, const QStringList& notes,
-                   bool cancelled);
+  void onEstimated(std::shared_ptr<const codyna::FreqRespJob> job, const JobOutcome& out);
   void setFreqStatus(const QString& text, bool error);
   void updateEstimateButtons();
 
@@ -166,13 +165,12 @@ class ControlView : public QWidget {
   QScatterSeries* phase_points_ = nullptr;
   std::shared_ptr<const codyna::FreqRespJob> freq_;
   std::shared_ptr<const codyna::Model> freq_model_;  // the model the estimate belongs to
-  QThread* thread_ = nullptr;
   QTimer* timer_ = nullptr;
-  std::atomic<bool> cancel_{false};
   std::atomic<int> runs_started_{0};
   std::atomic<double> run_t_{0}, run_t_end_{0};
   int runs_total_ = 0, freq_nu_ = 0;
-  bool estimating_ = false, drop_estimate_ = false;
+  bool drop_estimate_ = false;
+  JobThread freq_job_{this, QStringLiteral("codyna-freqresp")};  // last: joined before the other members go
 };
 
 }  // namespace codyna::gui

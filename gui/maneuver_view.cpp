@@ -13,7 +13,6 @@
 #include <QPlainTextEdit>
 #include <QProgressBar>
 #include <QPushButton>
-#include <QThread>
 #include <QTimer>
 #include <QVBoxLayout>
 #include <QValueAxis>
@@ -98,7 +97,7 @@ ManeuverView::ManeuverView(Document* doc, QWidget* parent) : QWidget(parent), do
     }
   });
   connect(doc_, &Document::replaced, this, [this] {
-    if (running_) drop_result_ = true;  // the running job's result belongs to the old model
+    if (isRunning()) drop_result_ = true;  // the running job's result belongs to the old model
     report_.reset();
     report_view_->clear();
     chart_->chart()->removeAllSeries();
@@ -108,13 +107,7 @@ ManeuverView::ManeuverView(Document* doc, QWidget* parent) : QWidget(parent), do
   updateButtons();
 }
 
-ManeuverView::~ManeuverView() {
-  if (thread_) {
-    cancel_.store(true);
-    thread_->wait();  // what it posted to this object is dropped with it
-    delete thread_;
-  }
-}
+ManeuverView::~ManeuverView() = default;
 
 void ManeuverView::buildUi() {
   auto* outer = new QHBoxLayout(this);
@@ -203,9 +196,9 @@ void ManeuverView::setStatus(const QString& text, bool error) {
 }
 
 void ManeuverView::updateButtons() {
-  run_->setEnabled(!running_);
-  cancel_button_->setEnabled(running_);
-  type_->setEnabled(!running_);
+  run_->setEnabled(!isRunning());
+  cancel_button_->setEnabled(isRunning());
+  type_->setEnabled(!isRunning());
 }
 
 // the request of the fields shown; a field that does not read is refused naming its label
@@ -257,7 +250,7 @@ ManeuverRequest ManeuverView::request() const {
 }
 
 bool ManeuverView::run() {
-  if (running_) return false;
+  if (isRunning()) return false;
   ManeuverRequest r;
   try {
     r = request();
@@ -266,59 +259,34 @@ bool ManeuverView::run() {
     emit message(tr("Maneuver: %1").arg(mq(e.what())));
     return false;
   }
-  if (thread_) {
-    thread_->wait();
-    delete thread_;
-    thread_ = nullptr;
-  }
-  cancel_.store(false);
   t_.store(0);
   t_end_.store(0);
-  r.cancel = &cancel_;
   r.progress = [this](double t, double t_end) {
     t_.store(t);
     t_end_.store(t_end);
   };
-  running_ = true;
   report_.reset();
+  const ModelSpec spec = doc_->spec();
+  auto result = std::make_shared<std::shared_ptr<const ManeuverReport>>();
+  job_.start(
+      [r, spec, result](const std::atomic<bool>& cancel, const StudyMessages& tell) mutable {
+        r.cancel = &cancel;
+        *result = std::make_shared<const ManeuverReport>(study_maneuver_job(r, spec, tell));
+      },
+      [this, result](const JobOutcome& out) { onFinished(*result, out); });
   progress_->setRange(0, 0);  // busy until the run reports its time
   progress_->setFormat(tr("searching the steady motion..."));
   setStatus(tr("Running %1...").arg(mq(r.type)), false);
   updateButtons();
-  const ModelSpec spec = doc_->spec();
-  thread_ = QThread::create([this, r, spec] {
-    QStringList notes;
-    const StudyMessages tell = [&notes](const StudyMessage& m) {
-      notes << (m.kind == StudyMessage::Warning ? QStringLiteral("warning: ") : QString()) + mq(m.text);
-    };
-    std::shared_ptr<const ManeuverReport> rep;
-    QString error;
-    bool cancelled = false;
-    try {
-      rep = std::make_shared<const ManeuverReport>(study_maneuver_job(r, spec, tell));
-    } catch (const StudyCancelled&) {
-      cancelled = true;
-    } catch (const std::exception& e) {
-      error = mq(e.what());
-    } catch (...) {
-      error = QStringLiteral("the maneuver failed (unknown error)");
-    }
-    QMetaObject::invokeMethod(
-        this, [this, rep, error, notes, cancelled] { onFinished(rep, error, notes, cancelled); }, Qt::QueuedConnection);
-  });
-  thread_->setObjectName(QStringLiteral("codyna-maneuver"));
   timer_->start();
-  thread_->start();
   return true;
 }
 
-void ManeuverView::cancel() {
-  if (running_) cancel_.store(true);
-}
+void ManeuverView::cancel() { job_.cancel(); }
 
-void ManeuverView::onFinished(std::shared_ptr<const ManeuverReport> report, const QString& error, const QStringList& notes,
-                              bool cancelled) {
-  running_ = false;
+void ManeuverView::onFinished(std::shared_ptr<const ManeuverReport> report, const JobOutcome& out) {
+  const QString& error = out.error;
+  const bool cancelled = out.cancelled;
   timer_->stop();
   progress_->setRange(0, 1);
   progress_->setValue(cancelled || !error.isEmpty() ? 0 : 1);
@@ -330,7 +298,7 @@ void ManeuverView::onFinished(std::shared_ptr<const ManeuverReport> report, cons
     emit finished();
     return;
   }
-  for (const QString& n : notes) emit message(tr("Maneuver: %1").arg(n));
+  for (const QString& n : out.notes) emit message(tr("Maneuver: %1").arg(n));
   if (cancelled) {
     setStatus(tr("Cancelled"), false);
   } else if (!report) {

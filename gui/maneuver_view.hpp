@@ -14,6 +14,7 @@
 #include <atomic>
 #include <memory>
 
+#include "gui/job_thread.hpp"
 #include "study/maneuver_job.hpp"
 
 class QComboBox;
@@ -23,7 +24,6 @@ class QLineEdit;
 class QPlainTextEdit;
 class QProgressBar;
 class QPushButton;
-class QThread;
 class QTimer;
 
 namespace codyna::gui {
@@ -41,7 +41,7 @@ class ManeuverView : public QWidget {
   // field does not read or a run is going. The job's own refusals come with finished().
   bool run();
   void cancel();
-  bool isRunning() const { return running_; }
+  bool isRunning() const { return job_.isRunning(); }
 
   QComboBox* typeBox() const { return type_; }
   // the field of a parameter, by its flag's name ("speed", "steer", "radius", ...; null: none)
@@ -64,8 +64,7 @@ class ManeuverView : public QWidget {
   void buildUi();
   void typeChosen();
   ManeuverRequest request() const;
-  void onFinished(std::shared_ptr<const ManeuverReport> report, const QString& error, const QStringList& notes,
-                  bool cancelled);
+  void onFinished(std::shared_ptr<const ManeuverReport> report, const JobOutcome& outcome);
   void showCurve();
   void setStatus(const QString& text, bool error);
   void updateButtons();
@@ -81,11 +80,10 @@ class ManeuverView : public QWidget {
   QPlainTextEdit* report_view_ = nullptr;
   ChartView* chart_ = nullptr;
   QTimer* timer_ = nullptr;
-  QThread* thread_ = nullptr;
-  std::atomic<bool> cancel_{false};
   std::atomic<double> t_{0}, t_end_{0};
-  bool running_ = false, drop_result_ = false;
+  bool drop_result_ = false;
   std::shared_ptr<const ManeuverReport> report_;
+  JobThread job_{this, QStringLiteral("codyna-maneuver")};  // last: joined before the other members go
 };
 
 }  // namespace codyna::gui

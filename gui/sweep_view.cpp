@@ -22,7 +22,6 @@
 #include <QSplitter>
 #include <QTabWidget>
 #include <QTableWidget>
-#include <QThread>
 #include <QTimer>
 #include <QVBoxLayout>
 #include <QValueAxis>
@@ -124,7 +123,7 @@ SweepView::SweepView(Document* doc, QWidget* parent) : QWidget(parent), doc_(doc
   connect(timer_, &QTimer::timeout, this, &SweepView::tick);
   // another model: its fields mean nothing here
   connect(doc_, &Document::replaced, this, [this] {
-    if (running_) drop_result_ = true;  // the running study's result belongs to the old model
+    if (isRunning()) drop_result_ = true;  // the running study's result belongs to the old model
     cancel();
     fields_->setRowCount(0);
     clearResult();
@@ -133,13 +132,7 @@ SweepView::SweepView(Document* doc, QWidget* parent) : QWidget(parent), doc_(doc
   updateButtons();
 }
 
-SweepView::~SweepView() {
-  if (thread_) {
-    cancel_.store(true);
-    thread_->wait();  // what it posted to this object is dropped with it
-    delete thread_;
-  }
-}
+SweepView::~SweepView() = default;
 
 void SweepView::buildUi() {
   auto* outer = new QHBoxLayout(this);
@@ -344,11 +337,11 @@ void SweepView::setStatus(const QString& text, bool error) {
 }
 
 void SweepView::updateButtons() {
-  run_button_->setEnabled(!running_);
-  cancel_button_->setEnabled(running_);
-  save_button_->setEnabled(!running_ && job_ != nullptr);
-  add_row_->setEnabled(!running_);
-  remove_row_->setEnabled(!running_ && fields_->rowCount() > 0);
+  run_button_->setEnabled(!isRunning());
+  cancel_button_->setEnabled(isRunning());
+  save_button_->setEnabled(!isRunning() && job_ != nullptr);
+  add_row_->setEnabled(!isRunning());
+  remove_row_->setEnabled(!isRunning() && fields_->rowCount() > 0);
 }
 
 void SweepView::addField(const QString& pointer, const QString& spec) {
@@ -442,7 +435,7 @@ SweepRequest SweepView::request() const {
 }
 
 bool SweepView::run() {
-  if (running_) return false;
+  if (isRunning()) return false;
   auto refuse = [this](const QString& why) {
     setStatus(why, true);
     emit message(tr("Sweep: %1").arg(why));
@@ -457,53 +450,31 @@ bool SweepView::run() {
   } catch (const std::exception& e) {
     return refuse(qs(e.what()));
   }
-  if (thread_) {
-    thread_->wait();
-    delete thread_;
-    thread_ = nullptr;
-  }
-  cancel_.store(false);
   done_.store(0);
   total_.store(0);
-  running_ = true;
+  auto result = std::make_shared<std::shared_ptr<const SweepJob>>();
+  worker_.start(
+      [this, r, result](const std::atomic<bool>& cancel, const StudyMessages& tell) {
+        SweepProgress progress;
+        progress.cancel = &cancel;
+        progress.done = [this](long long done, long long total) {  // on the workers' threads: atomics only
+          done_.store(done);
+          total_.store(total);
+        };
+        *result = std::make_shared<const SweepJob>(study_sweep_job(r, tell, progress));
+      },
+      [this, result](const JobOutcome& out) { onFinished(*result, out); });
   progress_->setRange(0, 1);
   progress_->setValue(0);
   progress_->setFormat(tr("starting..."));
   setStatus(tr("Running..."), false);
   updateButtons();
-  thread_ = QThread::create([this, r] {
-    QStringList notes;
-    StudyMessages tell = [&notes](const StudyMessage& m) {
-      notes << (m.kind == StudyMessage::Warning ? QStringLiteral("warning: ") : QString()) + qs(m.text);
-    };
-    SweepProgress progress;
-    progress.cancel = &cancel_;
-    progress.done = [this](long long done, long long total) {
-      done_.store(done);
-      total_.store(total);
-    };
-    std::shared_ptr<const SweepJob> job;
-    QString error;
-    try {
-      job = std::make_shared<const SweepJob>(study_sweep_job(r, tell, progress));
-    } catch (const std::exception& e) {
-      error = qs(e.what());
-    } catch (...) {
-      error = QStringLiteral("the study failed (unknown error)");
-    }
-    QMetaObject::invokeMethod(
-        this, [this, job, error, notes] { onFinished(job, error, notes); }, Qt::QueuedConnection);
-  });
-  thread_->setObjectName(QStringLiteral("codyna-sweep"));
   timer_->start();
   emit started();
-  thread_->start();
   return true;
 }
 
-void SweepView::cancel() {
-  if (running_) cancel_.store(true);
-}
+void SweepView::cancel() { worker_.cancel(); }
 
 void SweepView::tick() {
   const long long total = total_.load(), done = done_.load();
@@ -514,8 +485,8 @@ void SweepView::tick() {
   }
 }
 
-void SweepView::onFinished(std::shared_ptr<const SweepJob> job, const QString& error, const QStringList& notes) {
-  running_ = false;
+void SweepView::onFinished(std::shared_ptr<const SweepJob> job, const JobOutcome& out) {
+  const QString& error = out.error;
   timer_->stop();
   tick();
   if (drop_result_) {
@@ -525,7 +496,7 @@ void SweepView::onFinished(std::shared_ptr<const SweepJob> job, const QString& e
     emit finished();
     return;
   }
-  for (const QString& n : notes) emit message(tr("Sweep: %1").arg(n));
+  for (const QString& n : out.notes) emit message(tr("Sweep: %1").arg(n));
   if (job) {
     job_ = std::move(job);
     showResult();
@@ -842,7 +813,7 @@ bool SweepView::saveResults(const QString& path, QString* error) {
     return false;
   };
   if (!job_) return fail(tr("no results to save (run a study first)"));
-  if (running_) return fail(tr("a study is running"));
+  if (isRunning()) return fail(tr("a study is running"));
   try {
     study_save_sweep(*job_, ss(path));  // the format from the suffix, every output guarded (as codyna sweep's)
   } catch (const std::exception& e) {

@@ -34,6 +34,7 @@
 #include <memory>
 #include <vector>
 
+#include "gui/job_thread.hpp"
 #include "study/sweep.hpp"
 
 QT_BEGIN_NAMESPACE
@@ -48,7 +49,6 @@ class QScatterSeries;
 class QSpinBox;
 class QTabWidget;
 class QTableWidget;
-class QThread;
 class QTimer;
 QT_END_NAMESPACE
 
@@ -74,7 +74,7 @@ class SweepView : public QWidget {
   // running already, no field, a spec the core refuses.
   bool run();
   void cancel();
-  bool isRunning() const { return running_; }
+  bool isRunning() const { return worker_.isRunning(); }
   const codyna::SweepJob* result() const { return job_.get(); }
   void clearResult();
   // .h5, .csv or .mat (+ .m), by suffix; false with *error (and message()) when refused
@@ -121,7 +121,7 @@ class SweepView : public QWidget {
   void buildUi();
   void setStatus(const QString& text, bool error);
   void updateButtons();
-  void onFinished(std::shared_ptr<const codyna::SweepJob> job, const QString& error, const QStringList& notes);
+  void onFinished(std::shared_ptr<const codyna::SweepJob> job, const JobOutcome& out);
   void showResult();
   void drawPoles();
   void drawFigure();
@@ -131,10 +131,7 @@ class SweepView : public QWidget {
 
   Document* doc_;
   std::shared_ptr<const codyna::SweepJob> job_;
-  QThread* thread_ = nullptr;
-  std::atomic<bool> cancel_{false};
   std::atomic<long long> done_{0}, total_{0};
-  bool running_ = false;
   bool drop_result_ = false;  // the document was replaced while the study ran
   QTimer* timer_ = nullptr;
 
@@ -168,6 +165,7 @@ class SweepView : public QWidget {
   ChartView* figure_view_ = nullptr;
   QTableWidget* failed_ = nullptr;
   QPlainTextEdit* summary_ = nullptr;
+  JobThread worker_{this, QStringLiteral("codyna-sweep")};  // last: joined before the other members go
 };
 
 // The colour scale of the pole map: low values dark blue, high values yellow (viridis).
