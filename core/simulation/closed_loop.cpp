@@ -74,13 +74,16 @@ ClosedLoopSystem::ClosedLoopSystem(const Model& model, const Controller* control
     : model_(model), controller_(controller), plant_(plant), x_ref_(x_ref), u_nominal_(u_nominal), stab_(stab),
       data_(model) {
   if (controller_ && controller_->sample_time() == 0) continuous_states_ = controller_->nxc();
-  // a controller's output has no rate or acceleration to give a motion input
+  // a continuous controller's output has no rate or acceleration to give a motion input; a
+  // sampled one's (a driver's steer) is held between its samples: the coordinate steps there and
+  // rests between (zero-order hold, as the Stepper's co-simulation holds it)
   for (int k : model.plant_inputs)
-    if (controller_ && model.actuators[static_cast<std::size_t>(k)].type == ActuatorType::Motion)
-      throw std::invalid_argument("simulate: the controller drives the motion input \"" +
+    if (controller_ && controller_->sample_time() == 0 && model.actuators[static_cast<std::size_t>(k)].type == ActuatorType::Motion)
+      throw std::invalid_argument("simulate: the continuous controller drives the motion input \"" +
                                   model.actuators[static_cast<std::size_t>(k)].name +
-                                  "\", whose rate and acceleration it does not give: not simulated yet (linearize takes "
-                                  "it; simulate with it outside Plant/In, moved by a disturbance signal)");
+                                  "\", whose rate and acceleration it does not give: not simulated (linearize takes "
+                                  "it; a sampled controller, sample_time > 0, holds it between samples; or simulate "
+                                  "with it outside Plant/In, moved by a disturbance signal)");
   if (controller_ && controller_->needs_state() && !plant_)
     throw std::invalid_argument("state feedback needs the plant's linearization (its state order)");
 }
