@@ -995,7 +995,7 @@ void MainWindow::onManeuverFinished() {
   onResult(std::shared_ptr<const SimulationResult>(rep, &rep->result));
   setPlaybackTime(rep->result.t.front());
   view_->setFollowBody(body);
-  view_->frameBody(body, 1.5 * L);  // the car and the lane about it
+  view_->frameBody(body, 0.8 * L);  // the car and the lane about it
   message(tr("The maneuver's run is in the 3-D view: Play (%1 s%2)")
               .arg(rep->result.t.back() - rep->result.t.front(), 0, 'g', 4)
               .arg(body > 0 ? tr(", the track of %1 drawn, the camera following it").arg(qs(model->body_names[static_cast<std::size_t>(body)])) : QString()));

@@ -954,6 +954,16 @@ void Scene::placeGrid(const std::vector<SE3>& oMi) {
   // loops keep links from hanging at full reach, so trust the bound less there
   const double slack = m.constraints.empty() ? 1.2 : 0.5;
   const double height = std::min(low, std::max(bound, low - slack * L)) - 0.02 * L;
+  // a car on the ground's road plane: paths are drawn on that plane (the grid stays under the
+  // mechanism's lowest point)
+  path_height_ = std::nan("");
+  for (const EffectSpec& e : m.spec.effects) {
+    if (e.type != EffectType::Tire || e.road.body != kGroundName || !e.road.surface.empty() || e.road.grid ||
+        e.road.profile || e.road.iso8608 || e.road.normal.norm() == 0 || e.road.normal.normalized().dot(up_) < 1 - 1e-9)
+      continue;
+    path_height_ = e.road.point.dot(up_);
+    break;
+  }
 
   // centre under the mechanism, snapped to the grid so that lines go through the world origin
   grid_step_ = niceStep(L / 8);
@@ -996,7 +1006,8 @@ void Scene::setPaths(std::vector<ScenePath> paths) {
 
 Mesh Scene::pathMesh() const {
   Mesh mesh;
-  const double h = grid_center_.dot(up_) + 0.003 * length_;  // just over the grid
+  // just over the road a car rolls on, else over the grid
+  const double h = (std::isfinite(path_height_) ? path_height_ : grid_center_.dot(up_)) + 0.003 * length_;
   const auto onGround = [&](const Eigen::Vector3d& x) { return Eigen::Vector3d(x - (x.dot(up_) - h) * up_); };
   const Eigen::Vector3f n = up_.cast<float>();
   static const Mesh cone = unitCone(12);

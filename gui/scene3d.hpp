@@ -163,7 +163,9 @@ class Scene {
   // lines at most about 120 each way (a coarser step over a long track); build() clears them.
   void setPaths(std::vector<ScenePath> paths);
   const std::vector<ScenePath>& paths() const { return paths_; }
-  // their triangles (ribbons and cones, with normals), in world coordinates on the grid's plane
+  // their triangles (ribbons and cones, with normals), in world coordinates, on the ground road
+  // plane of a model's tires (the plane their road is, when it is the ground's, normal to up), else
+  // on the grid's plane
   Mesh pathMesh() const;
 
  private:
@@ -180,6 +182,7 @@ class Scene {
   double tire_force_scale_ = 0.0;  // m per N
   double tire_force_unit_ = 1.0;   // N in the legend's unit (1 or 1000)
   std::vector<ScenePath> paths_;
+  double path_height_ = std::nan("");  // along up: the ground road plane of the tires (NaN: the grid's)
   // the grid placeGrid() chose for the mechanism, before paths grew it
   Eigen::Vector3d base_grid_center_ = Eigen::Vector3d::Zero();
   double base_grid_half_ = 2.0, base_grid_step_ = 0.5;

@@ -581,6 +581,28 @@ class MainWindowXvfb : public QObject {
     save(screenOf(&w), "maneuver_playback.png");
     w.document()->undoStack()->setClean();
   }
+  // the sedan's fishhook played back at its largest roll: the car leaning out of the turn on its
+  // tires' forces, the track it left behind it
+  void sedanFishhookPlayback() {
+    MainWindow w;
+    w.resize(1600, 1000);
+    w.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&w));
+    QVERIFY(w.openFile(QStringLiteral(CODYNA_EXAMPLES_DIR "/sedan.json")));
+    ManeuverView* mv = w.maneuverView();
+    w.analysisTabs()->setCurrentWidget(mv);
+    w.findChild<QSplitter*>("centreSplitter")->setSizes({560, 380});
+    mv->typeBox()->setCurrentIndex(mv->typeBox()->findData(QStringLiteral("fishhook")));
+    mv->field("speed")->setText(QStringLiteral("22.2"));
+    QVERIFY(mv->run());
+    QTRY_VERIFY_WITH_TIMEOUT(!mv->isRunning(), 120000);
+    QVERIFY2(mv->report(), qPrintable(mv->statusText()));
+    const double t = mv->report()->fh_max_roll_time;
+    w.setPlaybackTime(t);
+    QTest::qWait(400);
+    save(screenOf(&w), "maneuver_playback_sedan.png");
+    w.document()->undoStack()->setClean();
+  }
 };
 
 QTEST_MAIN(MainWindowXvfb)
