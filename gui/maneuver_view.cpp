@@ -63,6 +63,8 @@ const QList<ManeuverField>& maneuver_fields() {
       {"width", "vehicle width (m)", "1.8", {"double-lane-change"}},
       {"preview", "driver preview (m)", "the model's", {"double-lane-change"}},
       {"friction", "friction (controller's reference)", "0.85", {"step-steer", "sine-with-dwell", "slowly-increasing-steer", "fishhook"}},
+      {"t-end", "run length (s)", "the maneuver's",
+       {"step-steer", "sine-with-dwell", "swept-sine", "double-lane-change", "slowly-increasing-steer", "fishhook"}},
       {"integrator", "integrator", "the model's",
        {"step-steer", "sine-with-dwell", "swept-sine", "double-lane-change", "slowly-increasing-steer", "fishhook"}},
       {"free-input", "free inputs", "the model's (a turn: steer,drive)",
@@ -233,6 +235,7 @@ ManeuverRequest ManeuverView::request() const {
   r.preview = number("preview");
   r.friction = number("friction");
   r.steer_rate = number("steer-rate");
+  r.t_end = number("t-end");
   r.open_loop = !open_loop_->isHidden() && open_loop_->isChecked();
   if (const auto p = number("points")) {
     if (*p != std::floor(*p) || std::abs(*p) > 1e6) throw std::invalid_argument("points: expected a whole number");

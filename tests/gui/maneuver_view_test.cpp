@@ -176,11 +176,13 @@ class ManeuverViewTest : public QObject {
     QVERIFY(!view()->openLoopBox()->isVisible());
     QVERIFY(drive::pickWithMouse(view()->typeBox(), "step-steer"));
     type("steer", "0.01");
+    type("t-end", "2");  // long enough for the step's metrics, short under the sanitizers
     runAndWait();
     QCOMPARE(view()->statusText(), QStringLiteral("Done"));
     ManeuverRequest r;
     r.type = "step-steer";
     r.steer = 0.01;
+    r.t_end = 2;
     const ManeuverReport rep = job(kSedanEsc, r);
     QVERIFY(!rep.controller.empty());
     QCOMPARE(view()->reportView()->toPlainText(), QString::fromStdString(study_maneuver_text(rep)));
