@@ -296,7 +296,9 @@ void PoleMap::updateRanges() {
   } else {
     const double im = std::max(std::abs(ylo), std::abs(yhi));
     double span = std::max(xhi - xlo, 2.0 * im);
-    if (span == 0.0) span = 2.0;
+    // nothing to show: a range on binary steps (0.5), whose ticks Qt adds up to exactly 0 (steps of
+    // 0.1 summed from -0.3 labelled the origin -2.8e-17, elided to "-2...")
+    if (span == 0.0) span = 10.0;
     // neither axis squashed to nothing; a bit of both half planes in view
     xlo = std::min(xlo, -0.1 * span);
     xhi = std::max(xhi, 0.1 * span);
