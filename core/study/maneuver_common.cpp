@@ -287,31 +287,29 @@ Model open_loop_run(ManeuverReport& rep, const ManeuverRequest& r, const OpenLoo
     rep.reference_limit = iy >= 0 ? limit : 0.0;
   }
   // the run stops when the car rolls over (past kRolledOver: it does not come back, and a car on its
-  // side is no maneuver), or at the user's cancel, both seen at each output sample
-  std::atomic<bool> stop{false};
-  bool user_cancelled = false;
+  // side is no maneuver), seen at each output sample; the user's cancel goes to the integrator itself,
+  // which sees it inside its steps
+  std::atomic<bool> rolled{false};
   double rolled_at = -1, roll_reached = 0;
   Data dk(run);
   const int body = ol.body;
   SimulationCallbacks cb;
-  cb.cancel = &stop;
+  cb.cancel = r.cancel;
+  cb.stop = &rolled;
   cb.progress = r.progress;
   cb.on_sample = [&](const Snapshot& sn) {
-    if (r.cancel && r.cancel->load()) {
-      user_cancelled = true;
-      stop.store(true);
-    }
     forward_kinematics<double>(run, dk, sn.q, sn.v);
     const SE3& X = dk.oMi[static_cast<std::size_t>(body)];
     const double roll = std::atan2(X.R(2, 1), X.R(2, 2));
     if (std::abs(roll) > kRolledOver && rolled_at < 0) {
       rolled_at = sn.t;
       roll_reached = roll;
-      stop.store(true);
+      rolled.store(true);
     }
   };
   rep.result = simulate(run, ol.controller.get(), ol.plant.get(), o, cb);
-  if (user_cancelled || (rep.result.cancelled && rolled_at < 0)) throw StudyCancelled("the maneuver was cancelled");
+  if ((r.cancel && r.cancel->load()) || (rep.result.cancelled && rolled_at < 0))
+    throw StudyCancelled("the maneuver was cancelled");
   if (ol.controller && rep.result.samples() > 0) {
     const Eigen::VectorXd& u0 = ol.plant->op.u;
     for (int k : run.plant_inputs) {

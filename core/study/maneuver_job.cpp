@@ -283,6 +283,7 @@ ManeuverReport mnv_lane_change(const ManeuverRequest& r, const ModelSpec& spec) 
   SimulationOptions o;
   const Model run = held_at(m, op, o);
   Stepper st(run, mnv::integrator(run));
+  st.set_cancel(r.cancel);  // seen inside the steps too
   st.reset(0, o.q0, o.v0);
   const Eigen::VectorXd y0 = st.outputs();
   const double yaw0 = y0[ds.out_yaw];
@@ -341,6 +342,7 @@ ManeuverReport mnv_lane_change(const ManeuverRequest& r, const ModelSpec& spec) 
     try {
       st.step(u, ds.sample_time);
     } catch (const std::exception& e) {
+      if (r.cancel && r.cancel->load()) throw StudyCancelled("the maneuver was cancelled");
       res.completed = false;
       res.failure = e.what();
       break;

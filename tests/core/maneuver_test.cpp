@@ -7,8 +7,11 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <string>
+#include <thread>
 #include <unsupported/Eigen/MatrixFunctions>
 #include <vector>
 
@@ -504,4 +507,45 @@ TEST(Maneuver, PathsProjectAndTheLaneChangeHasTheStandardsWidths) {
   // lane 3's right-hand line 3.5 m left of lane 1's
   EXPECT_NEAR((d.gate_center[1] - d.gate_width[1] / 2) - (d.gate_center[0] - d.gate_width[0] / 2), 3.5, 1e-12);
   EXPECT_NEAR(project_on_path(d, Eigen::Vector2d(100, d.gate_center[1] + 0.3)).lateral, 0.3, 1e-9);
+}
+
+// The user's Cancel reaches the integrator inside its steps: a sedan step steer recorded every 200 s
+// of model time (no output sample between the start and t = 200 s, which takes about 30 s of wall
+// time in Release on a 2-core machine: 20 s of model time take 3.3 s) is cancelled from another
+// thread 0.3 s after its first sample; the job must end with StudyCancelled within 5 s of the flag.
+// Before the fix, which saw the flag only at output samples, it ended about 30 s after it.
+TEST(Maneuver, ACancelFromAnotherThreadEndsTheSedansRunInsideItsSteps) {
+  const std::string file = maneuver_example("sedan.json");
+  const ModelSpec spec = study_read_model(file);
+  ManeuverRequest r;
+  r.model = file;
+  r.type = "step-steer";
+  r.steer = 0.3;
+  r.t_end = 400;
+  r.output_step = 200;
+  r.integrator = "arkode";
+  std::atomic<bool> cancel{false}, started{false};
+  r.cancel = &cancel;
+  r.progress = [&](double, double) { started.store(true); };
+  std::chrono::steady_clock::time_point set_at{};
+  std::thread canceller([&] {
+    while (!started.load()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    set_at = std::chrono::steady_clock::now();
+    cancel.store(true);
+  });
+  std::string outcome = "(completed)";
+  try {
+    study_maneuver_job(r, spec);
+  } catch (const StudyCancelled& e) {
+    outcome = e.what();
+  } catch (const std::exception& e) {
+    outcome = std::string("other error: ") + e.what();
+  }
+  const auto ended = std::chrono::steady_clock::now();
+  canceller.join();
+  EXPECT_EQ(outcome, "the maneuver was cancelled");
+  const double after = std::chrono::duration<double>(ended - set_at).count();
+  EXPECT_GE(after, 0.0);
+  EXPECT_LT(after, 5.0) << "the cancel took " << after << " s to end the run";
 }
