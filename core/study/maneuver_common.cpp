@@ -11,6 +11,7 @@
 #include "simulation/simulator.hpp"
 #include "study/files.hpp"
 #include "study/workflow.hpp"
+#include "study/workflow_detail.hpp"
 #include "study/maneuver_detail.hpp"
 
 namespace codyna::mnv {
@@ -174,19 +175,33 @@ void attach_controller(OpenLoop& ol, const ManeuverRequest& r, const ModelSpec& 
   // the intended yaw rate: the steady yaw rate of the linear car for the steer (its straight run,
   // steer in, yaw rate out), limited to what the road holds at the run's speed
   const double mu = positive(flag, r.friction, 0.85, "friction");
-  ModelSpec ls = straight_spec(r, spec);
-  ls.plant.inputs = {steer};
-  ls.controller = ControllerSpec{};
-  const StudyLinearization lin = study_linearize(study_model(ls, r.model));
-  if (!lin.handling || !(lin.handling->yaw_rate_gain != 0))
+  std::optional<HandlingNumbers> h;
+  try {
+    h = straight_handling(ol);
+  } catch (const std::exception&) {
+  }
+  if (!h || !(h->yaw_rate_gain != 0))
     throw ModelError(m.source_file, "/analysis/handling",
                      "the controller's yaw-rate reference needs the straight run's steady yaw-rate gain, which the "
                      "linearization does not give; run the maneuver " + flag("open-loop"));
-  ol.reference_gain = lin.handling->yaw_rate_gain;
+  ol.reference_gain = h->yaw_rate_gain;
   ol.reference_limit = mu * 9.80665 / std::max(ol.start.speed_along_heading, 1e-9);
 }
 
 }  // namespace
+
+HandlingNumbers straight_handling(const OpenLoop& ol) {
+  // what study_linearize gives a model whose only Plant/In is the steer, at the same point
+  Model with = ol.model;
+  with.plant_inputs = {ol.steer};
+  StudyLinearization sl;
+  sl.op = ol.op;
+  LinearizeOptions o;
+  o.method = workflow_detail::method_of_model(with);
+  o.independent = with.spec.analysis.independent;
+  sl.lin = linearize(with, sl.op, o);
+  return workflow_detail::study_handling(with, sl);
+}
 
 OpenLoop open_loop_setup(const ManeuverRequest& r, const ModelSpec& spec, bool controlled) {
   OpenLoop ol;
