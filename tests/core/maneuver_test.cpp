@@ -524,12 +524,13 @@ TEST(Maneuver, ACancelFromAnotherThreadEndsTheSedansRunInsideItsSteps) {
   r.t_end = 400;
   r.output_step = 200;
   r.integrator = "arkode";
-  std::atomic<bool> cancel{false}, started{false};
+  std::atomic<bool> cancel{false}, started{false}, finished{false};
   r.cancel = &cancel;
   r.progress = [&](double, double) { started.store(true); };
   std::chrono::steady_clock::time_point set_at{};
-  std::thread canceller([&] {
-    while (!started.load()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  std::thread canceller([&] {  // (gives up when the job ends before its first sample)
+    while (!started.load() && !finished.load()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    if (finished.load()) return;
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
     set_at = std::chrono::steady_clock::now();
     cancel.store(true);
@@ -543,7 +544,9 @@ TEST(Maneuver, ACancelFromAnotherThreadEndsTheSedansRunInsideItsSteps) {
     outcome = std::string("other error: ") + e.what();
   }
   const auto ended = std::chrono::steady_clock::now();
+  finished.store(true);
   canceller.join();
+  ASSERT_TRUE(cancel.load()) << outcome;
   EXPECT_EQ(outcome, "the maneuver was cancelled");
   const double after = std::chrono::duration<double>(ended - set_at).count();
   EXPECT_GE(after, 0.0);
@@ -729,4 +732,46 @@ TEST(Maneuver, TheSedanTooFastForTheDoubleLaneChangeHitsTheCones) {
   EXPECT_GT(rep.path.max_abs, 1.0);
   EXPECT_NEAR(rep.path.max_abs, c.max_abs, 5e-5);
   EXPECT_NEAR(rep.path.rms, c.rms, 5e-5);
+}
+
+// The same for the double lane change, whose driver steps the plant sample by sample (the stepper
+// gets the user's flag too): with a driver sample of 100 s (about 25 s of wall time for the first
+// sample, the steer held), a cancel 0.3 s after the run starts ends the job within 5 s.
+TEST(Maneuver, ACancelEndsTheDriversRunInsideItsSample) {
+  const std::string file = maneuver_example("sedan.json");
+  const ModelSpec spec = sedan_with_driver_signals(file);
+  ManeuverRequest r;
+  r.model = file;
+  r.type = "double-lane-change";
+  r.speed = 16.7;
+  r.speed_output = "forward_speed";
+  r.drive = "drive";
+  r.sample_time = 100;
+  r.t_end = 200;
+  std::atomic<bool> cancel{false}, started{false}, finished{false};
+  r.cancel = &cancel;
+  r.progress = [&](double, double) { started.store(true); };
+  std::chrono::steady_clock::time_point set_at{};
+  std::thread canceller([&] {
+    while (!started.load() && !finished.load()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    if (finished.load()) return;
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    set_at = std::chrono::steady_clock::now();
+    cancel.store(true);
+  });
+  std::string outcome = "(completed)";
+  try {
+    study_maneuver_job(r, spec);
+  } catch (const StudyCancelled& e) {
+    outcome = e.what();
+  } catch (const std::exception& e) {
+    outcome = std::string("other error: ") + e.what();
+  }
+  const auto ended = std::chrono::steady_clock::now();
+  finished.store(true);
+  canceller.join();
+  ASSERT_TRUE(cancel.load()) << outcome;
+  EXPECT_EQ(outcome, "the maneuver was cancelled");
+  const double after = std::chrono::duration<double>(ended - set_at).count();
+  EXPECT_LT(after, 5.0) << "the cancel took " << after << " s to end the run";
 }
