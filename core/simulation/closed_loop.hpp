@@ -76,8 +76,12 @@ class ClosedLoopSystem {
 
   // A flag the caller sets to stop: rhs() and residual() then throw (the integrator stops inside
   // its step, however long the step: a stiff run's output interval may take minutes); the caller
-  // tells the cancellation from a failure by the flag
-  void set_cancel(const std::atomic<bool>* cancel) { cancel_ = cancel; }
+  // tells the cancellation from a failure by the flag. A second flag (`stop`, may be null) is polled
+  // the same way: a front end's Cancel and the caller's own reason to end a run stay apart.
+  void set_cancel(const std::atomic<bool>* cancel, const std::atomic<bool>* stop = nullptr) {
+    cancel_ = cancel;
+    stop_ = stop;
+  }
 
   void rhs(double t, const Eigen::VectorXd& y, Eigen::VectorXd& ydot);
   void residual(double t, const Eigen::VectorXd& Y, const Eigen::VectorXd& Yp, Eigen::VectorXd& F);
@@ -131,8 +135,10 @@ class ClosedLoopSystem {
   mutable std::unique_ptr<DataT<ADScalar>> ad_data_;  // output rates (PD), made on first use
   long evaluations_ = 0;
   const std::atomic<bool>* cancel_ = nullptr;
+  const std::atomic<bool>* stop_ = nullptr;
   void check_cancel() const {
-    if (cancel_ && cancel_->load(std::memory_order_relaxed)) throw std::runtime_error("cancelled");
+    if ((cancel_ && cancel_->load(std::memory_order_relaxed)) || (stop_ && stop_->load(std::memory_order_relaxed)))
+      throw std::runtime_error("cancelled");
   }
   // exact Jacobians: made on first use
   std::unique_ptr<TreeDerivatives> deriv_;

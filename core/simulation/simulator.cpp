@@ -336,7 +336,8 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
   };
   record(o.t0);
 
-  sys.set_cancel(cb.cancel);  // from here a cancel stops the integrator inside its step
+  sys.set_cancel(cb.cancel, cb.stop);  // from here a cancel (or the caller's stop) ends the integrator's step
+  const auto halted = [&cb] { return (cb.cancel && cb.cancel->load()) || (cb.stop && cb.stop->load()); };
   const double eps = 1e-12 * std::max(1.0, std::abs(o.t_end));
   // drift the integrator leaves on the loops is not covered by its error test (IDA's
   // index-1 form): a drift of 1e-9 allowed at 1e-10 costs Andrews' squeezer two digits
@@ -346,7 +347,7 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
   std::size_t jump_index = 0;
   double t = o.t0;
   while (t < o.t_end - eps) {
-    if (cb.cancel && cb.cancel->load()) {
+    if (halted()) {
       r.cancelled = true;
       break;
     }
@@ -359,7 +360,7 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
     try {
       integrator->advance(target);
     } catch (const IntegratorFailure& f) {
-      if (cb.cancel && cb.cancel->load()) {  // stopped inside the step (ClosedLoopSystem::set_cancel)
+      if (halted()) {  // stopped inside the step (ClosedLoopSystem::set_cancel)
         r.cancelled = true;
         break;
       }

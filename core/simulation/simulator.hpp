@@ -55,7 +55,13 @@ struct Snapshot {
 struct SimulationCallbacks {
   std::function<void(double t, double t_end)> progress;
   std::function<void(const Snapshot&)> on_sample;
+  // a front end's Cancel: seen inside the integrator's steps (ClosedLoopSystem::set_cancel), the
+  // run returns at once with SimulationResult::cancelled
   const std::atomic<bool>* cancel = nullptr;
+  // the caller's own stop (e.g. set by on_sample when a car has rolled over), seen the same way and
+  // ending the run the same way (cancelled); kept apart from `cancel` so that the caller can tell
+  // the user's Cancel from its own reason
+  const std::atomic<bool>* stop = nullptr;
 };
 
 // The linearized plant a controller was designed on (state order, offsets).

@@ -74,7 +74,7 @@ const Eigen::VectorXd& Stepper::step(const Eigen::VectorXd& u, double dt) {
   try {
     integrator_->advance(t_ + dt);
   } catch (const IntegratorFailure& f) {
-    if (!chosen_ || settings_.method == kAutoFallbackIntegrator) throw;
+    if (!chosen_ || settings_.method == kAutoFallbackIntegrator || (cancel_ && cancel_->load())) throw;
     // auto's choice failed as the run turned stiff: this step again from its start, stiff
     extra_.integrator_choice += auto_fallback_note(settings_.method, f.time(), f.what(), t_);
     integrator_->add_stats(extra_);

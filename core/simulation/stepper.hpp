@@ -6,6 +6,7 @@
 // as in simulate(). One Stepper per thread.
 #pragma once
 
+#include <atomic>
 #include <memory>
 
 #include "simulation/closed_loop.hpp"
@@ -30,6 +31,12 @@ class Stepper {
   int nu() const { return static_cast<int>(model_.plant_inputs.size()); }
   int ny() const { return static_cast<int>(model_.plant_outputs.size()); }
   SolverStats stats() const;
+  // a front end's Cancel (may be null): seen inside the integrator's steps; step() then throws
+  // IntegratorFailure, and the caller tells it from a failure by the flag
+  void set_cancel(const std::atomic<bool>* cancel) {
+    cancel_ = cancel;
+    sys_.set_cancel(cancel);
+  }
 
  private:
   void measure();
@@ -45,6 +52,7 @@ class Stepper {
   Eigen::VectorXd y_, out_;
   double t_ = 0;
   SolverStats extra_;
+  const std::atomic<bool>* cancel_ = nullptr;
 };
 
 }  // namespace codyna

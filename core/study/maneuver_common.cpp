@@ -12,6 +12,7 @@
 #include "simulation/simulator.hpp"
 #include "study/files.hpp"
 #include "study/workflow.hpp"
+#include "study/workflow_detail.hpp"
 #include "study/maneuver_detail.hpp"
 
 namespace codyna::mnv {
@@ -175,19 +176,33 @@ void attach_controller(OpenLoop& ol, const ManeuverRequest& r, const ModelSpec& 
   // the intended yaw rate: the steady yaw rate of the linear car for the steer (its straight run,
   // steer in, yaw rate out), limited to what the road holds at the run's speed
   const double mu = positive(flag, r.friction, 0.85, "friction");
-  ModelSpec ls = straight_spec(r, spec);
-  ls.plant.inputs = {steer};
-  ls.controller = ControllerSpec{};
-  const StudyLinearization lin = study_linearize(study_model(ls, r.model));
-  if (!lin.handling || !(lin.handling->yaw_rate_gain != 0))
+  std::optional<HandlingNumbers> h;
+  try {
+    h = straight_handling(ol);
+  } catch (const std::exception&) {
+  }
+  if (!h || !(h->yaw_rate_gain != 0))
     throw ModelError(m.source_file, "/analysis/handling",
                      "the controller's yaw-rate reference needs the straight run's steady yaw-rate gain, which the "
                      "linearization does not give; run the maneuver " + flag("open-loop"));
-  ol.reference_gain = lin.handling->yaw_rate_gain;
+  ol.reference_gain = h->yaw_rate_gain;
   ol.reference_limit = mu * 9.80665 / std::max(ol.start.speed_along_heading, 1e-9);
 }
 
 }  // namespace
+
+HandlingNumbers straight_handling(const OpenLoop& ol) {
+  // what study_linearize gives a model whose only Plant/In is the steer, at the same point
+  Model with = ol.model;
+  with.plant_inputs = {ol.steer};
+  StudyLinearization sl;
+  sl.op = ol.op;
+  LinearizeOptions o;
+  o.method = workflow_detail::method_of_model(with);
+  o.independent = with.spec.analysis.independent;
+  sl.lin = linearize(with, sl.op, o);
+  return workflow_detail::study_handling(with, sl);
+}
 
 OpenLoop open_loop_setup(const ManeuverRequest& r, const ModelSpec& spec, bool controlled) {
   OpenLoop ol;
@@ -288,31 +303,29 @@ Model open_loop_run(ManeuverReport& rep, const ManeuverRequest& r, const OpenLoo
     rep.reference_limit = iy >= 0 ? limit : 0.0;
   }
   // the run stops when the car rolls over (past kRolledOver: it does not come back, and a car on its
-  // side is no maneuver), or at the user's cancel, both seen at each output sample
-  std::atomic<bool> stop{false};
-  bool user_cancelled = false;
+  // side is no maneuver), seen at each output sample; the user's cancel goes to the integrator itself,
+  // which sees it inside its steps
+  std::atomic<bool> rolled{false};
   double rolled_at = -1, roll_reached = 0;
   Data dk(run);
   const int body = ol.body;
   SimulationCallbacks cb;
-  cb.cancel = &stop;
+  cb.cancel = r.cancel;
+  cb.stop = &rolled;
   cb.progress = r.progress;
   cb.on_sample = [&](const Snapshot& sn) {
-    if (r.cancel && r.cancel->load()) {
-      user_cancelled = true;
-      stop.store(true);
-    }
     forward_kinematics<double>(run, dk, sn.q, sn.v);
     const SE3& X = dk.oMi[static_cast<std::size_t>(body)];
     const double roll = std::atan2(X.R(2, 1), X.R(2, 2));
     if (std::abs(roll) > kRolledOver && rolled_at < 0) {
       rolled_at = sn.t;
       roll_reached = roll;
-      stop.store(true);
+      rolled.store(true);
     }
   };
   rep.result = simulate(run, ol.controller.get(), ol.plant.get(), o, cb);
-  if (user_cancelled || (rep.result.cancelled && rolled_at < 0)) throw StudyCancelled("the maneuver was cancelled");
+  if ((r.cancel && r.cancel->load()) || (rep.result.cancelled && rolled_at < 0))
+    throw StudyCancelled("the maneuver was cancelled");
   if (ol.controller && rep.result.samples() > 0) {
     const Eigen::VectorXd& u0 = ol.plant->op.u;
     for (int k : run.plant_inputs) {

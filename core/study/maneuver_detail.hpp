@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "analysis/handling.hpp"
 #include "analysis/operating_point.hpp"
 #include "dynamics/data.hpp"
 #include "model/model.hpp"
@@ -78,6 +79,11 @@ struct OpenLoop {
   std::string controller_text;
   double reference_gain = 0, reference_limit = 0;  // 1/s (per steer unit), rad/s
 };
+// The straight run's handling numbers (steer in, yaw rate out: analysis.handling) at ol.op, on
+// ol.model with the steer as its only Plant/In: what study_linearize gives on the straight spec so
+// changed, without compiling it again or searching its steady motion again. Throws as
+// study_linearize's handling numbers do (a name the model lacks: ModelError).
+HandlingNumbers straight_handling(const OpenLoop& ol);
 // controlled: the run may take the model file's controller (step steer, sine with dwell); a
 // maneuver that compares with the open-loop linear model refuses one (unless --open-loop)
 OpenLoop open_loop_setup(const ManeuverRequest& r, const ModelSpec& spec, bool controlled = false);

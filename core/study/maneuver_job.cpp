@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -170,8 +171,11 @@ void mnv_name_result(SimulationResult& res, const Model& run, const ManeuverRequ
 }
 
 // the lateral error from the start of section 1 to the end of section 6, and the cones: the
-// rectangle's corners (width x length about the position outputs) in the lane's frame against
-// each section's lines; `local` the lane in its own frame, placed at `start` turned by yaw0
+// car's rectangle (width x length about the position outputs) in the lane's frame against each
+// section's lines. The part of the rectangle inside a section (between its first and last cones
+// along x) is its corners there and the points where its edges cross the section's ends (a car
+// leaving a section turned can touch its last cone with a side, its corners beyond or before it);
+// `local` the lane in its own frame, placed at `start` turned by yaw0
 void mnv_lane_metrics(ManeuverReport& rep, const mnv::Flags& flag, const DriverPath& local, const DriverSettings& ds,
                       const Eigen::Vector2d& start, double yaw0, const std::vector<double>& lateral, double width,
                       double length) {
@@ -180,7 +184,9 @@ void mnv_lane_metrics(ManeuverReport& rep, const mnv::Flags& flag, const DriverP
   const int done = static_cast<int>(res.t.size());
   const double gate_from = local.gate_start.front(), gate_to = local.gate_end.back();
   std::vector<double> tin, ein;
-  std::vector<bool> hit(local.gate_start.size(), false);
+  const std::size_t gates = local.gate_start.size();
+  std::vector<bool> hit(gates, false);
+  rep.cone_clearance.assign(gates, std::numeric_limits<double>::infinity());
   for (int k = 0; k < done; ++k) {
     const Eigen::Vector2d p = rot.inverse() * (Eigen::Vector2d(res.y(k, ds.out_x), res.y(k, ds.out_y)) - start);
     const double psi = res.y(k, ds.out_yaw) - yaw0;
@@ -189,20 +195,32 @@ void mnv_lane_metrics(ManeuverReport& rep, const mnv::Flags& flag, const DriverP
       ein.push_back(lateral[static_cast<std::size_t>(k)]);
     }
     const Eigen::Rotation2Dd body_rot(psi);
-    for (const double a : {-0.5, 0.5})
-      for (const double b : {-0.5, 0.5}) {
-        const Eigen::Vector2d corner = p + body_rot * Eigen::Vector2d(a * length, b * width);
-        for (std::size_t g = 0; g < hit.size(); ++g)
-          if (!hit[g] && corner.x() >= local.gate_start[g] && corner.x() <= local.gate_end[g] &&
-              std::abs(corner.y() - local.gate_center[g]) > local.gate_width[g] / 2) {
-            hit[g] = true;
-            std::ostringstream os;
-            os << "section " << (g == 0 ? 1 : g == 1 ? 3 : 5) << " (" << local.gate_width[g] << " m wide) at x = "
-               << std::setprecision(4) << corner.x() - local.gate_start.front() << " m, t = " << res.t[static_cast<std::size_t>(k)] << " s";
-            rep.cones_hit.push_back(os.str());
-          }
+    Eigen::Vector2d corner[4];
+    const double along[4] = {-0.5, 0.5, 0.5, -0.5}, across[4] = {-0.5, -0.5, 0.5, 0.5};  // around the outline
+    for (int c = 0; c < 4; ++c) corner[c] = p + body_rot * Eigen::Vector2d(along[c] * length, across[c] * width);
+    for (std::size_t g = 0; g < gates; ++g) {
+      const double x0 = local.gate_start[g], x1 = local.gate_end[g];
+      const auto check = [&](const Eigen::Vector2d& point) {
+        const double margin = local.gate_width[g] / 2 - std::abs(point.y() - local.gate_center[g]);
+        rep.cone_clearance[g] = std::min(rep.cone_clearance[g], margin);
+        if (margin >= 0 || hit[g]) return;
+        hit[g] = true;
+        std::ostringstream os;
+        os << "section " << (g == 0 ? 1 : g == 1 ? 3 : 5) << " (" << local.gate_width[g] << " m wide) at x = "
+           << std::setprecision(4) << point.x() - local.gate_start.front() << " m, t = " << res.t[static_cast<std::size_t>(k)] << " s";
+        rep.cones_hit.push_back(os.str());
+      };
+      for (int c = 0; c < 4; ++c) {
+        const Eigen::Vector2d& a = corner[c];
+        const Eigen::Vector2d& b = corner[(c + 1) % 4];
+        if (a.x() >= x0 && a.x() <= x1) check(a);
+        for (const double xe : {x0, x1})
+          if ((a.x() - xe) * (b.x() - xe) < 0) check(a + (b - a) * ((xe - a.x()) / (b.x() - a.x())));
       }
+    }
   }
+  for (double& c : rep.cone_clearance)
+    if (!std::isfinite(c)) c = std::nan("");  // the run ended before the section
   if (tin.empty()) {
     rep.valid = false;
     if (rep.invalid_reason.empty()) rep.invalid_reason = "the run ended before the lane (raise " + flag("t-end") + ")";
@@ -283,6 +301,7 @@ ManeuverReport mnv_lane_change(const ManeuverRequest& r, const ModelSpec& spec) 
   SimulationOptions o;
   const Model run = held_at(m, op, o);
   Stepper st(run, mnv::integrator(run));
+  st.set_cancel(r.cancel);  // seen inside the steps too
   st.reset(0, o.q0, o.v0);
   const Eigen::VectorXd y0 = st.outputs();
   const double yaw0 = y0[ds.out_yaw];
@@ -342,6 +361,7 @@ ManeuverReport mnv_lane_change(const ManeuverRequest& r, const ModelSpec& spec) 
     try {
       st.step(u, ds.sample_time);
     } catch (const std::exception& e) {
+      if (r.cancel && r.cancel->load()) throw StudyCancelled("the maneuver was cancelled");
       res.completed = false;
       res.failure = e.what();
       break;
@@ -509,6 +529,9 @@ std::string study_maneuver_text(const ManeuverReport& r) {
     os << "path error       max " << r.path.max_abs << " m at " << r.path.at << " s, RMS " << r.path.rms << " m\n"
        << "largest steer    " << r.max_steer << "\n"
        << "cones            " << (r.cones_hit.empty() ? "none hit" : std::to_string(r.cones_hit.size()) + " section(s) hit") << "\n";
+    if (r.cone_clearance.size() == 3)
+      os << "cone clearance   sections 1, 3, 5-6: " << r.cone_clearance[0] << ", " << r.cone_clearance[1] << ", "
+         << r.cone_clearance[2] << " m (< 0: a lane line crossed)\n";
     for (const std::string& c : r.cones_hit) os << "  hit: " << c << "\n";
   } else if (r.type == "slowly-increasing-steer") {
     const auto pct = [](double a, double b) { return std::abs(a - b) / std::abs(b) * 100; };

@@ -142,6 +142,10 @@ struct ManeuverReport {
   // double lane change
   PathErrorMetrics path;
   std::vector<std::string> cones_hit;    // "section 3 at x = 81.2 m" (empty: none)
+  // per section with cones (1, 3, 5-6): the smallest distance by which the car's outline inside the
+  // section stayed within its lane over the run (m; < 0: it crossed a lane line there, a cone hit;
+  // NaN: the run ended before the section)
+  std::vector<double> cone_clearance;
   double max_steer = 0;
   // swept sine: the frequency responses to steer on the table's frequencies (Hz), estimated from
   // the run (the ratio of the transforms) and the linear model's (straight-run linearization);

@@ -50,14 +50,9 @@ std::vector<BodyState> ramp_states(const Model& run, const ManeuverReport& rep, 
 }
 
 // the straight run's handling numbers with the steer as the input (its K, L and steering ratio)
-std::optional<HandlingNumbers> ramp_handling(ManeuverReport& rep, const ManeuverRequest& r, const ModelSpec& spec) {
+std::optional<HandlingNumbers> ramp_handling(ManeuverReport& rep, const OpenLoop& ol) {
   try {
-    ModelSpec ls = straight_spec(r, spec);
-    ls.plant.inputs = {spec.analysis.handling.steer};
-    ls.controller = ControllerSpec{};
-    const StudyLinearization lin = study_linearize(study_model(ls, r.model));
-    if (lin.handling) return lin.handling;
-    rep.notes.push_back("no handling numbers to compare with (analysis.handling)");
+    return straight_handling(ol);
   } catch (const std::exception& e) {
     rep.notes.push_back(std::string("no handling numbers to compare with: ") + e.what());
   }
@@ -84,7 +79,7 @@ ManeuverReport slowly_increasing_steer(const ManeuverRequest& r, const ModelSpec
   const double t_end = r.t_end ? *r.t_end : t0 + T;
   if (!(t_end > t0) || !std::isfinite(t_end)) throw std::invalid_argument(flag("t-end") + ": expected a time past the steer's start");
   const double sign = amplitude > 0 ? 1.0 : -1.0;
-  const std::optional<HandlingNumbers> h = ramp_handling(rep, r, spec);
+  const std::optional<HandlingNumbers> h = ramp_handling(rep, ol);
   if (h) rep.handling_gradient = h->understeer_gradient;
   const Model run = open_loop_run(rep, r, ol, piecewise_linear({t0, t0 + T}, {0.0, amplitude}), {t0, t0 + T}, t_end);
   if (rep.result.samples() < 3) return rep;
