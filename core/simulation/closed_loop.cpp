@@ -130,11 +130,20 @@ Eigen::VectorXd ClosedLoopSystem::saturate(Eigen::VectorXd u) const {
   return u;
 }
 
+void ClosedLoopSystem::apply_beside(Eigen::VectorXd& u, const Eigen::VectorXd& d) const {
+  if (beside_held_.size() != static_cast<Eigen::Index>(beside_actuators_.size())) return;  // not sampled yet
+  for (std::size_t i = 0; i < beside_actuators_.size(); ++i) {
+    const int a = beside_actuators_[i];
+    u[a] = beside_held_[static_cast<Eigen::Index>(i)] + (d.size() ? d[a] : 0.0);
+  }
+}
+
 Eigen::VectorXd ClosedLoopSystem::inputs(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
                                          const Eigen::VectorXd& xc) const {
   Eigen::VectorXd u = u_nominal_;
   const Eigen::VectorXd d = disturbance_ ? disturbance_(t) : Eigen::VectorXd();
   if (d.size()) u += d;
+  apply_beside(u, d);
   Eigen::VectorXd up;
   if (!controller_ || controller_->sample_time() > 0) {
     // held values: a discrete controller's last output, or inputs set from outside (co-simulation)
@@ -166,7 +175,9 @@ void ClosedLoopSystem::apply_motions(double t, Eigen::VectorXd& q, Eigen::Vector
   if (nm == 0) return;
   // u0 plus the disturbance, or a held Plant/In value (no controller drives a motion input)
   Eigen::VectorXd value = u_nominal_;
-  if (disturbance_) value += disturbance_(t);
+  const Eigen::VectorXd d = disturbance_ ? disturbance_(t) : Eigen::VectorXd();
+  if (d.size()) value += d;
+  apply_beside(value, d);
   if (held_)
     for (std::size_t k = 0; k < model_.plant_inputs.size(); ++k) value[model_.plant_inputs[k]] = (*held_)[k];
   value = saturate(value);

@@ -53,6 +53,12 @@ class ClosedLoopSystem {
   // the Plant/In values held until changed: by a discrete controller at its samples,
   // or from outside when there is no controller (co-simulation, Stepper)
   void set_held(const Eigen::VectorXd& u_plant) { held_ = u_plant; }
+  // A second controller beside the first, sampled (SimulationOptions::beside): the actuators it
+  // sets (Model::actuators indices, none of them a Plant/In the first controller drives) take the
+  // values it holds (plus a disturbance on them), set at its samples; a motion input among them
+  // rests between its samples (zero-order hold) as under a sampled controller
+  void set_beside(std::vector<int> actuators) { beside_actuators_ = std::move(actuators); }
+  void set_beside_held(const Eigen::VectorXd& u) { beside_held_ = u; }
   // r(t) for the Plant/Out outputs, handed to the controller (empty: its own setpoint)
   void set_reference(std::function<Eigen::VectorXd(double)> r) { reference_ = std::move(r); }
   // d(t) added to the actuators' nominal values (one entry per actuator, Model::actuators;
@@ -118,12 +124,16 @@ class ClosedLoopSystem {
 
  private:
   Eigen::VectorXd saturate(Eigen::VectorXd u_all) const;
+  // the beside controller's held values into u (one entry per actuator), d its disturbance (or empty)
+  void apply_beside(Eigen::VectorXd& u, const Eigen::VectorXd& d) const;
 
   const Model& model_;
   const Controller* controller_;
   const PlantFunction* plant_;
   Eigen::VectorXd x_ref_, u_nominal_;
   std::optional<Eigen::VectorXd> held_;
+  std::vector<int> beside_actuators_;
+  Eigen::VectorXd beside_held_;
   std::function<Eigen::VectorXd(double)> reference_, disturbance_, disturbance_rate_, disturbance_acceleration_;
   // the controller's state equation, told the Plant/In values applied (after saturation) in u
   Eigen::VectorXd controller_rates(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,

@@ -220,6 +220,42 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
                                     "feedback (the " + (reaction ? "reaction" : "acceleration") + " is then recorded as an output)");
       }
     }
+  const SampledBeside& bs = o.beside;
+  const Controller* beside = bs.controller;
+  if (beside) {
+    const double Tb = beside->sample_time();
+    if (!(Tb > 0) || !std::isfinite(Tb))
+      throw std::invalid_argument("simulate: the controller beside (" + beside->describe() +
+                                  ") must be sampled (a sample time > 0)");
+    if ((o.t_end - o.t0) / Tb > o.max_samples * 100.0) {
+      std::ostringstream os;
+      os << "simulate: the controller beside's sample time " << Tb << " s gives " << (o.t_end - o.t0) / Tb
+         << " samples over the run, more than 100 times the sample limit of " << o.max_samples;
+      throw std::invalid_argument(os.str());
+    }
+    if (beside->needs_state() || beside->needs_rates() || beside->nxc() < 0)
+      throw std::invalid_argument("simulate: the controller beside reads outputs only (no state feedback, no rates)");
+    if (bs.actuators.empty()) throw std::invalid_argument("simulate: the controller beside sets no actuator");
+    for (std::size_t i = 0; i < bs.actuators.size(); ++i) {
+      const int a = bs.actuators[i];
+      if (a < 0 || a >= model.nu()) throw std::invalid_argument("simulate: the controller beside names an actuator the model does not have");
+      const std::string& name = model.actuators[static_cast<std::size_t>(a)].name;
+      if (std::count(bs.actuators.begin(), bs.actuators.end(), a) > 1)
+        throw std::invalid_argument("simulate: the controller beside sets \"" + name + "\" twice");
+      if (controller && std::count(model.plant_inputs.begin(), model.plant_inputs.end(), a))
+        throw std::invalid_argument("simulate: the controller beside sets \"" + name +
+                                    "\", a Plant/In input the first controller drives: give each controller its own inputs");
+    }
+    for (const int k : bs.sensors) {
+      if (k < 0 || k >= static_cast<int>(model.sensors.size()))
+        throw std::invalid_argument("simulate: the controller beside names a sensor the model does not have");
+      if (sensor_reads_accelerations(model.sensors[static_cast<std::size_t>(k)].type))
+        throw std::invalid_argument("simulate: the controller beside reads \"" + model.sensors[static_cast<std::size_t>(k)].name +
+                                    "\", which depends on the inputs (an acceleration or a reaction): feed back positions or velocities");
+    }
+    if (o.compare_linear)
+      throw std::invalid_argument("simulate: the linear comparison does not run a controller beside the first");
+  }
   const auto wall0 = std::chrono::steady_clock::now();
 
   std::optional<PlantFunction> pf;
@@ -282,6 +318,30 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
     ++sample_index;
   };
   if (discrete) controller_sample(o.t0);
+  // the controller beside: its samples on its own clock, its outputs held on its actuators
+  const double Tb = beside ? beside->sample_time() : 0;
+  Eigen::VectorXd xcb = Eigen::VectorXd::Zero(beside ? beside->nxc() : 0);
+  long beside_index = 0;
+  Data db(model);
+  auto beside_sample = [&](double t) {
+    const Eigen::VectorXd q = y.head(model.nq), v = y.segment(model.nq, model.nv);
+    db.s = y.segment(i_s, ns);
+    forward_kinematics<double>(model, db, q, v);
+    ControllerInput in;
+    in.t = t;
+    in.y = sensor_outputs<double>(model, db, bs.sensors, q, v);
+    const Eigen::VectorXd u = beside->output(in, xcb);
+    if (u.size() != static_cast<Eigen::Index>(bs.actuators.size()))
+      throw std::invalid_argument("simulate: the controller beside gives " + std::to_string(u.size()) + " values for " +
+                                  std::to_string(bs.actuators.size()) + " actuators");
+    sys.set_beside_held(u);
+    xcb = beside->update(in, xcb);
+    ++beside_index;
+  };
+  if (beside) {
+    sys.set_beside(bs.actuators);
+    beside_sample(o.t0);
+  }
 
   SimulationResult r;
   IntegratorSettings settings = o.integrator;
@@ -306,7 +366,11 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
   auto record = [&](double t) {
     Eigen::VectorXd q = y.head(model.nq), v = y.segment(model.nq, model.nv);
     sys.apply_motions(t, q, v, &motion_acc);  // exactly where they are driven (the state integrates their rates)
-    const Eigen::VectorXd xc = discrete ? xcd : Eigen::VectorXd(y.tail(sys.nxc()));
+    Eigen::VectorXd xc = discrete ? xcd : Eigen::VectorXd(y.tail(sys.nxc()));
+    if (xcb.size()) {  // the beside controller's states after the first's
+      xc.conservativeResize(xc.size() + xcb.size());
+      xc.tail(xcb.size()) = xcb;
+    }
     const Eigen::VectorXd s = y.segment(i_s, ns);
     sys.set_effect_states(s);
     d.s = s;
@@ -356,7 +420,8 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
     // a motion input's rate jumps (a ramp starts, a table's knot): stop there for its impulse
     while (jump_index < o.rate_jumps.size() && o.rate_jumps[jump_index] <= t + eps) ++jump_index;
     const double next_jump = jump_index < o.rate_jumps.size() ? o.rate_jumps[jump_index] : o.t_end;
-    const double target = std::min({next_out, next_sample, next_jump, o.t_end});
+    const double next_beside = beside ? o.t0 + beside_index * Tb : o.t_end;
+    const double target = std::min({next_out, next_sample, next_beside, next_jump, o.t_end});
     try {
       integrator->advance(target);
     } catch (const IntegratorFailure& f) {
@@ -419,6 +484,10 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
       controller_sample(t);
       restart = true;
     }
+    if (beside && t >= next_beside - eps) {
+      beside_sample(t);
+      restart = true;
+    }
     if (restart) {
       integrator->reset(t, y);
       ++r.stats.restarts;
@@ -437,7 +506,7 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
   r.v = Recorder::stack(rec.v, model.nv);
   r.u = Recorder::stack(rec.u, model.nu());
   r.y = Recorder::stack(rec.y, static_cast<Eigen::Index>(model.plant_outputs.size()));
-  r.xc = Recorder::stack(rec.xc, discrete ? controller->nxc() : sys.nxc());
+  r.xc = Recorder::stack(rec.xc, (discrete ? controller->nxc() : sys.nxc()) + xcb.size());
   r.s = Recorder::stack(rec.s, ns);
   r.s_names = model.s_names;
   r.kinetic_energy = rec.T;
@@ -457,6 +526,8 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
     r.output_units.push_back(model.sensors[k].unit);
   }
   if (controller) r.controller_state_names = controller->state_names();
+  if (beside)
+    for (const std::string& n : beside->state_names()) r.controller_state_names.push_back(n);
   r.controller = controller ? controller->describe() : "none (actuators at their nominal values)";
   r.model_name = model.name;
   r.model_file = model.source_file;

@@ -20,6 +20,18 @@
 
 namespace codyna {
 
+// A second controller in the same run, beside the one simulate() is given: sampled (its
+// sample_time() > 0, zero-order hold), reading sensors and setting actuators by their indices in
+// the model rather than through Plant/Out and Plant/In (a driver that steers and holds the speed
+// while a yaw-moment controller acts on the brakes through Plant/In). It reads outputs only (no
+// rates, no state feedback); its actuators must not be Plant/In inputs when there is a first
+// controller. Its state is its own (not in SimulationResult::xc); its values are in u.
+struct SampledBeside {
+  const Controller* controller = nullptr;  // none: nothing beside
+  std::vector<int> sensors;                // Model::sensors, in the order its outputs() read them
+  std::vector<int> actuators;              // Model::actuators, in the order its output() gives them
+};
+
 struct SimulationOptions {
   IntegratorSettings integrator;
   double t0 = 0.0, t_end = 5.0, output_step = 0.01;
@@ -44,6 +56,7 @@ struct SimulationOptions {
   // start, a table's knots), where the run stops and applies the impulse (prescribed_velocity_jump)
   std::function<Eigen::VectorXd(double)> disturbance_rate, disturbance_acceleration;
   std::vector<double> rate_jumps;
+  SampledBeside beside;
 };
 
 // What a sample callback gets: copies, safe to hand to another thread.

@@ -143,10 +143,6 @@ void write(ManeuverReport& rep, const ManeuverRequest& r) {
 }
 
 
-namespace {
-
-// The model file's controller about the straight run, and the driver's intended yaw rate as its
-// reference on the yaw-rate output (when that is a Plant/Out)
 void attach_controller(OpenLoop& ol, const ManeuverRequest& r, const ModelSpec& spec, bool controlled) {
   const Model& m = ol.model;
   const Flags flag{r.style};
@@ -189,7 +185,19 @@ void attach_controller(OpenLoop& ol, const ManeuverRequest& r, const ModelSpec& 
   ol.reference_limit = mu * 9.80665 / std::max(ol.start.speed_along_heading, 1e-9);
 }
 
-}  // namespace
+void report_controller(ManeuverReport& rep, const OpenLoop& ol, const Model& run) {
+  rep.controller = ol.controller_text;
+  rep.reference_gain = ol.reference_gain;
+  rep.reference_limit = ol.yaw_rate >= 0 ? ol.reference_limit : 0.0;
+  if (rep.result.samples() == 0) return;
+  const Eigen::VectorXd& u0 = ol.plant->op.u;
+  for (int k : run.plant_inputs) {
+    double largest = 0;
+    for (int i = 0; i < rep.result.samples(); ++i) largest = std::max(largest, std::abs(rep.result.u(i, k) - u0[k]));
+    rep.controller_inputs.push_back(run.actuators[static_cast<std::size_t>(k)].name);
+    rep.controller_effort.push_back(largest);
+  }
+}
 
 HandlingNumbers straight_handling(const OpenLoop& ol) {
   // what study_linearize gives a model whose only Plant/In is the steer, at the same point
@@ -298,9 +306,6 @@ Model open_loop_run(ManeuverReport& rep, const ManeuverRequest& r, const OpenLoo
         ref[iy] += std::clamp(gain * profile.value(t), -limit, limit);
         return ref;
       };
-    rep.controller = ol.controller_text;
-    rep.reference_gain = gain;
-    rep.reference_limit = iy >= 0 ? limit : 0.0;
   }
   // the run stops when the car rolls over (past kRolledOver: it does not come back, and a car on its
   // side is no maneuver), seen at each output sample; the user's cancel goes to the integrator itself,
@@ -326,15 +331,7 @@ Model open_loop_run(ManeuverReport& rep, const ManeuverRequest& r, const OpenLoo
   rep.result = simulate(run, ol.controller.get(), ol.plant.get(), o, cb);
   if ((r.cancel && r.cancel->load()) || (rep.result.cancelled && rolled_at < 0))
     throw StudyCancelled("the maneuver was cancelled");
-  if (ol.controller && rep.result.samples() > 0) {
-    const Eigen::VectorXd& u0 = ol.plant->op.u;
-    for (int k : run.plant_inputs) {
-      double largest = 0;
-      for (int i = 0; i < rep.result.samples(); ++i) largest = std::max(largest, std::abs(rep.result.u(i, k) - u0[k]));
-      rep.controller_inputs.push_back(run.actuators[static_cast<std::size_t>(k)].name);
-      rep.controller_effort.push_back(largest);
-    }
-  }
+  if (ol.controller) report_controller(rep, ol, run);
   check_run(rep, rep.result, run, ol.body);
   if (rolled_at >= 0) {
     std::ostringstream os;

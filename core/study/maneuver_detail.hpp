@@ -79,6 +79,15 @@ struct OpenLoop {
   std::string controller_text;
   double reference_gain = 0, reference_limit = 0;  // 1/s (per steer unit), rad/s
 };
+// The model file's controller (not a driver) into ol, linearized about ol.op, and the driver's
+// intended yaw rate as its reference on the yaw-rate output (when ol.yaw_rate is a Plant/Out);
+// ol.model, op, steer, yaw_rate, start set. !controlled: refused, asking for --open-loop (a
+// maneuver that compares with the open-loop linear model). Refused when the controller acts on
+// the steer.
+void attach_controller(OpenLoop& ol, const ManeuverRequest& r, const ModelSpec& spec, bool controlled);
+// the controller's text, its reference gain and limit and its inputs' largest |u - u0| in
+// rep.result into rep (run: the model the run was made on)
+void report_controller(ManeuverReport& rep, const OpenLoop& ol, const Model& run);
 // The straight run's handling numbers (steer in, yaw rate out: analysis.handling) at ol.op, on
 // ol.model with the steer as its only Plant/In: what study_linearize gives on the straight spec so
 // changed, without compiling it again or searching its steady motion again. Throws as

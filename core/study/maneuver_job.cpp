@@ -9,11 +9,12 @@
 #include "dynamics/data.hpp"
 #include "dynamics/energy.hpp"
 #include "dynamics/kinematics.hpp"
+#include "dynamics/sensors.hpp"
 #include "io/atomic_file.hpp"
 #include "model/errors.hpp"
 #include "simulation/driver.hpp"
+#include "simulation/model_controller.hpp"
 #include "simulation/simulator.hpp"
-#include "simulation/stepper.hpp"
 #include "study/files.hpp"
 #include "study/maneuver_detail.hpp"
 
@@ -149,27 +150,6 @@ ManeuverReport mnv_open_loop(const ManeuverRequest& r, const ModelSpec& spec, bo
   return rep;
 }
 
-// a stepped run's names, units and provenance, as a simulation's result carries them
-void mnv_name_result(SimulationResult& res, const Model& run, const ManeuverRequest& r, const Controller& driver,
-                     const Stepper& st) {
-  res.q_names = run.q_names;
-  res.v_names = run.rate_names;
-  for (const ActuatorModel& a : run.actuators) {
-    res.input_names.push_back(a.name);
-    res.input_units.push_back(a.unit);
-  }
-  for (int k : run.plant_outputs) {
-    res.output_names.push_back(run.sensors[static_cast<std::size_t>(k)].name);
-    res.output_units.push_back(run.sensors[static_cast<std::size_t>(k)].unit);
-  }
-  res.controller_state_names = driver.state_names();
-  res.controller = driver.describe();
-  res.model_name = run.name;
-  res.model_file = r.model;
-  res.codyna_version = CODYNA_VERSION;
-  res.stats = st.stats();
-}
-
 // the lateral error from the start of section 1 to the end of section 6, and the cones: the
 // car's rectangle (width x length about the position outputs) in the lane's frame against each
 // section's lines. The part of the rectangle inside a section (between its first and last cones
@@ -250,132 +230,236 @@ void mnv_driver_gains(DriverSettings& ds, const ManeuverRequest& r, const mnv::F
   if (r.speed_ki && !(*r.speed_ki >= 0)) throw std::invalid_argument(flag("speed-ki") + ": expected a number >= 0");
 }
 
-// the driver's signals by name: the request's, else the model file's driver controller's, else
-// the study's handling steer
-DriverSignals mnv_driver_names(const ManeuverRequest& r, const Model& m, bool from_file) {
-  const ControllerSpec& c = m.spec.controller;
-  DriverSignals names;
-  if (from_file) names = DriverSignals{c.x, c.y, c.yaw, c.forward_speed, c.steer, c.drive};
-  else if (!m.spec.analysis.handling.steer.empty()) names.steer = m.spec.analysis.handling.steer;
-  if (r.x) names.x = *r.x;
-  if (r.y) names.y = *r.y;
-  if (r.yaw) names.yaw = *r.yaw;
-  if (r.speed_output) names.speed = *r.speed_output;
-  if (r.drive) names.drive = *r.drive;
-  return names;
+// A controller whose last output() is kept where another can read it: the driver's held steer,
+// from which the controller beside it takes its yaw-rate reference (the intended yaw rate of what
+// the driver steers, as an ESC reads the steering wheel)
+class Watched final : public Controller {
+ public:
+  Watched(const Controller& inner, std::shared_ptr<Eigen::VectorXd> last) : inner_(inner), last_(std::move(last)) {}
+  int nxc() const override { return inner_.nxc(); }
+  double sample_time() const override { return inner_.sample_time(); }
+  Eigen::VectorXd output(const ControllerInput& in, const Eigen::VectorXd& xc) const override {
+    *last_ = inner_.output(in, xc);
+    return *last_;
+  }
+  Eigen::VectorXd update(const ControllerInput& in, const Eigen::VectorXd& xc) const override { return inner_.update(in, xc); }
+  std::vector<std::string> state_names() const override { return inner_.state_names(); }
+  std::string describe() const override { return inner_.describe(); }
+
+ private:
+  const Controller& inner_;
+  std::shared_ptr<Eigen::VectorXd> last_;
+};
+
+// The driver's position, heading and forward speed: a name the model has no sensor of (and the
+// request did not give) is measured on the steady body's origin by a sensor the maneuver adds
+// under that name (the chassis origin's x and y in the ground's axes, its heading about the
+// vertical, its forward speed in its own axes); a note says so.
+ModelSpec with_driver_sensors(ModelSpec s, const DriverSignals& names, const ManeuverRequest& r,
+                              std::vector<std::string>& notes) {
+  const auto has = [&s](const std::string& n) {
+    return std::any_of(s.sensors.begin(), s.sensors.end(), [&n](const SensorSpec& x) { return x.name == n; });
+  };
+  struct Wanted {
+    const std::string& name;
+    bool given;
+    SensorType type;
+    int component;
+    const char* what;
+  };
+  const Wanted wanted[] = {{names.x, r.x.has_value(), SensorType::PointPosition, 0, "x in the ground's axes"},
+                           {names.y, r.y.has_value(), SensorType::PointPosition, 1, "y in the ground's axes"},
+                           {names.yaw, r.yaw.has_value(), SensorType::BodyAngle, 2, "heading about the vertical"},
+                           {names.speed, r.speed_output.has_value(), SensorType::PointVelocity, 0, "forward speed"}};
+  std::string body = s.analysis.steady.body, added;
+  for (const Wanted& w : wanted) {
+    if (w.given || has(w.name)) continue;
+    if (body.empty()) {
+      const Model m = study_model(s, r.model);
+      body = m.body_names[static_cast<std::size_t>(mnv::steady_body(m))];
+    }
+    SensorSpec x;
+    x.name = w.name;
+    x.type = w.type;
+    x.body = body;
+    x.component = w.component;
+    x.axis = Eigen::Vector3d::UnitZ();
+    if (w.type == SensorType::PointVelocity) x.frame = body;
+    s.sensors.push_back(x);
+    added += (added.empty() ? "" : ", ") + ("\"" + w.name + "\" (" + w.what + ")");
+  }
+  if (!added.empty())
+    notes.push_back("the driver reads " + body + "'s origin through sensors the maneuver added, the model having none of those names: " + added);
+  return s;
+}
+
+// the index of `name` in `names`, refused naming the field with the names there are
+int mnv_find(const std::vector<std::string>& names, const std::string& name, const std::string& label, const char* kind) {
+  for (std::size_t k = 0; k < names.size(); ++k)
+    if (names[k] == name) return static_cast<int>(k);
+  std::string all;
+  for (const std::string& n : names) all += (all.empty() ? "" : ", ") + n;
+  throw std::invalid_argument(label + ": the driver needs the " + kind + " \"" + name + "\", which the model does not have (" +
+                              kind + "s: " + all + ")");
 }
 
 ManeuverReport mnv_lane_change(const ManeuverRequest& r, const ModelSpec& spec) {
   const mnv::Flags flag{r.style};
   ManeuverReport rep;
   rep.type = r.type;
-  const Model m = study_model(mnv::straight_spec(r, spec), r.model);
+  ModelSpec s = mnv::straight_spec(r, spec);
+  const bool from_file = s.controller.type == ControllerType::Driver;
+  const ControllerSpec c = s.controller;
+  DriverSignals names;
+  if (from_file) names = DriverSignals{c.x, c.y, c.yaw, c.forward_speed, c.steer, c.drive};
+  else if (!s.analysis.handling.steer.empty()) names.steer = s.analysis.handling.steer;
+  if (r.x) names.x = *r.x;
+  if (r.y) names.y = *r.y;
+  if (r.yaw) names.yaw = *r.yaw;
+  if (r.speed_output) names.speed = *r.speed_output;
+  if (r.drive) names.drive = *r.drive;
+  s = with_driver_sensors(std::move(s), names, r, rep.notes);
+
+  // the car at its straight run, and the model file's controller (not a driver) beside the driver
+  // unless --open-loop
+  mnv::OpenLoop ol;
+  ol.model = study_model(s, r.model);
+  const Model& m = ol.model;
   rep.model_name = m.name;
-  const bool from_file = m.spec.controller.type == ControllerType::Driver;
-  const ControllerSpec& c = m.spec.controller;
-  const DriverSignals names = mnv_driver_names(r, m, from_file);
-  const int body = mnv::steady_body(m);
-  const OperatingPoint op = study_operating_point(m, "steady");
+  ol.body = mnv::steady_body(m);
+  ol.op = study_operating_point(m, "steady");
   Data d(m);
-  const mnv::BodyState s0 = mnv::body_state(m, d, body, op.q, op.v);
-  rep.speed = s0.v_body.norm();
+  ol.start = mnv::body_state(m, d, ol.body, ol.op.q, ol.op.v);
+  rep.speed = ol.start.v_body.norm();
+
+  // the driver's signals among the model's sensors and actuators: refused naming the flag when the
+  // request gave them, else the file's field
+  std::vector<std::string> sensors, actuators;
+  for (const SensorModel& x : m.sensors) sensors.push_back(x.name);
+  for (const ActuatorModel& a : m.actuators) actuators.push_back(a.name);
+  const std::string file_field = (m.source_file.empty() ? "" : m.source_file + ": ") + (from_file ? "/controller/" : "");
+  const auto label = [&](bool given, const char* key, const char* field) {
+    return given || !from_file ? flag(key) : file_field + field;
+  };
+  SampledBeside beside;
+  beside.sensors = {mnv_find(sensors, names.x, label(r.x.has_value(), "x", "x"), "sensor"),
+                    mnv_find(sensors, names.y, label(r.y.has_value(), "y", "y"), "sensor"),
+                    mnv_find(sensors, names.yaw, label(r.yaw.has_value(), "yaw", "yaw"), "sensor"),
+                    mnv_find(sensors, names.speed, label(r.speed_output.has_value(), "speed-output", "forward_speed"), "sensor")};
+  const std::string steer_label =
+      from_file ? file_field + "steer" : s.analysis.handling.steer.empty() ? flag("driver") + " steer" : (m.source_file.empty() ? "" : m.source_file + ": ") + "/analysis/handling/steer";
+  beside.actuators = {mnv_find(actuators, names.steer, steer_label, "actuator")};
+  if (!names.drive.empty())
+    beside.actuators.push_back(mnv_find(actuators, names.drive, label(r.drive.has_value(), "drive", "drive"), "actuator"));
+
+  if (!r.open_loop && has_model_controller(m) && !from_file) {
+    // what acts beside the driver: never on what the driver sets
+    for (const int a : beside.actuators)
+      if (std::count(m.plant_inputs.begin(), m.plant_inputs.end(), a))
+        throw ModelError(m.source_file, "/plant/inputs",
+                         "the driver sets \"" + actuators[static_cast<std::size_t>(a)] + "\", and the model file's " +
+                             to_string(m.spec.controller.type) + " controller acts on it too (a Plant/In): give the controller " +
+                             "other inputs (brakes, a yaw moment, rear steer), or run the maneuver " + flag("open-loop"));
+    ol.steer = beside.actuators.front();
+    const std::string& yaw_rate = m.spec.analysis.handling.yaw_rate;
+    ol.yaw_rate = yaw_rate.empty() ? -1 : mnv::output(m, yaw_rate, "/analysis/handling/yaw_rate", false);
+    mnv::attach_controller(ol, r, s, true);
+  }
 
   DriverSettings ds;
-  std::vector<std::string> outputs, inputs;
-  for (int k : m.plant_outputs) outputs.push_back(m.sensors[static_cast<std::size_t>(k)].name);
-  for (int k : m.plant_inputs) inputs.push_back(m.actuators[static_cast<std::size_t>(k)].name);
-  Eigen::VectorXd u0(static_cast<Eigen::Index>(inputs.size()));
-  for (std::size_t k = 0; k < m.plant_inputs.size(); ++k) u0[static_cast<Eigen::Index>(k)] = op.u[m.plant_inputs[k]];
-  ds.u0 = u0;
-  // the names: refused naming the flag when the request gave them, else the file's field
-  const std::string file_field = (m.source_file.empty() ? "" : m.source_file + ": ") + "/controller/";
-  resolve_driver_signals(ds, names, outputs, inputs, [&](const std::string& field) {
-    for (const auto& [given, name, key] : {std::tuple{r.x.has_value(), "x", "x"}, {r.y.has_value(), "y", "y"},
-                                           {r.yaw.has_value(), "yaw", "yaw"},
-                                           {r.speed_output.has_value(), "forward_speed", "speed-output"},
-                                           {r.drive.has_value(), "drive", "drive"}})
-      if (given && field == name) return flag(key);
-    return file_field + field;
-  });
-  // the output names were resolved: their values at the start
+  ds.u0.resize(static_cast<Eigen::Index>(beside.actuators.size()));
+  for (std::size_t k = 0; k < beside.actuators.size(); ++k) ds.u0[static_cast<Eigen::Index>(k)] = ol.op.u[beside.actuators[k]];
+  ds.out_x = 0, ds.out_y = 1, ds.out_yaw = 2, ds.out_speed = 3, ds.in_steer = 0, ds.in_drive = names.drive.empty() ? -1 : 1;
+  // the lane along the car's heading from where the car's position outputs are at the start
   SimulationOptions o;
-  const Model run = held_at(m, op, o);
-  Stepper st(run, mnv::integrator(run));
-  st.set_cancel(r.cancel);  // seen inside the steps too
-  st.reset(0, o.q0, o.v0);
-  const Eigen::VectorXd y0 = st.outputs();
-  const double yaw0 = y0[ds.out_yaw];
-  if (std::abs(yaw0) > 1e-9)
-    rep.notes.push_back("the lane is laid out along the car's heading at the start");
+  const Model run = held_at(m, ol.op, o);
+  Data dr(run);
+  forward_kinematics<double>(run, dr, ol.op.q, ol.op.v);
+  dr.s = ol.op.s;
+  const Eigen::VectorXd y0 = sensor_outputs<double>(run, dr, beside.sensors, ol.op.q, ol.op.v);
+  const double yaw0 = y0[2];
+  if (std::abs(yaw0) > 1e-9) rep.notes.push_back("the lane is laid out along the car's heading at the start");
   const double width = mnv::positive(flag, r.width, from_file ? c.vehicle_width : 1.8, "width");
   const double length = mnv::positive(flag, r.length, 4.5, "length");
   ds.path = path_double_lane_change(Eigen::Vector2d(0, 0), width);
-  // into the world: rotated by the start's heading about the start's position
-  const Eigen::Vector2d start(y0[ds.out_x], y0[ds.out_y]);
+  const Eigen::Vector2d start(y0[0], y0[1]);
   const Eigen::Rotation2Dd rot(yaw0);
   DriverPath local = ds.path;
   for (Eigen::Vector2d& p : ds.path.points) p = start + rot * p;
   mnv::lane_layout(rep, local, start, yaw0);
   mnv_driver_gains(ds, r, flag, m, from_file, rep.speed);
   const std::unique_ptr<Controller> driver = make_driver(ds, flag("driver"));
+  auto held = std::make_shared<Eigen::VectorXd>(ds.u0);
+  const Watched watched(*driver, held);
+  beside.controller = &watched;
 
-  // the run: sampled driver, zero-order hold on the plant (simulation/stepper.hpp)
+  // the run: the driver sampled (zero-order hold) beside the file's controller, recorded at the
+  // driver's samples
   const double lane_end = local.gate_end.back() + 20;
-  const double t_end = r.t_end ? *r.t_end : (lane_end) / std::max(rep.speed, 1.0);
-  const int steps = static_cast<int>(std::ceil(t_end / ds.sample_time));
-  if (steps > 2000000) throw std::invalid_argument(flag("t-end") + ": too many driver samples");
+  o.t_end = r.t_end ? *r.t_end : lane_end / std::max(rep.speed, 1.0);
+  if (!(o.t_end > 0) || !std::isfinite(o.t_end)) throw std::invalid_argument(flag("t-end") + ": expected a time > 0");
+  if (o.t_end / ds.sample_time > 2000000) throw std::invalid_argument(flag("t-end") + ": too many driver samples");
+  o.output_step = ds.sample_time;
+  o.integrator = mnv::integrator(run);
+  o.beside = beside;
+  if (ol.controller && ol.yaw_rate >= 0) {
+    // the intended yaw rate of the driver's held steer (less the straight run's)
+    const Eigen::VectorXd yr0 = ol.plant->lin.system.y0;
+    const int iy = ol.yaw_rate;
+    const double gain = ol.reference_gain, limit = ol.reference_limit, steer0 = ds.u0[0];
+    o.reference = [yr0, iy, gain, limit, steer0, held](double) {
+      Eigen::VectorXd ref = yr0;
+      ref[iy] += std::clamp(gain * ((*held)[0] - steer0), -limit, limit);
+      return ref;
+    };
+  }
+  SimulationCallbacks cb;
+  cb.cancel = r.cancel;
+  cb.progress = r.progress;
+  rep.result = simulate(run, ol.controller.get(), ol.plant.get(), o, cb);
   SimulationResult& res = rep.result;
-  res.q.resize(steps + 1, run.nq);
-  res.v.resize(steps + 1, run.nv);
-  res.u.resize(steps + 1, run.nu());
-  res.y.resize(steps + 1, static_cast<Eigen::Index>(outputs.size()));
-  res.xc.resize(steps + 1, 2);
-  Eigen::VectorXd xc = Eigen::VectorXd::Zero(2);
-  std::vector<double> lateral;
-  ControllerInput in;
-  int done = 0;
-  res.completed = true;
-  for (int k = 0; k <= steps; ++k) {
-    in.t = st.time();
-    in.y = st.outputs();
-    const Eigen::VectorXd u = driver->output(in, xc);
-    res.t.push_back(in.t);
-    res.q.row(k) = st.q().transpose();
-    res.v.row(k) = st.v().transpose();
-    Eigen::VectorXd ua = run.nu() ? Eigen::VectorXd(op.u) : Eigen::VectorXd();
-    for (std::size_t i = 0; i < m.plant_inputs.size(); ++i) ua[m.plant_inputs[i]] = u[static_cast<Eigen::Index>(i)];
-    res.u.row(k) = ua.transpose();
-    res.y.row(k) = in.y.transpose();
-    res.xc.row(k) = xc.transpose();
-    res.kinetic_energy.push_back(kinetic_energy<double>(run, d, st.q(), st.v()));
-    res.potential_energy.push_back(std::nan(""));
-    res.constraint_violation.push_back(0);
-    res.velocity_violation.push_back(0);
-    lateral.push_back(project_on_path(ds.path, Eigen::Vector2d(in.y[ds.out_x], in.y[ds.out_y])).lateral);
-    rep.max_steer = std::max(rep.max_steer, std::abs(u[ds.in_steer]));
-    done = k + 1;
-    if (k == steps) break;
-    if (r.cancel && r.cancel->load()) throw StudyCancelled("the maneuver was cancelled");
-    if (r.progress) r.progress(res.t.back(), t_end);
-    xc = driver->update(in, xc);
-    try {
-      st.step(u, ds.sample_time);
-    } catch (const std::exception& e) {
-      if (r.cancel && r.cancel->load()) throw StudyCancelled("the maneuver was cancelled");
-      res.completed = false;
-      res.failure = e.what();
-      break;
+  if ((r.cancel && r.cancel->load()) || res.cancelled) throw StudyCancelled("the maneuver was cancelled");
+  res.controller = "driver: " + driver->describe() + (ol.controller ? "; beside it " + ol.controller_text : "");
+  if (ol.controller) {
+    mnv::report_controller(rep, ol, run);
+    rep.controller += ", beside the driver";
+  }
+
+  // the driver's signals as the run's outputs (those not among Plant/Out), and its lateral error
+  const int N = res.samples();
+  int cols[4];
+  std::vector<int> extra;
+  for (int i = 0; i < 4; ++i) {
+    const std::string& n = sensors[static_cast<std::size_t>(beside.sensors[static_cast<std::size_t>(i)])];
+    const auto it = std::find(res.output_names.begin(), res.output_names.end(), n);
+    if (it != res.output_names.end() && std::find(extra.begin(), extra.end(), beside.sensors[static_cast<std::size_t>(i)]) == extra.end()) {
+      cols[i] = static_cast<int>(it - res.output_names.begin());
+    } else {
+      cols[i] = static_cast<int>(res.output_names.size());
+      extra.push_back(beside.sensors[static_cast<std::size_t>(i)]);
+      res.output_names.push_back(n);
+      res.output_units.push_back(run.sensors[static_cast<std::size_t>(beside.sensors[static_cast<std::size_t>(i)])].unit);
     }
   }
-  res.q.conservativeResize(done, Eigen::NoChange);
-  res.v.conservativeResize(done, Eigen::NoChange);
-  res.u.conservativeResize(done, Eigen::NoChange);
-  res.y.conservativeResize(done, Eigen::NoChange);
-  res.xc.conservativeResize(done, Eigen::NoChange);
-  mnv_name_result(res, run, r, *driver, st);
-  mnv::check_run(rep, res, run, body);
-
-  mnv_lane_metrics(rep, flag, local, ds, start, yaw0, lateral, width, length);
+  if (!extra.empty()) {
+    const Eigen::Index ny = res.y.cols();
+    res.y.conservativeResize(N, ny + static_cast<Eigen::Index>(extra.size()));
+    for (int k = 0; k < N; ++k) {
+      const Eigen::VectorXd q = res.q.row(k).transpose(), v = res.v.row(k).transpose();
+      if (run.ns) dr.s = res.s.row(k).transpose();
+      forward_kinematics<double>(run, dr, q, v);
+      res.y.row(k).tail(static_cast<Eigen::Index>(extra.size())) = sensor_outputs<double>(run, dr, extra, q, v).transpose();
+    }
+  }
+  std::vector<double> lateral(static_cast<std::size_t>(N));
+  for (int k = 0; k < N; ++k) {
+    lateral[static_cast<std::size_t>(k)] = project_on_path(ds.path, Eigen::Vector2d(res.y(k, cols[0]), res.y(k, cols[1]))).lateral;
+    rep.max_steer = std::max(rep.max_steer, std::abs(res.u(k, beside.actuators.front())));
+  }
+  mnv::check_run(rep, res, run, ol.body);
+  DriverSettings columns = ds;
+  columns.out_x = cols[0], columns.out_y = cols[1], columns.out_yaw = cols[2], columns.out_speed = cols[3];
+  mnv_lane_metrics(rep, flag, local, columns, start, yaw0, lateral, width, length);
   mnv::write(rep, r);
   return rep;
 }

@@ -21,6 +21,11 @@
 //   double-lane-change  ISO 3888-1, driven by the driver (simulation/driver.hpp) on the lane's
 //                       centre line for a car of --width: the lateral error (max, RMS), and the
 //                       cones hit (a --width x --length rectangle about the position outputs).
+//                       The driver reads sensors and sets actuators by name (a position, heading
+//                       or speed the model has no sensor of is measured on the steady body by
+//                       sensors the run adds); the model file's controller runs beside it
+//                       (simulate()'s SimulationOptions::beside), its yaw-rate reference from the
+//                       driver's held steer.
 //   constant-radius     ISO 4138 style: steady turns on one --radius at --points speeds rising from
 //                       --speed-min to --speed-max, each the steady motion's search (the file's
 //                       study, its free inputs) started from the one before; steer, road-wheel
@@ -42,7 +47,7 @@
 //   fishhook            NHTSA (fixed timing): to --steer (6.5 x the steer at 0.3 g) at --steer-rate
 //                       (720 deg/s), --dwell (0.25 s), to the opposite side, held 3 s, back over 2 s;
 //                       the largest roll, each tire's smallest load, the first two-wheel lift.
-// Step steer, sine with dwell, slowly increasing steer and fishhook run the model file's controller
+// Step steer, sine with dwell, slowly increasing steer, fishhook and the double lane change run the model file's controller
 // in the loop (ManeuverRequest::open_loop). An open-loop run stops when the car rolls over (60 deg).
 // A run that leaves the road (the integrator fails, the speed or yaw rate runs away) is reported
 // with its metrics marked invalid and the reason. Files: the run as HDF5 / CSV (--out, --csv;

@@ -49,14 +49,18 @@ grep -q "yaw-rate ratio at 1.00 s" out.txt || fail "sine with dwell: $(cat out.t
 # the lane change driven by the driver of the model file
 "$codyna" maneuver "$driver" --type double-lane-change --speed 22.2 --preview 6 > out.txt 2> err.txt || fail "lane change: exit $?: $(cat err.txt)"
 grep -q "cones            none hit" out.txt || fail "lane change: $(cat out.txt)"
+# a car whose file has no position sensors: the maneuver measures the chassis and says so
+"$codyna" maneuver "$car" --type double-lane-change --speed 22.2 > out.txt 2> err.txt || fail "lane change, no sensors: exit $?: $(cat err.txt)"
+grep -q 'sensors the maneuver added, the model having none of those names: "x"' err.txt || fail "lane change, no sensors: $(cat err.txt)"
+grep -q "^path error       max" out.txt || fail "lane change, no sensors: $(cat out.txt)"
 
 # bad input: named, exit 1, nothing written
 expect 1 '--type: unknown maneuver "slalom"' "$codyna" maneuver "$car" --type slalom --csv bad.csv
 [ -e bad.csv ] && fail "bad.csv written"
 expect 1 '--preview: expected a number > 0, got -1' "$codyna" maneuver "$driver" --type double-lane-change --preview -1
-expect 1 'single_track_car.json: /controller/x: the driver needs the Plant/Out "x"' \
-  "$codyna" maneuver "$car" --type double-lane-change
-expect 1 '--yaw: the driver needs the Plant/Out "heading"' "$codyna" maneuver "$driver" --type double-lane-change --yaw heading
+expect 1 '--drive: the driver needs the actuator "throttle", which the model does not have (actuators: steer, drive)' \
+  "$codyna" maneuver "$car" --type double-lane-change --drive throttle
+expect 1 '--yaw: the driver needs the sensor "heading", which the model does not have' "$codyna" maneuver "$driver" --type double-lane-change --yaw heading
 expect 1 '--radius: the constant-radius maneuver needs a radius' "$codyna" maneuver "$car" --type constant-radius
 expect 1 '--radius: expected a radius other than 0' "$codyna" maneuver "$car" --type constant-radius --radius 0
 sed 's/"preview": 15/"preview": -1/' "$driver" > neg.json

@@ -7,9 +7,11 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "model/errors.hpp"
+#include "simulation/controller.hpp"
 #include "simulation/driver.hpp"
 #include "simulation/simulator.hpp"
 #include "simulation/stepper.hpp"
@@ -114,6 +116,159 @@ TEST(DriverInSimulate, AContinuousControllerOnAMotionInputIsRefusedNamingIt) {
         << e.what();
     EXPECT_NE(std::string(e.what()).find("sample_time > 0"), std::string::npos) << e.what();
   }
+}
+
+// The single-track car with a yaw moment on the chassis (a body torque about its z axis, N m) as
+// its only Plant/In and the yaw rate its only Plant/Out: what a yaw-moment controller acts on
+// while the driver steers and holds the speed beside it
+Model car_with_yaw_moment(const std::string& file) {
+  nlohmann::json j = study_model_json(study_read_model(file));
+  j["actuators"].push_back({{"name", "yaw_moment"}, {"type", "body_torque"}, {"body", "chassis"},
+                            {"direction", {0, 0, 1}}, {"frame", "body"}, {"unit", "N m"}});
+  j["plant"]["inputs"] = {"yaw_moment"};
+  j["plant"]["outputs"] = {"yaw_rate"};
+  j.erase("controller");
+  return study_model(study_parse_model(j, file), file);
+}
+
+int index_of(const std::vector<std::string>& names, const std::string& name) {
+  for (std::size_t k = 0; k < names.size(); ++k)
+    if (names[k] == name) return static_cast<int>(k);
+  ADD_FAILURE() << "no " << name;
+  return -1;
+}
+
+// A sampled controller beside the first (SimulationOptions::beside): the driver steers and holds
+// the speed through the sensors and actuators it names while a P controller on the yaw rate acts
+// on the yaw moment through Plant/In.
+//  - with the P gain zero the run is the driver's own run as the first controller (the sampled
+//    path DriverInSimulate checks against the Stepper), to round-off;
+//  - with a gain, the yaw moment recorded at every sample is the P law on the yaw rate recorded
+//    there (the first controller acts continuously, between the driver's samples too: the moment
+//    is not held), it opposes the turn (-kp U / R once on the circle), and the driver's integral
+//    still settles the car on the circle (lateral error below 1e-4 m over the last 5 s of 60 s)
+//    with more steer than without it.
+TEST(DriverInSimulate, ADriverBesideAYawMomentControllerInOneRun) {
+  const std::string file = driver_data("single_track_car_driver.json");
+  const Model alone = study_model(study_read_model(file), file);
+  const OperatingPoint op_alone = study_operating_point(alone, "steady");
+  SimulationOptions o;
+  const Model run_alone = held_at(alone, op_alone, o);
+  Eigen::VectorXd u0(2);
+  u0 << op_alone.u[0], op_alone.u[1];
+  const DriverSettings ds = model_driver_settings(run_alone, u0);
+  const std::unique_ptr<Controller> driver = make_driver(ds);
+  o.t_end = 60;
+  o.output_step = ds.sample_time;
+  o.integrator.method = "cvode-bdf";
+  o.integrator.rtol = 1e-10;
+  o.integrator.atol = 1e-12;
+  const SimulationResult first = simulate(run_alone, driver.get(), nullptr, o);
+  ASSERT_TRUE(first.completed) << first.failure;
+
+  const Model car = car_with_yaw_moment(file);
+  const OperatingPoint op = study_operating_point(car, "steady");
+  SimulationOptions ob = o;
+  const Model run = held_at(car, op, ob);
+  std::vector<std::string> sensors, actuators;
+  for (const SensorModel& x : run.sensors) sensors.push_back(x.name);
+  for (const ActuatorModel& a : run.actuators) actuators.push_back(a.name);
+  // the driver's four outputs (x, y, yaw, speed) and two inputs (steer, drive), as it was made
+  ob.beside.controller = driver.get();
+  // the driver was made on run_alone's Plant/Out: the same names among the sensors, in that order
+  std::vector<std::string> read;
+  for (int k : run_alone.plant_outputs) read.push_back(run_alone.sensors[static_cast<std::size_t>(k)].name);
+  for (const std::string& n : read) ob.beside.sensors.push_back(index_of(sensors, n));
+  ob.beside.actuators = {index_of(actuators, "steer"), index_of(actuators, "drive")};
+  const int iyaw = index_of(actuators, "yaw_moment"), isteer = index_of(actuators, "steer");
+  const double y0 = 0;  // the reference: the straight run's yaw rate
+
+  const auto run_with = [&](double kp) {
+    const Eigen::MatrixXd Kp = Eigen::MatrixXd::Constant(1, 1, kp);
+    const std::unique_ptr<Controller> p =
+        make_pid(Kp, {}, {}, Eigen::VectorXd::Constant(1, y0), Eigen::VectorXd::Constant(1, op.u[iyaw]));
+    const SimulationResult r = simulate(run, p.get(), nullptr, ob);
+    EXPECT_TRUE(r.completed) << r.failure;
+    return r;
+  };
+  const SimulationResult zero = run_with(0.0);
+  ASSERT_EQ(zero.samples(), first.samples());
+  double dq = 0;
+  for (int k = 0; k < zero.samples(); ++k) dq = std::max(dq, (zero.q.row(k) - first.q.row(k)).cwiseAbs().maxCoeff());
+  EXPECT_LT(dq, 1e-9) << "the driver beside is not the driver's own run";
+  // the driver's two integrals are recorded after the first controller's (none)
+  ASSERT_EQ(zero.xc.cols(), 2);
+  EXPECT_EQ(zero.controller_state_names, driver->state_names());
+  EXPECT_LT((zero.xc - first.xc).cwiseAbs().maxCoeff(), 1e-7);
+
+  const double kp = 2.0e4;  // N m per rad/s: u = kp (0 - r), a moment against the yaw rate
+  const SimulationResult with = run_with(kp);
+  ASSERT_EQ(with.samples(), first.samples());
+  double law = 0, largest = 0, late = 0;
+  for (int k = 0; k < with.samples(); ++k) {
+    law = std::max(law, std::abs(with.u(k, iyaw) - kp * (y0 - with.y(k, 0))));
+    largest = std::max(largest, std::abs(with.u(k, iyaw)));
+    if (k >= with.samples() - 500) {
+      const Eigen::Vector2d p(with.q(k, 0), with.q(k, 1));
+      late = std::max(late, std::abs(driver_law(ds, p.x(), p.y(), with.q(k, 2)).lateral));
+    }
+  }
+  const int last = with.samples() - 1;
+  std::cout << "beside: |dq| at gain 0 " << dq << "; P law " << law << " N m of " << largest
+            << " N m; late lateral error " << late << " m; steer " << with.u(last, isteer) << " (alone "
+            << first.u(last, isteer) << ")\n";
+  EXPECT_LT(law, 1e-9 * largest);
+  EXPECT_GT(largest, 1000.0);  // it acts
+  // on the 120 m circle at the held 30 m/s the yaw rate is U / R: the moment there is -kp U / R
+  EXPECT_NEAR(with.u(last, iyaw), -kp * 30.0 / 120.0, 5.0);
+  EXPECT_LT(late, 1e-4);
+  EXPECT_GT(with.u(last, isteer), first.u(last, isteer) * 1.05);  // the driver steers more against it
+}
+
+// What cannot sit beside is refused before the run, naming what is wrong
+TEST(DriverInSimulate, WhatCannotSitBesideIsRefusedNamingIt) {
+  const std::string file = driver_data("single_track_car_driver.json");
+  const Model car = car_with_yaw_moment(file);
+  std::vector<std::string> sensors, actuators;
+  for (const SensorModel& x : car.sensors) sensors.push_back(x.name);
+  for (const ActuatorModel& a : car.actuators) actuators.push_back(a.name);
+  DriverSettings ds;
+  ds.path = path_straight({0, 0}, 0, 100);
+  ds.u0 = Eigen::VectorXd::Zero(1);
+  ds.out_x = 0, ds.out_y = 1, ds.out_yaw = 2, ds.out_speed = 3, ds.in_steer = 0;
+  const std::unique_ptr<Controller> driver = make_driver(ds);
+  const std::unique_ptr<Controller> p =
+      make_pid(Eigen::MatrixXd::Constant(1, 1, 1.0), {}, {}, Eigen::VectorXd::Zero(1), Eigen::VectorXd::Zero(1));
+  const auto refusal = [&](const SimulationOptions& o) {
+    try {
+      (void)simulate(car, p.get(), nullptr, o);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("simulated");
+  };
+  SimulationOptions o;
+  o.t_end = 0.05;
+  o.beside.controller = driver.get();
+  o.beside.sensors = {index_of(sensors, "x"), index_of(sensors, "y"), index_of(sensors, "yaw"), index_of(sensors, "speed")};
+  o.beside.actuators = {index_of(actuators, "yaw_moment")};  // the first controller's Plant/In
+  EXPECT_NE(refusal(o).find("sets \"yaw_moment\", a Plant/In input the first controller drives"), std::string::npos) << refusal(o);
+  o.beside.actuators = {index_of(actuators, "steer"), index_of(actuators, "steer")};
+  EXPECT_NE(refusal(o).find("sets \"steer\" twice"), std::string::npos) << refusal(o);
+  o.beside.actuators = {index_of(actuators, "steer"), index_of(actuators, "drive")};  // two values for one
+  EXPECT_NE(refusal(o).find("gives 1 values for 2 actuators"), std::string::npos) << refusal(o);
+  o.beside.actuators = {99};
+  EXPECT_NE(refusal(o).find("names an actuator the model does not have"), std::string::npos) << refusal(o);
+  o.beside.actuators = {index_of(actuators, "steer")};
+  o.beside.sensors.back() = index_of(sensors, "lateral_acceleration");
+  EXPECT_NE(refusal(o).find("reads \"lateral_acceleration\", which depends on the inputs"), std::string::npos) << refusal(o);
+  const HoldStill continuous;
+  o.beside.controller = &continuous;
+  EXPECT_NE(refusal(o).find("must be sampled"), std::string::npos) << refusal(o);
+  // and the one that fits runs
+  o.beside.controller = driver.get();
+  o.beside.sensors.back() = index_of(sensors, "speed");
+  EXPECT_EQ(refusal(o), "simulated");
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -447,12 +448,17 @@ TEST(Maneuver, BadInputIsRefusedNamingTheFieldOrFlag) {
   r.type = "slalom";
   EXPECT_NE(maneuver_error([&] { study_maneuver_job(r, spec); }).find("--type: unknown maneuver \"slalom\""), std::string::npos);
   r.type = "double-lane-change";
-  // the single-track car has no x output
-  const std::string e = maneuver_error([&] { study_maneuver_job(r, spec); });
-  EXPECT_NE(e.find("single_track_car.json: /controller/x: the driver needs the Plant/Out \"x\""), std::string::npos) << e;
+  // the single-track car has no x sensor: the maneuver adds what the driver reads unless named
   r.x = "xpos";
   const std::string e2 = maneuver_error([&] { study_maneuver_job(r, spec); });
-  EXPECT_NE(e2.find("--x: the driver needs the Plant/Out \"xpos\""), std::string::npos) << e2;
+  EXPECT_NE(e2.find("--x: the driver needs the sensor \"xpos\", which the model does not have (sensors: yaw_rate, "),
+            std::string::npos) << e2;
+  r.x.reset();
+  r.drive = "throttle";
+  const std::string e4 = maneuver_error([&] { study_maneuver_job(r, spec); });
+  EXPECT_NE(e4.find("--drive: the driver needs the actuator \"throttle\", which the model does not have (actuators: steer, drive)"),
+            std::string::npos) << e4;
+  r.drive.reset();
   r = ManeuverRequest{};
   r.model = file;
   r.type = "constant-radius";
@@ -732,6 +738,93 @@ TEST(Maneuver, TheSedanTooFastForTheDoubleLaneChangeHitsTheCones) {
   EXPECT_GT(rep.path.max_abs, 1.0);
   EXPECT_NEAR(rep.path.max_abs, c.max_abs, 5e-5);
   EXPECT_NEAR(rep.path.rms, c.rms, 5e-5);
+}
+
+// The single-track car's file with a yaw-moment controller in place of its driver: Plant/In a yaw
+// moment on the chassis (what an ESC's differential braking gives the car), Plant/Out the yaw
+// rate, a P controller on it (u = kp (r - yaw rate))
+ModelSpec car_with_yaw_controller(double kp, const std::string& input) {
+  const std::string file = maneuver_data("single_track_car_driver.json");
+  nlohmann::json j = study_model_json(study_read_model(file));
+  j["actuators"].push_back({{"name", "yaw_moment"}, {"type", "body_torque"}, {"body", "chassis"},
+                            {"direction", {0, 0, 1}}, {"frame", "body"}, {"unit", "N m"}});
+  j["plant"]["inputs"] = {input};
+  j["plant"]["outputs"] = {"yaw_rate"};
+  j["controller"] = {{"type", "pid"}, {"kp", {{kp}}}, {"operating_point", "steady"}};
+  return study_parse_model(j, file);
+}
+
+// The double lane change runs the model file's controller beside the driver (one run: the driver
+// sampled on the steer and drive, the controller continuous on its Plant/In), its yaw-rate
+// reference the driver's intended yaw rate: the straight run's steady gain times the driver's held
+// steer, within mu g / U. At every sample the yaw moment recorded is that law on the yaw rate
+// recorded; the controller brings the yaw rate closer to what the driver asks than the same run
+// with the controller left out (--open-loop), and the report names both. A controller on the
+// steer the driver sets is refused naming the field.
+TEST(Maneuver, TheDoubleLaneChangeRunsTheFilesControllerBesideTheDriver) {
+  const double kp = 3.0e4;
+  const ModelSpec spec = car_with_yaw_controller(kp, "yaw_moment");
+  ManeuverRequest r;
+  r.model = maneuver_data("single_track_car_driver.json");
+  r.type = "double-lane-change";
+  r.speed = 22.2;
+  r.preview = 6;
+  r.drive = "drive";
+  r.speed_kp = 2000;
+  r.speed_ki = 500;
+  const ManeuverReport rep = study_maneuver_job(r, spec);
+  r.open_loop = true;
+  const ManeuverReport alone = study_maneuver_job(r, spec);
+  ASSERT_TRUE(rep.valid) << rep.invalid_reason;
+  ASSERT_TRUE(alone.valid) << alone.invalid_reason;
+  EXPECT_NE(rep.controller.find("pid controller"), std::string::npos) << rep.controller;
+  EXPECT_NE(rep.result.controller.find("; beside it the model file's pid controller"), std::string::npos) << rep.result.controller;
+  EXPECT_TRUE(alone.controller.empty());
+  ASSERT_GT(rep.reference_gain, 0.0);
+  EXPECT_NEAR(rep.reference_limit, 0.85 * 9.80665 / 22.2, 1e-9);
+  ASSERT_EQ(rep.controller_inputs, std::vector<std::string>{"yaw_moment"});
+
+  const SimulationResult& res = rep.result;
+  const auto col = [&res](const std::string& name) {
+    return static_cast<int>(std::find(res.output_names.begin(), res.output_names.end(), name) - res.output_names.begin());
+  };
+  const auto act = [&res](const std::string& name) {
+    return static_cast<int>(std::find(res.input_names.begin(), res.input_names.end(), name) - res.input_names.begin());
+  };
+  const int iyr = col("yaw_rate"), im = act("yaw_moment"), is = act("steer");
+  ASSERT_EQ(iyr, 0);
+  ASSERT_LT(col("x"), static_cast<int>(res.output_names.size()));  // the driver's outputs are the run's too
+  EXPECT_EQ(alone.result.u(0, is), 0.0);  // the straight run's steer, the driver's on its line
+  double law = 0, largest = 0, effort = 0;
+  const auto tracking = [&](const SimulationResult& x) {  // RMS of (intended - actual) yaw rate
+    double sum = 0;
+    for (int k = 0; k < x.samples(); ++k) {
+      const double want = std::clamp(rep.reference_gain * x.u(k, is), -rep.reference_limit, rep.reference_limit);
+      sum += (want - x.y(k, iyr)) * (want - x.y(k, iyr));
+    }
+    return std::sqrt(sum / x.samples());
+  };
+  for (int k = 0; k < res.samples(); ++k) {
+    const double want = std::clamp(rep.reference_gain * res.u(k, is), -rep.reference_limit, rep.reference_limit);
+    law = std::max(law, std::abs(res.u(k, im) - kp * (want - res.y(k, iyr))));
+    largest = std::max(largest, std::abs(res.u(k, im)));
+  }
+  effort = rep.controller_effort.front();
+  const double with = tracking(res), without = tracking(alone.result);
+  std::cout << "yaw-moment controller beside the driver: law " << law << " of " << largest << " N m; yaw-rate tracking RMS "
+            << with << " rad/s (driver alone " << without << "); path error " << rep.path.max_abs << " m (alone "
+            << alone.path.max_abs << ")\n";
+  EXPECT_LT(law, 1e-9 * largest);
+  EXPECT_GT(largest, 500.0);
+  EXPECT_DOUBLE_EQ(effort, largest);
+  EXPECT_LT(with, 0.7 * without);
+
+  // a controller on the steer the driver sets
+  const ModelSpec on_steer = car_with_yaw_controller(kp, "steer");
+  r.open_loop = false;
+  const std::string e = maneuver_error([&] { study_maneuver_job(r, on_steer); });
+  EXPECT_NE(e.find("single_track_car_driver.json: /plant/inputs: the driver sets \"steer\", and the model file's pid controller "
+                   "acts on it too"), std::string::npos) << e;
 }
 
 // The same for the double lane change, whose driver steps the plant sample by sample (the stepper
