@@ -131,7 +131,7 @@ Model car_with_yaw_moment(const std::string& file) {
   return study_model(study_parse_model(j, file), file);
 }
 
-int index_of(const std::vector<std::string>& names, const std::string& name) {
+int name_index(const std::vector<std::string>& names, const std::string& name) {
   for (std::size_t k = 0; k < names.size(); ++k)
     if (names[k] == name) return static_cast<int>(k);
   ADD_FAILURE() << "no " << name;
@@ -178,9 +178,9 @@ TEST(DriverInSimulate, ADriverBesideAYawMomentControllerInOneRun) {
   // the driver was made on run_alone's Plant/Out: the same names among the sensors, in that order
   std::vector<std::string> read;
   for (int k : run_alone.plant_outputs) read.push_back(run_alone.sensors[static_cast<std::size_t>(k)].name);
-  for (const std::string& n : read) ob.beside.sensors.push_back(index_of(sensors, n));
-  ob.beside.actuators = {index_of(actuators, "steer"), index_of(actuators, "drive")};
-  const int iyaw = index_of(actuators, "yaw_moment"), isteer = index_of(actuators, "steer");
+  for (const std::string& n : read) ob.beside.sensors.push_back(name_index(sensors, n));
+  ob.beside.actuators = {name_index(actuators, "steer"), name_index(actuators, "drive")};
+  const int iyaw = name_index(actuators, "yaw_moment"), isteer = name_index(actuators, "steer");
   const double y0 = 0;  // the reference: the straight run's yaw rate
 
   const auto run_with = [&](double kp) {
@@ -250,24 +250,24 @@ TEST(DriverInSimulate, WhatCannotSitBesideIsRefusedNamingIt) {
   SimulationOptions o;
   o.t_end = 0.05;
   o.beside.controller = driver.get();
-  o.beside.sensors = {index_of(sensors, "x"), index_of(sensors, "y"), index_of(sensors, "yaw"), index_of(sensors, "speed")};
-  o.beside.actuators = {index_of(actuators, "yaw_moment")};  // the first controller's Plant/In
+  o.beside.sensors = {name_index(sensors, "x"), name_index(sensors, "y"), name_index(sensors, "yaw"), name_index(sensors, "speed")};
+  o.beside.actuators = {name_index(actuators, "yaw_moment")};  // the first controller's Plant/In
   EXPECT_NE(refusal(o).find("sets \"yaw_moment\", a Plant/In input the first controller drives"), std::string::npos) << refusal(o);
-  o.beside.actuators = {index_of(actuators, "steer"), index_of(actuators, "steer")};
+  o.beside.actuators = {name_index(actuators, "steer"), name_index(actuators, "steer")};
   EXPECT_NE(refusal(o).find("sets \"steer\" twice"), std::string::npos) << refusal(o);
-  o.beside.actuators = {index_of(actuators, "steer"), index_of(actuators, "drive")};  // two values for one
+  o.beside.actuators = {name_index(actuators, "steer"), name_index(actuators, "drive")};  // two values for one
   EXPECT_NE(refusal(o).find("gives 1 values for 2 actuators"), std::string::npos) << refusal(o);
   o.beside.actuators = {99};
   EXPECT_NE(refusal(o).find("names an actuator the model does not have"), std::string::npos) << refusal(o);
-  o.beside.actuators = {index_of(actuators, "steer")};
-  o.beside.sensors.back() = index_of(sensors, "lateral_acceleration");
+  o.beside.actuators = {name_index(actuators, "steer")};
+  o.beside.sensors.back() = name_index(sensors, "lateral_acceleration");
   EXPECT_NE(refusal(o).find("reads \"lateral_acceleration\", which depends on the inputs"), std::string::npos) << refusal(o);
   const HoldStill continuous;
   o.beside.controller = &continuous;
   EXPECT_NE(refusal(o).find("must be sampled"), std::string::npos) << refusal(o);
   // and the one that fits runs
   o.beside.controller = driver.get();
-  o.beside.sensors.back() = index_of(sensors, "speed");
+  o.beside.sensors.back() = name_index(sensors, "speed");
   EXPECT_EQ(refusal(o), "simulated");
 }
 
