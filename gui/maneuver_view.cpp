@@ -132,8 +132,9 @@ void ManeuverView::buildUi() {
   }
   open_loop_ = new QCheckBox(tr("Open loop: leave the model file's controller out"), this);
   open_loop_->setObjectName("maneuverOpenLoop");
-  open_loop_->setToolTip(tr("Step steer and sine with dwell run the model file's controller in the loop (on its Plant/In, never "
-                            "the steer); a swept sine needs it left out"));
+  open_loop_->setToolTip(tr("Step steer, sine with dwell, slowly increasing steer and fishhook run the model file's controller "
+                            "in the loop (on its Plant/In, never the steer), the double lane change beside its driver; a swept "
+                            "sine needs it left out"));
   form->addRow(open_loop_);
   left->addLayout(form);
   auto* buttons = new QHBoxLayout;
@@ -187,7 +188,7 @@ void ManeuverView::typeChosen() {
     labels_[f.key]->setVisible(on);
   }
   open_loop_->setVisible(t == "step-steer" || t == "sine-with-dwell" || t == "swept-sine" || t == "slowly-increasing-steer" ||
-                         t == "fishhook");
+                         t == "fishhook" || t == "double-lane-change");
 }
 
 QString ManeuverView::statusText() const { return status_->text(); }

@@ -195,6 +195,35 @@ class ManeuverViewTest : public QObject {
     QVERIFY(view()->reportView()->toPlainText().contains(QStringLiteral("largest sideslip")));
   }
 
+  // The lane change runs the model file's yaw-moment controller beside the driver, and Open loop
+  // leaves it out: the report is the job's for the same request either way
+  void laneChangeRunsTheFilesControllerBesideTheDriver() {
+    const QString file = QStringLiteral(CODYNA_TEST_DATA_DIR "/single_track_car_yaw_moment.json");
+    QVERIFY(w->openFile(file));
+    openTab();
+    QVERIFY(drive::pickWithMouse(view()->typeBox(), "double-lane-change"));
+    QVERIFY(view()->openLoopBox()->isVisible());
+    QVERIFY(!view()->openLoopBox()->isChecked());
+    type("speed", "22.2");
+    type("preview", "6");
+    runAndWait();
+    QCOMPARE(view()->statusText(), QStringLiteral("Done"));
+    ManeuverRequest r;
+    r.type = "double-lane-change";
+    r.speed = 22.2;
+    r.preview = 6;
+    const ManeuverReport rep = job(file, r);
+    QVERIFY(rep.controller.find("beside the driver") != std::string::npos);
+    QCOMPARE(view()->reportView()->toPlainText(), QString::fromStdString(study_maneuver_text(rep)));
+    QVERIFY(view()->reportView()->toPlainText().contains(QStringLiteral("largest |u - u0| yaw_moment")));
+    QTest::mouseClick(view()->openLoopBox(), Qt::LeftButton);
+    runAndWait();
+    QCOMPARE(view()->statusText(), QStringLiteral("Done"));
+    QVERIFY(view()->report() && view()->report()->controller.empty());
+    r.open_loop = true;
+    QCOMPARE(view()->reportView()->toPlainText(), QString::fromStdString(study_maneuver_text(job(file, r))));
+  }
+
   // The K&C tab (gui/kc_view.hpp) on the sedan's corner: ranges typed, Enter in a field runs it;
   // the report is codyna kc's text for the same request, the curves its points; a range that does
   // not read is shown naming it, and the last curves stay until a run succeeds

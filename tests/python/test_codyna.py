@@ -1033,6 +1033,19 @@ def test_maneuver_is_the_command_lines():
     assert len(dlc["cones_hit"]) == 1 and dlc["cones_hit"][0].startswith("section 5")
     # the hit section's clearance is the one below zero
     assert dlc["cone_clearance"].shape == (3,) and dlc["cone_clearance"][2] < 0 < min(dlc["cone_clearance"][:2])
+    # the model file's yaw-moment controller beside the driver: its input and effort, and the
+    # outputs the driver read (the file's Plant/Out is the yaw rate alone)
+    ym = codyna.Study(os.path.join(SOURCE_DIR, "tests", "data", "single_track_car_yaw_moment.json"))
+    both = ym.maneuver("double-lane-change", speed=22.2, preview=6, drive="drive", speed_kp=2000, speed_ki=500)
+    assert both["controller_inputs"] == ["yaw_moment"]
+    assert both["controller_effort"][0] == pytest.approx(3495.02, rel=1e-4)
+    assert both["output_names"] == ["yaw_rate", "x", "y", "yaw", "speed"]
+    assert both["cones_hit"] == [] and both["path_error_max"] == pytest.approx(0.311875, rel=1e-4)
+    alone = ym.maneuver("double-lane-change", speed=22.2, preview=6, drive="drive", speed_kp=2000, speed_ki=500,
+                        open_loop=True)
+    assert "controller" not in alone and alone["path_error_max"] == pytest.approx(0.30201, rel=1e-4)
+    with pytest.raises(ValueError, match="^drive: the driver needs the actuator \"throttle\""):
+        ym.maneuver("double-lane-change", drive="throttle")
     with pytest.raises(ValueError, match="^type: unknown maneuver"):
         codyna.Study(car).maneuver("slalom")
     # the swept sine: the command line's text; the responses as complex arrays beside the linear ones
