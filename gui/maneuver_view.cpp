@@ -62,7 +62,11 @@ const QList<ManeuverField>& maneuver_fields() {
       {"points", "points", "8 (swept sine: 12)", {"constant-radius", "constant-speed", "swept-sine"}},
       {"width", "vehicle width (m)", "1.8", {"double-lane-change"}},
       {"preview", "driver preview (m)", "the model's", {"double-lane-change"}},
-      {"friction", "friction (controller's reference)", "0.85", {"step-steer", "sine-with-dwell", "slowly-increasing-steer", "fishhook"}},
+      {"drive", "drive input (holds the speed)", "none", {"double-lane-change", "slowly-increasing-steer"}},
+      {"speed-kp", "speed PI: kp (per m/s)", "0", {"double-lane-change", "slowly-increasing-steer"}},
+      {"speed-ki", "speed PI: ki (per m)", "0", {"double-lane-change", "slowly-increasing-steer"}},
+      {"friction", "friction (controller's reference)", "0.85",
+       {"step-steer", "sine-with-dwell", "slowly-increasing-steer", "fishhook", "double-lane-change"}},
       {"t-end", "run length (s)", "the maneuver's",
        {"step-steer", "sine-with-dwell", "swept-sine", "double-lane-change", "slowly-increasing-steer", "fishhook"}},
       {"integrator", "integrator", "the model's",
@@ -235,6 +239,8 @@ ManeuverRequest ManeuverView::request() const {
   r.width = number("width");
   r.preview = number("preview");
   r.friction = number("friction");
+  r.speed_kp = number("speed-kp");
+  r.speed_ki = number("speed-ki");
   r.steer_rate = number("steer-rate");
   r.t_end = number("t-end");
   r.open_loop = !open_loop_->isHidden() && open_loop_->isChecked();
@@ -248,6 +254,8 @@ ManeuverRequest ManeuverView::request() const {
     for (const QString& n : free->text().split(',', Qt::SkipEmptyParts)) names.push_back(n.trimmed().toStdString());
     r.free_inputs = names;
   }
+  const QLineEdit* drive = fields_.value("drive");
+  if (!drive->isHidden() && !drive->text().trimmed().isEmpty()) r.drive = drive->text().trimmed().toStdString();
   const QLineEdit* integ = fields_.value("integrator");
   if (!integ->isHidden() && !integ->text().trimmed().isEmpty()) r.integrator = integ->text().trimmed().toStdString();
   return r;

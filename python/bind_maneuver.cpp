@@ -123,6 +123,7 @@ py::dict do_maneuver(const Study& s, const py::dict& options) {
     if (rep.handling_gradient) d["handling_understeer_gradient"] = *rep.handling_gradient;
     d["max_lateral_acceleration"] = rep.sis_ay_max;
     d["steer_at_max_lateral_acceleration"] = rep.sis_steer_at_ay_max;
+    d["speed_hold"] = rep.speed_hold;  // "" = the speed was not held
   } else if (rep.type == "fishhook") {
     d["max_roll"] = rep.fh_max_roll;
     d["max_roll_time"] = rep.fh_max_roll_time;

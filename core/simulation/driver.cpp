@@ -66,7 +66,39 @@ class Driver final : public Controller {
   DriverSettings s_;
 };
 
+class SpeedHold final : public Controller {
+ public:
+  explicit SpeedHold(SpeedHoldSettings s) : s_(s) {}
+  int nxc() const override { return 1; }
+  double sample_time() const override { return s_.sample_time; }
+  Eigen::VectorXd output(const ControllerInput& in, const Eigen::VectorXd& xc) const override {
+    return Eigen::VectorXd::Constant(1, s_.u0 + s_.kp * (s_.speed - in.y[0]) + s_.ki * xc[0]);
+  }
+  Eigen::VectorXd update(const ControllerInput& in, const Eigen::VectorXd& xc) const override {
+    return Eigen::VectorXd::Constant(1, xc[0] + s_.sample_time * (s_.speed - in.y[0]));
+  }
+  std::vector<std::string> state_names() const override { return {"speed.error_integral"}; }
+  std::string describe() const override {
+    std::ostringstream os;
+    os << "PI on speed " << s_.speed << " m/s, kp " << s_.kp << ", ki " << s_.ki << ", sampled every " << s_.sample_time << " s";
+    return os.str();
+  }
+
+ private:
+  SpeedHoldSettings s_;
+};
+
 }  // namespace
+
+std::unique_ptr<Controller> make_speed_hold(const SpeedHoldSettings& s, const std::string& where) {
+  if (!(s.kp >= 0)) driver_refuse(where, "speed_kp", "a number >= 0", s.kp);
+  if (!(s.ki >= 0)) driver_refuse(where, "speed_ki", "a number >= 0", s.ki);
+  if (s.kp == 0 && s.ki == 0) driver_refuse(where, "speed_kp", "a gain > 0 (or speed_ki > 0): a PI of zero gains holds nothing", s.kp);
+  if (!(s.sample_time > 0) || !std::isfinite(s.sample_time)) driver_refuse(where, "sample_time", "a number > 0", s.sample_time);
+  if (!std::isfinite(s.speed) || !std::isfinite(s.u0) || !std::isfinite(s.kp) || !std::isfinite(s.ki))
+    throw std::invalid_argument(where + ": the speed controller's numbers must be finite");
+  return std::make_unique<SpeedHold>(s);
+}
 
 PathProjection project_on_path(const DriverPath& path, const Eigen::Vector2d& p) {
   PathProjection r;

@@ -107,6 +107,19 @@ struct DriverLaw {
 };
 DriverLaw driver_law(const DriverSettings& s, double x, double y, double yaw);
 
+// The driver's speed controller alone: a PI on forward speed, sampled (zero-order hold), for a
+// maneuver whose steer is a set profile but whose speed is held (slowly increasing steer at
+// constant speed, SAE J266). It reads one output (the forward speed, y[0]) and writes one input
+// (the drive, u[0]):  u = u0 + kp (U_ref - U) + ki integral(U_ref - U) dt.  States: the integral.
+struct SpeedHoldSettings {
+  double speed = 0;                   // m/s, U_ref
+  double kp = 0, ki = 0;              // drive input per m/s, per m (>= 0, not both 0)
+  double sample_time = 0.01;          // s (> 0)
+  double u0 = 0;                      // the drive's nominal value
+};
+// checks the settings (std::invalid_argument naming the field as `where` + "/speed_kp" ...)
+std::unique_ptr<Controller> make_speed_hold(const SpeedHoldSettings& s, const std::string& where = "speed");
+
 // The settings a model file's controller of type "driver" gives (ModelSpec::controller), its names
 // resolved against the model's Plant/Out and Plant/In; u0: the Plant/In nominal values. Errors
 // name the file and the field ("FILE: /controller/x: the driver needs the Plant/Out ...").

@@ -278,7 +278,7 @@ SteerProfile piecewise_linear(const std::vector<double>& t, const std::vector<do
 }
 
 Model open_loop_run(ManeuverReport& rep, const ManeuverRequest& r, const OpenLoop& ol, const SteerProfile& profile,
-                    const std::vector<double>& stops, double t_end) {
+                    const std::vector<double>& stops, double t_end, const SampledBeside* beside) {
   const Flags flag{r.style};
   SimulationOptions o;
   o.integrator = integrator(ol.model);
@@ -296,6 +296,7 @@ Model open_loop_run(ManeuverReport& rep, const ManeuverRequest& r, const OpenLoo
   o.disturbance_rate = [one, profile](double t) { return one(profile.rate(t)); };
   o.disturbance_acceleration = [one, profile](double t) { return one(profile.acceleration(t)); };
   o.rate_jumps = stops;
+  if (beside) o.beside = *beside;
   if (ol.controller) {
     const Eigen::VectorXd y0 = ol.plant->lin.system.y0;
     const int iy = ol.yaw_rate;
@@ -348,6 +349,48 @@ Model open_loop_run(ManeuverReport& rep, const ManeuverRequest& r, const OpenLoo
     rep.end_yaw_rate = e.yaw_rate;
   }
   return run;
+}
+
+// The driver's position, heading and forward speed: a name the model has no sensor of (and the
+// request did not give) is measured on the steady body's origin by a sensor the maneuver adds
+// under that name (the chassis origin's x and y in the ground's axes, its heading about the
+// vertical, its forward speed in its own axes); a note says so.
+ModelSpec with_driver_sensors(ModelSpec s, const DriverSignals& names, const ManeuverRequest& r,
+                              std::vector<std::string>& notes, bool speed_only) {
+  const auto has = [&s](const std::string& n) {
+    return std::any_of(s.sensors.begin(), s.sensors.end(), [&n](const SensorSpec& x) { return x.name == n; });
+  };
+  struct Wanted {
+    const std::string& name;
+    bool given;
+    SensorType type;
+    int component;
+    const char* what;
+  };
+  const Wanted wanted[] = {{names.x, r.x.has_value(), SensorType::PointPosition, 0, "x in the ground's axes"},
+                           {names.y, r.y.has_value(), SensorType::PointPosition, 1, "y in the ground's axes"},
+                           {names.yaw, r.yaw.has_value(), SensorType::BodyAngle, 2, "heading about the vertical"},
+                           {names.speed, r.speed_output.has_value(), SensorType::PointVelocity, 0, "forward speed"}};
+  std::string body = s.analysis.steady.body, added;
+  for (const Wanted& w : wanted) {
+    if (w.given || has(w.name) || (speed_only && w.type != SensorType::PointVelocity)) continue;
+    if (body.empty()) {
+      const Model m = study_model(s, r.model);
+      body = m.body_names[static_cast<std::size_t>(steady_body(m))];
+    }
+    SensorSpec x;
+    x.name = w.name;
+    x.type = w.type;
+    x.body = body;
+    x.component = w.component;
+    x.axis = Eigen::Vector3d::UnitZ();
+    if (w.type == SensorType::PointVelocity) x.frame = body;
+    s.sensors.push_back(x);
+    added += (added.empty() ? "" : ", ") + ("\"" + w.name + "\" (" + w.what + ")");
+  }
+  if (!added.empty())
+    notes.push_back(std::string(speed_only ? "the speed controller" : "the driver") + " reads " + body + "'s origin through sensors the maneuver added, the model having none of those names: " + added);
+  return s;
 }
 
 void lane_layout(ManeuverReport& rep, const DriverPath& local, const Eigen::Vector2d& start, double heading) {

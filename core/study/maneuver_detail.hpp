@@ -112,8 +112,17 @@ SteerProfile piecewise_linear(const std::vector<double>& t, const std::vector<do
 // and acceleration exact: a motion input takes it), stopping at `stops` (where the steer's
 // acceleration jumps); fills rep.result, checks it (check_run), end_speed, end_yaw_rate. Returns
 // the run's model (the steady one held at the point: the result's q, v are its).
+// beside: a sampled controller beside the file's (a speed hold), or null
 Model open_loop_run(ManeuverReport& rep, const ManeuverRequest& r, const OpenLoop& ol, const SteerProfile& profile,
-                    const std::vector<double>& stops, double t_end);
+                    const std::vector<double>& stops, double t_end, const SampledBeside* beside = nullptr);
+
+// The driver's position, heading and forward speed (names: the request's, else the file driver's,
+// else the defaults): a name the model has no sensor of (and the request did not give) is measured
+// on the steady body's origin by a sensor added under that name (x, y in the ground's axes, the
+// heading about the vertical, the forward speed in the body's axes); a note says so. speed_only:
+// the forward speed alone (a speed controller without the driver).
+ModelSpec with_driver_sensors(ModelSpec s, const DriverSignals& names, const ManeuverRequest& r,
+                              std::vector<std::string>& notes, bool speed_only = false);
 
 // the maneuvers in their own files
 ManeuverReport swept_sine(const ManeuverRequest& r, const ModelSpec& spec);       // maneuver_swept.cpp

@@ -1,5 +1,6 @@
 #include "study/maneuver_job.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <limits>
@@ -251,48 +252,6 @@ class Watched final : public Controller {
   std::shared_ptr<Eigen::VectorXd> last_;
 };
 
-// The driver's position, heading and forward speed: a name the model has no sensor of (and the
-// request did not give) is measured on the steady body's origin by a sensor the maneuver adds
-// under that name (the chassis origin's x and y in the ground's axes, its heading about the
-// vertical, its forward speed in its own axes); a note says so.
-ModelSpec with_driver_sensors(ModelSpec s, const DriverSignals& names, const ManeuverRequest& r,
-                              std::vector<std::string>& notes) {
-  const auto has = [&s](const std::string& n) {
-    return std::any_of(s.sensors.begin(), s.sensors.end(), [&n](const SensorSpec& x) { return x.name == n; });
-  };
-  struct Wanted {
-    const std::string& name;
-    bool given;
-    SensorType type;
-    int component;
-    const char* what;
-  };
-  const Wanted wanted[] = {{names.x, r.x.has_value(), SensorType::PointPosition, 0, "x in the ground's axes"},
-                           {names.y, r.y.has_value(), SensorType::PointPosition, 1, "y in the ground's axes"},
-                           {names.yaw, r.yaw.has_value(), SensorType::BodyAngle, 2, "heading about the vertical"},
-                           {names.speed, r.speed_output.has_value(), SensorType::PointVelocity, 0, "forward speed"}};
-  std::string body = s.analysis.steady.body, added;
-  for (const Wanted& w : wanted) {
-    if (w.given || has(w.name)) continue;
-    if (body.empty()) {
-      const Model m = study_model(s, r.model);
-      body = m.body_names[static_cast<std::size_t>(mnv::steady_body(m))];
-    }
-    SensorSpec x;
-    x.name = w.name;
-    x.type = w.type;
-    x.body = body;
-    x.component = w.component;
-    x.axis = Eigen::Vector3d::UnitZ();
-    if (w.type == SensorType::PointVelocity) x.frame = body;
-    s.sensors.push_back(x);
-    added += (added.empty() ? "" : ", ") + ("\"" + w.name + "\" (" + w.what + ")");
-  }
-  if (!added.empty())
-    notes.push_back("the driver reads " + body + "'s origin through sensors the maneuver added, the model having none of those names: " + added);
-  return s;
-}
-
 // the index of `name` in `names`, refused naming the field with the names there are
 int mnv_find(const std::vector<std::string>& names, const std::string& name, const std::string& label, const char* kind) {
   for (std::size_t k = 0; k < names.size(); ++k)
@@ -318,7 +277,7 @@ ManeuverReport mnv_lane_change(const ManeuverRequest& r, const ModelSpec& spec) 
   if (r.yaw) names.yaw = *r.yaw;
   if (r.speed_output) names.speed = *r.speed_output;
   if (r.drive) names.drive = *r.drive;
-  s = with_driver_sensors(std::move(s), names, r, rep.notes);
+  s = mnv::with_driver_sensors(std::move(s), names, r, rep.notes);
 
   // the car at its straight run, and the model file's controller (not a driver) beside the driver
   // unless --open-loop
@@ -473,6 +432,44 @@ ManeuverReport study_maneuver_job(const ManeuverRequest& r, const ModelSpec& spe
   if (r.type.empty()) throw std::invalid_argument(flag("type") + ": expected one of " + known);
   for (const std::string& f : {r.out, r.csv})
     if (!f.empty()) study_guard_output(f, f == r.out ? OutputKind::ResultsHdf5 : (r.type == "constant-radius" || r.type == "constant-speed" ? OutputKind::CurvesCsv : OutputKind::ResultsCsv), {r.model});
+  // a flag the maneuver does not read is refused, naming the maneuvers that do (never ignored)
+  struct Only {
+    bool given;
+    const char* flag;
+    std::vector<std::string> types;
+  };
+  const std::vector<std::string> lane = {"double-lane-change"}, held = {"double-lane-change", "slowly-increasing-steer"};
+  const Only only[] = {
+      {r.ramp.has_value(), "ramp", {"step-steer"}},
+      {r.frequency.has_value(), "frequency", {"sine-with-dwell"}},
+      {r.frequency_min.has_value(), "frequency-min", {"swept-sine"}},
+      {r.frequency_max.has_value(), "frequency-max", {"swept-sine"}},
+      {r.sweep_time.has_value(), "sweep-time", {"swept-sine"}},
+      {r.steer_rate.has_value(), "steer-rate", {"slowly-increasing-steer", "fishhook"}},
+      {r.speed_min.has_value(), "speed-min", {"constant-radius"}},
+      {r.speed_max.has_value(), "speed-max", {"constant-radius"}},
+      {r.ay_min.has_value(), "ay-min", {"constant-speed"}},
+      {r.ay_max.has_value(), "ay-max", {"constant-speed"}},
+      {r.width.has_value(), "width", lane},
+      {r.length.has_value(), "length", lane},
+      {r.preview.has_value(), "preview", lane},
+      {r.lateral_gain.has_value(), "lateral-gain", lane},
+      {r.x.has_value(), "x", lane},
+      {r.y.has_value(), "y", lane},
+      {r.yaw.has_value(), "yaw", lane},
+      {r.drive.has_value(), "drive", held},
+      {r.speed_kp.has_value(), "speed-kp", held},
+      {r.speed_ki.has_value(), "speed-ki", held},
+      {r.speed_output.has_value(), "speed-output", held},
+      {r.sample_time.has_value(), "sample-time", held},
+  };
+  const bool known_type = std::find(std::begin(kManeuverTypes), std::end(kManeuverTypes), r.type) != std::end(kManeuverTypes);
+  for (const Only& o : only) {
+    if (!o.given || !known_type || std::find(o.types.begin(), o.types.end(), r.type) != o.types.end()) continue;
+    std::string which;
+    for (const std::string& t : o.types) which += (which.empty() ? "" : ", ") + t;
+    throw std::invalid_argument(flag(o.flag) + ": the " + r.type + " maneuver does not take it (it is for " + which + ")");
+  }
   ManeuverReport rep;
   ModelSpec given = spec;
   if (r.free_inputs) given.analysis.free_inputs = *r.free_inputs;
@@ -620,6 +617,7 @@ std::string study_maneuver_text(const ManeuverReport& r) {
   } else if (r.type == "slowly-increasing-steer") {
     const auto pct = [](double a, double b) { return std::abs(a - b) / std::abs(b) * 100; };
     os << "steer ramp       to " << r.steer << " (from " << r.steer_start << " s to " << r.steer_end << " s)\n";
+    os << "speed held       " << (r.speed_hold.empty() ? "no (the drive stays at the straight run's)" : r.speed_hold) << "\n";
     if (std::isfinite(r.sis_steer_03g)) {
       os << "at 0.3 g         steer " << r.sis_steer_03g << " at " << r.sis_time_03g << " s, speed " << r.sis_speed_03g
          << " m/s (a_y = U r)\n";

@@ -183,6 +183,9 @@ struct ManeuverReport {
   // delta / ratio - L / R between the turns at 0.1 and 0.3 g
   double sis_steady_gradient = std::nan("");
   double sis_ay_max = 0, sis_steer_at_ay_max = 0, sis_time_ay_max = 0;
+  // slowly increasing steer: the drive that held the speed and how ("" = none: the drive stays at
+  // the straight run's value and the speed falls as the turn tightens)
+  std::string speed_hold;
   // fishhook: the steady body's largest |roll| (rad) and when; per tire its name, side ("left" /
   // "right" of the steady body at the start), smallest normal load (N) and when; the first sample
   // at which both tires of one side are off the road (a two-wheel lift: -1 none) and that side;

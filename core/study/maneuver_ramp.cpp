@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "dynamics/kinematics.hpp"
+#include "dynamics/sensors.hpp"
 #include "model/errors.hpp"
 #include "study/maneuver_detail.hpp"
 #include "study/tire_contacts.hpp"
@@ -61,13 +62,74 @@ std::optional<HandlingNumbers> ramp_handling(ManeuverReport& rep, const OpenLoop
 
 }  // namespace
 
-ManeuverReport slowly_increasing_steer(const ManeuverRequest& r, const ModelSpec& spec) {
+namespace {
+
+// The speed held through the run by a PI on the forward speed (--drive, --speed-kp, --speed-ki,
+// --speed-output, --sample-time), beside the file's controller: its reference the speed output's
+// value at the start
+std::unique_ptr<Controller> speed_hold(ManeuverReport& rep, const ManeuverRequest& r, const OpenLoop& ol,
+                                       const std::string& speed_name, SampledBeside& hold) {
+  const Flags flag{r.style};
+  const Model& m = ol.model;
+  const auto find = [](const auto& list, const std::string& name) {
+    for (std::size_t k = 0; k < list.size(); ++k)
+      if (list[k].name == name) return static_cast<int>(k);
+    return -1;
+  };
+  const int drive = find(m.actuators, *r.drive), speed = find(m.sensors, speed_name);
+  if (drive < 0) {
+    std::string all;
+    for (const ActuatorModel& a : m.actuators) all += (all.empty() ? "" : ", ") + a.name;
+    throw std::invalid_argument(flag("drive") + ": the speed controller needs the actuator \"" + *r.drive +
+                                "\", which the model does not have (actuators: " + all + ")");
+  }
+  if (speed < 0) throw std::invalid_argument(flag("speed-output") + ": the model has no sensor \"" + speed_name + "\"");
+  if (ol.controller && std::count(m.plant_inputs.begin(), m.plant_inputs.end(), drive))
+    throw std::invalid_argument(flag("drive") + ": \"" + *r.drive + "\" is a Plant/In of the model file's controller, which acts on it already");
+  if (drive == ol.steer) throw std::invalid_argument(flag("drive") + ": \"" + *r.drive + "\" is the steer the maneuver drives");
+  SpeedHoldSettings s;
+  s.kp = r.speed_kp.value_or(0.0);
+  s.ki = r.speed_ki.value_or(0.0);
+  if (!(s.kp >= 0)) throw std::invalid_argument(flag("speed-kp") + ": expected a number >= 0");
+  if (!(s.ki >= 0)) throw std::invalid_argument(flag("speed-ki") + ": expected a number >= 0");
+  if (s.kp == 0 && s.ki == 0)
+    throw std::invalid_argument(flag("speed-kp") + ": the speed held through " + flag("drive") + " needs a gain > 0 (" +
+                                flag("speed-kp") + " or " + flag("speed-ki") + ")");
+  s.sample_time = positive(flag, r.sample_time, 0.01, "sample-time");
+  s.u0 = ol.op.u[drive];
+  Data d(m);
+  forward_kinematics<double>(m, d, ol.op.q, ol.op.v);
+  d.s = ol.op.s;
+  s.speed = sensor_outputs<double>(m, d, std::vector<int>{speed}, ol.op.q, ol.op.v)[0];
+  std::unique_ptr<Controller> pi = make_speed_hold(s, flag("drive"));
+  hold.controller = pi.get();
+  hold.sensors = {speed};
+  hold.actuators = {drive};
+  rep.speed_hold = "\"" + *r.drive + "\" by a " + pi->describe() + " (of \"" + speed_name + "\")";
+  return pi;
+}
+
+}  // namespace
+
+ManeuverReport slowly_increasing_steer(const ManeuverRequest& r, const ModelSpec& spec_given) {
   const Flags flag{r.style};
   ManeuverReport rep;
   rep.type = r.type;
+  // the speed held (SAE J266's constant speed) when a drive is given: its speed sensor added when
+  // the model has none of that name
+  ModelSpec spec = spec_given;
+  DriverSignals names;
+  if (r.speed_output) names.speed = *r.speed_output;
+  if (r.drive) spec = with_driver_sensors(std::move(spec), names, r, rep.notes, true);
+  else if (r.speed_kp || r.speed_ki || r.speed_output || r.sample_time)
+    throw std::invalid_argument(flag(r.speed_kp ? "speed-kp" : r.speed_ki ? "speed-ki" : r.speed_output ? "speed-output" : "sample-time") +
+                                ": the speed is held only through a drive input (" + flag("drive") + ")");
   const OpenLoop ol = open_loop_setup(r, spec, true);
   rep.model_name = ol.model.name;
   rep.speed = ol.start.v_body.norm();
+  SampledBeside hold;
+  std::unique_ptr<Controller> pi;
+  if (r.drive) pi = speed_hold(rep, r, ol, names.speed, hold);
   const double amplitude = ramp_amplitude(rep, r, spec, ol, 2.5);
   rep.steer = amplitude;
   const double rate = ramp_rate(r, 13.5 * kPi / 180);
@@ -81,7 +143,8 @@ ManeuverReport slowly_increasing_steer(const ManeuverRequest& r, const ModelSpec
   const double sign = amplitude > 0 ? 1.0 : -1.0;
   const std::optional<HandlingNumbers> h = ramp_handling(rep, ol);
   if (h) rep.handling_gradient = h->understeer_gradient;
-  const Model run = open_loop_run(rep, r, ol, piecewise_linear({t0, t0 + T}, {0.0, amplitude}), {t0, t0 + T}, t_end);
+  const Model run = open_loop_run(rep, r, ol, piecewise_linear({t0, t0 + T}, {0.0, amplitude}), {t0, t0 + T}, t_end,
+                                  pi ? &hold : nullptr);
   if (rep.result.samples() < 3) return rep;
   const std::vector<BodyState> st = ramp_states(run, rep, ol.body);
   const std::vector<double>& t = rep.result.t;

@@ -206,14 +206,21 @@ class ManeuverViewTest : public QObject {
     QVERIFY(!view()->openLoopBox()->isChecked());
     type("speed", "22.2");
     type("preview", "6");
+    type("drive", "drive");  // the driver holds the speed too
+    type("speed-kp", "2000");
+    type("speed-ki", "500");
     runAndWait();
     QCOMPARE(view()->statusText(), QStringLiteral("Done"));
     ManeuverRequest r;
     r.type = "double-lane-change";
     r.speed = 22.2;
     r.preview = 6;
+    r.drive = "drive";
+    r.speed_kp = 2000;
+    r.speed_ki = 500;
     const ManeuverReport rep = job(file, r);
     QVERIFY(rep.controller.find("beside the driver") != std::string::npos);
+    QVERIFY(rep.result.controller.find("PI on speed 22.2 m/s, kp 2000, ki 500") != std::string::npos);
     QCOMPARE(view()->reportView()->toPlainText(), QString::fromStdString(study_maneuver_text(rep)));
     QVERIFY(view()->reportView()->toPlainText().contains(QStringLiteral("largest |u - u0| yaw_moment")));
     QTest::mouseClick(view()->openLoopBox(), Qt::LeftButton);
