@@ -13,7 +13,7 @@ namespace {
 struct ManeuverArgs {
   std::string model, type, out, csv, x, y, yaw, speed_output, drive, integrator;
   std::vector<std::string> free_inputs;
-  double speed = 0, steer = 0, steer_time = 0, ramp = 0, frequency = 0, dwell = 0, t_end = 0, output_step = 0;
+  double speed = 0, steer = 0, steer_time = 0, ramp = 0, frequency = 0, dwell = 0, dwell_roll_rate = 0, t_end = 0, output_step = 0;
   double steer_scale = 0, frequency_min = 0, frequency_max = 0, sweep_time = 0, ay_min = 0, ay_max = 0;
   double radius = 0, speed_min = 0, speed_max = 0, width = 0, length = 0, preview = 0, lateral_gain = 0;
   double speed_kp = 0, speed_ki = 0, sample_time = 0;
@@ -37,6 +37,7 @@ void run_maneuver(const ManeuverArgs& a, const CLI::App* cmd) {
   num("--ramp", a.ramp, r.ramp);
   num("--frequency", a.frequency, r.frequency);
   num("--dwell", a.dwell, r.dwell);
+  num("--dwell-roll-rate", a.dwell_roll_rate, r.dwell_roll_rate);
   num("--steer-scale", a.steer_scale, r.steer_scale);
   num("--frequency-min", a.frequency_min, r.frequency_min);
   num("--frequency-max", a.frequency_max, r.frequency_max);
@@ -86,7 +87,8 @@ void add_maneuver(CLI::App& app) {
   cmd->add_option("--steer-time", a->steer_time, "s, when the steer starts (default 0.5)");
   cmd->add_option("--ramp", a->ramp, "s, the step's ramp (half cosine; default 0.05)");
   cmd->add_option("--frequency", a->frequency, "Hz, sine with dwell (default 0.7)");
-  cmd->add_option("--dwell", a->dwell, "s, sine with dwell (default 0.5)");
+  cmd->add_option("--dwell", a->dwell, "s, sine with dwell (default 0.5), fishhook (default 0.25)");
+  cmd->add_option("--dwell-roll-rate", a->dwell_roll_rate, "deg/s, fishhook: the dwell ends when the roll rate falls back to it (NHTSA's roll-rate feedback: 1.5)");
   cmd->add_option("--steer-scale", a->steer_scale, "the amplitude as a multiple of the steady steer at 0.3 g (sine with dwell, FMVSS 126: 5 .. 6.5; slowly increasing steer: default 2.5; fishhook: 6.5)");
   cmd->add_option("--steer-rate", a->steer_rate, "slowly increasing steer, fishhook: the steer's rate per s (13.5 deg/s, 720 deg/s, in rad)");
   cmd->add_option("--frequency-min", a->frequency_min, "Hz, swept sine's first frequency (default 0.1)");

@@ -51,6 +51,7 @@ const QList<ManeuverField>& maneuver_fields() {
       {"steer-rate", "steer rate (per s)", "13.5 deg/s (fishhook 720 deg/s)", {"slowly-increasing-steer", "fishhook"}},
       {"frequency", "frequency (Hz)", "0.7", {"sine-with-dwell"}},
       {"dwell", "dwell (s)", "0.5 (fishhook 0.25)", {"sine-with-dwell", "fishhook"}},
+      {"dwell-roll-rate", "or dwell until roll rate (deg/s)", "NHTSA: 1.5", {"fishhook"}},
       {"frequency-min", "lowest frequency (Hz)", "0.1", {"swept-sine"}},
       {"frequency-max", "highest frequency (Hz)", "2", {"swept-sine"}},
       {"sweep-time", "sweep time (s)", "30", {"swept-sine"}},
@@ -227,6 +228,7 @@ ManeuverRequest ManeuverView::request() const {
   r.steer = number("steer");
   r.frequency = number("frequency");
   r.dwell = number("dwell");
+  r.dwell_roll_rate = number("dwell-roll-rate");
   r.steer_scale = number("steer-scale");
   r.frequency_min = number("frequency-min");
   r.frequency_max = number("frequency-max");

@@ -39,6 +39,7 @@ py::dict do_maneuver(const Study& s, const py::dict& options) {
   r.ramp = k.number("ramp");
   r.frequency = k.number("frequency");
   r.dwell = k.number("dwell");
+  r.dwell_roll_rate = k.number("dwell_roll_rate");
   r.steer_scale = k.number("steer_scale");
   r.frequency_min = k.number("frequency_min");
   r.frequency_max = k.number("frequency_max");
@@ -126,6 +127,8 @@ py::dict do_maneuver(const Study& s, const py::dict& options) {
     d["speed_hold"] = rep.speed_hold;  // "" = the speed was not held
   } else if (rep.type == "fishhook") {
     d["max_roll"] = rep.fh_max_roll;
+    d["dwell"] = rep.fh_dwell;
+    d["roll_rate_dwell"] = rep.fh_roll_rate_dwell;
     d["max_roll_time"] = rep.fh_max_roll_time;
     d["max_lateral_acceleration"] = rep.fh_ay_max;
     d["tires"] = rep.fh_tires;

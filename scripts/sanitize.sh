@@ -49,7 +49,7 @@ cd "$build"
 # scripts/test.sh, which keeps them) are left out: the same code runs here on shorter sedan
 # maneuvers (step steer, sine with dwell at 0.3 g, constant radius, constant speed, the tall
 # car's rollover) and on the single-track car.
-slow_here='^(Maneuver\.SweptSineOnTheSedanIsItsLinearModelAtSmallSteer|YawControl\.TheSedanSpinsOutInTheSineWithDwellWithoutItAndPassesWithIt|ManeuverRamp\.TheSedansFishhookKeepsItsWheelsOnTheRoadAndItsLoadsAreItsSensors|Maneuver\.AutoGoesOnStiffWhereItsChoiceFailsInTheSedansSineWithDwell|Maneuver\.TheSedansDoubleLaneChangeErrorAndConesAreTheRunsOwn|Maneuver\.TheSedanTooFastForTheDoubleLaneChangeHitsTheCones)$'
+slow_here='^(Maneuver\.SweptSineOnTheSedanIsItsLinearModelAtSmallSteer|YawControl\.TheSedanSpinsOutInTheSineWithDwellWithoutItAndPassesWithIt|ManeuverRamp\.TheSedansFishhookKeepsItsWheelsOnTheRoadAndItsLoadsAreItsSensors|ManeuverRamp\.TheFishhooksRollRateDwellEndsWhereTheRollRateFallsBack|Maneuver\.AutoGoesOnStiffWhereItsChoiceFailsInTheSedansSineWithDwell|Maneuver\.TheSedansDoubleLaneChangeErrorAndConesAreTheRunsOwn|Maneuver\.TheSedanTooFastForTheDoubleLaneChangeHitsTheCones)$'
 ctest --output-on-failure -j "$jobs" -L "core|cli" -E "$slow_here" "$@"
 # the GUI under the sanitizers: Qt and the libraries under it are not
 # instrumented; what they keep until exit (fonts, the platform plugin) is

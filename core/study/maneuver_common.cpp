@@ -278,7 +278,8 @@ SteerProfile piecewise_linear(const std::vector<double>& t, const std::vector<do
 }
 
 Model open_loop_run(ManeuverReport& rep, const ManeuverRequest& r, const OpenLoop& ol, const SteerProfile& profile,
-                    const std::vector<double>& stops, double t_end, const SampledBeside* beside) {
+                    const std::vector<double>& stops, double t_end, const SampledBeside* beside,
+                    const RunUntil& until) {
   const Flags flag{r.style};
   SimulationOptions o;
   o.integrator = integrator(ol.model);
@@ -313,6 +314,7 @@ Model open_loop_run(ManeuverReport& rep, const ManeuverRequest& r, const OpenLoo
   // which sees it inside its steps
   std::atomic<bool> rolled{false};
   double rolled_at = -1, roll_reached = 0;
+  bool reached = false;  // `until` said so
   Data dk(run);
   const int body = ol.body;
   SimulationCallbacks cb;
@@ -328,10 +330,18 @@ Model open_loop_run(ManeuverReport& rep, const ManeuverRequest& r, const OpenLoo
       roll_reached = roll;
       rolled.store(true);
     }
+    if (until && rolled_at < 0 && !reached && until(run, sn)) {
+      reached = true;
+      rolled.store(true);  // the same stop: the run ends here
+    }
   };
   rep.result = simulate(run, ol.controller.get(), ol.plant.get(), o, cb);
-  if ((r.cancel && r.cancel->load()) || (rep.result.cancelled && rolled_at < 0))
+  if ((r.cancel && r.cancel->load()) || (rep.result.cancelled && rolled_at < 0 && !reached))
     throw StudyCancelled("the maneuver was cancelled");
+  if (reached) {  // ended where the caller asked: a complete run to there
+    rep.result.cancelled = false;
+    rep.result.completed = true;
+  }
   if (ol.controller) report_controller(rep, ol, run);
   check_run(rep, rep.result, run, ol.body);
   if (rolled_at >= 0) {

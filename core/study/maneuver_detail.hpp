@@ -112,9 +112,13 @@ SteerProfile piecewise_linear(const std::vector<double>& t, const std::vector<do
 // and acceleration exact: a motion input takes it), stopping at `stops` (where the steer's
 // acceleration jumps); fills rep.result, checks it (check_run), end_speed, end_yaw_rate. Returns
 // the run's model (the steady one held at the point: the result's q, v are its).
-// beside: a sampled controller beside the file's (a speed hold), or null
+// beside: a sampled controller beside the file's (a speed hold), or null; until: told every output
+// sample (the run's model and the sample) after the rollover check, the run ends where it returns
+// true (not a failure; rep.result ends at that sample)
+using RunUntil = std::function<bool(const Model& run, const Snapshot& sample)>;
 Model open_loop_run(ManeuverReport& rep, const ManeuverRequest& r, const OpenLoop& ol, const SteerProfile& profile,
-                    const std::vector<double>& stops, double t_end, const SampledBeside* beside = nullptr);
+                    const std::vector<double>& stops, double t_end, const SampledBeside* beside = nullptr,
+                    const RunUntil& until = {});
 
 // The driver's position, heading and forward speed (names: the request's, else the file driver's,
 // else the defaults): a name the model has no sensor of (and the request did not give) is measured

@@ -446,6 +446,7 @@ ManeuverReport study_maneuver_job(const ManeuverRequest& r, const ModelSpec& spe
       {r.frequency_max.has_value(), "frequency-max", {"swept-sine"}},
       {r.sweep_time.has_value(), "sweep-time", {"swept-sine"}},
       {r.steer_rate.has_value(), "steer-rate", {"slowly-increasing-steer", "fishhook"}},
+      {r.dwell_roll_rate.has_value(), "dwell-roll-rate", {"fishhook"}},
       {r.speed_min.has_value(), "speed-min", {"constant-radius"}},
       {r.speed_max.has_value(), "speed-max", {"constant-radius"}},
       {r.ay_min.has_value(), "ay-min", {"constant-speed"}},
@@ -639,6 +640,7 @@ std::string study_maneuver_text(const ManeuverReport& r) {
        << " (" << r.sis_time_ay_max << " s)\n";
   } else if (r.type == "fishhook") {
     os << "steer            +-" << std::abs(r.steer) << " (from " << r.steer_start << " s to " << r.steer_end << " s)\n"
+       << "dwell            " << r.fh_dwell << " s" << (r.fh_roll_rate_dwell ? " (until the roll rate fell back)" : "") << "\n"
        << "largest roll     " << r.fh_max_roll * deg << " deg at " << r.fh_max_roll_time << " s\n"
        << "largest a_y      " << r.fh_ay_max << " m/s^2 (" << r.fh_ay_max / 9.80665 << " g)\n"
        << "smallest tire loads\n";

@@ -44,8 +44,9 @@
 //                       against the steady turn's at the speed there, the understeer gradient fitted
 //                       over 0.1 .. 0.3 g against the steady turns' and the handling number
 //                       (maneuver_ramp.cpp).
-//   fishhook            NHTSA (fixed timing): to --steer (6.5 x the steer at 0.3 g) at --steer-rate
-//                       (720 deg/s), --dwell (0.25 s), to the opposite side, held 3 s, back over 2 s;
+//   fishhook            NHTSA: to --steer (6.5 x the steer at 0.3 g) at --steer-rate (720 deg/s),
+//                       --dwell (0.25 s; or, with --dwell-roll-rate R, until the roll rate falls to
+//                       R deg/s: NHTSA's roll-rate feedback), to the opposite side, held 3 s, back over 2 s;
 //                       the largest roll, each tire's smallest load, the first two-wheel lift.
 // Step steer, sine with dwell, slowly increasing steer, fishhook and the double lane change run the model file's controller
 // in the loop (ManeuverRequest::open_loop). An open-loop run stops when the car rolls over (60 deg).
@@ -89,6 +90,9 @@ struct ManeuverRequest {
   // the standards' at the steering wheel); their amplitude --steer, or --steer-scale times the
   // steady steer at 0.3 g (2.5, 6.5)
   std::optional<double> steer_rate;
+  // fishhook with NHTSA's roll-rate feedback: the dwell ends when the steady body's roll rate, having
+  // passed it, falls back to this (deg/s; NHTSA: 1.5); not with dwell
+  std::optional<double> dwell_roll_rate;
   std::optional<double> t_end, output_step;    // s
   std::optional<std::string> integrator;       // the runs' (default the model file's solver)
   std::optional<double> radius;                // constant radius, m
@@ -192,6 +196,9 @@ struct ManeuverReport {
   // the largest |a_y| (the lateral-acceleration output's, or U r without one)
   double fh_max_roll = 0, fh_max_roll_time = 0, fh_lift_time = -1, fh_ay_max = 0;
   std::string fh_lift_side;
+  // the dwell run (s): the one given, or where the roll rate fell to dwell_roll_rate (fh_roll_rate_dwell)
+  double fh_dwell = 0;
+  bool fh_roll_rate_dwell = false;
   std::vector<std::string> fh_tires, fh_sides;
   std::vector<double> fh_min_load, fh_min_load_time;
   // double lane change: the driver's path and the cones of its gates (at the lane's edges, about

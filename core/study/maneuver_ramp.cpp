@@ -5,6 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "dynamics/joint.hpp"
 #include "dynamics/kinematics.hpp"
 #include "dynamics/sensors.hpp"
 #include "model/errors.hpp"
@@ -198,8 +199,35 @@ ManeuverReport slowly_increasing_steer(const ManeuverRequest& r, const ModelSpec
   return rep;
 }
 
+namespace {
+
+// the steady body's roll (atan2(R21, R22) of its rotation) and its rate (the roll's derivative
+// along v: by the tangent step q (+) eps v, eps 1e-7 s)
+struct Roll {
+  double angle = 0, rate = 0;
+};
+Roll body_roll(const Model& m, Data& d, int body, const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
+  const auto angle = [&](const Eigen::VectorXd& x) {
+    forward_kinematics<double>(m, d, x, v);
+    const SE3& X = d.oMi[static_cast<std::size_t>(body)];
+    return std::atan2(X.R(2, 1), X.R(2, 2));
+  };
+  const double eps = 1e-7;
+  Roll r;
+  r.angle = angle(q);
+  const Eigen::VectorXd ahead = integrate<double>(m, q, Eigen::VectorXd(eps * v));
+  r.rate = std::remainder(angle(ahead) - r.angle, 2 * kPi) / eps;
+  return r;
+}
+
+}  // namespace
+
 ManeuverReport fishhook(const ManeuverRequest& r, const ModelSpec& spec) {
   const Flags flag{r.style};
+  if (r.dwell && r.dwell_roll_rate)
+    throw std::invalid_argument(flag("dwell-roll-rate") + ": give the dwell or the roll rate that ends it, not both (" + flag("dwell") + ")");
+  if (r.dwell_roll_rate && (!(*r.dwell_roll_rate > 0) || !std::isfinite(*r.dwell_roll_rate)))
+    throw std::invalid_argument(flag("dwell-roll-rate") + ": expected a roll rate > 0 (deg/s; NHTSA: 1.5)");
   ManeuverReport rep;
   rep.type = r.type;
   const OpenLoop ol = open_loop_setup(r, spec, true);
@@ -210,12 +238,58 @@ ManeuverReport fishhook(const ManeuverRequest& r, const ModelSpec& spec) {
   const double A = ramp_amplitude(rep, r, spec, ol, 6.5);
   rep.steer = A;
   const double rate = ramp_rate(r, 720 * kPi / 180);
-  const double dwell = r.dwell ? *r.dwell : 0.25;
+  double dwell = r.dwell ? *r.dwell : 0.25;
   if (!(dwell >= 0) || !std::isfinite(dwell)) throw std::invalid_argument(flag("dwell") + ": expected a time >= 0");
   const double t0 = r.steer_time ? *r.steer_time : 0.5;
   if (!(t0 >= 0) || !std::isfinite(t0)) throw std::invalid_argument(flag("steer-time") + ": expected a time >= 0");
+  const double t1 = t0 + std::abs(A) / rate;
+  if (r.dwell_roll_rate) {
+    // NHTSA's roll-rate feedback: a first run to A and held there finds where the roll rate, once
+    // past the threshold, falls back to it at or after the steer's peak (linear between samples);
+    // that run and the maneuver's are the same up to there (same profile, stops and samples)
+    const double threshold = *r.dwell_roll_rate * kPi / 180;
+    const double longest = 5.0;  // s of dwell looked through
+    double switch_at = -1, last_t = 0, last_rate = 0;
+    bool armed = false;
+    std::unique_ptr<Data> dd;
+    const RunUntil until = [&](const Model& run, const Snapshot& sn) {
+      if (!dd) dd = std::make_unique<Data>(run);
+      const double p = std::abs(body_roll(run, *dd, ol.body, sn.q, sn.v).rate);
+      const double prev_t = last_t, prev = last_rate;
+      last_t = sn.t, last_rate = p;
+      if (p > threshold) armed = true;
+      if (!armed || sn.t < t1 - 1e-12 || p > threshold) return false;
+      const double crossing = prev > threshold ? prev_t + (prev - threshold) / (prev - p) * (sn.t - prev_t) : sn.t;
+      switch_at = std::max(t1, std::min(crossing, sn.t));
+      return true;
+    };
+    ManeuverReport first;
+    first.type = r.type;
+    open_loop_run(first, r, ol, piecewise_linear({t0, t1}, {0.0, A}), {t0, t1}, t1 + longest, nullptr, until);
+    if (switch_at < 0) {
+      // never fell back (or never rose): the run to A and held is what there is to report
+      std::ostringstream os;
+      os << "the roll rate did not " << (armed ? "fall back to " : "reach ") << *r.dwell_roll_rate << " deg/s within "
+         << longest << " s of the steer's first peak: no roll-rate dwell";
+      if (first.valid) {
+        first.valid = false;
+        first.invalid_reason = os.str();
+      }
+      first.model_name = rep.model_name;
+      first.speed = rep.speed;
+      first.steer = rep.steer;
+      first.steer_03g = rep.steer_03g;
+      first.notes.insert(first.notes.begin(), rep.notes.begin(), rep.notes.end());
+      rep = first;
+      write(rep, r);
+      return rep;
+    }
+    dwell = switch_at - t1;
+    rep.fh_roll_rate_dwell = true;
+  }
+  rep.fh_dwell = dwell;
   // to A, the dwell, through to -A at the same rate, held 3 s, back to zero over 2 s (NHTSA)
-  const double t1 = t0 + std::abs(A) / rate, t2 = t1 + dwell, t3 = t2 + 2 * std::abs(A) / rate, t4 = t3 + 3.0, t5 = t4 + 2.0;
+  const double t2 = t1 + dwell, t3 = t2 + 2 * std::abs(A) / rate, t4 = t3 + 3.0, t5 = t4 + 2.0;
   std::vector<double> knots = {t0, t1}, values = {0.0, A};
   if (dwell > 0) knots.push_back(t2), values.push_back(A);
   for (const auto& [tk, vk] : {std::pair{t3, -A}, std::pair{t4, -A}, std::pair{t5, 0.0}}) knots.push_back(tk), values.push_back(vk);

@@ -10,6 +10,8 @@
 #include <iostream>
 #include <string>
 
+#include "dynamics/data.hpp"
+#include "dynamics/kinematics.hpp"
 #include "study/files.hpp"
 #include "study/maneuver_job.hpp"
 #include "study/tire_contacts.hpp"
@@ -154,6 +156,70 @@ TEST(ManeuverRamp, TheSedansFishhookKeepsItsWheelsOnTheRoadAndItsLoadsAreItsSens
   // the steer's knots: to A at 720 deg/s, the dwell, to -A, held 3 s, back to zero over 2 s
   const double A = rep.steer, rate = 720 * kPiRampTest / 180;
   EXPECT_NEAR(rep.steer_end - rep.steer_start, A / rate + 0.25 + 2 * A / rate + 3 + 2, 1e-12);
+}
+
+// NHTSA's roll-rate feedback on the same sedan: the dwell ends where the roll rate, once past
+// 1.5 deg/s, falls back to it at or after the steer's first peak. Checked from the run's own
+// samples by a second method (the roll's central differences over the 5 ms samples, against the
+// job's derivative along v): past the threshold at every sample of the dwell, at it where the dwell
+// ends (to the differences' error); and the same maneuver with that dwell given as a time is the
+// same run (the fixed-timing path, to round-off).
+TEST(ManeuverRamp, TheFishhooksRollRateDwellEndsWhereTheRollRateFallsBack) {
+  const std::string file = ramp_example("sedan.json");
+  const ModelSpec spec = study_read_model(file);
+  ManeuverRequest r;
+  r.model = file;
+  r.type = "fishhook";
+  r.speed = 22.2;
+  r.output_step = 0.005;
+  r.dwell_roll_rate = 1.5;
+  const ManeuverReport rep = study_maneuver_job(r, spec);
+  std::cout << study_maneuver_text(rep);
+  ASSERT_TRUE(rep.valid) << rep.invalid_reason;
+  ASSERT_TRUE(rep.fh_roll_rate_dwell);
+  const double rate = 720 * kPiRampTest / 180, t1 = rep.steer_start + std::abs(rep.steer) / rate, t2 = t1 + rep.fh_dwell;
+  EXPECT_GT(rep.fh_dwell, 0.05);
+  EXPECT_LT(rep.fh_dwell, 1.0);
+  // the roll of the chassis at every sample, and its rate by central differences
+  ModelSpec straight = spec;
+  straight.analysis.steady.speed = 22.2;
+  const Model m = study_model(straight, file);
+  Data d(m);
+  const int body = m.find_body("chassis");
+  const SimulationResult& res = rep.result;
+  std::vector<double> roll(static_cast<std::size_t>(res.samples()));
+  for (int k = 0; k < res.samples(); ++k) {
+    forward_kinematics<double>(m, d, res.q.row(k).transpose(), res.v.row(k).transpose());
+    const SE3& X = d.oMi[static_cast<std::size_t>(body)];
+    roll[static_cast<std::size_t>(k)] = std::atan2(X.R(2, 1), X.R(2, 2));
+  }
+  const double threshold = 1.5 * kPiRampTest / 180;
+  double at_switch = -1;
+  for (std::size_t k = 1; k + 1 < roll.size(); ++k) {
+    const double t = res.t[k], p = std::abs((roll[k + 1] - roll[k - 1]) / (res.t[k + 1] - res.t[k - 1]));
+    if (t > t1 + 0.006 && t < t2 - 0.006) EXPECT_GT(p, threshold) << "t = " << t;
+    if (at_switch < 0 && t >= t2) {  // between the samples either side of the end of the dwell
+      const double p0 = std::abs((roll[k] - roll[k - 2]) / (res.t[k] - res.t[k - 2]));
+      at_switch = p0 + (p - p0) * (t2 - res.t[k - 1]) / (t - res.t[k - 1]);
+    }
+  }
+  std::cout << "roll rate where the dwell ends, by central differences: " << at_switch * 180 / kPiRampTest << " deg/s\n";
+  EXPECT_NEAR(at_switch, threshold, 0.05 * threshold);
+  // the fixed-timing maneuver with that dwell
+  ManeuverRequest fixed = r;
+  fixed.dwell_roll_rate.reset();
+  fixed.dwell = rep.fh_dwell;
+  const ManeuverReport same = study_maneuver_job(fixed, spec);
+  ASSERT_EQ(same.result.samples(), res.samples());
+  EXPECT_LT((same.result.q - res.q).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_NEAR(same.fh_max_roll, rep.fh_max_roll, 1e-12);
+  EXPECT_FALSE(same.fh_roll_rate_dwell);
+  // both given, or a roll rate <= 0: refused naming the flag
+  fixed.dwell_roll_rate = 1.5;
+  EXPECT_NE(ramp_error(fixed).find("--dwell-roll-rate: give the dwell or the roll rate that ends it, not both"), std::string::npos);
+  fixed.dwell.reset();
+  fixed.dwell_roll_rate = 0;
+  EXPECT_NE(ramp_error(fixed).find("--dwell-roll-rate: expected a roll rate > 0"), std::string::npos) << ramp_error(fixed);
 }
 
 // The same sedan with its chassis' centre of mass 0.5 m higher: the fishhook lifts both inner

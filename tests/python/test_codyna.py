@@ -1046,6 +1046,10 @@ def test_maneuver_is_the_command_lines():
     assert "controller" not in alone and alone["path_error_max"] == pytest.approx(0.30201, rel=1e-4)
     with pytest.raises(ValueError, match="^drive: the driver needs the actuator \"throttle\""):
         ym.maneuver("double-lane-change", drive="throttle")
+    with pytest.raises(ValueError, match="^dwell_roll_rate: give the dwell or the roll rate that ends it, not both"):
+        codyna.Study(car).maneuver("fishhook", dwell=0.2, dwell_roll_rate=1.5)
+    with pytest.raises(ValueError, match="^dwell_roll_rate: the step-steer maneuver does not take it"):
+        codyna.Study(car).maneuver("step-steer", dwell_roll_rate=1.5)
     with pytest.raises(ValueError, match="^type: unknown maneuver"):
         codyna.Study(car).maneuver("slalom")
     # the swept sine: the command line's text; the responses as complex arrays beside the linear ones
