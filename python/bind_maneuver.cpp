@@ -137,6 +137,7 @@ py::dict do_maneuver(const Study& s, const py::dict& options) {
     d["path_error_max"] = rep.path.max_abs;
     d["path_error_rms"] = rep.path.rms;
     d["cones_hit"] = rep.cones_hit;
+    d["cone_clearance"] = vector_of(rep.cone_clearance);  // per section with cones (1, 3, 5-6), m
     // the lane's centre line and its cones, n x 2 (x, y)
     const auto points = [](const std::vector<Eigen::Vector2d>& v) {
       py::array_t<double> a({static_cast<py::ssize_t>(v.size()), static_cast<py::ssize_t>(2)});

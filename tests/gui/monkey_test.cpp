@@ -195,7 +195,9 @@ class MonkeyTest : public QObject {
         // Control view (its Estimate too) or K&C
         QTabWidget* tabs = w->analysisTabs();
         QWidget* pages[] = {w->linearizeView(), w->simulateView(), w->tireView(), w->maneuverView(), w->controlView(), w->kcView()};
-        QWidget* page = pages[rng.bounded(6)];
+        // in turn, not drawn: how many draws the random events take depends on the popups they
+        // meet, so a drawn page could miss a tab in a run (seed 7 once never showed the Tire tab)
+        QWidget* page = pages[(e / 40) % 6];
         tabs->setCurrentWidget(page);
         if (page == w->tireView()) ++tire_tab;
         if (page == w->maneuverView()) ++maneuver_tab;

@@ -1031,6 +1031,8 @@ def test_maneuver_is_the_command_lines():
     assert len(first) >= 4
     assert all(abs(abs(c[1]) - (1.1 * 1.8 + 0.25) / 2) < 1e-9 for c in first)
     assert len(dlc["cones_hit"]) == 1 and dlc["cones_hit"][0].startswith("section 5")
+    # the hit section's clearance is the one below zero
+    assert dlc["cone_clearance"].shape == (3,) and dlc["cone_clearance"][2] < 0 < min(dlc["cone_clearance"][:2])
     with pytest.raises(ValueError, match="^type: unknown maneuver"):
         codyna.Study(car).maneuver("slalom")
     # the swept sine: the command line's text; the responses as complex arrays beside the linear ones
