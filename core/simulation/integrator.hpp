@@ -7,8 +7,8 @@
 //   arkode       SUNDIALS ARKODE ERKStep, adaptive explicit Runge-Kutta (order 4 default); with
 //                loops it projects onto the constraints after every step (postprocess hook)
 //   rk4          fixed-step classical Runge-Kutta (step = max_step, or 1 ms), the reference
-//   alf          index-3 augmented Lagrangian with mass-orthogonal projections, trapezoidal rule at a
-//                fixed step (max_step, or 1 ms): passes singular positions and redundant constraints
+//   alf          index-3 augmented Lagrangian with mass-orthogonal projections, trapezoidal rule with
+//                error control (or a fixed step): passes singular positions and redundant constraints
 // All advance to an exact output/event time (stop time set, no overshoot) and
 // can be reset after a discontinuity (controller sample, projection).
 #pragma once
@@ -31,10 +31,12 @@ struct IntegratorSettings {
   // cvode-bdf / ida: the Newton matrix from the analytic derivatives where the system has them
   // (ClosedLoopSystem::exact_ode_jacobian / exact_dae_jacobian); false: SUNDIALS' difference quotients
   bool exact_jacobian = true;
-  // alf: the penalty alpha (> 0; in the units of the generalized forces per constraint violation)
-  // and the most Newton iterations per step (the step is max_step, default 1 ms)
+  // alf: the penalty alpha (> 0; in the units of the generalized forces per constraint violation),
+  // the most Newton iterations per step, and (alf_fixed_step) every step max_step (default 1 ms)
+  // instead of the error control at rtol, atol (simulation/alf.cpp)
   double alf_penalty = 1e8;
   int alf_iterations = 100;
+  bool alf_fixed_step = false;
 };
 
 class IntegratorFailure : public std::runtime_error {

@@ -19,11 +19,14 @@ struct AlfA02 {
   long steps = 0, iterations = 0;
 };
 
-AlfA02 alf_a02(int N, double h, double t_end, double alpha = 1e8) {
+// h > 0: fixed steps of h; h = 0: error control at rtol = atol = tol
+AlfA02 alf_a02(int N, double h, double t_end, double alpha = 1e8, double tol = 1e-6) {
   const Model m = compile(iftomm::a02_spec(N));
   SimulationOptions o;
   o.integrator.method = "alf";
   o.integrator.max_step = h;
+  o.integrator.alf_fixed_step = h > 0;
+  o.integrator.rtol = o.integrator.atol = tol;
   o.integrator.alf_penalty = alpha;
   o.t_end = t_end;
   o.output_step = 0.01;
@@ -32,15 +35,15 @@ AlfA02 alf_a02(int N, double h, double t_end, double alpha = 1e8) {
   AlfA02 a;
   a.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   a.completed = r.completed;
-  const int c0 = m.joints[static_cast<std::size_t>(m.find_joint("pivot0"))].idx_q;
   const Eigen::VectorXd exact = iftomm::a02_exact(N, r.t);
-  for (int i = 0; i < r.samples(); ++i) {
-    a.err = std::max(a.err, std::abs(r.q(i, c0) - exact[i]));
-    a.drift = std::max(a.drift, r.constraint_violation[i]);
+  for (int k = 0; k <= N; ++k) {  // every crank turns as phi(t)
+    const int c = m.joints[static_cast<std::size_t>(m.find_joint("pivot" + std::to_string(k)))].idx_q;
+    for (int i = 0; i < r.samples(); ++i) a.err = std::max(a.err, std::abs(r.q(i, c) - exact[i]));
   }
+  for (int i = 0; i < r.samples(); ++i) a.drift = std::max(a.drift, r.constraint_violation[i]);
   a.steps = r.stats.steps;
   a.iterations = r.stats.nonlinear_iterations;
-  std::cout << "alf A02 N = " << N << ", h = " << h << ", alpha = " << alpha << ": " << (r.completed ? "completed" : r.failure)
+  std::cout << "alf A02 N = " << N << ", h = " << h << ", tol = " << tol << ", alpha = " << alpha << ": " << (r.completed ? "completed" : r.failure)
             << "; |phi - exact| " << a.err << " rad, max |phi| " << a.drift << "; " << a.steps << " steps, " << a.iterations
             << " iterations, " << a.wall << " s\n";
   return a;
@@ -50,7 +53,18 @@ TEST(Alf, Explore) {
   const char* env = std::getenv("ALF_EXPLORE");
   if (!env) GTEST_SKIP();
   const int N = std::atoi(env);
-  for (double h : {1e-2, 5e-3, 2e-3, 1e-3, 5e-4}) alf_a02(N, h, 20.0);
+  const double alpha = std::getenv("ALF_ALPHA") ? std::atof(std::getenv("ALF_ALPHA")) : 1e8;
+  if (!std::getenv("ALF_NOFIXED"))
+    for (double h : {1e-2, 5e-3, 2e-3, 1e-3, 5e-4}) alf_a02(N, h, 20.0, alpha);
+  if (const char* one = std::getenv("ALF_H")) {
+    alf_a02(N, std::atof(one), std::getenv("ALF_TEND") ? std::atof(std::getenv("ALF_TEND")) : 20.0, alpha);
+    return;
+  }
+  if (const char* one = std::getenv("ALF_TOL")) {
+    alf_a02(N, 0, std::getenv("ALF_TEND") ? std::atof(std::getenv("ALF_TEND")) : 20.0, alpha, std::atof(one));
+    return;
+  }
+  for (double tol : {1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9}) alf_a02(N, 0, 20.0, alpha, tol);
 }
 
 }  // namespace
