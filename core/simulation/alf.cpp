@@ -9,12 +9,17 @@
 //   lambda* += alpha phi after each iteration (the multipliers, kept from step to step);
 // then v and a projected onto the constraints' tangent (mass-orthogonally):
 //   (M + h^2/4 Jc^T alpha Jc) v = M v*,   (M + h^2/4 Jc^T alpha Jc) a = M a* - h^2/4 Jc^T alpha gamma.
-// Newton stops when every correction is within 0.1 of the error weight atol + rtol |q_i|.
+// Newton stops when every correction is within 1e-3 of the error weight atol + rtol |q_i| or
+// within 1e-10 (1 + |q_i|), whichever is larger.
 // The step: error control by default. The trapezoidal rule's local error in q is h^3/12 q''',
-// estimated as h^2/12 (a_n+1 - a_n) with the projected accelerations; a step is accepted when
-// that is within the weights atol + rtol |q_i| everywhere, and the next step is
-// h 0.9 err^(-1/3) (between 0.2 h and 2 h, at most max_step when max_step > 0); a rejected step
-// or one whose Newton does not converge is retried shorter. IntegratorSettings::alf_fixed_step:
+// estimated as h^2/12 (a_n+1 - a_n) with the projected accelerations and taken per unit step
+// (divided by h: the global error of a second-order method is that sum); a step is accepted
+// when h/12 |a_n+1 - a_n| is within the weights atol + rtol |q_i| everywhere, and the next step
+// is h 0.9 err^(-1/2) (between 0.2 h and 2 h, at most max_step when max_step > 0); a rejected
+// step is retried at 0.1..0.5 of itself, one whose Newton does not converge at a quarter.
+// The penalty: alf_penalty for steps of 10 ms and longer, alf_penalty (10 ms / h)^2 for shorter
+// ones (the weight h^2/4 alpha of Jc^T Jc against M held; with alpha itself the multipliers'
+// iteration stalls at short steps, each iteration shrinking the error only by 1/(1 + h^2/4 alpha s^2 / m)). IntegratorSettings::alf_fixed_step:
 // every step max_step (default 1 ms), no error control.
 // Additive coordinates only (no ball or free joint), no effect states and no continuous controller
 // states: refused by name otherwise. The penalty and the iterations are alf_penalty and
@@ -99,8 +104,9 @@ class Alf final : public Integrator {
       return;
     }
     while (t_ < t_out) {
-      double h = std::min(next_, t_out - t_);
-      if (t_out - t_ - h < 1e-3 * h) h = t_out - t_;  // no sliver left before the stop
+      // to the stop in one step, or two equal ones when one would leave a sliver
+      const double rest = t_out - t_;
+      double h = rest <= next_ * (1 + 1e-3) ? rest : rest < 2 * next_ ? rest / 2 : next_;
       for (int tries = 0;; ++tries) {
         if (tries > 60 || h < 1e-12 * std::max(1.0, std::abs(t_)))
           throw IntegratorFailure(t_, "alf: no step down to " + number(h) + " s passes the Newton iteration and the error test");
@@ -163,7 +169,9 @@ class Alf final : public Integrator {
     const Eigen::VectorXd vhat = (2 / h) * q_ + v_, ahat = (4 / (h * h)) * q_ + (4 / h) * v_ + a_;
     Eigen::VectorXd q = q_ + h * v_ + (h * h / 2) * a_, v, a;
     Eigen::VectorXd lambda = lambda_;
-    const Eigen::ArrayXd w = atol_ + rtol_ * q_.array().abs();
+    // Newton's test: each correction within kNewton of the error weight, but no tighter than
+    // kNewtonFloor (1 + |q_i|) (the multipliers' iteration creeps near a singular position)
+    const Eigen::ArrayXd w = (kNewton * (atol_ + rtol_ * q_.array().abs())).max(kNewtonFloor * (1 + q_.array().abs()));
     bool converged = false;
     double last = 0;
     for (int it = 0; it < iterations_; ++it) {
@@ -187,7 +195,7 @@ class Alf final : public Integrator {
       if (trace_)
         std::fprintf(stderr, "t %.9g h %g it %d |dq|/w %g |dq| %g |phi| %g\n", t1, h, it, last, dq.cwiseAbs().maxCoeff(),
                      m_.nc ? d_.phi.cwiseAbs().maxCoeff() : 0.0);
-      if (last <= kNewton) {
+      if (last <= 1) {
         converged = true;
         break;
       }
@@ -269,7 +277,7 @@ class Alf final : public Integrator {
     ++factorizations_;
   }
 
-  static constexpr double kNewton = 1e-3;
+  static constexpr double kNewton = 1e-3, kNewtonFloor = 1e-10;
   static constexpr double kPenaltyStep = 1e-2;
   ClosedLoopSystem& sys_;
   const Model& m_;

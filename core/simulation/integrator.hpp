@@ -31,10 +31,12 @@ struct IntegratorSettings {
   // cvode-bdf / ida: the Newton matrix from the analytic derivatives where the system has them
   // (ClosedLoopSystem::exact_ode_jacobian / exact_dae_jacobian); false: SUNDIALS' difference quotients
   bool exact_jacobian = true;
-  // alf: the penalty alpha (> 0; in the units of the generalized forces per constraint violation),
+  // alf: the penalty alpha (> 0; in the units of the generalized forces per constraint violation;
+  // used as alpha (10 ms / h)^2 at steps h under 10 ms; 1e11: A02's multipliers converge near the
+  // flat position at tolerances to 1e-7, 1e8 stalls there below 1e-4, measured),
   // the most Newton iterations per step, and (alf_fixed_step) every step max_step (default 1 ms)
   // instead of the error control at rtol, atol (simulation/alf.cpp)
-  double alf_penalty = 1e8;
+  double alf_penalty = 1e11;
   int alf_iterations = 100;
   bool alf_fixed_step = false;
 };
