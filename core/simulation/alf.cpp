@@ -165,7 +165,9 @@ class Alf final : public Integrator {
     h_now_ = h;
     // the penalty as given for steps of kPenaltyStep and longer, alpha (kPenaltyStep / h)^2 below:
     // h^2/4 alpha, its weight against M in the Newton matrix, no smaller than at kPenaltyStep
-    const double alpha = alpha_now_ = alpha_given_ * std::max(1.0, (kPenaltyStep / h) * (kPenaltyStep / h));
+    // and never above kPenaltyMax by that rule (lambda += alpha phi: phi's rounding times alpha)
+    const double alpha = alpha_now_ =
+        std::max(alpha_given_, std::min(kPenaltyMax, alpha_given_ * (kPenaltyStep / h) * (kPenaltyStep / h)));
     const Eigen::VectorXd vhat = (2 / h) * q_ + v_, ahat = (4 / (h * h)) * q_ + (4 / h) * v_ + a_;
     Eigen::VectorXd q = q_ + h * v_ + (h * h / 2) * a_, v, a;
     Eigen::VectorXd lambda = lambda_;
@@ -278,7 +280,7 @@ class Alf final : public Integrator {
   }
 
   static constexpr double kNewton = 1e-3, kNewtonFloor = 1e-10;
-  static constexpr double kPenaltyStep = 1e-2;
+  static constexpr double kPenaltyStep = 1e-2, kPenaltyMax = 1e13;
   ClosedLoopSystem& sys_;
   const Model& m_;
   Data d_;
