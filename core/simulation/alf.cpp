@@ -183,8 +183,7 @@ class Alf final : public Integrator {
       Eigen::VectorXd f = d_.M * a + bias_;
       if (m_.nc) f += d_.Jc.transpose() * (lambda + alpha * d_.phi);
       f *= c;
-      if (fd_) fd_matrix(t1, q, lambda, f, h, vhat, ahat);
-      else newton_matrix();
+      newton_matrix();
       const Eigen::VectorXd dq = -lu_.solve(f);
       q += dq;
       ++iterations_done_;
@@ -247,30 +246,6 @@ class Alf final : public Integrator {
     throw IntegratorFailure(t1, os.str());
   }
 
-  Eigen::VectorXd residual(double t1, const Eigen::VectorXd& q, const Eigen::VectorXd& lambda, double h,
-                           const Eigen::VectorXd& vhat, const Eigen::VectorXd& ahat) {
-    const Eigen::VectorXd v = (2 / h) * q - vhat, a = (4 / (h * h)) * q - ahat;
-    evaluate(t1, q, v);
-    Eigen::VectorXd f = d_.M * a + bias_;
-    if (m_.nc) f += d_.Jc.transpose() * (lambda + alpha_now_ * d_.phi);
-    return (h * h / 4) * f;
-  }
-  // experiment: the full tangent by differences of the residual
-  void fd_matrix(double t1, const Eigen::VectorXd& q, const Eigen::VectorXd& lambda, const Eigen::VectorXd& f, double h,
-                 const Eigen::VectorXd& vhat, const Eigen::VectorXd& ahat) {
-    K_.resize(m_.nv, m_.nv);
-    Eigen::VectorXd qp = q;
-    for (int j = 0; j < m_.nv; ++j) {
-      const double e = 1e-7 * (1 + std::abs(q[j]));
-      qp[j] = q[j] + e;
-      K_.col(j) = (residual(t1, qp, lambda, h, vhat, ahat) - f) / e;
-      qp[j] = q[j];
-    }
-    residual(t1, q, lambda, h, vhat, ahat);
-    lu_.compute(K_);
-    ++factorizations_;
-  }
-
   // M + h^2/4 Jc^T alpha Jc at the last evaluation, factored
   void newton_matrix() {
     K_ = d_.M;
@@ -287,7 +262,7 @@ class Alf final : public Integrator {
   double h_, alpha_given_, alpha_now_ = 0;
   int iterations_;
   double rtol_, atol_;
-  bool fixed_, trace_, fd_ = std::getenv("ALF_FD") != nullptr;
+  bool fixed_, trace_;  // trace_: ALF_TRACE set, each Newton iteration printed
   double next_ = 0, last_failure_ = 0, h_now_ = 0, t_ = 0;
   Eigen::VectorXd q_, v_, a_, xc_, lambda_, bias_, qn_, vn_, an_, lambdan_;
   Eigen::MatrixXd K_;
