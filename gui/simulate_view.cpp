@@ -296,7 +296,7 @@ void SimulateView::buildUi() {
   for (const char* name : codyna::kIntegratorNames) integrator_->addItem(QLatin1String(name), QLatin1String(name));
   integrator_->setToolTip(tr("auto chooses from the eigenvalues at the start (stiff: cvode-bdf; otherwise cvode-adams "
                              "for trees, arkode for closed loops; the choice is reported); or ida, cvode-bdf, "
-                             "cvode-adams, arkode, the fixed-step rk4"));
+                             "cvode-adams, arkode, the fixed-step rk4, alf (closed loops through singular positions)"));
   form->addRow(tr("Integrator"), integrator_);
   rtol_ = new QLineEdit(solver_box);
   atol_ = new QLineEdit(solver_box);

@@ -1189,6 +1189,9 @@ class Compiler {
     positive(s.t_end, "t_end");
     positive(s.output_step, "output_step");
     if (!std::isfinite(s.max_step) || s.max_step < 0) fail("/solver/max_step", "expected a non-negative number (0 = no limit)");
+    if (s.integrator == "alf" && s.max_step > s.t_end)
+      fail("/solver/max_step", "alf: a step of " + compile_number(s.max_step) + " s is longer than the run (t_end " +
+                                   compile_number(s.t_end) + " s)");
   }
 
   void initial_state() {

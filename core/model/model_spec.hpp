@@ -371,7 +371,7 @@ struct ControllerSpec {
 // Every integrator a run can name, "auto" first (chosen per model at the start of a run,
 // simulation/integrator_choice.hpp): the one list the file check, the CLI's help, the GUI's
 // drop-down and the errors are made from.
-inline constexpr const char* kIntegratorNames[] = {"auto", "ida", "cvode-bdf", "cvode-adams", "arkode", "rk4"};
+inline constexpr const char* kIntegratorNames[] = {"auto", "ida", "cvode-bdf", "cvode-adams", "arkode", "rk4", "alf"};
 bool is_integrator_name(const std::string& name);
 // the names joined by `separator` ("auto, ida, ..."); without "auto" when `with_auto` is false
 std::string integrator_names(const std::string& separator = ", ", bool with_auto = true);

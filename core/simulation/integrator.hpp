@@ -7,6 +7,8 @@
 //   arkode       SUNDIALS ARKODE ERKStep, adaptive explicit Runge-Kutta (order 4 default); with
 //                loops it projects onto the constraints after every step (postprocess hook)
 //   rk4          fixed-step classical Runge-Kutta (step = max_step, or 1 ms), the reference
+//   alf          index-3 augmented Lagrangian with mass-orthogonal projections, trapezoidal rule with
+//                error control (or a fixed step): passes singular positions and redundant constraints
 // All advance to an exact output/event time (stop time set, no overshoot) and
 // can be reset after a discontinuity (controller sample, projection).
 #pragma once
@@ -29,6 +31,14 @@ struct IntegratorSettings {
   // cvode-bdf / ida: the Newton matrix from the analytic derivatives where the system has them
   // (ClosedLoopSystem::exact_ode_jacobian / exact_dae_jacobian); false: SUNDIALS' difference quotients
   bool exact_jacobian = true;
+  // alf: the penalty alpha (> 0; in the units of the generalized forces per constraint violation;
+  // used as alpha (10 ms / h)^2 at steps h under 10 ms; 1e11: A02's multipliers converge near the
+  // flat position at tolerances to 1e-7, 1e8 stalls there below 1e-4, measured),
+  // the most Newton iterations per step, and (alf_fixed_step) every step max_step (default 1 ms)
+  // instead of the error control at rtol, atol (simulation/alf.cpp)
+  double alf_penalty = 1e11;
+  int alf_iterations = 100;
+  bool alf_fixed_step = false;
 };
 
 class IntegratorFailure : public std::runtime_error {
@@ -69,6 +79,10 @@ class OdeIntegrator {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// the index-3 augmented Lagrangian integrator (simulation/alf.cpp); throws std::invalid_argument
+// for a model it does not take or bad settings, naming them
+std::unique_ptr<Integrator> make_alf_integrator(ClosedLoopSystem& system, const IntegratorSettings& settings);
 
 // throws std::invalid_argument for an unknown method or bad tolerances, and for "auto", which
 // the caller resolves first (choose_integrator)

@@ -382,6 +382,7 @@ std::unique_ptr<Integrator> make_integrator(ClosedLoopSystem& system, const Inte
   if (s.method == "cvode-adams") return std::make_unique<Cvode>(system, s, false);
   if (s.method == "arkode") return std::make_unique<Erk>(system, s);
   if (s.method == "rk4") return std::make_unique<Rk4>(system, s);
+  if (s.method == "alf") return make_alf_integrator(system, s);
   if (s.method == "auto")
     throw std::invalid_argument("integrator \"auto\" is chosen from the model's state: resolve it with choose_integrator first");
   throw std::invalid_argument("unknown integrator \"" + s.method + "\" (expected one of: " + integrator_names(", ", false) + ")");

@@ -1,0 +1,279 @@
+// alf: the index-3 augmented Lagrangian formulation with mass-orthogonal projections of the
+// velocities and accelerations (Bayo and Ledesma 1996; Cuadrado, Cardenal, Bayo 1997, "ALI3-P"),
+// integrated by the trapezoidal rule. It never inverts the constraint Jacobian alone: the Newton
+// matrix is M + (h^2/4) Jc^T alpha Jc, regular while M is, whatever the rank of Jc, so it passes
+// singular positions (a four-bar's flat position, IFToMM A02) and takes redundant constraints
+// (Bricard) as they are. Per step h, from (q_n, v_n, a_n):
+//   q^ = q_n + h v_n + h^2/2 a_n,  v = 2/h q - (2/h q_n + v_n),  a = 4/h^2 q - (4/h^2 q_n + 4/h v_n + a_n)
+//   f(q) = h^2/4 (M a + nle - Q + Jc^T (lambda* + alpha phi)),  Newton on f = 0 with the matrix above,
+//   lambda* += alpha phi after each iteration (the multipliers, kept from step to step);
+// then v and a projected onto the constraints' tangent (mass-orthogonally):
+//   (M + h^2/4 Jc^T alpha Jc) v = M v*,   (M + h^2/4 Jc^T alpha Jc) a = M a* - h^2/4 Jc^T alpha gamma.
+// Newton stops when every correction is within 1e-3 of the error weight atol + rtol |q_i| or
+// within 1e-10 (1 + |q_i|), whichever is larger.
+// The step: error control by default. The trapezoidal rule's local error in q is h^3/12 q''',
+// estimated as h^2/12 (a_n+1 - a_n) with the projected accelerations and taken per unit step
+// (divided by h: the global error of a second-order method is that sum); a step is accepted
+// when h/12 |a_n+1 - a_n| is within the weights atol + rtol |q_i| everywhere, and the next step
+// is h 0.9 err^(-1/2) (between 0.2 h and 2 h, at most max_step when max_step > 0); a rejected
+// step is retried at 0.1..0.5 of itself, one whose Newton does not converge at a quarter.
+// The penalty: alf_penalty for steps of 10 ms and longer, alf_penalty (10 ms / h)^2 for shorter
+// ones (the weight h^2/4 alpha of Jc^T Jc against M held; with alpha itself the multipliers'
+// iteration stalls at short steps, each iteration shrinking the error only by 1/(1 + h^2/4 alpha s^2 / m)). IntegratorSettings::alf_fixed_step:
+// every step max_step (default 1 ms), no error control.
+// Additive coordinates only (no ball or free joint), no effect states and no continuous controller
+// states: refused by name otherwise. The penalty and the iterations are alf_penalty and
+// alf_iterations.
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+
+#include "dynamics/constraints.hpp"
+#include "dynamics/crba.hpp"
+#include "dynamics/effects.hpp"
+#include "dynamics/forward_dynamics.hpp"
+#include "dynamics/kinematics.hpp"
+#include "dynamics/rnea.hpp"
+#include "simulation/closed_loop.hpp"
+#include "simulation/integrator.hpp"
+
+namespace codyna {
+
+namespace {
+
+std::string number(double x) {
+  std::ostringstream os;
+  os << x;
+  return os.str();
+}
+
+class Alf final : public Integrator {
+ public:
+  Alf(ClosedLoopSystem& sys, const IntegratorSettings& s)
+      : sys_(sys), m_(sys.model()), d_(sys.model()), h_(s.max_step), alpha_given_(s.alf_penalty), iterations_(s.alf_iterations),
+        rtol_(s.rtol), atol_(s.atol), fixed_(s.alf_fixed_step), trace_(std::getenv("ALF_TRACE") != nullptr) {
+    if (!(alpha_given_ > 0) || !std::isfinite(alpha_given_))
+      throw std::invalid_argument("integrator alf: alf_penalty: expected a number > 0, got " + number(alpha_given_));
+    if (iterations_ < 1)
+      throw std::invalid_argument("integrator alf: alf_iterations: expected at least 1, got " + std::to_string(iterations_));
+    if (!(h_ >= 0) || !std::isfinite(h_))
+      throw std::invalid_argument("integrator alf: max_step: expected a number >= 0, got " + number(h_));
+    if (!(rtol_ > 0) || !(atol_ > 0))
+      throw std::invalid_argument("integrator alf: rtol and atol: expected numbers > 0");
+    if (fixed_ && h_ == 0) h_ = 1e-3;
+    if (m_.nq != m_.nv)
+      throw std::invalid_argument("integrator alf: the model has ball or free joints (their quaternions are not additive "
+                                  "coordinates): not integrated by alf yet");
+    if (m_.ns > 0) throw std::invalid_argument("integrator alf: the model has effect states (a tire's transient slip): not integrated by alf yet");
+    if (sys.nxc() > 0) throw std::invalid_argument("integrator alf: the controller has continuous states: not integrated by alf yet");
+    if (!m_.motions.empty()) throw std::invalid_argument("integrator alf: the model has motion inputs: not integrated by alf yet");
+  }
+
+  void reset(double t, const Eigen::VectorXd& y) override {
+    t_ = t;
+    q_ = y.head(m_.nq);
+    v_ = y.segment(m_.nq, m_.nv);
+    xc_ = y.tail(y.size() - m_.nq - m_.nv);
+    // the accelerations and multipliers of the constrained dynamics there
+    const Eigen::VectorXd u = sys_.inputs(t, q_, v_, xc_);
+    a_ = forward_dynamics<double>(m_, d_, q_, v_, u);
+    lambda_ = m_.nc ? Eigen::VectorXd(d_.lambda) : Eigen::VectorXd();
+    if (!a_.allFinite()) throw IntegratorFailure(t, "alf: the accelerations at the start are not finite");
+    if (next_ <= 0) {  // the first step: a small fraction of what the accelerations allow
+      const Eigen::ArrayXd w = atol_ + rtol_ * q_.array().abs();
+      const double acc = (a_.array().abs() / w).maxCoeff();
+      next_ = acc > 0 ? 0.5 * std::sqrt(1.0 / acc) : 1e-3;
+      next_ = std::clamp(next_, 1e-6, 1e-2);
+      if (h_ > 0) next_ = std::min(next_, h_);
+    }
+  }
+
+  void advance(double t_out) override {
+    if (fixed_) {  // the interval in equal steps of at most h_
+      const int n = std::max(1, static_cast<int>(std::ceil((t_out - t_) / h_ - 1e-9)));
+      const double h = (t_out - t_) / n, t0 = t_;
+      for (int i = 0; i < n; ++i) {
+        if (!step(h)) fail_newton(t_ + h, h);
+        accept(i + 1 == n ? t_out : t0 + (i + 1) * h);
+      }
+      return;
+    }
+    while (t_ < t_out) {
+      // to the stop in one step, or two equal ones when one would leave a sliver
+      const double rest = t_out - t_;
+      double h = rest <= next_ * (1 + 1e-3) ? rest : rest < 2 * next_ ? rest / 2 : next_;
+      for (int tries = 0;; ++tries) {
+        if (tries > 60 || h < 1e-12 * std::max(1.0, std::abs(t_)))
+          throw IntegratorFailure(t_, "alf: no step down to " + number(h) + " s passes the Newton iteration and the error test");
+        if (!step(h)) {
+          h *= 0.25;
+          continue;
+        }
+        const double err = error_estimate(h);
+        if (err > 1) {
+          ++rejected_;
+          h *= std::clamp(0.9 * std::pow(err, -0.5), 0.1, 0.5);
+          continue;
+        }
+        const bool last = t_out - t_ - h <= 1e-12 * std::max(1.0, std::abs(t_out));
+        accept(last ? t_out : t_ + h);
+        // the next step from this one's error; the step cut only to reach the stop is not a limit
+        next_ = std::max(next_ * (last ? 1.0 : 0.0), h * std::clamp(0.9 * std::pow(std::max(err, 1e-8), -0.5), 0.2, 2.0));
+        if (h_ > 0) next_ = std::min(next_, h_);
+        break;
+      }
+    }
+  }
+
+  Eigen::VectorXd state() const override {
+    Eigen::VectorXd y(m_.nq + m_.nv + xc_.size());
+    y << q_, v_, xc_;
+    return y;
+  }
+  bool projects() const override { return true; }
+  void add_stats(SolverStats& s) const override {
+    s.steps += steps_;
+    s.rhs_evals += evaluations_;
+    s.jac_evals += factorizations_;
+    s.nonlinear_iterations += iterations_done_;
+    s.nonlinear_failures += failures_;
+    s.error_test_failures += rejected_;
+  }
+
+ private:
+  // M, nle - Q, and (loops) phi, Jc, gamma at (q, v) and time t
+  void evaluate(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
+    ++evaluations_;
+    const Eigen::VectorXd u = sys_.inputs(t, q, v, xc_);
+    forward_kinematics<double>(m_, d_, q, v);
+    const Eigen::VectorXd Q = applied_forces<double>(m_, d_, q, v, u);
+    crba<double>(m_, d_, q);
+    nonlinear_effects<double>(m_, d_, q, v);
+    bias_ = d_.nle - Q;
+    if (m_.nc) constraint_terms<double>(m_, d_, q, v);
+  }
+
+  // one trapezoidal step of h from (t_, q_, v_, a_, lambda_) into (qn_, vn_, an_, lambdan_);
+  // false when Newton does not converge
+  bool step(double h) {
+    const double t1 = t_ + h, c = h * h / 4;
+    h_now_ = h;
+    // the penalty as given for steps of kPenaltyStep and longer, alpha (kPenaltyStep / h)^2 below:
+    // h^2/4 alpha, its weight against M in the Newton matrix, no smaller than at kPenaltyStep
+    // and never above kPenaltyMax by that rule (lambda += alpha phi: phi's rounding times alpha)
+    const double alpha = alpha_now_ =
+        std::max(alpha_given_, std::min(kPenaltyMax, alpha_given_ * (kPenaltyStep / h) * (kPenaltyStep / h)));
+    const Eigen::VectorXd vhat = (2 / h) * q_ + v_, ahat = (4 / (h * h)) * q_ + (4 / h) * v_ + a_;
+    Eigen::VectorXd q = q_ + h * v_ + (h * h / 2) * a_, v, a;
+    Eigen::VectorXd lambda = lambda_;
+    // Newton's test: each correction within kNewton of the error weight, but no tighter than
+    // kNewtonFloor (1 + |q_i|) (the multipliers' iteration creeps near a singular position)
+    const Eigen::ArrayXd w = (kNewton * (atol_ + rtol_ * q_.array().abs())).max(kNewtonFloor * (1 + q_.array().abs()));
+    bool converged = false;
+    double last = 0;
+    for (int it = 0; it < iterations_; ++it) {
+      v = (2 / h) * q - vhat;
+      a = (4 / (h * h)) * q - ahat;
+      evaluate(t1, q, v);
+      Eigen::VectorXd f = d_.M * a + bias_;
+      if (m_.nc) f += d_.Jc.transpose() * (lambda + alpha * d_.phi);
+      f *= c;
+      newton_matrix();
+      const Eigen::VectorXd dq = -lu_.solve(f);
+      q += dq;
+      ++iterations_done_;
+      if (m_.nc) {
+        constraint_residual<double>(m_, d_, q);
+        lambda += alpha * d_.phi;
+      }
+      if (!dq.allFinite()) break;
+      last = (dq.array().abs() / w).maxCoeff();
+      if (trace_)
+        std::fprintf(stderr, "t %.9g h %g it %d |dq|/w %g |dq| %g |phi| %g\n", t1, h, it, last, dq.cwiseAbs().maxCoeff(),
+                     m_.nc ? d_.phi.cwiseAbs().maxCoeff() : 0.0);
+      if (last <= 1) {
+        converged = true;
+        break;
+      }
+    }
+    if (!converged) {
+      ++failures_;
+      last_failure_ = last;
+      return false;
+    }
+    // the mass-orthogonal projections of v and a onto the constraints at q
+    v = (2 / h) * q - vhat;
+    a = (4 / (h * h)) * q - ahat;
+    evaluate(t1, q, v);
+    if (m_.nc) {
+      newton_matrix();
+      v = lu_.solve(d_.M * v);
+      constraint_terms<double>(m_, d_, q, v);  // gamma at the projected velocities
+      a = lu_.solve(d_.M * a - c * alpha * (d_.Jc.transpose() * d_.gamma));
+    }
+    if (!q.allFinite() || !v.allFinite() || !a.allFinite()) return false;
+    qn_ = q;
+    vn_ = v;
+    an_ = a;
+    lambdan_ = lambda;
+    return true;
+  }
+
+  // the local error in q, h^2/12 (a_n+1 - a_n), in the weights atol + rtol |q| (<= 1: accepted)
+  double error_estimate(double h) const {
+    const Eigen::ArrayXd w = atol_ + rtol_ * q_.array().abs().max(qn_.array().abs());
+    return ((h / 12) * (an_ - a_).array().abs() / w).maxCoeff();
+  }
+
+  void accept(double t1) {
+    q_ = qn_;
+    v_ = vn_;
+    a_ = an_;
+    lambda_ = lambdan_;
+    t_ = t1;
+    ++steps_;
+  }
+
+  [[noreturn]] void fail_newton(double t1, double h) {
+    std::ostringstream os;
+    os << "alf: Newton did not converge in " << iterations_ << " iterations at step " << h << " s (the last correction "
+       << last_failure_ << " times its tolerance; alf_iterations; a smaller step, max_step, or another alf_penalty)";
+    throw IntegratorFailure(t1, os.str());
+  }
+
+  // M + h^2/4 Jc^T alpha Jc at the last evaluation, factored
+  void newton_matrix() {
+    K_ = d_.M;
+    if (m_.nc) K_.noalias() += (h_now_ * h_now_ / 4 * alpha_now_) * (d_.Jc.transpose() * d_.Jc);
+    lu_.compute(K_);
+    ++factorizations_;
+  }
+
+  static constexpr double kNewton = 1e-3, kNewtonFloor = 1e-10;
+  static constexpr double kPenaltyStep = 1e-2, kPenaltyMax = 1e13;
+  ClosedLoopSystem& sys_;
+  const Model& m_;
+  Data d_;
+  double h_, alpha_given_, alpha_now_ = 0;
+  int iterations_;
+  double rtol_, atol_;
+  bool fixed_, trace_;  // trace_: ALF_TRACE set, each Newton iteration printed
+  double next_ = 0, last_failure_ = 0, h_now_ = 0, t_ = 0;
+  Eigen::VectorXd q_, v_, a_, xc_, lambda_, bias_, qn_, vn_, an_, lambdan_;
+  Eigen::MatrixXd K_;
+  Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
+  long steps_ = 0, evaluations_ = 0, factorizations_ = 0, iterations_done_ = 0, failures_ = 0, rejected_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<Integrator> make_alf_integrator(ClosedLoopSystem& system, const IntegratorSettings& settings) {
+  return std::make_unique<Alf>(system, settings);
+}
+
+}  // namespace codyna
