@@ -46,7 +46,7 @@ namespace codyna {
 
 namespace {
 
-std::string number(double x) {
+std::string alf_number(double x) {
   std::ostringstream os;
   os << x;
   return os.str();
@@ -58,11 +58,11 @@ class Alf final : public Integrator {
       : sys_(sys), m_(sys.model()), d_(sys.model()), h_(s.max_step), alpha_given_(s.alf_penalty), iterations_(s.alf_iterations),
         rtol_(s.rtol), atol_(s.atol), fixed_(s.alf_fixed_step), trace_(std::getenv("ALF_TRACE") != nullptr) {
     if (!(alpha_given_ > 0) || !std::isfinite(alpha_given_))
-      throw std::invalid_argument("integrator alf: alf_penalty: expected a number > 0, got " + number(alpha_given_));
+      throw std::invalid_argument("integrator alf: alf_penalty: expected a number > 0, got " + alf_number(alpha_given_));
     if (iterations_ < 1)
       throw std::invalid_argument("integrator alf: alf_iterations: expected at least 1, got " + std::to_string(iterations_));
     if (!(h_ >= 0) || !std::isfinite(h_))
-      throw std::invalid_argument("integrator alf: max_step: expected a number >= 0, got " + number(h_));
+      throw std::invalid_argument("integrator alf: max_step: expected a number >= 0, got " + alf_number(h_));
     if (!(rtol_ > 0) || !(atol_ > 0))
       throw std::invalid_argument("integrator alf: rtol and atol: expected numbers > 0");
     if (fixed_ && h_ == 0) h_ = 1e-3;
@@ -109,7 +109,7 @@ class Alf final : public Integrator {
       double h = rest <= next_ * (1 + 1e-3) ? rest : rest < 2 * next_ ? rest / 2 : next_;
       for (int tries = 0;; ++tries) {
         if (tries > 60 || h < 1e-12 * std::max(1.0, std::abs(t_)))
-          throw IntegratorFailure(t_, "alf: no step down to " + number(h) + " s passes the Newton iteration and the error test");
+          throw IntegratorFailure(t_, "alf: no step down to " + alf_number(h) + " s passes the Newton iteration and the error test");
         if (!step(h)) {
           h *= 0.25;
           continue;
