@@ -305,8 +305,9 @@ ManeuverReport mnv_lane_change(const ManeuverRequest& r, const ModelSpec& spec) 
                     mnv_find(sensors, names.y, label(r.y.has_value(), "y", "y"), "sensor"),
                     mnv_find(sensors, names.yaw, label(r.yaw.has_value(), "yaw", "yaw"), "sensor"),
                     mnv_find(sensors, names.speed, label(r.speed_output.has_value(), "speed-output", "forward_speed"), "sensor")};
-  const std::string steer_label =
-      from_file ? file_field + "steer" : s.analysis.handling.steer.empty() ? flag("driver") + " steer" : (m.source_file.empty() ? "" : m.source_file + ": ") + "/analysis/handling/steer";
+  // the steer: the file's driver's, else the study's handling steer (default "steer")
+  const std::string steer_label = from_file ? file_field + "steer"
+                                            : (m.source_file.empty() ? "" : m.source_file + ": ") + "/analysis/handling/steer";
   beside.actuators = {mnv_find(actuators, names.steer, steer_label, "actuator")};
   if (!names.drive.empty())
     beside.actuators.push_back(mnv_find(actuators, names.drive, label(r.drive.has_value(), "drive", "drive"), "actuator"));

@@ -129,6 +129,16 @@ class ManeuverViewTest : public QObject {
     QTest::mouseClick(view()->runButton(), Qt::LeftButton);
     QVERIFY(!view()->isRunning());
     QCOMPARE(view()->statusText(), QStringLiteral("radius: \"12o\" is not a number"));
+    // the fishhook's dwell given both ways, Enter in the roll-rate field: refused by its keyword
+    QVERIFY(drive::pickWithMouse(view()->typeBox(), "fishhook"));
+    QVERIFY(!view()->field("radius")->isVisible());
+    type("dwell", "0.2");
+    type("dwell-roll-rate", "1.5");
+    QTest::keyClick(view()->field("dwell-roll-rate"), Qt::Key_Return);
+    QTRY_VERIFY_WITH_TIMEOUT(!view()->isRunning(), 60000);
+    QVERIFY2(view()->statusText().startsWith(QStringLiteral("dwell_roll_rate: give the dwell or the roll rate that ends it, not both")),
+             qPrintable(view()->statusText()));
+    QVERIFY(drive::pickWithMouse(view()->typeBox(), "constant-radius"));
     // then the turns, the free inputs typed as the command line's --free-input
     type("radius", "500");
     type("speed-min", "2");
