@@ -235,6 +235,34 @@ void TreeDerivatives::size_for(const Model& model) {
     if (llt_ff_.rows() != nf) llt_ff_ = Eigen::LLT<Eigen::MatrixXd>(nf);
   }
   Minv_.setZero(nv, nv);
+  scratch_rows_.setZero(6, nv);
+  IA_.assign(nb, Mat6::Zero());
+  Fb_.resize(static_cast<std::size_t>(nb));
+  Ab_.resize(static_cast<std::size_t>(nb));
+  for (int i = 0; i < nb; ++i) {
+    Fb_[i].setZero(6, nv);
+    Ab_[i].setZero(6, nv);
+  }
+  Uu_.assign(nu, Mat6::Zero());
+  pa_.assign(nb, Vec6::Zero());
+  av_.assign(nb, Vec6::Zero());
+  Dinv_.assign(nu, Mat6::Zero());
+  col_begin_.assign(nb, nv);
+  col_end_.assign(nb, 0);
+  for (int i = nb - 1; i > 0; --i) {
+    const JointModel& j = model.joints[i];
+    if (j.nv > 0) {
+      col_begin_[i] = std::min(col_begin_[i], j.idx_v);
+      col_end_[i] = std::max(col_end_[i], j.idx_v + j.nv);
+    }
+    const int p = model.parent[i];
+    if (p > 0 && col_begin_[i] < col_end_[i]) {
+      col_begin_[p] = std::min(col_begin_[p], col_begin_[i]);
+      col_end_[p] = std::max(col_end_[p], col_end_[i]);
+    }
+  }
+  for (int i = 0; i < nb; ++i)
+    if (col_begin_[i] >= col_end_[i]) col_begin_[i] = col_end_[i] = 0;
   scratch_.setZero(nv);
   Jc.setZero(model.nc, nv);
   dc_dq.setZero(model.nc, nv);
@@ -364,6 +392,172 @@ void TreeDerivatives::mass_matrix() {
     }
   }
   if (m_->armature.size() != 0) M.diagonal() += m_->armature;  // rotor inertia
+}
+
+// M^-1 by the articulated-body algorithm in world axes, with a unit force on every coordinate at
+// once (no velocity, no gravity): row r of M^-1 holds the accelerations of coordinate r. Backward,
+// each unit of body i (last first) with U = IA S, D = S^T U (+ armature) gives the rows
+// B = D^-1 (E - S^T F) of its coordinates over the subtree's columns (E: the unit forces on its
+// own), then F += U B and IA -= U D^-1 U^T pass to the unit or body above. Forward, each unit's
+// rows become D^-1 (u - U^T A_above) = B - D^-1 U^T A_above and A += S rows. Rows are contiguous
+// (row-major), so every step is a few fused passes over the columns.
+void TreeDerivatives::inverse_mass_matrix() {
+  const int nb = m_->nbodies, nv = m_->nv;
+  const bool arm = m_->armature.size() != 0;
+  for (int i = 1; i < nb; ++i) {
+    IA_[i] = I_[i];
+    Fb_[i].middleCols(col_begin_[i], col_end_[i] - col_begin_[i]).setZero();
+  }
+  for (int i = nb - 1; i > 0; --i) {
+    const JointModel& j = m_->joints[i];
+    const int c0 = col_begin_[i], len = col_end_[i] - c0;
+    Mat6& Ia = IA_[i];
+    double* F = Fb_[i].data() + c0;  // row r of the subtree's columns at F + r * nv
+    for (int u = unit_end_[i] - 1; u >= unit_begin_[i]; --u) {
+      const Unit& un = units_[u];
+      const int k = un.n;
+      const auto S = S_[i].middleCols(un.iv - j.idx_v, k);
+      Mat6& U = Uu_[u];
+      Mat6& Dinv = Dinv_[u];
+      U.leftCols(k).noalias() = Ia * S;
+      if (k == 1) {
+        double D = S.col(0).dot(U.col(0));
+        if (arm) D += m_->armature[un.iv];
+        if (!(D > 0)) throw std::runtime_error("the mass matrix is not positive definite at this configuration");
+        Dinv(0, 0) = 1.0 / D;
+      } else {
+        Mat6 D = Mat6::Identity();
+        D.topLeftCorner(k, k).noalias() = S.transpose() * U.leftCols(k);
+        if (arm) D.topLeftCorner(k, k).diagonal() += m_->armature.segment(un.iv, k);
+        const Eigen::LLT<Mat6> llt(D);
+        if (llt.info() != Eigen::Success)
+          throw std::runtime_error("the mass matrix is not positive definite at this configuration");
+        Dinv = llt.solve(Mat6::Identity());
+      }
+      // B = D^-1 (E - S^T F) on the subtree's columns, into the unit's rows of M^-1
+      for (int a = 0; a < k; ++a) {
+        double* row = Minv_.row(un.iv + a).data();
+        std::fill(row + c0, row + nv, 0.0);  // the forward pass reads from the subtree's first column on
+        double* w = row + c0;
+        const double s0 = S(0, a), s1 = S(1, a), s2 = S(2, a), s3 = S(3, a), s4 = S(4, a), s5 = S(5, a);
+        for (int c = 0; c < len; ++c)
+          w[c] = -(s0 * F[c] + s1 * F[nv + c] + s2 * F[2 * nv + c] + s3 * F[3 * nv + c] + s4 * F[4 * nv + c] +
+                   s5 * F[5 * nv + c]);
+        w[un.iv - c0 + a] += 1.0;
+      }
+      if (k == 1) {
+        double* w = Minv_.row(un.iv).data() + c0;
+        const double d = Dinv(0, 0);
+        for (int c = 0; c < len; ++c) w[c] *= d;
+      } else {
+        auto rows = Minv_.block(un.iv, c0, k, len);
+        scratch_rows_.topLeftCorner(k, len) = rows;
+        rows = Dinv.topLeftCorner(k, k).lazyProduct(scratch_rows_.topLeftCorner(k, len));
+      }
+      // F += U B
+      for (int a = 0; a < k; ++a) {
+        const double* b = Minv_.row(un.iv + a).data() + c0;
+        for (int r = 0; r < 6; ++r) {
+          const double ur = U(r, a);
+          double* fr = F + r * nv;
+          for (int c = 0; c < len; ++c) fr[c] += ur * b[c];
+        }
+      }
+      if (k == 1) {
+        Ia.noalias() -= Dinv(0, 0) * U.col(0) * U.col(0).transpose();
+      } else {
+        Mat6 UD;
+        UD.leftCols(k) = U.leftCols(k).lazyProduct(Dinv.topLeftCorner(k, k));
+        Ia -= UD.leftCols(k).lazyProduct(U.leftCols(k).transpose());
+      }
+    }
+    const int p = j.parent;
+    if (p > 0) {
+      IA_[p] += Ia;
+      Fb_[p].middleCols(c0, len) += Fb_[i].middleCols(c0, len);
+    }
+  }
+  // forward, on the columns from the subtree's first on: every other entry is the mirror of one
+  // computed there (c < first(r) <= r gives r >= first(c)), as accurate as the upper triangle
+  for (int i = 1; i < nb; ++i) {
+    const JointModel& j = m_->joints[i];
+    const int p = j.parent, cb = col_begin_[i], w = nv - cb;
+    Rows6& A = Ab_[i];
+    const bool moving = p > 0;
+    if (moving) A.middleCols(cb, w) = Ab_[p].middleCols(cb, w);
+    else A.middleCols(cb, w).setZero();
+    double* Ad = A.data() + cb;
+    bool any = moving;
+    for (int u = unit_begin_[i]; u < unit_end_[i]; ++u) {
+      const Unit& un = units_[u];
+      const int k = un.n;
+      const auto S = S_[i].middleCols(un.iv - j.idx_v, k);
+      if (any) {  // rows -= D^-1 U^T A
+        Mat6 G;   // D^-1 U^T, k x 6 (padded)
+        G.topRows(k) = Dinv_[u].topLeftCorner(k, k).lazyProduct(Uu_[u].leftCols(k).transpose());
+        for (int a = 0; a < k; ++a) {
+          double* row = Minv_.row(un.iv + a).data() + cb;
+          const double g0 = G(a, 0), g1 = G(a, 1), g2 = G(a, 2), g3 = G(a, 3), g4 = G(a, 4), g5 = G(a, 5);
+          for (int c = 0; c < w; ++c)
+            row[c] -= g0 * Ad[c] + g1 * Ad[nv + c] + g2 * Ad[2 * nv + c] + g3 * Ad[3 * nv + c] + g4 * Ad[4 * nv + c] +
+                      g5 * Ad[5 * nv + c];
+        }
+      }
+      for (int a = 0; a < k; ++a) {  // A += S rows
+        const double* row = Minv_.row(un.iv + a).data() + cb;
+        for (int r = 0; r < 6; ++r) {
+          const double sr = S(r, a);
+          if (sr == 0.0) continue;
+          double* ar = Ad + r * nv;
+          for (int c = 0; c < w; ++c) ar[c] += sr * row[c];
+        }
+      }
+      any = true;
+    }
+  }
+  for (int i = 1; i < nb; ++i) {
+    const JointModel& j = m_->joints[i];
+    for (int a = 0; a < j.nv; ++a) {
+      const int r = j.idx_v + a;
+      for (int c = 0; c < col_begin_[i]; ++c) Minv_(r, c) = Minv_(c, r);
+    }
+  }
+}
+
+// x = M^-1 f by the same articulated bodies (after inverse_mass_matrix): as accurate as the
+// forward dynamics' own recursion, where the product M^-1 f loses digits to the cancellation in f
+// (the derivatives of x, taken at x, would lose them again: 1e-10 against 1e-12 on a 60-link chain)
+void TreeDerivatives::articulated_solve(const Eigen::VectorXd& f, Eigen::VectorXd& x) {
+  const int nb = m_->nbodies;
+  for (int i = 1; i < nb; ++i) pa_[i].setZero();
+  Vec6 t, w;
+  for (int i = nb - 1; i > 0; --i) {
+    const JointModel& j = m_->joints[i];
+    Vec6& pa = pa_[i];
+    for (int u = unit_end_[i] - 1; u >= unit_begin_[i]; --u) {
+      const Unit& un = units_[u];
+      const int k = un.n;
+      for (int a = 0; a < k; ++a) t[a] = f[un.iv + a] - S_[i].col(un.iv - j.idx_v + a).dot(pa);  // u
+      for (int a = 0; a < k; ++a) {
+        x[un.iv + a] = t[a];
+        w[a] = Dinv_[u].row(a).head(k).dot(t.head(k));
+      }
+      for (int a = 0; a < k; ++a) pa.noalias() += w[a] * Uu_[u].col(a);
+    }
+    if (j.parent > 0) pa_[j.parent] += pa;
+  }
+  for (int i = 1; i < nb; ++i) {
+    const JointModel& j = m_->joints[i];
+    Vec6 acc = j.parent > 0 ? av_[j.parent] : Vec6::Zero();
+    for (int u = unit_begin_[i]; u < unit_end_[i]; ++u) {
+      const Unit& un = units_[u];
+      const int k = un.n;
+      for (int a = 0; a < k; ++a) t[a] = x[un.iv + a] - Uu_[u].col(a).dot(acc);
+      for (int a = 0; a < k; ++a) x[un.iv + a] = Dinv_[u].row(a).head(k).dot(t.head(k));
+      for (int a = 0; a < k; ++a) acc.noalias() += x[un.iv + a] * S_[i].col(un.iv - j.idx_v + a);
+    }
+    av_[i] = acc;
+  }
 }
 
 void TreeDerivatives::differentiate_rnea() {
@@ -875,26 +1069,15 @@ void TreeDerivatives::compute(const Eigen::VectorXd& q, const Eigen::VectorXd& v
   scratch_ = tau;
   applied_force_derivatives(q, v, u_all);
   mass_matrix();
-  llt_.compute(M);
-  if (llt_.info() != Eigen::Success)
-    throw std::runtime_error("the mass matrix is not positive definite at this configuration");
-  qdd = Q - scratch_;
-  llt_.solveInPlace(qdd);
+  inverse_mass_matrix();
+  scratch_ = Q - scratch_;
+  articulated_solve(scratch_, qdd);
   // inverse dynamics at the true accelerations, and its derivatives
   accelerations(v, qdd);
   forces();
   add_armature_force(*m_, qdd, tau);
   differentiate_rnea();
-  // M^-1 once (nv right-hand sides), then products: on these sizes a matrix
-  // product runs faster than triangular solves with 2 nv + nu right-hand
-  // sides, and a joint-force input's column is a column of M^-1
-  Minv_.setIdentity();
-  for (Eigen::Index c0 = 0; c0 < nv; c0 += 48) {
-    // in panels of columns: Eigen's blocked triangular solves then keep their
-    // packing buffers on the stack (a heap allocation above 128 KiB)
-    auto panel = Minv_.middleCols(c0, std::min<Eigen::Index>(48, nv - c0));
-    llt_.solveInPlace(panel);
-  }
+  // M^-1 (inverse_mass_matrix above), then products: a joint-force input's column is a column of M^-1
   rhs_.leftCols(nv) = dQ_dq - dtau_dq;
   rhs_.middleCols(nv, nv) = dQ_dv - dtau_dv;
   dqdd_dq.noalias() = Minv_ * rhs_.leftCols(nv);

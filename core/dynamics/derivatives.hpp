@@ -138,6 +138,8 @@ class TreeDerivatives {
   void composites();                                                           // Ic, hc, Bc, P, R
   void forces();                                                               // F, tau
   void mass_matrix();                                                          // M from P and S
+  void inverse_mass_matrix();                                                  // Minv_ (articulated bodies)
+  void articulated_solve(const Eigen::VectorXd& f, Eigen::VectorXd& x);        // x = M^-1 f, the same bodies
   void differentiate_rnea();
   void applied_force_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& u);
   void add_body_wrench(int body, const Vec6T<double>& w, const Eigen::Matrix<double, 6, 24>& dw, int body_a,
@@ -167,7 +169,17 @@ class TreeDerivatives {
   std::vector<Mat6T<double>> P_, R_;             // [units] rows S^T Ic and S^T (Bc + H(hc)), padded to 6
   std::vector<char> below_;                      // [nbodies] scratch: in the subtree of a body
   Eigen::VectorXd qdd_zero_, scratch_;
-  Eigen::MatrixXd rhs_, Minv_;
+  Eigen::MatrixXd rhs_;
+  // M^-1 without M: the articulated-body recursion in world axes applied to every unit force at
+  // once (one row of M^-1 per coordinate; O(n d) for a tree of depth d)
+  using Rows6 = Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor>;
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> Minv_;
+  std::vector<Mat6T<double>> IA_;                // [nbodies] articulated inertia (world)
+  Rows6 scratch_rows_;
+  std::vector<Rows6> Fb_, Ab_;                   // [nbodies] articulated forces, accelerations per unit force
+  std::vector<Mat6T<double>> Uu_, Dinv_;         // [units] IA S and (S^T IA S + armature)^-1, padded
+  std::vector<Vec6T<double>> pa_, av_;           // [nbodies] articulated_solve's forces and accelerations
+  std::vector<int> col_begin_, col_end_;         // [nbodies] columns of the subtree (a contiguous superset)
   Eigen::LLT<Eigen::MatrixXd> llt_;
   // closed loops: kept rows of Jc, M^-1 Jr^T, the Schur complement and its right-hand sides
   Eigen::MatrixXd Jr_, Y_, Sc_, T_;
