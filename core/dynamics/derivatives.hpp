@@ -140,6 +140,11 @@ class TreeDerivatives {
   void mass_matrix();                                                          // M from P and S
   void inverse_mass_matrix();                                                  // Minv_ (articulated bodies)
   void articulated_solve(const Eigen::VectorXd& f, Eigen::VectorXd& x);        // x = M^-1 f, the same bodies
+  void articulated_solve_rows();                                               // X_ := M^-1 X_
+  // from this many coordinates on, compute() solves for its derivatives by the articulated bodies
+  // (48 nv^2 multiply-adds) rather than products with M^-1 (2 nv^3); measured crossing on
+  // bench/pinocchio_bench.cpp's chains
+  static constexpr int kRowsSolveFrom = 12;
   void differentiate_rnea();
   void applied_force_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& u);
   void add_body_wrench(int body, const Vec6T<double>& w, const Eigen::Matrix<double, 6, 24>& dw, int body_a,
@@ -179,7 +184,12 @@ class TreeDerivatives {
   std::vector<Rows6> Fb_, Ab_;                   // [nbodies] articulated forces, accelerations per unit force
   std::vector<Mat6T<double>> Uu_, Dinv_;         // [units] IA S and (S^T IA S + armature)^-1, padded
   std::vector<Vec6T<double>> pa_, av_;           // [nbodies] articulated_solve's forces and accelerations
-  std::vector<int> col_begin_, col_end_;         // [nbodies] columns of the subtree (a contiguous superset)
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> X_;  // [nv x 2 nv]
+  Rows6 scratch_rows2_;
+  std::vector<Rows6> Fr_, Ar_;                   // [nbodies] forces, accelerations of X_'s columns
+  std::vector<int> col_begin_, col_end_;
+  std::vector<int> children_, sub_nv_;           // [nbodies] number of child bodies; columns of the subtree
+  bool depth_first_ = false;                     // every subtree's columns exactly its range         // [nbodies] columns of the subtree (a contiguous superset)
   Eigen::LLT<Eigen::MatrixXd> llt_;
   // closed loops: kept rows of Jc, M^-1 Jr^T, the Schur complement and its right-hand sides
   Eigen::MatrixXd Jr_, Y_, Sc_, T_;
