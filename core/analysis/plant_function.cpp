@@ -604,7 +604,7 @@ bool PlantFunction::analytic_jacobian(const Eigen::VectorXd& x, const Eigen::Vec
   td.feedthrough_read = true;  // D from dy_du below (acceleration sensors)
   td.compute(q_ref_, ws_.v, ws_.u_all, m.plant_outputs);
   if (J.rows() != 2 * n + ny_p || J.cols() != 2 * n + nu_p) J.resize(2 * n + ny_p, 2 * n + nu_p);
-  J.setZero();
+  J.topRows(n).setZero();  // the rows below are written whole
   // d/dt of the position deviation: the velocity, turned by the tangent map of rotations
   J.block(0, n, n, n).setIdentity();
   for (int b = 1; b < m.nbodies; ++b) {
