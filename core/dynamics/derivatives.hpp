@@ -142,9 +142,10 @@ class TreeDerivatives {
   void articulated_solve(const Eigen::VectorXd& f, Eigen::VectorXd& x);        // x = M^-1 f, the same bodies
   void articulated_solve_rows();                                               // X_ := M^-1 X_
   // from this many coordinates on, compute() solves for its derivatives by the articulated bodies
-  // (48 nv^2 multiply-adds) rather than products with M^-1 (2 nv^3); measured crossing on
-  // bench/pinocchio_bench.cpp's chains
-  static constexpr int kRowsSolveFrom = 12;
+  // (48 nv^2 multiply-adds) rather than products with M^-1 (2 nv^3). Measured on the speed
+  // models' chains (bench/pinocchio_bench.cpp, clang -O3): the products are faster up to 20 links
+  // (4.0 against 4.9 us at 7, 16.2 against 18.5 at 20), even at 30, the solve 25% faster at 60
+  static constexpr int kRowsSolveFrom = 32;
   void differentiate_rnea();
   void applied_force_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& u);
   void add_body_wrench(int body, const Vec6T<double>& w, const Eigen::Matrix<double, 6, 24>& dw, int body_a,
