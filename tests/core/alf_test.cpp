@@ -35,6 +35,7 @@ AlfA02 alf_a02(int N, double h, double t_end, double alpha = 1e8, double tol = 1
   o.integrator.max_step = h;
   o.integrator.alf_fixed_step = h > 0;
   o.integrator.rtol = o.integrator.atol = tol;
+  if (const char* rtol = std::getenv("ALF_RTOL")) o.integrator.rtol = std::atof(rtol);  // Explore: rtol apart
   o.integrator.alf_penalty = alpha;
   o.t_end = t_end;
   o.output_step = 0.01;
