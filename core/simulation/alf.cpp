@@ -25,6 +25,9 @@
 // Newton stops when the error left, theta / (1 - theta) |dq| with theta the contraction rate
 // (the first correction taken at face value), is within 1e-3 of the error weight
 // atol + rtol |q_i| or within 1e-14 (1 + |q_i|), whichever is larger.
+// Inputs that jump at a stop (a reference's step): the step ending at the stop reads them 1e-9 s
+// before it, and the next advance() restarts a and the multipliers from the dynamics after the
+// jump (as reset() does), so the error estimate does not see a's jump.
 // The step: error control by default. The trapezoidal rule's local error in q is h^3/12 q''',
 // estimated as h^2/12 (a_n+1 - a_n) with the projected accelerations and taken per unit step
 // (divided by h: the global error of a second-order method is that sum); a step is accepted
@@ -109,11 +112,12 @@ class Alf final : public Integrator {
   }
 
   void advance(double t_out) override {
+    restart_at_input_jump();
     if (fixed_) {  // the interval in equal steps of at most h_
       const int n = std::max(1, static_cast<int>(std::ceil((t_out - t_) / h_ - 1e-9)));
       const double h = (t_out - t_) / n, t0 = t_;
       for (int i = 0; i < n; ++i) {
-        if (!step(h)) fail_newton(t_ + h, h);
+        if (!step(h, i + 1 == n)) fail_newton(t_ + h, h);
         accept(i + 1 == n ? t_out : t0 + (i + 1) * h);
       }
       return;
@@ -125,7 +129,7 @@ class Alf final : public Integrator {
       for (int tries = 0;; ++tries) {
         if (tries > 60 || h < 1e-12 * std::max(1.0, std::abs(t_)))
           throw IntegratorFailure(t_, "alf: no step down to " + alf_number(h) + " s passes the Newton iteration and the error test");
-        if (!step(h)) {
+        if (!step(h, h >= rest)) {
           h *= 0.25;
           continue;
         }
@@ -178,8 +182,11 @@ class Alf final : public Integrator {
 
   // one trapezoidal step of h from (t_, q_, v_, a_, lambda_) into (qn_, vn_, an_, lambdan_);
   // false when Newton does not converge
-  bool step(double h) {
+  bool step(double h, bool to_stop) {
     const double t1 = t_ + h, c = h * h / 4;
+    // the inputs of a step that ends at a stop are read just before it (their left limit): a
+    // reference or disturbance that jumps there enters the next step, from a restarted a
+    const double t_inputs = to_stop ? t1 - kLeftLimit * std::max(1.0, std::abs(t1)) : t1;
     h_now_ = h;
     // the penalty as given for steps of kPenaltyStep and longer, alpha (kPenaltyStep / h)^2 below:
     // h^2/4 alpha, its weight against M in the Newton matrix, no smaller than at kPenaltyStep
@@ -202,12 +209,12 @@ class Alf final : public Integrator {
     for (int it = 0; it < iterations_; ++it) {
       v = (2 / h) * q - vhat;
       a = (4 / (h * h)) * q - ahat;
-      residual(t1, q, v, a, lambda, alpha);
+      residual(t_inputs, q, v, a, lambda, alpha);
       if (refactor || tangent_stale_) {
         // the matrix: the tangent kept (formed again when stale) at this step's h, with this
         // iterate's Jc in the penalty
         if (tangent_stale_ || !have_tangent_) {
-          form_tangent(t1, q, v, a, lambda, alpha);
+          form_tangent(t_inputs, q, v, a, lambda, alpha);
           refreshed = true;
         }
         if (!factor(h, alpha, q)) break;
@@ -278,6 +285,22 @@ class Alf final : public Integrator {
     an_ = a;
     lambdan_ = lambda;
     return true;
+  }
+
+  // at a stop: where the inputs jump there (u(t) against its left limit, at the same state),
+  // a and the multipliers are those of the dynamics after the jump (as reset() makes them); the
+  // trapezoidal rule would otherwise carry a's jump into its error estimate, h/12 |a_n+1 - a_n|,
+  // which no step short of ~1e-8 s passes at tight tolerances
+  void restart_at_input_jump() {
+    if (steps_ == 0) return;  // reset() has just made a
+    const Eigen::VectorXd u = sys_.inputs(t_, q_, v_, xc_);
+    const Eigen::VectorXd before = sys_.inputs(t_ - kLeftLimit * std::max(1.0, std::abs(t_)), q_, v_, xc_);
+    if (u.size() == 0 || (u - before).cwiseAbs().maxCoeff() <= 1e-9 * (1 + u.cwiseAbs().maxCoeff())) return;
+    const Eigen::VectorXd a = forward_dynamics<double>(m_, d_, q_, v_, u);
+    if (!a.allFinite()) return;
+    a_ = a;
+    if (m_.nc) lambda_ = d_.lambda;
+    ++input_restarts_;
   }
 
   // the local error in q, h^2/12 (a_n+1 - a_n), in the weights atol + rtol |q| (<= 1: accepted)
@@ -370,7 +393,7 @@ class Alf final : public Integrator {
     return true;
   }
 
-  static constexpr double kNewton = 1e-3, kNewtonFloor = 1e-14;
+  static constexpr double kNewton = 1e-3, kNewtonFloor = 1e-14, kLeftLimit = 1e-9;
   // the modified Newton: the tangent is kept over steps while Newton's corrections shrink by
   // kRate at least per iteration, for kTangentAge steps at most; the matrix is factored each step
   static constexpr double kRate = 0.5;
@@ -395,7 +418,7 @@ class Alf final : public Integrator {
   int tangent_age_ = 0;
   bool factored_ = false, fresh_mass_ = false;
   double h_factored_ = 0;
-  long tangents_ = 0, tangent_failures_ = 0;
+  long tangents_ = 0, tangent_failures_ = 0, input_restarts_ = 0;
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
   long steps_ = 0, evaluations_ = 0, factorizations_ = 0, iterations_done_ = 0, failures_ = 0, rejected_ = 0;
 };
