@@ -1,16 +1,33 @@
 // alf: the index-3 augmented Lagrangian formulation with mass-orthogonal projections of the
 // velocities and accelerations (Bayo and Ledesma 1996; Cuadrado, Cardenal, Bayo 1997, "ALI3-P"),
 // integrated by the trapezoidal rule. It never inverts the constraint Jacobian alone: the Newton
-// matrix is M + (h^2/4) Jc^T alpha Jc, regular while M is, whatever the rank of Jc, so it passes
-// singular positions (a four-bar's flat position, IFToMM A02) and takes redundant constraints
-// (Bricard) as they are. Per step h, from (q_n, v_n, a_n):
+// matrix holds M + (h^2/4) Jc^T alpha Jc, regular while M is, whatever the rank of Jc, so it
+// passes singular positions (a four-bar's flat position, IFToMM A02) and takes redundant
+// constraints (Bricard) as they are. Per step h, from (q_n, v_n, a_n):
 //   q^ = q_n + h v_n + h^2/2 a_n,  v = 2/h q - (2/h q_n + v_n),  a = 4/h^2 q - (4/h^2 q_n + 4/h v_n + a_n)
-//   f(q) = h^2/4 (M a + nle - Q + Jc^T (lambda* + alpha phi)),  Newton on f = 0 with the matrix above,
+//   f(q) = h^2/4 (M a + nle - Q + Jc^T (lambda* + alpha phi)),  Newton on f = 0,
 //   lambda* += alpha phi after each iteration (the multipliers, kept from step to step);
 // then v and a projected onto the constraints' tangent (mass-orthogonally):
-//   (M + h^2/4 Jc^T alpha Jc) v = M v*,   (M + h^2/4 Jc^T alpha Jc) a = M a* - h^2/4 Jc^T alpha gamma.
-// Newton stops when every correction is within 1e-3 of the error weight atol + rtol |q_i| or
-// within 1e-10 (1 + |q_i|), whichever is larger.
+//   (M + h^2/4 Jc^T alpha Jc) v = M v*,   (M + h^2/4 Jc^T alpha Jc) a = M a* - h^2/4 Jc^T alpha gamma
+// (M and Jc at the step's end, factored for these two solves).
+// The Newton matrix is the full tangent of f (issue 41): M + h/2 C + h^2/4 (K + Jc^T alpha Jc),
+// K = d(M a + nle - Q)/dq at fixed a, C = d(nle - Q)/dv, from the analytic derivatives of the
+// open tree (TreeDerivatives::compute_constrained with no kept rows and zero multipliers: the
+// loop closures enter only through the penalty; their reactions' turning, d(Jc^T lambda)/dq, is
+// left out: on Bricard's redundant loops it made Newton diverge). Where the derivatives throw
+// (an effect or constraint they do not take, M not positive definite) C = K = 0, as before.
+// Modified Newton, with rules: C and K are kept for up to 20 steps (formed again when Newton's
+// corrections shrink by less than 1/2 per iteration, and after a failed step); the matrix is
+// combined at each step's h and factored at its first iterate (on trees only when h changes or
+// the tangent is new; with loops every step, with M and Jc there: the penalty's weight makes it
+// follow Jc so closely that a matrix from the last step's end left Newton's error test blind),
+// and again at any iterate whose correction shrank by less than 1/2.
+// Newton stops when the error left, theta / (1 - theta) |dq| with theta the contraction rate
+// (the first correction taken at face value), is within 1e-3 of the error weight
+// atol + rtol |q_i| or within 1e-14 (1 + |q_i|), whichever is larger.
+// Inputs that jump at a stop (a reference's step): the step ending at the stop reads them 1e-9 s
+// before it, and the next advance() restarts a and the multipliers from the dynamics after the
+// jump (as reset() does), so the error estimate does not see a's jump.
 // The step: error control by default. The trapezoidal rule's local error in q is h^3/12 q''',
 // estimated as h^2/12 (a_n+1 - a_n) with the projected accelerations and taken per unit step
 // (divided by h: the global error of a second-order method is that sum); a step is accepted
@@ -35,6 +52,7 @@
 
 #include "dynamics/constraints.hpp"
 #include "dynamics/crba.hpp"
+#include "dynamics/derivatives.hpp"
 #include "dynamics/effects.hpp"
 #include "dynamics/forward_dynamics.hpp"
 #include "dynamics/kinematics.hpp"
@@ -94,11 +112,12 @@ class Alf final : public Integrator {
   }
 
   void advance(double t_out) override {
+    restart_at_input_jump();
     if (fixed_) {  // the interval in equal steps of at most h_
       const int n = std::max(1, static_cast<int>(std::ceil((t_out - t_) / h_ - 1e-9)));
       const double h = (t_out - t_) / n, t0 = t_;
       for (int i = 0; i < n; ++i) {
-        if (!step(h)) fail_newton(t_ + h, h);
+        if (!step(h, i + 1 == n)) fail_newton(t_ + h, h);
         accept(i + 1 == n ? t_out : t0 + (i + 1) * h);
       }
       return;
@@ -110,7 +129,7 @@ class Alf final : public Integrator {
       for (int tries = 0;; ++tries) {
         if (tries > 60 || h < 1e-12 * std::max(1.0, std::abs(t_)))
           throw IntegratorFailure(t_, "alf: no step down to " + alf_number(h) + " s passes the Newton iteration and the error test");
-        if (!step(h)) {
+        if (!step(h, h >= rest)) {
           h *= 0.25;
           continue;
         }
@@ -146,22 +165,28 @@ class Alf final : public Integrator {
   }
 
  private:
-  // M, nle - Q, and (loops) phi, Jc, gamma at (q, v) and time t
-  void evaluate(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
+  // f_ = h^2/4 (M a + nle - Q + Jc^T (lambda + alpha phi)) at (q, v, a) and time t: M a + nle by
+  // the inverse dynamics (no mass matrix); u_ the inputs there
+  void residual(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& a,
+                const Eigen::VectorXd& lambda, double alpha) {
     ++evaluations_;
-    const Eigen::VectorXd u = sys_.inputs(t, q, v, xc_);
-    forward_kinematics<double>(m_, d_, q, v);
-    const Eigen::VectorXd Q = applied_forces<double>(m_, d_, q, v, u);
-    crba<double>(m_, d_, q);
-    nonlinear_effects<double>(m_, d_, q, v);
-    bias_ = d_.nle - Q;
-    if (m_.nc) constraint_terms<double>(m_, d_, q, v);
+    u_ = sys_.inputs(t, q, v, xc_);
+    f_ = rnea<double>(m_, d_, q, v, a);  // forward kinematics at (q, v, a) included
+    f_ -= applied_forces<double>(m_, d_, q, v, u_);
+    if (m_.nc) {
+      constraint_terms<double>(m_, d_, q, v);
+      f_.noalias() += d_.Jc.transpose() * (lambda + alpha * d_.phi);
+    }
+    f_ *= h_now_ * h_now_ / 4;
   }
 
   // one trapezoidal step of h from (t_, q_, v_, a_, lambda_) into (qn_, vn_, an_, lambdan_);
   // false when Newton does not converge
-  bool step(double h) {
+  bool step(double h, bool to_stop) {
     const double t1 = t_ + h, c = h * h / 4;
+    // the inputs of a step that ends at a stop are read just before it (their left limit): a
+    // reference or disturbance that jumps there enters the next step, from a restarted a
+    const double t_inputs = to_stop ? t1 - kLeftLimit * std::max(1.0, std::abs(t1)) : t1;
     h_now_ = h;
     // the penalty as given for steps of kPenaltyStep and longer, alpha (kPenaltyStep / h)^2 below:
     // h^2/4 alpha, its weight against M in the Newton matrix, no smaller than at kPenaltyStep
@@ -171,50 +196,88 @@ class Alf final : public Integrator {
     const Eigen::VectorXd vhat = (2 / h) * q_ + v_, ahat = (4 / (h * h)) * q_ + (4 / h) * v_ + a_;
     Eigen::VectorXd q = q_ + h * v_ + (h * h / 2) * a_, v, a;
     Eigen::VectorXd lambda = lambda_;
-    // Newton's test: each correction within kNewton of the error weight, but no tighter than
-    // kNewtonFloor (1 + |q_i|) (the multipliers' iteration creeps near a singular position)
+    // Newton's test (per coordinate, in the weights w): the error left in q, estimated from the
+    // corrections' rate of contraction theta as theta / (1 - theta) |dq| (the first correction
+    // taken at face value), within kNewton of the error weight atol + rtol |q_i|, but no tighter
+    // than kNewtonFloor (1 + |q_i|)
     const Eigen::ArrayXd w = (kNewton * (atol_ + rtol_ * q_.array().abs())).max(kNewtonFloor * (1 + q_.array().abs()));
-    bool converged = false;
-    double last = 0;
+    // the matrix is factored at the first iterate (on a tree: kept while h is the same); with loop
+    // closures always, as the penalty's weight makes it follow Jc closely
+    bool converged = false, refreshed = false, refactor = m_.nc > 0 || !factored_ || h != h_factored_;
+    double last = 0, previous = 0;
+    int since_factor = 0;
     for (int it = 0; it < iterations_; ++it) {
       v = (2 / h) * q - vhat;
       a = (4 / (h * h)) * q - ahat;
-      evaluate(t1, q, v);
-      Eigen::VectorXd f = d_.M * a + bias_;
-      if (m_.nc) f += d_.Jc.transpose() * (lambda + alpha * d_.phi);
-      f *= c;
-      newton_matrix();
-      const Eigen::VectorXd dq = -lu_.solve(f);
+      residual(t_inputs, q, v, a, lambda, alpha);
+      if (refactor || tangent_stale_) {
+        // the matrix: the tangent kept (formed again when stale) at this step's h, with this
+        // iterate's Jc in the penalty
+        if (tangent_stale_ || !have_tangent_) {
+          form_tangent(t_inputs, q, v, a, lambda, alpha);
+          refreshed = true;
+        }
+        if (!factor(h, alpha, q)) break;
+        refactor = false;
+        previous = 0;
+        since_factor = 0;
+      }
+      const Eigen::VectorXd dq = -lu_.solve(f_);
+      if (!dq.allFinite()) break;
       q += dq;
       ++iterations_done_;
+      ++since_factor;
       if (m_.nc) {
         constraint_residual<double>(m_, d_, q);
         lambda += alpha * d_.phi;
       }
-      if (!dq.allFinite()) break;
       last = (dq.array().abs() / w).maxCoeff();
+      const double theta = previous > 0 ? last / previous : 0;
+      previous = last;
       if (trace_)
-        std::fprintf(stderr, "t %.9g h %g it %d |dq|/w %g |dq| %g |phi| %g\n", t1, h, it, last, dq.cwiseAbs().maxCoeff(),
-                     m_.nc ? d_.phi.cwiseAbs().maxCoeff() : 0.0);
-      if (last <= 1) {
+        std::fprintf(stderr, "t %.9g h %g it %d |dq|/w %g theta %g |dq| %g |phi| %g%s\n", t1, h, it, last, theta,
+                     dq.cwiseAbs().maxCoeff(), m_.nc ? d_.phi.cwiseAbs().maxCoeff() : 0.0,
+                     since_factor == 1 ? (refreshed ? " (new tangent)" : " (new factorization)") : "");
+      const double left = theta > 0 && theta < 1 ? last * theta / (1 - theta) : last;
+      if (left <= 1 && (theta < 1 || last <= 1)) {
         converged = true;
         break;
       }
+      // the modified Newton's rule: where the corrections shrink by less than kRate per
+      // iteration, the matrix is factored again at this iterate (its Jc; the penalty's weight
+      // makes the matrix follow Jc closely), and if that was just done, the tangent is formed
+      // again too (once a step; after that the iteration goes on: the multipliers' iteration
+      // may creep near a singular position)
+      if (theta > kRate) {
+        refactor = true;
+        if (since_factor <= 2 && !refreshed) tangent_stale_ = true;
+      }
     }
+    ++tangent_age_;
+    if (tangent_age_ >= kTangentAge) tangent_stale_ = true;
     if (!converged) {
       ++failures_;
       last_failure_ = last;
+      tangent_stale_ = true;  // the retry forms the tangent again (this one's may be from a wild iterate)
       return false;
     }
-    // the mass-orthogonal projections of v and a onto the constraints at q
+    // the mass-orthogonal projections of v and a onto the constraints at q:
+    //   (M + h^2/4 alpha Jc^T Jc) v = M v*,   (M + h^2/4 alpha Jc^T Jc) a = M a* - h^2/4 alpha Jc^T gamma,
+    // M and Jc at q (their own factorization)
     v = (2 / h) * q - vhat;
     a = (4 / (h * h)) * q - ahat;
-    evaluate(t1, q, v);
     if (m_.nc) {
-      newton_matrix();
-      v = lu_.solve(d_.M * v);
+      Mp_ = crba<double>(m_, d_, q);
+      constraint_terms<double>(m_, d_, q, v);  // Jc at q
+      Kp_ = Mp_;
+      Kp_.noalias() += (c * alpha) * (d_.Jc.transpose() * d_.Jc);
+      lup_.compute(Kp_);
+      ++factorizations_;
+      v = lup_.solve(Mp_ * v);
       constraint_terms<double>(m_, d_, q, v);  // gamma at the projected velocities
-      a = lu_.solve(d_.M * a - c * alpha * (d_.Jc.transpose() * d_.gamma));
+      Eigen::VectorXd rhs = Mp_ * a;
+      rhs.noalias() -= (c * alpha) * (d_.Jc.transpose() * d_.gamma);
+      a = lup_.solve(rhs);
     }
     if (!q.allFinite() || !v.allFinite() || !a.allFinite()) return false;
     qn_ = q;
@@ -222,6 +285,22 @@ class Alf final : public Integrator {
     an_ = a;
     lambdan_ = lambda;
     return true;
+  }
+
+  // at a stop: where the inputs jump there (u(t) against its left limit, at the same state),
+  // a and the multipliers are those of the dynamics after the jump (as reset() makes them); the
+  // trapezoidal rule would otherwise carry a's jump into its error estimate, h/12 |a_n+1 - a_n|,
+  // which no step short of ~1e-8 s passes at tight tolerances
+  void restart_at_input_jump() {
+    if (steps_ == 0) return;  // reset() has just made a
+    const Eigen::VectorXd u = sys_.inputs(t_, q_, v_, xc_);
+    const Eigen::VectorXd before = sys_.inputs(t_ - kLeftLimit * std::max(1.0, std::abs(t_)), q_, v_, xc_);
+    if (u.size() == 0 || (u - before).cwiseAbs().maxCoeff() <= 1e-9 * (1 + u.cwiseAbs().maxCoeff())) return;
+    const Eigen::VectorXd a = forward_dynamics<double>(m_, d_, q_, v_, u);
+    if (!a.allFinite()) return;
+    a_ = a;
+    if (m_.nc) lambda_ = d_.lambda;
+    ++input_restarts_;
   }
 
   // the local error in q, h^2/12 (a_n+1 - a_n), in the weights atol + rtol |q| (<= 1: accepted)
@@ -246,15 +325,80 @@ class Alf final : public Integrator {
     throw IntegratorFailure(t1, os.str());
   }
 
-  // M + h^2/4 Jc^T alpha Jc at the last evaluation, factored
-  void newton_matrix() {
-    K_ = d_.M;
-    if (m_.nc) K_.noalias() += (h_now_ * h_now_ / 4 * alpha_now_) * (d_.Jc.transpose() * d_.Jc);
-    lu_.compute(K_);
-    ++factorizations_;
+  // The tangent at (q, v, a): the parts of the full tangent of f,
+  //   M + h/2 C + h^2/4 (K + Jc^T alpha Jc),  K = d(M a + nle - Q + Jc^T lambda~)/dq at fixed a
+  //   and lambda~ = lambda + alpha phi (the reactions' turning included), C = d(nle - Q)/dv,
+  // kept as Mt_, Ct_, Kt_ (so a step of another h combines them again), from the analytic
+  // derivatives (TreeDerivatives::compute_constrained on no kept rows: the open tree's
+  // derivatives, the loop closures' reactions as given forces). Where they do not apply (they
+  // throw: an effect or constraint they do not differentiate, a mass matrix that is not positive
+  // definite; or a derivative that is not finite) the mass matrix alone (C = K = 0), and after
+  // kTangentFailures such failures the mass matrix from then on.
+  void form_tangent(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& a,
+                    const Eigen::VectorXd& lambda, double alpha) {
+    bool tangent = false;
+    if (use_tangent_) {
+      try {
+        if (!td_) {
+          td_ = std::make_unique<TreeDerivatives>(m_);
+          zero_multipliers_.setZero(m_.nc);
+        }
+        // (d_ holds the residual's evaluation at this iterate: phi and the inputs u_)
+        td_->compute_constrained(q, v, u_, a, zero_multipliers_, kNoRows, kNoRows);
+        Mt_ = td_->M;
+        Ct_ = td_->dtau_dv - td_->dQ_dv;
+        Kt_ = td_->dtau_dq - td_->dQ_dq;
+        tangent = Mt_.allFinite() && Ct_.allFinite() && Kt_.allFinite();
+      } catch (const std::exception& e) {
+        if (trace_) std::fprintf(stderr, "alf: no tangent at t %.9g (%s): the mass matrix alone\n", t, e.what());
+      }
+      if (!tangent && ++tangent_failures_ >= kTangentFailures) use_tangent_ = false;  // not again
+    }
+    if (!tangent) {
+      const Eigen::MatrixXd Jc = d_.Jc;  // (crba's kinematics leave Jc as it is; kept to be sure)
+      Mt_ = crba<double>(m_, d_, q);
+      d_.Jc = Jc;
+      Ct_.setZero(m_.nv, m_.nv);
+      Kt_.setZero(m_.nv, m_.nv);
+    } else {
+      ++tangents_;
+    }
+    have_tangent_ = true;
+    fresh_mass_ = true;  // (Mt_ is at this iterate)
+    tangent_stale_ = false;
+    tangent_age_ = 0;
   }
 
-  static constexpr double kNewton = 1e-3, kNewtonFloor = 1e-10;
+  // the Newton matrix Mt + h/2 Ct + h^2/4 (Kt + alpha Jc^T Jc) of this step (Jc: d_.Jc, the
+  // residual's last evaluation), factored; false: not finite
+  bool factor(double h, double alpha, const Eigen::VectorXd& q) {
+    const double c = h * h / 4;
+    if (m_.nc && !fresh_mass_) {  // M at this iterate (the tangent's C and K are kept)
+      const Eigen::MatrixXd Jc = d_.Jc;
+      Mt_ = crba<double>(m_, d_, q);
+      d_.Jc = Jc;
+    }
+    fresh_mass_ = false;
+    K_ = Mt_;
+    if (use_tangent_ || tangents_ > 0) {
+      K_.noalias() += (h / 2) * Ct_;
+      K_.noalias() += c * Kt_;
+    }
+    if (m_.nc) K_.noalias() += (c * alpha) * (d_.Jc.transpose() * d_.Jc);
+    if (!K_.allFinite()) return false;
+    lu_.compute(K_);
+    ++factorizations_;
+    factored_ = true;
+    h_factored_ = h;
+    return true;
+  }
+
+  static constexpr double kNewton = 1e-3, kNewtonFloor = 1e-14, kLeftLimit = 1e-9;
+  // the modified Newton: the tangent is kept over steps while Newton's corrections shrink by
+  // kRate at least per iteration, for kTangentAge steps at most; the matrix is factored each step
+  static constexpr double kRate = 0.5;
+  static constexpr int kTangentAge = 20, kTangentFailures = 3;
+  static inline const std::vector<int> kNoRows{};
   static constexpr double kPenaltyStep = 1e-2, kPenaltyMax = 1e13;
   ClosedLoopSystem& sys_;
   const Model& m_;
@@ -264,8 +408,17 @@ class Alf final : public Integrator {
   double rtol_, atol_;
   bool fixed_, trace_;  // trace_: ALF_TRACE set, each Newton iteration printed
   double next_ = 0, last_failure_ = 0, h_now_ = 0, t_ = 0;
-  Eigen::VectorXd q_, v_, a_, xc_, lambda_, bias_, qn_, vn_, an_, lambdan_;
-  Eigen::MatrixXd K_;
+  Eigen::VectorXd q_, v_, a_, xc_, lambda_, qn_, vn_, an_, lambdan_, f_, u_;
+  Eigen::MatrixXd K_, Mt_, Ct_, Kt_;  // the Newton matrix; the tangent's parts
+  Eigen::MatrixXd Kp_, Mp_;           // the projections' matrix, and M, at the step's end
+  Eigen::PartialPivLU<Eigen::MatrixXd> lup_;  // the Newton matrix, and it less the penalty
+  std::unique_ptr<TreeDerivatives> td_;
+  Eigen::VectorXd zero_multipliers_;
+  bool use_tangent_ = true, have_tangent_ = false, tangent_stale_ = true;
+  int tangent_age_ = 0;
+  bool factored_ = false, fresh_mass_ = false;
+  double h_factored_ = 0;
+  long tangents_ = 0, tangent_failures_ = 0, input_restarts_ = 0;
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
   long steps_ = 0, evaluations_ = 0, factorizations_ = 0, iterations_done_ = 0, failures_ = 0, rejected_ = 0;
 };

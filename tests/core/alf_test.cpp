@@ -6,10 +6,17 @@
 #include <cstdlib>
 #include <iostream>
 
+#include <fstream>
+#include <nlohmann/json.hpp>
+
 #include "dynamics/prepare.hpp"
 #include "model/errors.hpp"
 #include "models/iftomm_a02.hpp"
 #include "simulation/simulator.hpp"
+#include "study/files.hpp"
+#include "study/jobs.hpp"
+#include "study/sweep.hpp"
+#include "test_util.hpp"
 
 namespace codyna {
 namespace {
@@ -28,6 +35,7 @@ AlfA02 alf_a02(int N, double h, double t_end, double alpha = 1e8, double tol = 1
   o.integrator.max_step = h;
   o.integrator.alf_fixed_step = h > 0;
   o.integrator.rtol = o.integrator.atol = tol;
+  if (const char* rtol = std::getenv("ALF_RTOL")) o.integrator.rtol = std::atof(rtol);  // Explore: rtol apart
   o.integrator.alf_penalty = alpha;
   o.t_end = t_end;
   o.output_step = 0.01;
@@ -123,6 +131,136 @@ TEST(Alf, Refusals) {
   }
   spec.solver.max_step = 0.5;
   EXPECT_NO_THROW(compile(spec));
+}
+
+// A05 (the stiff flyball: spring-dampers k = 8e5, c = 4e4 on a 4-DOF tree), 2 s: alf's Newton on
+// the full tangent M + h/2 C + h^2/4 K takes the steps its error control asks for (before it,
+// with M alone, Newton held the step near the springs' stability limit: about 10000 steps for
+// these 2 s whatever the tolerance: about 50000 for the study's 10 s, docs/work-precision.md),
+// and the slider height agrees with cvode-bdf at 1e-11
+SimulationResult alf_flyball_run(const Model& m, const std::string& method, double tol) {
+  SimulationOptions o;
+  o.integrator.method = method;
+  o.integrator.rtol = o.integrator.atol = tol;
+  o.t_end = 2.0;
+  o.output_step = 0.01;
+  return simulate(m, nullptr, nullptr, o);
+}
+
+TEST(Alf, A05StiffFlyballOnTheFullTangent) {
+  const Model m = test::load_example("iftomm_a05_flyball.json");
+  const SimulationResult ref = alf_flyball_run(m, "cvode-bdf", 1e-11);
+  ASSERT_TRUE(ref.completed) << ref.failure;
+  double previous_err = 1;
+  long previous_steps = 0;
+  for (double tol : {1e-4, 1e-6}) {
+    const SimulationResult r = alf_flyball_run(m, "alf", tol);
+    ASSERT_TRUE(r.completed) << r.failure;
+    ASSERT_EQ(r.y.rows(), ref.y.rows());
+    const double err = (r.y.col(0) - ref.y.col(0)).cwiseAbs().maxCoeff();  // slider_y [m]
+    std::cout << "alf A05 2 s, tol " << tol << ": slider height off cvode-bdf 1e-11 by " << err << " m; "
+              << r.stats.steps << " steps, " << r.stats.nonlinear_iterations << " Newton iterations, "
+              << r.stats.jac_evals << " factorizations, " << r.stats.wall_time << " s\n";
+    if (tol == 1e-4) {
+      EXPECT_LT(r.stats.steps, 1000);  // measured 349 (0.7 ms)
+      EXPECT_LT(err, 5e-4);            // measured 1.7e-4 m
+    } else {
+      EXPECT_LT(r.stats.steps, 7500);  // measured 2549 (8 ms)
+      EXPECT_LT(err, 1e-5);            // measured 3.3e-6 m
+    }
+    EXPECT_LT(err, previous_err);
+    EXPECT_GT(r.stats.steps, previous_steps);
+    EXPECT_LT(r.stats.nonlinear_iterations, 3 * r.stats.steps);  // modified Newton: about 2 a step
+    previous_err = err;
+    previous_steps = r.stats.steps;
+  }
+}
+
+// the held four-bar (examples/four_bar_held.json: a loop closure, an LQR about the equilibrium,
+// a step of the rocker's reference at 0.5 s) with the linear comparison, run by alf and by
+// cvode-bdf at a tight tolerance: the two nonlinear runs agree, the linear run beside them is
+// the same, and so is the gap between the nonlinear and the linear loop
+SimulateJob alf_held_four_bar(const std::string& integrator, double tol) {
+  const std::string path = test::example_path("four_bar_held.json");
+  SimulateRequest r;
+  r.model = path;
+  r.compare_linear = true;
+  r.integrator = integrator;
+  if (tol > 0) r.rtol = r.atol = tol;  // otherwise the file's (rtol 1e-8, atol 1e-10)
+  return study_simulate_job(r, study_read_model(path));
+}
+
+TEST(Alf, HeldFourBarComparesWithTheLinearLoop) {
+  const SimulateJob alf = alf_held_four_bar("alf", 1e-7), bdf = alf_held_four_bar("cvode-bdf", 1e-11);
+  const SimulationResult &a = alf.result, &b = bdf.result;
+  ASSERT_TRUE(a.completed) << a.failure;
+  ASSERT_TRUE(b.completed) << b.failure;
+  ASSERT_EQ(a.y.rows(), b.y.rows());
+  ASSERT_EQ(a.y_linear.rows(), a.y.rows());
+  ASSERT_EQ(b.y_linear.rows(), b.y.rows());
+  const double dy = (a.y - b.y).cwiseAbs().maxCoeff(), dlin = (a.y_linear - b.y_linear).cwiseAbs().maxCoeff();
+  const double excursion = (b.y.col(0).array() - b.y(b.y.rows() - 1, 0)).abs().maxCoeff();
+  std::cout << "held four-bar, alf 1e-7 against cvode-bdf 1e-11: |y| " << dy << " rad, |y_linear| " << dlin
+            << ", gap to the linear loop " << alf.linear_gap[0] << " / " << bdf.linear_gap[0] << " rad (excursion "
+            << excursion << "); alf " << a.stats.steps << " steps, max |phi| " << alf.max_constraint_violation << "\n";
+  EXPECT_GT(excursion, 0.02);          // a real step: measured 0.047 rad
+  EXPECT_LT(dy, 2e-7);                 // measured 6.4e-8 rad
+  EXPECT_LT(dlin, 1e-10);              // the linear run does not depend on the integrator: 7.6e-13
+  EXPECT_GT(alf.linear_gap[0], 1e-3);  // the plant is not linear over the step: measured 1.74e-3 rad
+  EXPECT_NEAR(alf.linear_gap[0], bdf.linear_gap[0], 2e-7);  // measured 4e-8 apart
+  EXPECT_LT(alf.max_constraint_violation, 1e-10);           // measured 1.1e-13
+  // at the file's tolerances: through the reference's jump at 0.5 s (a stop) only with the inputs'
+  // left limit up to the stop and a restarted after it (before, no step down to 1e-13 s passed
+  // the error test at t = 0.5 s)
+  const SimulateJob tight = alf_held_four_bar("alf", 0);
+  ASSERT_TRUE(tight.result.completed) << tight.result.failure;
+  std::cout << "held four-bar, alf at the file's tolerances: gap " << tight.linear_gap[0] << " rad, |y - cvode-bdf| "
+            << (tight.result.y - b.y).cwiseAbs().maxCoeff() << "; " << tight.result.stats.steps << " steps\n";
+  EXPECT_LT((tight.result.y - b.y).cwiseAbs().maxCoeff(), 3e-8);  // measured 7.7e-9 rad (6007 steps)
+  EXPECT_NEAR(tight.linear_gap[0], bdf.linear_gap[0], 3e-8);       // measured 1e-8 apart
+}
+
+// a sweep of 100 variants of the held four-bar (the coupler's mass 3..5 kg, the nominal LQR
+// fixed), each run by alf (the model file's solver): every variant's figures against the same
+// sweep run by cvode-bdf at a tight tolerance
+TEST(Alf, SweepOfHeldFourBars) {
+  const std::string path = test::example_path("four_bar_held.json");
+  std::ifstream in(path);
+  nlohmann::json j = nlohmann::json::parse(in);
+  auto sweep = [&](const std::string& integrator, double tol) {
+    j["solver"]["integrator"] = integrator;
+    j["solver"]["rtol"] = tol;
+    j["solver"]["atol"] = tol;
+    SweepRequest r;
+    r.model = path;
+    r.model_text = j.dump();
+    r.vary = {"/bodies/1/mass=3:5:100"};
+    r.simulate = true;
+    r.threads = 2;
+    return study_sweep_job(r);
+  };
+  const auto t0 = std::chrono::steady_clock::now();
+  const SweepJob alf = sweep("alf", 1e-7);
+  const double alf_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const SweepJob bdf = sweep("cvode-bdf", 1e-11);
+  ASSERT_EQ(alf.variants.size(), 100u);
+  ASSERT_EQ(bdf.variants.size(), 100u);
+  double worst_final = 0, worst_peak = 0, spread_final = 0;
+  for (std::size_t i = 0; i < 100; ++i) {
+    const SweepVariant &a = alf.variants[i], &b = bdf.variants[i];
+    ASSERT_EQ(a.sim_status, 0) << i << ": " << a.sim_reason;
+    ASSERT_EQ(b.sim_status, 0) << i << ": " << b.sim_reason;
+    EXPECT_EQ(a.values, b.values);
+    worst_final = std::max(worst_final, std::abs(a.final_error - b.final_error));
+    worst_peak = std::max(worst_peak, std::abs(a.peak_input[0] - b.peak_input[0]) / std::abs(b.peak_input[0]));
+    spread_final = std::max(spread_final, std::abs(b.final_error - bdf.variants[0].final_error));
+  }
+  std::cout << "sweep of 100 held four-bars, alf 1e-7 against cvode-bdf 1e-11: final error off by " << worst_final
+            << " rad (spread over the variants " << spread_final << "), peak input off by " << worst_peak
+            << " of itself; alf's sweep " << alf_wall << " s\n";
+  EXPECT_GT(spread_final, 1e-4);  // the variants differ (measured 2.7e-4 rad): the comparison sees each
+  EXPECT_LT(worst_final, 5e-9);   // measured 1.5e-9 rad
+  EXPECT_LT(worst_peak, 3e-6);    // measured 1.1e-6 of the peak
 }
 
 TEST(Alf, Explore) {
