@@ -68,6 +68,7 @@
 #include "dynamics/data.hpp"
 #include "models/speed_models.hpp"
 #include "peers_mujoco/mjcf.hpp"
+#include "peer_report.hpp"
 
 namespace {
 
@@ -230,62 +231,11 @@ void jac_mujoco(benchmark::State& st, Case* c) {
 
 const char* const kOps[] = {"fd", "crba", "crba_k", "crba_q", "jac"};
 
-// collects the median CPU time (ns) of every benchmark while the console reporter prints
-class Collector : public benchmark::ConsoleReporter {
- public:
-  std::map<std::string, double> median_ns;
-  std::map<std::string, std::vector<double>> reps_ns;
-  void ReportRuns(const std::vector<Run>& runs) override {
-    for (const Run& r : runs) {
-      const std::string name = r.run_name.function_name;
-      if (r.run_type == Run::RT_Aggregate) {
-        if (r.aggregate_name == "median") median_ns[name] = r.GetAdjustedCPUTime() * to_ns(r.time_unit);
-      } else if (r.iterations > 0 && !r.error_occurred) {
-        reps_ns[name].push_back(r.cpu_accumulated_time / static_cast<double>(r.iterations) * 1e9);
-      }
-    }
-    ConsoleReporter::ReportRuns(runs);
-  }
-  // the median over repetitions (GB's own aggregate, else the single run)
-  double get(const std::string& name) const {
-    auto it = median_ns.find(name);
-    if (it != median_ns.end()) return it->second;
-    auto jt = reps_ns.find(name);
-    if (jt == reps_ns.end() || jt->second.empty()) return -1.0;
-    std::vector<double> v = jt->second;
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-  }
+using bench::PeerCollector;
+const auto fmt_time = bench::peer_fmt_time;
+const auto fmt_ratio = bench::peer_fmt_ratio;
 
- private:
-  static double to_ns(benchmark::TimeUnit u) {
-    switch (u) {
-      case benchmark::kNanosecond: return 1.0;
-      case benchmark::kMicrosecond: return 1e3;
-      case benchmark::kMillisecond: return 1e6;
-      case benchmark::kSecond: return 1e9;
-    }
-    return 1.0;
-  }
-};
-
-std::string fmt_time(double ns) {
-  char buf[32];
-  if (ns < 0) return "-";
-  if (ns < 1e4) std::snprintf(buf, sizeof buf, "%.3g us", ns * 1e-3);
-  else if (ns < 1e7) std::snprintf(buf, sizeof buf, "%.4g us", ns * 1e-3);
-  else std::snprintf(buf, sizeof buf, "%.4g ms", ns * 1e-6);
-  return buf;
-}
-std::string fmt_ratio(double a, double b) {
-  if (a <= 0 || b <= 0) return "-";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.2f", a / b);
-  return buf;
-}
-
-std::string table(const Collector& col) {
+std::string table(const PeerCollector& col) {
   std::ostringstream t;
   t << "Ratios codyna / MuJoCo " << mj_versionString()
     << " (median CPU time of interleaved repetitions; below 1: codyna is faster)\n\n"
@@ -304,11 +254,6 @@ std::string table(const Collector& col) {
   return t.str();
 }
 
-bool has_flag(const std::vector<std::string>& args, const std::string& flag) {
-  for (const std::string& a : args)
-    if (a.rfind(flag, 0) == 0) return true;
-  return false;
-}
 
 }  // namespace
 
@@ -333,12 +278,6 @@ int main(int argc, char** argv) {
       args.push_back(a);
     }
   }
-  if (!has_flag(args, "--benchmark_repetitions")) args.push_back("--benchmark_repetitions=10");
-  if (!has_flag(args, "--benchmark_enable_random_interleaving"))
-    args.push_back("--benchmark_enable_random_interleaving=true");
-  if (!has_flag(args, "--benchmark_display_aggregates_only") && !has_flag(args, "--benchmark_report_aggregates_only"))
-    args.push_back("--benchmark_display_aggregates_only=true");
-
   std::printf("MuJoCo %s; codyna %s\n", mj_versionString(), CODYNA_VERSION);
   std::vector<ModelSpec> specs;
   for (int n : {1, 2, 4, 7, 15, 30, 60, 90}) specs.push_back(chain(n));
@@ -367,25 +306,5 @@ int main(int argc, char** argv) {
     benchmark::RegisterBenchmark(("jac/" + p->name + "/mujoco").c_str(), jac_mujoco, p)->Unit(benchmark::kMillisecond);
   }
 
-  std::vector<char*> bargv{argv[0]};
-  for (std::string& a : args) bargv.push_back(a.data());
-  int bargc = static_cast<int>(bargv.size());
-  benchmark::Initialize(&bargc, bargv.data());
-  if (benchmark::ReportUnrecognizedArguments(bargc, bargv.data())) return 1;
-  Collector collector;
-  benchmark::RunSpecifiedBenchmarks(&collector);
-  benchmark::Shutdown();
-
-  const std::string t = table(collector);
-  std::printf("\n%s", t.c_str());
-  if (!table_file.empty()) {
-    std::ofstream f(table_file);
-    f << t;
-    if (!f) {
-      std::fprintf(stderr, "could not write %s\n", table_file.c_str());
-      return 1;
-    }
-    std::printf("table written to %s\n", table_file.c_str());
-  }
-  return 0;
+  return bench::run_peer_benchmarks(argv[0], args, table, table_file);
 }

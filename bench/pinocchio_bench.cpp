@@ -63,6 +63,7 @@
 #include "dynamics/prepare.hpp"
 #include "dynamics/rnea.hpp"
 #include "models/speed_models.hpp"
+#include "peer_report.hpp"
 
 namespace {
 
@@ -291,49 +292,17 @@ void deriv_pin(benchmark::State& st, PinCase* c) {
   }
 }
 
-// collects the median CPU time (ns) of every benchmark while the console reporter prints
-class Collector : public benchmark::ConsoleReporter {
- public:
-  std::map<std::string, double> median_ns;
-  std::map<std::string, std::vector<double>> reps_ns;
-  void ReportRuns(const std::vector<Run>& runs) override {
-    for (const Run& r : runs) {
-      if (r.run_type == Run::RT_Aggregate) {
-        if (r.aggregate_name == "median")
-          median_ns[r.run_name.function_name] = r.GetAdjustedCPUTime() / benchmark::GetTimeUnitMultiplier(r.time_unit) * 1e9;
-      } else if (r.iterations > 0 && !r.error_occurred) {
-        reps_ns[r.run_name.function_name].push_back(r.cpu_accumulated_time / static_cast<double>(r.iterations) * 1e9);
-      }
-    }
-    ConsoleReporter::ReportRuns(runs);
-  }
-  // the median over repetitions (Google Benchmark's own aggregate, else the runs')
-  double get(const std::string& name) const {
-    if (auto m = median_ns.find(name); m != median_ns.end()) return m->second;
-    auto it = reps_ns.find(name);
-    if (it == reps_ns.end() || it->second.empty()) return -1.0;
-    std::vector<double> v = it->second;
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-  }
-};
-
-std::string fmt_time(double ns) {
-  char buf[32];
-  if (ns < 0) return "-";
-  std::snprintf(buf, sizeof buf, ns < 1e4 ? "%.3g us" : "%.4g us", ns * 1e-3);
-  return buf;
-}
+using bench::PeerCollector;
 
 std::string cell(double a, double b) {
   if (a <= 0 || b <= 0) return "-";
   char buf[96];
-  std::snprintf(buf, sizeof buf, "**%.2f** (%s / %s)", a / b, fmt_time(a).c_str(), fmt_time(b).c_str());
+  std::snprintf(buf, sizeof buf, "**%.2f** (%s / %s)", a / b, bench::peer_fmt_time(a).c_str(),
+                bench::peer_fmt_time(b).c_str());
   return buf;
 }
 
-std::string table(const Collector& col) {
+std::string table(const PeerCollector& col) {
   std::ostringstream t;
   t << "Ratios codyna / Pinocchio " << PINOCCHIO_VERSION
     << " (median CPU time of interleaved repetitions; Pinocchio's faster convention; below 1: codyna is faster)\n\n"
@@ -353,11 +322,6 @@ std::string table(const Collector& col) {
   return t.str();
 }
 
-bool has_flag(const std::vector<std::string>& args, const std::string& flag) {
-  for (const std::string& a : args)
-    if (a.rfind(flag, 0) == 0) return true;
-  return false;
-}
 
 }  // namespace
 
@@ -380,11 +344,6 @@ int main(int argc, char** argv) {
       args.push_back(a);
     }
   }
-  if (!has_flag(args, "--benchmark_repetitions")) args.push_back("--benchmark_repetitions=10");
-  if (!has_flag(args, "--benchmark_enable_random_interleaving"))
-    args.push_back("--benchmark_enable_random_interleaving=true");
-  if (!has_flag(args, "--benchmark_display_aggregates_only") && !has_flag(args, "--benchmark_report_aggregates_only"))
-    args.push_back("--benchmark_display_aggregates_only=true");
   std::printf("Pinocchio %s; codyna %s\n", PINOCCHIO_VERSION, CODYNA_VERSION);
   std::vector<ModelSpec> specs;
   for (int n : {2, 7, 30, 60}) specs.push_back(speed_models::chain(n));
@@ -414,24 +373,5 @@ int main(int argc, char** argv) {
     benchmark::RegisterBenchmark(("jac/" + n + "/codyna").c_str(), jac_codyna, p);
     benchmark::RegisterBenchmark(("deriv/" + n + "/pinocchio").c_str(), deriv_pin, p);
   }
-  std::vector<char*> cargv;
-  std::string prog = argv[0];
-  cargv.push_back(prog.data());
-  for (std::string& a : args) cargv.push_back(a.data());
-  int cargc = static_cast<int>(cargv.size());
-  benchmark::Initialize(&cargc, cargv.data());
-  Collector col;
-  benchmark::RunSpecifiedBenchmarks(&col);
-  const std::string t = table(col);
-  std::printf("\n%s", t.c_str());
-  if (!table_file.empty()) {
-    std::ofstream f(table_file);
-    f << t;
-    if (!f) {
-      std::fprintf(stderr, "cannot write %s\n", table_file.c_str());
-      return 1;
-    }
-  }
-  benchmark::Shutdown();
-  return 0;
+  return bench::run_peer_benchmarks(argv[0], args, table, table_file);
 }

@@ -242,7 +242,6 @@ void TreeDerivatives::size_for(const Model& model) {
     if (llt_ff_.rows() != nf) llt_ff_ = Eigen::LLT<Eigen::MatrixXd>(nf);
   }
   Minv_.setZero(nv, nv);
-  scratch_rows_.setZero(6, nv);
   IA_.assign(nb, Mat6::Zero());
   Fb_.resize(static_cast<std::size_t>(nb));
   Ab_.resize(static_cast<std::size_t>(nb));
@@ -253,7 +252,7 @@ void TreeDerivatives::size_for(const Model& model) {
   Uu_.assign(nu, Mat6::Zero());
   pa_.assign(nb, Vec6::Zero());
   X_.setZero(nv, 2 * nv);
-  scratch_rows2_.setZero(6, 2 * nv);
+  scratch_rows_.setZero(6, 2 * nv);  // k rows of a unit over nv (M^-1) or 2 nv (X_) columns
   Fr_.resize(static_cast<std::size_t>(nb));
   Ar_.resize(static_cast<std::size_t>(nb));
   for (int i = 0; i < nb; ++i) {
@@ -492,7 +491,7 @@ void TreeDerivatives::inverse_mass_matrix() {
       } else {
         auto rows = Minv_.block(un.iv, c0, k, len);
         scratch_rows_.topLeftCorner(k, len) = rows;
-        rows = Dinv.topLeftCorner(k, k).lazyProduct(scratch_rows_.topLeftCorner(k, len));
+        rows = Dinv.topLeftCorner(k, k).lazyProduct(scratch_rows_.topLeftCorner(k, len));  // (len <= nv)
       }
       // F += U B
       for (int a = 0; a < k; ++a) {
@@ -628,8 +627,8 @@ void TreeDerivatives::articulated_solve_rows() {
         X_.row(un.iv) *= Dinv(0, 0);
       } else {
         auto rows = X_.middleRows(un.iv, k);
-        scratch_rows2_.topRows(k) = rows;
-        rows = Dinv.topLeftCorner(k, k).lazyProduct(scratch_rows2_.topRows(k));
+        scratch_rows_.topLeftCorner(k, mc) = rows;
+        rows = Dinv.topLeftCorner(k, k).lazyProduct(scratch_rows_.topLeftCorner(k, mc));
       }
       const Mat6& U = Uu_[u];
       for (int r = 0; r < 6; ++r) {

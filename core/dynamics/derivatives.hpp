@@ -186,7 +186,6 @@ class TreeDerivatives {
   std::vector<Mat6T<double>> Uu_, Dinv_;         // [units] IA S and (S^T IA S + armature)^-1, padded
   std::vector<Vec6T<double>> pa_, av_;           // [nbodies] articulated_solve's forces and accelerations
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> X_;  // [nv x 2 nv]
-  Rows6 scratch_rows2_;
   std::vector<Rows6> Fr_, Ar_;                   // [nbodies] forces, accelerations of X_'s columns
   std::vector<int> col_begin_, col_end_;
   std::vector<int> children_, sub_nv_;           // [nbodies] number of child bodies; columns of the subtree
