@@ -1,5 +1,7 @@
 #include "dynamics/crba.hpp"
 
+#include <type_traits>
+
 #include "dynamics/kinematics.hpp"
 #include "spatial/autodiff.hpp"
 
@@ -49,6 +51,37 @@ const MatXT<S>& crba_composite(const Model& model, DataT<S>& d) {
   if (d.M.rows() != nv || d.M.cols() != nv) d.M.setZero(nv, nv);
   else if (!k.dense_mass_matrix) d.M.setZero();
   S* M = d.M.data();
+  if constexpr (std::is_same_v<S, double>) {
+    // the same products with the force's six components in registers: a Vec6 made by scalar
+    // stores and read back as vectors stalls on every pair (store forwarding); a chain's
+    // ancestors are the indices below, without the walk through dof_parent
+    for (int a = 0; a < nv; ++a) {
+      const RigidInertiaT<double>& I = d.Ic[k.dof_body[a]];
+      const double* s = d.Sw[a].data();
+      const double w0 = s[0], w1 = s[1], w2 = s[2], v0 = s[3], v1 = s[4], v2 = s[5];
+      const double* h = I.h.data();
+      const double f0 = I.I(0, 0) * w0 + I.I(0, 1) * w1 + I.I(0, 2) * w2 + (h[1] * v2 - h[2] * v1);
+      const double f1 = I.I(1, 0) * w0 + I.I(1, 1) * w1 + I.I(1, 2) * w2 + (h[2] * v0 - h[0] * v2);
+      const double f2 = I.I(2, 0) * w0 + I.I(2, 1) * w1 + I.I(2, 2) * w2 + (h[0] * v1 - h[1] * v0);
+      const double f3 = I.m * v0 - (h[1] * w2 - h[2] * w1);
+      const double f4 = I.m * v1 - (h[2] * w0 - h[0] * w2);
+      const double f5 = I.m * v2 - (h[0] * w1 - h[1] * w0);
+      double* col = M + static_cast<std::ptrdiff_t>(a) * nv;  // M(:, a)
+      auto pair = [&](int b) {
+        const double* t = d.Sw[b].data();
+        const double m = t[0] * f0 + t[1] * f1 + t[2] * f2 + t[3] * f3 + t[4] * f4 + t[5] * f5;
+        col[b] = m;
+        M[a + static_cast<std::ptrdiff_t>(b) * nv] = m;
+      };
+      if (k.dense_mass_matrix)
+        for (int b = a; b >= 0; --b) pair(b);
+      else
+        for (int b = a; b >= 0; b = k.dof_parent[b]) pair(b);
+    }
+    if (model.armature.size() != 0)
+      for (int a = 0; a < nv; ++a) M[a + static_cast<std::ptrdiff_t>(a) * nv] += model.armature[a];
+    return d.M;
+  }
   for (int a = 0; a < nv; ++a) {
     const Vec6T<S> F = d.Ic[k.dof_body[a]].apply(d.Sw[a]);
     for (int b = a; b >= 0; b = k.dof_parent[b]) {

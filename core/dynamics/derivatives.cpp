@@ -206,8 +206,7 @@ void TreeDerivatives::size_for(const Model& model) {
   Bc_.assign(nb, Mat6::Zero());
   hc_.assign(nb, Vec6::Zero());
   F_.assign(nb, Vec6::Zero());
-  P_.assign(nu, Mat6::Zero());
-  R_.assign(nu, Mat6::Zero());
+  PR_.assign(nu, Rows12::Zero());
   below_.assign(nb, 0);
   Icom_.assign(nb, Mat3::Zero());
   for (int i = 1; i < nb; ++i) {
@@ -371,8 +370,8 @@ void TreeDerivatives::composites() {
     for (int u = unit_begin_[i]; u < unit_end_[i]; ++u) {
       const Unit& un = units_[u];
       const auto Su = S_[i].middleCols(un.iv - j.idx_v, un.n);
-      P_[u].topRows(un.n).noalias() = Su.transpose() * Ic_[i];
-      R_[u].topRows(un.n).noalias() = Su.transpose() * BH;
+      PR_[u].topLeftCorner(un.n, 6).noalias() = Su.transpose() * Ic_[i];
+      PR_[u].topRightCorner(un.n, 6).noalias() = Su.transpose() * BH;
     }
   }
 }
@@ -401,18 +400,18 @@ void TreeDerivatives::mass_matrix() {
         const Unit& b = units_[uj];
         const auto Sj = S_[b.body].middleCols(b.iv - m_->joints[b.body].idx_v, b.n);
         if (a.n == 1 && b.n == 1) {
-          M(a.iv, b.iv) = M(b.iv, a.iv) = P_[ui].row(0).dot(Vec6(Sj.col(0)));
+          M(a.iv, b.iv) = M(b.iv, a.iv) = PR_[ui].row(0).head<6>().dot(Vec6(Sj.col(0)));
           if (uj == ui) break;
           continue;
         }
         if (a.n == 3 && b.n == 3) {
           const Eigen::Matrix<double, 6, 3> sj = Sj;
-          M.block<3, 3>(a.iv, b.iv).noalias() = P_[ui].topRows<3>() * sj;
+          M.block<3, 3>(a.iv, b.iv).noalias() = PR_[ui].topLeftCorner<3, 6>() * sj;
           if (uj == ui) break;
           M.block<3, 3>(b.iv, a.iv) = M.block<3, 3>(a.iv, b.iv).transpose();
           continue;
         }
-        M.block(a.iv, b.iv, a.n, b.n).noalias() = P_[ui].topRows(a.n) * Sj;
+        M.block(a.iv, b.iv, a.n, b.n).noalias() = PR_[ui].topLeftCorner(a.n, 6) * Sj;
         if (uj != ui) M.block(b.iv, a.iv, b.n, a.n) = M.block(a.iv, b.iv, a.n, b.n).transpose();
         if (uj == ui) break;
       }
@@ -716,23 +715,27 @@ void TreeDerivatives::differentiate_rnea() {
         const Vec6 u = crm(s, Vp);
         const Vec6 dw = crm(u, Vp) - crm(s, Ap);
         const Vec6 cv = -crm(s, Vsum);
+        // dtau_dq = P dw - R u, dtau_dv = P cv + R s: one dot product with [P, R] each
+        Eigen::Matrix<double, 12, 1> xq, xv;
+        xq << dw, -u;
+        xv << cv, s;
         // units at or below k
         for (int b = i; b < nb; ++b) {
           if (!below_[b]) continue;
           for (int j = (b == i ? k : unit_begin_[b]); j < unit_end_[b]; ++j) {
             const Unit& uj = units_[j];
             if (uj.n == 1) {  // one column: fixed-size dot products
-              dtau_dq(uj.iv, col) = P_[j].row(0).dot(dw) - R_[j].row(0).dot(u);
-              dtau_dv(uj.iv, col) = R_[j].row(0).dot(s) + P_[j].row(0).dot(cv);
+              dtau_dq(uj.iv, col) = PR_[j].row(0).dot(xq);
+              dtau_dv(uj.iv, col) = PR_[j].row(0).dot(xv);
               continue;
             }
             if (uj.n == 3) {  // a ball joint: fixed-size 3 x 6 products
-              dtau_dq.block<3, 1>(uj.iv, col).noalias() = P_[j].topRows<3>() * dw - R_[j].topRows<3>() * u;
-              dtau_dv.block<3, 1>(uj.iv, col).noalias() = R_[j].topRows<3>() * s + P_[j].topRows<3>() * cv;
+              dtau_dq.block<3, 1>(uj.iv, col).noalias() = PR_[j].topRows<3>() * xq;
+              dtau_dv.block<3, 1>(uj.iv, col).noalias() = PR_[j].topRows<3>() * xv;
               continue;
             }
-            dtau_dq.block(uj.iv, col, uj.n, 1).noalias() = P_[j].topRows(uj.n) * dw - R_[j].topRows(uj.n) * u;
-            dtau_dv.block(uj.iv, col, uj.n, 1).noalias() = R_[j].topRows(uj.n) * s + P_[j].topRows(uj.n) * cv;
+            dtau_dq.block(uj.iv, col, uj.n, 1).noalias() = PR_[j].topRows(uj.n) * xq;
+            dtau_dv.block(uj.iv, col, uj.n, 1).noalias() = PR_[j].topRows(uj.n) * xv;
           }
         }
         // units above k: the whole subtree's force change
@@ -1222,8 +1225,13 @@ void TreeDerivatives::compute(const Eigen::VectorXd& q, const Eigen::VectorXd& v
   } else {
     rhs_.leftCols(nv) = dQ_dq - dtau_dq;
     rhs_.middleCols(nv, nv) = dQ_dv - dtau_dv;
-    dqdd_dq.noalias() = Minv_ * rhs_.leftCols(nv);
-    dqdd_dv.noalias() = Minv_ * rhs_.middleCols(nv, nv);
+    if (nv <= kLazyProductUpTo) {  // below the blocked product's packing cost
+      dqdd_dq.noalias() = Minv_.lazyProduct(rhs_.leftCols(nv));
+      dqdd_dv.noalias() = Minv_.lazyProduct(rhs_.middleCols(nv, nv));
+    } else {
+      dqdd_dq.noalias() = Minv_ * rhs_.leftCols(nv);
+      dqdd_dv.noalias() = Minv_ * rhs_.middleCols(nv, nv);
+    }
   }
   for (int k = 0; k < nu; ++k) {
     const ActuatorModel& act = m_->actuators[k];

@@ -146,6 +146,9 @@ class TreeDerivatives {
   // models' chains (bench/pinocchio_bench.cpp, clang -O3): the products are faster up to 20 links
   // (4.0 against 4.9 us at 7, 16.2 against 18.5 at 20), even at 30, the solve 25% faster at 60
   static constexpr int kRowsSolveFrom = 32;
+  // below this many coordinates the products with M^-1 are coefficient by coefficient (Eigen's
+  // blocked product packs its operands first, which costs more than it saves on small matrices)
+  static constexpr int kLazyProductUpTo = 12;
   void differentiate_rnea();
   void applied_force_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& u);
   void add_body_wrench(int body, const Vec6T<double>& w, const Eigen::Matrix<double, 6, 24>& dw, int body_a,
@@ -172,7 +175,10 @@ class TreeDerivatives {
   std::vector<Mat6T<double>> I_, Ic_, Bc_;       // [nbodies]
   std::vector<Eigen::Matrix3d> Icom_;            // [nbodies] rotational inertia about the com, body axes
   std::vector<Vec6T<double>> hc_, F_;            // [nbodies]
-  std::vector<Mat6T<double>> P_, R_;             // [units] rows S^T Ic and S^T (Bc + H(hc)), padded to 6
+  // [units] the rows [S^T Ic, S^T (Bc + H(hc))] side by side (P, R), padded to 6 rows: one contiguous
+  // 12-vector per coordinate, so that each entry of the RNEA derivatives is one 12-term dot product
+  using Rows12 = Eigen::Matrix<double, 6, 12, Eigen::RowMajor>;
+  std::vector<Rows12> PR_;
   std::vector<char> below_;                      // [nbodies] scratch: in the subtree of a body
   Eigen::VectorXd qdd_zero_, scratch_;
   Eigen::MatrixXd rhs_;

@@ -35,8 +35,9 @@ Quat<S> quat_exp(const Vec3T<S>& w) {
     k = S(0.5) - t2 / S(48);
   } else {
     const S t = sqrt(t2);
-    c = cos(t / S(2));
-    k = sin(t / S(2)) / t;
+    S sh;
+    sin_cos(S(t / S(2)), sh, c);
+    k = sh / t;
   }
   return {c, k * w.x(), k * w.y(), k * w.z()};
 }

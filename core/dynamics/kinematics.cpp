@@ -24,8 +24,6 @@ Vec6T<S> body_velocity(const JointModel& j, DataT<S>& d, int i, const VecXT<S>& 
 
 template <class S>
 void fk(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>* v, const VecXT<S>* qdd) {
-  using std::cos;
-  using std::sin;
   SE3T<S> X_FM;
   Mat6xT<S> S_M;
   for (int i = 1; i < model.nbodies; ++i) {
@@ -35,8 +33,9 @@ void fk(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>* v, c
     SE3T<S>& liMi = d.liMi[i];
     if (j.type == JointType::Revolute) {
       // X_PF Rot(axis, q) X_CM^-1 = (Rot(R_PF axis, q) R0, Rot(R_PF axis, q) p0 + p_PF)
-      const S qi = q[j.idx_q];
-      const Mat3T<S> Rq = axis_rotation<S>(k.axis_P, cos(qi), sin(qi));
+      S sq, cq;
+      sin_cos(q[j.idx_q], sq, cq);
+      const Mat3T<S> Rq = axis_rotation<S>(k.axis_P, cq, sq);
       liMi.R.noalias() = Rq * k.R0.template cast<S>();
       liMi.p.noalias() = Rq * k.p0.template cast<S>();
       liMi.p += k.X_PF.p.template cast<S>();

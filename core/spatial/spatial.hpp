@@ -6,6 +6,8 @@
 // runs through the same code.
 #pragma once
 
+#include <cmath>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -18,6 +20,17 @@ template <class S> using Mat6T = Eigen::Matrix<S, 6, 6>;
 template <class S> using Mat6xT = Eigen::Matrix<S, 6, Eigen::Dynamic, 0, 6, 6>;  // at most 6 columns, no heap
 template <class S> using VecXT = Eigen::Matrix<S, Eigen::Dynamic, 1>;
 template <class S> using MatXT = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>;
+
+// sine and cosine of one angle: in double one call to the C library's sincos (the two values are
+// those of sin and cos, at about the cost of one); any other scalar (autodiff) takes the two
+template <class S>
+void sin_cos(const S& a, S& s, S& c) {
+  using std::cos;
+  using std::sin;
+  s = sin(a);
+  c = cos(a);
+}
+inline void sin_cos(double a, double& s, double& c) { ::sincos(a, &s, &c); }
 
 template <class S>
 Mat3T<S> skew(const Vec3T<S>& w) {
@@ -240,9 +253,8 @@ Mat3T<S> axis_rotation(const Eigen::Vector3d& a, const S& c, const S& s) {
 // Rotation by angle about a unit axis, for any scalar.
 template <class S>
 Mat3T<S> axis_angle(const Eigen::Vector3d& axis, const S& angle) {
-  using std::cos;
-  using std::sin;
-  const S c = cos(angle), s = sin(angle);
+  S s, c;
+  sin_cos(angle, s, c);
   const Mat3T<S> K = skew<S>(axis.template cast<S>());
   return Mat3T<S>::Identity() + s * K + (S(1) - c) * (K * K);
 }
