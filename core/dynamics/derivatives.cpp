@@ -207,7 +207,22 @@ void TreeDerivatives::size_for(const Model& model) {
   hc_.assign(nb, Vec6::Zero());
   F_.assign(nb, Vec6::Zero());
   PR_.assign(nu, Rows12::Zero());
-  below_.assign(nb, 0);
+  {
+    std::vector<char>& below = below_;
+    below.assign(static_cast<std::size_t>(nb), 0);
+    sub_begin_.assign(static_cast<std::size_t>(nb) + 1, 0);
+    sub_bodies_.clear();
+    for (int i = 0; i < nb; ++i) {
+      sub_begin_[i] = static_cast<int>(sub_bodies_.size());
+      if (i == 0) continue;
+      std::fill(below.begin(), below.end(), 0);
+      below[i] = 1;
+      for (int b = i + 1; b < nb; ++b) below[b] = below[model.parent[b]];
+      for (int b = i; b < nb; ++b)
+        if (below[b] && unit_begin_[b] < unit_end_[b]) sub_bodies_.push_back(b);
+    }
+    sub_begin_[nb] = static_cast<int>(sub_bodies_.size());
+  }
   Icom_.assign(nb, Mat3::Zero());
   for (int i = 1; i < nb; ++i) {
     const Mat3 cx = skew<double>(model.com[i]);
@@ -699,9 +714,6 @@ void TreeDerivatives::differentiate_rnea() {
   for (int i = 1; i < nb; ++i) {
     if (unit_begin_[i] == unit_end_[i]) continue;
     const JointModel& ji = m_->joints[i];
-    for (int b = 0; b < nb; ++b) below_[b] = 0;
-    below_[i] = 1;
-    for (int b = i + 1; b < nb; ++b) below_[b] = below_[m_->parent[b]];
     Mat6 BH = Bc_[i];
     add_momentum_operator(hc_[i], BH);
     for (int k = unit_begin_[i]; k < unit_end_[i]; ++k) {
@@ -720,8 +732,8 @@ void TreeDerivatives::differentiate_rnea() {
         xq << dw, -u;
         xv << cv, s;
         // units at or below k
-        for (int b = i; b < nb; ++b) {
-          if (!below_[b]) continue;
+        for (int sb = sub_begin_[i]; sb < sub_begin_[i + 1]; ++sb) {
+          const int b = sub_bodies_[sb];
           for (int j = (b == i ? k : unit_begin_[b]); j < unit_end_[b]; ++j) {
             const Unit& uj = units_[j];
             if (uj.n == 1) {  // one column: fixed-size dot products
@@ -1204,7 +1216,6 @@ void TreeDerivatives::compute(const Eigen::VectorXd& q, const Eigen::VectorXd& v
   forces();
   scratch_ = tau;
   applied_force_derivatives(q, v, u_all);
-  mass_matrix();
   inverse_mass_matrix();
   scratch_ = Q - scratch_;
   articulated_solve(scratch_, qdd);

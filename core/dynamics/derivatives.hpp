@@ -120,7 +120,10 @@ class TreeDerivatives {
   Eigen::MatrixXd dtau_dq, dtau_dv;         // [nv x nv]
   Eigen::VectorXd Q;                        // applied generalized forces
   Eigen::MatrixXd dQ_dq, dQ_dv, dQ_du;      // [nv x nv], [nv x nv], [nv x nu_all]
-  Eigen::MatrixXd M;                        // mass matrix at q
+  // mass matrix at q: compute_constrained() fills it; compute() does not need it (M^-1 comes from
+  // the articulated bodies), and fills it only through fill_mass_matrix(), after it
+  Eigen::MatrixXd M;
+  void fill_mass_matrix() { mass_matrix(); }
   // results of compute_constrained(), one row per constraint row [nc x nv]
   Eigen::MatrixXd Jc;                       // d phi / dq (tangent), as constraint_terms gives it
   Eigen::MatrixXd dc_dq, dc_dv;             // derivatives of c = Jc a + gamma at the given a
@@ -179,7 +182,10 @@ class TreeDerivatives {
   // 12-vector per coordinate, so that each entry of the RNEA derivatives is one 12-term dot product
   using Rows12 = Eigen::Matrix<double, 6, 12, Eigen::RowMajor>;
   std::vector<Rows12> PR_;
-  std::vector<char> below_;                      // [nbodies] scratch: in the subtree of a body
+  // the bodies of each body's subtree with a joint that moves (itself first, then in increasing
+  // order): sub_bodies_[sub_begin_[i] .. sub_begin_[i + 1])
+  std::vector<int> sub_begin_, sub_bodies_;
+  std::vector<char> below_;                      // [nbodies] scratch of size_for
   Eigen::VectorXd qdd_zero_, scratch_;
   Eigen::MatrixXd rhs_;
   // M^-1 without M: the articulated-body recursion in world axes applied to every unit force at

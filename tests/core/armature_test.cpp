@@ -252,6 +252,7 @@ TEST(Armature, TreeDerivativesMatchAutodiffOnAChain) {
     const Eigen::VectorXd q = test::random_q(m, rng), v = test::random_v(m, rng, 2.0);
     const Eigen::VectorXd u = test::random_v(m, rng, 3.0).head(nu);
     td.compute(q, v, u, m.plant_outputs);
+    td.fill_mass_matrix();
     const int n = 2 * nv + nu;
     const ADVec dz = ad_seed(Eigen::VectorXd::Zero(nv), n, 0), va = ad_seed(v, n, nv), ua = ad_seed(u, n, 2 * nv);
     DataT<ADScalar> d(m);
