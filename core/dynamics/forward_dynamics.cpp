@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <type_traits>
 
+#include <Eigen/Cholesky>
+
 #include "dynamics/aba.hpp"
 #include "dynamics/assembly.hpp"
 #include "dynamics/constraints.hpp"
@@ -18,39 +20,15 @@
 namespace codyna {
 
 namespace {
-// L L^T = A into L (lower triangle; the upper one is left as it was), as
-// cholesky_solve (spatial/linalg.hpp) computes it; no heap once L has A's size
-void cholesky_factor_into(const Eigen::MatrixXd& A, Eigen::MatrixXd& L) {
-  const Eigen::Index n = A.rows();
-  if (L.rows() != n || L.cols() != n) L.resize(n, n);
-  for (Eigen::Index j = 0; j < n; ++j) {
-    double d = A(j, j);
-    for (Eigen::Index k = 0; k < j; ++k) d -= L(j, k) * L(j, k);
-    if (!(d > 0.0)) throw std::runtime_error("matrix is not positive definite");
-    L(j, j) = std::sqrt(d);
-    for (Eigen::Index i = j + 1; i < n; ++i) {
-      double s = A(i, j);
-      for (Eigen::Index k = 0; k < j; ++k) s -= L(i, k) * L(j, k);
-      L(i, j) = s / L(j, j);
-    }
-  }
-}
-// X <- A^-1 X for A = L L^T
-template <class M>
-void cholesky_solve_in_place(const Eigen::MatrixXd& L, M& X) {
-  const Eigen::Index n = L.rows();
-  for (Eigen::Index c = 0; c < X.cols(); ++c) {
-    for (Eigen::Index i = 0; i < n; ++i) {  // L y = b
-      double s = X(i, c);
-      for (Eigen::Index k = 0; k < i; ++k) s -= L(i, k) * X(k, c);
-      X(i, c) = s / L(i, i);
-    }
-    for (Eigen::Index i = n - 1; i >= 0; --i) {  // L^T x = y
-      double s = X(i, c);
-      for (Eigen::Index k = i + 1; k < n; ++k) s -= L(k, i) * X(k, c);
-      X(i, c) = s / L(i, i);
-    }
-  }
+// A = L L^T in place in L (a copy of A; Eigen's blocked, vectorized Cholesky on a Ref: no heap once
+// L has A's size), then X <- A^-1 X by its two triangular solves
+void cholesky_solve_into(const Eigen::MatrixXd& A, Eigen::MatrixXd& L, Eigen::Ref<Eigen::MatrixXd> X) {
+  L = A;  // (the same size as before: no reallocation)
+  Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(L);
+  // (a NaN pivot passes Eigen's test d <= 0: refused here as the sum of the diagonal)
+  if (llt.info() != Eigen::Success || !std::isfinite(L.diagonal().sum()))
+    throw std::runtime_error("matrix is not positive definite");
+  llt.solveInPlace(X);
 }
 template <class M>
 void resize_if(M& m, Eigen::Index r, Eigen::Index c) {
@@ -61,15 +39,13 @@ void resize_if(M& m, Eigen::Index r, Eigen::Index c) {
 // w.J and w.rhs the kept rows. One factorization of M gives [M^-1 f, M^-1 J^T], the Schur
 // complement J M^-1 J^T the multipliers (w.lam), and w.X.col(0) becomes a; no heap once sized
 void schur_solve(const Eigen::MatrixXd& M, Data::LoopSolve& w, int na) {
-  cholesky_factor_into(M, w.L);
-  cholesky_solve_in_place(w.L, w.X);
+  cholesky_solve_into(M, w.L, w.X);
   resize_if(w.A, na, na);
   w.A.noalias() = w.J * w.X.rightCols(na);
   resize_if(w.lam, na, 1);
   w.lam.noalias() = w.J * w.X.col(0);
   w.lam += w.rhs;
-  cholesky_factor_into(w.A, w.LA);
-  cholesky_solve_in_place(w.LA, w.lam);
+  cholesky_solve_into(w.A, w.LA, w.lam);
   w.X.col(0).noalias() -= w.X.rightCols(na) * w.lam;
 }
 
