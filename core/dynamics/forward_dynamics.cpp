@@ -20,33 +20,55 @@
 namespace codyna {
 
 namespace {
-// A = L L^T in place in L (a copy of A; Eigen's blocked, vectorized Cholesky on a Ref: no heap once
-// L has A's size), then X <- A^-1 X by its two triangular solves
-void cholesky_solve_into(const Eigen::MatrixXd& A, Eigen::MatrixXd& L, Eigen::Ref<Eigen::MatrixXd> X) {
-  L = A;  // (the same size as before: no reallocation)
-  Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(L);
-  // (a NaN pivot passes Eigen's test d <= 0: refused here as the sum of the diagonal)
-  if (llt.info() != Eigen::Success || !std::isfinite(L.diagonal().sum()))
-    throw std::runtime_error("matrix is not positive definite");
-  llt.solveInPlace(X);
-}
 template <class M>
 void resize_if(M& m, Eigen::Index r, Eigen::Index c) {
   if (m.rows() != r || m.cols() != c) m.resize(r, c);
 }
 
 // M a + J^T lam = f, J a + rhs = 0 in the loop workspace: w.X holds [f, J^T] (M's size x 1 + na),
-// w.J and w.rhs the kept rows. One factorization of M gives [M^-1 f, M^-1 J^T], the Schur
-// complement J M^-1 J^T the multipliers (w.lam), and w.X.col(0) becomes a; no heap once sized
+// w.J and w.rhs the kept rows. With M = L L^T (Eigen's blocked Cholesky in place in w.L, a copy of
+// M: no heap once sized), [y, Y] = L^-1 [f, J^T] by one triangular solve; the Schur complement
+// J M^-1 J^T = Y^T Y and J M^-1 f = Y^T y give the multipliers (w.lam), and w.X.col(0) becomes
+// a = L^-T (y - Y lam). Throws for a matrix that is not positive definite (a NaN pivot included).
 void schur_solve(const Eigen::MatrixXd& M, Data::LoopSolve& w, int na) {
-  cholesky_solve_into(M, w.L, w.X);
+  auto factor = [](const Eigen::MatrixXd& A, Eigen::MatrixXd& L) {
+    L = A;  // (the same size as before: no reallocation)
+    Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(L);
+    // (a NaN pivot passes Eigen's test d <= 0: refused here by the diagonal's sum)
+    if (llt.info() != Eigen::Success || !std::isfinite(L.diagonal().sum()))
+      throw std::runtime_error("matrix is not positive definite");
+  };
+  factor(M, w.L);
+  w.L.triangularView<Eigen::Lower>().solveInPlace(w.X);
+  const auto y = w.X.col(0);
+  const auto Y = w.X.rightCols(na);
   resize_if(w.A, na, na);
-  w.A.noalias() = w.J * w.X.rightCols(na);
+  w.A.noalias() = Y.transpose() * Y;
   resize_if(w.lam, na, 1);
-  w.lam.noalias() = w.J * w.X.col(0);
+  w.lam.noalias() = Y.transpose() * y;
   w.lam += w.rhs;
-  cholesky_solve_into(w.A, w.LA, w.lam);
-  w.X.col(0).noalias() -= w.X.rightCols(na) * w.lam;
+  factor(w.A, w.LA);
+  w.LA.triangularView<Eigen::Lower>().solveInPlace(w.lam);
+  w.LA.transpose().triangularView<Eigen::Upper>().solveInPlace(w.lam);
+  w.X.col(0).noalias() -= Y * w.lam;
+  w.L.transpose().triangularView<Eigen::Upper>().solveInPlace(w.X.col(0));
+}
+
+// d.loop.rows: the rows of Jc kept at this configuration, the first of the column-pivoted QR of
+// Jc^T up to the rank fixed at assembly, in increasing order. Where that rank is every row (no
+// redundant constraint) the answer is all of them, without the factorization.
+void kept_loop_rows(const Model& model, Data& d) {
+  Data::LoopSolve& w = d.loop;
+  const int rank = static_cast<int>(model.active_rows.size());
+  w.rows.clear();
+  if (rank == model.nc) {
+    for (int k = 0; k < rank; ++k) w.rows.push_back(k);
+    return;
+  }
+  w.qr.compute(d.Jc.transpose());
+  const auto& perm = w.qr.colsPermutation().indices();
+  for (int k = 0; k < rank; ++k) w.rows.push_back(perm[k]);
+  std::sort(w.rows.begin(), w.rows.end());
 }
 
 // the closed-loop branch of forward_dynamics in double, in data's workspace
@@ -61,13 +83,8 @@ const Eigen::VectorXd& closed_loop_dynamics(const Model& model, Data& d, const E
   Data::LoopSolve& w = d.loop;
   const int nv = model.nv;
   // independent rows at this configuration (partition_rows with the rank fixed at assembly)
-  w.qr.compute(d.Jc.transpose());
-  const int rank = static_cast<int>(model.active_rows.size());
-  const auto& perm = w.qr.colsPermutation().indices();
-  w.rows.clear();
-  for (int k = 0; k < rank; ++k) w.rows.push_back(perm[k]);
-  std::sort(w.rows.begin(), w.rows.end());
-  const int na = rank;
+  kept_loop_rows(model, d);
+  const int na = static_cast<int>(w.rows.size());
   resize_if(w.J, na, nv);
   resize_if(w.rhs, na, 1);
   for (int k = 0; k < na; ++k) {
@@ -114,11 +131,7 @@ const Eigen::VectorXd& prescribed_dynamics_double(const Model& model, Data& d, c
   w.rows.clear();
   if (model.nc > 0) {
     constraint_terms<double>(model, d, q, v);
-    w.qr.compute(d.Jc.transpose());
-    const int rank = static_cast<int>(model.active_rows.size());
-    const auto& perm = w.qr.colsPermutation().indices();
-    for (int k = 0; k < rank; ++k) w.rows.push_back(perm[k]);
-    std::sort(w.rows.begin(), w.rows.end());
+    kept_loop_rows(model, d);
   }
   const int na = static_cast<int>(w.rows.size());
   resize_if(w.Mff, nf, nf);
