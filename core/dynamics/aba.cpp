@@ -1,5 +1,7 @@
 #include "dynamics/aba.hpp"
 
+#include <type_traits>
+
 #include "dynamics/kinematics.hpp"
 #include "spatial/autodiff.hpp"
 
@@ -69,7 +71,10 @@ void aba_velocity_terms(const Model& model, DataT<S>& d, const VecXT<S>& v) {
   for (int i = 1; i < model.nbodies; ++i) {
     const JointModel& j = model.joints[i];
     const Vec6T<S>& vi = d.v[i];
-    d.pB[i] = cross_force<S>(vi, Vec6T<S>(model.inertia[i].template cast<S>() * vi));
+    if constexpr (std::is_same_v<S, double>)  // the structured inertia: no 6 x 6 product
+      d.pB[i] = cross_force<S>(vi, d.constants.body_inertia[i].apply(vi));
+    else
+      d.pB[i] = cross_force<S>(vi, Vec6T<S>(model.inertia[i].template cast<S>() * vi));
     d.pA[i] = d.pB[i];
     Vec6T<S> vJ;
     if (j.nv == 1) vJ = d.Sb[i].col(0) * v[j.idx_v];

@@ -11,10 +11,14 @@ void ModelConstants::assign(const Model& model) {
   const auto nb = static_cast<std::size_t>(model.nbodies);
   joints.assign(nb, Joint{});
   com_inertia.resize(nb);
+  body_inertia.resize(nb);
   root.assign(nb, 0);
   dof_body.assign(static_cast<std::size_t>(model.nv), 0);
   dof_parent.assign(static_cast<std::size_t>(model.nv), -1);
-  for (int i = 0; i < model.nbodies; ++i) com_inertia[i] = ComInertia::from_matrix(model.inertia[i]);
+  for (int i = 0; i < model.nbodies; ++i) {
+    com_inertia[i] = ComInertia::from_matrix(model.inertia[i]);
+    body_inertia[i] = RigidInertiaT<double>::from_matrix(model.inertia[i]);
+  }
   std::vector<int> last_dof(nb, -1);  // the last velocity index at or above body i
   const Eigen::VectorXd q_neutral = neutral(model);
   for (int i = 1; i < model.nbodies; ++i) {

@@ -1,5 +1,7 @@
 #include "dynamics/rnea.hpp"
 
+#include <type_traits>
+
 #include "dynamics/kinematics.hpp"
 #include "spatial/autodiff.hpp"
 
@@ -12,8 +14,13 @@ const VecXT<S>& rnea(const Model& model, DataT<S>& d, const VecXT<S>& q, const V
   for (int i = 1; i < model.nbodies; ++i) {
     Vec6T<S> ag = d.a[i];
     if (model.has_gravity) ag.template tail<3>() -= d.oMi[i].R.transpose() * g;
-    const Mat6T<S> I = model.inertia[i].cast<S>();
-    d.f[i] = I * ag + cross_force<S>(d.v[i], Vec6T<S>(I * d.v[i]));
+    if constexpr (std::is_same_v<S, double>) {  // the structured inertia (m, h, I): no 6 x 6 products
+      const RigidInertiaT<double>& I = d.constants.body_inertia[i];
+      d.f[i] = I.apply(ag) + cross_force<S>(d.v[i], I.apply(d.v[i]));
+    } else {
+      const Mat6T<S> I = model.inertia[i].cast<S>();
+      d.f[i] = I * ag + cross_force<S>(d.v[i], Vec6T<S>(I * d.v[i]));
+    }
   }
   for (int i = model.nbodies - 1; i > 0; --i) {
     const JointModel& j = model.joints[i];
