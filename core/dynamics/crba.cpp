@@ -78,16 +78,14 @@ const MatXT<S>& crba_composite(const Model& model, DataT<S>& d) {
       else
         for (int b = a; b >= 0; b = k.dof_parent[b]) pair(b);
     }
-    if (model.armature.size() != 0)
-      for (int a = 0; a < nv; ++a) M[a + static_cast<std::ptrdiff_t>(a) * nv] += model.armature[a];
-    return d.M;
-  }
-  for (int a = 0; a < nv; ++a) {
-    const Vec6T<S> F = d.Ic[k.dof_body[a]].apply(d.Sw[a]);
-    for (int b = a; b >= 0; b = k.dof_parent[b]) {
-      const S m = d.Sw[b].dot(F);
-      M[a + static_cast<std::ptrdiff_t>(b) * nv] = m;
-      M[b + static_cast<std::ptrdiff_t>(a) * nv] = m;
+  } else {
+    for (int a = 0; a < nv; ++a) {
+      const Vec6T<S> F = d.Ic[k.dof_body[a]].apply(d.Sw[a]);
+      for (int b = a; b >= 0; b = k.dof_parent[b]) {
+        const S m = d.Sw[b].dot(F);
+        M[a + static_cast<std::ptrdiff_t>(b) * nv] = m;
+        M[b + static_cast<std::ptrdiff_t>(a) * nv] = m;
+      }
     }
   }
   // rotor inertia (armature) on the diagonal

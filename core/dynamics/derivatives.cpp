@@ -1236,13 +1236,8 @@ void TreeDerivatives::compute(const Eigen::VectorXd& q, const Eigen::VectorXd& v
   } else {
     rhs_.leftCols(nv) = dQ_dq - dtau_dq;
     rhs_.middleCols(nv, nv) = dQ_dv - dtau_dv;
-    if (nv <= kLazyProductUpTo) {  // below the blocked product's packing cost
-      dqdd_dq.noalias() = Minv_.lazyProduct(rhs_.leftCols(nv));
-      dqdd_dv.noalias() = Minv_.lazyProduct(rhs_.middleCols(nv, nv));
-    } else {
-      dqdd_dq.noalias() = Minv_ * rhs_.leftCols(nv);
-      dqdd_dv.noalias() = Minv_ * rhs_.middleCols(nv, nv);
-    }
+    dqdd_dq.noalias() = Minv_ * rhs_.leftCols(nv);
+    dqdd_dv.noalias() = Minv_ * rhs_.middleCols(nv, nv);
   }
   for (int k = 0; k < nu; ++k) {
     const ActuatorModel& act = m_->actuators[k];

@@ -149,9 +149,6 @@ class TreeDerivatives {
   // models' chains (bench/pinocchio_bench.cpp, clang -O3): the products are faster up to 20 links
   // (4.0 against 4.9 us at 7, 16.2 against 18.5 at 20), even at 30, the solve 25% faster at 60
   static constexpr int kRowsSolveFrom = 32;
-  // below this many coordinates the products with M^-1 are coefficient by coefficient (Eigen's
-  // blocked product packs its operands first, which costs more than it saves on small matrices)
-  static constexpr int kLazyProductUpTo = 12;
   void differentiate_rnea();
   void applied_force_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& u);
   void add_body_wrench(int body, const Vec6T<double>& w, const Eigen::Matrix<double, 6, 24>& dw, int body_a,
