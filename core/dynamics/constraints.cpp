@@ -75,19 +75,19 @@ constexpr double kDiscFlatness = 1e-6;
 template <class S>
 void contact_row(const Model& model, DataT<S>& d, const ConstraintModel& c, int r, const Attached<S>& t,
                  const Vec3T<S>& Rn, const Vec3T<S>& Rnd, const Vec3T<S>& dpc, const Vec3T<S>& dpd,
-                 const Vec3T<S>& dpdd, Eigen::Index nd) {
+                 const Vec3T<S>& dpdd, Eigen::Index nd, Eigen::Index k) {
   (void)model;
   auto coh = [nd](auto& m) { ad_make_coherent(m, nd); };
-  const MatXT<S>&Jp = d.Jp, &Jwa = d.Jwa, &Jwb = d.Jwb;
+  const auto Jp = d.Jp.leftCols(k), Jwa = d.Jwa.leftCols(k), Jwb = d.Jwb.leftCols(k);  // the first k columns: fill_rows
   Vec3T<S> Pa = -dpc - Rn;  // P - p_a
   coh(Pa);
   Vec3T<S> tn = t.x.cross(Rn), tP = t.x.cross(Pa), mt = -t.x;
   coh(tn);
   coh(tP);
   coh(mt);
-  d.Jc.row(r).noalias() = mt.transpose() * Jp;
-  d.Jc.row(r).noalias() += tn.transpose() * Jwb;
-  d.Jc.row(r).noalias() += tP.transpose() * Jwa;
+  d.Jc.row(r).head(k).noalias() = mt.transpose() * Jp;
+  d.Jc.row(r).head(k).noalias() += tn.transpose() * Jwb;
+  d.Jc.row(r).head(k).noalias() += tP.transpose() * Jwa;
   Vec3T<S> wa = angular_velocity<S>(d, c.body_a), wb = angular_velocity<S>(d, c.body_b);
   Vec3T<S> aa = angular_acceleration<S>(d, c.body_a), ab = angular_acceleration<S>(d, c.body_b);
   coh(wa);
@@ -119,10 +119,28 @@ void contact_row(const Model& model, DataT<S>& d, const ConstraintModel& c, int 
   d.gamma[r] = s1 + s2;
 }
 
+// the rows r0 .. r0 + n of Jc, written in their first k columns (the constraint's support, cols
+// ascending), spread to their columns, zeros elsewhere (in place: cols[p] >= p, so from the end)
+void spread_rows(Eigen::MatrixXd& Jc, int r0, int n, const std::vector<int>& cols) {
+  const Eigen::Index k = static_cast<Eigen::Index>(cols.size());
+  for (int r = r0; r < r0 + n; ++r) {
+    Eigen::Index next = Jc.cols();  // columns from next on are done
+    for (Eigen::Index p = k - 1; p >= 0; --p) {
+      const Eigen::Index col = cols[static_cast<std::size_t>(p)];
+      for (Eigen::Index j = col + 1; j < next; ++j) Jc(r, j) = 0.0;
+      Jc(r, col) = Jc(r, p);
+      next = col;
+    }
+    for (Eigen::Index j = 0; j < next; ++j) Jc(r, j) = 0.0;
+  }
+}
+
 template <class S>
 void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool with_velocity, Eigen::Index nd) {
   auto coh = [nd](auto& m) { ad_make_coherent(m, nd); };
-  for (const ConstraintModel& c : model.constraints) {
+  constexpr bool kDouble = std::is_same_v<S, double>;
+  for (std::size_t ci = 0; ci < model.constraints.size(); ++ci) {
+    const ConstraintModel& c = model.constraints[ci];
     if (c.type == ConstraintType::Coupler) {
       coupler_row<S>(c, d, q, with_velocity, nd);
       continue;
@@ -130,23 +148,48 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool with_vel
     const Vec3T<S> pa = point_position<S>(d, c.body_a, c.point_a), pb = point_position<S>(d, c.body_b, c.point_b);
     const Vec3T<S> dp = pa - pb;
     Vec3T<S> dpd, dpdd;
-    MatXT<S>&Jp = d.Jp, &Jwa = d.Jwa, &Jwb = d.Jwb;  // Data's workspace: no heap after the first call
+    // in double the Jacobians are formed on the constraint's support only (k columns: the joints on
+    // its bodies' paths), the rows written in Jc's first k columns and spread at the end
+    const std::vector<int>& cols = d.constants.constraint_cols[ci];
+    const Eigen::Index k = kDouble ? static_cast<Eigen::Index>(cols.size()) : model.nv;
+    if constexpr (kDouble) {  // Data's workspace: no heap after the first call
+      for (MatXT<S>* m : {&d.Jp, &d.Jwa, &d.Jwb, &d.Jwd})
+        if (m->cols() != model.nv) m->resize(3, model.nv);
+    }
     if (with_velocity) {
       dpd = point_velocity<S>(d, c.body_a, c.point_a) - point_velocity<S>(d, c.body_b, c.point_b);
       dpdd = point_acceleration<S>(d, c.body_a, c.point_a) - point_acceleration<S>(d, c.body_b, c.point_b);
-      if constexpr (std::is_same_v<S, double>) {
-        body_jacobian_world_into<S>(model, d, c.body_a, d.J6a);
-        body_jacobian_world_into<S>(model, d, c.body_b, d.J6b);
-        Jwa = d.J6a.topRows(3);
-        Jwb = d.J6b.topRows(3);
+      if constexpr (kDouble) {
+        // the joints' world motions on the support, each on the side(s) whose path holds it; the
         // point Jacobians: linear rows less (point x angular rows)
-        Jp = d.J6a.bottomRows(3) - d.J6b.bottomRows(3);
-        Jp.noalias() -= skew<S>(pa) * Jwa;
-        Jp.noalias() += skew<S>(pb) * Jwb;
+        const std::vector<int>& side = d.constants.constraint_side[ci];
+        for (Eigen::Index p = 0; p < k; ++p) {
+          const int col = cols[static_cast<std::size_t>(p)], i = d.constants.dof_body[static_cast<std::size_t>(col)];
+          const SE3T<S>& X = d.oMi[i];
+          const Eigen::Index sub = col - model.joints[i].idx_v;
+          const Vec3T<S> w = X.R * d.Sb[i].col(sub).template head<3>();
+          const Vec3T<S> lin = X.R * d.Sb[i].col(sub).template tail<3>() + X.p.cross(w);
+          const int sd = side[static_cast<std::size_t>(p)];
+          Vec3T<S> jp = Vec3T<S>::Zero();
+          d.Jwa.col(p).setZero();
+          d.Jwb.col(p).setZero();
+          if (sd == 3) {  // on both paths: the two points' velocities differ by the lever arms only
+            d.Jwa.col(p) = w;
+            d.Jwb.col(p) = w;
+            jp = pb.cross(w) - pa.cross(w);
+          } else if (sd == 1) {
+            d.Jwa.col(p) = w;
+            jp = lin - pa.cross(w);
+          } else {
+            d.Jwb.col(p) = w;
+            jp = pb.cross(w) - lin;
+          }
+          d.Jp.col(p) = jp;
+        }
       } else {
-        Jp = point_jacobian<S>(model, d, c.body_a, c.point_a) - point_jacobian<S>(model, d, c.body_b, c.point_b);
-        Jwa = body_jacobian_world<S>(model, d, c.body_a).topRows(3);
-        Jwb = body_jacobian_world<S>(model, d, c.body_b).topRows(3);
+        d.Jp = point_jacobian<S>(model, d, c.body_a, c.point_a) - point_jacobian<S>(model, d, c.body_b, c.point_b);
+        d.Jwa = body_jacobian_world<S>(model, d, c.body_a).topRows(3);
+        d.Jwb = body_jacobian_world<S>(model, d, c.body_b).topRows(3);
       }
     }
     // constants (ground, fixed axes) beside variables: one derivative size for all
@@ -155,18 +198,25 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool with_vel
     if (with_velocity) {
       coh(dpd);
       coh(dpdd);
-      coh(Jp);
-      coh(Jwa);
-      coh(Jwb);
-      d.Jwd = Jwa - Jwb;
+      if constexpr (!kDouble) {
+        coh(d.Jp);
+        coh(d.Jwa);
+        coh(d.Jwb);
+        d.Jwd = d.Jwa - d.Jwb;
+      } else {
+        d.Jwd.leftCols(k) = d.Jwa.leftCols(k) - d.Jwb.leftCols(k);
+      }
     }
+    // (blocks made after the autodiff path's assignments, which may resize)
+    const Eigen::Index kb = with_velocity ? k : 0;
+    const auto Jp = d.Jp.leftCols(kb), Jwa = d.Jwa.leftCols(kb), Jwd = d.Jwd.leftCols(kb);
     int r = c.row;
     switch (c.type) {
       case ConstraintType::Ball:
       case ConstraintType::Revolute:
         d.phi.template segment<3>(r) = dpc;
         if (with_velocity) {
-          d.Jc.middleRows(r, 3) = Jp;
+          d.Jc.middleRows(r, 3).leftCols(k) = Jp;
           d.gamma.template segment<3>(r) = dpdd;
         }
         if (c.type == ConstraintType::Ball) break;
@@ -178,7 +228,7 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool with_vel
           if (with_velocity) {
             Vec3T<S> axb = a.x.cross(b.x);
             coh(axb);
-            d.Jc.row(r).noalias() = axb.transpose() * d.Jwd;
+            d.Jc.row(r).head(k).noalias() = axb.transpose() * Jwd;
             const S g1 = dot3<S>(a.xdd, b.x, nd), g2 = dot3<S>(a.xd, b.xd, nd), g3 = dot3<S>(a.x, b.xdd, nd);
             const S g2x2 = ad_coherent(S(S(2) * g2), nd);
             const S g12 = g1 + g2x2;
@@ -194,8 +244,8 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool with_vel
           if (with_velocity) {
             Vec3T<S> exd = e.x.cross(dpc);
             coh(exd);
-            d.Jc.row(r).noalias() = exd.transpose() * Jwa;
-            d.Jc.row(r).noalias() += e.x.transpose() * Jp;
+            d.Jc.row(r).head(k).noalias() = exd.transpose() * Jwa;
+            d.Jc.row(r).head(k).noalias() += e.x.transpose() * Jp;
             const S g1 = dot3<S>(e.xdd, dpc, nd), g2 = dot3<S>(e.xd, dpd, nd), g3 = dot3<S>(e.x, dpdd, nd);
             const S g2x2 = ad_coherent(S(S(2) * g2), nd);
             const S g12 = g1 + g2x2;
@@ -216,8 +266,8 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool with_vel
         const S h = dot3<S>(n.x, dpc, nd);
         d.phi[r] = -h - R;
         if (with_velocity) {
-          d.Jc.row(r).noalias() = ndp.transpose() * Jwa;
-          d.Jc.row(r).noalias() += mn.transpose() * Jp;
+          d.Jc.row(r).head(k).noalias() = ndp.transpose() * Jwa;
+          d.Jc.row(r).head(k).noalias() += mn.transpose() * Jp;
           const S g1 = dot3<S>(n.xdd, dpc, nd), g2 = dot3<S>(n.xd, dpd, nd), g3 = dot3<S>(n.x, dpdd, nd);
           const S g2x2 = ad_coherent(S(S(2) * g2), nd);
           const S g12 = g1 + g2x2;
@@ -230,7 +280,7 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool with_vel
         for (const Eigen::Vector3d* perp : {&c.perp_a1, &c.perp_a2}) {
           d.phi[r] = ad_coherent(S(0), nd);
           if (with_velocity)
-            contact_row<S>(model, d, c, r, attached<S>(d, c.body_a, *perp, nd), Rn, Rnd, dpc, dpd, dpdd, nd);
+            contact_row<S>(model, d, c, r, attached<S>(d, c.body_a, *perp, nd), Rn, Rnd, dpc, dpd, dpdd, nd, kb);
           ++r;
         }
         break;
@@ -287,16 +337,18 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool with_vel
         Vec3T<S> Rd = dir * R, Rdd = dird * R;
         coh(Rd);
         coh(Rdd);
-        contact_row<S>(model, d, c, r++, n, Rd, Rdd, dpc, dpd, dpdd, nd);
+        contact_row<S>(model, d, c, r++, n, Rd, Rdd, dpc, dpd, dpdd, nd, kb);
         for (const Eigen::Vector3d* perp : {&c.perp_a1, &c.perp_a2}) {
           d.phi[r] = ad_coherent(S(0), nd);
-          contact_row<S>(model, d, c, r, attached<S>(d, c.body_a, *perp, nd), Rd, Rdd, dpc, dpd, dpdd, nd);
+          contact_row<S>(model, d, c, r, attached<S>(d, c.body_a, *perp, nd), Rd, Rdd, dpc, dpd, dpdd, nd, kb);
           ++r;
         }
         break;
       }
       case ConstraintType::Coupler: break;  // coupler_row
     }
+    if constexpr (kDouble)
+      if (with_velocity) spread_rows(d.Jc, c.row, c.nrows, cols);
   }
 }
 

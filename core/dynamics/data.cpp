@@ -1,5 +1,7 @@
 #include "dynamics/data.hpp"
 
+#include <algorithm>
+
 #include "dynamics/joint.hpp"
 #include "spatial/autodiff.hpp"
 
@@ -50,6 +52,28 @@ void ModelConstants::assign(const Model& model) {
   for (int a = 0; a < model.nv; ++a)
     for (int b = a; b >= 0; b = dof_parent[b]) ++pairs;
   dense_mass_matrix = pairs == static_cast<long>(model.nv) * (model.nv + 1) / 2;
+  // the constraints' supports (the inner vectors keep their storage when the shape is the same)
+  constraint_cols.resize(model.constraints.size());
+  constraint_side.resize(model.constraints.size());
+  std::vector<int> side(static_cast<std::size_t>(model.nv), 0);
+  for (std::size_t k = 0; k < model.constraints.size(); ++k) {
+    const ConstraintModel& c = model.constraints[k];
+    std::fill(side.begin(), side.end(), 0);
+    if (c.type == ConstraintType::Coupler) {
+      for (int i = 0; i < c.ncoupled; ++i) side[static_cast<std::size_t>(c.iv[i])] = 3;
+    } else {
+      for (int which = 0; which < 2; ++which)
+        for (int b = which == 0 ? c.body_a : c.body_b; b > 0; b = model.parent[b])
+          for (int i = 0; i < model.joints[b].nv; ++i) side[static_cast<std::size_t>(model.joints[b].idx_v + i)] |= 1 << which;
+    }
+    constraint_cols[k].clear();
+    constraint_side[k].clear();
+    for (int i = 0; i < model.nv; ++i)
+      if (side[static_cast<std::size_t>(i)]) {
+        constraint_cols[k].push_back(i);
+        constraint_side[k].push_back(side[static_cast<std::size_t>(i)]);
+      }
+  }
   body_force_sources = !model.springs.empty() || !model.body_forces.empty() || !model.bushings.empty() ||
                        !model.tires.empty();
   for (const ActuatorModel& a : model.actuators)
@@ -70,7 +94,7 @@ void DataT<S>::reset(const Model& model) {
 
 // every stage's arrays sized for the model and zeroed (std::vector::assign and Eigen's resize keep
 // their storage when the sizes are those they had: reset() on a model of the same shape makes no
-// heap allocation but ModelConstants' two scratch arrays)
+// heap allocation but ModelConstants' three scratch arrays)
 template <class S>
 void DataT<S>::size_for(const Model& model) {
   const auto nb = static_cast<std::size_t>(model.nbodies);

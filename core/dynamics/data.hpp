@@ -32,6 +32,11 @@ struct ModelConstants {
   std::vector<int> dof_body;                     // [nv] body whose joint a velocity index belongs to
   std::vector<int> dof_parent;                   // [nv] next velocity index towards the root (-1: none)
   bool dense_mass_matrix = false;                // every pair of velocity indices is related (a chain): M has no structural zero
+  // loop closures (Model::constraints): for constraint k the velocity indices its rows can touch,
+  // those of the joints on the paths of its two bodies to the ground, ascending (Jc is zero in
+  // every other column), and for each which path holds it (1: body_a's, 2: body_b's, 3: both);
+  // a coupler's: its coordinates (side 3)
+  std::vector<std::vector<int>> constraint_cols, constraint_side;
   bool body_force_sources = false;               // springs, body forces or body-force actuators write fext
   explicit ModelConstants(const Model& model);
   void assign(const Model& model);  // the same as constructing it again, reusing the arrays

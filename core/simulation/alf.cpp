@@ -270,7 +270,7 @@ class Alf final : public Integrator {
       Mp_ = crba<double>(m_, d_, q);
       constraint_terms<double>(m_, d_, q, v);  // Jc at q
       Kp_ = Mp_;
-      Kp_.noalias() += (c * alpha) * (d_.Jc.transpose() * d_.Jc);
+      add_penalty(Kp_, c * alpha);
       lup_.compute(Kp_);
       ++factorizations_;
       v = lup_.solve(Mp_ * v);
@@ -384,13 +384,28 @@ class Alf final : public Integrator {
       K_.noalias() += (h / 2) * Ct_;
       K_.noalias() += c * Kt_;
     }
-    if (m_.nc) K_.noalias() += (c * alpha) * (d_.Jc.transpose() * d_.Jc);
+    if (m_.nc) add_penalty(K_, c * alpha);
     if (!K_.allFinite()) return false;
     lu_.compute(K_);
     ++factorizations_;
     factored_ = true;
     h_factored_ = h;
     return true;
+  }
+
+  // K += s Jc^T Jc (Jc: d_.Jc), row by row on each constraint's support (ModelConstants::
+  // constraint_cols: Jc is zero elsewhere), so a loop of k columns costs k^2 per row, not nv^2
+  void add_penalty(Eigen::MatrixXd& K, double s) const {
+    for (std::size_t ci = 0; ci < m_.constraints.size(); ++ci) {
+      const ConstraintModel& c = m_.constraints[ci];
+      const std::vector<int>& cols = d_.constants.constraint_cols[ci];
+      for (int r = c.row; r < c.row + c.nrows; ++r)
+        for (const int a : cols) {
+          const double x = s * d_.Jc(r, a);
+          if (x == 0) continue;
+          for (const int b : cols) K(b, a) += x * d_.Jc(r, b);
+        }
+    }
   }
 
   static constexpr double kNewton = 1e-3, kNewtonFloor = 1e-14, kLeftLimit = 1e-9;

@@ -49,6 +49,16 @@ AlfA02 alf_a02(int N, double h, double t_end, double alpha = 1e8, double tol = 1
     const int c = m.joints[static_cast<std::size_t>(m.find_joint("pivot" + std::to_string(k)))].idx_q;
     for (int i = 0; i < r.samples(); ++i) a.err = std::max(a.err, std::abs(r.q(i, c) - exact[i]));
   }
+  if (std::getenv("ALF_SERIES"))
+    for (int i = 0; i < r.samples(); i += 5) {
+      double e = 0, s = 0;
+      for (int k = 0; k <= N; ++k) {
+        const int c = m.joints[static_cast<std::size_t>(m.find_joint("pivot" + std::to_string(k)))].idx_q;
+        e = std::max(e, std::abs(r.q(i, c) - exact[i]));
+        s += r.q(i, c) - exact[i];
+      }
+      std::printf("S %.3f %.4f %.3e %.3e\n", r.t[i], exact[i], e, s / (N + 1));
+    }
   for (int i = 0; i < r.samples(); ++i) a.drift = std::max(a.drift, r.constraint_violation[i]);
   a.steps = r.stats.steps;
   a.iterations = r.stats.nonlinear_iterations;
