@@ -1,6 +1,7 @@
 // Work-precision study (docs/work-precision.md, docs/performance.md): for each problem,
 // each codyna integrator (ida, cvode-bdf, cvode-adams, arkode, alf; alf skips the models it
-// refuses, those with ball or free joints) (and each Simbody integrator when the Simbody peer is built) and
+// refuses, those with ball or free joints; on request alf-fixed: alf at fixed steps of
+// 0.1 sqrt(tol), not in the default list) (and each Simbody integrator when the Simbody peer is built) and
 // rtol = atol = 10^-(2 + k/2), k = 0..kmax, one run, its error against an exact solution,
 // a published reference, an exact invariant or a tight reference run, and its CPU time.
 //
@@ -316,6 +317,11 @@ CodynaRun run_codyna(const Problem& p, const std::string& method, double tol, in
   SimulationOptions o;
   o.integrator.method = method;
   o.integrator.rtol = o.integrator.atol = tol;
+  if (method == "alf-fixed") {  // alf at fixed steps h = 0.1 sqrt(tol) (10 ms at 1e-2): its error goes as h^2, like tol
+    o.integrator.method = "alf";
+    o.integrator.alf_fixed_step = true;
+    o.integrator.max_step = 0.1 * std::sqrt(tol);
+  }
   o.t_end = p.t_end;
   o.output_step = p.output_step;
   o.projection_tolerance = 0.1 * tol;  // projections must not spoil the accuracy asked for
@@ -537,7 +543,7 @@ int main(int argc, char** argv) {
             return x;
           });
         } catch (const std::exception& e) {
-          if (method == "alf" && std::string(e.what()).find("not integrated by alf") != std::string::npos) {
+          if (method.rfind("alf", 0) == 0 && std::string(e.what()).find("not integrated by alf") != std::string::npos) {
             std::cout << method << ": does not take " << p.name << " (" << e.what() << ")" << std::endl;
             break;  // a model alf refuses (ball or free joints): no column entry
           }

@@ -52,14 +52,14 @@ Attached<S> attached(const DataT<S>& d, int body, const Eigen::Vector3d& local, 
 
 // a coupler's row: sum_k ratio_k q_k - offset; Jc holds the ratios, gamma is zero
 template <class S>
-void coupler_row(const ConstraintModel& c, DataT<S>& d, const VecXT<S>& q, bool with_velocity, Eigen::Index nd) {
+void coupler_row(const ConstraintModel& c, DataT<S>& d, const VecXT<S>& q, bool jac, Eigen::Index nd) {
   S phi = ad_coherent(S(-c.offset), nd);
   for (int k = 0; k < c.ncoupled; ++k) {
     const S term = ad_coherent(S(c.ratio[k] * q[c.iq[k]]), nd);
     phi = phi + term;
   }
   d.phi[c.row] = phi;
-  if (!with_velocity) return;
+  if (!jac) return;
   for (Eigen::Index j = 0; j < d.Jc.cols(); ++j) d.Jc(c.row, j) = ad_coherent(S(0), nd);
   for (int k = 0; k < c.ncoupled; ++k) d.Jc(c.row, c.iv[k]) = ad_coherent(S(c.ratio[k]), nd);
   d.gamma[c.row] = ad_coherent(S(0), nd);
@@ -75,7 +75,7 @@ constexpr double kDiscFlatness = 1e-6;
 template <class S>
 void contact_row(const Model& model, DataT<S>& d, const ConstraintModel& c, int r, const Attached<S>& t,
                  const Vec3T<S>& Rn, const Vec3T<S>& Rnd, const Vec3T<S>& dpc, const Vec3T<S>& dpd,
-                 const Vec3T<S>& dpdd, Eigen::Index nd, Eigen::Index k) {
+                 const Vec3T<S>& dpdd, Eigen::Index nd, Eigen::Index k, bool gam) {
   (void)model;
   auto coh = [nd](auto& m) { ad_make_coherent(m, nd); };
   const auto Jp = d.Jp.leftCols(k), Jwa = d.Jwa.leftCols(k), Jwb = d.Jwb.leftCols(k);  // the first k columns: fill_rows
@@ -88,6 +88,7 @@ void contact_row(const Model& model, DataT<S>& d, const ConstraintModel& c, int 
   d.Jc.row(r).head(k).noalias() = mt.transpose() * Jp;
   d.Jc.row(r).head(k).noalias() += tn.transpose() * Jwb;
   d.Jc.row(r).head(k).noalias() += tP.transpose() * Jwa;
+  if (!gam) return;
   Vec3T<S> wa = angular_velocity<S>(d, c.body_a), wb = angular_velocity<S>(d, c.body_b);
   Vec3T<S> aa = angular_acceleration<S>(d, c.body_a), ab = angular_acceleration<S>(d, c.body_b);
   coh(wa);
@@ -135,19 +136,21 @@ void spread_rows(Eigen::MatrixXd& Jc, int r0, int n, const std::vector<int>& col
   }
 }
 
+// phi always; Jc with jac; gamma with gam (only with jac); with jac alone, the Jacobians from the
+// positions of forward kinematics (velocities and accelerations not read for any output)
 template <class S>
-void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool with_velocity, Eigen::Index nd) {
+void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool jac, bool gam, Eigen::Index nd) {
   auto coh = [nd](auto& m) { ad_make_coherent(m, nd); };
   constexpr bool kDouble = std::is_same_v<S, double>;
   for (std::size_t ci = 0; ci < model.constraints.size(); ++ci) {
     const ConstraintModel& c = model.constraints[ci];
     if (c.type == ConstraintType::Coupler) {
-      coupler_row<S>(c, d, q, with_velocity, nd);
+      coupler_row<S>(c, d, q, jac, nd);
       continue;
     }
     const Vec3T<S> pa = point_position<S>(d, c.body_a, c.point_a), pb = point_position<S>(d, c.body_b, c.point_b);
     const Vec3T<S> dp = pa - pb;
-    Vec3T<S> dpd, dpdd;
+    Vec3T<S> dpd = Vec3T<S>::Zero(), dpdd = Vec3T<S>::Zero();
     // in double the Jacobians are formed on the constraint's support only (k columns: the joints on
     // its bodies' paths), the rows written in Jc's first k columns and spread at the end
     const std::vector<int>& cols = d.constants.constraint_cols[ci];
@@ -156,9 +159,11 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool with_vel
       for (MatXT<S>* m : {&d.Jp, &d.Jwa, &d.Jwb, &d.Jwd})
         if (m->cols() != model.nv) m->resize(3, model.nv);
     }
-    if (with_velocity) {
+    if (gam) {
       dpd = point_velocity<S>(d, c.body_a, c.point_a) - point_velocity<S>(d, c.body_b, c.point_b);
       dpdd = point_acceleration<S>(d, c.body_a, c.point_a) - point_acceleration<S>(d, c.body_b, c.point_b);
+    }
+    if (jac) {
       if constexpr (kDouble) {
         // the joints' world motions on the support, each on the side(s) whose path holds it; the
         // point Jacobians: linear rows less (point x angular rows)
@@ -195,9 +200,11 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool with_vel
     // constants (ground, fixed axes) beside variables: one derivative size for all
     Vec3T<S> dpc = dp;
     coh(dpc);
-    if (with_velocity) {
+    if (gam) {
       coh(dpd);
       coh(dpdd);
+    }
+    if (jac) {
       if constexpr (!kDouble) {
         coh(d.Jp);
         coh(d.Jwa);
@@ -208,27 +215,27 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool with_vel
       }
     }
     // (blocks made after the autodiff path's assignments, which may resize)
-    const Eigen::Index kb = with_velocity ? k : 0;
+    const Eigen::Index kb = jac ? k : 0;
     const auto Jp = d.Jp.leftCols(kb), Jwa = d.Jwa.leftCols(kb), Jwd = d.Jwd.leftCols(kb);
     int r = c.row;
     switch (c.type) {
       case ConstraintType::Ball:
       case ConstraintType::Revolute:
         d.phi.template segment<3>(r) = dpc;
-        if (with_velocity) {
-          d.Jc.middleRows(r, 3).leftCols(k) = Jp;
-          d.gamma.template segment<3>(r) = dpdd;
-        }
+        if (jac) d.Jc.middleRows(r, 3).leftCols(k) = Jp;
+        if (gam) d.gamma.template segment<3>(r) = dpdd;
         if (c.type == ConstraintType::Ball) break;
         r += 3;
         for (const Eigen::Vector3d* perp : {&c.perp_b1, &c.perp_b2}) {
           // a . b with a on body_a, b on body_b
           const Attached<S> a = attached<S>(d, c.body_a, c.axis_a, nd), b = attached<S>(d, c.body_b, *perp, nd);
           d.phi[r] = dot3<S>(a.x, b.x, nd);
-          if (with_velocity) {
+          if (jac) {
             Vec3T<S> axb = a.x.cross(b.x);
             coh(axb);
             d.Jc.row(r).head(k).noalias() = axb.transpose() * Jwd;
+          }
+          if (gam) {
             const S g1 = dot3<S>(a.xdd, b.x, nd), g2 = dot3<S>(a.xd, b.xd, nd), g3 = dot3<S>(a.x, b.xdd, nd);
             const S g2x2 = ad_coherent(S(S(2) * g2), nd);
             const S g12 = g1 + g2x2;
@@ -241,11 +248,13 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool with_vel
         for (const Eigen::Vector3d* perp : {&c.perp_a1, &c.perp_a2}) {
           const Attached<S> e = attached<S>(d, c.body_a, *perp, nd);
           d.phi[r] = dot3<S>(e.x, dpc, nd);
-          if (with_velocity) {
+          if (jac) {
             Vec3T<S> exd = e.x.cross(dpc);
             coh(exd);
             d.Jc.row(r).head(k).noalias() = exd.transpose() * Jwa;
             d.Jc.row(r).head(k).noalias() += e.x.transpose() * Jp;
+          }
+          if (gam) {
             const S g1 = dot3<S>(e.xdd, dpc, nd), g2 = dot3<S>(e.xd, dpd, nd), g3 = dot3<S>(e.x, dpdd, nd);
             const S g2x2 = ad_coherent(S(S(2) * g2), nd);
             const S g12 = g1 + g2x2;
@@ -265,9 +274,11 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool with_vel
         coh(mn);
         const S h = dot3<S>(n.x, dpc, nd);
         d.phi[r] = -h - R;
-        if (with_velocity) {
+        if (jac) {
           d.Jc.row(r).head(k).noalias() = ndp.transpose() * Jwa;
           d.Jc.row(r).head(k).noalias() += mn.transpose() * Jp;
+        }
+        if (gam) {
           const S g1 = dot3<S>(n.xdd, dpc, nd), g2 = dot3<S>(n.xd, dpd, nd), g3 = dot3<S>(n.x, dpdd, nd);
           const S g2x2 = ad_coherent(S(S(2) * g2), nd);
           const S g12 = g1 + g2x2;
@@ -279,8 +290,7 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool with_vel
         coh(Rnd);
         for (const Eigen::Vector3d* perp : {&c.perp_a1, &c.perp_a2}) {
           d.phi[r] = ad_coherent(S(0), nd);
-          if (with_velocity)
-            contact_row<S>(model, d, c, r, attached<S>(d, c.body_a, *perp, nd), Rn, Rnd, dpc, dpd, dpdd, nd, kb);
+          if (jac) contact_row<S>(model, d, c, r, attached<S>(d, c.body_a, *perp, nd), Rn, Rnd, dpc, dpd, dpdd, nd, kb, gam);
           ++r;
         }
         break;
@@ -312,7 +322,7 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool with_vel
         const S h = dot3<S>(n.x, dpc, nd);
         const S Rs = ad_coherent(S(R * sv), nd);
         d.phi[r] = -h - Rs;  // n . (c - p_a) - R s
-        if (!with_velocity) {
+        if (!jac) {
           d.phi[r + 1] = ad_coherent(S(0), nd);
           d.phi[r + 2] = ad_coherent(S(0), nd);
           break;
@@ -337,10 +347,10 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool with_vel
         Vec3T<S> Rd = dir * R, Rdd = dird * R;
         coh(Rd);
         coh(Rdd);
-        contact_row<S>(model, d, c, r++, n, Rd, Rdd, dpc, dpd, dpdd, nd, kb);
+        contact_row<S>(model, d, c, r++, n, Rd, Rdd, dpc, dpd, dpdd, nd, kb, gam);
         for (const Eigen::Vector3d* perp : {&c.perp_a1, &c.perp_a2}) {
           d.phi[r] = ad_coherent(S(0), nd);
-          contact_row<S>(model, d, c, r, attached<S>(d, c.body_a, *perp, nd), Rd, Rdd, dpc, dpd, dpdd, nd, kb);
+          contact_row<S>(model, d, c, r, attached<S>(d, c.body_a, *perp, nd), Rd, Rdd, dpc, dpd, dpdd, nd, kb, gam);
           ++r;
         }
         break;
@@ -348,7 +358,7 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool with_vel
       case ConstraintType::Coupler: break;  // coupler_row
     }
     if constexpr (kDouble)
-      if (with_velocity) spread_rows(d.Jc, c.row, c.nrows, cols);
+      if (jac) spread_rows(d.Jc, c.row, c.nrows, cols);
   }
 }
 
@@ -357,7 +367,7 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool with_vel
 template <class S>
 const VecXT<S>& constraint_residual(const Model& model, DataT<S>& d, const VecXT<S>& q) {
   forward_kinematics<S>(model, d, q);
-  fill_rows<S>(model, d, q, false, ad_size(q));
+  fill_rows<S>(model, d, q, false, false, ad_size(q));
   return d.phi;
 }
 
@@ -365,7 +375,11 @@ template <class S>
 void constraint_terms(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>& v) {
   if (d.zero_v.size() != model.nv) d.zero_v = VecXT<S>::Zero(model.nv);
   forward_kinematics<S>(model, d, q, v, d.zero_v);
-  fill_rows<S>(model, d, q, true, std::max(ad_size(q), ad_size(v)));
+  fill_rows<S>(model, d, q, true, true, std::max(ad_size(q), ad_size(v)));
+}
+
+void constraint_jacobian_after_kinematics(const Model& model, Data& d, const Eigen::VectorXd& q) {
+  fill_rows<double>(model, d, q, true, false, 0);
 }
 
 #define CODYNA_INSTANTIATE(S)                                                                           \

@@ -8,6 +8,9 @@
 // constraint_residual(q):   writes liMi, oMi, Sb, phi.
 // constraint_terms(q, v):   + v, cJ, a (at qdd = 0), Jc = d phi/dq (tangent), gamma = dJc/dt v,
 //                           so that d2/dt2 phi = Jc qdd + gamma.
+// constraint_jacobian_after_kinematics(q): phi and Jc only, from the positions data holds: call it
+//                           after forward kinematics at q (of any stage: rnea's, crba's); no
+//                           kinematics of its own, gamma not written (the Newton iterations of alf).
 #pragma once
 
 #include "dynamics/data.hpp"
@@ -19,5 +22,7 @@ const VecXT<S>& constraint_residual(const Model& model, DataT<S>& data, const Ve
 
 template <class S>
 void constraint_terms(const Model& model, DataT<S>& data, const VecXT<S>& q, const VecXT<S>& v);
+
+void constraint_jacobian_after_kinematics(const Model& model, Data& data, const Eigen::VectorXd& q);
 
 }  // namespace codyna
