@@ -34,10 +34,17 @@ struct Attached {
   Vec3T<S> x, xd, xdd;
 };
 
+// (rates false: x alone, xd and xdd zero: for phi and Jc, which do not read them)
 template <class S>
-Attached<S> attached(const DataT<S>& d, int body, const Eigen::Vector3d& local, Eigen::Index nd) {
+Attached<S> attached(const DataT<S>& d, int body, const Eigen::Vector3d& local, Eigen::Index nd, bool rates = true) {
   auto coh = [nd](auto& m) { ad_make_coherent(m, nd); };
   const Vec3T<S> x = d.oMi[body].R * local.cast<S>();
+  if (!rates) {
+    Vec3T<S> xc = x, z = Vec3T<S>::Zero();
+    coh(xc);
+    coh(z);
+    return {xc, z, z};
+  }
   const Vec3T<S> w = angular_velocity<S>(d, body), al = angular_acceleration<S>(d, body);
   Vec3T<S> xc = x, wc = w, alc = al;
   coh(xc);
@@ -228,7 +235,7 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool jac, boo
         r += 3;
         for (const Eigen::Vector3d* perp : {&c.perp_b1, &c.perp_b2}) {
           // a . b with a on body_a, b on body_b
-          const Attached<S> a = attached<S>(d, c.body_a, c.axis_a, nd), b = attached<S>(d, c.body_b, *perp, nd);
+          const Attached<S> a = attached<S>(d, c.body_a, c.axis_a, nd, gam), b = attached<S>(d, c.body_b, *perp, nd, gam);
           d.phi[r] = dot3<S>(a.x, b.x, nd);
           if (jac) {
             Vec3T<S> axb = a.x.cross(b.x);
@@ -246,7 +253,7 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool jac, boo
         break;
       case ConstraintType::PlanarRevolute:
         for (const Eigen::Vector3d* perp : {&c.perp_a1, &c.perp_a2}) {
-          const Attached<S> e = attached<S>(d, c.body_a, *perp, nd);
+          const Attached<S> e = attached<S>(d, c.body_a, *perp, nd, gam);
           d.phi[r] = dot3<S>(e.x, dpc, nd);
           if (jac) {
             Vec3T<S> exd = e.x.cross(dpc);

@@ -23,8 +23,22 @@
 // follow Jc so closely that a matrix from the last step's end left Newton's error test blind),
 // and again at any iterate whose correction shrank by less than 1/2.
 // Newton stops when the error left, theta / (1 - theta) |dq| with theta the contraction rate
-// (the first correction taken at face value), is within 1e-3 of the error weight
-// atol + rtol |q_i| or within 1e-14 (1 + |q_i|), whichever is larger.
+// (the first correction taken at face value), is within 1e-3 of the error weights, or within
+// 1e-14 (1 + |q_i|), whichever is larger. The weights: atol + rtol |q_i| with error control; at
+// fixed steps, where no error test watches the step, also those in v, min(atol + rtol |q_i|,
+// h/2 (atol + rtol |v_i|)) (an error in q reaches v = 2/h q - ... as 2/h of itself: with the
+// weights in q alone, A02's errors at fixed steps stopped falling below 2e-4 rad whatever the
+// step). Near a singular position the
+// multipliers' iteration creeps (each iteration shrinks phi along a row of small singular value
+// s only by 1/(1 + h^2/4 alpha s^2/m)): an iteration whose correction shrinks by less than 0.8
+// (two or more after a factorization) is a stall, accepted when the correction is within a tenth
+// of the weights in q and in v (whatever the step control); otherwise the penalty is raised tenfold
+// for the rest of the step (up to 1e13). A stalled step's accelerations carry its error in q
+// times 4/h^2 in directions the projections leave: the error test does not judge it or the step
+// after it. The Newton and projection matrices are factored dense, or sparse (SparseLU in COLAMD
+// order) for 24 coordinates and more when at most a fifth of the entries can be nonzero: the
+// structural pattern of M (pairs on one path to the ground) and Jc^T Jc (pairs in one
+// constraint's support), grown by the nonzeros of C and K when they are formed.
 // Inputs that jump at a stop (a reference's step): the step ending at the stop reads them 1e-9 s
 // before it, and the next advance() restarts a and the multipliers from the dynamics after the
 // jump (as reset() does), so the error estimate does not see a's jump.
@@ -34,8 +48,8 @@
 // when h/12 |a_n+1 - a_n| is within the weights atol + rtol |q_i| everywhere, and the next step
 // is h 0.9 err^(-1/2) (between 0.2 h and 2 h, at most max_step when max_step > 0); a rejected
 // step is retried at 0.1..0.5 of itself, one whose Newton does not converge at a quarter.
-// The penalty: alf_penalty for steps of 10 ms and longer, alf_penalty (10 ms / h)^2 for shorter
-// ones (the weight h^2/4 alpha of Jc^T Jc against M held; with alpha itself the multipliers'
+// The penalty: at fixed steps alf_penalty; with error control alf_penalty for steps of 10 ms and
+// longer, alf_penalty (10 ms / h)^2 for shorter ones (the weight h^2/4 alpha of Jc^T Jc against M held; with alpha itself the multipliers'
 // iteration stalls at short steps, each iteration shrinking the error only by 1/(1 + h^2/4 alpha s^2 / m)). IntegratorSettings::alf_fixed_step:
 // every step max_step (default 1 ms), no error control.
 // Additive coordinates only (no ball or free joint), no effect states and no continuous controller
@@ -285,7 +299,10 @@ class Alf final : public Integrator {
     // the penalty as given for steps of kPenaltyStep and longer, alpha (kPenaltyStep / h)^2 below:
     // h^2/4 alpha, its weight against M in the Newton matrix, no smaller than at kPenaltyStep
     // and never above kPenaltyMax by that rule (lambda += alpha phi: phi's rounding times alpha)
-    double alpha = alpha_now_ =
+    // (at fixed steps the penalty as given: there the rule's growth, 100-fold at 1 ms, amplified
+    // phi's rounding into an error floor on A02, ~3e-4 rad below 3 ms steps, and a stall raises
+    // the penalty for its own step anyway)
+    double alpha = alpha_now_ = fixed_ ? alpha_given_ :
         std::max(alpha_given_, std::min(kPenaltyMax, alpha_given_ * (kPenaltyStep / h) * (kPenaltyStep / h)));
     const Eigen::VectorXd vhat = (2 / h) * q_ + v_, ahat = (4 / (h * h)) * q_ + (4 / h) * v_ + a_;
     Eigen::VectorXd q = q_ + h * v_ + (h * h / 2) * a_, v, a;
@@ -296,7 +313,10 @@ class Alf final : public Integrator {
     // than kNewtonFloor (1 + |q_i|)
     const Eigen::ArrayXd floor = kNewtonFloor * (1 + q_.array().abs());
     const Eigen::ArrayXd wq = atol_ + rtol_ * q_.array().abs(), wv = (h / 2) * (atol_ + rtol_ * v_.array().abs());
-    const Eigen::ArrayXd w = (kNewton * wq.min(wv)).max(floor), wl = (kNewton * wq).max(floor);
+    // (with error control the weights in q alone: the error test judges the step's accelerations,
+    // and the weights in v made A05 take two iterations a step instead of one, 2.5 times the CPU)
+    const Eigen::ArrayXd wqv = wq.min(wv), wn = fixed_ ? wqv : wq;
+    const Eigen::ArrayXd w = (kNewton * wn).max(floor), wl = (kStallTolerance * wqv).max(floor);
     // the matrix is factored at the first iterate (on a tree: kept while h is the same); with loop
     // closures always, as the penalty's weight makes it follow Jc closely
     stalled_ = false;
@@ -518,7 +538,7 @@ class Alf final : public Integrator {
 
   static double left_loose(const Eigen::VectorXd& dq, const Eigen::ArrayXd& wl) { return (dq.array().abs() / wl).maxCoeff(); }
 
-  static constexpr double kStall = 0.8, kBoost = 10;
+  static constexpr double kStall = 0.8, kBoost = 10, kStallTolerance = 0.1;
   static constexpr double kNewton = 1e-3, kNewtonFloor = 1e-14, kLeftLimit = 1e-9;
   // the modified Newton: the tangent is kept over steps while Newton's corrections shrink by
   // kRate at least per iteration, for kTangentAge steps at most; the matrix is factored each step

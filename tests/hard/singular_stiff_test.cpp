@@ -112,14 +112,49 @@ TEST(HardSingular, A02FortyFourBarsAlf) {
             << r.stats.steps << " steps, " << r.stats.nonlinear_iterations << " Newton iterations, " << r.stats.wall_time
             << " s\n";
   EXPECT_EQ(a.passages, 20);
-  // measured (Newton on the full tangent, modified): rigid-rotation defect 1.4e-7 rad, |dE|/E0
-  // 8.0e-5, |phi - exact| 3.2e-3 rad (the trapezoidal rule's phase error: second order, and the
-  // error control is per step), max |phi| 3.2e-11; 7366 steps, 14597 Newton iterations, 4.9 s
-  // (with M + h^2/4 alpha Jc^T Jc re-formed at every iteration: 4.5e-3 rad, 7367 steps, 5-12 s)
+  // measured (Newton on the full tangent, modified; stalls at the flat positions accepted, session
+  // 34): rigid-rotation defect 1.5e-7 rad, |dE|/E0 8.0e-5, |phi - exact| 3.4e-3 rad (the
+  // trapezoidal rule's phase error: second order, and the error control is per step), max |phi|
+  // 3.4e-11; 7366 steps, 14593 Newton iterations, 1.4-1.9 s (before the sparse steps: 3.2e-3
+  // rad, 7366 steps, 4.9 s; with M + h^2/4 alpha Jc^T Jc re-formed at every
+  // iteration: 4.5e-3 rad, 7367 steps, 5-12 s)
   EXPECT_LT(a.rigid, 5e-7);
   EXPECT_LT(a.dE, 2.5e-4);
   EXPECT_LT(a.dphi, 1.5e-2);
   EXPECT_LT(a.drift, 1e-9);
+}
+
+// A02 with N = 40 at fixed steps (alf_fixed_step, default penalty; Newton's weights in q and v,
+// stalls at the flat positions accepted or the penalty raised): the trapezoidal rule's h^2
+// through all 20 passages, no floor (session 34; before, 10, 5, 2, 1 ms gave 1.1e-3, 1.6e-4,
+// 3.5e-4, 7.3e-4 rad)
+TEST(HardSingular, A02FortyFourBarsAlfFixedStepsSecondOrder) {
+  const int N = 40;
+  const Model m = compile(a02_spec(N));
+  std::vector<A02Run> runs;
+  for (double h : {1e-2, 5e-3, 2.5e-3}) {
+    SimulationOptions o;
+    o.integrator.method = "alf";
+    o.integrator.alf_fixed_step = true;
+    o.integrator.max_step = h;
+    o.integrator.rtol = o.integrator.atol = 1e-6;
+    o.t_end = 20.0;
+    o.output_step = 0.05;
+    const SimulationResult r = simulate(m, nullptr, nullptr, o);
+    ASSERT_TRUE(r.completed) << h << ": " << r.failure;
+    runs.push_back(measure_a02(m, N, r));
+    std::cout << "A02 N = 40 alf, fixed steps of " << h << " s: " << runs.back().passages << " passages, |phi - exact| "
+              << runs.back().dphi << " rad, rigid-rotation defect " << runs.back().rigid << " rad; " << r.stats.steps
+              << " steps, " << r.stats.nonlinear_iterations << " Newton iterations, " << r.stats.wall_time << " s\n";
+    EXPECT_EQ(runs.back().passages, 20);
+    EXPECT_LT(runs.back().rigid, 1e-6);
+  }
+  // measured: 1.10e-3, 2.70e-4, 5.98e-5 rad (ratios 4.07, 4.52); 0.35, 0.69, 1.43 s
+  EXPECT_LT(runs[0].dphi, 1.5e-3);
+  for (int i = 1; i < 3; ++i) {
+    EXPECT_GT(runs[i - 1].dphi / runs[i].dphi, 3.2) << i;
+    EXPECT_LT(runs[i - 1].dphi / runs[i].dphi, 5.0) << i;
+  }
 }
 
 // N = 4, 20 s, 20 passages, every SUNDIALS integrator. arkode pays for the passages in energy
