@@ -356,8 +356,8 @@ class Alf final : public Integrator {
         converged = true;
         break;
       }
-      // a stall (the multipliers' iteration creeping near a singular position): accepted within the
-      // weights in q alone; otherwise the penalty raised for the rest of the step
+      // a stall (the multipliers' iteration creeping near a singular position): accepted within a
+      // tenth of the weights in q and v (wl); otherwise the penalty raised for the rest of the step
       if (theta >= kStall && since_factor >= 2) {
         if (left_loose(dq, wl) <= 1) {
           ++stalls_;
