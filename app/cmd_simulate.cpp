@@ -20,7 +20,9 @@ struct SimulateArgs {
   std::string model, out, csv, controller, integrator;
   bool compare_linear = false, quiet = false, open_loop = false;
   double linear_region = 0;
-  double t_end = 0, rtol = 0, atol = 0, max_step = -1, output_step = 0;
+  double t_end = 0, rtol = 0, atol = 0, max_step = -1, output_step = 0, alf_penalty = 0;
+  int alf_iterations = 0;
+  bool alf_fixed_step = false;
   // the simulator's own limits unless given (shown as the defaults in --help)
   double max_samples = SimulationOptions{}.max_samples, divergence_bound = SimulationOptions{}.divergence_bound;
   PointFlags point;
@@ -64,9 +66,22 @@ SimulateRequest simulate_request_of(const SimulateArgs& a) {
   if (given(a.cmd, "--max-step")) r.max_step = a.max_step;
   if (given(a.cmd, "--t-end")) r.t_end = a.t_end;
   if (given(a.cmd, "--output-step")) r.output_step = a.output_step;
+  if (given(a.cmd, "--alf-penalty")) r.alf_penalty = a.alf_penalty;
+  if (given(a.cmd, "--alf-iterations")) r.alf_iterations = a.alf_iterations;
+  if (a.alf_fixed_step) r.alf_fixed_step = true;
   if (given(a.cmd, "--max-samples")) r.max_samples = a.max_samples;
   if (given(a.cmd, "--divergence-bound")) r.divergence_bound = a.divergence_bound;
   return r;
+}
+
+// alf's own settings as the run used them ("fixed steps of 0.005 s, penalty 1e+11, Newton ")
+std::string alf_settings(const SolverSpec& sp, const SolverStats& stats) {
+  if (stats.integrator != "alf") return "";
+  const IntegratorSettings is = integrator_settings(sp);
+  std::ostringstream os;
+  if (is.alf_fixed_step) os << "fixed steps of " << (is.max_step > 0 ? is.max_step : 1e-3) << " s, ";
+  os << "penalty " << is.alf_penalty << ", at most " << is.alf_iterations << " iterations a step, Newton at ";
+  return os.str();
 }
 
 // what is known before the run: the controller, the linear closed loop, the operating point and the start
@@ -128,8 +143,8 @@ void summary(const SimulateJob& job) {
             << r.t.front() << " .. " << r.t.back() << " s, " << N << " samples\n";
   if (!r.failure.empty()) std::cout << "failure          " << r.failure << "\n";
   std::cout << "controller       " << r.controller << "\n"
-            << "integrator       " << r.stats.integrator << " (rtol " << r.stats.rtol << ", atol " << r.stats.atol
-            << "): " << r.stats.steps << " steps, " << r.stats.rhs_evals << " evaluations, " << r.stats.jac_evals
+            << "integrator       " << r.stats.integrator << " (" << alf_settings(job.model.spec.solver, r.stats) << "rtol "
+            << r.stats.rtol << ", atol " << r.stats.atol << "): " << r.stats.steps << " steps, " << r.stats.rhs_evals << " evaluations, " << r.stats.jac_evals
             << " Jacobians, " << r.stats.projections << " projections, " << std::setprecision(3) << r.stats.wall_time
             << " s\n" << std::setprecision(6);
   if (!r.stats.integrator_choice.empty()) std::cout << "                 " << r.stats.integrator_choice << "\n";
@@ -258,7 +273,10 @@ void add_simulate(CLI::App& app) {
   cmd->add_option("--integrator", a->integrator, integrator_names(" | ") + " (default: the model file's solver, auto when it names none)");
   cmd->add_option("--rtol", a->rtol, "relative tolerance");
   cmd->add_option("--atol", a->atol, "absolute tolerance");
-  cmd->add_option("--max-step", a->max_step, "largest step [s] (rk4: its fixed step)");
+  cmd->add_option("--max-step", a->max_step, "largest step [s] (rk4 and alf with --alf-fixed-step: the fixed step)");
+  cmd->add_option("--alf-penalty", a->alf_penalty, "alf: the penalty on the constraints (> 0; default the file's, else 1e11)");
+  cmd->add_option("--alf-iterations", a->alf_iterations, "alf: the most Newton iterations a step (>= 1; default 100)");
+  cmd->add_flag("--alf-fixed-step", a->alf_fixed_step, "alf: every step --max-step (default 1 ms) instead of the error control");
   cmd->add_option("--output-step", a->output_step, "output interval [s]");
   cmd->add_flag("--quiet", a->quiet, "no progress bar");
   cmd->add_option("--max-samples", a->max_samples, "refuse runs that would record more output samples")->capture_default_str();

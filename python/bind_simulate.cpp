@@ -5,6 +5,7 @@
 #include "bind_common.hpp"
 
 #include <atomic>
+#include <climits>
 #include <chrono>
 
 namespace codyna::python {
@@ -63,6 +64,9 @@ SimulateRequest simulate_request(const Study& s, const py::dict& options) {
   r.atol = k.number("atol");
   r.max_step = k.number("max_step");
   r.output_step = k.number("output_step");
+  r.alf_penalty = k.number("alf_penalty");
+  if (const auto n = k.whole("alf_iterations", INT_MIN, INT_MAX)) r.alf_iterations = static_cast<int>(*n);
+  if (k.flag("alf_fixed_step")) r.alf_fixed_step = true;
   r.max_samples = k.number("max_samples");
   r.divergence_bound = k.number("divergence_bound");
   k.finish();

@@ -1297,6 +1297,22 @@ const Schema<SolverSpec>& schema<SolverSpec>() {
       field("t_end", &SolverSpec::t_end, in_range([](double x) { return x > 0; }, "an end time > 0 (s)")),
       field("output_step", &SolverSpec::output_step, in_range([](double x) { return x > 0; }, "an output step > 0 (s)")),
       field("max_step", &SolverSpec::max_step, in_range([](double x) { return x >= 0; }, "a largest step >= 0 (s; 0 = no limit)")),
+      // alf's settings, written only where they were given
+      field("alf_penalty", &SolverSpec::alf_penalty,
+            [](const Node& n) {
+              const double x = read_number(n);
+              if (!(x > 0) || !std::isfinite(x)) n.expected("a penalty > 0 (alf's default 1e11)");
+              return std::optional<double>(x);
+            }),
+      field("alf_iterations", &SolverSpec::alf_iterations,
+            [](const Node& n) {
+              const int k = read_integer(n);
+              if (k < 1) n.expected("a number of Newton iterations >= 1 (alf's default 100)");
+              return std::optional<int>(k);
+            },
+            [](const std::optional<int>& k) { return k ? ojson(*k) : ojson(); }),
+      field("alf_fixed_step", &SolverSpec::alf_fixed_step, read_bool,
+            [](bool fixed) { return fixed ? ojson(true) : ojson(); }),
   }};
   return s;
 }

@@ -1189,6 +1189,11 @@ class Compiler {
     positive(s.t_end, "t_end");
     positive(s.output_step, "output_step");
     if (!std::isfinite(s.max_step) || s.max_step < 0) fail("/solver/max_step", "expected a non-negative number (0 = no limit)");
+    if (s.alf_penalty && !(*s.alf_penalty > 0 && std::isfinite(*s.alf_penalty)))
+      fail("/solver/alf_penalty", "expected a penalty > 0 (alf's default 1e11), got " + compile_number(*s.alf_penalty));
+    if (s.alf_iterations && *s.alf_iterations < 1)
+      fail("/solver/alf_iterations",
+           "expected a number of Newton iterations >= 1 (alf's default 100), got " + std::to_string(*s.alf_iterations));
     if (s.integrator == "alf" && s.max_step > s.t_end)
       fail("/solver/max_step", "alf: a step of " + compile_number(s.max_step) + " s is longer than the run (t_end " +
                                    compile_number(s.t_end) + " s)");

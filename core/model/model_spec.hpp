@@ -383,6 +383,11 @@ struct SolverSpec {
   double t_end = 5.0;
   double output_step = 0.01;
   double max_step = 0.0;  // 0 = no limit
+  // alf only (simulation/alf.cpp; absent: its defaults, IntegratorSettings): the penalty, the most
+  // Newton iterations a step, and every step max_step (0: 1 ms) instead of the error control
+  std::optional<double> alf_penalty;
+  std::optional<int> alf_iterations;
+  bool alf_fixed_step = false;
 };
 
 struct ModelSpec {

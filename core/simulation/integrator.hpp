@@ -41,6 +41,9 @@ struct IntegratorSettings {
   bool alf_fixed_step = false;
 };
 
+// a model file's solver settings as the integrators take them (alf's absent settings: its defaults)
+IntegratorSettings integrator_settings(const SolverSpec& solver);
+
 class IntegratorFailure : public std::runtime_error {
  public:
   IntegratorFailure(double t, const std::string& reason) : std::runtime_error(reason), t_(t) {}

@@ -374,6 +374,18 @@ class Rk4 final : public Integrator {
 
 }  // namespace
 
+IntegratorSettings integrator_settings(const SolverSpec& solver) {
+  IntegratorSettings s;
+  s.method = solver.integrator;
+  s.rtol = solver.rtol;
+  s.atol = solver.atol;
+  s.max_step = solver.max_step;
+  if (solver.alf_penalty) s.alf_penalty = *solver.alf_penalty;
+  if (solver.alf_iterations) s.alf_iterations = *solver.alf_iterations;
+  s.alf_fixed_step = solver.alf_fixed_step;
+  return s;
+}
+
 std::unique_ptr<Integrator> make_integrator(ClosedLoopSystem& system, const IntegratorSettings& s) {
   if (!(s.rtol > 0) || !(s.atol > 0)) throw std::invalid_argument("integrator: rtol and atol must be positive");
   if (!(s.max_step >= 0)) throw std::invalid_argument("integrator: max_step must be >= 0");

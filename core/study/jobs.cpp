@@ -280,10 +280,7 @@ void trajectory_job(LinearizeJob& job, const LinearizeRequest& a) {
     throw std::invalid_argument(opt("trajectory") + ": export is continuous-time only (drop " + opt("discrete") + ")");
   if (m.spec.analysis.mat_version != "5") throw std::invalid_argument(opt("trajectory") + ": export is MAT v5 only");
   SimulationOptions o;
-  o.integrator.method = m.spec.solver.integrator;
-  o.integrator.rtol = m.spec.solver.rtol;
-  o.integrator.atol = m.spec.solver.atol;
-  o.integrator.max_step = m.spec.solver.max_step;
+  o.integrator = integrator_settings(m.spec.solver);
   const double T = *a.trajectory;
   o.t_end = T;
   o.output_step = a.trajectory_step && *a.trajectory_step > 0 ? *a.trajectory_step : m.spec.solver.output_step;
@@ -499,6 +496,15 @@ ModelSpec simulate_spec(const SimulateRequest& a, ModelSpec spec) {
   if (check("t-end", a.t_end, [](double x) { return x > 0; }, "a number of seconds > 0")) sp.t_end = *a.t_end;
   if (check("output-step", a.output_step, [](double x) { return x > 0; }, "a number of seconds > 0"))
     sp.output_step = *a.output_step;
+  if (check("alf-penalty", a.alf_penalty, [](double x) { return x > 0; }, "a penalty > 0 (alf's default 1e11)"))
+    sp.alf_penalty = *a.alf_penalty;
+  if (a.alf_iterations) {
+    if (*a.alf_iterations < 1)
+      throw std::invalid_argument(opt("alf-iterations") + " " + std::to_string(*a.alf_iterations) +
+                                  ": expected a number of Newton iterations >= 1 (alf's default 100)");
+    sp.alf_iterations = *a.alf_iterations;
+  }
+  if (a.alf_fixed_step) sp.alf_fixed_step = *a.alf_fixed_step;
   check("max-samples", a.max_samples, [](double x) { return x >= 1; }, "a number >= 1");
   check("divergence-bound", a.divergence_bound, [](double x) { return x > 0; }, "a number > 0");
   return spec;
@@ -534,6 +540,9 @@ GivenFields simulate_fields(const SimulateRequest& a) {
   g.add(a.max_step.has_value(), "/solver/max_step", "max-step");
   g.add(a.t_end.has_value(), "/solver/t_end", "t-end");
   g.add(a.output_step.has_value(), "/solver/output_step", "output-step");
+  g.add(a.alf_penalty.has_value(), "/solver/alf_penalty", "alf-penalty");
+  g.add(a.alf_iterations.has_value(), "/solver/alf_iterations", "alf-iterations");
+  g.add(a.alf_fixed_step.has_value(), "/solver/alf_fixed_step", "alf-fixed-step");
   return g;
 }
 }  // namespace

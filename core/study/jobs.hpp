@@ -114,6 +114,9 @@ struct SimulateRequest {
   std::optional<std::vector<double>> q_weights, r_weights;
   std::optional<std::string> integrator;
   std::optional<double> t_end, rtol, atol, max_step, output_step, max_samples, divergence_bound;
+  std::optional<double> alf_penalty;   // alf's settings (SolverSpec)
+  std::optional<int> alf_iterations;
+  std::optional<bool> alf_fixed_step;
 };
 
 // The sample limit of a run shown live in a window, which keeps each run several times (plots, the

@@ -75,12 +75,7 @@ BodyState body_state(const Model& m, Data& d, int body, const Eigen::VectorXd& q
 }
 
 IntegratorSettings integrator(const Model& m) {
-  IntegratorSettings is;
-  is.method = m.spec.solver.integrator;
-  is.rtol = m.spec.solver.rtol;
-  is.atol = m.spec.solver.atol;
-  is.max_step = m.spec.solver.max_step;
-  return is;
+  return integrator_settings(m.spec.solver);
 }
 
 // the study's straight steady run at the request's speed

@@ -43,13 +43,7 @@ const std::vector<SE3>& StudyPoses::at(const Eigen::VectorXd& q) {
 }
 
 IntegratorSettings study_integrator_settings(const Model& model) {
-  IntegratorSettings s;
-  const SolverSpec& sp = model.spec.solver;
-  s.method = sp.integrator;
-  s.rtol = sp.rtol;
-  s.atol = sp.atol;
-  s.max_step = sp.max_step;
-  return s;
+  return integrator_settings(model.spec.solver);
 }
 std::unique_ptr<Stepper> study_stepper(const Model& model, const IntegratorSettings& settings) {
   return std::make_unique<Stepper>(model, settings);

@@ -78,10 +78,7 @@ JacobianMethod method_of_model(const Model& m) {
 SimulationOptions solver_options(const Model& m) {
   SimulationOptions o;
   const SolverSpec& sp = m.spec.solver;
-  o.integrator.method = sp.integrator;
-  o.integrator.rtol = sp.rtol;
-  o.integrator.atol = sp.atol;
-  o.integrator.max_step = sp.max_step;
+  o.integrator = integrator_settings(sp);
   o.t_end = sp.t_end;
   o.output_step = sp.output_step;
   return o;

@@ -258,6 +258,9 @@ class Study:
         atol=None,
         max_step=None,
         output_step=None,
+        alf_penalty=None,
+        alf_iterations=None,
+        alf_fixed_step=None,
         controller=None,
         open_loop=None,
         lqr=None,
@@ -303,8 +306,11 @@ class Study:
         t_end             end time, s
         integrator        one of codyna.integrators: @INTEGRATORS@
         rtol, atol        tolerances
-        max_step          largest step, s (rk4: its fixed step)
+        max_step          largest step, s (rk4, and alf with alf_fixed_step: its fixed step)
         output_step       output interval, s
+        alf_penalty, alf_iterations   alf: the constraints' penalty (> 0, default 1e11) and the
+                          most Newton iterations a step (>= 1, default 100)
+        alf_fixed_step    True: alf steps max_step (default 1 ms) with no error control
         controller        a controller .mat: K (state feedback), Kp/Ki/Kd (PID) or Ac, Bc, Cc, Dc
                           [, Ts] (LTI); default the model file's controller
         open_loop         True: ignore the model's controller (actuators at their nominal values)

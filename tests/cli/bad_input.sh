@@ -66,6 +66,17 @@ expect 1 "--max-samples" -- "$codyna" simulate model.json --out r.h5 --quiet --o
 expect 1 "1e9" -- "$codyna" simulate model.json --out r.h5 --quiet --integrator rk4 --max-step 1e-12
 expect 1 "--max-step" -- "$codyna" simulate model.json --out r.h5 --quiet --integrator ida --max-step 1e-12
 expect 1 "--trajectory-step" -- "$codyna" linearize model.json --out lin --trajectory 1e9
+# alf's settings: each bad value refused with its flag; good ones used and said
+held="$src/examples/four_bar_held.json"
+expect 1 "--alf-penalty" -- "$codyna" simulate "$held" --out r.h5 --quiet --integrator alf --alf-penalty 0
+expect 1 "--alf-iterations" -- "$codyna" simulate "$held" --out r.h5 --quiet --integrator alf --alf-iterations 0
+expect 1 "--max-step" -- "$codyna" simulate "$held" --out r.h5 --quiet --integrator alf --alf-fixed-step --max-step 9 --t-end 1
+[ ! -e r.h5 ] || fail "r.h5 written although the alf runs were refused"
+"$codyna" simulate "$held" --out alf.h5 --quiet --integrator alf --alf-fixed-step --max-step 0.005 --alf-penalty 1e10 \
+  --t-end 1 > alf.txt 2>&1 || fail "alf at fixed steps: $(cat alf.txt)"
+grep -q "alf (fixed steps of 0.005 s, penalty 1e+10, at most 100 iterations a step, Newton at rtol" alf.txt ||
+  fail "alf's settings not said: $(grep integrator alf.txt)"
+grep -q ": 200 steps" alf.txt || fail "alf at 5 ms over 1 s: $(grep integrator alf.txt)"
 [ $(( $(date +%s) - start )) -lt 20 ] || fail "refusing the runs took more than 20 s"
 
 # a degenerate mechanism: refused clearly by simulate, never a crash

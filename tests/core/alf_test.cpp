@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "dynamics/prepare.hpp"
+#include "io/model_file.hpp"
 #include "model/errors.hpp"
 #include "models/iftomm_a02.hpp"
 #include "simulation/simulator.hpp"
@@ -141,6 +142,106 @@ TEST(Alf, Refusals) {
   }
   spec.solver.max_step = 0.5;
   EXPECT_NO_THROW(compile(spec));
+}
+
+// alf's settings in a model file and as a request's options (codyna simulate --alf-penalty,
+// --alf-iterations, --alf-fixed-step): read, written back only where given, used by the run
+// (fixed steps: exactly t_end / h steps), and each bad value refused with its field or option named
+TEST(Alf, SettingsInTheModelFileAndTheRequest) {
+  const std::string path = test::example_path("four_bar_held.json");
+  std::ifstream in(path);
+  nlohmann::json j = nlohmann::json::parse(in);
+  // not given: not written
+  const nlohmann::json plain = to_json(parse_model_spec(j, "four_bar_held.json"));
+  EXPECT_FALSE(plain["solver"].contains("alf_penalty"));
+  EXPECT_FALSE(plain["solver"].contains("alf_iterations"));
+  EXPECT_FALSE(plain["solver"].contains("alf_fixed_step"));
+  j["solver"]["integrator"] = "alf";
+  j["solver"]["alf_penalty"] = 1e9;
+  j["solver"]["alf_iterations"] = 30;
+  j["solver"]["alf_fixed_step"] = true;
+  j["solver"]["max_step"] = 0.004;
+  j["solver"]["t_end"] = 1.0;
+  const ModelSpec spec = parse_model_spec(j, "four_bar_held.json");
+  ASSERT_TRUE(spec.solver.alf_penalty && spec.solver.alf_iterations);
+  EXPECT_EQ(*spec.solver.alf_penalty, 1e9);
+  EXPECT_EQ(*spec.solver.alf_iterations, 30);
+  EXPECT_TRUE(spec.solver.alf_fixed_step);
+  const nlohmann::json back = to_json(spec);
+  EXPECT_EQ(back["solver"]["alf_penalty"], 1e9);
+  EXPECT_EQ(back["solver"]["alf_iterations"], 30);
+  EXPECT_EQ(back["solver"]["alf_fixed_step"], true);
+  const IntegratorSettings is = integrator_settings(spec.solver);
+  EXPECT_EQ(is.method, "alf");
+  EXPECT_EQ(is.alf_penalty, 1e9);
+  EXPECT_EQ(is.alf_iterations, 30);
+  EXPECT_TRUE(is.alf_fixed_step);
+  EXPECT_EQ(is.max_step, 0.004);
+
+  // the run takes them: every output time (10 ms apart) is a stop, met in equal steps of at most
+  // 4 ms: 3 steps each, 300 in 1 s
+  SimulateRequest r;
+  r.model = path;
+  const SimulateJob fixed = study_simulate_job(r, spec);
+  ASSERT_TRUE(fixed.result.completed) << fixed.result.failure;
+  EXPECT_EQ(fixed.result.stats.integrator, "alf");
+  EXPECT_EQ(fixed.result.stats.steps, 300);
+  EXPECT_LT(fixed.max_constraint_violation, 1e-9);
+  // the request's options override the file's: at most 8 ms, 2 steps an output interval
+  r.max_step = 0.008;
+  const SimulateJob coarser = study_simulate_job(r, spec);
+  ASSERT_TRUE(coarser.result.completed) << coarser.result.failure;
+  EXPECT_EQ(coarser.result.stats.steps, 200);
+  // one Newton iteration a step is too few at 1e-8: the run fails and says which setting limits it
+  r.alf_iterations = 1;
+  const SimulateJob starved = study_simulate_job(r, spec);
+  EXPECT_FALSE(starved.result.completed);
+  EXPECT_NE(starved.result.failure.find("alf_iterations"), std::string::npos) << starved.result.failure;
+
+  // bad values, each refused with its place named
+  auto file_refusal = [&](const char* key, const nlohmann::json& value) {
+    nlohmann::json bad = j;
+    bad["solver"][key] = value;
+    try {
+      parse_model_spec(bad, "bad.json");
+    } catch (const std::exception& e) {
+      return std::string(e.what());
+    }
+    return std::string("taken");
+  };
+  EXPECT_NE(file_refusal("alf_penalty", -1.0).find("/solver/alf_penalty"), std::string::npos) << file_refusal("alf_penalty", -1.0);
+  EXPECT_NE(file_refusal("alf_penalty", 0.0).find("a penalty > 0"), std::string::npos);
+  EXPECT_NE(file_refusal("alf_iterations", 0).find("/solver/alf_iterations"), std::string::npos) << file_refusal("alf_iterations", 0);
+  EXPECT_NE(file_refusal("alf_iterations", 2.5).find("an integer"), std::string::npos);
+  EXPECT_NE(file_refusal("alf_fixed_step", "yes").find("/solver/alf_fixed_step"), std::string::npos)
+      << file_refusal("alf_fixed_step", "yes");
+  // a spec built in code: compile() refuses the same
+  ModelSpec coded = spec;
+  coded.solver.alf_penalty = 0.0;
+  try {
+    compile(coded);
+    ADD_FAILURE() << "a zero alf_penalty was compiled";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("/solver/alf_penalty"), std::string::npos) << e.what();
+  }
+  auto request_refusal = [&](SimulateRequest q) {
+    q.model = path;
+    try {
+      study_simulate_job(q, spec);
+    } catch (const std::exception& e) {
+      return std::string(e.what());
+    }
+    return std::string("taken");
+  };
+  SimulateRequest q;
+  q.alf_penalty = -5.0;
+  EXPECT_NE(request_refusal(q).find("--alf-penalty"), std::string::npos) << request_refusal(q);
+  q = SimulateRequest();
+  q.alf_iterations = 0;
+  EXPECT_NE(request_refusal(q).find("--alf-iterations"), std::string::npos) << request_refusal(q);
+  q = SimulateRequest();
+  q.max_step = 2.0;  // longer than the run's 1 s
+  EXPECT_NE(request_refusal(q).find("--max-step"), std::string::npos) << request_refusal(q);
 }
 
 // A05 (the stiff flyball: spring-dampers k = 8e5, c = 4e4 on a 4-DOF tree), 2 s: alf's Newton on

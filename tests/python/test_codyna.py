@@ -1007,6 +1007,27 @@ def test_the_integrators_are_the_cores_one_list():
         assert n in str(e.value)
 
 
+def test_alf_settings_are_the_command_lines(tmp_path):
+    """alf's settings as keywords: the same run as codyna simulate's flags (fixed steps of 5 ms over
+    1 s: 200 steps, the same samples); a bad value names its keyword."""
+    held = os.path.join(SOURCE_DIR, "examples", "four_bar_held.json")
+    r = codyna.Study(held).simulate(integrator="alf", alf_fixed_step=True, max_step=0.005, alf_penalty=1e10,
+                                    alf_iterations=50, t_end=1.0)
+    assert r.completed
+    stdout, _ = cli("simulate", held, "--out", tmp_path / "alf.h5", "--quiet", "--integrator", "alf", "--alf-fixed-step",
+                    "--max-step", "0.005", "--alf-penalty", "1e10", "--alf-iterations", "50", "--t-end", "1")
+    assert "alf (fixed steps of 0.005 s, penalty 1e+10, at most 50 iterations a step" in stdout
+    assert ": 200 steps" in stdout
+    end = float(next(l for l in stdout.splitlines() if l.startswith("output rocker_angle")).split()[5])
+    assert abs(r.y[-1, 0] - end) < 1e-5 * abs(end)
+    with pytest.raises(ValueError) as e:
+        codyna.Study(held).simulate(integrator="alf", alf_penalty=-1.0, t_end=0.1)
+    assert "alf_penalty" in str(e.value)
+    with pytest.raises(ValueError) as e:
+        codyna.Study(held).simulate(integrator="alf", alf_iterations=0, t_end=0.1)
+    assert "alf_iterations" in str(e.value)
+
+
 def test_maneuver_is_the_command_lines():
     """Study.maneuver runs codyna maneuver's job: the same report text; bad keywords name themselves."""
     car = os.path.join(SOURCE_DIR, "examples", "single_track_car.json")
