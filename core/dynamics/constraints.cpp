@@ -128,19 +128,19 @@ void contact_row(const Model& model, DataT<S>& d, const ConstraintModel& c, int 
 }
 
 // the rows r0 .. r0 + n of Jc, written in their first k columns (the constraint's support, cols
-// ascending), spread to their columns, zeros elsewhere (in place: cols[p] >= p, so from the end)
+// ascending), moved to their columns; Jc is zero elsewhere (fill_rows zeroes it first, as a
+// block: the rows' other columns, strided, cost more than the whole matrix). In place from the
+// end: cols[p] >= p, and a slot p left behind is zeroed after it is read (a smaller p may then
+// move into it).
 void spread_rows(Eigen::MatrixXd& Jc, int r0, int n, const std::vector<int>& cols) {
   const Eigen::Index k = static_cast<Eigen::Index>(cols.size());
-  for (int r = r0; r < r0 + n; ++r) {
-    Eigen::Index next = Jc.cols();  // columns from next on are done
+  for (int r = r0; r < r0 + n; ++r)
     for (Eigen::Index p = k - 1; p >= 0; --p) {
       const Eigen::Index col = cols[static_cast<std::size_t>(p)];
-      for (Eigen::Index j = col + 1; j < next; ++j) Jc(r, j) = 0.0;
+      if (col == p) continue;
       Jc(r, col) = Jc(r, p);
-      next = col;
+      Jc(r, p) = 0.0;
     }
-    for (Eigen::Index j = 0; j < next; ++j) Jc(r, j) = 0.0;
-  }
 }
 
 // phi always; Jc with jac; gamma with gam (only with jac); with jac alone, the Jacobians from the
@@ -149,6 +149,8 @@ template <class S>
 void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool jac, bool gam, Eigen::Index nd) {
   auto coh = [nd](auto& m) { ad_make_coherent(m, nd); };
   constexpr bool kDouble = std::is_same_v<S, double>;
+  if constexpr (kDouble)
+    if (jac) d.Jc.setZero();  // (the rows are written on their supports: spread_rows)
   for (std::size_t ci = 0; ci < model.constraints.size(); ++ci) {
     const ConstraintModel& c = model.constraints[ci];
     if (c.type == ConstraintType::Coupler) {

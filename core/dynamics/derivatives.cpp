@@ -1539,6 +1539,21 @@ void TreeDerivatives::constraint_derivatives(const Eigen::VectorXd& lambda, cons
   }
 }
 
+void TreeDerivatives::compute_balance(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& u_all,
+                                      const Eigen::VectorXd& a, const Eigen::VectorXd& lambda) {
+  if (!m_->motions.empty()) throw std::invalid_argument("TreeDerivatives::compute_balance: the model has motion inputs");
+  world_kinematics(q, v);
+  accelerations(v, a);
+  composites();
+  forces();
+  add_armature_force(*m_, a, tau);
+  differentiate_rnea();
+  applied_force_derivatives(q, v, u_all);
+  constraint_derivatives(lambda, a);
+  mass_matrix();
+  qdd = a;
+}
+
 void TreeDerivatives::compute_constrained(const Eigen::VectorXd& q, const Eigen::VectorXd& v,
                                           const Eigen::VectorXd& u_all, const Eigen::VectorXd& a,
                                           const Eigen::VectorXd& lambda, const std::vector<int>& rows,

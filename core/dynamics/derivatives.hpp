@@ -84,6 +84,12 @@ class TreeDerivatives {
   void compute_constrained(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& u_all,
                            const Eigen::VectorXd& a, const Eigen::VectorXd& lambda, const std::vector<int>& rows,
                            const std::vector<int>& outputs);
+  // The balance's parts alone (for an implicit integrator's Newton matrix, simulation/alf.cpp):
+  // tau/dtau at a, Q/dQ (including -Jc^T lambda), M, Jc, dc_dq, dc_dv, as compute_constrained
+  // gives them, without solving for the accelerations' derivatives (dqdd_* and the sensors'
+  // derivatives are not touched). Models without motion inputs.
+  void compute_balance(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& u_all,
+                       const Eigen::VectorXd& a, const Eigen::VectorXd& lambda);
 
   // Everything at (q, v, u_all) (u_all: one value per actuator). `outputs` are
   // sensor indices whose values and derivatives are wanted. After the first

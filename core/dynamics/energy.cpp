@@ -7,9 +7,9 @@
 
 namespace codyna {
 
+namespace {
 template <class S>
-S kinetic_energy(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>& v) {
-  forward_kinematics<S>(model, d, q, v);
+S kinetic_sum(const Model& model, const DataT<S>& d, const VecXT<S>& v) {
   S T(0);
   for (int i = 1; i < model.nbodies; ++i) T += S(0.5) * d.v[i].dot(model.inertia[i].cast<S>() * d.v[i]);
   if (model.armature.size() != 0)  // the rotors' (armature): 1/2 armature v^2 on each coordinate
@@ -22,9 +22,8 @@ S kinetic_energy(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT
 }
 
 template <class S>
-S potential_energy(const Model& model, DataT<S>& d, const VecXT<S>& q) {
+S potential_sum(const Model& model, const DataT<S>& d, const VecXT<S>& q) {
   using std::sqrt;
-  forward_kinematics<S>(model, d, q);
   S V(0);
   if (model.has_gravity)
     for (int i = 1; i < model.nbodies; ++i)
@@ -39,6 +38,26 @@ S potential_energy(const Model& model, DataT<S>& d, const VecXT<S>& q) {
     V += S(0.5 * s.stiffness) * e * e;
   }
   return V;
+}
+}  // namespace
+
+template <class S>
+S kinetic_energy(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>& v) {
+  forward_kinematics<S>(model, d, q, v);
+  return kinetic_sum<S>(model, d, v);
+}
+
+template <class S>
+S potential_energy(const Model& model, DataT<S>& d, const VecXT<S>& q) {
+  forward_kinematics<S>(model, d, q);
+  return potential_sum<S>(model, d, q);
+}
+
+double kinetic_energy_after_kinematics(const Model& model, const Data& data, const Eigen::VectorXd& v) {
+  return kinetic_sum<double>(model, data, v);
+}
+double potential_energy_after_kinematics(const Model& model, const Data& data, const Eigen::VectorXd& q) {
+  return potential_sum<double>(model, data, q);
 }
 
 template double kinetic_energy<double>(const Model&, DataT<double>&, const VecXT<double>&, const VecXT<double>&);

@@ -12,10 +12,10 @@
 // (M and Jc at the step's end, factored for these two solves).
 // The Newton matrix is the full tangent of f (issue 41): M + h/2 C + h^2/4 (K + Jc^T alpha Jc),
 // K = d(M a + nle - Q)/dq at fixed a, C = d(nle - Q)/dv, from the analytic derivatives of the
-// open tree (TreeDerivatives::compute_constrained with no kept rows and zero multipliers: the
-// loop closures enter only through the penalty; their reactions' turning, d(Jc^T lambda)/dq, is
-// left out: on Bricard's redundant loops it made Newton diverge). Where the derivatives throw
-// (an effect or constraint they do not take, M not positive definite) C = K = 0, as before.
+// open tree (TreeDerivatives::compute_balance with zero multipliers, the balance's derivatives
+// without the accelerations' solve: the loop closures enter only through the penalty; their
+// reactions' turning, d(Jc^T lambda)/dq, is left out: on Bricard's redundant loops it made Newton
+// diverge). Where the derivatives throw (an effect or constraint they do not take) C = K = 0.
 // Modified Newton, with rules: C and K are kept for up to 20 steps (formed again when Newton's
 // corrections shrink by less than 1/2 per iteration, and after a failed step); the matrix is
 // combined at each step's h and factored at its first iterate (on trees only when h changes or
@@ -86,11 +86,17 @@ std::string alf_number(double x) {
   return os.str();
 }
 
-// A Newton or projection matrix of alf, factored: dense (partial pivoting), or sparse where the
-// matrix is (a long mechanism of many loops: M has the tree's zeros, Jc^T Jc couples only each
-// loop's joints): Eigen's SparseLU in COLAMD order, its pattern (the nonzeros seen so far, kept)
-// analysed once and again only when a nonzero appears outside it. A02 with N = 40 (81 x 81, 4%
-// nonzero): 12 us a factorization against 53 us dense.
+// A Newton or projection matrix of alf, factored. Three ways, chosen from the matrices'
+// structural nonzeros (the pattern: M's pairs on one path to the ground, Jc^T Jc's pairs in one
+// loop's support, and what C and K add when formed):
+//  * banded: where the pattern in reverse Cuthill-McKee order has a narrow band (a row of loops,
+//    A02: bandwidth 2 of 81), LU without pivoting in that band, n b^2 flops (~1 us for A02). The
+//    matrices are M + h/2 C + h^2/4 (K + alpha Jc^T Jc), M positive definite and C, K small beside
+//    it at the steps alf takes, and M + h^2/4 alpha Jc^T Jc (positive definite): no pivoting is
+//    needed, and a pivot below kBandPivot of its diagonal sends that matrix to the sparse LU;
+//  * sparse: Eigen's SparseLU in COLAMD order, its pattern analysed once and again only when a
+//    nonzero appears outside it (A02 N = 40: 12 us against 53 us dense);
+//  * dense, partial pivoting: small or dense matrices.
 class FactoredMatrix {
  public:
   // the structural nonzeros (column-major n x n flags) that every matrix given may have
@@ -104,7 +110,7 @@ class FactoredMatrix {
     if (!K.allFinite()) return false;
     const Eigen::Index n = K.rows();
     if (n < kSparseMin || dense_only_) {
-      sparse_ = false;
+      kind_ = Kind::Dense;
       dense_.compute(K);
       return true;
     }
@@ -121,32 +127,137 @@ class FactoredMatrix {
             grown = true;
           }
     if (grown) {
+      std::size_t count = 0;
+      for (Eigen::Index j = 0; j < n; ++j)
+        for (Eigen::Index i = 0; i < n; ++i) count += mask_[static_cast<std::size_t>(j * n + i)] || i == j;
+      if (static_cast<double>(count) > kSparseDensity * static_cast<double>(n * n)) {  // dense enough: dense from now on
+        dense_only_ = true;
+        return compute(K, false);
+      }
+      order_band(n);
+      sparse_analysed_ = false;
+      analysed_ = true;
+    }
+    if (band_ >= 0 && factor_band(K)) {
+      kind_ = Kind::Band;
+      return true;
+    }
+    // the sparse LU (no narrow band, or a small pivot in it)
+    if (!sparse_analysed_) {
       std::vector<Eigen::Triplet<double>> entries;
       for (Eigen::Index j = 0; j < n; ++j)
         for (Eigen::Index i = 0; i < n; ++i)
           if (mask_[static_cast<std::size_t>(j * n + i)] || i == j) entries.emplace_back(static_cast<int>(i), static_cast<int>(j), 0.0);
-      if (static_cast<double>(entries.size()) > kSparseDensity * static_cast<double>(n * n)) {  // dense enough: dense from now on
-        dense_only_ = true;
-        return compute(K, false);
-      }
       S_.resize(n, n);
       S_.setFromTriplets(entries.begin(), entries.end());
       S_.makeCompressed();
       slu_.analyzePattern(S_);
-      analysed_ = true;
+      sparse_analysed_ = true;
     }
     for (Eigen::Index j = 0; j < S_.outerSize(); ++j)
       for (Eigen::SparseMatrix<double>::InnerIterator it(S_, j); it; ++it) it.valueRef() = K(it.row(), it.col());
     slu_.factorize(S_);
-    sparse_ = true;
+    kind_ = Kind::Sparse;
     return slu_.info() == Eigen::Success;
   }
-  Eigen::VectorXd solve(const Eigen::VectorXd& b) { return sparse_ ? Eigen::VectorXd(slu_.solve(b)) : Eigen::VectorXd(dense_.solve(b)); }
+  Eigen::VectorXd solve(const Eigen::VectorXd& b) {
+    switch (kind_) {
+      case Kind::Band: return solve_band(b);
+      case Kind::Sparse: return slu_.solve(b);
+      case Kind::Dense: break;
+    }
+    return dense_.solve(b);
+  }
+  bool banded() const { return kind_ == Kind::Band; }
 
  private:
+  // the reverse Cuthill-McKee order of the pattern (symmetrized) and its bandwidth; no band
+  // (band_ < 0) where it would hold more than kBandShare of the matrix
+  void order_band(Eigen::Index n) {
+    const auto N = static_cast<std::size_t>(n);
+    std::vector<std::vector<int>> adj(N);
+    for (std::size_t j = 0; j < N; ++j)
+      for (std::size_t i = 0; i < N; ++i)
+        if (i != j && (mask_[j * N + i] || mask_[i * N + j])) adj[j].push_back(static_cast<int>(i));
+    for (auto& a : adj)
+      std::stable_sort(a.begin(), a.end(), [&](int x, int y) { return adj[static_cast<std::size_t>(x)].size() < adj[static_cast<std::size_t>(y)].size(); });
+    std::vector<int> order;
+    order.reserve(N);
+    std::vector<char> seen(N, 0);
+    while (order.size() < N) {  // each connected part breadth first from a node of least degree
+      std::size_t start = N;
+      for (std::size_t i = 0; i < N; ++i)
+        if (!seen[i] && (start == N || adj[i].size() < adj[start].size())) start = i;
+      seen[start] = 1;
+      order.push_back(static_cast<int>(start));
+      for (std::size_t head = order.size() - 1; head < order.size(); ++head)
+        for (const int j : adj[static_cast<std::size_t>(order[head])])
+          if (!seen[static_cast<std::size_t>(j)]) {
+            seen[static_cast<std::size_t>(j)] = 1;
+            order.push_back(j);
+          }
+    }
+    std::reverse(order.begin(), order.end());
+    perm_ = order;
+    std::vector<int> place(N);
+    for (std::size_t k = 0; k < N; ++k) place[static_cast<std::size_t>(perm_[k])] = static_cast<int>(k);
+    Eigen::Index width = 0;
+    for (std::size_t j = 0; j < N; ++j)
+      for (const int i : adj[j]) width = std::max<Eigen::Index>(width, std::abs(place[j] - place[static_cast<std::size_t>(i)]));
+    band_ = static_cast<double>((2 * width + 1) * n) <= kBandShare * static_cast<double>(n * n) ? width : -1;
+  }
+
+  // LU without pivoting in the band (perm_'s order); false where a pivot is not finite or below
+  // kBandPivot of its diagonal (the sparse LU takes that matrix)
+  bool factor_band(const Eigen::MatrixXd& K) {
+    const Eigen::Index n = K.rows(), b = band_, w = 2 * band_ + 1;
+    B_.resize(n, w);
+    for (Eigen::Index i = 0; i < n; ++i)
+      for (Eigen::Index j = std::max<Eigen::Index>(0, i - b); j <= std::min(n - 1, i + b); ++j)
+        B_(i, j - i + b) = K(perm_[static_cast<std::size_t>(i)], perm_[static_cast<std::size_t>(j)]);
+    for (Eigen::Index k = 0; k < n; ++k) {
+      const double p = B_(k, b);
+      if (!std::isfinite(p) || !(std::abs(p) > kBandPivot * std::abs(K(perm_[static_cast<std::size_t>(k)], perm_[static_cast<std::size_t>(k)]))))
+        return false;
+      const Eigen::Index last = std::min(n - 1, k + b);
+      for (Eigen::Index i = k + 1; i <= last; ++i) {
+        double& l = B_(i, k - i + b);
+        if (l == 0) continue;
+        l /= p;
+        for (Eigen::Index j = k + 1; j <= last; ++j) B_(i, j - i + b) -= l * B_(k, j - k + b);
+      }
+    }
+    return true;
+  }
+  Eigen::VectorXd solve_band(const Eigen::VectorXd& rhs) {
+    const Eigen::Index n = rhs.size(), b = band_;
+    y_.resize(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      double s = rhs[perm_[static_cast<std::size_t>(i)]];
+      for (Eigen::Index k = std::max<Eigen::Index>(0, i - b); k < i; ++k) s -= B_(i, k - i + b) * y_[k];
+      y_[i] = s;
+    }
+    for (Eigen::Index i = n - 1; i >= 0; --i) {
+      double s = y_[i];
+      for (Eigen::Index j = i + 1; j <= std::min(n - 1, i + b); ++j) s -= B_(i, j - i + b) * y_[j];
+      y_[i] = s / B_(i, b);
+    }
+    Eigen::VectorXd x(n);
+    for (Eigen::Index i = 0; i < n; ++i) x[perm_[static_cast<std::size_t>(i)]] = y_[i];
+    return x;
+  }
+
+  enum class Kind { Dense, Sparse, Band };
   static constexpr Eigen::Index kSparseMin = 24;  // below this many coordinates dense is as fast
   static constexpr double kSparseDensity = 0.2;   // above this share of nonzeros, dense
-  bool sparse_ = false, dense_only_ = false, analysed_ = false;
+  static constexpr double kBandShare = 0.25, kBandPivot = 1e-10;
+  Kind kind_ = Kind::Dense;
+  bool dense_only_ = false, analysed_ = false, sparse_analysed_ = false;
+  Eigen::Index band_ = -1;  // the bandwidth in perm_'s order; -1: not banded
+  std::vector<int> perm_;   // perm_[k]: the coordinate at place k of the band's order
+  // the band, n x (2 band_ + 1), row by row: B_(i, j - i + band_) = K(perm_ i, perm_ j), then its LU
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> B_;
+  Eigen::VectorXd y_;
   Eigen::PartialPivLU<Eigen::MatrixXd> dense_;
   std::vector<char> mask_;
   Eigen::SparseMatrix<double> S_;
@@ -189,6 +300,8 @@ class Alf final : public Integrator {
 
   void reset(double t, const Eigen::VectorXd& y) override {
     t_ = t;
+    shown_ = false;
+    start_mass_ = stalled_before_ = false;  // (a new start: no projection's M there, no stall before it)
     q_ = y.head(m_.nq);
     v_ = y.segment(m_.nq, m_.nv);
     xc_ = y.tail(y.size() - m_.nq - m_.nv);
@@ -206,7 +319,43 @@ class Alf final : public Integrator {
     }
   }
 
+  // at fixed steps: on in steps of (at most) h_ toward the stop, each stop's interval in equal
+  // steps, past t_out when a step ends beyond it; the state there is the cubic Hermite
+  // interpolation of (q, v) and of (v, a) over that step (an error of order h^4, beside the
+  // rule's h^2), so that the steps do not bend to the output times (before: every output a stop,
+  // a 10 ms output step and 4 ms steps made three steps an interval, not 2.5)
+  void advance_output(double t_out, double t_stop) override {
+    if (!fixed_ || !(t_stop > t_out)) {
+      advance(t_out);
+      return;
+    }
+    shown_ = false;
+    const double eps = 1e-12 * std::max(1.0, std::abs(t_stop));
+    // (every step reads its inputs at its end's left limit and the next restarts a where they
+    // jumped: a reference's step at a step's end enters at the next step, as at a stop; one inside
+    // a step is smeared over it, the fixed step's own error)
+    while (t_ < t_out - eps) {
+      restart_at_input_jump();
+      const int n = std::max(1, static_cast<int>(std::ceil((t_stop - t_) / h_ - 1e-9)));
+      const double h = (t_stop - t_) / n;
+      tp_ = t_;
+      qp_ = q_;
+      vp_ = v_;
+      ap_ = a_;
+      if (!step(h, true)) fail_newton(t_ + h, h);
+      accept(n == 1 ? t_stop : t_ + h);
+    }
+    if (t_ > t_out + eps) show(t_out);
+  }
+
   void advance(double t_out) override {
+    shown_ = false;
+    const double eps = 1e-12 * std::max(1.0, std::abs(t_out));
+    if (t_ > t_out + eps) {  // stepped past it already (advance_output)
+      show(t_out);
+      return;
+    }
+    if (t_ >= t_out - eps) return;  // there already (advance_output's last step ended at its stop)
     restart_at_input_jump();
     if (fixed_) {  // the interval in equal steps of at most h_
       const int n = std::max(1, static_cast<int>(std::ceil((t_out - t_) / h_ - 1e-9)));
@@ -255,6 +404,7 @@ class Alf final : public Integrator {
   }
 
   Eigen::VectorXd state() const override {
+    if (shown_) return shown_y_;
     Eigen::VectorXd y(m_.nq + m_.nv + xc_.size());
     y << q_, v_, xc_;
     return y;
@@ -435,6 +585,17 @@ class Alf final : public Integrator {
     ++input_restarts_;
   }
 
+  // state() at t inside the last step (tp_ .. t_): cubic Hermite in (q, v) and in (v, a)
+  void show(double t) {
+    const double h = t_ - tp_, s = std::clamp((t - tp_) / h, 0.0, 1.0), s2 = s * s, s3 = s2 * s;
+    const double h00 = 2 * s3 - 3 * s2 + 1, h10 = (s3 - 2 * s2 + s) * h, h01 = -2 * s3 + 3 * s2, h11 = (s3 - s2) * h;
+    shown_y_.resize(m_.nq + m_.nv + xc_.size());
+    shown_y_.head(m_.nq) = h00 * qp_ + h10 * vp_ + h01 * q_ + h11 * v_;
+    shown_y_.segment(m_.nq, m_.nv) = h00 * vp_ + h10 * ap_ + h01 * v_ + h11 * a_;
+    shown_y_.tail(xc_.size()) = xc_;
+    shown_ = true;
+  }
+
   // the local error in q, h^2/12 (a_n+1 - a_n), in the weights atol + rtol |q| (<= 1: accepted)
   double error_estimate(double h) const {
     const Eigen::ArrayXd w = atol_ + rtol_ * q_.array().abs().max(qn_.array().abs());
@@ -443,6 +604,7 @@ class Alf final : public Integrator {
 
   void accept(double t1) {
     stalled_before_ = stalled_;
+    start_mass_ = m_.nc > 0;  // (Mp_: M at qn_)
     q_ = qn_;
     v_ = vn_;
     a_ = an_;
@@ -459,14 +621,12 @@ class Alf final : public Integrator {
   }
 
   // The tangent at (q, v, a): the parts of the full tangent of f,
-  //   M + h/2 C + h^2/4 (K + Jc^T alpha Jc),  K = d(M a + nle - Q + Jc^T lambda~)/dq at fixed a
-  //   and lambda~ = lambda + alpha phi (the reactions' turning included), C = d(nle - Q)/dv,
-  // kept as Mt_, Ct_, Kt_ (so a step of another h combines them again), from the analytic
-  // derivatives (TreeDerivatives::compute_constrained on no kept rows: the open tree's
-  // derivatives, the loop closures' reactions as given forces). Where they do not apply (they
-  // throw: an effect or constraint they do not differentiate, a mass matrix that is not positive
-  // definite; or a derivative that is not finite) the mass matrix alone (C = K = 0), and after
-  // kTangentFailures such failures the mass matrix from then on.
+  //   M + h/2 C + h^2/4 (K + Jc^T alpha Jc),  K = d(M a + nle - Q)/dq at fixed a, C = d(nle - Q)/dv
+  // (the reactions' turning left out), kept as Mt_, Ct_, Kt_ (so a step of another h combines
+  // them again), from the analytic derivatives (TreeDerivatives::compute_balance: the open tree's
+  // derivatives, no solve for the accelerations'). Where they do not apply (they throw: an effect
+  // or constraint they do not differentiate; or a derivative that is not finite) the mass matrix
+  // alone (C = K = 0), and after kTangentFailures such failures the mass matrix from then on.
   void form_tangent(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& a,
                     const Eigen::VectorXd& lambda, double alpha) {
     bool tangent = false;
@@ -477,7 +637,7 @@ class Alf final : public Integrator {
           zero_multipliers_.setZero(m_.nc);
         }
         // (d_ holds the residual's evaluation at this iterate: phi and the inputs u_)
-        td_->compute_constrained(q, v, u_, a, zero_multipliers_, kNoRows, kNoRows);
+        td_->compute_balance(q, v, u_, a, zero_multipliers_);
         Mt_ = td_->M;
         Ct_ = td_->dtau_dv - td_->dQ_dv;
         Kt_ = td_->dtau_dq - td_->dQ_dq;
@@ -505,8 +665,16 @@ class Alf final : public Integrator {
   // residual's last evaluation), factored; false: not finite
   bool factor(double h, double alpha, const Eigen::VectorXd& q) {
     const double c = h * h / 4;
-    if (m_.nc && !fresh_mass_) Mt_ = crba<double>(m_, d_, q);  // M at this iterate (C and K kept; crba leaves Jc)
-    fresh_mass_ = false;
+    // M at this iterate (C and K kept; crba leaves Jc), or at a step's first factorization the
+    // projection's M at the step's start (h v away from the predictor: Newton's matrix, not its
+    // residual; one mass matrix a step fewer)
+    if (m_.nc && !fresh_mass_) {
+      if (start_mass_)
+        Mt_ = Mp_;
+      else
+        Mt_ = crba<double>(m_, d_, q);
+    }
+    fresh_mass_ = start_mass_ = false;
     K_ = Mt_;
     if (use_tangent_ || tangents_ > 0) {
       K_.noalias() += (h / 2) * Ct_;
@@ -544,7 +712,6 @@ class Alf final : public Integrator {
   // kRate at least per iteration, for kTangentAge steps at most; the matrix is factored each step
   static constexpr double kRate = 0.5;
   static constexpr int kTangentAge = 20, kTangentFailures = 3;
-  static inline const std::vector<int> kNoRows{};
   static constexpr double kPenaltyStep = 1e-2, kPenaltyMax = 1e13;
   ClosedLoopSystem& sys_;
   const Model& m_;
@@ -555,6 +722,9 @@ class Alf final : public Integrator {
   bool fixed_, trace_;  // trace_: ALF_TRACE set, each Newton iteration printed
   double next_ = 0, last_failure_ = 0, h_now_ = 0, t_ = 0;
   Eigen::VectorXd q_, v_, a_, xc_, lambda_, qn_, vn_, an_, lambdan_, f_, u_;
+  double tp_ = 0;                      // advance_output: the last step's start (tp_, qp_, vp_, ap_)
+  Eigen::VectorXd qp_, vp_, ap_, shown_y_;
+  bool shown_ = false;                 // state() is shown_y_, interpolated inside the last step
   Eigen::MatrixXd K_, Mt_, Ct_, Kt_;  // the Newton matrix; the tangent's parts
   Eigen::MatrixXd Kp_, Mp_;           // the projections' matrix, and M, at the step's end
   FactoredMatrix lup_;  // the projections' matrix
@@ -563,6 +733,7 @@ class Alf final : public Integrator {
   bool use_tangent_ = true, have_tangent_ = false, tangent_stale_ = true;
   int tangent_age_ = 0;
   bool factored_ = false, fresh_mass_ = false, scan_newton_ = true;
+  bool start_mass_ = false;  // Mp_ is M at the step's start, not yet used by its first factorization
   double h_factored_ = 0;
   bool stalled_ = false, stalled_before_ = false;
   long boosts_ = 0, stalls_ = 0, tangents_ = 0, tangent_failures_ = 0, input_restarts_ = 0;

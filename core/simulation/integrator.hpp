@@ -58,6 +58,14 @@ class Integrator {
   virtual ~Integrator() = default;
   virtual void reset(double t, const Eigen::VectorXd& y) = 0;  // y in ODE layout [q; v; xc]
   virtual void advance(double t_out) = 0;                       // throws IntegratorFailure
+  // to an output time t_out that the integrator may step past (state() is then interpolated at
+  // t_out), never past t_stop >= t_out, the next time it must stop at (a controller sample, a
+  // jump, the run's end); by default a stop at t_out (alf at fixed steps: its steps do not bend
+  // to the outputs)
+  virtual void advance_output(double t_out, double t_stop) {
+    (void)t_stop;
+    advance(t_out);
+  }
   virtual Eigen::VectorXd state() const = 0;                    // ODE layout
   virtual bool projects() const { return false; }               // keeps loops on the manifold itself
   virtual void add_stats(SolverStats& s) const = 0;

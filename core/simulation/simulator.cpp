@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "dynamics/assembly.hpp"
+#include "dynamics/constraints.hpp"
 #include "dynamics/effects.hpp"
 #include "dynamics/forward_dynamics.hpp"
 #include "dynamics/energy.hpp"
@@ -379,9 +380,16 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
       d.motion_acc = motion_acc;
       forward_dynamics<double>(model, d, q, v, u);
     }
+    // one pass of kinematics for the outputs, the energies and the loops' drift
     forward_kinematics<double>(model, d, q, v);
     const Eigen::VectorXd out = sensor_outputs<double>(model, d, model.plant_outputs, q, v);
-    const auto [pv, vv] = sys.violation(q, v);
+    const double kinetic = kinetic_energy_after_kinematics(model, d, v), potential = potential_energy_after_kinematics(model, d, q);
+    double pv = 0, vv = 0;  // max |phi|, max |Jc v|
+    if (model.nc) {
+      constraint_jacobian_after_kinematics(model, d, q);
+      pv = d.phi.cwiseAbs().maxCoeff();
+      vv = (d.Jc * v).cwiseAbs().maxCoeff();
+    }
     rec.t.push_back(t);
     rec.q.push_back(q);
     rec.v.push_back(v);
@@ -389,8 +397,8 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
     rec.y.push_back(out);
     rec.xc.push_back(xc);
     rec.s.push_back(s);
-    rec.T.push_back(kinetic_energy<double>(model, d, q, v));
-    rec.V.push_back(potential_energy<double>(model, d, q));
+    rec.T.push_back(kinetic);
+    rec.V.push_back(potential);
     rec.pv.push_back(pv);
     rec.vv.push_back(vv);
     if (o.reference) rec.r.push_back(o.reference(t));
@@ -422,8 +430,13 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
     const double next_jump = jump_index < o.rate_jumps.size() ? o.rate_jumps[jump_index] : o.t_end;
     const double next_beside = beside ? o.t0 + beside_index * Tb : o.t_end;
     const double target = std::min({next_out, next_sample, next_beside, next_jump, o.t_end});
+    // the times the run must stop at exactly; an output time before them may be stepped past
+    const double stop = std::min({next_sample, next_beside, next_jump, o.t_end});
     try {
-      integrator->advance(target);
+      if (target < stop - eps)
+        integrator->advance_output(target, stop);
+      else
+        integrator->advance(target);
     } catch (const IntegratorFailure& f) {
       if (halted()) {  // stopped inside the step (ClosedLoopSystem::set_cancel)
         r.cancelled = true;
