@@ -1,6 +1,7 @@
 #include "dynamics/constraints.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -128,10 +129,9 @@ void contact_row(const Model& model, DataT<S>& d, const ConstraintModel& c, int 
 }
 
 // the rows r0 .. r0 + n of Jc, written in their first k columns (the constraint's support, cols
-// ascending), moved to their columns; Jc is zero elsewhere (fill_rows zeroes it first, as a
-// block: the rows' other columns, strided, cost more than the whole matrix). In place from the
-// end: cols[p] >= p, and a slot p left behind is zeroed after it is read (a smaller p may then
-// move into it).
+// ascending), moved to their columns; Jc is zero elsewhere (fill_rows keeps it so: clearing only
+// the supports costs k a row, not nv). In place from the end: cols[p] >= p, and a slot p left
+// behind is zeroed after it is read (a smaller p may then move into it).
 void spread_rows(Eigen::MatrixXd& Jc, int r0, int n, const std::vector<int>& cols) {
   const Eigen::Index k = static_cast<Eigen::Index>(cols.size());
   for (int r = r0; r < r0 + n; ++r)
@@ -149,8 +149,6 @@ template <class S>
 void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool jac, bool gam, Eigen::Index nd) {
   auto coh = [nd](auto& m) { ad_make_coherent(m, nd); };
   constexpr bool kDouble = std::is_same_v<S, double>;
-  if constexpr (kDouble)
-    if (jac) d.Jc.setZero();  // (the rows are written on their supports: spread_rows)
   for (std::size_t ci = 0; ci < model.constraints.size(); ++ci) {
     const ConstraintModel& c = model.constraints[ci];
     if (c.type == ConstraintType::Coupler) {
@@ -167,6 +165,12 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool jac, boo
     if constexpr (kDouble) {  // Data's workspace: no heap after the first call
       for (MatXT<S>* m : {&d.Jp, &d.Jwa, &d.Jwb, &d.Jwd})
         if (m->cols() != model.nv) m->resize(3, model.nv);
+      // Jc is zero off the supports (Data makes it zero; only these rows write it, and
+      // plant_function zeroes whole rows): the rows' last values, on the support, cleared for
+      // the compact rows and spread_rows
+      if (jac)
+        for (int r = c.row; r < c.row + c.nrows; ++r)
+          for (const int col : cols) d.Jc(r, col) = 0.0;
     }
     if (gam) {
       dpd = point_velocity<S>(d, c.body_a, c.point_a) - point_velocity<S>(d, c.body_b, c.point_b);
@@ -369,6 +373,17 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool jac, boo
     if constexpr (kDouble)
       if (jac) spread_rows(d.Jc, c.row, c.nrows, cols);
   }
+#ifndef NDEBUG
+  if constexpr (kDouble)  // (debug builds: the rows are zero off their supports, as the clearing assumes)
+    if (jac)
+      for (std::size_t ci = 0; ci < model.constraints.size(); ++ci) {
+        const ConstraintModel& c = model.constraints[ci];
+        std::vector<char> on(static_cast<std::size_t>(model.nv), 0);
+        for (const int col : d.constants.constraint_cols[ci]) on[static_cast<std::size_t>(col)] = 1;
+        for (int r = c.row; r < c.row + c.nrows; ++r)
+          for (int j = 0; j < model.nv; ++j) assert(on[static_cast<std::size_t>(j)] || d.Jc(r, j) == 0.0);
+      }
+#endif
 }
 
 }  // namespace

@@ -107,8 +107,9 @@ class FactoredMatrix {
   // scan: K may have nonzeros outside the pattern (they are added to it); false: not finite, or
   // singular to the sparse factorization
   bool compute(const Eigen::MatrixXd& K, bool scan) {
-    if (!K.allFinite()) return false;
     const Eigen::Index n = K.rows();
+    // (the band's factorization checks its pivots: a NaN or infinity in the band reaches one)
+    if ((band_ < 0 || n < kSparseMin || dense_only_ || scan || !analysed_) && !K.allFinite()) return false;
     if (n < kSparseMin || dense_only_) {
       kind_ = Kind::Dense;
       dense_.compute(K);
@@ -143,6 +144,7 @@ class FactoredMatrix {
       return true;
     }
     // the sparse LU (no narrow band, or a small pivot in it)
+    if (!K.allFinite()) return false;
     if (!sparse_analysed_) {
       std::vector<Eigen::Triplet<double>> entries;
       for (Eigen::Index j = 0; j < n; ++j)
@@ -433,7 +435,7 @@ class Alf final : public Integrator {
     if (m_.nc) {
       constraint_jacobian_after_kinematics(m_, d_, q);  // (rnea's kinematics at q)
       if (pending) lambda += alpha * d_.phi;
-      f_.noalias() += d_.Jc.transpose() * (lambda + alpha * d_.phi);
+      add_jc_transpose(f_, lambda + alpha * d_.phi, 1.0);
     }
     f_ *= h_now_ * h_now_ / 4;
   }
@@ -555,10 +557,10 @@ class Alf final : public Integrator {
       add_penalty(Kp_, c * alpha);
       if (!lup_.compute(Kp_, false)) return false;  // (M + c alpha Jc^T Jc: the structural pattern)
       ++factorizations_;
-      v = lup_.solve(Mp_ * v);
+      v = lup_.solve(mass_times(Mp_, v));
       constraint_terms<double>(m_, d_, q, v);  // gamma at the projected velocities
-      Eigen::VectorXd rhs = Mp_ * a;
-      rhs.noalias() -= (c * alpha) * (d_.Jc.transpose() * d_.gamma);
+      Eigen::VectorXd rhs = mass_times(Mp_, a);
+      add_jc_transpose(rhs, d_.gamma, -c * alpha);
       a = lup_.solve(rhs);
     }
     if (!q.allFinite() || !v.allFinite() || !a.allFinite()) return false;
@@ -702,6 +704,30 @@ class Alf final : public Integrator {
           for (const int b : cols) K(b, a) += x * d_.Jc(r, b);
         }
     }
+  }
+
+  // y += s Jc^T x, on the constraints' supports (Jc is zero elsewhere)
+  void add_jc_transpose(Eigen::VectorXd& y, const Eigen::VectorXd& x, double s) const {
+    for (std::size_t ci = 0; ci < m_.constraints.size(); ++ci) {
+      const ConstraintModel& c = m_.constraints[ci];
+      const std::vector<int>& cols = d_.constants.constraint_cols[ci];
+      for (int r = c.row; r < c.row + c.nrows; ++r) {
+        const double xr = s * x[r];
+        if (xr == 0) continue;
+        for (const int a : cols) y[a] += d_.Jc(r, a) * xr;
+      }
+    }
+  }
+
+  // M x for a mass matrix of the tree (zero but for pairs of coordinates on one path to the ground)
+  Eigen::VectorXd mass_times(const Eigen::MatrixXd& M, const Eigen::VectorXd& x) const {
+    Eigen::VectorXd y = M.diagonal().cwiseProduct(x);
+    for (int a = 0; a < m_.nv; ++a)
+      for (int b = d_.constants.dof_parent[static_cast<std::size_t>(a)]; b >= 0; b = d_.constants.dof_parent[static_cast<std::size_t>(b)]) {
+        y[a] += M(a, b) * x[b];
+        y[b] += M(b, a) * x[a];
+      }
+    return y;
   }
 
   static double left_loose(const Eigen::VectorXd& dq, const Eigen::ArrayXd& wl) { return (dq.array().abs() / wl).maxCoeff(); }
