@@ -170,7 +170,6 @@ class FactoredMatrix {
     }
     return dense_.solve(b);
   }
-  bool banded() const { return kind_ == Kind::Band; }
 
  private:
   // the reverse Cuthill-McKee order of the pattern (symmetrized) and its bandwidth; no band
@@ -303,6 +302,7 @@ class Alf final : public Integrator {
   void reset(double t, const Eigen::VectorXd& y) override {
     t_ = t;
     shown_ = false;
+    knots_ = 0;
     start_mass_ = stalled_before_ = false;  // (a new start: no projection's M there, no stall before it)
     q_ = y.head(m_.nq);
     v_ = y.segment(m_.nq, m_.nv);
@@ -339,15 +339,10 @@ class Alf final : public Integrator {
     while (t_ < t_out - eps) {
       restart_at_input_jump();
       const int n = std::max(1, static_cast<int>(std::ceil((t_stop - t_) / h_ - 1e-9)));
-      const double h = (t_stop - t_) / n;
-      tp_ = t_;
-      qp_ = q_;
-      vp_ = v_;
-      ap_ = a_;
-      if (!step(h, true)) fail_newton(t_ + h, h);
-      accept(n == 1 ? t_stop : t_ + h);
+      knots_ = 0;
+      fixed_step(n == 1 ? t_stop : t_ + (t_stop - t_) / n, true, 0);
     }
-    if (t_ > t_out + eps) show(t_out);
+    if (t_ > t_out + eps) show(t_out);  // (inside the last step, this call's or an earlier one's)
   }
 
   void advance(double t_out) override {
@@ -363,8 +358,8 @@ class Alf final : public Integrator {
       const int n = std::max(1, static_cast<int>(std::ceil((t_out - t_) / h_ - 1e-9)));
       const double h = (t_out - t_) / n, t0 = t_;
       for (int i = 0; i < n; ++i) {
-        if (!step(h, i + 1 == n)) fail_newton(t_ + h, h);
-        accept(i + 1 == n ? t_out : t0 + (i + 1) * h);
+        knots_ = 0;
+        fixed_step(i + 1 == n ? t_out : t0 + (i + 1) * h, i + 1 == n, 0);
       }
       return;
     }
@@ -587,13 +582,45 @@ class Alf final : public Integrator {
     ++input_restarts_;
   }
 
-  // state() at t inside the last step (tp_ .. t_): cubic Hermite in (q, v) and in (v, a)
+  // a fixed step to t1, or where Newton does not pass it, two
+  // of half the length (down to 1/2^kHalvings of it): a stall at a singular position that the
+  // penalty's raise does not rescue passes at a shorter step (A02 at 9 ms: one step at t = 16.45 s
+  // diverged after the raise to 1e13; before, the run failed there)
+  // (each substep's start is kept as a knot of the step, for show())
+  void fixed_step(double t1, bool to_stop, int depth) {
+    const double h = t1 - t_;
+    if (step(h, to_stop)) {
+      if (knots_ == static_cast<int>(knot_.size())) knot_.emplace_back();
+      Knot& k = knot_[static_cast<std::size_t>(knots_++)];  // (assigned in place: no heap once sized)
+      k.t = t_;
+      k.q = q_;
+      k.v = v_;
+      k.a = a_;
+      accept(t1);
+      return;
+    }
+    if (depth >= kHalvings) fail_newton(t1, h);
+    ++halvings_;
+    fixed_step(t_ + h / 2, to_stop, depth + 1);
+    fixed_step(t1, to_stop, depth + 1);
+  }
+
+  // state() at t inside the last fixed step (its substeps' knots, then the state reached): cubic
+  // Hermite in (q, v) and in (v, a) over the substep that holds t
   void show(double t) {
-    const double h = t_ - tp_, s = std::clamp((t - tp_) / h, 0.0, 1.0), s2 = s * s, s3 = s2 * s;
+    if (knots_ == 0) return;  // (not after a fixed step: state() is the state reached)
+    int k = knots_ - 1;
+    while (k > 0 && knot_[static_cast<std::size_t>(k)].t > t) --k;
+    const Knot& a = knot_[static_cast<std::size_t>(k)];
+    const bool last = k + 1 == knots_;
+    const Knot& b = last ? Knot{} : knot_[static_cast<std::size_t>(k + 1)];
+    const double tb = last ? t_ : b.t;
+    const Eigen::VectorXd &qb = last ? q_ : b.q, &vb = last ? v_ : b.v, &ab = last ? a_ : b.a;
+    const double h = tb - a.t, s = std::clamp((t - a.t) / h, 0.0, 1.0), s2 = s * s, s3 = s2 * s;
     const double h00 = 2 * s3 - 3 * s2 + 1, h10 = (s3 - 2 * s2 + s) * h, h01 = -2 * s3 + 3 * s2, h11 = (s3 - s2) * h;
     shown_y_.resize(m_.nq + m_.nv + xc_.size());
-    shown_y_.head(m_.nq) = h00 * qp_ + h10 * vp_ + h01 * q_ + h11 * v_;
-    shown_y_.segment(m_.nq, m_.nv) = h00 * vp_ + h10 * ap_ + h01 * v_ + h11 * a_;
+    shown_y_.head(m_.nq) = h00 * a.q + h10 * a.v + h01 * qb + h11 * vb;
+    shown_y_.segment(m_.nq, m_.nv) = h00 * a.v + h10 * a.a + h01 * vb + h11 * ab;
     shown_y_.tail(xc_.size()) = xc_;
     shown_ = true;
   }
@@ -733,6 +760,7 @@ class Alf final : public Integrator {
   static double left_loose(const Eigen::VectorXd& dq, const Eigen::ArrayXd& wl) { return (dq.array().abs() / wl).maxCoeff(); }
 
   static constexpr double kStall = 0.8, kBoost = 10, kStallTolerance = 0.1;
+  static constexpr int kHalvings = 4;
   static constexpr double kNewton = 1e-3, kNewtonFloor = 1e-14, kLeftLimit = 1e-9;
   // the modified Newton: the tangent is kept over steps while Newton's corrections shrink by
   // kRate at least per iteration, for kTangentAge steps at most; the matrix is factored each step
@@ -748,9 +776,15 @@ class Alf final : public Integrator {
   bool fixed_, trace_;  // trace_: ALF_TRACE set, each Newton iteration printed
   double next_ = 0, last_failure_ = 0, h_now_ = 0, t_ = 0;
   Eigen::VectorXd q_, v_, a_, xc_, lambda_, qn_, vn_, an_, lambdan_, f_, u_;
-  double tp_ = 0;                      // advance_output: the last step's start (tp_, qp_, vp_, ap_)
-  Eigen::VectorXd qp_, vp_, ap_, shown_y_;
-  bool shown_ = false;                 // state() is shown_y_, interpolated inside the last step
+  // a fixed step's substeps' starts (one, or more where Newton made it halve the step), for show()
+  struct Knot {
+    double t = 0;
+    Eigen::VectorXd q, v, a;
+  };
+  std::vector<Knot> knot_;
+  int knots_ = 0;
+  Eigen::VectorXd shown_y_;
+  bool shown_ = false;  // state() is shown_y_, interpolated inside the last step
   Eigen::MatrixXd K_, Mt_, Ct_, Kt_;  // the Newton matrix; the tangent's parts
   Eigen::MatrixXd Kp_, Mp_;           // the projections' matrix, and M, at the step's end
   FactoredMatrix lup_;  // the projections' matrix
@@ -762,7 +796,7 @@ class Alf final : public Integrator {
   bool start_mass_ = false;  // Mp_ is M at the step's start, not yet used by its first factorization
   double h_factored_ = 0;
   bool stalled_ = false, stalled_before_ = false;
-  long boosts_ = 0, stalls_ = 0, tangents_ = 0, tangent_failures_ = 0, input_restarts_ = 0;
+  long boosts_ = 0, stalls_ = 0, tangents_ = 0, tangent_failures_ = 0, input_restarts_ = 0, halvings_ = 0;
   FactoredMatrix lu_;  // the Newton matrix
   long steps_ = 0, evaluations_ = 0, factorizations_ = 0, iterations_done_ = 0, failures_ = 0, rejected_ = 0;
 };
