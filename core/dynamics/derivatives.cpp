@@ -1542,6 +1542,11 @@ void TreeDerivatives::constraint_derivatives(const Eigen::VectorXd& lambda, cons
 void TreeDerivatives::compute_balance(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& u_all,
                                       const Eigen::VectorXd& a, const Eigen::VectorXd& lambda) {
   if (!m_->motions.empty()) throw std::invalid_argument("TreeDerivatives::compute_balance: the model has motion inputs");
+  balance(q, v, u_all, a, lambda);
+}
+
+void TreeDerivatives::balance(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& u_all,
+                              const Eigen::VectorXd& a, const Eigen::VectorXd& lambda) {
   world_kinematics(q, v);
   accelerations(v, a);
   composites();
@@ -1559,16 +1564,7 @@ void TreeDerivatives::compute_constrained(const Eigen::VectorXd& q, const Eigen:
                                           const Eigen::VectorXd& lambda, const std::vector<int>& rows,
                                           const std::vector<int>& outputs) {
   const int nv = m_->nv, nu = m_->nu(), na = static_cast<int>(rows.size());
-  world_kinematics(q, v);
-  accelerations(v, a);
-  composites();
-  forces();
-  add_armature_force(*m_, a, tau);
-  differentiate_rnea();
-  applied_force_derivatives(q, v, u_all);
-  constraint_derivatives(lambda, a);
-  mass_matrix();
-  qdd = a;
+  balance(q, v, u_all, a, lambda);
   if (!m_->motions.empty()) {
     solve_prescribed(rows);
     sensor_derivatives(q, v, outputs);

@@ -137,6 +137,9 @@ class TreeDerivatives {
   Eigen::VectorXd c;                        // c itself (zero on the kept rows, up to round-off)
 
  private:
+  // compute_constrained's and compute_balance's common part: everything up to the mass matrix
+  void balance(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& u_all, const Eigen::VectorXd& a,
+               const Eigen::VectorXd& lambda);
   struct Unit {
     int body = 0;  // child body of the joint
     int iv = 0;    // first velocity index
