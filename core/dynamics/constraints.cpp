@@ -60,17 +60,17 @@ Attached<S> attached(const DataT<S>& d, int body, const Eigen::Vector3d& local, 
 
 // a coupler's row: sum_k ratio_k q_k - offset; Jc holds the ratios, gamma is zero
 template <class S>
-void coupler_row(const ConstraintModel& c, DataT<S>& d, const VecXT<S>& q, bool jac, Eigen::Index nd) {
+void coupler_row(const ConstraintModel& c, DataT<S>& d, const VecXT<S>& q, bool jac, bool gam, Eigen::Index nd) {
   S phi = ad_coherent(S(-c.offset), nd);
   for (int k = 0; k < c.ncoupled; ++k) {
     const S term = ad_coherent(S(c.ratio[k] * q[c.iq[k]]), nd);
     phi = phi + term;
   }
   d.phi[c.row] = phi;
+  if (gam) d.gamma[c.row] = ad_coherent(S(0), nd);
   if (!jac) return;
   for (Eigen::Index j = 0; j < d.Jc.cols(); ++j) d.Jc(c.row, j) = ad_coherent(S(0), nd);
   for (int k = 0; k < c.ncoupled; ++k) d.Jc(c.row, c.iv[k]) = ad_coherent(S(c.ratio[k]), nd);
-  d.gamma[c.row] = ad_coherent(S(0), nd);
 }
 
 // a disc lying flat on its plane: |n - (n . a) a| below this has no contact direction
@@ -143,8 +143,10 @@ void spread_rows(Eigen::MatrixXd& Jc, int r0, int n, const std::vector<int>& col
     }
 }
 
-// phi always; Jc with jac; gamma with gam (only with jac); with jac alone, the Jacobians from the
-// positions of forward kinematics (velocities and accelerations not read for any output)
+// phi always; Jc with jac; gamma with gam (from the velocities and accelerations at qdd = 0 of
+// the kinematics); with jac alone, the Jacobians from the positions of forward kinematics
+// (velocities and accelerations not read for any output); a contact row's Jc writes are empty
+// without jac (its k is 0)
 template <class S>
 void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool jac, bool gam, Eigen::Index nd) {
   auto coh = [nd](auto& m) { ad_make_coherent(m, nd); };
@@ -152,7 +154,7 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool jac, boo
   for (std::size_t ci = 0; ci < model.constraints.size(); ++ci) {
     const ConstraintModel& c = model.constraints[ci];
     if (c.type == ConstraintType::Coupler) {
-      coupler_row<S>(c, d, q, jac, nd);
+      coupler_row<S>(c, d, q, jac, gam, nd);
       continue;
     }
     const Vec3T<S> pa = point_position<S>(d, c.body_a, c.point_a), pb = point_position<S>(d, c.body_b, c.point_b);
@@ -303,7 +305,8 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool jac, boo
         coh(Rnd);
         for (const Eigen::Vector3d* perp : {&c.perp_a1, &c.perp_a2}) {
           d.phi[r] = ad_coherent(S(0), nd);
-          if (jac) contact_row<S>(model, d, c, r, attached<S>(d, c.body_a, *perp, nd), Rn, Rnd, dpc, dpd, dpdd, nd, kb, gam);
+          if (jac || gam)
+            contact_row<S>(model, d, c, r, attached<S>(d, c.body_a, *perp, nd), Rn, Rnd, dpc, dpd, dpdd, nd, kb, gam);
           ++r;
         }
         break;
@@ -338,7 +341,7 @@ void fill_rows(const Model& model, DataT<S>& d, const VecXT<S>& q, bool jac, boo
         if (!jac) {
           d.phi[r + 1] = ad_coherent(S(0), nd);
           d.phi[r + 2] = ad_coherent(S(0), nd);
-          break;
+          if (!gam) break;
         }
         // k' = n' . a + n . a', u' = n' - k' a - k a', d' = (u' - d (d . u')) / s
         const S k1 = dot3<S>(n.xd, a.x, nd), k2 = dot3<S>(n.x, a.xd, nd);
@@ -404,6 +407,19 @@ void constraint_terms(const Model& model, DataT<S>& d, const VecXT<S>& q, const 
 
 void constraint_jacobian_after_kinematics(const Model& model, Data& d, const Eigen::VectorXd& q) {
   fill_rows<double>(model, d, q, true, false, 0);
+}
+
+std::pair<double, double> constraint_violation_after_kinematics(const Model& model, Data& d, const Eigen::VectorXd& q,
+                                                                 const Eigen::VectorXd& v) {
+  if (model.nc == 0) return {0.0, 0.0};
+  fill_rows<double>(model, d, q, true, false, 0);
+  return {d.phi.cwiseAbs().maxCoeff(), (d.Jc * v).cwiseAbs().maxCoeff()};
+}
+
+void constraint_gamma_after_positions(const Model& model, Data& d, const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
+  if (d.zero_v.size() != model.nv) d.zero_v = Eigen::VectorXd::Zero(model.nv);
+  rate_kinematics<double>(model, d, q, v, d.zero_v);
+  fill_rows<double>(model, d, q, false, true, 0);
 }
 
 #define CODYNA_INSTANTIATE(S)                                                                           \

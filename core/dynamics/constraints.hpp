@@ -13,6 +13,8 @@
 //                           kinematics of its own, gamma not written (the Newton iterations of alf).
 #pragma once
 
+#include <utility>
+
 #include "dynamics/data.hpp"
 
 namespace codyna {
@@ -24,5 +26,12 @@ template <class S>
 void constraint_terms(const Model& model, DataT<S>& data, const VecXT<S>& q, const VecXT<S>& v);
 
 void constraint_jacobian_after_kinematics(const Model& model, Data& data, const Eigen::VectorXd& q);
+// constraint_violation_after_kinematics(q, v): the drift (max |phi|, max |Jc v|) from the
+// positions data holds (phi and Jc written; 0, 0 without loops)
+std::pair<double, double> constraint_violation_after_kinematics(const Model& model, Data& data, const Eigen::VectorXd& q,
+                                                                 const Eigen::VectorXd& v);
+// constraint_gamma_after_positions(q, v): phi and gamma (v, cJ, a at qdd = 0 written) from the
+// positions data holds (after forward kinematics at q of any stage); Jc not written
+void constraint_gamma_after_positions(const Model& model, Data& data, const Eigen::VectorXd& q, const Eigen::VectorXd& v);
 
 }  // namespace codyna

@@ -105,7 +105,6 @@ struct DataT {
   // loop-closure workspace (constraint_terms, forward_dynamics<double>): sized
   // by the first call, so that later calls do not allocate
   VecXT<S> zero_v;               // [nv] zeros, never written
-  MatXT<S> J6a, J6b;             // [6 x nv] body Jacobians of a constraint's two bodies
   MatXT<S> Jp, Jwa, Jwb, Jwd;    // [3 x nv] point, angular (a, b) and relative angular Jacobians
   struct LoopSolve {
     Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr;  // independent rows of Jc

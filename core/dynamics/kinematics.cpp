@@ -22,6 +22,16 @@ Vec6T<S> body_velocity(const JointModel& j, DataT<S>& d, int i, const VecXT<S>& 
   return vJ;
 }
 
+// a[i] of body i from its parent's (v[i], cJ[i] written; vJ the joint velocity)
+template <class S>
+void body_acceleration(const JointModel& j, DataT<S>& d, int i, const Vec6T<S>& vJ, const VecXT<S>& qdd) {
+  Vec6T<S> aJ;
+  if (j.nv == 1) aJ = d.Sb[i].col(0) * qdd[j.idx_v];
+  else if (j.nv > 0) aJ.noalias() = d.Sb[i] * qdd.segment(j.idx_v, j.nv);
+  else aJ.setZero();
+  d.a[i] = d.liMi[i].inv_act_motion(d.a[j.parent]) + aJ + d.cJ[i] + cross_motion<S>(d.v[i], vJ);
+}
+
 template <class S>
 void fk(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>* v, const VecXT<S>* qdd) {
   SE3T<S> X_FM;
@@ -55,12 +65,7 @@ void fk(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>* v, c
     }
     if (!v) continue;
     const Vec6T<S> vJ = body_velocity<S>(j, d, i, q, *v);
-    if (!qdd) continue;
-    Vec6T<S> aJ;
-    if (j.nv == 1) aJ = d.Sb[i].col(0) * (*qdd)[j.idx_v];
-    else if (j.nv > 0) aJ.noalias() = d.Sb[i] * qdd->segment(j.idx_v, j.nv);
-    else aJ.setZero();
-    d.a[i] = liMi.inv_act_motion(d.a[p]) + aJ + d.cJ[i] + cross_motion<S>(d.v[i], vJ);
+    if (qdd) body_acceleration<S>(j, d, i, vJ, *qdd);
   }
 }
 }  // namespace
@@ -81,6 +86,14 @@ void forward_kinematics(const Model& model, DataT<S>& data, const VecXT<S>& q, c
 template <class S>
 void velocity_kinematics(const Model& model, DataT<S>& data, const VecXT<S>& q, const VecXT<S>& v) {
   for (int i = 1; i < model.nbodies; ++i) body_velocity<S>(model.joints[i], data, i, q, v);
+}
+
+template <class S>
+void rate_kinematics(const Model& model, DataT<S>& data, const VecXT<S>& q, const VecXT<S>& v, const VecXT<S>& qdd) {
+  for (int i = 1; i < model.nbodies; ++i) {
+    const Vec6T<S> vJ = body_velocity<S>(model.joints[i], data, i, q, v);
+    body_acceleration<S>(model.joints[i], data, i, vJ, qdd);
+  }
 }
 
 template <class S>
@@ -155,6 +168,8 @@ MatXT<S> point_jacobian(const Model& model, const DataT<S>& data, int body, cons
   template void forward_kinematics<S>(const Model&, DataT<S>&, const VecXT<S>&, const VecXT<S>&,          \
                                       const VecXT<S>&);                                                   \
   template void velocity_kinematics<S>(const Model&, DataT<S>&, const VecXT<S>&, const VecXT<S>&);        \
+  template void rate_kinematics<S>(const Model&, DataT<S>&, const VecXT<S>&, const VecXT<S>&,              \
+                                   const VecXT<S>&);                                                      \
   template void body_jacobian_world_into<S>(const Model&, const DataT<S>&, int, MatXT<S>&);                \
   template Vec3T<S> point_position<S>(const DataT<S>&, int, const Eigen::Vector3d&);                      \
   template Vec3T<S> point_velocity<S>(const DataT<S>&, int, const Eigen::Vector3d&);                      \

@@ -22,6 +22,10 @@ void forward_kinematics(const Model& model, DataT<S>& data, const VecXT<S>& q, c
 // forward_kinematics(q) already wrote: a velocity change at the same q
 template <class S>
 void velocity_kinematics(const Model& model, DataT<S>& data, const VecXT<S>& q, const VecXT<S>& v);
+// the velocity and acceleration stages (v, cJ, a) on the positions forward_kinematics(q) wrote:
+// forward_kinematics(q, v, qdd) without its positions' trigonometry
+template <class S>
+void rate_kinematics(const Model& model, DataT<S>& data, const VecXT<S>& q, const VecXT<S>& v, const VecXT<S>& qdd);
 
 // world position, velocity and (classical) acceleration of point p (body coordinates) of a body
 template <class S>

@@ -300,8 +300,8 @@ bool ClosedLoopSystem::rows_degraded(const Eigen::VectorXd& q) {
 
 std::pair<double, double> ClosedLoopSystem::violation(const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
   if (model_.nc == 0) return {0.0, 0.0};
-  constraint_terms<double>(model_, data_, q, v);
-  return {data_.phi.cwiseAbs().maxCoeff(), (data_.Jc * v).cwiseAbs().maxCoeff()};
+  forward_kinematics<double>(model_, data_, q);
+  return constraint_violation_after_kinematics(model_, data_, q, v);
 }
 
 void ClosedLoopSystem::project_tangent(const Eigen::VectorXd& y, Eigen::VectorXd& e) {

@@ -384,12 +384,7 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
     forward_kinematics<double>(model, d, q, v);
     const Eigen::VectorXd out = sensor_outputs<double>(model, d, model.plant_outputs, q, v);
     const double kinetic = kinetic_energy_after_kinematics(model, d, v), potential = potential_energy_after_kinematics(model, d, q);
-    double pv = 0, vv = 0;  // max |phi|, max |Jc v|
-    if (model.nc) {
-      constraint_jacobian_after_kinematics(model, d, q);
-      pv = d.phi.cwiseAbs().maxCoeff();
-      vv = (d.Jc * v).cwiseAbs().maxCoeff();
-    }
+    const auto [pv, vv] = constraint_violation_after_kinematics(model, d, q, v);  // max |phi|, max |Jc v|
     rec.t.push_back(t);
     rec.q.push_back(q);
     rec.v.push_back(v);

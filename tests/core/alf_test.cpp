@@ -50,6 +50,18 @@ AlfA02 alf_a02(int N, double h, double t_end, double alpha = 1e8, double tol = 1
     const int c = m.joints[static_cast<std::size_t>(m.find_joint("pivot" + std::to_string(k)))].idx_q;
     for (int i = 0; i < r.samples(); ++i) a.err = std::max(a.err, std::abs(r.q(i, c) - exact[i]));
   }
+  if (std::getenv("ALF_DUMP")) {
+    FILE* f = std::fopen(std::getenv("ALF_DUMP"), "w");
+    for (int i = 0; i < r.samples(); ++i) {
+      std::fprintf(f, "%.17g", r.t[i]);
+      for (int k = 0; k <= N; ++k) {
+        const int c = m.joints[static_cast<std::size_t>(m.find_joint("pivot" + std::to_string(k)))].idx_q;
+        std::fprintf(f, " %.17g", r.q(i, c) - exact[i]);
+      }
+      std::fprintf(f, "\n");
+    }
+    std::fclose(f);
+  }
   if (std::getenv("ALF_SERIES"))
     for (int i = 0; i < r.samples(); i += 5) {
       double e = 0, s = 0;

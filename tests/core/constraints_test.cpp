@@ -2,6 +2,7 @@
 #include "dynamics/constraints.hpp"
 
 #include "dynamics/joint.hpp"
+#include "dynamics/kinematics.hpp"
 #include "test_util.hpp"
 
 namespace codyna {
@@ -46,6 +47,32 @@ TEST(Constraints, JacobianAndGammaMatchFiniteDifferences) {
     check_jacobian(m, q);
     check_gamma(m, q, test::random_v(m, rng, 2.0));
   }
+}
+
+// gamma from the positions already made (alf's projection: no second pass of the positions'
+// trigonometry) is constraint_terms' gamma to the last bit, on every row type: planar revolute,
+// revolute, coupler, rolling ball, rolling disc
+TEST(Constraints, GammaAfterPositionsIsConstraintTermsGamma) {
+  int rows = 0;
+  for (const char* name : {"four_bar.json", "andrews_squeezer.json", "bricard.json", "ball_beam.json", "ball_plate.json",
+                           "rolling_disc.json"}) {
+    const Model m = test::load_example(name);
+    std::mt19937 rng(11);
+    const Eigen::VectorXd q = integrate<double>(m, m.q0, test::random_v(m, rng, 0.2)), v = test::random_v(m, rng, 2.0);
+    Data full(m), after(m);
+    constraint_terms<double>(m, full, q, v);
+    forward_kinematics<double>(m, after, q);  // positions only (crba's, rnea's)
+    constraint_gamma_after_positions(m, after, q, v);
+    ASSERT_EQ(after.gamma.size(), m.nc) << name;
+    if (std::string(name) != "ball_beam.json")  // (a coupler's gamma is zero)
+      EXPECT_GT(full.gamma.cwiseAbs().maxCoeff(), 1e-3) << name;  // a term that can be wrong
+    for (int r = 0; r < m.nc; ++r) {
+      EXPECT_EQ(after.gamma[r], full.gamma[r]) << name << " row " << r;
+      EXPECT_EQ(after.phi[r], full.phi[r]) << name << " row " << r;
+    }
+    rows += m.nc;
+  }
+  EXPECT_EQ(rows, 20);  // 2 + 6 + 5 + 1 + 3 + 3: every row of the six models compared
 }
 
 // a ball closure on a random 3-D chain with spherical joints
