@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "study/files.hpp"
+#include "model/compile.hpp"
 #include "model/errors.hpp"
 #include "study/model_issues.hpp"
 #include "study/workflow.hpp"
@@ -139,7 +140,7 @@ bool Document::setStudyChecked(const StudySpec& study, const QString& text, QStr
       error, mergeKey);
 }
 
-bool Document::setSolver(const SolverSpec& solver, const QString& text, int mergeKey) {
+bool Document::setSolver(const SolverSpec& solver, const QString& text, int mergeKey, QString* error) {
   return edit(
       text,
       [&](ModelSpec& s) {
@@ -150,8 +151,9 @@ bool Document::setSolver(const SolverSpec& solver, const QString& text, int merg
         } catch (const ModelError& e) {
           if (e.path().rfind("/solver", 0) == 0) throw;
         }
+        check_solver_spec(s.solver, ss(displayName()));  // and compile's (alf's step within the run)
       },
-      nullptr, mergeKey);
+      error, mergeKey);
 }
 
 bool Document::load(const QString& path, QString* error) {

@@ -76,7 +76,9 @@ class Document : public QObject {
   // independent coordinates; only when the model compiled before). A refusal changes
   // nothing and gives the core's message (file, field path, what was expected).
   bool setStudyChecked(const StudySpec& study, const QString& text, QString* error, int mergeKey = -1);
-  bool setSolver(const SolverSpec& solver, const QString& text = "Change solver settings", int mergeKey = -1);
+  // false: refused by the model file's checks on the solver section (error: why, naming the field)
+  bool setSolver(const SolverSpec& solver, const QString& text = "Change solver settings", int mergeKey = -1,
+                 QString* error = nullptr);
 
   // replaces the spec without an undo step (used by the undo commands)
   void restore(const ModelSpec& spec);

@@ -24,6 +24,8 @@
 #include <QVBoxLayout>
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
+#include <optional>
 
 #include "gui/document.hpp"
 #include "gui/result_plots.hpp"
@@ -304,6 +306,31 @@ void SimulateView::buildUi() {
   atol_->setToolTip(tr("Absolute tolerance of the integrator, in the states' units (e.g. 1e-10)"));
   form->addRow(tr("Relative tolerance"), rtol_);
   form->addRow(tr("Absolute tolerance"), atol_);
+  max_step_ = new QLineEdit(solver_box);
+  max_step_->setObjectName("maxStep");
+  max_step_->setPlaceholderText(tr("no limit"));
+  max_step_->setToolTip(tr("The longest step the integrator may take, in s (empty: no limit); the step of rk4 "
+                           "and of alf at fixed steps (the file's solver.max_step, codyna simulate --max-step)"));
+  form->addRow(tr("Maximum step"), max_step_);
+  // alf's own settings: editable when alf is the integrator (the file keeps them either way)
+  alf_fixed_ = new QCheckBox(tr("alf at fixed steps of the maximum step"), solver_box);
+  alf_fixed_->setObjectName("alfFixedStep");
+  alf_fixed_->setToolTip(tr("alf steps at the maximum step (1 ms when none is given) instead of choosing its steps "
+                            "by its error estimate; give it tight tolerances, which set Newton's (solver.alf_fixed_step, "
+                            "--alf-fixed-step)"));
+  form->addRow(alf_fixed_);
+  alf_penalty_ = new QLineEdit(solver_box);
+  alf_penalty_->setObjectName("alfPenalty");
+  alf_penalty_->setPlaceholderText(tr("1e11 (alf's default)"));
+  alf_penalty_->setToolTip(tr("alf's penalty alpha on the loop closures, a number > 0 (empty: the default 1e11; "
+                              "solver.alf_penalty, --alf-penalty)"));
+  form->addRow(tr("alf penalty"), alf_penalty_);
+  alf_iterations_ = new QLineEdit(solver_box);
+  alf_iterations_->setObjectName("alfIterations");
+  alf_iterations_->setPlaceholderText(tr("100 (alf's default)"));
+  alf_iterations_->setToolTip(tr("alf's most Newton iterations a step, a whole number >= 1 (empty: the default 100; "
+                                 "solver.alf_iterations, --alf-iterations)"));
+  form->addRow(tr("alf iterations"), alf_iterations_);
   compare_linear_ = new QCheckBox(tr("Compare with the linear closed loop"), solver_box);
   compare_linear_->setToolTip(tr("Also run the linear plant with the same controller from the same start; its outputs "
                                  "are drawn dashed (codyna simulate --compare-linear)"));
@@ -445,6 +472,12 @@ void SimulateView::buildUi() {
     const std::string m = ss(integrator_->itemData(i).toString());
     writeSolver([&](SolverSpec& s) { s.integrator = m; }, tr("Change the integrator"));
   });
+  connect(max_step_, &QLineEdit::editingFinished, this, [this] { solverNumberEdited(max_step_); });
+  connect(alf_penalty_, &QLineEdit::editingFinished, this, [this] { solverNumberEdited(alf_penalty_); });
+  connect(alf_iterations_, &QLineEdit::editingFinished, this, [this] { solverNumberEdited(alf_iterations_); });
+  connect(alf_fixed_, &QCheckBox::toggled, this, [this](bool on) {
+    writeSolver([&](SolverSpec& s) { s.alf_fixed_step = on; }, on ? tr("alf at fixed steps") : tr("alf with error control"));
+  });
   connect(rtol_, &QLineEdit::editingFinished, this, [this] { toleranceEdited(true); });
   connect(atol_, &QLineEdit::editingFinished, this, [this] { toleranceEdited(false); });
   connect(compare_linear_, &QCheckBox::toggled, this, [this](bool on) {
@@ -555,9 +588,14 @@ void SimulateView::writeSolver(const std::function<void(SolverSpec&)>& change, c
   change(s);
   const SolverSpec& o = doc_->spec().solver;
   if (s.integrator == o.integrator && s.rtol == o.rtol && s.atol == o.atol && s.t_end == o.t_end &&
-      s.output_step == o.output_step && s.max_step == o.max_step)
+      s.output_step == o.output_step && s.max_step == o.max_step && s.alf_penalty == o.alf_penalty &&
+      s.alf_iterations == o.alf_iterations && s.alf_fixed_step == o.alf_fixed_step)
     return;
-  if (!doc_->setSolver(s, text, mergeKey)) refreshFromDocument();  // refused: show the model's value again
+  QString why;
+  if (!doc_->setSolver(s, text, mergeKey, &why)) {  // refused: said, and the model's value shown again
+    emit message(why);
+    refreshFromDocument();
+  }
 }
 
 void SimulateView::refreshFromDocument() {
@@ -598,6 +636,13 @@ void SimulateView::refreshFromDocument() {
     integrator_->setCurrentIndex(i);
     rtol_->setText(simNumber(so.rtol));
     atol_->setText(simNumber(so.atol));
+    max_step_->setText(so.max_step > 0 ? QString::number(so.max_step, 'g', 17) : QString());
+    const bool alf = so.integrator == "alf";
+    const QSignalBlocker b7(alf_fixed_);
+    alf_fixed_->setChecked(so.alf_fixed_step);
+    alf_penalty_->setText(so.alf_penalty ? QString::number(*so.alf_penalty, 'g', 17) : QString());
+    alf_iterations_->setText(so.alf_iterations ? QString::number(*so.alf_iterations) : QString());
+    for (QWidget* w : std::initializer_list<QWidget*>{alf_fixed_, alf_penalty_, alf_iterations_}) w->setEnabled(alf);
     compare_linear_->setChecked(st.compare_linear);
   }
   {
@@ -731,6 +776,37 @@ void SimulateView::toleranceEdited(bool relative) {
   }
   writeSolver([&](SolverSpec& s) { (relative ? s.rtol : s.atol) = v; },
               relative ? tr("Change the relative tolerance") : tr("Change the absolute tolerance"));
+}
+
+// the maximum step (empty: no limit), alf's penalty and iterations (empty: alf's defaults):
+// a value that is not a number of the field's kind is refused here, one the core refuses (a step
+// longer than the run with alf) by writeSolver; both say why, and the field shows the model's value
+void SimulateView::solverNumberEdited(QLineEdit* e) {
+  const QString text = e->text().trimmed();
+  bool ok = true;
+  const double v = text.isEmpty() ? 0.0 : text.toDouble(&ok);
+  const auto refuse = [&](const QString& why) {
+    emit message(why);
+    refreshFromDocument();
+  };
+  if (!ok || !std::isfinite(v)) {
+    if (e == max_step_) return refuse(tr("Maximum step: expected a number of seconds >= 0 (empty: no limit), got \"%1\"").arg(text));
+    if (e == alf_penalty_) return refuse(tr("alf penalty: expected a number > 0 (empty: 1e11), got \"%1\"").arg(text));
+    return refuse(tr("alf iterations: expected a whole number >= 1 (empty: 100), got \"%1\"").arg(text));
+  }
+  if (e == max_step_) {
+    if (v < 0) return refuse(tr("Maximum step: expected a number of seconds >= 0 (empty: no limit), got %1").arg(text));
+    writeSolver([&](SolverSpec& s) { s.max_step = v; }, tr("Change the maximum step"));
+  } else if (e == alf_penalty_) {
+    if (!text.isEmpty() && !(v > 0)) return refuse(tr("alf penalty: expected a number > 0 (empty: 1e11), got %1").arg(text));
+    writeSolver([&](SolverSpec& s) { s.alf_penalty = text.isEmpty() ? std::nullopt : std::optional<double>(v); },
+                tr("Change alf's penalty"));
+  } else {
+    if (!text.isEmpty() && (!(v >= 1) || v != std::floor(v) || v > 1e9))
+      return refuse(tr("alf iterations: expected a whole number >= 1 (empty: 100), got %1").arg(text));
+    writeSolver([&](SolverSpec& s) { s.alf_iterations = text.isEmpty() ? std::nullopt : std::optional<int>(static_cast<int>(v)); },
+                tr("Change alf's iterations"));
+  }
 }
 
 // ---------------------------------------------------------------------------

@@ -106,6 +106,10 @@ class SimulateView : public QWidget {
   QComboBox* integratorCombo() const { return integrator_; }
   QLineEdit* rtolEdit() const { return rtol_; }
   QLineEdit* atolEdit() const { return atol_; }
+  QLineEdit* maxStepEdit() const { return max_step_; }
+  QCheckBox* alfFixedCheck() const { return alf_fixed_; }
+  QLineEdit* alfPenaltyEdit() const { return alf_penalty_; }
+  QLineEdit* alfIterationsEdit() const { return alf_iterations_; }
   QCheckBox* compareLinearCheck() const { return compare_linear_; }
   SignalTable* referencesTable() const { return references_; }      // one row per Plant/Out followed
   SignalTable* disturbancesTable() const { return disturbances_; }  // actuators that are not Plant/In
@@ -138,6 +142,7 @@ class SimulateView : public QWidget {
   void browseControllerFile();
   void weightsEdited(bool q);
   void toleranceEdited(bool relative);
+  void solverNumberEdited(QLineEdit* e);  // max_step_, alf_penalty_ or alf_iterations_
   void onSamples(const SampleBatch& batch);
   void onProgress(double t, double tEnd);
   void onFinished(std::shared_ptr<const codyna::SimulationResult> r);
@@ -178,6 +183,10 @@ class SimulateView : public QWidget {
   QComboBox* integrator_ = nullptr;
   QLineEdit* rtol_ = nullptr;
   QLineEdit* atol_ = nullptr;
+  QLineEdit* max_step_ = nullptr;
+  QCheckBox* alf_fixed_ = nullptr;
+  QLineEdit* alf_penalty_ = nullptr;
+  QLineEdit* alf_iterations_ = nullptr;
   QCheckBox* compare_linear_ = nullptr;
   QCheckBox* closed_loop_ = nullptr;
   QCheckBox* lqr_controllable_ = nullptr;

@@ -1177,27 +1177,7 @@ class Compiler {
     m_.plant_outputs = resolve(spec_.plant.outputs, "outputs", false);
   }
 
-  void check_solver() {
-    const SolverSpec& s = spec_.solver;
-    if (!is_integrator_name(s.integrator))
-      fail("/solver/integrator", "unknown integrator " + quote(s.integrator) + " (expected one of: " + integrator_names() + ")");
-    auto positive = [&](double x, const char* f) {
-      if (!std::isfinite(x) || x <= 0) fail(std::string("/solver/") + f, "expected a positive number, got " + compile_number(x));
-    };
-    positive(s.rtol, "rtol");
-    positive(s.atol, "atol");
-    positive(s.t_end, "t_end");
-    positive(s.output_step, "output_step");
-    if (!std::isfinite(s.max_step) || s.max_step < 0) fail("/solver/max_step", "expected a non-negative number (0 = no limit)");
-    if (s.alf_penalty && !(*s.alf_penalty > 0 && std::isfinite(*s.alf_penalty)))
-      fail("/solver/alf_penalty", "expected a penalty > 0 (alf's default 1e11), got " + compile_number(*s.alf_penalty));
-    if (s.alf_iterations && *s.alf_iterations < 1)
-      fail("/solver/alf_iterations",
-           "expected a number of Newton iterations >= 1 (alf's default 100), got " + std::to_string(*s.alf_iterations));
-    if (s.integrator == "alf" && s.max_step > s.t_end)
-      fail("/solver/max_step", "alf: a step of " + compile_number(s.max_step) + " s is longer than the run (t_end " +
-                                   compile_number(s.t_end) + " s)");
-  }
+  void check_solver() { check_solver_spec(spec_.solver, file_); }
 
   void initial_state() {
     Eigen::VectorXd q = neutral(m_), v = Eigen::VectorXd::Zero(m_.nv);
@@ -1248,6 +1228,27 @@ std::string unattached_body_detail(const std::string& body) {
   return "body \"" + body + "\" is not the child of any joint (attach it, e.g. with a \"fixed\" joint)";
 }
 
+void check_solver_spec(const SolverSpec& s, const std::string& file) {
+  const auto fail = [&](const std::string& path, const std::string& what) { throw ModelError(file, path, what); };
+  if (!is_integrator_name(s.integrator))
+    fail("/solver/integrator", "unknown integrator " + quote(s.integrator) + " (expected one of: " + integrator_names() + ")");
+  auto positive = [&](double x, const char* f) {
+    if (!std::isfinite(x) || x <= 0) fail(std::string("/solver/") + f, "expected a positive number, got " + compile_number(x));
+  };
+  positive(s.rtol, "rtol");
+  positive(s.atol, "atol");
+  positive(s.t_end, "t_end");
+  positive(s.output_step, "output_step");
+  if (!std::isfinite(s.max_step) || s.max_step < 0) fail("/solver/max_step", "expected a non-negative number (0 = no limit)");
+  if (s.alf_penalty && !(*s.alf_penalty > 0 && std::isfinite(*s.alf_penalty)))
+    fail("/solver/alf_penalty", "expected a penalty > 0 (alf's default 1e11), got " + compile_number(*s.alf_penalty));
+  if (s.alf_iterations && *s.alf_iterations < 1)
+    fail("/solver/alf_iterations",
+         "expected a number of Newton iterations >= 1 (alf's default 100), got " + std::to_string(*s.alf_iterations));
+  if (s.integrator == "alf" && s.max_step > s.t_end)
+    fail("/solver/max_step", "alf: a step of " + compile_number(s.max_step) + " s is longer than the run (t_end " +
+                                 compile_number(s.t_end) + " s)");
+}
 Model compile_structure(const ModelSpec& spec, const std::string& file) { return Compiler(spec, file).run(); }
 
 Model compile_numbers(const Model& structure, const ModelSpec& spec, NumbersChanged what, const std::string& file) {

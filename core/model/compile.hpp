@@ -17,6 +17,11 @@ namespace codyna {
 
 Model compile_structure(const ModelSpec& spec, const std::string& file = "");
 
+// The solver section's own checks (compile_structure makes them): the integrator's name, positive
+// tolerances, times and steps, alf's penalty and iterations, alf's step no longer than the run;
+// ModelError naming the field (/solver/...) otherwise. The GUI checks an edit of it with this.
+void check_solver_spec(const SolverSpec& solver, const std::string& file = "");
+
 // What compile_structure says of a body no joint moves (study/model_issues.hpp lists every one).
 std::string unattached_body_detail(const std::string& body);
 

@@ -47,6 +47,7 @@
 #include "gui/simulate_view.hpp"
 #include "gui/study_widgets.hpp"
 #include "io/model_file.hpp"
+#include "study/files.hpp"
 #include "study/jobs.hpp"
 #include "study/tools.hpp"
 #include "study/workflow.hpp"
@@ -1109,6 +1110,92 @@ class ViewsTest : public QObject {
     // the model file's controller is described (an LQR here)
     QVERIFY(view.controllerDescription()->text().contains("LQR"));
     QVERIFY(!view.pidTable()->isVisibleTo(&view));
+  }
+
+  // alf's settings and the maximum step, typed as a person does (select, type, Return): each lands
+  // in the model's solver section and in the run; a value that is not of the field's kind, and one
+  // the model file's checks refuse (alf with a step longer than the run), is said and not taken
+  void alfSettingsAndTheMaximumStepAreTypedIntoTheRun() {
+    Document doc;
+    QVERIFY(doc.load(kFourBar));
+    SimulateView view(&doc);
+    view.show();
+    QSignalSpy messages(&view, &SimulateView::message);
+    const auto type = [](QLineEdit* e, const QString& text) {
+      e->setFocus();
+      e->selectAll();
+      if (text.isEmpty()) QTest::keyClick(e, Qt::Key_Backspace);
+      else QTest::keyClicks(e, text);
+      QTest::keyClick(e, Qt::Key_Return);
+    };
+    const auto said = [&](const QString& what) {
+      return messages.count() > 0 && messages.last().at(0).toString().contains(what);
+    };
+    // alf's own fields wait for alf
+    QVERIFY(!view.alfPenaltyEdit()->isEnabled() && !view.alfIterationsEdit()->isEnabled() && !view.alfFixedCheck()->isEnabled());
+    QCOMPARE(view.maxStepEdit()->text(), QString());  // no limit
+    view.integratorCombo()->setCurrentIndex(view.integratorCombo()->findData("alf"));
+    QCOMPARE(doc.spec().solver.integrator, std::string("alf"));
+    QVERIFY(view.alfPenaltyEdit()->isEnabled() && view.alfIterationsEdit()->isEnabled() && view.alfFixedCheck()->isEnabled());
+
+    type(view.maxStepEdit(), "0.002");
+    QCOMPARE(doc.spec().solver.max_step, 0.002);
+    QTest::mouseClick(view.alfFixedCheck(), Qt::LeftButton, {}, QPoint(6, view.alfFixedCheck()->height() / 2));
+    QVERIFY(doc.spec().solver.alf_fixed_step);
+    type(view.alfPenaltyEdit(), "lots");
+    QVERIFY(said("alf penalty: expected a number > 0"));
+    QVERIFY(!doc.spec().solver.alf_penalty);
+    QCOMPARE(view.alfPenaltyEdit()->text(), QString());
+    type(view.alfPenaltyEdit(), "-5");
+    QVERIFY(said("alf penalty"));
+    QVERIFY(!doc.spec().solver.alf_penalty);
+    type(view.alfPenaltyEdit(), "1e9");
+    QCOMPARE(doc.spec().solver.alf_penalty.value_or(0), 1e9);
+    type(view.alfIterationsEdit(), "2.5");
+    QVERIFY(said("alf iterations: expected a whole number >= 1"));
+    QVERIFY(!doc.spec().solver.alf_iterations);
+    type(view.alfIterationsEdit(), "30");
+    QCOMPARE(doc.spec().solver.alf_iterations.value_or(0), 30);
+    // the model file's rule: alf's step no longer than the run (the field, the end time)
+    const int before = static_cast<int>(messages.count());
+    type(view.maxStepEdit(), "100");
+    QCOMPARE(static_cast<int>(messages.count()), before + 1);
+    QVERIFY(said("/solver/max_step") && said("longer than the run"));
+    QCOMPARE(doc.spec().solver.max_step, 0.002);
+    QCOMPARE(view.maxStepEdit()->text(), QString("0.002"));
+    type(view.maxStepEdit(), "-1");
+    QVERIFY(said("Maximum step: expected a number of seconds >= 0"));
+    QCOMPARE(doc.spec().solver.max_step, 0.002);
+
+    // the run takes them: 0.5 s at fixed steps of 2 ms is 250 steps
+    view.endTimeSpin()->setValue(0.5);
+    QSignalSpy finished(&view, &SimulateView::runFinished);
+    view.run();
+    QVERIFY(waitFor([&] { return finished.count() == 1; }));
+    QVERIFY(view.result() && view.result()->completed);
+    QCOMPARE(view.result()->stats.integrator, std::string("alf"));
+    QCOMPARE(view.result()->stats.steps, 250L);
+    QVERIFY(view.result()->constraint_violation.back() < 1e-9);
+
+    // emptied: alf's default again; undone: the typed value back in the field
+    type(view.alfPenaltyEdit(), "");
+    QVERIFY(!doc.spec().solver.alf_penalty);
+    doc.undoStack()->undo();
+    QCOMPARE(doc.spec().solver.alf_penalty.value_or(0), 1e9);
+    QCOMPARE(view.alfPenaltyEdit()->text(), QString("1000000000"));
+    // saved and read back: the file holds what was typed
+    const QString path = tmp.filePath("four_bar_alf.json");
+    QString err;
+    QVERIFY2(doc.saveAs(path, &err), qPrintable(err));
+    const ModelSpec back = study_read_model(path.toStdString());
+    QCOMPARE(back.solver.max_step, 0.002);
+    QVERIFY(back.solver.alf_fixed_step);
+    QCOMPARE(back.solver.alf_penalty.value_or(0), 1e9);
+    QCOMPARE(back.solver.alf_iterations.value_or(0), 30);
+    // another integrator: alf's fields kept in the file, not editable
+    view.integratorCombo()->setCurrentIndex(view.integratorCombo()->findData("arkode"));
+    QVERIFY(!view.alfPenaltyEdit()->isEnabled());
+    QCOMPARE(view.alfIterationsEdit()->text(), QString("30"));
   }
 
   void pidGainsAreEditableInTheTable() {
