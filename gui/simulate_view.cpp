@@ -306,12 +306,18 @@ void SimulateView::buildUi() {
   atol_->setToolTip(tr("Absolute tolerance of the integrator, in the states' units (e.g. 1e-10)"));
   form->addRow(tr("Relative tolerance"), rtol_);
   form->addRow(tr("Absolute tolerance"), atol_);
-  max_step_ = new QLineEdit(solver_box);
-  max_step_->setObjectName("maxStep");
-  max_step_->setPlaceholderText(tr("no limit"));
-  max_step_->setToolTip(tr("The longest step the integrator may take, in s (empty: no limit); the step of rk4 "
-                           "and of alf at fixed steps (the file's solver.max_step, codyna simulate --max-step)"));
-  form->addRow(tr("Maximum step"), max_step_);
+  // a number field of the solver section: its object name, what empty means, its tooltip
+  const auto numberField = [&](const char* name, const QString& label, const QString& empty, const QString& tip) {
+    auto* e = new QLineEdit(solver_box);
+    e->setObjectName(QLatin1String(name));
+    e->setPlaceholderText(empty);
+    e->setToolTip(tip);
+    form->addRow(label, e);
+    return e;
+  };
+  max_step_ = numberField("maxStep", tr("Maximum step"), tr("no limit"),
+                          tr("The longest step the integrator may take, in s (empty: no limit); the step of rk4 and of "
+                             "alf at fixed steps (the file's solver.max_step, codyna simulate --max-step)"));
   // alf's own settings: editable when alf is the integrator (the file keeps them either way)
   alf_fixed_ = new QCheckBox(tr("alf at fixed steps of the maximum step"), solver_box);
   alf_fixed_->setObjectName("alfFixedStep");
@@ -319,18 +325,12 @@ void SimulateView::buildUi() {
                             "by its error estimate; give it tight tolerances, which set Newton's (solver.alf_fixed_step, "
                             "--alf-fixed-step)"));
   form->addRow(alf_fixed_);
-  alf_penalty_ = new QLineEdit(solver_box);
-  alf_penalty_->setObjectName("alfPenalty");
-  alf_penalty_->setPlaceholderText(tr("1e11 (alf's default)"));
-  alf_penalty_->setToolTip(tr("alf's penalty alpha on the loop closures, a number > 0 (empty: the default 1e11; "
-                              "solver.alf_penalty, --alf-penalty)"));
-  form->addRow(tr("alf penalty"), alf_penalty_);
-  alf_iterations_ = new QLineEdit(solver_box);
-  alf_iterations_->setObjectName("alfIterations");
-  alf_iterations_->setPlaceholderText(tr("100 (alf's default)"));
-  alf_iterations_->setToolTip(tr("alf's most Newton iterations a step, a whole number >= 1 (empty: the default 100; "
-                                 "solver.alf_iterations, --alf-iterations)"));
-  form->addRow(tr("alf iterations"), alf_iterations_);
+  alf_penalty_ = numberField("alfPenalty", tr("alf penalty"), tr("1e11 (alf's default)"),
+                             tr("alf's penalty alpha on the loop closures, a number > 0 (empty: the default 1e11; "
+                                "solver.alf_penalty, --alf-penalty)"));
+  alf_iterations_ = numberField("alfIterations", tr("alf iterations"), tr("100 (alf's default)"),
+                                tr("alf's most Newton iterations a step, a whole number >= 1 (empty: the default 100; "
+                                   "solver.alf_iterations, --alf-iterations)"));
   compare_linear_ = new QCheckBox(tr("Compare with the linear closed loop"), solver_box);
   compare_linear_->setToolTip(tr("Also run the linear plant with the same controller from the same start; its outputs "
                                  "are drawn dashed (codyna simulate --compare-linear)"));
