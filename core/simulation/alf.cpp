@@ -506,19 +506,22 @@ class Alf final : public Integrator {
                      dq.cwiseAbs().maxCoeff(), m_.nc ? d_.phi.cwiseAbs().maxCoeff() : 0.0,  // (phi before the correction)
                      since_factor == 1 ? (refreshed ? " (new tangent)" : " (new factorization)") : "");
       // (at fixed steps, the first correction after a factorization: the contraction rate of the
-      // last step that measured one, raised to the power 0.8 for every step that used it instead
+      // last step that measured one, when it had this step's length, raised to the power 0.8 for every step that used it instead
       // (it drifts towards 1, so that a second iteration measures it again now and then: RADAU5's
       // rule), where it was below kTrustTheta. Not with error control: there the Newton error it
       // leaves reaches the error estimate, h/12 |a_n+1 - a_n|, and Bricard's error at rtol 3e-5
       // grew tenfold, 2.6e-5 -> 1.4e-4 rad)
       const double rate = theta > 0 ? theta
-                          : fixed_ && since_factor == 1 && theta_step_ > 0 && theta_step_ < kTrustTheta ? theta_step_
-                                                                                                          : 0;
+                          : fixed_ && since_factor == 1 && theta_step_ > 0 && theta_step_ < kTrustTheta &&
+                                    std::abs(h - h_theta_) <= 1e-9 * h
+                              ? theta_step_
+                              : 0;
       const double left = rate > 0 && rate < 1 ? last * rate / (1 - rate) : last;
       if (left <= 1 && (theta < 1 || last <= 1)) {
         converged = true;
         if (theta > 0) theta_step_ = theta;
         else if (rate > 0) theta_step_ = std::pow(rate, 0.8);
+        h_theta_ = h;
         break;
       }
       // a stall (the multipliers' iteration creeping near a singular position): accepted within a
@@ -804,6 +807,7 @@ class Alf final : public Integrator {
   Eigen::VectorXd jerk_rate_;  // (a_n - a_n-1) / h_n-1 of the last accepted step (jerk_: valid)
   bool jerk_ = false;
   double theta_step_ = 0;  // Newton's contraction rate in the last step that measured it (0: none)
+  double h_theta_ = 0;     // that step's length (the rate stands for another step's of this length only)
   // a fixed step's substeps' starts (one, or more where Newton made it halve the step), for show()
   struct Knot {
     double t = 0;
