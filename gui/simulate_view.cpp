@@ -322,7 +322,7 @@ void SimulateView::buildUi() {
   alf_fixed_ = new QCheckBox(tr("alf at fixed steps of the maximum step"), solver_box);
   alf_fixed_->setObjectName("alfFixedStep");
   alf_fixed_->setToolTip(tr("alf steps at the maximum step (1 ms when none is given) instead of choosing its steps "
-                            "by its error estimate; give it tight tolerances, which set Newton's (solver.alf_fixed_step, "
+                            "by its error estimate; Newton then works to rtol, atol of at most 1e-6 (solver.alf_fixed_step, "
                             "--alf-fixed-step)"));
   form->addRow(alf_fixed_);
   alf_penalty_ = numberField("alfPenalty", tr("alf penalty"), tr("1e11 (alf's default)"),

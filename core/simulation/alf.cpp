@@ -51,7 +51,7 @@
 // The penalty: at fixed steps alf_penalty; with error control alf_penalty for steps of 10 ms and
 // longer, alf_penalty (10 ms / h)^2 for shorter ones (the weight h^2/4 alpha of Jc^T Jc against M held; with alpha itself the multipliers'
 // iteration stalls at short steps, each iteration shrinking the error only by 1/(1 + h^2/4 alpha s^2 / m)). IntegratorSettings::alf_fixed_step:
-// every step max_step (default 1 ms), no error control.
+// every step max_step (default 1 ms), no error control, Newton at rtol, atol of at most 1e-6.
 // Additive coordinates only (no ball or free joint), no effect states and no continuous controller
 // states: refused by name otherwise. The penalty and the iterations are alf_penalty and
 // alf_iterations.
@@ -464,9 +464,14 @@ class Alf final : public Integrator {
     // Newton's test (per coordinate, in the weights w): the error left in q, estimated from the
     // corrections' rate of contraction theta as theta / (1 - theta) |dq| (the first correction
     // taken at face value), within kNewton of the error weight atol + rtol |q_i|, but no tighter
-    // than kNewtonFloor (1 + |q_i|)
+    // than kNewtonFloor (1 + |q_i|). At fixed steps rtol and atol no looser than kFixedNewton, for
+    // this test and for a stall's: the step alone sets the error there (with Newton and stalls at
+    // rtol = atol = 3.2e-3, A02 at 5.6 ms ended 7.3e-3 rad off, at 1e-6 3.5e-4; at 10 ms the loose
+    // Newton's error happened to help, 8.9e-4 against the rule's own 1.1e-3). The price: steps of
+    // 0.56 ms and shorter no longer pass A02's flat positions (loose stalls let 0.56 ms through)
+    const double rt = fixed_ ? std::min(rtol_, kFixedNewton) : rtol_, at = fixed_ ? std::min(atol_, kFixedNewton) : atol_;
     const Eigen::ArrayXd floor = kNewtonFloor * (1 + q_.array().abs());
-    const Eigen::ArrayXd wq = atol_ + rtol_ * q_.array().abs(), wv = (h / 2) * (atol_ + rtol_ * v_.array().abs());
+    const Eigen::ArrayXd wq = at + rt * q_.array().abs(), wv = (h / 2) * (at + rt * v_.array().abs());
     // (with error control the weights in q alone: the error test judges the step's accelerations,
     // and the weights in v made A05 take two iterations a step instead of one, 2.5 times the CPU)
     const Eigen::ArrayXd wqv = wq.min(wv), wn = fixed_ ? wqv : wq;
@@ -790,6 +795,8 @@ class Alf final : public Integrator {
   static constexpr double kNewton = 1e-3, kNewtonFloor = 1e-14, kLeftLimit = 1e-9;
   // the last step's contraction rate stands for the first correction's below this
   static constexpr double kTrustTheta = 0.01;
+  // at fixed steps Newton's rtol and atol are at most this (the step, not Newton, sets the error)
+  static constexpr double kFixedNewton = 1e-6;
   // the modified Newton: the tangent is kept over steps while Newton's corrections shrink by
   // kRate at least per iteration, for kTangentAge steps at most; the matrix is factored each step
   static constexpr double kRate = 0.5;
