@@ -141,6 +141,12 @@ bool Document::setStudyChecked(const StudySpec& study, const QString& text, QStr
 }
 
 bool Document::setSolver(const SolverSpec& solver, const QString& text, int mergeKey, QString* error) {
+  {  // the same section: no edit, and no checks (a file whose section the checks refuse is not
+     // refused again each time a field loses focus)
+    ModelSpec next = spec_;
+    next.solver = solver;
+    if (same(next, spec_)) return true;
+  }
   return edit(
       text,
       [&](ModelSpec& s) {

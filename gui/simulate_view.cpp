@@ -472,14 +472,27 @@ void SimulateView::buildUi() {
     const std::string m = ss(integrator_->itemData(i).toString());
     writeSolver([&](SolverSpec& s) { s.integrator = m; }, tr("Change the integrator"));
   });
-  connect(max_step_, &QLineEdit::editingFinished, this, [this] { solverNumberEdited(max_step_); });
-  connect(alf_penalty_, &QLineEdit::editingFinished, this, [this] { solverNumberEdited(alf_penalty_); });
-  connect(alf_iterations_, &QLineEdit::editingFinished, this, [this] { solverNumberEdited(alf_iterations_); });
+  // the solver's number fields: what each takes, what empty means, where it goes (one parser, one
+  // refusal message naming the field, the value and what was expected)
+  using Opt = std::optional<double>;
+  solver_numbers_ = {
+      {rtol_, tr("Relative tolerance"), tr("a number > 0"), NumberRule::Positive, false,
+       [](SolverSpec& s, Opt v) { s.rtol = *v; }, tr("Change the relative tolerance")},
+      {atol_, tr("Absolute tolerance"), tr("a number > 0"), NumberRule::Positive, false,
+       [](SolverSpec& s, Opt v) { s.atol = *v; }, tr("Change the absolute tolerance")},
+      {max_step_, tr("Maximum step"), tr("a number of seconds >= 0 (empty: no limit)"), NumberRule::NonNegative, true,
+       [](SolverSpec& s, Opt v) { s.max_step = v.value_or(0.0); }, tr("Change the maximum step")},
+      {alf_penalty_, tr("alf penalty"), tr("a number > 0 (empty: 1e11)"), NumberRule::Positive, true,
+       [](SolverSpec& s, Opt v) { s.alf_penalty = v; }, tr("Change alf's penalty")},
+      {alf_iterations_, tr("alf iterations"), tr("a whole number >= 1 (empty: 100)"), NumberRule::Count, true,
+       [](SolverSpec& s, Opt v) { s.alf_iterations = v ? std::optional<int>(static_cast<int>(*v)) : std::nullopt; },
+       tr("Change alf's iterations")},
+  };
+  for (std::size_t i = 0; i < solver_numbers_.size(); ++i)
+    connect(solver_numbers_[i].edit, &QLineEdit::editingFinished, this, [this, i] { solverNumberEdited(solver_numbers_[i]); });
   connect(alf_fixed_, &QCheckBox::toggled, this, [this](bool on) {
     writeSolver([&](SolverSpec& s) { s.alf_fixed_step = on; }, on ? tr("alf at fixed steps") : tr("alf with error control"));
   });
-  connect(rtol_, &QLineEdit::editingFinished, this, [this] { toleranceEdited(true); });
-  connect(atol_, &QLineEdit::editingFinished, this, [this] { toleranceEdited(false); });
   connect(compare_linear_, &QCheckBox::toggled, this, [this](bool on) {
     writeStudy([&](StudySpec& s) { s.compare_linear = on; }, on ? tr("Compare with the linear loop") : tr("Do not compare with the linear loop"));
   });
@@ -586,12 +599,7 @@ void SimulateView::writeSolver(const std::function<void(SolverSpec&)>& change, c
   if (syncing_) return;
   SolverSpec s = doc_->spec().solver;
   change(s);
-  const SolverSpec& o = doc_->spec().solver;
-  if (s.integrator == o.integrator && s.rtol == o.rtol && s.atol == o.atol && s.t_end == o.t_end &&
-      s.output_step == o.output_step && s.max_step == o.max_step && s.alf_penalty == o.alf_penalty &&
-      s.alf_iterations == o.alf_iterations && s.alf_fixed_step == o.alf_fixed_step)
-    return;
-  QString why;
+  QString why;  // (an edit that changes nothing is no edit: Document::setSolver checks nothing then)
   if (!doc_->setSolver(s, text, mergeKey, &why)) {  // refused: said, and the model's value shown again
     emit message(why);
     refreshFromDocument();
@@ -765,48 +773,27 @@ void SimulateView::weightsEdited(bool q) {
       q ? tr("Change the LQR state weights") : tr("Change the LQR input weights"));
 }
 
-void SimulateView::toleranceEdited(bool relative) {
-  QLineEdit* e = relative ? rtol_ : atol_;
-  bool ok = false;
-  const double v = e->text().trimmed().toDouble(&ok);
-  if (!ok || !(v > 0) || !std::isfinite(v)) {
-    emit message(tr("%1 tolerance: expected a positive number").arg(relative ? tr("Relative") : tr("Absolute")));
-    refreshFromDocument();
-    return;
+// a number field of the solver section: a value that is not a number of the field's kind is
+// refused here, one the model file's checks refuse (a step longer than the run with alf) by
+// writeSolver; both say why, once, and the field shows the model's value again
+void SimulateView::solverNumberEdited(const NumberRule& r) {
+  const QString text = r.edit->text().trimmed();
+  std::optional<double> value;
+  if (!text.isEmpty() || !r.empty_allowed) {
+    bool ok = false;
+    const double v = text.toDouble(&ok);
+    const bool fits = ok && std::isfinite(v) &&
+                      (r.kind == NumberRule::Positive      ? v > 0
+                       : r.kind == NumberRule::NonNegative ? v >= 0
+                                                           : v >= 1 && v <= 1e9 && v == std::floor(v));
+    if (!fits) {
+      emit message(tr("%1: expected %2, got \"%3\"").arg(r.label, r.expected, text));
+      refreshFromDocument();
+      return;
+    }
+    value = v;
   }
-  writeSolver([&](SolverSpec& s) { (relative ? s.rtol : s.atol) = v; },
-              relative ? tr("Change the relative tolerance") : tr("Change the absolute tolerance"));
-}
-
-// the maximum step (empty: no limit), alf's penalty and iterations (empty: alf's defaults):
-// a value that is not a number of the field's kind is refused here, one the core refuses (a step
-// longer than the run with alf) by writeSolver; both say why, and the field shows the model's value
-void SimulateView::solverNumberEdited(QLineEdit* e) {
-  const QString text = e->text().trimmed();
-  bool ok = true;
-  const double v = text.isEmpty() ? 0.0 : text.toDouble(&ok);
-  const auto refuse = [&](const QString& why) {
-    emit message(why);
-    refreshFromDocument();
-  };
-  if (!ok || !std::isfinite(v)) {
-    if (e == max_step_) return refuse(tr("Maximum step: expected a number of seconds >= 0 (empty: no limit), got \"%1\"").arg(text));
-    if (e == alf_penalty_) return refuse(tr("alf penalty: expected a number > 0 (empty: 1e11), got \"%1\"").arg(text));
-    return refuse(tr("alf iterations: expected a whole number >= 1 (empty: 100), got \"%1\"").arg(text));
-  }
-  if (e == max_step_) {
-    if (v < 0) return refuse(tr("Maximum step: expected a number of seconds >= 0 (empty: no limit), got %1").arg(text));
-    writeSolver([&](SolverSpec& s) { s.max_step = v; }, tr("Change the maximum step"));
-  } else if (e == alf_penalty_) {
-    if (!text.isEmpty() && !(v > 0)) return refuse(tr("alf penalty: expected a number > 0 (empty: 1e11), got %1").arg(text));
-    writeSolver([&](SolverSpec& s) { s.alf_penalty = text.isEmpty() ? std::nullopt : std::optional<double>(v); },
-                tr("Change alf's penalty"));
-  } else {
-    if (!text.isEmpty() && (!(v >= 1) || v != std::floor(v) || v > 1e9))
-      return refuse(tr("alf iterations: expected a whole number >= 1 (empty: 100), got %1").arg(text));
-    writeSolver([&](SolverSpec& s) { s.alf_iterations = text.isEmpty() ? std::nullopt : std::optional<int>(static_cast<int>(v)); },
-                tr("Change alf's iterations"));
-  }
+  writeSolver([&](SolverSpec& s) { r.write(s, value); }, r.undo_text);
 }
 
 // ---------------------------------------------------------------------------

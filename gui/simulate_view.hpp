@@ -31,6 +31,7 @@
 #include <QWidget>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "model/model.hpp"
@@ -141,8 +142,18 @@ class SimulateView : public QWidget {
   void pidEdited(int row, int column);
   void browseControllerFile();
   void weightsEdited(bool q);
-  void toleranceEdited(bool relative);
-  void solverNumberEdited(QLineEdit* e);  // max_step_, alf_penalty_ or alf_iterations_
+  // a number field of the solver section (rtol, atol, the maximum step, alf's penalty and
+  // iterations): its kind, whether empty is allowed (write gets nullopt), where it goes
+  struct NumberRule {
+    enum Kind { Positive, NonNegative, Count };
+    QLineEdit* edit;
+    QString label, expected;
+    Kind kind;
+    bool empty_allowed;
+    std::function<void(codyna::SolverSpec&, std::optional<double>)> write;
+    QString undo_text;
+  };
+  void solverNumberEdited(const NumberRule& r);
   void onSamples(const SampleBatch& batch);
   void onProgress(double t, double tEnd);
   void onFinished(std::shared_ptr<const codyna::SimulationResult> r);
@@ -181,6 +192,7 @@ class SimulateView : public QWidget {
   QDoubleSpinBox* t_end_ = nullptr;
   QDoubleSpinBox* output_step_ = nullptr;
   QComboBox* integrator_ = nullptr;
+  std::vector<NumberRule> solver_numbers_;
   QLineEdit* rtol_ = nullptr;
   QLineEdit* atol_ = nullptr;
   QLineEdit* max_step_ = nullptr;

@@ -1134,7 +1134,7 @@ class ViewsTest : public QObject {
     // alf's own fields wait for alf
     QVERIFY(!view.alfPenaltyEdit()->isEnabled() && !view.alfIterationsEdit()->isEnabled() && !view.alfFixedCheck()->isEnabled());
     QCOMPARE(view.maxStepEdit()->text(), QString());  // no limit
-    view.integratorCombo()->setCurrentIndex(view.integratorCombo()->findData("alf"));
+    QVERIFY(drive::pickWithKeys(view.integratorCombo(), "alf"));  // the list opened, arrow keys, Enter
     QCOMPARE(doc.spec().solver.integrator, std::string("alf"));
     QVERIFY(view.alfPenaltyEdit()->isEnabled() && view.alfIterationsEdit()->isEnabled() && view.alfFixedCheck()->isEnabled());
 
@@ -1163,9 +1163,21 @@ class ViewsTest : public QObject {
     QVERIFY(said("/solver/max_step") && said("longer than the run"));
     QCOMPARE(doc.spec().solver.max_step, 0.002);
     QCOMPARE(view.maxStepEdit()->text(), QString("0.002"));
+    const int refusals = static_cast<int>(messages.count());
     type(view.maxStepEdit(), "-1");
-    QVERIFY(said("Maximum step: expected a number of seconds >= 0"));
+    QCOMPARE(static_cast<int>(messages.count()), refusals + 1);  // said once
+    QVERIFY(said("Maximum step: expected a number of seconds >= 0 (empty: no limit), got \"-1\""));
     QCOMPARE(doc.spec().solver.max_step, 0.002);
+    // the tolerances take the same rule: a value that is not > 0 is refused with the field named
+    type(view.rtolEdit(), "0");
+    QVERIFY(said("Relative tolerance: expected a number > 0, got \"0\""));
+    QCOMPARE(view.rtolEdit()->text().toDouble(), doc.spec().solver.rtol);
+    // leaving a field as it is: no edit, nothing said
+    const int undo = doc.undoStack()->index(), said_before = static_cast<int>(messages.count());
+    type(view.alfIterationsEdit(), "30");
+    type(view.maxStepEdit(), "0.002");
+    QCOMPARE(doc.undoStack()->index(), undo);
+    QCOMPARE(static_cast<int>(messages.count()), said_before);
 
     // the run takes them: 0.5 s at fixed steps of 2 ms is 250 steps
     view.endTimeSpin()->setValue(0.5);
@@ -1193,9 +1205,21 @@ class ViewsTest : public QObject {
     QCOMPARE(back.solver.alf_penalty.value_or(0), 1e9);
     QCOMPARE(back.solver.alf_iterations.value_or(0), 30);
     // another integrator: alf's fields kept in the file, not editable
-    view.integratorCombo()->setCurrentIndex(view.integratorCombo()->findData("arkode"));
+    QVERIFY(drive::pickWithMouse(view.integratorCombo(), "arkode"));
+    QCOMPARE(doc.spec().solver.integrator, std::string("arkode"));
     QVERIFY(!view.alfPenaltyEdit()->isEnabled());
     QCOMPARE(view.alfIterationsEdit()->text(), QString("30"));
+
+    // a file whose integrator codyna does not know: leaving a field unchanged says nothing (it used
+    // to be refused each time a field lost focus); a change is refused, naming the integrator
+    QVERIFY(doc.edit("an unknown integrator", [](ModelSpec& s) { s.solver.integrator = "euler"; }));
+    const int quiet = static_cast<int>(messages.count());
+    type(view.rtolEdit(), view.rtolEdit()->text());
+    type(view.maxStepEdit(), view.maxStepEdit()->text());
+    QCOMPARE(static_cast<int>(messages.count()), quiet);
+    type(view.rtolEdit(), "1e-5");
+    QVERIFY(said("/solver/integrator"));
+    QCOMPARE(doc.spec().solver.integrator, std::string("euler"));
   }
 
   void pidGainsAreEditableInTheTable() {
