@@ -28,13 +28,18 @@ void crba_world_terms(const Model& model, DataT<S>& d) {
     const SE3T<S>& X = d.oMi[i];
     const Vec3T<S> r = X.p - d.oMi[k.root[i]].p;  // body origin from the tree origin
     k.com_inertia[i].template to_frame<S>(X.R, r, d.Iw[i]);
+    const bool angular = k.joints[i].sb_angular_only;  // (X.R 0 + r x w is r x w, bit for bit)
     for (int c = 0; c < j.nv; ++c) {
       Vec6T<S>& sw = d.Sw[j.idx_v + c];
       const auto sb = d.Sb[i].col(c);
       const Vec3T<S> w = X.R * sb.template head<3>();
       sw.template head<3>() = w;
-      sw.template tail<3>().noalias() = X.R * sb.template tail<3>();
-      sw.template tail<3>() += r.cross(w);
+      if (angular) {
+        sw.template tail<3>() = r.cross(w);
+      } else {
+        sw.template tail<3>().noalias() = X.R * sb.template tail<3>();
+        sw.template tail<3>() += r.cross(w);
+      }
     }
   }
 }

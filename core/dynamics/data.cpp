@@ -38,6 +38,12 @@ void ModelConstants::assign(const Model& model) {
     c.axis_P = j.X_PF.R * j.axis;
     c.R0 = j.X_PF.R * c.X_MC.R;
     c.p0 = j.X_PF.R * c.X_MC.p;
+    const Eigen::Matrix3d I3 = Eigen::Matrix3d::Identity();
+    c.r0_identity = c.R0 == I3;
+    c.p0_zero = c.p0 == Eigen::Vector3d::Zero();
+    c.pf_rotation_identity = j.X_PF.R == I3;
+    c.mc_identity = c.X_MC.R == I3 && c.X_MC.p == Eigen::Vector3d::Zero();
+    c.sb_angular_only = c.constant_S && c.Sb.cols() > 0 && c.Sb.bottomRows(3).isZero(0.0);
     const int p = j.parent;
     root[i] = p == 0 ? i : root[p];
     int up = last_dof[p];

@@ -23,6 +23,10 @@ struct ModelConstants {
     // revolute: liMi = (Rot(axis_P, q) R0, Rot(axis_P, q) p0 + X_PF.p)
     Eigen::Vector3d axis_P = Eigen::Vector3d::UnitZ(), p0 = Eigen::Vector3d::Zero();
     Eigen::Matrix3d R0 = Eigen::Matrix3d::Identity();
+    // exact identities the kinematics skip (a product with them is the other factor, bit for bit):
+    // R0 = 1 and p0 = 0 (revolute), X_PF's rotation 1, X_MC = 1 (ball and free joints), Sb's
+    // linear rows zero (its axes through the body's origin)
+    bool r0_identity = true, p0_zero = true, pf_rotation_identity = true, mc_identity = true, sb_angular_only = false;
   };
   std::vector<Joint> joints;                     // [nbodies]
   std::vector<ComInertia> com_inertia;           // [nbodies] body inertia about its com, body axes (= Model::inertia)

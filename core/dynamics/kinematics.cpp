@@ -46,9 +46,41 @@ void fk(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>* v, c
       S sq, cq;
       sin_cos(q[j.idx_q], sq, cq);
       const Mat3T<S> Rq = axis_rotation<S>(k.axis_P, cq, sq);
-      liMi.R.noalias() = Rq * k.R0.template cast<S>();
-      liMi.p.noalias() = Rq * k.p0.template cast<S>();
-      liMi.p += k.X_PF.p.template cast<S>();
+      if (k.r0_identity) liMi.R = Rq;
+      else liMi.R.noalias() = Rq * k.R0.template cast<S>();
+      if (k.p0_zero) {
+        liMi.p = k.X_PF.p.template cast<S>();
+      } else {
+        liMi.p.noalias() = Rq * k.p0.template cast<S>();
+        liMi.p += k.X_PF.p.template cast<S>();
+      }
+    } else if (j.type == JointType::Spherical || j.type == JointType::Free) {
+      // X_PF (Rq, t) X_MC, t = 0 or the free joint's position, the products in joint_transform's
+      // order and without those by exact identities (the same numbers, bit for bit)
+      const int iq = j.idx_q + (j.type == JointType::Free ? 3 : 0);
+      const Mat3T<S> Rq = quat_to_matrix<S>(q[iq], q[iq + 1], q[iq + 2], q[iq + 3]);
+      const Vec3T<S> pf = k.X_PF.p.template cast<S>();
+      Mat3T<S> R;
+      Vec3T<S> p;
+      if (k.pf_rotation_identity) {
+        R = Rq;
+        if (j.type == JointType::Free) p = Vec3T<S>(q[j.idx_q], q[j.idx_q + 1], q[j.idx_q + 2]) + pf;
+        else p = pf;
+      } else {
+        const Mat3T<S> Rpf = k.X_PF.R.template cast<S>();
+        R.noalias() = Rpf * Rq;
+        if (j.type == JointType::Free) p.noalias() = Rpf * Vec3T<S>(q[j.idx_q], q[j.idx_q + 1], q[j.idx_q + 2]);
+        else p.setZero();
+        p += pf;
+      }
+      if (k.mc_identity) {
+        liMi.R = R;
+        liMi.p = p;
+      } else {
+        liMi.R.noalias() = R * k.X_MC.R.template cast<S>();
+        liMi.p.noalias() = R * k.X_MC.p.template cast<S>();
+        liMi.p += p;
+      }
     } else {
       joint_transform<S>(j, q, X_FM, S_M);
       liMi = k.X_PF.template cast<S>() * X_FM * k.X_MC.template cast<S>();

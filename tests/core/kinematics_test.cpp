@@ -73,5 +73,44 @@ TEST(Kinematics, PointAccelerationMatchesDifferenceOfVelocity) {
   EXPECT_TRUE(MatrixNear(acc, (vel(h) - vel(-h)) / (2 * h), 1e-8));
 }
 
+// forward kinematics' shortcuts (a hinge's R0 and p0, a ball or free joint's frames; the products
+// by exact identities skipped) give the placements of the generic composition X_PF X_FM(q) X_MC,
+// bit for bit, with rotated frames, with the parent frame's rotation the identity, with the child
+// frame the identity, and with both
+TEST(Kinematics, ShortcutPlacementsAreTheGenericCompositionBitForBit) {
+  for (int variant = 0; variant < 4; ++variant) {
+    ModelSpec s = test::random_tree_spec(77, 20);
+    for (JointSpec& j : s.joints) {
+      if (variant & 1) j.parent_frame.rotation.setIdentity();
+      if (variant & 2) j.child_frame = FrameSpec{};
+    }
+    const Model m = compile(s);
+    std::mt19937 rng(78 + variant);
+    Data d(m);
+    int shortcuts = 0;
+    for (int trial = 0; trial < 3; ++trial) {
+      const Eigen::VectorXd q = test::random_q(m, rng);
+      forward_kinematics<double>(m, d, q);
+      for (int i = 1; i < m.nbodies; ++i) {
+        const JointModel& j = m.joints[i];
+        SE3 X_FM;
+        Mat6xT<double> S_M;
+        joint_transform<double>(j, q, X_FM, S_M);
+        const SE3 X = j.X_PF * X_FM * j.X_CM.inverse();
+        const bool shortcut = j.type == JointType::Revolute || j.type == JointType::Spherical || j.type == JointType::Free;
+        shortcuts += shortcut;
+        if (j.type == JointType::Revolute) {  // the revolute path rotates about the axis in F: rounding differs
+          EXPECT_TRUE(MatrixNear(d.liMi[i].R, X.R, 1e-15)) << "variant " << variant << " body " << i;
+          EXPECT_TRUE(MatrixNear(d.liMi[i].p, X.p, 1e-15)) << "variant " << variant << " body " << i;
+        } else {
+          EXPECT_EQ(d.liMi[i].R, X.R) << "variant " << variant << " body " << i;
+          EXPECT_EQ(d.liMi[i].p, X.p) << "variant " << variant << " body " << i;
+        }
+      }
+    }
+    EXPECT_GE(shortcuts, 3 * 10) << "variant " << variant;  // (every other joint of the tree)
+  }
+}
+
 }  // namespace
 }  // namespace codyna
