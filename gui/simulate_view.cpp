@@ -300,13 +300,9 @@ void SimulateView::buildUi() {
                              "for trees, arkode for closed loops; the choice is reported); or ida, cvode-bdf, "
                              "cvode-adams, arkode, the fixed-step rk4, alf (closed loops through singular positions)"));
   form->addRow(tr("Integrator"), integrator_);
-  rtol_ = new QLineEdit(solver_box);
-  atol_ = new QLineEdit(solver_box);
-  rtol_->setToolTip(tr("Relative tolerance of the integrator (e.g. 1e-8)"));
-  atol_->setToolTip(tr("Absolute tolerance of the integrator, in the states' units (e.g. 1e-10)"));
-  form->addRow(tr("Relative tolerance"), rtol_);
-  form->addRow(tr("Absolute tolerance"), atol_);
-  // a number field of the solver section: its object name, what empty means, its tooltip
+  solver_form_ = form;
+  // a number field of the solver section: its object name, its label (also the name its refusals
+  // give it), what empty means, its tooltip
   const auto numberField = [&](const char* name, const QString& label, const QString& empty, const QString& tip) {
     auto* e = new QLineEdit(solver_box);
     e->setObjectName(QLatin1String(name));
@@ -315,6 +311,9 @@ void SimulateView::buildUi() {
     form->addRow(label, e);
     return e;
   };
+  rtol_ = numberField("rtol", tr("Relative tolerance"), QString(), tr("Relative tolerance of the integrator (e.g. 1e-8)"));
+  atol_ = numberField("atol", tr("Absolute tolerance"), QString(),
+                      tr("Absolute tolerance of the integrator, in the states' units (e.g. 1e-10)"));
   max_step_ = numberField("maxStep", tr("Maximum step"), tr("no limit"),
                           tr("The longest step the integrator may take, in s (empty: no limit); the step of rk4 and of "
                              "alf at fixed steps (the file's solver.max_step, codyna simulate --max-step)"));
@@ -476,15 +475,15 @@ void SimulateView::buildUi() {
   // refusal message naming the field, the value and what was expected)
   using Opt = std::optional<double>;
   solver_numbers_ = {
-      {rtol_, tr("Relative tolerance"), tr("a number > 0"), NumberRule::Positive, false,
+      {rtol_, tr("a number > 0"), NumberRule::Positive, false,
        [](SolverSpec& s, Opt v) { s.rtol = *v; }, tr("Change the relative tolerance")},
-      {atol_, tr("Absolute tolerance"), tr("a number > 0"), NumberRule::Positive, false,
+      {atol_, tr("a number > 0"), NumberRule::Positive, false,
        [](SolverSpec& s, Opt v) { s.atol = *v; }, tr("Change the absolute tolerance")},
-      {max_step_, tr("Maximum step"), tr("a number of seconds >= 0 (empty: no limit)"), NumberRule::NonNegative, true,
+      {max_step_, tr("a number of seconds >= 0 (empty: no limit)"), NumberRule::NonNegative, true,
        [](SolverSpec& s, Opt v) { s.max_step = v.value_or(0.0); }, tr("Change the maximum step")},
-      {alf_penalty_, tr("alf penalty"), tr("a number > 0 (empty: 1e11)"), NumberRule::Positive, true,
+      {alf_penalty_, tr("a number > 0 (empty: 1e11)"), NumberRule::Positive, true,
        [](SolverSpec& s, Opt v) { s.alf_penalty = v; }, tr("Change alf's penalty")},
-      {alf_iterations_, tr("alf iterations"), tr("a whole number >= 1 (empty: 100)"), NumberRule::Count, true,
+      {alf_iterations_, tr("a whole number >= 1 (empty: 100)"), NumberRule::Count, true,
        [](SolverSpec& s, Opt v) { s.alf_iterations = v ? std::optional<int>(static_cast<int>(*v)) : std::nullopt; },
        tr("Change alf's iterations")},
   };
@@ -787,7 +786,8 @@ void SimulateView::solverNumberEdited(const NumberRule& r) {
                        : r.kind == NumberRule::NonNegative ? v >= 0
                                                            : v >= 1 && v <= 1e9 && v == std::floor(v));
     if (!fits) {
-      emit message(tr("%1: expected %2, got \"%3\"").arg(r.label, r.expected, text));
+      const auto* label = qobject_cast<QLabel*>(solver_form_->labelForField(r.edit));  // (its row's label)
+      emit message(tr("%1: expected %2, got \"%3\"").arg(label ? label->text() : r.edit->objectName(), r.expected, text));
       refreshFromDocument();
       return;
     }

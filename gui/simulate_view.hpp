@@ -43,6 +43,7 @@ class QCheckBox;
 class QComboBox;
 class QDoubleSpinBox;
 class QLabel;
+class QFormLayout;
 class QLineEdit;
 class QProgressBar;
 class QPushButton;
@@ -146,8 +147,8 @@ class SimulateView : public QWidget {
   // iterations): its kind, whether empty is allowed (write gets nullopt), where it goes
   struct NumberRule {
     enum Kind { Positive, NonNegative, Count };
-    QLineEdit* edit;
-    QString label, expected;
+    QLineEdit* edit;  // (its form row's label names it in a refusal)
+    QString expected;
     Kind kind;
     bool empty_allowed;
     std::function<void(codyna::SolverSpec&, std::optional<double>)> write;
@@ -193,6 +194,7 @@ class SimulateView : public QWidget {
   QDoubleSpinBox* output_step_ = nullptr;
   QComboBox* integrator_ = nullptr;
   std::vector<NumberRule> solver_numbers_;
+  QFormLayout* solver_form_ = nullptr;  // the solver section's form (its rows' labels)
   QLineEdit* rtol_ = nullptr;
   QLineEdit* atol_ = nullptr;
   QLineEdit* max_step_ = nullptr;
