@@ -1541,7 +1541,6 @@ void TreeDerivatives::constraint_derivatives(const Eigen::VectorXd& lambda, cons
 
 void TreeDerivatives::compute_balance(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& u_all,
                                       const Eigen::VectorXd& a, const Eigen::VectorXd& lambda) {
-  if (!m_->motions.empty()) throw std::invalid_argument("TreeDerivatives::compute_balance: the model has motion inputs");
   balance(q, v, u_all, a, lambda);
 }
 

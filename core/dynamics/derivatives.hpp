@@ -87,7 +87,8 @@ class TreeDerivatives {
   // The balance's parts alone (for an implicit integrator's Newton matrix, simulation/alf.cpp):
   // tau/dtau at a, Q/dQ (including -Jc^T lambda), M, Jc, dc_dq, dc_dv, as compute_constrained
   // gives them, without solving for the accelerations' derivatives (dqdd_* and the sensors'
-  // derivatives are not touched). Models without motion inputs.
+  // derivatives are not touched). With motion inputs, a driven coordinate's row is its balance at
+  // the a given (which holds the motion's reaction): the caller replaces it by the motion's.
   void compute_balance(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& u_all,
                        const Eigen::VectorXd& a, const Eigen::VectorXd& lambda);
 

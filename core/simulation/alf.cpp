@@ -52,9 +52,15 @@
 // longer, alf_penalty (10 ms / h)^2 for shorter ones (the weight h^2/4 alpha of Jc^T Jc against M held; with alpha itself the multipliers'
 // iteration stalls at short steps, each iteration shrinking the error only by 1/(1 + h^2/4 alpha s^2 / m)). IntegratorSettings::alf_fixed_step:
 // every step max_step (default 1 ms), no error control, Newton at rtol, atol of at most 1e-6.
-// Additive coordinates only (no ball or free joint), no effect states and no continuous controller
-// states: refused by name otherwise. The penalty and the iterations are alf_penalty and
-// alf_iterations.
+// Ball and free joints: the rule steps on the group, its unknown the step dl in the tangent space
+// (q = q_n (+) dl, v = 2/h dl - v_n, a = 4/h^2 dl - 4/h v_n - a_n), Newton's matrix the tangent's
+// at q (the retraction's Jacobian taken as the identity: a modified Newton), the error weights in
+// a rotation's rates atol + rtol times its angle. Motion inputs: each driven coordinate is its
+// signal's (value, rate, acceleration) at the step's end; its rows of the Newton and projection
+// matrices are its own coordinate alone, so Newton and the projections solve the others (the
+// balance's row there holds the motion's reaction). No effect states, no continuous controller
+// states, no rolling constraints (conditions on the velocities alone): refused by name otherwise.
+// The penalty and the iterations are alf_penalty and alf_iterations.
 #include <Eigen/LU>
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
@@ -71,6 +77,7 @@
 #include "dynamics/derivatives.hpp"
 #include "dynamics/effects.hpp"
 #include "dynamics/forward_dynamics.hpp"
+#include "dynamics/joint.hpp"
 #include "dynamics/kinematics.hpp"
 #include "dynamics/rnea.hpp"
 #include "simulation/closed_loop.hpp"
@@ -280,12 +287,14 @@ class Alf final : public Integrator {
     if (!(rtol_ > 0) || !(atol_ > 0))
       throw std::invalid_argument("integrator alf: rtol and atol: expected numbers > 0");
     if (fixed_ && h_ == 0) h_ = 1e-3;
-    if (m_.nq != m_.nv)
-      throw std::invalid_argument("integrator alf: the model has ball or free joints (their quaternions are not additive "
-                                  "coordinates): not integrated by alf yet");
     if (m_.ns > 0) throw std::invalid_argument("integrator alf: the model has effect states (a tire's transient slip): not integrated by alf yet");
     if (sys.nxc() > 0) throw std::invalid_argument("integrator alf: the controller has continuous states: not integrated by alf yet");
-    if (!m_.motions.empty()) throw std::invalid_argument("integrator alf: the model has motion inputs: not integrated by alf yet");
+    if (!m_.velocity_rows.empty())
+      throw std::invalid_argument("integrator alf: the model has rolling constraints (conditions on the velocities alone): not integrated by alf yet");
+    for (const int k : m_.motions) {
+      driven_q_.push_back(m_.actuators[static_cast<std::size_t>(k)].iq);
+      driven_v_.push_back(m_.actuators[static_cast<std::size_t>(k)].iv);
+    }
     // the matrices' structural nonzeros: M's (pairs of coordinates on one path to the ground) and
     // Jc^T Jc's (pairs in one constraint's support), the diagonal
     const auto n = static_cast<std::size_t>(m_.nv);
@@ -310,7 +319,9 @@ class Alf final : public Integrator {
     q_ = y.head(m_.nq);
     v_ = y.segment(m_.nq, m_.nv);
     xc_ = y.tail(y.size() - m_.nq - m_.nv);
-    // the accelerations and multipliers of the constrained dynamics there
+    // the accelerations and multipliers of the constrained dynamics there (the motions' coordinates
+    // and rates where their signals are)
+    drive_state(t);
     const Eigen::VectorXd u = sys_.inputs(t, q_, v_, xc_);
     a_ = forward_dynamics<double>(m_, d_, q_, v_, u);
     lambda_ = m_.nc ? Eigen::VectorXd(d_.lambda) : Eigen::VectorXd();
@@ -383,7 +394,7 @@ class Alf final : public Integrator {
         // measure of the step's error; such a step is accepted, and the next one is no longer
         if (stalled_ || stalled_before_) err = std::min(err, 1.0);
         if (trace_) {
-          const Eigen::ArrayXd w = atol_ + rtol_ * q_.array().abs().max(qn_.array().abs());
+          const Eigen::ArrayXd w = atol_ + rtol_ * magnitude(q_).max(magnitude(qn_));
           Eigen::Index imax;
           ((h / 12) * (an_ - a_).array().abs() / w).maxCoeff(&imax);
           std::fprintf(stderr, "err t %.9g h %g err %g at %d (a %g -> %g)\n", t_ + h, h, err, static_cast<int>(imax), a_[imax], an_[imax]);
@@ -436,6 +447,7 @@ class Alf final : public Integrator {
       add_jc_transpose(f_, lambda + alpha * d_.phi, 1.0);
     }
     f_ *= h_now_ * h_now_ / 4;
+    for (const int i : driven_v_) f_[i] = 0;  // (a motion's balance holds its unknown force: not solved)
   }
 
   // one trapezoidal step of h from (t_, q_, v_, a_, lambda_) into (qn_, vn_, an_, lambdan_);
@@ -448,18 +460,45 @@ class Alf final : public Integrator {
     h_now_ = h;
     // the penalty as given for steps of kPenaltyStep and longer, alpha (kPenaltyStep / h)^2 below:
     // h^2/4 alpha, its weight against M in the Newton matrix, no smaller than at kPenaltyStep
-    // and never above kPenaltyMax by that rule (lambda += alpha phi: phi's rounding times alpha)
+    // and never above kRuleMax by that rule (lambda += alpha phi: phi's rounding times alpha; at
+    // 1e13, kPenaltyMax, the double wishbone's K&C rig and the sedan at rtol 1e-6 took steps of a
+    // few us at their start and lost their loops there, the weight h^2/4 alpha beside M ~1:
+    // "no step passes"; at 1e15 and 1e17 both run, and A02, Andrews, Bricard and A05, whose steps
+    // stay above 1 ms or whose failures are elsewhere, take the same steps to the last one)
     // (at fixed steps the penalty as given: there the rule's growth, 100-fold at 1 ms, amplified
     // phi's rounding into an error floor on A02, ~3e-4 rad below 3 ms steps, and a stall raises
     // the penalty for its own step anyway)
     double alpha = alpha_now_ = fixed_ ? alpha_given_ :
-        std::max(alpha_given_, std::min(kPenaltyMax, alpha_given_ * (kPenaltyStep / h) * (kPenaltyStep / h)));
-    const Eigen::VectorXd vhat = (2 / h) * q_ + v_, ahat = (4 / (h * h)) * q_ + (4 / h) * v_ + a_;
+        std::max(alpha_given_, std::min(kRuleMax, alpha_given_ * (kPenaltyStep / h) * (kPenaltyStep / h)));
+    // (additive coordinates: v and a from q itself, v = 2/h q - vhat; on the group: from the step
+    // in the tangent space, dl, with q = q_n (+) dl)
+    const Eigen::VectorXd vhat = additive_ ? Eigen::VectorXd((2 / h) * q_ + v_) : v_;
+    const Eigen::VectorXd ahat = additive_ ? Eigen::VectorXd((4 / (h * h)) * q_ + (4 / h) * v_ + a_) : Eigen::VectorXd((4 / h) * v_ + a_);
     // the predictor: the trapezoidal rule's own q_n+1 = q_n + h v_n + h^2/4 (a_n + a_n+1) with
     // a_n+1 extrapolated from the last step's change of a: its first correction is h^4 where a
     // is smooth, against h^3 with a_n+1 = a_n (A02 at 10 ms: 5e-8 rad against 3.3e-6)
-    Eigen::VectorXd q = q_ + h * v_ + (h * h / 2) * a_, v, a;
-    if (jerk_) q.noalias() += (h * h * h / 4) * jerk_rate_;
+    Eigen::VectorXd q, dl, v, a;
+    if (additive_) {
+      q = q_ + h * v_ + (h * h / 2) * a_;
+      if (jerk_) q.noalias() += (h * h * h / 4) * jerk_rate_;
+    } else {
+      dl = h * v_ + (h * h / 2) * a_;
+      if (jerk_) dl.noalias() += (h * h * h / 4) * jerk_rate_;
+      q = integrate<double>(m_, q_, dl);
+    }
+    // the motion inputs' coordinates where their signals are at the step's end (held there by
+    // Newton: their rows are u's, not the balance), their rates and accelerations too
+    drive(t_inputs, q);
+    // v = 2/h (q - q_n) - v_n, a = 4/h^2 (q - q_n) - 4/h v_n - a_n (the motions' from their signals)
+    auto rates = [&] {
+      const Eigen::VectorXd& x = additive_ ? q : dl;
+      v = (2 / h) * x - vhat;
+      a = (4 / (h * h)) * x - ahat;
+      for (std::size_t k = 0; k < driven_v_.size(); ++k) {
+        v[driven_v_[k]] = driven_rate_[static_cast<Eigen::Index>(k)];
+        a[driven_v_[k]] = driven_acc_[static_cast<Eigen::Index>(k)];
+      }
+    };
     Eigen::VectorXd lambda = lambda_;
     // Newton's test (per coordinate, in the weights w): the error left in q, estimated from the
     // corrections' rate of contraction theta as theta / (1 - theta) |dq| (the first correction
@@ -470,8 +509,9 @@ class Alf final : public Integrator {
     // Newton's error happened to help, 8.9e-4 against the rule's own 1.1e-3). The price: steps of
     // 0.56 ms and shorter no longer pass A02's flat positions (loose stalls let 0.56 ms through)
     const double rt = fixed_ ? std::min(rtol_, kFixedNewton) : rtol_, at = fixed_ ? std::min(atol_, kFixedNewton) : atol_;
-    const Eigen::ArrayXd floor = kNewtonFloor * (1 + q_.array().abs());
-    const Eigen::ArrayXd wq = at + rt * q_.array().abs(), wv = (h / 2) * (at + rt * v_.array().abs());
+    const Eigen::ArrayXd qmag = magnitude(q_);
+    const Eigen::ArrayXd floor = kNewtonFloor * (1 + qmag);
+    const Eigen::ArrayXd wq = at + rt * qmag, wv = (h / 2) * (at + rt * v_.array().abs());
     // (with error control the weights in q alone: the error test judges the step's accelerations,
     // and the weights in v made A05 take two iterations a step instead of one, 2.5 times the CPU)
     const Eigen::ArrayXd wqv = wq.min(wv), wn = fixed_ ? wqv : wq;
@@ -483,8 +523,7 @@ class Alf final : public Integrator {
     double last = 0, previous = 0;
     int since_factor = 0;
     for (int it = 0; it < iterations_; ++it) {
-      v = (2 / h) * q - vhat;
-      a = (4 / (h * h)) * q - ahat;
+      rates();
       residual(t_inputs, q, v, a, lambda, alpha, it > 0);
       if (refactor || tangent_stale_) {
         // the matrix: the tangent kept (formed again when stale) at this step's h, with this
@@ -500,7 +539,13 @@ class Alf final : public Integrator {
       }
       const Eigen::VectorXd dq = -lu_.solve(f_);
       if (!dq.allFinite()) break;
-      q += dq;
+      if (additive_) {
+        q += dq;
+      } else {
+        dl += dq;
+        integrate_into<double>(m_, q_, dl, q);
+      }
+      hold_driven(q);  // (exactly its signal's value: its row of dq is zero up to rounding)
       ++iterations_done_;
       ++since_factor;
       last = (dq.array().abs() / w).maxCoeff();
@@ -569,20 +614,23 @@ class Alf final : public Integrator {
     // the mass-orthogonal projections of v and a onto the constraints at q:
     //   (M + h^2/4 alpha Jc^T Jc) v = M v*,   (M + h^2/4 alpha Jc^T Jc) a = M a* - h^2/4 alpha Jc^T gamma,
     // M and Jc at q (their own factorization)
-    v = (2 / h) * q - vhat;
-    a = (4 / (h * h)) * q - ahat;
+    rates();
     if (m_.nc) {
       Mp_ = crba<double>(m_, d_, q);
       constraint_jacobian_after_kinematics(m_, d_, q);  // Jc at q (crba's kinematics), and phi: the multipliers' last update
       lambda += alpha * d_.phi;
       Kp_ = Mp_;
       add_penalty(Kp_, c * alpha);
+      hold_rows(Kp_);  // (a motion's row: its rate and acceleration are its signal's)
       if (!lup_.compute(Kp_, false)) return false;  // (M + c alpha Jc^T Jc: the structural pattern)
       ++factorizations_;
-      v = lup_.solve(mass_times(Mp_, v));
+      Eigen::VectorXd rhs = mass_times(Mp_, v);
+      for (const int i : driven_v_) rhs[i] = v[i];
+      v = lup_.solve(rhs);
       constraint_gamma_after_positions(m_, d_, q, v);  // gamma at the projected velocities (crba's positions)
-      Eigen::VectorXd rhs = mass_times(Mp_, a);
+      rhs = mass_times(Mp_, a);
       add_jc_transpose(rhs, d_.gamma, -c * alpha);
+      for (const int i : driven_v_) rhs[i] = a[i];
       a = lup_.solve(rhs);
     }
     if (!q.allFinite() || !v.allFinite() || !a.allFinite()) return false;
@@ -602,6 +650,7 @@ class Alf final : public Integrator {
     const Eigen::VectorXd u = sys_.inputs(t_, q_, v_, xc_);
     const Eigen::VectorXd before = sys_.inputs(t_ - kLeftLimit * std::max(1.0, std::abs(t_)), q_, v_, xc_);
     if (u.size() == 0 || (u - before).cwiseAbs().maxCoeff() <= 1e-9 * (1 + u.cwiseAbs().maxCoeff())) return;
+    drive_state(t_);  // (a motion's signal that jumps moves its coordinate and rate here)
     const Eigen::VectorXd a = forward_dynamics<double>(m_, d_, q_, v_, u);
     if (!a.allFinite()) return;
     a_ = a;
@@ -647,7 +696,12 @@ class Alf final : public Integrator {
     const double h = tb - a.t, s = std::clamp((t - a.t) / h, 0.0, 1.0), s2 = s * s, s3 = s2 * s;
     const double h00 = 2 * s3 - 3 * s2 + 1, h10 = (s3 - 2 * s2 + s) * h, h01 = -2 * s3 + 3 * s2, h11 = (s3 - s2) * h;
     shown_y_.resize(m_.nq + m_.nv + xc_.size());
-    shown_y_.head(m_.nq) = h00 * a.q + h10 * a.v + h01 * qb + h11 * vb;
+    if (additive_) {
+      shown_y_.head(m_.nq) = h00 * a.q + h10 * a.v + h01 * qb + h11 * vb;
+    } else {  // on the group: q_a (+) (h10 v_a + h01 (q_b (-) q_a) + h11 v_b), as h00 + h01 = 1
+      const Eigen::VectorXd dl = h10 * a.v + h01 * difference(m_, a.q, qb) + h11 * vb;
+      shown_y_.head(m_.nq) = integrate<double>(m_, a.q, dl);
+    }
     shown_y_.segment(m_.nq, m_.nv) = h00 * a.v + h10 * a.a + h01 * vb + h11 * ab;
     shown_y_.tail(xc_.size()) = xc_;
     shown_ = true;
@@ -655,7 +709,7 @@ class Alf final : public Integrator {
 
   // the local error in q, h^2/12 (a_n+1 - a_n), in the weights atol + rtol |q| (<= 1: accepted)
   double error_estimate(double h) const {
-    const Eigen::ArrayXd w = atol_ + rtol_ * q_.array().abs().max(qn_.array().abs());
+    const Eigen::ArrayXd w = atol_ + rtol_ * magnitude(q_).max(magnitude(qn_));
     return ((h / 12) * (an_ - a_).array().abs() / w).maxCoeff();
   }
 
@@ -741,6 +795,7 @@ class Alf final : public Integrator {
       K_.noalias() += c * Kt_;
     }
     if (m_.nc) add_penalty(K_, c * alpha);
+    hold_rows(K_);  // (Newton leaves a motion's coordinate where its signal is)
     if (!lu_.compute(K_, scan_newton_)) return false;  // (C and K: nonzeros seen when formed)
     scan_newton_ = false;
     ++factorizations_;
@@ -788,6 +843,62 @@ class Alf final : public Integrator {
     return y;
   }
 
+  // the motion inputs at t: their coordinates in q (their values), their rates and accelerations
+  // kept for the step (driven_rate_, driven_acc_); nothing without motions
+  void drive(double t, Eigen::VectorXd& q) {
+    if (driven_v_.empty()) return;
+    Eigen::VectorXd v = v_;
+    sys_.apply_motions(t, q, v, &driven_acc_);
+    driven_value_.resize(static_cast<Eigen::Index>(driven_q_.size()));
+    driven_rate_.resize(static_cast<Eigen::Index>(driven_v_.size()));
+    for (std::size_t k = 0; k < driven_v_.size(); ++k) {
+      driven_value_[static_cast<Eigen::Index>(k)] = q[driven_q_[k]];
+      driven_rate_[static_cast<Eigen::Index>(k)] = v[driven_v_[k]];
+    }
+  }
+  // the state's motion coordinates and rates at t, and their accelerations in d_ (for
+  // forward_dynamics)
+  void drive_state(double t) {
+    if (driven_v_.empty()) return;
+    Eigen::VectorXd acc;
+    sys_.apply_motions(t, q_, v_, &acc);
+    d_.motion_acc = acc;
+  }
+  void hold_driven(Eigen::VectorXd& q) const {
+    for (std::size_t k = 0; k < driven_q_.size(); ++k) q[driven_q_[k]] = driven_value_[static_cast<Eigen::Index>(k)];
+  }
+  // a motion's row of a Newton or projection matrix: its own coordinate alone (the unknown is
+  // known: its signal)
+  void hold_rows(Eigen::MatrixXd& K) const {
+    for (const int i : driven_v_) {
+      K.row(i).setZero();
+      K(i, i) = 1;
+    }
+  }
+  // the size of each coordinate, for the error weights atol + rtol |q|, in the velocities' places:
+  // |q_i| for additive coordinates; a ball's or free joint's rotation angle for its three rates,
+  // a free joint's position components for its linear rates
+  Eigen::ArrayXd magnitude(const Eigen::VectorXd& q) const {
+    if (additive_) return q.array().abs();
+    Eigen::ArrayXd r(m_.nv);
+    for (int b = 1; b < m_.nbodies; ++b) {
+      const JointModel& j = m_.joints[static_cast<std::size_t>(b)];
+      const int iq = j.idx_q, iv = j.idx_v;
+      switch (j.type) {
+        case JointType::Spherical:
+          r.segment<3>(iv).setConstant(rotation_log(q.segment<4>(iq)).norm());
+          break;
+        case JointType::Free:
+          r.segment<3>(iv).setConstant(rotation_log(q.segment<4>(iq + 3)).norm());
+          r.segment<3>(iv + 3) = q.segment<3>(iq).array().abs();
+          break;
+        default:
+          for (int k = 0; k < j.nv; ++k) r[iv + k] = std::abs(q[iq + k]);
+      }
+    }
+    return r;
+  }
+
   static double left_loose(const Eigen::VectorXd& dq, const Eigen::ArrayXd& wl) { return (dq.array().abs() / wl).maxCoeff(); }
 
   static constexpr double kStall = 0.8, kBoost = 10, kStallTolerance = 0.1;
@@ -801,10 +912,18 @@ class Alf final : public Integrator {
   // kRate at least per iteration, for kTangentAge steps at most; the matrix is factored each step
   static constexpr double kRate = 0.5;
   static constexpr int kTangentAge = 20, kTangentFailures = 3;
-  static constexpr double kPenaltyStep = 1e-2, kPenaltyMax = 1e13;
+  // the penalty: the error control's rule up to kRuleMax; a stall's raise up to kPenaltyMax
+  static constexpr double kPenaltyStep = 1e-2, kPenaltyMax = 1e13, kRuleMax = 1e15;
   ClosedLoopSystem& sys_;
   const Model& m_;
   Data d_;
+  // additive coordinates (no ball or free joint): q itself is the trapezoidal rule's unknown;
+  // otherwise the step in the tangent space, q = q_n (+) dl
+  const bool additive_ = m_.nq == m_.nv;
+  // the motion inputs' coordinates (q and v places), and at the step's end their values, rates
+  // and accelerations (from their signals)
+  std::vector<int> driven_q_, driven_v_;
+  Eigen::VectorXd driven_value_, driven_rate_, driven_acc_;
   double h_, alpha_given_, alpha_now_ = 0;
   int iterations_;
   double rtol_, atol_;
