@@ -58,9 +58,13 @@
 // a rotation's rates atol + rtol times its angle. Motion inputs: each driven coordinate is its
 // signal's (value, rate, acceleration) at the step's end; its rows of the Newton and projection
 // matrices are its own coordinate alone, so Newton and the projections solve the others (the
-// balance's row there holds the motion's reaction). No effect states, no continuous controller
-// states, no rolling constraints (conditions on the velocities alone): refused by name otherwise.
-// The penalty and the iterations are alf_penalty and alf_iterations.
+// balance's row there holds the motion's reaction). First-order states z (a tire's transient
+// slip, a controller's continuous states): the trapezoidal rule z = z_n + h/2 (g_n + g(z)) by
+// Newton on their own block, I - h/2 dg/dz (central differences, kept as the positions' tangent
+// is), beside the positions' (a block Jacobi iteration: both corrections at the same iterate);
+// their error h^2/12 |z^(3)| from the rates' divided differences over two steps. No rolling
+// constraints (conditions on the velocities alone): refused by name. The penalty and the
+// iterations are alf_penalty and alf_iterations.
 #include <Eigen/LU>
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
@@ -287,8 +291,6 @@ class Alf final : public Integrator {
     if (!(rtol_ > 0) || !(atol_ > 0))
       throw std::invalid_argument("integrator alf: rtol and atol: expected numbers > 0");
     if (fixed_ && h_ == 0) h_ = 1e-3;
-    if (m_.ns > 0) throw std::invalid_argument("integrator alf: the model has effect states (a tire's transient slip): not integrated by alf yet");
-    if (sys.nxc() > 0) throw std::invalid_argument("integrator alf: the controller has continuous states: not integrated by alf yet");
     if (!m_.velocity_rows.empty())
       throw std::invalid_argument("integrator alf: the model has rolling constraints (conditions on the velocities alone): not integrated by alf yet");
     for (const int k : m_.motions) {
@@ -318,12 +320,15 @@ class Alf final : public Integrator {
     theta_step_ = 0;                         // (nor Newton's rate)
     q_ = y.head(m_.nq);
     v_ = y.segment(m_.nq, m_.nv);
-    xc_ = y.tail(y.size() - m_.nq - m_.nv);
+    z_ = y.tail(nz_);
+    zslope_ok_ = false;  // (no step before it for the first-order states' error estimate)
     // the accelerations and multipliers of the constrained dynamics there (the motions' coordinates
     // and rates where their signals are)
     drive_state(t);
-    const Eigen::VectorXd u = sys_.inputs(t, q_, v_, xc_);
+    set_effect_states(z_);
+    const Eigen::VectorXd u = sys_.inputs(t, q_, v_, z_.tail(nxc_));
     a_ = forward_dynamics<double>(m_, d_, q_, v_, u);
+    g_ = first_order_rates(t, q_, v_, z_);
     lambda_ = m_.nc ? Eigen::VectorXd(d_.lambda) : Eigen::VectorXd();
     if (!a_.allFinite()) throw IntegratorFailure(t, "alf: the accelerations at the start are not finite");
     if (next_ <= 0) {  // the first step: a small fraction of what the accelerations allow
@@ -416,8 +421,8 @@ class Alf final : public Integrator {
 
   Eigen::VectorXd state() const override {
     if (shown_) return shown_y_;
-    Eigen::VectorXd y(m_.nq + m_.nv + xc_.size());
-    y << q_, v_, xc_;
+    Eigen::VectorXd y(m_.nq + m_.nv + nz_);
+    y << q_, v_, z_;
     return y;
   }
   bool projects() const override { return true; }
@@ -435,12 +440,19 @@ class Alf final : public Integrator {
   // the inverse dynamics (no mass matrix); u_ the inputs there
   // (with pending, the multipliers' update after the last correction, lambda += alpha phi, is made
   // here, with phi at q: one evaluation of the constraints per iteration)
-  void residual(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& a,
+  // (and gz_, the first-order states' rates at z)
+  void residual(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& a, const Eigen::VectorXd& z,
                 Eigen::VectorXd& lambda, double alpha, bool pending) {
     ++evaluations_;
-    u_ = sys_.inputs(t, q, v, xc_);
+    set_effect_states(z);
+    u_ = sys_.inputs(t, q, v, z.tail(nxc_));
     f_ = rnea<double>(m_, d_, q, v, a);  // forward kinematics at (q, v, a) included
     f_ -= applied_forces<double>(m_, d_, q, v, u_);
+    if (nz_) {
+      gz_.resize(nz_);
+      gz_.head(m_.ns) = d_.sdot;
+      if (nxc_) gz_.tail(nxc_) = sys_.controller_rates(t, q, v, z.tail(nxc_), u_);
+    }
     if (m_.nc) {
       constraint_jacobian_after_kinematics(m_, d_, q);  // (rnea's kinematics at q)
       if (pending) lambda += alpha * d_.phi;
@@ -489,6 +501,11 @@ class Alf final : public Integrator {
     // the motion inputs' coordinates where their signals are at the step's end (held there by
     // Newton: their rows are u's, not the balance), their rates and accelerations too
     drive(t_inputs, q);
+    // the first-order states (effect states, a controller's): the trapezoidal rule
+    // z = z_n + h/2 (g_n + g(z)), from z_n + h g_n, by Newton on their own block (I - h/2 dg/dz)
+    // beside the positions' (a block Jacobi iteration: each block's correction at the same iterate)
+    Eigen::VectorXd z = nz_ ? Eigen::VectorXd(z_ + h * g_) : Eigen::VectorXd();
+    const Eigen::VectorXd zhat = nz_ ? Eigen::VectorXd(z_ + (h / 2) * g_) : Eigen::VectorXd();
     // v = 2/h (q - q_n) - v_n, a = 4/h^2 (q - q_n) - 4/h v_n - a_n (the motions' from their signals)
     auto rates = [&] {
       const Eigen::VectorXd& x = additive_ ? q : dl;
@@ -509,6 +526,7 @@ class Alf final : public Integrator {
     // Newton's error happened to help, 8.9e-4 against the rule's own 1.1e-3). The price: steps of
     // 0.56 ms and shorter no longer pass A02's flat positions (loose stalls let 0.56 ms through)
     const double rt = fixed_ ? std::min(rtol_, kFixedNewton) : rtol_, at = fixed_ ? std::min(atol_, kFixedNewton) : atol_;
+    const Eigen::ArrayXd wz = nz_ ? Eigen::ArrayXd(kNewton * (at + rt * z_.array().abs())) : Eigen::ArrayXd();  // (z's Newton test)
     const Eigen::ArrayXd qmag = magnitude(q_);
     const Eigen::ArrayXd floor = kNewtonFloor * (1 + qmag);
     const Eigen::ArrayXd wq = at + rt * qmag, wv = (h / 2) * (at + rt * v_.array().abs());
@@ -524,7 +542,18 @@ class Alf final : public Integrator {
     int since_factor = 0;
     for (int it = 0; it < iterations_; ++it) {
       rates();
-      residual(t_inputs, q, v, a, lambda, alpha, it > 0);
+      residual(t_inputs, q, v, a, z, lambda, alpha, it > 0);
+      Eigen::VectorXd dz;
+      if (nz_) {
+        const Eigen::VectorXd rz = z - zhat - (h / 2) * gz_;
+        if (!z_jacobian_ok_ || z_jacobian_age_ >= kTangentAge || tangent_stale_) form_z_jacobian(t_inputs, q, v, z);
+        if (h != h_z_) {
+          luz_.compute(Eigen::MatrixXd::Identity(nz_, nz_) - (h / 2) * Gz_);
+          h_z_ = h;
+        }
+        dz = -luz_.solve(rz);
+        if (!dz.allFinite()) break;
+      }
       if (refactor || tangent_stale_) {
         // the matrix: the tangent kept (formed again when stale) at this step's h, with this
         // iterate's Jc in the penalty
@@ -546,9 +575,11 @@ class Alf final : public Integrator {
         integrate_into<double>(m_, q_, dl, q);
       }
       hold_driven(q);  // (exactly its signal's value: its row of dq is zero up to rounding)
+      if (nz_) z += dz;
       ++iterations_done_;
       ++since_factor;
       last = (dq.array().abs() / w).maxCoeff();
+      if (nz_) last = std::max(last, (dz.array().abs() / wz.max(kNewtonFloor)).maxCoeff());
       const double theta = previous > 0 ? last / previous : 0;
       previous = last;
       if (trace_)
@@ -638,6 +669,10 @@ class Alf final : public Integrator {
     vn_ = v;
     an_ = a;
     lambdan_ = lambda;
+    if (nz_) {  // (the rates the rule implies, as a's: no evaluation more)
+      zn_ = z;
+      gn_ = (2 / h) * (z - z_) - g_;
+    }
     return true;
   }
 
@@ -647,15 +682,17 @@ class Alf final : public Integrator {
   // which no step short of ~1e-8 s passes at tight tolerances
   void restart_at_input_jump() {
     if (steps_ == 0) return;  // reset() has just made a
-    const Eigen::VectorXd u = sys_.inputs(t_, q_, v_, xc_);
-    const Eigen::VectorXd before = sys_.inputs(t_ - kLeftLimit * std::max(1.0, std::abs(t_)), q_, v_, xc_);
+    set_effect_states(z_);
+    const Eigen::VectorXd u = sys_.inputs(t_, q_, v_, z_.tail(nxc_));
+    const Eigen::VectorXd before = sys_.inputs(t_ - kLeftLimit * std::max(1.0, std::abs(t_)), q_, v_, z_.tail(nxc_));
     if (u.size() == 0 || (u - before).cwiseAbs().maxCoeff() <= 1e-9 * (1 + u.cwiseAbs().maxCoeff())) return;
     drive_state(t_);  // (a motion's signal that jumps moves its coordinate and rate here)
     const Eigen::VectorXd a = forward_dynamics<double>(m_, d_, q_, v_, u);
     if (!a.allFinite()) return;
     a_ = a;
     if (m_.nc) lambda_ = d_.lambda;
-    jerk_ = false;  // (a jumped: the last step's change of a says nothing of the next)
+    g_ = first_order_rates(t_, q_, v_, z_);
+    jerk_ = zslope_ok_ = false;  // (a jumped: the last step's change of a says nothing of the next)
     ++input_restarts_;
   }
 
@@ -673,6 +710,8 @@ class Alf final : public Integrator {
       k.q = q_;
       k.v = v_;
       k.a = a_;
+      k.z = z_;
+      k.g = g_;
       accept(t1);
       return;
     }
@@ -693,9 +732,10 @@ class Alf final : public Integrator {
     const Knot& b = last ? Knot{} : knot_[static_cast<std::size_t>(k + 1)];
     const double tb = last ? t_ : b.t;
     const Eigen::VectorXd &qb = last ? q_ : b.q, &vb = last ? v_ : b.v, &ab = last ? a_ : b.a;
+    const Eigen::VectorXd &zb = last ? z_ : b.z, &gb = last ? g_ : b.g;
     const double h = tb - a.t, s = std::clamp((t - a.t) / h, 0.0, 1.0), s2 = s * s, s3 = s2 * s;
     const double h00 = 2 * s3 - 3 * s2 + 1, h10 = (s3 - 2 * s2 + s) * h, h01 = -2 * s3 + 3 * s2, h11 = (s3 - s2) * h;
-    shown_y_.resize(m_.nq + m_.nv + xc_.size());
+    shown_y_.resize(m_.nq + m_.nv + nz_);
     if (additive_) {
       shown_y_.head(m_.nq) = h00 * a.q + h10 * a.v + h01 * qb + h11 * vb;
     } else {  // on the group: q_a (+) (h10 v_a + h01 (q_b (-) q_a) + h11 v_b), as h00 + h01 = 1
@@ -703,14 +743,22 @@ class Alf final : public Integrator {
       shown_y_.head(m_.nq) = integrate<double>(m_, a.q, dl);
     }
     shown_y_.segment(m_.nq, m_.nv) = h00 * a.v + h10 * a.a + h01 * vb + h11 * ab;
-    shown_y_.tail(xc_.size()) = xc_;
+    if (nz_) shown_y_.tail(nz_) = h00 * a.z + h10 * a.g + h01 * zb + h11 * gb;
     shown_ = true;
   }
 
   // the local error in q, h^2/12 (a_n+1 - a_n), in the weights atol + rtol |q| (<= 1: accepted)
   double error_estimate(double h) const {
     const Eigen::ArrayXd w = atol_ + rtol_ * magnitude(q_).max(magnitude(qn_));
-    return ((h / 12) * (an_ - a_).array().abs() / w).maxCoeff();
+    double err = ((h / 12) * (an_ - a_).array().abs() / w).maxCoeff();
+    // the first-order states': h^2/12 |z^(3)| per unit step, z^(3) from the rates' divided
+    // differences over this step and the last (none after a start or a restart)
+    if (nz_ && zslope_ok_) {
+      const Eigen::ArrayXd wz = atol_ + rtol_ * z_.array().abs().max(zn_.array().abs());
+      const Eigen::ArrayXd z3 = ((gn_ - g_) / h - zslope_).array() / ((h + h_last_) / 2);
+      err = std::max(err, ((h * h / 12) * z3.abs() / wz).maxCoeff());
+    }
+    return err;
   }
 
   void accept(double t1) {
@@ -719,6 +767,14 @@ class Alf final : public Integrator {
     // the step's change of a, per unit time, for the next step's predictor
     jerk_rate_ = (an_ - a_) / (t1 - t_);
     jerk_ = true;
+    if (nz_) {
+      zslope_ = (gn_ - g_) / (t1 - t_);
+      h_last_ = t1 - t_;
+      zslope_ok_ = true;
+      z_ = zn_;
+      g_ = gn_;
+      ++z_jacobian_age_;
+    }
     q_ = qn_;
     v_ = vn_;
     a_ = an_;
@@ -843,6 +899,46 @@ class Alf final : public Integrator {
     return y;
   }
 
+  // the effect states in z (its head) where applied_forces and the sensors read them
+  void set_effect_states(const Eigen::VectorXd& z) {
+    if (m_.ns == 0) return;
+    d_.s = z.head(m_.ns);
+    sys_.set_effect_states(d_.s);
+  }
+  // the first-order states' rates at (t, q, v, z): the effect states' (applied_forces), the
+  // controller's (its state equation at the inputs there)
+  Eigen::VectorXd first_order_rates(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& z) {
+    Eigen::VectorXd g(nz_);
+    if (nz_ == 0) return g;
+    set_effect_states(z);
+    const Eigen::VectorXd u = sys_.inputs(t, q, v, z.tail(nxc_));
+    forward_kinematics<double>(m_, d_, q, v);
+    applied_forces<double>(m_, d_, q, v, u);
+    g.head(m_.ns) = d_.sdot;
+    if (nxc_) g.tail(nxc_) = sys_.controller_rates(t, q, v, z.tail(nxc_), u);
+    return g;
+  }
+  // dg/dz at (t, q, v, z) by central differences (nz small: a tire's two deflections, a
+  // controller's states), kept for kTangentAge steps as the positions' tangent is; the block's
+  // matrix I - h/2 dg/dz is factored again at the next step
+  void form_z_jacobian(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& z) {
+    Gz_.resize(nz_, nz_);
+    Eigen::VectorXd zp = z;
+    for (int j = 0; j < nz_; ++j) {
+      const double dz = 1e-6 * std::max(1.0, std::abs(z[j]));
+      zp[j] = z[j] + dz;
+      const Eigen::VectorXd gp = first_order_rates(t, q, v, zp);
+      zp[j] = z[j] - dz;
+      Gz_.col(j) = (gp - first_order_rates(t, q, v, zp)) / (2 * dz);
+      zp[j] = z[j];
+    }
+    set_effect_states(z);  // (the iterate's again, for what follows in this iteration)
+    z_jacobian_ok_ = Gz_.allFinite();
+    if (!z_jacobian_ok_) Gz_.setZero();
+    z_jacobian_age_ = 0;
+    h_z_ = 0;  // (factored again)
+  }
+
   // the motion inputs at t: their coordinates in q (their values), their rates and accelerations
   // kept for the step (driven_rate_, driven_acc_); nothing without motions
   void drive(double t, Eigen::VectorXd& q) {
@@ -924,12 +1020,22 @@ class Alf final : public Integrator {
   // and accelerations (from their signals)
   std::vector<int> driven_q_, driven_v_;
   Eigen::VectorXd driven_value_, driven_rate_, driven_acc_;
+  // the first-order states z = [s; xc] (the effect states, the controller's), at the step's start
+  // and end, their rates g there (the end's implied by the rule), the rates' slope over the last
+  // step (zslope_ok_: there was one) and its length; dg/dz and the block's factored matrix
+  const int nxc_ = sys_.nxc(), nz_ = m_.ns + nxc_;
+  Eigen::VectorXd z_, zn_, g_, gn_, gz_, zslope_;
+  bool zslope_ok_ = false, z_jacobian_ok_ = false;
+  double h_last_ = 0, h_z_ = 0;
+  int z_jacobian_age_ = 0;
+  Eigen::MatrixXd Gz_;
+  Eigen::PartialPivLU<Eigen::MatrixXd> luz_;
   double h_, alpha_given_, alpha_now_ = 0;
   int iterations_;
   double rtol_, atol_;
   bool fixed_, trace_;  // trace_: ALF_TRACE set, each Newton iteration printed
   double next_ = 0, last_failure_ = 0, h_now_ = 0, t_ = 0;
-  Eigen::VectorXd q_, v_, a_, xc_, lambda_, qn_, vn_, an_, lambdan_, f_, u_;
+  Eigen::VectorXd q_, v_, a_, lambda_, qn_, vn_, an_, lambdan_, f_, u_;
   Eigen::VectorXd jerk_rate_;  // (a_n - a_n-1) / h_n-1 of the last accepted step (jerk_: valid)
   bool jerk_ = false;
   double theta_step_ = 0;  // Newton's contraction rate in the last step that measured it (0: none)
@@ -937,7 +1043,7 @@ class Alf final : public Integrator {
   // a fixed step's substeps' starts (one, or more where Newton made it halve the step), for show()
   struct Knot {
     double t = 0;
-    Eigen::VectorXd q, v, a;
+    Eigen::VectorXd q, v, a, z, g;
   };
   std::vector<Knot> knot_;
   int knots_ = 0;

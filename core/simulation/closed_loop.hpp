@@ -122,6 +122,11 @@ class ClosedLoopSystem {
   // dF/dY + cj dF/dY' of residual() [dae_size x dae_size] (rows chosen by consistent())
   bool dae_jacobian(double t, const Eigen::VectorXd& Y, const Eigen::VectorXd& Yp, double cj, Eigen::MatrixXd& J);
 
+  // the controller's state equation, told the Plant/In values applied (after saturation) in u
+  // (the effect states measured are those set last: set_effect_states)
+  Eigen::VectorXd controller_rates(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+                                   const Eigen::VectorXd& xc, const Eigen::VectorXd& u) const;
+
  private:
   Eigen::VectorXd saturate(Eigen::VectorXd u_all) const;
   // the beside controller's held values into u (one entry per actuator), d its disturbance (or empty)
@@ -135,9 +140,6 @@ class ClosedLoopSystem {
   std::vector<int> beside_actuators_;
   Eigen::VectorXd beside_held_;
   std::function<Eigen::VectorXd(double)> reference_, disturbance_, disturbance_rate_, disturbance_acceleration_;
-  // the controller's state equation, told the Plant/In values applied (after saturation) in u
-  Eigen::VectorXd controller_rates(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
-                                   const Eigen::VectorXd& xc, const Eigen::VectorXd& u) const;
   Baumgarte stab_;
   int continuous_states_ = 0;
   std::vector<int> rows_;  // DAE form: constraint rows carrying multipliers

@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 
 #include "dynamics/prepare.hpp"
@@ -432,7 +433,7 @@ TEST(Alf, SedanAndTheDoubleWishboneRig) {
   const SimulationResult alf = example_run("sedan.json", "alf", 1.0, 1e-3, 1e-5);
   const double gap = max_q_gap(alf, ref);
   double drift = 0;
-  for (Eigen::Index i = 0; i < alf.constraint_violation.size(); ++i) drift = std::max(drift, alf.constraint_violation[i]);
+  for (std::size_t i = 0; i < alf.constraint_violation.size(); ++i) drift = std::max(drift, alf.constraint_violation[i]);
   std::cout << "sedan 1 s, alf at 1e-3 against arkode at 1e-8: " << gap << " (" << alf.stats.steps << " steps against "
             << ref.stats.steps << "), max |phi| " << drift << "\n";
   EXPECT_LT(gap, 1e-3);      // measured 5.3e-4 rad (an upper arm in the start's transient)
@@ -442,6 +443,85 @@ TEST(Alf, SedanAndTheDoubleWishboneRig) {
   const SimulationResult rig = example_run("kc_double_wishbone.json", "alf", 1.0, 1e-5, 1e-7);
   std::cout << "K&C rig 1 s (settling on its springs), alf at 1e-5 against cvode-bdf at 1e-9: " << max_q_gap(rig, rig_ref) << "\n";
   EXPECT_LT(max_q_gap(rig, rig_ref), 1e-6);  // measured 9e-9 rad
+}
+
+// an example's model, changed (its JSON document), run by `integrator` as example_run does
+SimulationResult changed_example_run(const std::string& file, const std::function<void(nlohmann::json&)>& change,
+                                     const std::string& integrator, double t_end, double rtol, double atol, double h = 0) {
+  std::ifstream in(test::example_path(file));
+  nlohmann::json j = nlohmann::json::parse(in);
+  change(j);
+  SimulateRequest r;
+  r.model = test::example_path(file);
+  r.open_loop = !j.contains("controller");
+  r.integrator = integrator;
+  r.t_end = t_end;
+  r.rtol = rtol;
+  r.atol = atol;
+  if (h > 0) {
+    r.max_step = h;
+    r.alf_fixed_step = true;
+  }
+  SimulateJob job = study_simulate_job(r, parse_model_spec(j, r.model));
+  EXPECT_TRUE(job.result.completed) << file << " by " << integrator << ": " << job.result.failure;
+  return std::move(job.result);
+}
+
+// a controller with continuous states (a PID's integral, the held four-bar's rocker through its
+// reference's step at 0.5 s): the states by the trapezoidal rule beside the positions, their
+// block by its own Newton; against cvode-bdf at 1e-11 the output and the integral fall as h^2
+TEST(Alf, PidIntegralStateSecondOrder) {
+  auto pid = [](nlohmann::json& j) {
+    j["analysis"].erase("controller");
+    j["analysis"].erase("q_weights");
+    j["analysis"].erase("r_weights");
+    j["controller"] = {{"type", "pid"}, {"kp", {{40.0}}}, {"ki", {{60.0}}}, {"kd", {{4.0}}}};
+  };
+  const SimulationResult ref = changed_example_run("four_bar_held.json", pid, "cvode-bdf", 5.0, 1e-11, 1e-11);
+  const SimulationResult coarse = changed_example_run("four_bar_held.json", pid, "alf", 5.0, 1e-8, 1e-8, 2e-3);
+  const SimulationResult fine = changed_example_run("four_bar_held.json", pid, "alf", 5.0, 1e-8, 1e-8, 1e-3);
+  ASSERT_EQ(ref.xc.cols(), 1);
+  ASSERT_EQ(fine.xc.rows(), ref.xc.rows());
+  ASSERT_EQ(coarse.xc.rows(), ref.xc.rows());
+  const double yc = (coarse.y - ref.y).cwiseAbs().maxCoeff(), yf = (fine.y - ref.y).cwiseAbs().maxCoeff();
+  const double xc = (coarse.xc - ref.xc).cwiseAbs().maxCoeff(), xf = (fine.xc - ref.xc).cwiseAbs().maxCoeff();
+  std::cout << "held four-bar under PID, alf at 2 ms and 1 ms against cvode-bdf 1e-11: y " << yc << ", " << yf << "; xi " << xc
+            << ", " << xf << " (xi up to " << ref.xc.cwiseAbs().maxCoeff() << ")\n";
+  EXPECT_GT(ref.xc.cwiseAbs().maxCoeff(), 0.01);  // the integral works: measured 0.039
+  EXPECT_LT(yf, 1e-6);                            // measured 4.8e-7 rad
+  EXPECT_LT(xf, 3e-7);                            // measured 1.4e-7
+  EXPECT_GT(yc / yf, 3.5);                        // h^2: measured 4.0
+  EXPECT_LT(yc / yf, 4.5);
+  EXPECT_GT(xc / xf, 3.5);                        // measured 4.0
+  EXPECT_LT(xc / xf, 4.5);
+  // with error control: tighter, closer
+  const SimulationResult loose = changed_example_run("four_bar_held.json", pid, "alf", 5.0, 1e-5, 1e-5);
+  const SimulationResult tight = changed_example_run("four_bar_held.json", pid, "alf", 5.0, 1e-7, 1e-7);
+  const double el = (loose.y - ref.y).cwiseAbs().maxCoeff(), et = (tight.y - ref.y).cwiseAbs().maxCoeff();
+  std::cout << "  error control at 1e-5 and 1e-7: y " << el << ", " << et << "\n";
+  EXPECT_LT(et, 3e-6);  // measured 9.5e-7 (1e-5: 4.6e-5)
+  EXPECT_LT(et, el / 10);
+}
+
+// effect states (the sedan's tires with transient slip, relaxation lengths 0.4 m and 0.3 m: eight
+// deflections): the positions and the deflections within the tolerance's reach of arkode at 1e-10
+TEST(Alf, SedanWithTransientTires) {
+  auto transient = [](nlohmann::json& j) {
+    for (auto& e : j["effects"])
+      if (e["type"] == "tire") {
+        e["longitudinal_relaxation_length"] = 0.4;
+        e["lateral_relaxation_length"] = 0.3;
+      }
+  };
+  const SimulationResult ref = changed_example_run("sedan.json", transient, "arkode", 1.0, 1e-10, 1e-12);
+  const SimulationResult alf = changed_example_run("sedan.json", transient, "alf", 1.0, 1e-5, 1e-7);
+  ASSERT_EQ(ref.s.cols(), 8);
+  ASSERT_EQ(alf.s.rows(), ref.s.rows());
+  const double dq = max_q_gap(alf, ref), ds = (alf.s - ref.s).cwiseAbs().maxCoeff();
+  std::cout << "sedan with transient tires 1 s, alf at 1e-5 against arkode at 1e-10: q " << dq << ", deflections " << ds
+            << " m (up to " << ref.s.cwiseAbs().maxCoeff() << ")\n";
+  EXPECT_LT(dq, 2e-4);  // measured 9.4e-5 rad (an upper arm in the start's transient)
+  EXPECT_LT(ds, 4e-6);  // measured 1.7e-6 m, 1e-3 of the largest deflection
 }
 
 // a sweep of 100 variants of the held four-bar (the coupler's mass 3..5 kg, the nominal LQR
