@@ -1,6 +1,6 @@
 // Work-precision study (docs/work-precision.md, docs/performance.md): for each problem,
 // each codyna integrator (ida, cvode-bdf, cvode-adams, arkode, alf; alf skips the models it
-// refuses, those with ball or free joints; on request alf-fixed: alf at fixed steps of
+// refuses, those with rolling constraints; on request alf-fixed: alf at fixed steps of
 // 0.1 sqrt(tol), not in the default list) (and each Simbody integrator when the Simbody peer is built) and
 // rtol = atol = 10^-(2 + k/2), k = 0..kmax, one run, its error against an exact solution,
 // a published reference, an exact invariant or a tight reference run, and its CPU time.
@@ -545,7 +545,7 @@ int main(int argc, char** argv) {
         } catch (const std::exception& e) {
           if (method.rfind("alf", 0) == 0 && std::string(e.what()).find("not integrated by alf") != std::string::npos) {
             std::cout << method << ": does not take " << p.name << " (" << e.what() << ")" << std::endl;
-            break;  // a model alf refuses (ball or free joints): no column entry
+            break;  // a model alf refuses (rolling constraints): no column entry
           }
           std::cerr << method << ": " << e.what() << "\n";
           return 1;
