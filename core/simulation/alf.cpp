@@ -388,7 +388,12 @@ class Alf final : public Integrator {
       double h = rest <= next_ * (1 + 1e-3) ? rest : rest < 2 * next_ ? rest / 2 : next_;
       for (int tries = 0;; ++tries) {
         if (tries > 60 || h < 1e-12 * std::max(1.0, std::abs(t_)))
-          throw IntegratorFailure(t_, "alf: no step down to " + alf_number(h) + " s passes the Newton iteration and the error test");
+          throw IntegratorFailure(t_, "alf: no step down to " + alf_number(h) +
+                                          " s passes the Newton iteration and the error test (alf is second order: at "
+                                          "rtol " + alf_number(rtol_) + ", atol " + alf_number(atol_) + " its steps became too short" +
+                                          (m_.nc ? " for its penalty to hold the loops" : "") +
+                                          "; a looser rtol and atol, such as 1e-4 and 1e-6, or fixed steps: alf_fixed_step "
+                                          "with max_step)");
         if (!step(h, h >= rest)) {
           h *= 0.25;
           continue;

@@ -443,6 +443,19 @@ TEST(Alf, SedanAndTheDoubleWishboneRig) {
   const SimulationResult rig = example_run("kc_double_wishbone.json", "alf", 1.0, 1e-5, 1e-7);
   std::cout << "K&C rig 1 s (settling on its springs), alf at 1e-5 against cvode-bdf at 1e-9: " << max_q_gap(rig, rig_ref) << "\n";
   EXPECT_LT(max_q_gap(rig, rig_ref), 1e-6);  // measured 9e-9 rad
+  // at the file's tolerances (1e-8, 1e-10) alf's steps at the start fall below 1e-10 s, where the
+  // penalty's weight is gone and a = 4/h^2 (q - q_n) - ... is rounding: the failure says so and
+  // what to do
+  SimulateRequest tight;
+  tight.model = test::example_path("sedan.json");
+  tight.open_loop = true;
+  tight.integrator = "alf";
+  tight.t_end = 0.01;
+  const SimulateJob failed = study_simulate_job(tight, study_read_model(tight.model));
+  ASSERT_FALSE(failed.result.completed);
+  EXPECT_NE(failed.result.failure.find("rtol 1e-08, atol 1e-10"), std::string::npos) << failed.result.failure;
+  EXPECT_NE(failed.result.failure.find("to hold the loops; a looser rtol"), std::string::npos) << failed.result.failure;
+  EXPECT_NE(failed.result.failure.find("alf_fixed_step"), std::string::npos) << failed.result.failure;
 }
 
 // an example's model, changed (its JSON document), run by `integrator` as example_run does
