@@ -365,12 +365,16 @@ TEST(Alf, HeldFourBarComparesWithTheLinearLoop) {
   EXPECT_NEAR(tight.linear_gap[0], bdf.linear_gap[0], 3e-8);       // measured 1e-8 apart
 }
 
-// an example run open loop by `integrator` (rtol, atol given; h > 0 with alf: fixed steps of h)
-SimulationResult example_run(const std::string& file, const std::string& integrator, double t_end, double rtol, double atol,
-                             double h = 0) {
+// an example's model, changed (its JSON document; `change` may be empty), run by `integrator` at
+// rtol, atol (h > 0: alf at fixed steps of h); open loop unless the change gave it a controller
+SimulationResult changed_example_run(const std::string& file, const std::function<void(nlohmann::json&)>& change,
+                                     const std::string& integrator, double t_end, double rtol, double atol, double h = 0) {
+  std::ifstream in(test::example_path(file));
+  nlohmann::json j = nlohmann::json::parse(in);
+  if (change) change(j);
   SimulateRequest r;
   r.model = test::example_path(file);
-  r.open_loop = true;
+  r.open_loop = !j.contains("controller");
   r.integrator = integrator;
   r.t_end = t_end;
   r.rtol = rtol;
@@ -379,9 +383,14 @@ SimulationResult example_run(const std::string& file, const std::string& integra
     r.max_step = h;
     r.alf_fixed_step = true;
   }
-  SimulateJob job = study_simulate_job(r, study_read_model(r.model));
+  SimulateJob job = study_simulate_job(r, parse_model_spec(j, r.model));
   EXPECT_TRUE(job.result.completed) << file << " by " << integrator << ": " << job.result.failure;
   return std::move(job.result);
+}
+
+SimulationResult example_run(const std::string& file, const std::string& integrator, double t_end, double rtol, double atol,
+                             double h = 0) {
+  return changed_example_run(file, {}, integrator, t_end, rtol, atol, h);
 }
 
 double max_q_gap(const SimulationResult& a, const SimulationResult& b) {
@@ -456,28 +465,6 @@ TEST(Alf, SedanAndTheDoubleWishboneRig) {
   EXPECT_NE(failed.result.failure.find("rtol 1e-08, atol 1e-10"), std::string::npos) << failed.result.failure;
   EXPECT_NE(failed.result.failure.find("to hold the loops; a looser rtol"), std::string::npos) << failed.result.failure;
   EXPECT_NE(failed.result.failure.find("alf_fixed_step"), std::string::npos) << failed.result.failure;
-}
-
-// an example's model, changed (its JSON document), run by `integrator` as example_run does
-SimulationResult changed_example_run(const std::string& file, const std::function<void(nlohmann::json&)>& change,
-                                     const std::string& integrator, double t_end, double rtol, double atol, double h = 0) {
-  std::ifstream in(test::example_path(file));
-  nlohmann::json j = nlohmann::json::parse(in);
-  change(j);
-  SimulateRequest r;
-  r.model = test::example_path(file);
-  r.open_loop = !j.contains("controller");
-  r.integrator = integrator;
-  r.t_end = t_end;
-  r.rtol = rtol;
-  r.atol = atol;
-  if (h > 0) {
-    r.max_step = h;
-    r.alf_fixed_step = true;
-  }
-  SimulateJob job = study_simulate_job(r, parse_model_spec(j, r.model));
-  EXPECT_TRUE(job.result.completed) << file << " by " << integrator << ": " << job.result.failure;
-  return std::move(job.result);
 }
 
 // a controller with continuous states (a PID's integral, the held four-bar's rocker through its
