@@ -332,7 +332,7 @@ class Alf final : public Integrator {
     lambda_ = m_.nc ? Eigen::VectorXd(d_.lambda) : Eigen::VectorXd();
     if (!a_.allFinite()) throw IntegratorFailure(t, "alf: the accelerations at the start are not finite");
     if (next_ <= 0) {  // the first step: a small fraction of what the accelerations allow
-      const Eigen::ArrayXd w = atol_ + rtol_ * q_.array().abs();
+      const Eigen::ArrayXd w = atol_ + rtol_ * magnitude(q_);
       const double acc = (a_.array().abs() / w).maxCoeff();
       next_ = acc > 0 ? 0.5 * std::sqrt(1.0 / acc) : 1e-3;
       next_ = std::clamp(next_, 1e-6, 1e-2);
