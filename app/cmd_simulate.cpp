@@ -23,6 +23,7 @@ struct SimulateArgs {
   double t_end = 0, rtol = 0, atol = 0, max_step = -1, output_step = 0, alf_penalty = 0;
   int alf_iterations = 0;
   bool alf_fixed_step = false;
+  bool alf_extrapolate = false;
   // the simulator's own limits unless given (shown as the defaults in --help)
   double max_samples = SimulationOptions{}.max_samples, divergence_bound = SimulationOptions{}.divergence_bound;
   PointFlags point;
@@ -69,6 +70,7 @@ SimulateRequest simulate_request_of(const SimulateArgs& a) {
   if (given(a.cmd, "--alf-penalty")) r.alf_penalty = a.alf_penalty;
   if (given(a.cmd, "--alf-iterations")) r.alf_iterations = a.alf_iterations;
   if (a.alf_fixed_step) r.alf_fixed_step = true;
+  if (a.alf_extrapolate) r.alf_extrapolate = true;
   if (given(a.cmd, "--max-samples")) r.max_samples = a.max_samples;
   if (given(a.cmd, "--divergence-bound")) r.divergence_bound = a.divergence_bound;
   return r;
@@ -80,6 +82,7 @@ std::string alf_settings(const SolverSpec& sp, const SolverStats& stats) {
   const IntegratorSettings is = integrator_settings(sp);
   std::ostringstream os;
   if (is.alf_fixed_step) os << "fixed steps of " << (is.max_step > 0 ? is.max_step : 1e-3) << " s, ";
+  if (is.alf_extrapolate) os << "each step extrapolated from two halves, ";
   os << "penalty " << is.alf_penalty << ", at most " << is.alf_iterations << " iterations a step, Newton at ";
   return os.str();
 }
@@ -277,6 +280,8 @@ void add_simulate(CLI::App& app) {
   cmd->add_option("--alf-penalty", a->alf_penalty, "alf: the penalty on the constraints (> 0; default the file's, else 1e11)");
   cmd->add_option("--alf-iterations", a->alf_iterations, "alf: the most Newton iterations a step (>= 1; default 100)");
   cmd->add_flag("--alf-fixed-step", a->alf_fixed_step, "alf: every step --max-step (default 1 ms) instead of the error control");
+  cmd->add_flag("--alf-extrapolate", a->alf_extrapolate,
+                "alf: each step also as two of half its length, combined (Richardson's extrapolation: fourth order, three steps' work)");
   cmd->add_option("--output-step", a->output_step, "output interval [s]");
   cmd->add_flag("--quiet", a->quiet, "no progress bar");
   cmd->add_option("--max-samples", a->max_samples, "refuse runs that would record more output samples")->capture_default_str();

@@ -1,7 +1,8 @@
 // Work-precision study (docs/work-precision.md, docs/performance.md): for each problem,
 // each codyna integrator (ida, cvode-bdf, cvode-adams, arkode, alf; alf skips the models it
 // refuses, those with rolling constraints; on request alf-fixed: alf at fixed steps of
-// 0.1 sqrt(tol), not in the default list) (and each Simbody integrator when the Simbody peer is built) and
+// 0.1 sqrt(tol), and alf-x-fixed: alf extrapolated (alf_extrapolate) at fixed steps of
+// 0.16 tol^(1/4), neither in the default list) (and each Simbody integrator when the Simbody peer is built) and
 // rtol = atol = 10^-(2 + k/2), k = 0..kmax, one run, its error against an exact solution,
 // a published reference, an exact invariant or a tight reference run, and its CPU time.
 //
@@ -321,6 +322,10 @@ CodynaRun run_codyna(const Problem& p, const std::string& method, double tol, in
     o.integrator.method = "alf";
     o.integrator.alf_fixed_step = true;
     o.integrator.max_step = 0.1 * std::sqrt(tol);
+  } else if (method == "alf-x-fixed") {  // alf with Richardson's extrapolation at fixed steps h = 0.16 tol^(1/4) (50 ms at 1e-2, 5 ms at 1e-6): fourth order
+    o.integrator.method = "alf";
+    o.integrator.alf_extrapolate = o.integrator.alf_fixed_step = true;
+    o.integrator.max_step = 0.16 * std::sqrt(std::sqrt(tol));
   }
   o.t_end = p.t_end;
   o.output_step = p.output_step;

@@ -324,6 +324,12 @@ void SimulateView::buildUi() {
                             "by its error estimate; Newton then works to rtol, atol of at most 1e-6 (solver.alf_fixed_step, "
                             "--alf-fixed-step)"));
   form->addRow(alf_fixed_);
+  alf_extrapolate_ = new QCheckBox(tr("alf: each step extrapolated from two halves"), solver_box);
+  alf_extrapolate_->setObjectName("alfExtrapolate");
+  alf_extrapolate_->setToolTip(tr("alf takes each step also as two of half its length and combines the two ends "
+                                  "(Richardson's extrapolation): fourth order instead of second, for three steps' work "
+                                  "(solver.alf_extrapolate, --alf-extrapolate)"));
+  form->addRow(alf_extrapolate_);
   alf_penalty_ = numberField("alfPenalty", tr("alf penalty"), tr("1e11 (alf's default)"),
                              tr("alf's penalty alpha on the loop closures, a number > 0 (empty: the default 1e11; "
                                 "solver.alf_penalty, --alf-penalty)"));
@@ -490,7 +496,12 @@ void SimulateView::buildUi() {
   for (std::size_t i = 0; i < solver_numbers_.size(); ++i)
     connect(solver_numbers_[i].edit, &QLineEdit::editingFinished, this, [this, i] { solverNumberEdited(solver_numbers_[i]); });
   connect(alf_fixed_, &QCheckBox::toggled, this, [this](bool on) {
-    writeSolver([&](SolverSpec& s) { s.alf_fixed_step = on; }, on ? tr("alf at fixed steps") : tr("alf with error control"));
+    // (extrapolation is for fixed steps: it goes with them)
+    writeSolver([&](SolverSpec& s) { s.alf_fixed_step = on, s.alf_extrapolate = s.alf_extrapolate && on; },
+                on ? tr("alf at fixed steps") : tr("alf with error control"));
+  });
+  connect(alf_extrapolate_, &QCheckBox::toggled, this, [this](bool on) {
+    writeSolver([&](SolverSpec& s) { s.alf_extrapolate = on; }, on ? tr("alf extrapolated") : tr("alf not extrapolated"));
   });
   connect(compare_linear_, &QCheckBox::toggled, this, [this](bool on) {
     writeStudy([&](StudySpec& s) { s.compare_linear = on; }, on ? tr("Compare with the linear loop") : tr("Do not compare with the linear loop"));
@@ -647,9 +658,12 @@ void SimulateView::refreshFromDocument() {
     const bool alf = so.integrator == "alf";
     const QSignalBlocker b7(alf_fixed_);
     alf_fixed_->setChecked(so.alf_fixed_step);
+    const QSignalBlocker b8(alf_extrapolate_);
+    alf_extrapolate_->setChecked(so.alf_extrapolate);
     alf_penalty_->setText(so.alf_penalty ? QString::number(*so.alf_penalty, 'g', 17) : QString());
     alf_iterations_->setText(so.alf_iterations ? QString::number(*so.alf_iterations) : QString());
     for (QWidget* w : std::initializer_list<QWidget*>{alf_fixed_, alf_penalty_, alf_iterations_}) w->setEnabled(alf);
+    alf_extrapolate_->setEnabled(alf && so.alf_fixed_step);  // (fixed steps only)
     compare_linear_->setChecked(st.compare_linear);
   }
   {

@@ -110,6 +110,7 @@ class SimulateView : public QWidget {
   QLineEdit* atolEdit() const { return atol_; }
   QLineEdit* maxStepEdit() const { return max_step_; }
   QCheckBox* alfFixedCheck() const { return alf_fixed_; }
+  QCheckBox* alfExtrapolateCheck() const { return alf_extrapolate_; }
   QLineEdit* alfPenaltyEdit() const { return alf_penalty_; }
   QLineEdit* alfIterationsEdit() const { return alf_iterations_; }
   QCheckBox* compareLinearCheck() const { return compare_linear_; }
@@ -199,6 +200,7 @@ class SimulateView : public QWidget {
   QLineEdit* atol_ = nullptr;
   QLineEdit* max_step_ = nullptr;
   QCheckBox* alf_fixed_ = nullptr;
+  QCheckBox* alf_extrapolate_ = nullptr;
   QLineEdit* alf_penalty_ = nullptr;
   QLineEdit* alf_iterations_ = nullptr;
   QCheckBox* compare_linear_ = nullptr;

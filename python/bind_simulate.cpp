@@ -67,6 +67,7 @@ SimulateRequest simulate_request(const Study& s, const py::dict& options) {
   r.alf_penalty = k.number("alf_penalty");
   if (const auto n = k.whole("alf_iterations", INT_MIN, INT_MAX)) r.alf_iterations = static_cast<int>(*n);
   if (k.flag("alf_fixed_step")) r.alf_fixed_step = true;
+  if (k.flag("alf_extrapolate")) r.alf_extrapolate = true;
   r.max_samples = k.number("max_samples");
   r.divergence_bound = k.number("divergence_bound");
   k.finish();

@@ -1313,6 +1313,8 @@ const Schema<SolverSpec>& schema<SolverSpec>() {
             [](const std::optional<int>& k) { return k ? ojson(*k) : ojson(); }),
       field("alf_fixed_step", &SolverSpec::alf_fixed_step, read_bool,
             [](bool fixed) { return fixed ? ojson(true) : ojson(); }),
+      field("alf_extrapolate", &SolverSpec::alf_extrapolate, read_bool,
+            [](bool on) { return on ? ojson(true) : ojson(); }),
   }};
   return s;
 }

@@ -388,6 +388,7 @@ struct SolverSpec {
   std::optional<double> alf_penalty;
   std::optional<int> alf_iterations;
   bool alf_fixed_step = false;
+  bool alf_extrapolate = false;  // alf: Richardson's extrapolation of each step (fourth order)
 };
 
 struct ModelSpec {

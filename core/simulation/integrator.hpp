@@ -39,6 +39,9 @@ struct IntegratorSettings {
   double alf_penalty = 1e11;
   int alf_iterations = 100;
   bool alf_fixed_step = false;
+  // alf: each step also taken as two of half its length, and the two ends combined (Richardson's
+  // extrapolation, x2 + (x2 - x1)/3: the trapezoidal rule's h^2 term cancels, fourth order)
+  bool alf_extrapolate = false;
 };
 
 // a model file's solver settings as the integrators take them (alf's absent settings: its defaults)

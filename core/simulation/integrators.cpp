@@ -383,6 +383,7 @@ IntegratorSettings integrator_settings(const SolverSpec& solver) {
   if (solver.alf_penalty) s.alf_penalty = *solver.alf_penalty;
   if (solver.alf_iterations) s.alf_iterations = *solver.alf_iterations;
   s.alf_fixed_step = solver.alf_fixed_step;
+  s.alf_extrapolate = solver.alf_extrapolate;
   return s;
 }
 

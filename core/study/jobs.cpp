@@ -505,6 +505,10 @@ ModelSpec simulate_spec(const SimulateRequest& a, ModelSpec spec) {
     sp.alf_iterations = *a.alf_iterations;
   }
   if (a.alf_fixed_step) sp.alf_fixed_step = *a.alf_fixed_step;
+  if (a.alf_extrapolate) sp.alf_extrapolate = *a.alf_extrapolate;
+  if (sp.integrator == "alf" && sp.alf_extrapolate && !sp.alf_fixed_step)
+    throw std::invalid_argument(opt("alf-extrapolate") + ": needs fixed steps, " + opt("alf-fixed-step") +
+                                " (alf's error control does not extrapolate)");
   check("max-samples", a.max_samples, [](double x) { return x >= 1; }, "a number >= 1");
   check("divergence-bound", a.divergence_bound, [](double x) { return x > 0; }, "a number > 0");
   return spec;
@@ -543,6 +547,7 @@ GivenFields simulate_fields(const SimulateRequest& a) {
   g.add(a.alf_penalty.has_value(), "/solver/alf_penalty", "alf-penalty");
   g.add(a.alf_iterations.has_value(), "/solver/alf_iterations", "alf-iterations");
   g.add(a.alf_fixed_step.has_value(), "/solver/alf_fixed_step", "alf-fixed-step");
+  g.add(a.alf_extrapolate.has_value(), "/solver/alf_extrapolate", "alf-extrapolate");
   return g;
 }
 }  // namespace

@@ -117,6 +117,7 @@ struct SimulateRequest {
   std::optional<double> alf_penalty;   // alf's settings (SolverSpec)
   std::optional<int> alf_iterations;
   std::optional<bool> alf_fixed_step;
+  std::optional<bool> alf_extrapolate;
 };
 
 // The sample limit of a run shown live in a window, which keeps each run several times (plots, the

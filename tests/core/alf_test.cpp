@@ -30,12 +30,13 @@ struct AlfA02 {
 };
 
 // h > 0: fixed steps of h; h = 0: error control at rtol = atol = tol
-AlfA02 alf_a02(int N, double h, double t_end, double alpha = 1e8, double tol = 1e-6) {
+AlfA02 alf_a02(int N, double h, double t_end, double alpha = 1e8, double tol = 1e-6, bool extrapolate = false) {
   const Model m = compile(iftomm::a02_spec(N));
   SimulationOptions o;
   o.integrator.method = "alf";
   o.integrator.max_step = h;
   o.integrator.alf_fixed_step = h > 0;
+  o.integrator.alf_extrapolate = extrapolate;
   o.integrator.rtol = o.integrator.atol = tol;
   if (const char* rtol = std::getenv("ALF_RTOL")) o.integrator.rtol = std::atof(rtol);  // Explore: rtol apart
   o.integrator.alf_penalty = alpha;
@@ -94,6 +95,27 @@ TEST(Alf, A02FourBarsSecondOrderAgainstExact) {
   EXPECT_LT(std::max(coarse.drift, fine.drift), 1e-8);
 }
 
+// Richardson's extrapolation (alf_extrapolate): the trapezoidal rule is symmetric, its error an
+// expansion in h^2, so a step of h against two of h/2 cancels the h^2 term. A02's four-bars
+// before their first flat position (0.6 s): at 20 and 10 ms the error falls by ~h^4's 16, and at
+// 10 ms it is thousands of times below the plain rule's at 2.5 ms (the same work: three steps a
+// 10 ms against four); through two flat positions (2.2 s) still a hundred times below, the
+// loops closed to rounding, the samples (every 10 ms) inside the 20 ms steps interpolated
+TEST(Alf, A02FourBarsExtrapolatedFourthOrder) {
+  const double alpha = 1e11;
+  const AlfA02 plain = alf_a02(4, 2.5e-3, 0.6, alpha), coarse = alf_a02(4, 20e-3, 0.6, alpha, 1e-6, true),
+               fine = alf_a02(4, 10e-3, 0.6, alpha, 1e-6, true);
+  ASSERT_TRUE(plain.completed && coarse.completed && fine.completed);
+  EXPECT_GT(coarse.err / fine.err, 10);  // measured 13.6 (h^4: 16; the plain rule's 4)
+  EXPECT_LT(fine.err, 1e-8);             // measured 4.3e-9
+  EXPECT_GT(plain.err / fine.err, 1e3);  // measured 1.0e-5 against 4.3e-9
+  const AlfA02 through = alf_a02(4, 10e-3, 2.2, alpha, 1e-6, true), plain_through = alf_a02(4, 2.5e-3, 2.2, alpha);
+  ASSERT_TRUE(through.completed && plain_through.completed);
+  EXPECT_LT(through.err, 3e-7);                     // measured 1.1e-7
+  EXPECT_GT(plain_through.err / through.err, 50);   // measured 1.4e-5 against 1.1e-7
+  EXPECT_LT(std::max(coarse.drift, through.drift), 1e-10);
+}
+
 // the same at N = 16 (33 coordinates: the Newton and projection matrices factored in their band,
 // reverse Cuthill-McKee order, bandwidth 2; at N = 4 dense): every crank turns as the exact 1-DOF
 // motion, so the error is that of N = 4 at the same steps, whatever the factorization; and the
@@ -142,6 +164,11 @@ TEST(Alf, Refusals) {
   is.alf_iterations = 0;
   EXPECT_NE(refusal(m, is).find("alf_iterations"), std::string::npos) << refusal(m, is);
   EXPECT_EQ(refusal(m, IntegratorSettings()), "");
+  is = IntegratorSettings();
+  is.alf_extrapolate = true;  // (with error control: not offered)
+  EXPECT_NE(refusal(m, is).find("alf_extrapolate: needs alf_fixed_step"), std::string::npos) << refusal(m, is);
+  is.alf_fixed_step = true;
+  EXPECT_EQ(refusal(m, is), "");
   // rolling without slip (conditions on the velocities alone): not integrated by alf yet
   const Model disc = compile(study_read_model(test::example_path("rolling_disc.json")));
   EXPECT_NE(refusal(disc, IntegratorSettings()).find("rolling constraints"), std::string::npos) << refusal(disc, IntegratorSettings());
@@ -172,6 +199,7 @@ TEST(Alf, SettingsInTheModelFileAndTheRequest) {
   EXPECT_FALSE(plain["solver"].contains("alf_penalty"));
   EXPECT_FALSE(plain["solver"].contains("alf_iterations"));
   EXPECT_FALSE(plain["solver"].contains("alf_fixed_step"));
+  EXPECT_FALSE(plain["solver"].contains("alf_extrapolate"));
   j["solver"]["integrator"] = "alf";
   j["solver"]["alf_penalty"] = 1e9;
   j["solver"]["alf_iterations"] = 30;
@@ -226,6 +254,27 @@ TEST(Alf, SettingsInTheModelFileAndTheRequest) {
   EXPECT_LT(e4, 2e-6);
   EXPECT_GT(e5 / e4, 1.4);
   EXPECT_LT(e5 / e4, 1.75);
+  // extrapolated (the file's alf_extrapolate, written back; --alf-extrapolate): 4 ms steps of three
+  // trapezoidal steps each (750), far closer to the reference (the reference step at 0.5 s a stop of every
+  // run; measured 6.1e-10 rad against 7.5e-7)
+  nlohmann::json jx = j;
+  jx["solver"]["alf_extrapolate"] = true;
+  const ModelSpec spec_x = parse_model_spec(jx, "four_bar_held.json");
+  EXPECT_TRUE(spec_x.solver.alf_extrapolate && integrator_settings(spec_x.solver).alf_extrapolate);
+  EXPECT_EQ(to_json(spec_x)["solver"]["alf_extrapolate"], true);
+  SimulateRequest rx;
+  rx.model = path;
+  const SimulateJob extrapolated = study_simulate_job(rx, spec_x);
+  ASSERT_TRUE(extrapolated.result.completed) << extrapolated.result.failure;
+  EXPECT_EQ(extrapolated.result.stats.steps, 750);
+  const double ex = (extrapolated.result.y - ref.result.y).cwiseAbs().maxCoeff();
+  std::cout << "the same extrapolated at 4 ms: " << ex << " rad\n";
+  EXPECT_LT(ex, e4 / 20);
+  rx.alf_extrapolate = true;  // (the request's option, on a file without it)
+  const SimulateJob by_request = study_simulate_job(rx, spec);
+  ASSERT_TRUE(by_request.result.completed) << by_request.result.failure;
+  EXPECT_EQ(by_request.result.stats.steps, 750);
+  EXPECT_EQ((by_request.result.y - extrapolated.result.y).cwiseAbs().maxCoeff(), 0.0);
   // one Newton iteration a step is too few at 1e-8: the run fails and says which setting limits it
   r.alf_iterations = 1;
   const SimulateJob starved = study_simulate_job(r, spec);
@@ -249,6 +298,8 @@ TEST(Alf, SettingsInTheModelFileAndTheRequest) {
   EXPECT_NE(file_refusal("alf_iterations", 2.5).find("an integer"), std::string::npos);
   EXPECT_NE(file_refusal("alf_fixed_step", "yes").find("/solver/alf_fixed_step"), std::string::npos)
       << file_refusal("alf_fixed_step", "yes");
+  EXPECT_NE(file_refusal("alf_extrapolate", 1).find("/solver/alf_extrapolate"), std::string::npos)
+      << file_refusal("alf_extrapolate", 1);
   // a spec built in code: compile() refuses the same
   ModelSpec coded = spec;
   coded.solver.alf_penalty = 0.0;
@@ -319,6 +370,30 @@ TEST(Alf, A05StiffFlyballOnTheFullTangent) {
     previous_err = err;
     previous_steps = r.stats.steps;
   }
+}
+
+// extrapolated, the stiff flyball (a spring of 1e6 N/m) fails, and says why: the combined rule is
+// not A-stable (a stiff mode's factor tends to 5/3 a step), so the long steps that the plain rule
+// passes at 10 ms (it damps the mode) do not pass; a step whose long and half steps disagree by a
+// tenth of its motion is halved instead of extrapolated (before: a run on to 1e18 rad/s, "diverged")
+TEST(Alf, A05ExtrapolatedFailsAndSaysWhy) {
+  const Model m = test::load_example("iftomm_a05_flyball.json");
+  SimulationOptions o;
+  o.integrator.method = "alf";
+  o.integrator.alf_fixed_step = o.integrator.alf_extrapolate = true;
+  o.integrator.max_step = 0.05;
+  o.integrator.rtol = o.integrator.atol = 1e-2;
+  o.t_end = 2.0;
+  o.output_step = 0.05;
+  const SimulationResult r = simulate(m, nullptr, nullptr, o);
+  EXPECT_FALSE(r.completed);
+  EXPECT_NE(r.failure.find("alf_extrapolate"), std::string::npos) << r.failure;
+  EXPECT_NE(r.failure.find("not A-stable"), std::string::npos) << r.failure;
+  EXPECT_EQ(r.failure.find("diverged"), std::string::npos) << r.failure;
+  o.integrator.alf_extrapolate = false;  // the plain rule at 10 ms passes
+  o.integrator.max_step = 0.01;
+  const SimulationResult plain = simulate(m, nullptr, nullptr, o);
+  EXPECT_TRUE(plain.completed) << plain.failure;
 }
 
 // the held four-bar (examples/four_bar_held.json: a loop closure, an LQR about the equilibrium,
@@ -411,6 +486,25 @@ TEST(Alf, HeavyTopOnItsBallJointSecondOrder) {
   EXPECT_LT(ef, 0.05);       // measured 0.037 (the quaternion's components; the top spins at 100+ rad/s)
   EXPECT_GT(ec / ef, 3.5);   // h^2: measured 4.0
   EXPECT_LT(ec / ef, 4.5);
+  double unit = 0;
+  for (Eigen::Index i = 0; i < fine.q.rows(); ++i) unit = std::max(unit, std::abs(fine.q.row(i).head<4>().norm() - 1));
+  EXPECT_LT(unit, 1e-14);
+}
+
+// the same extrapolated (alf_extrapolate) on the group: q2 (+) (q2 (-) q1)/3. At 4 and 2 ms (the
+// work of the plain rule at 1.33 and 0.67 ms) the error falls by more than h^2's 4, and at 2 ms it
+// is below the plain rule's at 0.5 ms; the quaternion stays a unit one
+TEST(Alf, HeavyTopExtrapolatedOnItsBallJoint) {
+  const SimulationResult ref = example_run("heavy_top.json", "arkode", 2.0, 1e-11, 1e-13);
+  const auto extrapolated = [](nlohmann::json& j) { j["solver"]["alf_extrapolate"] = true; };
+  const SimulationResult coarse = changed_example_run("heavy_top.json", extrapolated, "alf", 2.0, 1e-8, 1e-10, 4e-3);
+  const SimulationResult fine = changed_example_run("heavy_top.json", extrapolated, "alf", 2.0, 1e-8, 1e-10, 2e-3);
+  const SimulationResult plain = example_run("heavy_top.json", "alf", 2.0, 1e-8, 1e-10, 5e-4);
+  const double ec = max_q_gap(coarse, ref), ef = max_q_gap(fine, ref), ep = max_q_gap(plain, ref);
+  std::cout << "heavy top, alf extrapolated at 4 and 2 ms against arkode 1e-11: " << ec << ", " << ef << " (plain at 0.5 ms " << ep << ")\n";
+  EXPECT_GT(ec / ef, 10);  // measured 21 (0.030 and 0.0014: h^4 is 16; the fast spin's phase)
+  EXPECT_LT(ef, 5e-3);
+  EXPECT_GT(ep / ef, 10);  // measured 26 (0.037)
   double unit = 0;
   for (Eigen::Index i = 0; i < fine.q.rows(); ++i) unit = std::max(unit, std::abs(fine.q.row(i).head<4>().norm() - 1));
   EXPECT_LT(unit, 1e-14);
@@ -576,7 +670,7 @@ TEST(Alf, Explore) {
     for (double h : {1e-2, 5e-3, 2e-3, 1e-3, 5e-4}) alf_a02(N, h, 20.0, alpha);
   if (const char* one = std::getenv("ALF_H")) {
     alf_a02(N, std::atof(one), std::getenv("ALF_TEND") ? std::atof(std::getenv("ALF_TEND")) : 20.0, alpha,
-            std::getenv("ALF_TOL") ? std::atof(std::getenv("ALF_TOL")) : 1e-6);
+            std::getenv("ALF_TOL") ? std::atof(std::getenv("ALF_TOL")) : 1e-6, std::getenv("ALF_EXTRAPOLATE") != nullptr);
     return;
   }
   if (const char* one = std::getenv("ALF_TOL")) {

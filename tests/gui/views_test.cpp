@@ -1140,8 +1140,13 @@ class ViewsTest : public QObject {
 
     type(view.maxStepEdit(), "0.002");
     QCOMPARE(doc.spec().solver.max_step, 0.002);
+    QVERIFY(!view.alfExtrapolateCheck()->isEnabled());  // (extrapolation waits for fixed steps)
     QTest::mouseClick(view.alfFixedCheck(), Qt::LeftButton, {}, QPoint(6, view.alfFixedCheck()->height() / 2));
     QVERIFY(doc.spec().solver.alf_fixed_step);
+    QVERIFY(view.alfExtrapolateCheck()->isEnabled() && !doc.spec().solver.alf_extrapolate);
+    QTest::mouseClick(view.alfExtrapolateCheck(), Qt::LeftButton, {}, QPoint(6, view.alfExtrapolateCheck()->height() / 2));
+    QVERIFY(doc.spec().solver.alf_extrapolate);
+    QCOMPARE(doc.undoStack()->undoText(), QString("alf extrapolated"));
     type(view.alfPenaltyEdit(), "lots");
     QVERIFY(said("alf penalty: expected a number > 0"));
     QVERIFY(!doc.spec().solver.alf_penalty);
@@ -1179,14 +1184,15 @@ class ViewsTest : public QObject {
     QCOMPARE(doc.undoStack()->index(), undo);
     QCOMPARE(static_cast<int>(messages.count()), said_before);
 
-    // the run takes them: 0.5 s at fixed steps of 2 ms is 250 steps
+    // the run takes them: 0.5 s at fixed steps of 2 ms is 250 steps, each extrapolated from
+    // three trapezoidal steps (750)
     view.endTimeSpin()->setValue(0.5);
     QSignalSpy finished(&view, &SimulateView::runFinished);
     view.run();
     QVERIFY(waitFor([&] { return finished.count() == 1; }));
     QVERIFY(view.result() && view.result()->completed);
     QCOMPARE(view.result()->stats.integrator, std::string("alf"));
-    QCOMPARE(view.result()->stats.steps, 250L);
+    QCOMPARE(view.result()->stats.steps, 750L);
     QVERIFY(view.result()->constraint_violation.back() < 1e-9);
 
     // emptied: alf's default again; undone: the typed value back in the field
@@ -1201,7 +1207,7 @@ class ViewsTest : public QObject {
     QVERIFY2(doc.saveAs(path, &err), qPrintable(err));
     const ModelSpec back = study_read_model(path.toStdString());
     QCOMPARE(back.solver.max_step, 0.002);
-    QVERIFY(back.solver.alf_fixed_step);
+    QVERIFY(back.solver.alf_fixed_step && back.solver.alf_extrapolate);
     QCOMPARE(back.solver.alf_penalty.value_or(0), 1e9);
     QCOMPARE(back.solver.alf_iterations.value_or(0), 30);
     // another integrator: alf's fields kept in the file, not editable

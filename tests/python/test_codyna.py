@@ -1020,6 +1020,18 @@ def test_alf_settings_are_the_command_lines(tmp_path):
     assert ": 200 steps" in stdout
     end = float(next(l for l in stdout.splitlines() if l.startswith("output rocker_angle")).split()[5])
     assert abs(r.y[-1, 0] - end) < 1e-5 * abs(end)
+    # extrapolated: three trapezoidal steps a 5 ms step, the same end by keyword and by flag
+    x = codyna.Study(held).simulate(integrator="alf", alf_fixed_step=True, alf_extrapolate=True, max_step=0.005, t_end=1.0)
+    assert x.completed
+    stdout, _ = cli("simulate", held, "--out", tmp_path / "alfx.h5", "--quiet", "--integrator", "alf", "--alf-fixed-step",
+                    "--alf-extrapolate", "--max-step", "0.005", "--t-end", "1")
+    assert "alf (fixed steps of 0.005 s, each step extrapolated from two halves, penalty 1e+11" in stdout
+    assert ": 600 steps" in stdout
+    end = float(next(l for l in stdout.splitlines() if l.startswith("output rocker_angle")).split()[5])
+    assert abs(x.y[-1, 0] - end) < 1e-5 * abs(end)
+    with pytest.raises(ValueError) as e:
+        codyna.Study(held).simulate(integrator="alf", alf_extrapolate=True, t_end=0.1)
+    assert "alf-extrapolate" in str(e.value) or "alf_extrapolate" in str(e.value)
     with pytest.raises(ValueError) as e:
         codyna.Study(held).simulate(integrator="alf", alf_penalty=-1.0, t_end=0.1)
     assert "alf_penalty" in str(e.value)
