@@ -326,8 +326,10 @@ void SimulateView::buildUi() {
   form->addRow(alf_fixed_);
   alf_extrapolate_ = new QCheckBox(tr("alf: each step extrapolated from two halves"), solver_box);
   alf_extrapolate_->setObjectName("alfExtrapolate");
-  alf_extrapolate_->setToolTip(tr("alf takes each step also as two of half its length and combines the two ends "
-                                  "(Richardson's extrapolation): fourth order instead of second, for three steps' work "
+  alf_extrapolate_->setToolTip(tr("At fixed steps: alf takes each step also as two of half its length and combines "
+                                  "the two ends (Richardson's extrapolation): fourth order instead of second, for three "
+                                  "steps' work, on smooth motion. Not for stiff models: a model whose fastest mode is too "
+                                  "fast for the step is refused, with the longest step that passes "
                                   "(solver.alf_extrapolate, --alf-extrapolate)"));
   form->addRow(alf_extrapolate_);
   alf_penalty_ = numberField("alfPenalty", tr("alf penalty"), tr("1e11 (alf's default)"),

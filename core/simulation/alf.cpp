@@ -65,6 +65,8 @@
 // their error h^2/12 |z^(3)| from the rates' divided differences over two steps. No rolling
 // constraints (conditions on the velocities alone): refused by name. The penalty and the
 // iterations are alf_penalty and alf_iterations.
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
@@ -337,6 +339,7 @@ class Alf final : public Integrator {
     g_ = first_order_rates(t, q_, v_, z_);
     lambda_ = m_.nc ? Eigen::VectorXd(d_.lambda) : Eigen::VectorXd();
     if (!a_.allFinite()) throw IntegratorFailure(t, "alf: the accelerations at the start are not finite");
+    if (extrapolate_ && !stability_checked_) check_extrapolation_is_stable(t);  // (at the run's start)
     if (next_ <= 0) {  // the first step: a small fraction of what the accelerations allow
       const Eigen::ArrayXd w = atol_ + rtol_ * magnitude(q_);
       const double acc = (a_.array().abs() / w).maxCoeff();
@@ -812,8 +815,81 @@ class Alf final : public Integrator {
       g_ += (g_ - x1g_) / 3;
     }
     start_mass_ = false;  // (Mp_: M at the half steps' end, not at the combination)
+    if (++since_check_ >= kCheckSteps) check_extrapolation_is_stable(t1, false);
     return true;
   }
+  // The extrapolated rule's factor on a mode y' = lambda y is (4 R(z/2)^2 - R(z))/3, z = h lambda,
+  // R(z) = (1 + z/2)/(1 - z/2): on the imaginary axis (an undamped oscillation) |.|^2 =
+  // 1 + 8 (1 - cos(4 atan(y/4) - 2 atan(y/2)))/9 for z = i y, 1 + y^6/576 and so the rule's own
+  // error below y ~ 1, 1.077 a step at y = 3; on the negative axis it passes 1 near z = -30 and
+  // tends to 5/3 (the plain rule's factor is at most 1 in both). So the fastest mode of the
+  // linearization, [0 I; -M^-1 K  -M^-1 C] with K, C the balance's derivatives on the tree with
+  // the loops' reactions at their multipliers (their turning: Andrews' squeezer 389 1/s without,
+  // 1749 with; its runs that passed the first ended 1e-3 off), and the first-order states'
+  // dg/dz, must have h |lambda| <= kStableZ: checked at the start (a refusal, naming the mode's
+  // rate and the step that would pass) and every kCheckSteps steps (the run ends there; 7% of
+  // A02's time). A05's flyball (a spring of 1e6 N/m, 8117 1/s) before: its runs went on to 1e18
+  // rad/s or, at 16 to 21 ms, ended 0.02 to 0.06 m off where the plain rule at 10 ms is 2e-3 off
+  // (at the run's start: a refusal; on the way, every kCheckSteps extrapolated steps at the
+  // state reached, as K and C change with the motion: the run ends there)
+  void check_extrapolation_is_stable(double t, bool start = true) {
+    stability_checked_ = true;
+    since_check_ = 0;
+    double fastest = 0;
+    try {
+      if (!td_) {
+        td_ = std::make_unique<TreeDerivatives>(m_);
+        zero_multipliers_.setZero(m_.nc);
+      }
+      set_effect_states(z_);
+      const Eigen::VectorXd u = sys_.inputs(t, q_, v_, z_.tail(nxc_));
+      td_->compute_balance(q_, v_, u, a_, m_.nc ? lambda_ : zero_multipliers_);  // (the loops' reactions turning)
+      Eigen::MatrixXd M = td_->M, K = td_->dtau_dq - td_->dQ_dq, C = td_->dtau_dv - td_->dQ_dv;
+      for (const int i : driven_v_) {  // (a motion's coordinate is its signal's: no mode)
+        M.row(i).setZero(), M.col(i).setZero(), K.row(i).setZero(), K.col(i).setZero(), C.row(i).setZero(), C.col(i).setZero();
+        M(i, i) = 1;
+      }
+      fastest = fastest_mode(M, K, C);
+    } catch (const std::exception& e) {
+      if (trace_) std::fprintf(stderr, "alf: no tangent for the extrapolation's check (%s)\n", e.what());
+    }
+    if (nz_ && start) {
+      form_z_jacobian(t, q_, v_, z_);
+      if (z_jacobian_ok_) fastest = std::max(fastest, Eigen::EigenSolver<Eigen::MatrixXd>(Gz_, false).eigenvalues().cwiseAbs().maxCoeff());
+    }
+    if (trace_) std::fprintf(stderr, "alf: fastest mode %g 1/s at t %.9g (h |lambda| = %g)\n", fastest, t, h_ * fastest);
+    if (!(h_ * fastest > kStableZ)) return;
+    if (start) throw std::invalid_argument("integrator alf: " + too_fast(fastest, "at the start"));
+    throw IntegratorFailure(t, "alf: " + too_fast(fastest, "here"));
+  }
+  std::string too_fast(double fastest, const char* where) const {
+    std::ostringstream os;
+    os << "alf_extrapolate: the model's fastest mode " << where << ", " << alf_number(fastest) << " 1/s, makes h |lambda| = "
+       << alf_number(h_ * fastest) << " at max_step " << alf_number(h_) << " s, where the extrapolated rule is unstable (above "
+       << kStableZ << "); max_step at most " << alf_number(kStableZ / fastest)
+       << " s, or alf without alf_extrapolate (the plain rule damps it)";
+    return os.str();
+  }
+  // |lambda| of the fastest mode of x'' = -M^-1 (K x + C x'), by the power iteration on
+  // [0 I; -M^-1 K  -M^-1 C] (the growth of its 40th power, each an O(n^2) product and solve)
+  static double fastest_mode(const Eigen::MatrixXd& M, const Eigen::MatrixXd& K, const Eigen::MatrixXd& C) {
+    const Eigen::LLT<Eigen::MatrixXd> llt(M);
+    if (llt.info() != Eigen::Success) return 0;
+    const Eigen::Index n = M.rows();
+    Eigen::VectorXd x(n), y(n);
+    for (Eigen::Index i = 0; i < n; ++i) x[i] = std::sin(1.0 + i), y[i] = std::cos(2.0 + i);
+    double grown = 0;
+    constexpr int kIterations = 40, kSettle = 10;
+    for (int k = 0; k < kIterations; ++k) {
+      const Eigen::VectorXd x1 = y, y1 = -llt.solve(K * x + C * y);
+      const double s = std::sqrt(x1.squaredNorm() + y1.squaredNorm()), before = std::sqrt(x.squaredNorm() + y.squaredNorm());
+      if (!(s > 0) || !std::isfinite(s)) return s > 0 ? 1e300 : 0;
+      if (k >= kSettle) grown += std::log(s / before);
+      x = x1 / s, y = y1 / s;
+    }
+    return std::exp(grown / (kIterations - kSettle));
+  }
+
   // back to the extrapolated step's start (a half step failed, or the error test)
   void restore_start() {
     const Knot& k = start_.at;
@@ -1163,6 +1239,10 @@ class Alf final : public Integrator {
   } start_;
   Eigen::VectorXd x1q_, x1v_, x1a_, x1l_, x1z_, x1g_;  // (the extrapolation's long step's end)
   double theta_other_ = 0, h_theta_other_ = 0;         // (Newton's rate at the other step length)
+  bool stability_checked_ = false;
+  int since_check_ = 0;  // (extrapolated steps since the last check of the fastest mode)
+  static constexpr int kCheckSteps = 20;
+  static constexpr double kStableZ = 2;  // the extrapolation's limit on h |lambda| (1.077 a step at 3 on the imaginary axis)
   long disagreements_ = 0;  // (extrapolated steps whose two ends disagreed: halved)
   static constexpr double kDisagree = 0.1;
   int knots_ = 0;
