@@ -28,9 +28,11 @@ TITLES = {
 }
 _HIGH = (1e-3, "IFToMM high precision (1e-3)")
 BOUNDS = {"a01": _HIGH, "a02": _HIGH, "bricard": _HIGH, "a05": _HIGH}  # problem -> (value, label)
+# problem -> the (CPU time [s], error) points a method must reach or pass below and to the left of
+TARGETS = {"a02": ([(0.2, 1e-3), (1.0, 1e-6)], "issue 41's targets (1e-3 in 0.2 s, 1e-6 in 1 s)")}
 
 
-def main(path, outdir):
+def main(path, outdir, suffix=""):
     runs = defaultdict(lambda: defaultdict(list))
     with open(path) as f:
         for row in csv.DictReader(f):
@@ -39,7 +41,7 @@ def main(path, outdir):
                 continue
             runs[row["problem"]][row["integrator"]].append((cpu, max(err, 1e-16), float(row["tol"])))
     for problem, by_int in runs.items():
-        fig, ax = plt.subplots(figsize=(7, 5))
+        fig, ax = plt.subplots(figsize=(9, 5))
         for name, pts in sorted(by_int.items()):
             pts.sort(key=lambda p: -p[2])
             ax.loglog([p[0] for p in pts], [p[1] for p in pts], "--" if name.startswith("simbody-") else "-",
@@ -47,17 +49,21 @@ def main(path, outdir):
         if problem in BOUNDS:
             v, lab = BOUNDS[problem]
             ax.axhline(v, color="grey", lw=1, ls=":", label=lab)
+        if problem in TARGETS:
+            pts, lab = TARGETS[problem]
+            ax.plot([p[0] for p in pts], [p[1] for p in pts], "k+", ms=12, mew=1.5, ls="none", label=lab)
         ax.set_xlabel("CPU time [s] (best of repeats)")
         ax.set_ylabel("error")
         ax.set_title(TITLES.get(problem, problem), fontsize=10)
         ax.grid(True, which="major", alpha=0.4)
-        ax.legend(fontsize=8)
+        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1))  # (outside: no line hidden)
         fig.tight_layout()
-        out = f"{outdir}/{problem}.png"
+        out = f"{outdir}/{problem}{suffix}.png"
         fig.savefig(out, dpi=100)
         plt.close(fig)
         print("wrote", out)
 
 
 if __name__ == "__main__":
-    main(sys.argv[1], sys.argv[2] if len(sys.argv) > 2 else "docs/work_precision")
+    # (a third argument is appended to each file's name: a02_alf.png from one problem's own run)
+    main(sys.argv[1], sys.argv[2] if len(sys.argv) > 2 else "docs/work_precision", sys.argv[3] if len(sys.argv) > 3 else "")
