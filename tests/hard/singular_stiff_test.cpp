@@ -124,6 +124,19 @@ TEST(HardSingular, A02FortyFourBarsAlf) {
   EXPECT_LT(a.drift, 1e-9);
 }
 
+// A02 over 20 s with alf at fixed steps of h (Newton at 1e-6, samples every 50 ms), extrapolated or not
+SimulationResult simulate_a02_alf_fixed(const Model& m, double h, bool extrapolate) {
+  SimulationOptions o;
+  o.integrator.method = "alf";
+  o.integrator.alf_fixed_step = true;
+  o.integrator.alf_extrapolate = extrapolate;
+  o.integrator.max_step = h;
+  o.integrator.rtol = o.integrator.atol = 1e-6;
+  o.t_end = 20.0;
+  o.output_step = 0.05;
+  return simulate(m, nullptr, nullptr, o);
+}
+
 // A02 with N = 40 at fixed steps (alf_fixed_step, default penalty; Newton's weights in q and v,
 // stalls at the flat positions accepted or the penalty raised): the trapezoidal rule's h^2
 // through all 20 passages, no floor (session 34; before, 10, 5, 2, 1 ms gave 1.1e-3, 1.6e-4,
@@ -135,14 +148,7 @@ TEST(HardSingular, A02FortyFourBarsAlfFixedStepsSecondOrder) {
   // (then 9 ms, where one step at t = 16.45 s diverged after the penalty's raise and is now taken
   // as two halves, and 125 ms / 4 = 31.25 ms, longer than the output step: samples interpolated)
   for (double h : {1e-2, 5e-3, 2.5e-3, 9e-3, 3.125e-2}) {
-    SimulationOptions o;
-    o.integrator.method = "alf";
-    o.integrator.alf_fixed_step = true;
-    o.integrator.max_step = h;
-    o.integrator.rtol = o.integrator.atol = 1e-6;
-    o.t_end = 20.0;
-    o.output_step = 0.05;
-    const SimulationResult r = simulate(m, nullptr, nullptr, o);
+    const SimulationResult r = simulate_a02_alf_fixed(m, h, false);
     ASSERT_TRUE(r.completed) << h << ": " << r.failure;
     runs.push_back(measure_a02(m, N, r));
     std::cout << "A02 N = 40 alf, fixed steps of " << h << " s: " << runs.back().passages << " passages, |phi - exact| "
@@ -176,14 +182,7 @@ TEST(HardSingular, A02FortyFourBarsAlfExtrapolatedToAMicroradian) {
   const int N = 40;
   const Model m = compile(a02_spec(N));
   for (const double h : {0.16 * std::pow(1e-5, 0.25), 0.16 * std::pow(1e-6, 0.25)}) {
-    SimulationOptions o;
-    o.integrator.method = "alf";
-    o.integrator.alf_fixed_step = o.integrator.alf_extrapolate = true;
-    o.integrator.max_step = h;
-    o.integrator.rtol = o.integrator.atol = 1e-6;
-    o.t_end = 20.0;
-    o.output_step = 0.05;
-    const SimulationResult r = simulate(m, nullptr, nullptr, o);
+    const SimulationResult r = simulate_a02_alf_fixed(m, h, true);
     ASSERT_TRUE(r.completed) << h << ": " << r.failure;
     const A02Run a = measure_a02(m, N, r);
     std::cout << "A02 N = 40 alf extrapolated, fixed steps of " << h << " s: " << a.passages << " passages, |phi - exact| "
