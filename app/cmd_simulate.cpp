@@ -281,7 +281,7 @@ void add_simulate(CLI::App& app) {
   cmd->add_option("--alf-iterations", a->alf_iterations, "alf: the most Newton iterations a step (>= 1; default 100)");
   cmd->add_flag("--alf-fixed-step", a->alf_fixed_step, "alf: every step --max-step (default 1 ms) instead of the error control");
   cmd->add_flag("--alf-extrapolate", a->alf_extrapolate,
-                "alf: each step also as two of half its length, combined (Richardson's extrapolation: fourth order, three steps' work)");
+                "alf: each step combined from finer trapezoidal steps (Richardson's extrapolation: fourth order; at fixed steps the step and two halves, with error control two halves and four quarters)");
   cmd->add_option("--output-step", a->output_step, "output interval [s]");
   cmd->add_flag("--quiet", a->quiet, "no progress bar");
   cmd->add_option("--max-samples", a->max_samples, "refuse runs that would record more output samples")->capture_default_str();

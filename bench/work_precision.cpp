@@ -2,7 +2,8 @@
 // each codyna integrator (ida, cvode-bdf, cvode-adams, arkode, alf; alf skips the models it
 // refuses, those with rolling constraints; on request alf-fixed: alf at fixed steps of
 // 0.1 sqrt(tol), and alf-x-fixed: alf extrapolated (alf_extrapolate) at fixed steps of
-// 0.16 tol^(1/4), neither in the default list) (and each Simbody integrator when the Simbody peer is built) and
+// 0.16 tol^(1/4), and alf-x: alf extrapolated with error control (halves and quarters), none
+// in the default list) (and each Simbody integrator when the Simbody peer is built) and
 // rtol = atol = 10^-(2 + k/2), k = 0..kmax, one run, its error against an exact solution,
 // a published reference, an exact invariant or a tight reference run, and its CPU time.
 //
@@ -326,6 +327,9 @@ CodynaRun run_codyna(const Problem& p, const std::string& method, double tol, in
     o.integrator.method = "alf";
     o.integrator.alf_extrapolate = o.integrator.alf_fixed_step = true;
     o.integrator.max_step = 0.16 * std::sqrt(std::sqrt(tol));
+  } else if (method == "alf-x") {  // alf extrapolated with error control (two steps of H/2 and four of H/4 a step)
+    o.integrator.method = "alf";
+    o.integrator.alf_extrapolate = true;
   }
   o.t_end = p.t_end;
   o.output_step = p.output_step;

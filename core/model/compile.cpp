@@ -1245,8 +1245,6 @@ void check_solver_spec(const SolverSpec& s, const std::string& file) {
   if (s.alf_iterations && *s.alf_iterations < 1)
     fail("/solver/alf_iterations",
          "expected a number of Newton iterations >= 1 (alf's default 100), got " + std::to_string(*s.alf_iterations));
-  if (s.integrator == "alf" && s.alf_extrapolate && !s.alf_fixed_step)
-    fail("/solver/alf_extrapolate", "needs fixed steps, alf_fixed_step: true (alf's error control does not extrapolate)");
   if (s.integrator == "alf" && s.max_step > s.t_end)
     fail("/solver/max_step", "alf: a step of " + compile_number(s.max_step) + " s is longer than the run (t_end " +
                                  compile_number(s.t_end) + " s)");

@@ -55,6 +55,10 @@
 // longer, alf_penalty (10 ms / h)^2 for shorter ones (the weight h^2/4 alpha of Jc^T Jc against M held; with alpha itself the multipliers'
 // iteration stalls at short steps, each iteration shrinking the error only by 1/(1 + h^2/4 alpha s^2 / m)). IntegratorSettings::alf_fixed_step:
 // every step max_step (default 1 ms), no error control, Newton at rtol, atol of at most 1e-6.
+// IntegratorSettings::alf_extrapolate: at fixed steps each step H is also taken as two of H/2 and
+// the ends combined, x2 + (x2 - x1)/3; with error control each step H is taken as two of H/2 (x1)
+// and four of H/4 (x2), combined the same way, the error |x2 - x1|/3 per unit step, the next step
+// H 0.9 err^(-1/2) (extrapolated_pair below: why halves and quarters, not the step and its halves).
 // Ball and free joints: the rule steps on the group, its unknown the step dl in the tangent space
 // (q = q_n (+) dl, v = 2/h dl - v_n, a = 4/h^2 dl - 4/h v_n - a_n), Newton's matrix the tangent's
 // at q (the retraction's Jacobian taken as the identity: a modified Newton), the error weights in
@@ -295,12 +299,6 @@ class Alf final : public Integrator {
       throw std::invalid_argument("integrator alf: max_step: expected a number >= 0, got " + alf_number(h_));
     if (!(rtol_ > 0) || !(atol_ > 0))
       throw std::invalid_argument("integrator alf: rtol and atol: expected numbers > 0");
-    // (with error control, the half steps' difference (x2 - x1)/3 as the error estimate, a local
-    // error in q, let the global error stay far above the tolerance: A01 1.1e-5 m at rtol 1e-6,
-    // Andrews 3.9e-5 at 1e-7, Bricard 5e-5 at 1e-7, A02 2.9 rad at 1e-2; not offered)
-    if (extrapolate_ && !fixed_)
-      throw std::invalid_argument("integrator alf: alf_extrapolate: needs alf_fixed_step (fixed steps of max_step); "
-                                  "the error control does not extrapolate");
     if (fixed_ && h_ == 0) h_ = 1e-3;
     if (!m_.velocity_rows.empty())
       throw std::invalid_argument("integrator alf: the model has rolling constraints (conditions on the velocities alone): not integrated by alf yet");
@@ -342,7 +340,7 @@ class Alf final : public Integrator {
     g_ = first_order_rates(t, q_, v_, z_);
     lambda_ = m_.nc ? Eigen::VectorXd(d_.lambda) : Eigen::VectorXd();
     if (!a_.allFinite()) throw IntegratorFailure(t, "alf: the accelerations at the start are not finite");
-    if (extrapolate_ && !stability_checked_) check_extrapolation_is_stable(t);  // (at the run's start)
+    if (extrapolate_ && fixed_ && !stability_checked_) check_extrapolation_is_stable(t);  // (at the run's start)
     if (next_ <= 0) {  // the first step: a small fraction of what the accelerations allow
       const Eigen::ArrayXd w = atol_ + rtol_ * magnitude(q_);
       const double acc = (a_.array().abs() / w).maxCoeff();
@@ -401,33 +399,43 @@ class Alf final : public Integrator {
       for (int tries = 0;; ++tries) {
         if (tries > 60 || h < 1e-12 * std::max(1.0, std::abs(t_)))
           throw IntegratorFailure(t_, "alf: no step down to " + alf_number(h) +
-                                          " s passes the Newton iteration and the error test (alf is second order: at "
+                                          " s passes the Newton iteration and the error test (" +
+                                          (extrapolate_ ? "alf extrapolated" : "alf is second order") + ": at "
                                           "rtol " + alf_number(rtol_) + ", atol " + alf_number(atol_) + " its steps became too short" +
                                           (m_.nc ? " for its penalty to hold the loops" : "") +
                                           "; a looser rtol and atol, such as 1e-4 and 1e-6, or fixed steps: alf_fixed_step "
                                           "with max_step)");
-        if (!step(h, h >= rest)) {
-          h *= 0.25;
-          continue;
-        }
-        double err = error_estimate(h);
-        // a stalled step's accelerations (and so the next one's estimate) carry the stall's error
-        // in q times 4/h^2, in directions the projections leave (near a singular position): not a
-        // measure of the step's error; such a step is accepted, and the next one is no longer
-        if (stalled_ || stalled_before_) err = std::min(err, 1.0);
-        if (trace_) {
-          const Eigen::ArrayXd w = atol_ + rtol_ * magnitude(q_).max(magnitude(qn_));
-          Eigen::Index imax;
-          ((h / 12) * (an_ - a_).array().abs() / w).maxCoeff(&imax);
-          std::fprintf(stderr, "err t %.9g h %g err %g at %d (a %g -> %g)\n", t_ + h, h, err, static_cast<int>(imax), a_[imax], an_[imax]);
+        const bool last = t_out - t_ - h <= 1e-12 * std::max(1.0, std::abs(t_out));
+        double err = 0;
+        if (extrapolate_) {
+          if (!extrapolated_pair(last ? t_out : t_ + h, h >= rest, err)) {
+            h *= 0.25;
+            continue;
+          }
+        } else {
+          if (!step(h, h >= rest)) {
+            h *= 0.25;
+            continue;
+          }
+          err = error_estimate(h);
+          // a stalled step's accelerations (and so the next one's estimate) carry the stall's error
+          // in q times 4/h^2, in directions the projections leave (near a singular position): not a
+          // measure of the step's error; such a step is accepted, and the next one is no longer
+          if (stalled_ || stalled_before_) err = std::min(err, 1.0);
+          if (trace_) {
+            const Eigen::ArrayXd w = atol_ + rtol_ * magnitude(q_).max(magnitude(qn_));
+            Eigen::Index imax;
+            ((h / 12) * (an_ - a_).array().abs() / w).maxCoeff(&imax);
+            std::fprintf(stderr, "err t %.9g h %g err %g at %d (a %g -> %g)\n", t_ + h, h, err, static_cast<int>(imax), a_[imax], an_[imax]);
+          }
         }
         if (err > 1) {
           ++rejected_;
+          if (extrapolate_) restore_start(), steps_ = pair_steps_;
           h *= std::clamp(0.9 * std::pow(err, -0.5), 0.1, 0.5);
           continue;
         }
-        const bool last = t_out - t_ - h <= 1e-12 * std::max(1.0, std::abs(t_out));
-        accept(last ? t_out : t_ + h);
+        if (!extrapolate_) accept(last ? t_out : t_ + h);
         // the next step from this one's error; the step cut only to reach the stop is not a limit
         next_ = std::max(next_ * (last ? 1.0 : 0.0), h * std::clamp(0.9 * std::pow(std::max(err, 1e-8), -0.5), 0.2, 2.0));
         if (h_ > 0) next_ = std::min(next_, h_);
@@ -826,6 +834,80 @@ class Alf final : public Integrator {
     }
     start_mass_ = false;  // (Mp_: M at the half steps' end, not at the combination)
     if (++since_check_ >= kCheckSteps) check_extrapolation_is_stable(t1, false);
+    return true;
+  }
+  // With error control (alf_extrapolate without alf_fixed_step), one step to t1 of H = t1 - t_n
+  // as two steps of H/2 (x1) and four of H/4 (x2), combined as x2 + (x2 - x1)/3 (on the group
+  // q2 (+) (q2 (-) q1)/3). Even counts on both sides: the combination's factor on a mode
+  // y' = lambda y is (4 R(z/4)^4 - R(z/2)^2)/3 with z = H lambda, at most 1 on the whole negative
+  // axis (0.9992 at z = -1e5; it tends to 1, as the plain rule's R tends to -1) and wherever the
+  // mode's damping ratio is 0.3 or more (|Im z| <= 3 |Re z|); the (1, 2) sequence of the fixed
+  // steps tends to 5/3 there, and a stiff mode grew (A05, Andrews: refused at fixed steps). Where
+  // a lightly damped mode is too fast for H (|T| up to 1.25 at damping 0.1, 1.66 undamped) the two
+  // ends differ by the mode's amplitude and the error test shortens the step. The same work per
+  // unit time as the (1, 2) sequence at fixed steps (six substeps of H/2 and H/4 per H).
+  // The error test: x2's error, |x2 - x1| / 3 in q (and in the first-order states), per unit
+  // step (divided by H, as the plain rule's: the global error of the unextrapolated x2 is that
+  // sum), in the weights atol + rtol |q|; the step taken is the extrapolated x2, of fourth order,
+  // whose error is well below that (local extrapolation, as ODEX's). H's next length from that
+  // estimate, which goes as H^2: H 0.9 err^(-1/2).
+  // (Before: the (1, 2) sequence with its difference as a local error in q, not per unit step:
+  // the global error stayed far above the tolerance, A01 1.1e-5 m at rtol 1e-6, A02 2.9 rad at
+  // 1e-2, and stiff modes grew.) False: a substep did not pass Newton (the start restored).
+  bool extrapolated_pair(double t1, bool to_stop, double& err) {
+    const double t0 = t_, H = t1 - t0;
+    start_.lambda = lambda_, start_.jerk = jerk_rate_, start_.zslope = zslope_;
+    start_.jerk_ok = jerk_, start_.zslope_ok = zslope_ok_, start_.stalled = stalled_before_, start_.h_last = h_last_;
+    save_start(start_.at);
+    pair_steps_ = steps_;
+    bool stalled = false;
+    for (int k = 1; k <= 2; ++k) {
+      const double tk = k == 2 ? t1 : t0 + H / 2;
+      if (!step(tk - t_, to_stop && k == 2)) {
+        restore_start();
+        return false;
+      }
+      stalled = stalled || stalled_;
+      accept(tk);
+    }
+    x1q_ = q_, x1v_ = v_, x1a_ = a_, x1l_ = lambda_, x1z_ = z_, x1g_ = g_;
+    restore_start();
+    for (int k = 1; k <= 4; ++k) {
+      const double tk = k == 4 ? t1 : t0 + k * (H / 4);
+      if (!step(tk - t_, to_stop && k == 4)) {
+        restore_start();
+        return false;
+      }
+      stalled = stalled || stalled_;
+      accept(tk);
+    }
+    const Eigen::VectorXd dq = additive_ ? Eigen::VectorXd(q_ - x1q_) : difference(m_, x1q_, q_);
+    const Eigen::ArrayXd w = atol_ + rtol_ * magnitude(q_).max(magnitude(x1q_));
+    err = (dq.array().abs() / (3 * H) / w).maxCoeff();
+    if (nz_) {
+      const Eigen::ArrayXd wz = atol_ + rtol_ * z_.array().abs().max(x1z_.array().abs());
+      err = std::max(err, ((z_ - x1z_).array().abs() / (3 * H) / wz).maxCoeff());
+    }
+    if (!std::isfinite(err)) err = 1e300;
+    // a stalled substep (near a singular position) leaves its error in q at a tenth of the
+    // weights and its accelerations carry it times 4/h^2: the estimate then is not the step's
+    // error; such a step is accepted, and the next one is no longer (as with the plain rule)
+    if (stalled || start_.stalled) err = std::min(err, 1.0);
+    if (trace_) std::fprintf(stderr, "extrapolated pair t %.9g H %g err %g%s\n", t1, H, err, stalled ? " (stalled)" : "");
+    if (additive_)
+      q_ += dq / 3;
+    else
+      q_ = integrate<double>(m_, q_, Eigen::VectorXd(dq / 3));
+    v_ += (v_ - x1v_) / 3;
+    a_ += (a_ - x1a_) / 3;
+    if (m_.nc) lambda_ += (lambda_ - x1l_) / 3;
+    if (nz_) {
+      z_ += (z_ - x1z_) / 3;
+      g_ += (g_ - x1g_) / 3;
+    }
+    stalled_before_ = stalled;
+    start_mass_ = false;  // (Mp_: M at the fine steps' end, not at the combination)
+    // (the predictor's change of a: over the last fine step, as accept() left it)
     return true;
   }
   // The extrapolated rule's factor on a mode y' = lambda y is (4 R(z/2)^2 - R(z))/3, z = h lambda,
@@ -1262,6 +1344,7 @@ class Alf final : public Integrator {
   static constexpr int kCheckSteps = 20;
   static constexpr double kStableZ = 2;  // the extrapolation's limit on h |lambda| (1.077 a step at 3 on the imaginary axis)
   long disagreements_ = 0;  // (extrapolated steps whose two ends disagreed: halved)
+  long pair_steps_ = 0;     // (steps_ before an error-controlled extrapolated step, for its rejection)
   static constexpr double kDisagree = 0.1;
   int knots_ = 0;
   Eigen::VectorXd shown_y_;

@@ -39,8 +39,10 @@ struct IntegratorSettings {
   double alf_penalty = 1e11;
   int alf_iterations = 100;
   bool alf_fixed_step = false;
-  // alf: each step also taken as two of half its length, and the two ends combined (Richardson's
-  // extrapolation, x2 + (x2 - x1)/3: the trapezoidal rule's h^2 term cancels, fourth order)
+  // alf: each step combined from finer trapezoidal steps (Richardson's extrapolation, the
+  // trapezoidal rule's h^2 term cancels, fourth order): at fixed steps the step and its two halves
+  // (x2 + (x2 - x1)/3), with error control two halves x1 and four quarters x2 (the same formula;
+  // |x2 - x1|/3 the error estimate)
   bool alf_extrapolate = false;
 };
 

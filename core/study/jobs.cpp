@@ -506,9 +506,6 @@ ModelSpec simulate_spec(const SimulateRequest& a, ModelSpec spec) {
   }
   if (a.alf_fixed_step) sp.alf_fixed_step = *a.alf_fixed_step;
   if (a.alf_extrapolate) sp.alf_extrapolate = *a.alf_extrapolate;
-  if (sp.integrator == "alf" && sp.alf_extrapolate && !sp.alf_fixed_step)
-    throw std::invalid_argument(opt("alf-extrapolate") + ": needs fixed steps, " + opt("alf-fixed-step") +
-                                " (alf's error control does not extrapolate)");
   check("max-samples", a.max_samples, [](double x) { return x >= 1; }, "a number >= 1");
   check("divergence-bound", a.divergence_bound, [](double x) { return x > 0; }, "a number > 0");
   return spec;

@@ -312,8 +312,9 @@ class Study:
         alf_penalty, alf_iterations   alf: the constraints' penalty (> 0, default 1e11) and the
                           most Newton iterations a step (>= 1, default 100)
         alf_fixed_step    True: alf steps max_step (default 1 ms) with no error control
-        alf_extrapolate   True: alf takes each step also as two halves and combines them
-                          (Richardson's extrapolation: fourth order, three steps' work)
+        alf_extrapolate   True: alf combines each step from finer trapezoidal steps (Richardson's
+                          extrapolation: fourth order; at fixed steps the step and two halves, with
+                          error control two halves and four quarters)
         controller        a controller .mat: K (state feedback), Kp/Ki/Kd (PID) or Ac, Bc, Cc, Dc
                           [, Ts] (LTI); default the model file's controller
         open_loop         True: ignore the model's controller (actuators at their nominal values)
