@@ -326,10 +326,11 @@ void SimulateView::buildUi() {
   form->addRow(alf_fixed_);
   alf_extrapolate_ = new QCheckBox(tr("alf: each step extrapolated from two halves"), solver_box);
   alf_extrapolate_->setObjectName("alfExtrapolate");
-  alf_extrapolate_->setToolTip(tr("At fixed steps: alf takes each step also as two of half its length and combines "
-                                  "the two ends (Richardson's extrapolation): fourth order instead of second, for three "
-                                  "steps' work, on smooth motion. Not for stiff models: a model whose fastest mode is too "
-                                  "fast for the step is refused, with the longest step that passes "
+  alf_extrapolate_->setToolTip(tr("alf combines each step from finer trapezoidal steps (Richardson's extrapolation): "
+                                  "fourth order instead of second on smooth motion. At fixed steps two halves, three "
+                                  "steps' work (a model whose fastest mode is too fast for the step is refused, with the "
+                                  "longest step that passes); with error control two halves and four quarters, six "
+                                  "steps' work, their difference the error estimate (stable on stiff springs) "
                                   "(solver.alf_extrapolate, --alf-extrapolate)"));
   form->addRow(alf_extrapolate_);
   alf_penalty_ = numberField("alfPenalty", tr("alf penalty"), tr("1e11 (alf's default)"),
@@ -498,8 +499,7 @@ void SimulateView::buildUi() {
   for (std::size_t i = 0; i < solver_numbers_.size(); ++i)
     connect(solver_numbers_[i].edit, &QLineEdit::editingFinished, this, [this, i] { solverNumberEdited(solver_numbers_[i]); });
   connect(alf_fixed_, &QCheckBox::toggled, this, [this](bool on) {
-    // (extrapolation is for fixed steps: it goes with them)
-    writeSolver([&](SolverSpec& s) { s.alf_fixed_step = on, s.alf_extrapolate = s.alf_extrapolate && on; },
+    writeSolver([&](SolverSpec& s) { s.alf_fixed_step = on; },
                 on ? tr("alf at fixed steps") : tr("alf with error control"));
   });
   connect(alf_extrapolate_, &QCheckBox::toggled, this, [this](bool on) {
@@ -665,7 +665,7 @@ void SimulateView::refreshFromDocument() {
     alf_penalty_->setText(so.alf_penalty ? QString::number(*so.alf_penalty, 'g', 17) : QString());
     alf_iterations_->setText(so.alf_iterations ? QString::number(*so.alf_iterations) : QString());
     for (QWidget* w : std::initializer_list<QWidget*>{alf_fixed_, alf_penalty_, alf_iterations_}) w->setEnabled(alf);
-    alf_extrapolate_->setEnabled(alf && so.alf_fixed_step);  // (fixed steps only)
+    alf_extrapolate_->setEnabled(alf);
     compare_linear_->setChecked(st.compare_linear);
   }
   {

@@ -1140,13 +1140,14 @@ class ViewsTest : public QObject {
 
     type(view.maxStepEdit(), "0.002");
     QCOMPARE(doc.spec().solver.max_step, 0.002);
-    QVERIFY(!view.alfExtrapolateCheck()->isEnabled());  // (extrapolation waits for fixed steps)
-    QTest::mouseClick(view.alfFixedCheck(), Qt::LeftButton, {}, QPoint(6, view.alfFixedCheck()->height() / 2));
-    QVERIFY(doc.spec().solver.alf_fixed_step);
+    // extrapolation with error control and at fixed steps alike: each box its own field
     QVERIFY(view.alfExtrapolateCheck()->isEnabled() && !doc.spec().solver.alf_extrapolate);
     QTest::mouseClick(view.alfExtrapolateCheck(), Qt::LeftButton, {}, QPoint(6, view.alfExtrapolateCheck()->height() / 2));
-    QVERIFY(doc.spec().solver.alf_extrapolate);
+    QVERIFY(doc.spec().solver.alf_extrapolate && !doc.spec().solver.alf_fixed_step);
     QCOMPARE(doc.undoStack()->undoText(), QString("alf extrapolated"));
+    QTest::mouseClick(view.alfFixedCheck(), Qt::LeftButton, {}, QPoint(6, view.alfFixedCheck()->height() / 2));
+    QVERIFY(doc.spec().solver.alf_fixed_step && doc.spec().solver.alf_extrapolate);
+    QVERIFY(view.alfExtrapolateCheck()->isChecked());
     type(view.alfPenaltyEdit(), "lots");
     QVERIFY(said("alf penalty: expected a number > 0"));
     QVERIFY(!doc.spec().solver.alf_penalty);
