@@ -58,7 +58,8 @@
 // IntegratorSettings::alf_extrapolate: at fixed steps each step H is also taken as two of H/2 and
 // the ends combined, x2 + (x2 - x1)/3; with error control each step H is taken as two of H/2 (x1)
 // and four of H/4 (x2), combined the same way, the error |x2 - x1|/3 per unit step, the next step
-// H 0.9 err^(-1/2) (extrapolated_pair below: why halves and quarters, not the step and its halves).
+// H 0.9 err^(-1/2) (extrapolated_pair below: why halves and quarters, not the step and its halves);
+// extrapolated, Newton works at rtol, atol of at most 1e-6 as at fixed steps.
 // Ball and free joints: the rule steps on the group, its unknown the step dl in the tangent space
 // (q = q_n (+) dl, v = 2/h dl - v_n, a = 4/h^2 dl - 4/h v_n - a_n), Newton's matrix the tangent's
 // at q (the retraction's Jacobian taken as the identity: a modified Newton), the error weights in
