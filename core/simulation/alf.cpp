@@ -827,6 +827,14 @@ class Alf final : public Integrator {
       restore_start();
       return false;
     }
+    combine_richardson(dq);
+    start_mass_ = false;  // (Mp_: M at the half steps' end, not at the combination)
+    if (++since_check_ >= kCheckSteps) check_extrapolation_is_stable(t1, false);
+    return true;
+  }
+  // Richardson's combination of the finer end (the state now) with the coarser x1: x2 + (x2 - x1)/3
+  // (q on the group: q2 (+) dq/3 with dq = q2 (-) q1), for both pairs of steps
+  void combine_richardson(const Eigen::VectorXd& dq) {
     if (additive_)
       q_ += dq / 3;
     else
@@ -838,9 +846,6 @@ class Alf final : public Integrator {
       z_ += (z_ - x1z_) / 3;
       g_ += (g_ - x1g_) / 3;
     }
-    start_mass_ = false;  // (Mp_: M at the half steps' end, not at the combination)
-    if (++since_check_ >= kCheckSteps) check_extrapolation_is_stable(t1, false);
-    return true;
   }
   // With error control (alf_extrapolate without alf_fixed_step), one step to t1 of H = t1 - t_n
   // as two steps of H/2 (x1) and four of H/4 (x2), combined as x2 + (x2 - x1)/3 (on the group
@@ -900,17 +905,7 @@ class Alf final : public Integrator {
     // error; such a step is accepted, and the next one is no longer (as with the plain rule)
     if (stalled || start_.stalled) err = std::min(err, 1.0);
     if (trace_) std::fprintf(stderr, "extrapolated pair t %.9g H %g err %g%s\n", t1, H, err, stalled ? " (stalled)" : "");
-    if (additive_)
-      q_ += dq / 3;
-    else
-      q_ = integrate<double>(m_, q_, Eigen::VectorXd(dq / 3));
-    v_ += (v_ - x1v_) / 3;
-    a_ += (a_ - x1a_) / 3;
-    if (m_.nc) lambda_ += (lambda_ - x1l_) / 3;
-    if (nz_) {
-      z_ += (z_ - x1z_) / 3;
-      g_ += (g_ - x1g_) / 3;
-    }
+    combine_richardson(dq);
     stalled_before_ = stalled;
     start_mass_ = false;  // (Mp_: M at the fine steps' end, not at the combination)
     // (the predictor's change of a: over the last fine step, as accept() left it)
