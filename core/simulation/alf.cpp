@@ -780,6 +780,12 @@ class Alf final : public Integrator {
     k.g = g_;
   }
 
+  // the state before an extrapolated step, for restore_start() (both pairs of steps)
+  void save_pair_start() {
+    start_.lambda = lambda_, start_.jerk = jerk_rate_, start_.zslope = zslope_;
+    start_.jerk_ok = jerk_, start_.zslope_ok = zslope_ok_, start_.stalled = stalled_before_, start_.h_last = h_last_;
+    save_start(start_.at);
+  }
   // one step to t1 by Richardson's extrapolation: the step of h from the start (x1), two of h/2
   // (x2), and x2 + (x2 - x1)/3 (on the group q2 (+) (q2 (-) q1)/3). The trapezoidal rule is
   // symmetric: its error's expansion has even powers of h alone, so the h^2 terms cancel and the
@@ -793,9 +799,7 @@ class Alf final : public Integrator {
   // (the start restored)
   bool extrapolated_step(double t1, bool to_stop) {
     const double t0 = t_, h = t1 - t0;
-    start_.lambda = lambda_, start_.jerk = jerk_rate_, start_.zslope = zslope_;
-    start_.jerk_ok = jerk_, start_.zslope_ok = zslope_ok_, start_.stalled = stalled_before_, start_.h_last = h_last_;
-    save_start(start_.at);
+    save_pair_start();
     swap_theta(h);
     const bool big = step(h, to_stop);
     swap_theta(h / 2);
@@ -855,8 +859,8 @@ class Alf final : public Integrator {
   // mode's damping ratio is 0.3 or more (|Im z| <= 3 |Re z|); the (1, 2) sequence of the fixed
   // steps tends to 5/3 there, and a stiff mode grew (A05, Andrews: refused at fixed steps). Where
   // a lightly damped mode is too fast for H (|T| up to 1.25 at damping 0.1, 1.66 undamped) the two
-  // ends differ by the mode's amplitude and the error test shortens the step. The same work per
-  // unit time as the (1, 2) sequence at fixed steps (six substeps of H/2 and H/4 per H).
+  // ends differ by the mode's amplitude and the error test shortens the step. Twice the work per
+  // H of the (1, 2) sequence at fixed steps (six substeps against three).
   // The error test: x2's error, |x2 - x1| / 3 in q (and in the first-order states), per unit
   // step (divided by H, as the plain rule's: the global error of the unextrapolated x2 is that
   // sum), in the weights atol + rtol |q|; the step taken is the extrapolated x2, of fourth order,
@@ -867,31 +871,26 @@ class Alf final : public Integrator {
   // 1e-2, and stiff modes grew.) False: a substep did not pass Newton (the start restored).
   bool extrapolated_pair(double t1, bool to_stop, double& err) {
     const double t0 = t_, H = t1 - t0;
-    start_.lambda = lambda_, start_.jerk = jerk_rate_, start_.zslope = zslope_;
-    start_.jerk_ok = jerk_, start_.zslope_ok = zslope_ok_, start_.stalled = stalled_before_, start_.h_last = h_last_;
-    save_start(start_.at);
+    save_pair_start();
     pair_steps_ = steps_;
     bool stalled = false;
-    for (int k = 1; k <= 2; ++k) {
-      const double tk = k == 2 ? t1 : t0 + H / 2;
-      if (!step(tk - t_, to_stop && k == 2)) {
-        restore_start();
-        return false;
+    // n substeps of H/n from the start; false: one did not pass Newton (the start restored)
+    const auto substeps = [&](int n) {
+      for (int k = 1; k <= n; ++k) {
+        const double tk = k == n ? t1 : t0 + k * (H / n);
+        if (!step(tk - t_, to_stop && k == n)) {
+          restore_start();
+          return false;
+        }
+        stalled = stalled || stalled_;
+        accept(tk);
       }
-      stalled = stalled || stalled_;
-      accept(tk);
-    }
+      return true;
+    };
+    if (!substeps(2)) return false;
     x1q_ = q_, x1v_ = v_, x1a_ = a_, x1l_ = lambda_, x1z_ = z_, x1g_ = g_;
     restore_start();
-    for (int k = 1; k <= 4; ++k) {
-      const double tk = k == 4 ? t1 : t0 + k * (H / 4);
-      if (!step(tk - t_, to_stop && k == 4)) {
-        restore_start();
-        return false;
-      }
-      stalled = stalled || stalled_;
-      accept(tk);
-    }
+    if (!substeps(4)) return false;
     const Eigen::VectorXd dq = additive_ ? Eigen::VectorXd(q_ - x1q_) : difference(m_, x1q_, q_);
     const Eigen::ArrayXd w = atol_ + rtol_ * magnitude(q_).max(magnitude(x1q_));
     err = (dq.array().abs() / (3 * H) / w).maxCoeff();

@@ -93,18 +93,24 @@ TEST(HardSingular, A02FortyFourBarsStayOnTheRigidBranch) {
   }
 }
 
+// A02 over 20 s with alf under error control at rtol = atol = tol, extrapolated or not
+SimulationResult simulate_a02_alf(const Model& m, double tol, bool extrapolate, double output_step) {
+  SimulationOptions o;
+  o.integrator.method = "alf";
+  o.integrator.alf_extrapolate = extrapolate;
+  o.integrator.rtol = o.integrator.atol = tol;
+  o.t_end = 20.0;
+  o.output_step = output_step;
+  return simulate(m, nullptr, nullptr, o);
+}
+
 // N = 40, 20 s, with alf (index-3 augmented Lagrangian, core/simulation/alf.cpp) at rtol = atol
 // = 1e-6: its Newton matrix M + h^2/4 alpha Jc^T Jc stays regular through the 20 flat positions
 // and it stays on the rigid branch; its phase error is far larger than cvode-bdf's.
 TEST(HardSingular, A02FortyFourBarsAlf) {
   const int N = 40;
   const Model m = compile(a02_spec(N));
-  SimulationOptions o;
-  o.integrator.method = "alf";
-  o.integrator.rtol = o.integrator.atol = 1e-6;
-  o.t_end = 20.0;
-  o.output_step = 0.01;
-  const SimulationResult r = simulate(m, nullptr, nullptr, o);
+  const SimulationResult r = simulate_a02_alf(m, 1e-6, false, 0.01);
   ASSERT_TRUE(r.completed) << r.failure;
   const A02Run a = measure_a02(m, N, r);
   std::cout << "A02 N = 40 alf 1e-6 20 s: " << a.passages << " passages, rigid-rotation defect " << a.rigid
@@ -134,13 +140,7 @@ TEST(HardSingular, A02FortyFourBarsAlf) {
 TEST(HardSingular, A02FortyFourBarsAlfExtrapolatedLooseToleranceStaysRigid) {
   const int N = 40;
   const Model m = compile(a02_spec(N));
-  SimulationOptions o;
-  o.integrator.method = "alf";
-  o.integrator.alf_extrapolate = true;
-  o.integrator.rtol = o.integrator.atol = 1e-2;
-  o.t_end = 20.0;
-  o.output_step = 0.05;
-  const SimulationResult r = simulate(m, nullptr, nullptr, o);
+  const SimulationResult r = simulate_a02_alf(m, 1e-2, true, 0.05);
   ASSERT_TRUE(r.completed) << r.failure;
   const A02Run a = measure_a02(m, N, r);
   std::cout << "A02 N = 40 alf extrapolated 1e-2 20 s: " << a.passages << " passages, rigid-rotation defect " << a.rigid
