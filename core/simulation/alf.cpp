@@ -515,22 +515,23 @@ class Alf final : public Integrator {
     // the penalty for its own step anyway)
     double alpha = alpha_now_ = fixed_ ? alpha_given_ :
         std::max(alpha_given_, std::min(kRuleMax, alpha_given_ * (kPenaltyStep / h) * (kPenaltyStep / h)));
-    // (additive coordinates: v and a from q itself, v = 2/h q - vhat; on the group: from the step
-    // in the tangent space, dl, with q = q_n (+) dl)
-    const Eigen::VectorXd vhat = additive_ ? Eigen::VectorXd((2 / h) * q_ + v_) : v_;
-    const Eigen::VectorXd ahat = additive_ ? Eigen::VectorXd((4 / (h * h)) * q_ + (4 / h) * v_ + a_) : Eigen::VectorXd((4 / h) * v_ + a_);
+    // the unknown is the step itself, dl, with q = q_n + dl (additive coordinates) or q_n (+) dl
+    // (on the group), and v = 2/h dl - v_n, a = 4/h^2 dl - 4/h v_n - a_n from it. (Taken from q
+    // itself, 4/h^2 q - 4/h^2 q_n rounded to 4/h^2 eps |q|: at h = 1e-10 and |q| ~ 1, accelerations
+    // in powers of two up to 1e5, which the error test read as the step's error, so that every
+    // step below ~1e-8 s failed it at rtol 1e-8 and a run that needed one (the four-bar at 0.93 s,
+    // a start's transient) failed; from dl the rounding is 4 eps |v| / h, and the error test's
+    // share of it, eps |v| / 3, does not grow as the step shrinks)
+    const Eigen::VectorXd vhat = v_;
+    const Eigen::VectorXd ahat = (4 / h) * v_ + a_;
     // the predictor: the trapezoidal rule's own q_n+1 = q_n + h v_n + h^2/4 (a_n + a_n+1) with
     // a_n+1 extrapolated from the last step's change of a: its first correction is h^4 where a
     // is smooth, against h^3 with a_n+1 = a_n (A02 at 10 ms: 5e-8 rad against 3.3e-6)
     Eigen::VectorXd q, dl, v, a;
-    if (additive_) {
-      q = q_ + h * v_ + (h * h / 2) * a_;
-      if (jerk_) q.noalias() += (h * h * h / 4) * jerk_rate_;
-    } else {
-      dl = h * v_ + (h * h / 2) * a_;
-      if (jerk_) dl.noalias() += (h * h * h / 4) * jerk_rate_;
-      q = integrate<double>(m_, q_, dl);
-    }
+    dl = h * v_ + (h * h / 2) * a_;
+    if (jerk_) dl.noalias() += (h * h * h / 4) * jerk_rate_;
+    if (additive_) q = q_ + dl;
+    else q = integrate<double>(m_, q_, dl);
     // the motion inputs' coordinates where their signals are at the step's end (held there by
     // Newton: their rows are u's, not the balance), their rates and accelerations too
     drive(t_inputs, q);
@@ -539,11 +540,10 @@ class Alf final : public Integrator {
     // beside the positions' (a block Jacobi iteration: each block's correction at the same iterate)
     Eigen::VectorXd z = nz_ ? Eigen::VectorXd(z_ + h * g_) : Eigen::VectorXd();
     const Eigen::VectorXd zhat = nz_ ? Eigen::VectorXd(z_ + (h / 2) * g_) : Eigen::VectorXd();
-    // v = 2/h (q - q_n) - v_n, a = 4/h^2 (q - q_n) - 4/h v_n - a_n (the motions' from their signals)
+    // v = 2/h dl - v_n, a = 4/h^2 dl - 4/h v_n - a_n (the motions' from their signals)
     auto rates = [&] {
-      const Eigen::VectorXd& x = additive_ ? q : dl;
-      v = (2 / h) * x - vhat;
-      a = (4 / (h * h)) * x - ahat;
+      v = (2 / h) * dl - vhat;
+      a = (4 / (h * h)) * dl - ahat;
       for (std::size_t k = 0; k < driven_v_.size(); ++k) {
         v[driven_v_[k]] = driven_rate_[static_cast<Eigen::Index>(k)];
         a[driven_v_[k]] = driven_acc_[static_cast<Eigen::Index>(k)];
@@ -606,12 +606,9 @@ class Alf final : public Integrator {
       }
       const Eigen::VectorXd dq = -lu_.solve(f_);
       if (!dq.allFinite()) break;
-      if (additive_) {
-        q += dq;
-      } else {
-        dl += dq;
-        integrate_into<double>(m_, q_, dl, q);
-      }
+      dl += dq;
+      if (additive_) q = q_ + dl;
+      else integrate_into<double>(m_, q_, dl, q);
       hold_driven(q);  // (exactly its signal's value: its row of dq is zero up to rounding)
       if (nz_) z += dz;
       ++iterations_done_;

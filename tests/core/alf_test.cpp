@@ -550,6 +550,24 @@ double max_q_gap(const SimulationResult& a, const SimulationResult& b) {
   return (a.q - b.q).cwiseAbs().maxCoeff();
 }
 
+// the four-bar at its file's tolerances (rtol 1e-8, atol 1e-10): near t = 0.93 s its steps fall
+// below 1e-8 s. With v and a taken from q itself (4/h^2 (q - q_n)), their rounding there was up to
+// 1e5 rad/s^2 in powers of two, the error test failed every step and the run stopped ("no step
+// down to 8e-13 s passes"); from the step dl the rounding stays eps |v| / h
+TEST(Alf, FourBarAtItsFilesTolerancesThroughShortSteps) {
+  const double rtol = 1e-8, atol = 1e-10, t_end = 1.5;
+  const SimulationResult ref = example_run("four_bar.json", "cvode-bdf", t_end, 1e-12, 1e-14);
+  for (const bool x : {false, true}) {
+    const SimulationResult r = changed_example_run(
+        "four_bar.json", [&](nlohmann::json& j) { j["solver"]["alf_extrapolate"] = x; }, "alf", t_end, rtol, atol);
+    ASSERT_TRUE(r.completed) << r.failure;
+    const double gap = max_q_gap(r, ref);
+    std::cout << "four-bar, alf" << (x ? " extrapolated" : "") << " at rtol 1e-8, atol 1e-10 against cvode-bdf 1e-12: "
+              << gap << " rad; " << r.stats.steps << " steps\n";
+    EXPECT_LT(gap, x ? 1e-8 : 6e-8);  // measured 2.7e-9 and 1.9e-8 rad
+  }
+}
+
 // a ball joint (the heavy top, a quaternion): alf steps on the rotation group, q_n+1 = q_n (+) dl
 // with dl the trapezoidal rule's step in the tangent space; against arkode at 1e-11 over 2 s its
 // error falls as h^2 (the fast spin's phase), the quaternion stays a unit one
