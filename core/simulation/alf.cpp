@@ -509,7 +509,13 @@ class Alf final : public Integrator {
     // 1e13, kPenaltyMax, the double wishbone's K&C rig and the sedan at rtol 1e-6 took steps of a
     // few us at their start and lost their loops there, the weight h^2/4 alpha beside M ~1:
     // "no step passes"; at 1e15 and 1e17 both run, and A02, Andrews, Bricard and A05, whose steps
-    // stay above 1 ms or whose failures are elsewhere, take the same steps to the last one)
+    // stay above 1 ms or whose failures are elsewhere, take the same steps to the last one. At
+    // 1e15 the runs at rtol 1e-8 to 1e-10, whose steps at a start's transient fall below 1e-7 s,
+    // lost their loops in the same way: the weight h^2/4 alpha 2.5e-4 at 1e-9 s. With 1e20 (the
+    // rule's own alpha down to 3e-7 s) the sedan, the K&C rig, Andrews' squeezer and the driven
+    // slider-crank run at their files' tolerances. phi's rounding times alpha reaches lambda,
+    // but Newton's matrix carries the same h^2/4 alpha on Jc^T Jc, so its share in q stays at
+    // phi's rounding)
     // (at fixed steps the penalty as given: there the rule's growth, 100-fold at 1 ms, amplified
     // phi's rounding into an error floor on A02, ~3e-4 rad below 3 ms steps, and a stall raises
     // the penalty for its own step anyway)
@@ -889,8 +895,13 @@ class Alf final : public Integrator {
     restore_start();
     if (!substeps(4)) return false;
     const Eigen::VectorXd dq = additive_ ? Eigen::VectorXd(q_ - x1q_) : difference(m_, x1q_, q_);
-    const Eigen::ArrayXd w = atol_ + rtol_ * magnitude(q_).max(magnitude(x1q_));
-    err = (dq.array().abs() / (3 * H) / w).maxCoeff();
+    const Eigen::ArrayXd qmag = magnitude(q_).max(magnitude(x1q_)), w = atol_ + rtol_ * qmag;
+    // (less what Newton may leave in q at the six substeps' ends, kNewtonFloor (1 + |q|) each: x2 - x1
+    // below that is Newton's and rounding's, not the step's. Without it, per unit step, that noise
+    // grew as 1/H: at rtol 1e-10, atol 1e-12 the driven slider-crank, Andrews' squeezer, the sedan
+    // and the K&C rig failed at their first step, no H down to 1e-13 s passing)
+    const Eigen::ArrayXd floor = 6 * kNewtonFloor * (1 + qmag);
+    err = (((dq.array().abs() - floor).max(0.0)) / (3 * H) / w).maxCoeff();
     if (nz_) {
       const Eigen::ArrayXd wz = atol_ + rtol_ * z_.array().abs().max(x1z_.array().abs());
       err = std::max(err, ((z_ - x1z_).array().abs() / (3 * H) / wz).maxCoeff());
@@ -1023,8 +1034,12 @@ class Alf final : public Integrator {
 
   // the local error in q, h^2/12 (a_n+1 - a_n), in the weights atol + rtol |q| (<= 1: accepted)
   double error_estimate(double h) const {
-    const Eigen::ArrayXd w = atol_ + rtol_ * magnitude(q_).max(magnitude(qn_));
-    double err = ((h / 12) * (an_ - a_).array().abs() / w).maxCoeff();
+    const Eigen::ArrayXd qmag = magnitude(q_).max(magnitude(qn_)), w = atol_ + rtol_ * qmag;
+    // (less what Newton may leave in q at either end, kNewtonFloor (1 + |q|) each, 4/h^2 times
+    // that in a: at atol 1e-12 that alone is above the tolerance per unit step once h < 1e-5 s,
+    // and the steps collapsed with nothing to resolve; at looser tolerances it is nothing)
+    const Eigen::ArrayXd floor = 2 * kNewtonFloor * (1 + qmag);
+    double err = ((((h * h / 12) * (an_ - a_).array().abs()) - floor).max(0.0) / (h * w)).maxCoeff();
     // the first-order states': h^2/12 |z^(3)| per unit step, z^(3) from the rates' divided
     // differences over this step and the last (none after a start or a restart)
     if (nz_ && zslope_ok_) {
@@ -1295,7 +1310,7 @@ class Alf final : public Integrator {
   static constexpr double kRate = 0.5;
   static constexpr int kTangentAge = 20, kTangentFailures = 3;
   // the penalty: the error control's rule up to kRuleMax; a stall's raise up to kPenaltyMax
-  static constexpr double kPenaltyStep = 1e-2, kPenaltyMax = 1e13, kRuleMax = 1e15;
+  static constexpr double kPenaltyStep = 1e-2, kPenaltyMax = 1e13, kRuleMax = 1e20;
   ClosedLoopSystem& sys_;
   const Model& m_;
   Data d_;
