@@ -528,7 +528,6 @@ class Alf final : public Integrator {
     // step below ~1e-8 s failed it at rtol 1e-8 and a run that needed one (the four-bar at 0.93 s,
     // a start's transient) failed; from dl the rounding is 4 eps |v| / h, and the error test's
     // share of it, eps |v| / 3, does not grow as the step shrinks)
-    const Eigen::VectorXd vhat = v_;
     const Eigen::VectorXd ahat = (4 / h) * v_ + a_;
     // the predictor: the trapezoidal rule's own q_n+1 = q_n + h v_n + h^2/4 (a_n + a_n+1) with
     // a_n+1 extrapolated from the last step's change of a: its first correction is h^4 where a
@@ -548,7 +547,7 @@ class Alf final : public Integrator {
     const Eigen::VectorXd zhat = nz_ ? Eigen::VectorXd(z_ + (h / 2) * g_) : Eigen::VectorXd();
     // v = 2/h dl - v_n, a = 4/h^2 dl - 4/h v_n - a_n (the motions' from their signals)
     auto rates = [&] {
-      v = (2 / h) * dl - vhat;
+      v = (2 / h) * dl - v_;
       a = (4 / (h * h)) * dl - ahat;
       for (std::size_t k = 0; k < driven_v_.size(); ++k) {
         v[driven_v_[k]] = driven_rate_[static_cast<Eigen::Index>(k)];
