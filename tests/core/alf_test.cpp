@@ -157,6 +157,30 @@ TEST(Alf, A02FourBarsErrorControl) {
   EXPECT_GT(tight.steps, loose.steps);
 }
 
+// where no step passes (A02, N = 40, at rtol = atol = 1e-9: its first flat position, t = 0.72 s,
+// where Newton does not converge), the failure names the tolerances and what to try instead;
+// should the run pass there, it must be on the rigid branch
+TEST(Alf, A02FortyFourBarsAtTightToleranceFailsSayingWhatToTry) {
+  const Model m = compile(iftomm::a02_spec(40));
+  SimulationOptions o;
+  o.integrator.method = "alf";
+  o.integrator.rtol = o.integrator.atol = 1e-9;
+  o.t_end = 1.0;
+  o.output_step = 0.05;
+  const SimulationResult r = simulate(m, nullptr, nullptr, o);
+  if (r.completed) {
+    const Eigen::VectorXd exact = iftomm::a02_exact(40, r.t);
+    const int c = m.joints[static_cast<std::size_t>(m.find_joint("pivot0"))].idx_q;
+    for (int i = 0; i < r.samples(); ++i) EXPECT_NEAR(r.q(i, c), exact[i], 1e-6) << "t = " << r.t[i];
+    return;
+  }
+  std::cout << "A02 N = 40 by alf at 1e-9: " << r.failure << "\n";
+  EXPECT_NE(r.failure.find("no step down to"), std::string::npos) << r.failure;
+  EXPECT_NE(r.failure.find("rtol 1e-09, atol 1e-09"), std::string::npos) << r.failure;
+  EXPECT_NE(r.failure.find("a looser rtol and atol"), std::string::npos) << r.failure;
+  EXPECT_NE(r.failure.find("alf_fixed_step"), std::string::npos) << r.failure;
+}
+
 // bad settings and models alf does not take are refused, naming the field or the reason
 TEST(Alf, Refusals) {
   const Model m = compile(iftomm::a02_spec(2));
