@@ -296,8 +296,9 @@ void SimulateView::buildUi() {
   form->addRow(tr("Output step"), output_step_);
   integrator_ = new QComboBox(solver_box);
   for (const char* name : codyna::kIntegratorNames) integrator_->addItem(QLatin1String(name), QLatin1String(name));
-  integrator_->setToolTip(tr("auto chooses from the eigenvalues at the start (stiff: cvode-bdf; otherwise cvode-adams "
-                             "for trees, arkode for closed loops; the choice is reported); or ida, cvode-bdf, "
+  integrator_->setToolTip(tr("auto chooses from the eigenvalues at the start (stiff: alf extrapolated at rtol 1e-4 or "
+                             "looser, cvode-bdf tighter; otherwise cvode-adams for trees, arkode for closed loops; the "
+                             "choice is reported); or ida, cvode-bdf, "
                              "cvode-adams, arkode, the fixed-step rk4, alf (closed loops through singular positions)"));
   form->addRow(tr("Integrator"), integrator_);
   solver_form_ = form;

@@ -8,7 +8,7 @@
 
 namespace codyna {
 
-IntegratorChoice choose_integrator(ClosedLoopSystem& sys, double t, const Eigen::VectorXd& y, double span) {
+IntegratorChoice choose_integrator(ClosedLoopSystem& sys, double t, const Eigen::VectorXd& y, double span, double rtol) {
   IntegratorChoice c;
   const bool loops = sys.model().nc > 0;
   const int n = sys.ode_size();
@@ -57,10 +57,24 @@ IntegratorChoice choose_integrator(ClosedLoopSystem& sys, double t, const Eigen:
         << " times faster than the motion (" << c.slow_rate << " 1/s)";
   else
     why << "not stiff: the fastest decay " << c.fastest_decay << " 1/s against the motion's " << c.slow_rate << " 1/s";
-  c.method = c.stiff ? "cvode-bdf" : loops ? "arkode" : "cvode-adams";
-  why << (c.stiff ? "" : loops ? "; closed loops" : "; a tree");
-  c.reason = "auto: " + c.method + ", " + why.str();
+  // alf refuses rolling constraints (conditions on the velocities alone)
+  const bool alf = c.stiff && rtol >= kAlfLooseRtol && sys.model().velocity_rows.empty();
+  c.method = alf ? "alf" : c.stiff ? "cvode-bdf" : loops ? "arkode" : "cvode-adams";
+  c.alf_extrapolate = alf;
+  if (alf)
+    why << "; at rtol " << rtol << " >= " << kAlfLooseRtol;
+  else
+    why << (c.stiff ? "" : loops ? "; closed loops" : "; a tree");
+  c.reason = "auto: " + c.method + (alf ? " (extrapolated)" : "") + ", " + why.str();
   return c;
+}
+
+void apply_choice(const IntegratorChoice& c, IntegratorSettings& s) {
+  s.method = c.method;
+  if (c.method == "alf") {
+    s.alf_extrapolate = c.alf_extrapolate;
+    s.alf_fixed_step = false;  // auto's alf is under error control
+  }
 }
 
 std::string auto_fallback_note(const std::string& failed, double t_failed, const std::string& why, double t_from) {

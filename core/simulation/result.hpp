@@ -10,7 +10,7 @@
 namespace codyna {
 
 struct SolverStats {
-  std::string integrator;          // "ida", "cvode-bdf", "cvode-adams", "arkode", "rk4" (never "auto": the one chosen)
+  std::string integrator;          // "ida", "cvode-bdf", "cvode-adams", "arkode", "rk4", "alf" (never "auto": the one chosen)
   double rtol = 0, atol = 0, max_step = 0;
   long steps = 0;                  // internal steps
   long rhs_evals = 0;              // right-hand side / residual evaluations

@@ -348,8 +348,8 @@ SimulationResult simulate(const Model& model, const Controller* controller, cons
   IntegratorSettings settings = o.integrator;
   const bool chosen = settings.method == "auto";
   if (chosen) {  // the default: chosen from the closed loop at the initial state
-    const IntegratorChoice choice = choose_integrator(sys, o.t0, y, o.t_end - o.t0);
-    settings.method = choice.method;
+    const IntegratorChoice choice = choose_integrator(sys, o.t0, y, o.t_end - o.t0, settings.rtol);
+    apply_choice(choice, settings);
     r.stats.integrator_choice = choice.reason;
   }
   r.stats.integrator = settings.method;

@@ -16,8 +16,8 @@ Stepper::Stepper(const Model& model, const IntegratorSettings& settings, double 
   settings_ = settings;
   chosen_ = settings.method == "auto";
   if (chosen_) {  // chosen at the model's initial state; a stepped run has no length: 1 s
-    const IntegratorChoice choice = choose_integrator(sys_, t_, y_, 1.0);
-    settings_.method = choice.method;
+    const IntegratorChoice choice = choose_integrator(sys_, t_, y_, 1.0, settings_.rtol);
+    apply_choice(choice, settings_);
     extra_.integrator_choice = choice.reason;
   }
   integrator_ = make_integrator(sys_, settings_);
