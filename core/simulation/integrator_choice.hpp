@@ -33,7 +33,7 @@ constexpr int kMaxAnalysed = 600;
 // The tightest accuracy where alf, extrapolated, wins on stiff models (docs/work-precision.md,
 // "Twelfth round"): at rtol 1e-2 to 1e-4 on IFToMM's flyball (A05, a tree) and the K&C rig
 // (closed loops), the only stiff examples, it takes 0.6 to 1.6 times cvode-bdf's time at the same
-// rtol for errors 500 to 10000 times smaller, and is the faster of the two at equal error.
+// rtol for errors 300 to 10000 times smaller, and is the faster of the two at equal error.
 // Tighter, its error control gives far more than is asked, at up to 15 times the time (A05 at
 // 1e-8), so cvode-bdf stays.
 constexpr double kAlfLooseRtol = 1e-4;
