@@ -496,8 +496,9 @@ class Alf final : public Integrator {
   }
 
   // one trapezoidal step of h from (t_, q_, v_, a_, lambda_) into (qn_, vn_, an_, lambdan_);
-  // false when Newton does not converge
-  bool step(double h, bool to_stop) {
+  // false when Newton does not converge; projecting: v and a projected onto the loops at the end
+  // (all but an extrapolated pair's inner substeps)
+  bool step(double h, bool to_stop, bool projecting = true) {
     const double t1 = t_ + h, c = h * h / 4;
     // the inputs of a step that ends at a stop are read just before it (their left limit): a
     // reference or disturbance that jumps there enters the next step, from a restarted a
@@ -684,7 +685,8 @@ class Alf final : public Integrator {
     }
     // v and a projected onto the constraints at q
     rates();
-    if (m_.nc && project_substeps_ && !project(q, v, a, lambda, c, alpha)) return false;
+    projected_ = m_.nc > 0 && projecting;
+    if (projected_ && !project(q, v, a, lambda, c, alpha)) return false;
     if (!q.allFinite() || !v.allFinite() || !a.allFinite()) return false;
     qn_ = q;
     vn_ = v;
@@ -884,9 +886,7 @@ class Alf final : public Integrator {
     const auto substeps = [&](int n) {
       for (int k = 1; k <= n; ++k) {
         const double tk = k == n ? t1 : t0 + k * (H / n);
-        project_substeps_ = k == n;
-        if (!step(tk - t_, to_stop && k == n)) {
-          project_substeps_ = true;
+        if (!step(tk - t_, to_stop && k == n, k == n)) {
           restore_start();
           return false;
         }
@@ -1068,7 +1068,7 @@ class Alf final : public Integrator {
 
   void accept(double t1) {
     stalled_before_ = stalled_;
-    start_mass_ = m_.nc > 0 && project_substeps_;  // (Mp_: M at qn_)
+    start_mass_ = projected_;  // (Mp_: M at qn_, where the step projected)
     // the step's change of a, per unit time, for the next step's predictor
     jerk_rate_ = (an_ - a_) / (t1 - t_);
     jerk_ = true;
@@ -1351,8 +1351,7 @@ class Alf final : public Integrator {
   int iterations_;
   double rtol_, atol_;
   bool fixed_, extrapolate_, trace_;  // trace_: ALF_TRACE set, each Newton iteration printed
-  // false on the substeps of an extrapolated pair but its two sequences' last (extrapolated_pair)
-  bool project_substeps_ = true;
+  bool projected_ = false;  // the last step() projected v and a (Mp_ is M at its end)
   double next_ = 0, last_failure_ = 0, h_now_ = 0, t_ = 0;
   Eigen::VectorXd q_, v_, a_, lambda_, qn_, vn_, an_, lambdan_, f_, u_;
   Eigen::VectorXd jerk_rate_;  // (a_n - a_n-1) / h_n-1 of the last accepted step (jerk_: valid)
