@@ -256,6 +256,9 @@ void TreeDerivatives::size_for(const Model& model) {
     if (llt_ff_.rows() != nf) llt_ff_ = Eigen::LLT<Eigen::MatrixXd>(nf);
   }
   Minv_.setZero(nv, nv);
+  chol_.setZero(nv, nv);
+  chol_inv_.setZero(nv, nv);
+  scratch_row_.setZero(nv);
   IA_.assign(nb, Mat6::Zero());
   Fb_.resize(static_cast<std::size_t>(nb));
   Ab_.resize(static_cast<std::size_t>(nb));
@@ -581,6 +584,49 @@ void TreeDerivatives::inverse_mass_matrix() {
 // x = M^-1 f by the same articulated bodies (after inverse_mass_matrix): as accurate as the
 // forward dynamics' own recursion, where the product M^-1 f loses digits to the cancellation in f
 // (the derivatives of x, taken at x, would lose them again: 1e-10 against 1e-12 on a 60-link chain)
+// M^-1 of a small model's M (nv < kDenseInverseBelow) from its root-free Cholesky factors,
+// M = L D L^T (L unit lower), M^-1 = L^-T D^-1 L^-1, in plain loops: at these sizes Eigen's
+// blocked solvers cost more in setup than the arithmetic, and the articulated bodies' passes
+// more than both. No square root: a one-coordinate model's M^-1 is 1 / M exactly.
+void TreeDerivatives::small_inverse() {
+  const int n = m_->nv;
+  double* L = chol_.data();  // column-major: L(i, j) at L[i + j n], i > j; 1 / D(j) at L[j + j n]
+  double* W = chol_inv_.data();
+  double* t = scratch_row_.data();  // L(j, k) D(k), k < j
+  for (int j = 0; j < n; ++j) {
+    double d = M(j, j);
+    for (int k = 0; k < j; ++k) {
+      t[k] = L[j + k * n] * W[k + k * n];  // (W's diagonal holds D until W is formed)
+      d -= L[j + k * n] * t[k];
+    }
+    if (!(d > 0)) throw std::runtime_error("the mass matrix is not positive definite at this configuration");
+    const double inv = 1.0 / d;
+    L[j + j * n] = inv;
+    W[j + j * n] = d;
+    for (int i = j + 1; i < n; ++i) {
+      double s = M(i, j);
+      for (int k = 0; k < j; ++k) s -= L[i + k * n] * t[k];
+      L[i + j * n] = s * inv;
+    }
+  }
+  // W = L^-1 (unit lower, its diagonal not stored): column j by forward substitution on e_j
+  for (int j = 0; j < n; ++j)
+    for (int i = j + 1; i < n; ++i) {
+      double s = -L[i + j * n];
+      for (int k = j + 1; k < i; ++k) s -= L[i + k * n] * W[k + j * n];
+      W[i + j * n] = s;
+    }
+  // M^-1 (a, b) = sum over k >= max(a, b) of W(k, a) W(k, b) / D(k), W(k, k) = 1
+  for (int a = 0; a < n; ++a)
+    for (int b = 0; b <= a; ++b) {
+      const double wb = a == b ? 1.0 : W[a + b * n];
+      double s = wb * L[a + a * n];
+      for (int k = a + 1; k < n; ++k) s += W[k + a * n] * W[k + b * n] * L[k + k * n];
+      Minv_(a, b) = s;
+      Minv_(b, a) = s;
+    }
+}
+
 void TreeDerivatives::articulated_solve(const Eigen::VectorXd& f, Eigen::VectorXd& x) {
   const int nb = m_->nbodies;
   for (int i = 1; i < nb; ++i) pa_[i].setZero();
@@ -1216,9 +1262,15 @@ void TreeDerivatives::compute(const Eigen::VectorXd& q, const Eigen::VectorXd& v
   forces();
   scratch_ = tau;
   applied_force_derivatives(q, v, u_all);
-  inverse_mass_matrix();
   scratch_ = Q - scratch_;
-  articulated_solve(scratch_, qdd);
+  if (nv < kDenseInverseBelow) {
+    mass_matrix();
+    small_inverse();
+    qdd.noalias() = Minv_ * scratch_;
+  } else {
+    inverse_mass_matrix();
+    articulated_solve(scratch_, qdd);
+  }
   // inverse dynamics at the true accelerations, and its derivatives
   accelerations(v, qdd);
   forces();

@@ -127,8 +127,9 @@ class TreeDerivatives {
   Eigen::MatrixXd dtau_dq, dtau_dv;         // [nv x nv]
   Eigen::VectorXd Q;                        // applied generalized forces
   Eigen::MatrixXd dQ_dq, dQ_dv, dQ_du;      // [nv x nv], [nv x nv], [nv x nu_all]
-  // mass matrix at q: compute_constrained() fills it; compute() does not need it (M^-1 comes from
-  // the articulated bodies), and fills it only through fill_mass_matrix(), after it
+  // mass matrix at q: compute_constrained() fills it; compute() fills it below kDenseInverseBelow
+  // coordinates (M^-1 from its factors) and otherwise only through fill_mass_matrix(), after it
+  // (M^-1 from the articulated bodies)
   Eigen::MatrixXd M;
   void fill_mass_matrix() { mass_matrix(); }
   // results of compute_constrained(), one row per constraint row [nc x nv]
@@ -154,11 +155,17 @@ class TreeDerivatives {
   void inverse_mass_matrix();                                                  // Minv_ (articulated bodies)
   void articulated_solve(const Eigen::VectorXd& f, Eigen::VectorXd& x);        // x = M^-1 f, the same bodies
   void articulated_solve_rows();                                               // X_ := M^-1 X_
+  void small_inverse();                                                        // Minv_ from M (small nv)
   // from this many coordinates on, compute() solves for its derivatives by the articulated bodies
   // (48 nv^2 multiply-adds) rather than products with M^-1 (2 nv^3). Measured on the speed
   // models' chains (bench/pinocchio_bench.cpp, clang -O3): the products are faster up to 20 links
   // (4.0 against 4.9 us at 7, 16.2 against 18.5 at 20), even at 30, the solve 25% faster at 60
   static constexpr int kRowsSolveFrom = 32;
+  // below this many coordinates, compute() takes M^-1 from M's Cholesky factor (small_inverse)
+  // instead of the articulated bodies
+  static constexpr int kDenseInverseBelow = 16;
+  Eigen::MatrixXd chol_, chol_inv_;  // [nv x nv] small_inverse's L (1 / D on the diagonal) and L^-1
+  Eigen::VectorXd scratch_row_;      // [nv]
   void differentiate_rnea();
   void applied_force_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& u);
   void add_body_wrench(int body, const Vec6T<double>& w, const Eigen::Matrix<double, 6, 24>& dw, int body_a,
