@@ -43,7 +43,15 @@ Mat6 coriolis_inertia(const Vec6& V, const Mat6& I) {
   Y.bottomLeftCorner<3, 3>().noalias() = B.transpose() * w;
   Y.bottomLeftCorner<3, 3>() += m * v;
   Y.bottomRightCorner<3, 3>() = m * w;
-  return -(Y + Y.transpose());
+  // -(Y + Y^T) by its 21 distinct entries (Eigen's transposed sum walks all 36 with a strided read)
+  Mat6 C;
+  for (int c = 0; c < 6; ++c)
+    for (int r = 0; r <= c; ++r) {
+      const double e = -(Y(r, c) + Y(c, r));
+      C(r, c) = e;
+      C(c, r) = e;
+    }
+  return C;
 }
 
 // H(h) u = u x* h
