@@ -217,15 +217,20 @@ void expect_plant_agrees(const Model& m, const OperatingPoint& op, const std::st
   EXPECT_EQ((Jex2 - Jex).cwiseAbs().maxCoeff(), 0.0) << label;
 }
 
+// a random moving state with random inputs (moving: rotation tangents couple to the velocities)
+OperatingPoint random_moving_point(const Model& m, unsigned seed) {
+  std::mt19937 rng(seed);
+  OperatingPoint op = initial_point(m);
+  op.q = test::random_q(m, rng);
+  op.v = test::random_v(m, rng, 1.5);
+  op.u = test::random_v(m, rng, 1.0).head(m.nu());
+  return op;
+}
+
 TEST(TreeDerivatives, PlantJacobianMatchesAutodiffOnRandomTrees) {
   for (unsigned seed : {21u, 22u, 23u}) {
     const Model m = compile(rich_tree(seed));
-    std::mt19937 rng(seed);
-    OperatingPoint op = initial_point(m);
-    op.q = test::random_q(m, rng);
-    op.v = test::random_v(m, rng, 1.5);  // moving: rotation tangents couple to the velocities
-    op.u = test::random_v(m, rng, 1.0).head(m.nu());
-    expect_plant_agrees(m, op, "rich tree " + std::to_string(seed));
+    expect_plant_agrees(m, random_moving_point(m, seed), "rich tree " + std::to_string(seed));
   }
 }
 
@@ -236,48 +241,29 @@ TEST(TreeDerivatives, PlantJacobianMatchesAutodiffOnBranchedTrees) {
     ModelSpec s = rich_tree(seed);
     for (std::size_t i = 2; i < s.joints.size(); ++i) s.joints[i].parent = i % 2 ? "b0" : "b1";
     const Model m = compile(s);
-    std::mt19937 rng(seed);
-    OperatingPoint op = initial_point(m);
-    op.q = test::random_q(m, rng);
-    op.v = test::random_v(m, rng, 1.5);
-    op.u = test::random_v(m, rng, 1.0).head(m.nu());
-    expect_plant_agrees(m, op, "branched rich tree " + std::to_string(seed));
+    expect_plant_agrees(m, random_moving_point(m, seed), "branched rich tree " + std::to_string(seed));
   }
   const Model h = compile(speed_models::tree28());
-  std::mt19937 rng(5);
-  OperatingPoint op = initial_point(h);
-  op.q = test::random_q(h, rng);
-  op.v = test::random_v(h, rng, 1.5);
-  op.u = test::random_v(h, rng, 1.0).head(h.nu());
-  expect_plant_agrees(h, op, "tree28");
+  expect_plant_agrees(h, random_moving_point(h, 5), "tree28");
 }
 
 // compute() takes M^-1 from M's root-free Cholesky factors below 16 coordinates and from the
 // articulated bodies from 16 on: both sides of that size, on random trees (every joint type; the
-// rich one with every effect, actuator and sensor) and on the speed benchmarks' chains (at 31 links the factors' M^-1 gave
-// 6.5e-12 against autodiff, the articulated bodies 1.6e-12 at 32: the bound is kept low)
+// rich one with every effect, actuator and sensor) and on the speed benchmarks' chains (at 31
+// links the factors' M^-1 gave 6.5e-12 against autodiff, the articulated bodies 1.6e-12 at 32:
+// the bound is kept low)
 TEST(TreeDerivatives, PlantJacobianMatchesAutodiffOnBothSidesOfTheDenseSize) {
   bool below = false, above = false;
-  for (int n : {5, 6, 7, 10}) {  // random trees of every joint type; the rich tree (effects, sensors) from 10 bodies
+  for (int n : {5, 6, 7, 10}) {  // every joint type; at 10 bodies the rich tree (effects, sensors)
     const Model m = compile(n < 10 ? test::random_tree_spec(40u + static_cast<unsigned>(n), n) : rich_tree(50u));
     below = below || m.nv < 16;
     above = above || m.nv >= 16;
-    std::mt19937 rng(n);
-    OperatingPoint op = initial_point(m);
-    op.q = test::random_q(m, rng);
-    op.v = test::random_v(m, rng, 1.5);
-    op.u = test::random_v(m, rng, 1.0).head(m.nu());
-    expect_plant_agrees(m, op, "random tree of " + std::to_string(n) + " bodies, nv " + std::to_string(m.nv));
+    expect_plant_agrees(m, random_moving_point(m, static_cast<unsigned>(n)), "random tree of " + std::to_string(n) + " bodies, nv " + std::to_string(m.nv));
   }
   EXPECT_TRUE(below && above) << "the random trees no longer straddle 16 coordinates";
   for (int n : {15, 16}) {
     const Model m = compile(speed_models::chain(n));
-    std::mt19937 rng(n);
-    OperatingPoint op = initial_point(m);
-    op.q = test::random_q(m, rng);
-    op.v = test::random_v(m, rng, 1.5);
-    op.u = test::random_v(m, rng, 1.0).head(m.nu());
-    expect_plant_agrees(m, op, "chain_" + std::to_string(n));
+    expect_plant_agrees(m, random_moving_point(m, static_cast<unsigned>(n)), "chain_" + std::to_string(n));
   }
 }
 
