@@ -589,9 +589,6 @@ void TreeDerivatives::inverse_mass_matrix() {
   }
 }
 
-// x = M^-1 f by the same articulated bodies (after inverse_mass_matrix): as accurate as the
-// forward dynamics' own recursion, where the product M^-1 f loses digits to the cancellation in f
-// (the derivatives of x, taken at x, would lose them again: 1e-10 against 1e-12 on a 60-link chain)
 // M^-1 of a small model's M (nv < kDenseInverseBelow) from its root-free Cholesky factors,
 // M = L D L^T (L unit lower), M^-1 = L^-T D^-1 L^-1, in plain loops: at these sizes Eigen's
 // blocked solvers cost more in setup than the arithmetic, and the articulated bodies' passes
@@ -604,7 +601,7 @@ void TreeDerivatives::small_inverse() {
   for (int j = 0; j < n; ++j) {
     double d = M(j, j);
     for (int k = 0; k < j; ++k) {
-      t[k] = L[j + k * n] * W[k + k * n];  // (W's diagonal holds D until W is formed)
+      t[k] = L[j + k * n] * W[k + k * n];  // (W's diagonal, 1 and not stored, holds D)
       d -= L[j + k * n] * t[k];
     }
     if (!(d > 0)) throw std::runtime_error("the mass matrix is not positive definite at this configuration");
@@ -635,6 +632,9 @@ void TreeDerivatives::small_inverse() {
     }
 }
 
+// x = M^-1 f by the same articulated bodies (after inverse_mass_matrix): as accurate as the
+// forward dynamics' own recursion, where the product M^-1 f loses digits to the cancellation in f
+// (the derivatives of x, taken at x, would lose them again: 1e-10 against 1e-12 on a 60-link chain)
 void TreeDerivatives::articulated_solve(const Eigen::VectorXd& f, Eigen::VectorXd& x) {
   const int nb = m_->nbodies;
   for (int i = 1; i < nb; ++i) pa_[i].setZero();

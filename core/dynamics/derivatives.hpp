@@ -161,10 +161,10 @@ class TreeDerivatives {
   // models' chains (bench/pinocchio_bench.cpp, clang -O3): the products are faster up to 20 links
   // (4.0 against 4.9 us at 7, 16.2 against 18.5 at 20), even at 30, the solve 25% faster at 60
   static constexpr int kRowsSolveFrom = 32;
-  // below this many coordinates, compute() takes M^-1 from M's Cholesky factor (small_inverse)
-  // instead of the articulated bodies
+  // below this many coordinates, compute() takes M^-1 from M's root-free Cholesky factors
+  // (small_inverse) instead of the articulated bodies
   static constexpr int kDenseInverseBelow = 16;
-  Eigen::MatrixXd chol_, chol_inv_;  // [nv x nv] small_inverse's L (1 / D on the diagonal) and L^-1
+  Eigen::MatrixXd chol_, chol_inv_;  // [nv x nv] small_inverse's L (1 / D on the diagonal), L^-1 (D on it)
   Eigen::VectorXd scratch_row_;      // [nv]
   void differentiate_rnea();
   void applied_force_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& u);

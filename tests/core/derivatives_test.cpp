@@ -258,7 +258,8 @@ TEST(TreeDerivatives, PlantJacobianMatchesAutodiffOnBothSidesOfTheDenseSize) {
     const Model m = compile(n < 10 ? test::random_tree_spec(40u + static_cast<unsigned>(n), n) : rich_tree(50u));
     below = below || m.nv < 16;
     above = above || m.nv >= 16;
-    expect_plant_agrees(m, random_moving_point(m, static_cast<unsigned>(n)), "random tree of " + std::to_string(n) + " bodies, nv " + std::to_string(m.nv));
+    expect_plant_agrees(m, random_moving_point(m, static_cast<unsigned>(n)),
+                        "random tree of " + std::to_string(n) + " bodies, nv " + std::to_string(m.nv));
   }
   EXPECT_TRUE(below && above) << "the random trees no longer straddle 16 coordinates";
   for (int n : {15, 16}) {
