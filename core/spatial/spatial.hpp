@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cmath>
+#include <type_traits>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -51,32 +52,83 @@ struct SE3T {
   SE3T inverse() const { return SE3T(R.transpose(), -(R.transpose() * p)); }
   Vec3T<S> act_point(const Vec3T<S>& x) const { return R * x + p; }
 
+  // The four transforms below: in double, each of the six components as one scalar expression
+  // and the result written at once. Written as two 3-vectors, the halves were stored as 2 + 1
+  // doubles and read back by the caller as aligned pairs, a load that spans two stores and
+  // stalls on every transform (store forwarding). The sums are Eigen's, in Eigen's order, so the
+  // results are the same bit for bit (its R x adds a row's three products left to right in the
+  // first two rows and the last two first in the third; R^T x left to right).
+
   // motion given in B coordinates -> A coordinates
   Vec6T<S> act_motion(const Vec6T<S>& m) const {
     Vec6T<S> r;
-    r.template head<3>() = R * m.template head<3>();
-    r.template tail<3>() = R * m.template tail<3>() + p.cross(Vec3T<S>(r.template head<3>()));
+    if constexpr (std::is_same_v<S, double>) {
+      const double w0 = R(0, 0) * m[0] + R(0, 1) * m[1] + R(0, 2) * m[2];
+      const double w1 = R(1, 0) * m[0] + R(1, 1) * m[1] + R(1, 2) * m[2];
+      const double w2 = R(2, 0) * m[0] + (R(2, 1) * m[1] + R(2, 2) * m[2]);
+      r << w0, w1, w2,  //
+          R(0, 0) * m[3] + R(0, 1) * m[4] + R(0, 2) * m[5] + (p[1] * w2 - p[2] * w1),
+          R(1, 0) * m[3] + R(1, 1) * m[4] + R(1, 2) * m[5] + (p[2] * w0 - p[0] * w2),
+          R(2, 0) * m[3] + (R(2, 1) * m[4] + R(2, 2) * m[5]) + (p[0] * w1 - p[1] * w0);
+    } else {
+      r.template head<3>() = R * m.template head<3>();
+      r.template tail<3>() = R * m.template tail<3>() + p.cross(Vec3T<S>(r.template head<3>()));
+    }
     return r;
   }
   // motion given in A coordinates -> B coordinates
   Vec6T<S> inv_act_motion(const Vec6T<S>& m) const {
     Vec6T<S> r;
-    r.template head<3>() = R.transpose() * m.template head<3>();
-    r.template tail<3>() = R.transpose() * (m.template tail<3>() - p.cross(Vec3T<S>(m.template head<3>())));
+    if constexpr (std::is_same_v<S, double>) {
+      const double u0 = m[3] - (p[1] * m[2] - p[2] * m[1]);
+      const double u1 = m[4] - (p[2] * m[0] - p[0] * m[2]);
+      const double u2 = m[5] - (p[0] * m[1] - p[1] * m[0]);
+      r << R(0, 0) * m[0] + R(1, 0) * m[1] + R(2, 0) * m[2],  //
+          R(0, 1) * m[0] + R(1, 1) * m[1] + R(2, 1) * m[2],   //
+          R(0, 2) * m[0] + R(1, 2) * m[1] + R(2, 2) * m[2],   //
+          R(0, 0) * u0 + R(1, 0) * u1 + R(2, 0) * u2,         //
+          R(0, 1) * u0 + R(1, 1) * u1 + R(2, 1) * u2,         //
+          R(0, 2) * u0 + R(1, 2) * u1 + R(2, 2) * u2;
+    } else {
+      r.template head<3>() = R.transpose() * m.template head<3>();
+      r.template tail<3>() = R.transpose() * (m.template tail<3>() - p.cross(Vec3T<S>(m.template head<3>())));
+    }
     return r;
   }
   // force given in B coordinates -> A coordinates
   Vec6T<S> act_force(const Vec6T<S>& f) const {
     Vec6T<S> r;
-    r.template tail<3>() = R * f.template tail<3>();
-    r.template head<3>() = R * f.template head<3>() + p.cross(Vec3T<S>(r.template tail<3>()));
+    if constexpr (std::is_same_v<S, double>) {
+      const double f0 = R(0, 0) * f[3] + R(0, 1) * f[4] + R(0, 2) * f[5];
+      const double f1 = R(1, 0) * f[3] + R(1, 1) * f[4] + R(1, 2) * f[5];
+      const double f2 = R(2, 0) * f[3] + (R(2, 1) * f[4] + R(2, 2) * f[5]);
+      r << R(0, 0) * f[0] + R(0, 1) * f[1] + R(0, 2) * f[2] + (p[1] * f2 - p[2] * f1),
+          R(1, 0) * f[0] + R(1, 1) * f[1] + R(1, 2) * f[2] + (p[2] * f0 - p[0] * f2),
+          R(2, 0) * f[0] + (R(2, 1) * f[1] + R(2, 2) * f[2]) + (p[0] * f1 - p[1] * f0),  //
+          f0, f1, f2;
+    } else {
+      r.template tail<3>() = R * f.template tail<3>();
+      r.template head<3>() = R * f.template head<3>() + p.cross(Vec3T<S>(r.template tail<3>()));
+    }
     return r;
   }
   // force given in A coordinates -> B coordinates
   Vec6T<S> inv_act_force(const Vec6T<S>& f) const {
     Vec6T<S> r;
-    r.template tail<3>() = R.transpose() * f.template tail<3>();
-    r.template head<3>() = R.transpose() * (f.template head<3>() - p.cross(Vec3T<S>(f.template tail<3>())));
+    if constexpr (std::is_same_v<S, double>) {
+      const double n0 = f[0] - (p[1] * f[5] - p[2] * f[4]);
+      const double n1 = f[1] - (p[2] * f[3] - p[0] * f[5]);
+      const double n2 = f[2] - (p[0] * f[4] - p[1] * f[3]);
+      r << R(0, 0) * n0 + R(1, 0) * n1 + R(2, 0) * n2,  //
+          R(0, 1) * n0 + R(1, 1) * n1 + R(2, 1) * n2,   //
+          R(0, 2) * n0 + R(1, 2) * n1 + R(2, 2) * n2,   //
+          R(0, 0) * f[3] + R(1, 0) * f[4] + R(2, 0) * f[5],  //
+          R(0, 1) * f[3] + R(1, 1) * f[4] + R(2, 1) * f[5],  //
+          R(0, 2) * f[3] + R(1, 2) * f[4] + R(2, 2) * f[5];
+    } else {
+      r.template tail<3>() = R.transpose() * f.template tail<3>();
+      r.template head<3>() = R.transpose() * (f.template head<3>() - p.cross(Vec3T<S>(f.template tail<3>())));
+    }
     return r;
   }
   // 6x6 motion transform (B coordinates -> A coordinates), for Jacobian columns and inertias
@@ -100,8 +152,15 @@ Vec6T<S> cross_motion(const Vec6T<S>& m1, const Vec6T<S>& m2) {
   const Vec3T<S> w = m1.template head<3>(), v = m1.template tail<3>();
   const Vec3T<S> w2 = m2.template head<3>(), v2 = m2.template tail<3>();
   Vec6T<S> r;
-  r.template head<3>() = w.cross(w2);
-  r.template tail<3>() = w.cross(v2) + v.cross(w2);
+  if constexpr (std::is_same_v<S, double>) {  // one write (see SE3T's transforms)
+    r << w[1] * w2[2] - w[2] * w2[1], w[2] * w2[0] - w[0] * w2[2], w[0] * w2[1] - w[1] * w2[0],
+        (w[1] * v2[2] - w[2] * v2[1]) + (v[1] * w2[2] - v[2] * w2[1]),
+        (w[2] * v2[0] - w[0] * v2[2]) + (v[2] * w2[0] - v[0] * w2[2]),
+        (w[0] * v2[1] - w[1] * v2[0]) + (v[0] * w2[1] - v[1] * w2[0]);
+  } else {
+    r.template head<3>() = w.cross(w2);
+    r.template tail<3>() = w.cross(v2) + v.cross(w2);
+  }
   return r;
 }
 
@@ -111,8 +170,15 @@ Vec6T<S> cross_force(const Vec6T<S>& m, const Vec6T<S>& f) {
   const Vec3T<S> w = m.template head<3>(), v = m.template tail<3>();
   const Vec3T<S> n = f.template head<3>(), fl = f.template tail<3>();
   Vec6T<S> r;
-  r.template head<3>() = w.cross(n) + v.cross(fl);
-  r.template tail<3>() = w.cross(fl);
+  if constexpr (std::is_same_v<S, double>) {  // one write (see SE3T's transforms)
+    r << (w[1] * n[2] - w[2] * n[1]) + (v[1] * fl[2] - v[2] * fl[1]),
+        (w[2] * n[0] - w[0] * n[2]) + (v[2] * fl[0] - v[0] * fl[2]),
+        (w[0] * n[1] - w[1] * n[0]) + (v[0] * fl[1] - v[1] * fl[0]),  //
+        w[1] * fl[2] - w[2] * fl[1], w[2] * fl[0] - w[0] * fl[2], w[0] * fl[1] - w[1] * fl[0];
+  } else {
+    r.template head<3>() = w.cross(n) + v.cross(fl);
+    r.template tail<3>() = w.cross(fl);
+  }
   return r;
 }
 
