@@ -71,11 +71,17 @@ void aba_velocity_terms(const Model& model, DataT<S>& d, const VecXT<S>& v) {
   for (int i = 1; i < model.nbodies; ++i) {
     const JointModel& j = model.joints[i];
     const Vec6T<S>& vi = d.v[i];
+    Vec6T<S> pb;  // written to both from registers (a copy of d.pB[i] would reload it)
     if constexpr (std::is_same_v<S, double>)  // the structured inertia: no 6 x 6 product
-      d.pB[i] = cross_force<S>(vi, d.constants.body_inertia[i].apply(vi));
+      pb = cross_force<S>(vi, d.constants.body_inertia[i].apply(vi));
     else
-      d.pB[i] = cross_force<S>(vi, Vec6T<S>(model.inertia[i].template cast<S>() * vi));
-    d.pA[i] = d.pB[i];
+      pb = cross_force<S>(vi, Vec6T<S>(model.inertia[i].template cast<S>() * vi));
+    d.pB[i] = pb;
+    d.pA[i] = pb;
+    if (j.nv == 1) {
+      d.c[i] = d.cJ[i] + cross_motion_scaled<S>(vi, d.Sb[i].data(), v[j.idx_v]);
+      continue;
+    }
     Vec6T<S> vJ;
     if (j.nv == 1) vJ = d.Sb[i].col(0) * v[j.idx_v];
     else if (j.nv > 0) vJ.noalias() = d.Sb[i] * v.segment(j.idx_v, j.nv);

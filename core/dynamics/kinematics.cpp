@@ -24,10 +24,16 @@ Vec6T<S> body_velocity(const JointModel& j, DataT<S>& d, int i, const VecXT<S>& 
 
 // a[i] of body i from its parent's (v[i], cJ[i] written; vJ the joint velocity)
 template <class S>
-void body_acceleration(const JointModel& j, DataT<S>& d, int i, const Vec6T<S>& vJ, const VecXT<S>& qdd) {
+void body_acceleration(const JointModel& j, DataT<S>& d, int i, const Vec6T<S>& vJ, const VecXT<S>& v,
+                       const VecXT<S>& qdd) {
   Vec6T<S> aJ;
-  if (j.nv == 1) aJ = d.Sb[i].col(0) * qdd[j.idx_v];
-  else if (j.nv > 0) aJ.noalias() = d.Sb[i] * qdd.segment(j.idx_v, j.nv);
+  if (j.nv == 1) {
+    aJ = d.Sb[i].col(0) * qdd[j.idx_v];
+    d.a[i] = d.liMi[i].inv_act_motion(d.a[j.parent]) + aJ + d.cJ[i] +
+             cross_motion_scaled<S>(d.v[i], d.Sb[i].data(), v[j.idx_v]);  // (vJ not read back)
+    return;
+  }
+  if (j.nv > 0) aJ.noalias() = d.Sb[i] * qdd.segment(j.idx_v, j.nv);
   else aJ.setZero();
   d.a[i] = d.liMi[i].inv_act_motion(d.a[j.parent]) + aJ + d.cJ[i] + cross_motion<S>(d.v[i], vJ);
 }
@@ -97,7 +103,7 @@ void fk(const Model& model, DataT<S>& d, const VecXT<S>& q, const VecXT<S>* v, c
     }
     if (!v) continue;
     const Vec6T<S> vJ = body_velocity<S>(j, d, i, q, *v);
-    if (qdd) body_acceleration<S>(j, d, i, vJ, *qdd);
+    if (qdd) body_acceleration<S>(j, d, i, vJ, *v, *qdd);
   }
 }
 }  // namespace
@@ -124,7 +130,7 @@ template <class S>
 void rate_kinematics(const Model& model, DataT<S>& data, const VecXT<S>& q, const VecXT<S>& v, const VecXT<S>& qdd) {
   for (int i = 1; i < model.nbodies; ++i) {
     const Vec6T<S> vJ = body_velocity<S>(model.joints[i], data, i, q, v);
-    body_acceleration<S>(model.joints[i], data, i, vJ, qdd);
+    body_acceleration<S>(model.joints[i], data, i, vJ, v, qdd);
   }
 }
 

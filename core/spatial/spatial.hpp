@@ -40,6 +40,11 @@ Mat3T<S> skew(const Vec3T<S>& w) {
   return m;
 }
 
+// r = (x0, ..., x5), the six components of a spatial vector computed as scalars and written at once
+inline void set6(Vec6T<double>& r, double x0, double x1, double x2, double x3, double x4, double x5) {
+  r << x0, x1, x2, x3, x4, x5;
+}
+
 template <class S>
 struct SE3T {
   Mat3T<S> R = Mat3T<S>::Identity();
@@ -53,7 +58,7 @@ struct SE3T {
   Vec3T<S> act_point(const Vec3T<S>& x) const { return R * x + p; }
 
   // The four transforms below: in double, each of the six components as one scalar expression
-  // and the result written at once. Written as two 3-vectors, the halves were stored as 2 + 1
+  // and the result written at once (set6). Written as two 3-vectors, the halves were stored as 2 + 1
   // doubles and read back by the caller as aligned pairs, a load that spans two stores and
   // stalls on every transform (store forwarding). The sums are Eigen's, in Eigen's order, so the
   // results are the same bit for bit (its R x adds a row's three products left to right in the
@@ -66,10 +71,13 @@ struct SE3T {
       const double w0 = R(0, 0) * m[0] + R(0, 1) * m[1] + R(0, 2) * m[2];
       const double w1 = R(1, 0) * m[0] + R(1, 1) * m[1] + R(1, 2) * m[2];
       const double w2 = R(2, 0) * m[0] + (R(2, 1) * m[1] + R(2, 2) * m[2]);
-      r << w0, w1, w2,  //
-          R(0, 0) * m[3] + R(0, 1) * m[4] + R(0, 2) * m[5] + (p[1] * w2 - p[2] * w1),
-          R(1, 0) * m[3] + R(1, 1) * m[4] + R(1, 2) * m[5] + (p[2] * w0 - p[0] * w2),
-          R(2, 0) * m[3] + (R(2, 1) * m[4] + R(2, 2) * m[5]) + (p[0] * w1 - p[1] * w0);
+      set6(r,
+           w0,
+           w1,
+           w2,
+           R(0, 0) * m[3] + R(0, 1) * m[4] + R(0, 2) * m[5] + (p[1] * w2 - p[2] * w1),
+           R(1, 0) * m[3] + R(1, 1) * m[4] + R(1, 2) * m[5] + (p[2] * w0 - p[0] * w2),
+           R(2, 0) * m[3] + (R(2, 1) * m[4] + R(2, 2) * m[5]) + (p[0] * w1 - p[1] * w0));
     } else {
       r.template head<3>() = R * m.template head<3>();
       r.template tail<3>() = R * m.template tail<3>() + p.cross(Vec3T<S>(r.template head<3>()));
@@ -83,12 +91,13 @@ struct SE3T {
       const double u0 = m[3] - (p[1] * m[2] - p[2] * m[1]);
       const double u1 = m[4] - (p[2] * m[0] - p[0] * m[2]);
       const double u2 = m[5] - (p[0] * m[1] - p[1] * m[0]);
-      r << R(0, 0) * m[0] + R(1, 0) * m[1] + R(2, 0) * m[2],  //
-          R(0, 1) * m[0] + R(1, 1) * m[1] + R(2, 1) * m[2],   //
-          R(0, 2) * m[0] + R(1, 2) * m[1] + R(2, 2) * m[2],   //
-          R(0, 0) * u0 + R(1, 0) * u1 + R(2, 0) * u2,         //
-          R(0, 1) * u0 + R(1, 1) * u1 + R(2, 1) * u2,         //
-          R(0, 2) * u0 + R(1, 2) * u1 + R(2, 2) * u2;
+      set6(r,
+           R(0, 0) * m[0] + R(1, 0) * m[1] + R(2, 0) * m[2],
+           R(0, 1) * m[0] + R(1, 1) * m[1] + R(2, 1) * m[2],
+           R(0, 2) * m[0] + R(1, 2) * m[1] + R(2, 2) * m[2],
+           R(0, 0) * u0 + R(1, 0) * u1 + R(2, 0) * u2,
+           R(0, 1) * u0 + R(1, 1) * u1 + R(2, 1) * u2,
+           R(0, 2) * u0 + R(1, 2) * u1 + R(2, 2) * u2);
     } else {
       r.template head<3>() = R.transpose() * m.template head<3>();
       r.template tail<3>() = R.transpose() * (m.template tail<3>() - p.cross(Vec3T<S>(m.template head<3>())));
@@ -102,10 +111,13 @@ struct SE3T {
       const double f0 = R(0, 0) * f[3] + R(0, 1) * f[4] + R(0, 2) * f[5];
       const double f1 = R(1, 0) * f[3] + R(1, 1) * f[4] + R(1, 2) * f[5];
       const double f2 = R(2, 0) * f[3] + (R(2, 1) * f[4] + R(2, 2) * f[5]);
-      r << R(0, 0) * f[0] + R(0, 1) * f[1] + R(0, 2) * f[2] + (p[1] * f2 - p[2] * f1),
-          R(1, 0) * f[0] + R(1, 1) * f[1] + R(1, 2) * f[2] + (p[2] * f0 - p[0] * f2),
-          R(2, 0) * f[0] + (R(2, 1) * f[1] + R(2, 2) * f[2]) + (p[0] * f1 - p[1] * f0),  //
-          f0, f1, f2;
+      set6(r,
+           R(0, 0) * f[0] + R(0, 1) * f[1] + R(0, 2) * f[2] + (p[1] * f2 - p[2] * f1),
+           R(1, 0) * f[0] + R(1, 1) * f[1] + R(1, 2) * f[2] + (p[2] * f0 - p[0] * f2),
+           R(2, 0) * f[0] + (R(2, 1) * f[1] + R(2, 2) * f[2]) + (p[0] * f1 - p[1] * f0),
+           f0,
+           f1,
+           f2);
     } else {
       r.template tail<3>() = R * f.template tail<3>();
       r.template head<3>() = R * f.template head<3>() + p.cross(Vec3T<S>(r.template tail<3>()));
@@ -119,12 +131,13 @@ struct SE3T {
       const double n0 = f[0] - (p[1] * f[5] - p[2] * f[4]);
       const double n1 = f[1] - (p[2] * f[3] - p[0] * f[5]);
       const double n2 = f[2] - (p[0] * f[4] - p[1] * f[3]);
-      r << R(0, 0) * n0 + R(1, 0) * n1 + R(2, 0) * n2,  //
-          R(0, 1) * n0 + R(1, 1) * n1 + R(2, 1) * n2,   //
-          R(0, 2) * n0 + R(1, 2) * n1 + R(2, 2) * n2,   //
-          R(0, 0) * f[3] + R(1, 0) * f[4] + R(2, 0) * f[5],  //
-          R(0, 1) * f[3] + R(1, 1) * f[4] + R(2, 1) * f[5],  //
-          R(0, 2) * f[3] + R(1, 2) * f[4] + R(2, 2) * f[5];
+      set6(r,
+           R(0, 0) * n0 + R(1, 0) * n1 + R(2, 0) * n2,
+           R(0, 1) * n0 + R(1, 1) * n1 + R(2, 1) * n2,
+           R(0, 2) * n0 + R(1, 2) * n1 + R(2, 2) * n2,
+           R(0, 0) * f[3] + R(1, 0) * f[4] + R(2, 0) * f[5],
+           R(0, 1) * f[3] + R(1, 1) * f[4] + R(2, 1) * f[5],
+           R(0, 2) * f[3] + R(1, 2) * f[4] + R(2, 2) * f[5]);
     } else {
       r.template tail<3>() = R.transpose() * f.template tail<3>();
       r.template head<3>() = R.transpose() * (f.template head<3>() - p.cross(Vec3T<S>(f.template tail<3>())));
@@ -153,15 +166,38 @@ Vec6T<S> cross_motion(const Vec6T<S>& m1, const Vec6T<S>& m2) {
   const Vec3T<S> w2 = m2.template head<3>(), v2 = m2.template tail<3>();
   Vec6T<S> r;
   if constexpr (std::is_same_v<S, double>) {  // one write (see SE3T's transforms)
-    r << w[1] * w2[2] - w[2] * w2[1], w[2] * w2[0] - w[0] * w2[2], w[0] * w2[1] - w[1] * w2[0],
-        (w[1] * v2[2] - w[2] * v2[1]) + (v[1] * w2[2] - v[2] * w2[1]),
-        (w[2] * v2[0] - w[0] * v2[2]) + (v[2] * w2[0] - v[0] * w2[2]),
-        (w[0] * v2[1] - w[1] * v2[0]) + (v[0] * w2[1] - v[1] * w2[0]);
+    set6(r,
+         w[1] * w2[2] - w[2] * w2[1],
+         w[2] * w2[0] - w[0] * w2[2],
+         w[0] * w2[1] - w[1] * w2[0],
+         (w[1] * v2[2] - w[2] * v2[1]) + (v[1] * w2[2] - v[2] * w2[1]),
+         (w[2] * v2[0] - w[0] * v2[2]) + (v[2] * w2[0] - v[0] * w2[2]),
+         (w[0] * v2[1] - w[1] * v2[0]) + (v[0] * w2[1] - v[1] * w2[0]));
   } else {
     r.template head<3>() = w.cross(w2);
     r.template tail<3>() = w.cross(v2) + v.cross(w2);
   }
   return r;
+}
+
+// m1 x (k s): the cross product with a joint's motion s qd (s a 6-vector at s_data), the same
+// numbers as cross_motion(m1, Vec6(s * k)). In double without that 6-vector in memory: written
+// there by pairs and read back by the cross product's pairs (1, 2), it stalled on store
+// forwarding (a quarter of the ABA's velocity terms on chain 30).
+template <class S>
+Vec6T<S> cross_motion_scaled(const Vec6T<S>& m1, const S* s_data, const S& k) {
+  if constexpr (std::is_same_v<S, double>) {
+    const double a0 = s_data[0] * k, a1 = s_data[1] * k, a2 = s_data[2] * k;
+    const double b0 = s_data[3] * k, b1 = s_data[4] * k, b2 = s_data[5] * k;
+    const double w0 = m1[0], w1 = m1[1], w2 = m1[2], v0 = m1[3], v1 = m1[4], v2 = m1[5];
+    Vec6T<double> r;
+    set6(r, w1 * a2 - w2 * a1, w2 * a0 - w0 * a2, w0 * a1 - w1 * a0,
+         (w1 * b2 - w2 * b1) + (v1 * a2 - v2 * a1), (w2 * b0 - w0 * b2) + (v2 * a0 - v0 * a2),
+         (w0 * b1 - w1 * b0) + (v0 * a1 - v1 * a0));
+    return r;
+  } else {
+    return cross_motion<S>(m1, Vec6T<S>(Eigen::Map<const Vec6T<S>>(s_data) * k));
+  }
 }
 
 // m x* f (motion cross force)
@@ -171,10 +207,13 @@ Vec6T<S> cross_force(const Vec6T<S>& m, const Vec6T<S>& f) {
   const Vec3T<S> n = f.template head<3>(), fl = f.template tail<3>();
   Vec6T<S> r;
   if constexpr (std::is_same_v<S, double>) {  // one write (see SE3T's transforms)
-    r << (w[1] * n[2] - w[2] * n[1]) + (v[1] * fl[2] - v[2] * fl[1]),
-        (w[2] * n[0] - w[0] * n[2]) + (v[2] * fl[0] - v[0] * fl[2]),
-        (w[0] * n[1] - w[1] * n[0]) + (v[0] * fl[1] - v[1] * fl[0]),  //
-        w[1] * fl[2] - w[2] * fl[1], w[2] * fl[0] - w[0] * fl[2], w[0] * fl[1] - w[1] * fl[0];
+    set6(r,
+         (w[1] * n[2] - w[2] * n[1]) + (v[1] * fl[2] - v[2] * fl[1]),
+         (w[2] * n[0] - w[0] * n[2]) + (v[2] * fl[0] - v[0] * fl[2]),
+         (w[0] * n[1] - w[1] * n[0]) + (v[0] * fl[1] - v[1] * fl[0]),
+         w[1] * fl[2] - w[2] * fl[1],
+         w[2] * fl[0] - w[0] * fl[2],
+         w[0] * fl[1] - w[1] * fl[0]);
   } else {
     r.template head<3>() = w.cross(n) + v.cross(fl);
     r.template tail<3>() = w.cross(fl);

@@ -81,6 +81,11 @@ TEST(Spatial, TransformsAreTheBlockExpressionsBitForBit) {
     e.head<3>() = w.cross(w2) + v.cross(v2);
     e.tail<3>() = w.cross(v2);
     EXPECT_EQ(cross_force<double>(c.a, c.b), e);
+    RigidInertiaT<double> I;  // (not written out; against its matrix) a rigid inertia: mass, first moment, symmetric rotational inertia
+    I.m = 1.0 + c.b[0] * c.b[0];
+    I.h = c.b.tail<3>();
+    I.I = R * Eigen::Vector3d(2.0, 3.0, 4.0).asDiagonal() * R.transpose();
+    EXPECT_LT((I.apply(c.a) - I.matrix() * c.a).norm(), 1e-13);
   }
 }
 
