@@ -81,6 +81,8 @@ TEST(Spatial, TransformsAreTheBlockExpressionsBitForBit) {
     e.head<3>() = w.cross(w2) + v.cross(v2);
     e.tail<3>() = w.cross(v2);
     EXPECT_EQ(cross_force<double>(c.a, c.b), e);
+    const double k = c.b[1];  // a joint's motion s qd: s = a, qd = k
+    EXPECT_EQ(cross_motion_scaled<double>(c.b, c.a.data(), k), cross_motion<double>(c.b, Vec6T<double>(c.a * k)));
     RigidInertiaT<double> I;  // (not written out; against its matrix) a rigid inertia: mass, first moment, symmetric rotational inertia
     I.m = 1.0 + c.b[0] * c.b[0];
     I.h = c.b.tail<3>();
