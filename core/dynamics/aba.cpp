@@ -83,8 +83,7 @@ void aba_velocity_terms(const Model& model, DataT<S>& d, const VecXT<S>& v) {
       continue;
     }
     Vec6T<S> vJ;
-    if (j.nv == 1) vJ = d.Sb[i].col(0) * v[j.idx_v];
-    else if (j.nv > 0) vJ.noalias() = d.Sb[i] * v.segment(j.idx_v, j.nv);
+    if (j.nv > 0) vJ.noalias() = d.Sb[i] * v.segment(j.idx_v, j.nv);
     else vJ.setZero();
     d.c[i] = d.cJ[i] + cross_motion<S>(vi, vJ);
   }
