@@ -29,37 +29,36 @@ using Mat3A = Eigen::Matrix<AD, 3, 3>;
 Vec6 crm(const Vec6& m, const Vec6& x) { return cross_motion<double>(m, x); }
 Vec6 crf(const Vec6& m, const Vec6& f) { return cross_force<double>(m, f); }
 
-// V x* I - I V x, the "Coriolis inertia" of a world inertia I = [A B; B^T m 1] moving with V:
-// with X = crm(V) = [w 0; v w] and crf(V) = -X^T, it is -(Y + Y^T) for Y = I X (I symmetric),
-// four 3 x 3 products
-Mat6 coriolis_inertia(const Vec6& V, const Mat6& I) {
-  const Mat3 w = skew<double>(Vec3(V.head<3>())), v = skew<double>(Vec3(V.tail<3>()));
-  const Mat3 A = I.topLeftCorner<3, 3>(), B = I.topRightCorner<3, 3>();
-  const double m = I(3, 3);
-  Mat6 Y;
-  Y.topLeftCorner<3, 3>().noalias() = A * w;
-  Y.topLeftCorner<3, 3>().noalias() += B * v;
-  Y.topRightCorner<3, 3>().noalias() = B * w;
-  Y.bottomLeftCorner<3, 3>().noalias() = B.transpose() * w;
-  Y.bottomLeftCorner<3, 3>() += m * v;
-  Y.bottomRightCorner<3, 3>() = m * w;
-  // -(Y + Y^T) by its 21 distinct entries (Eigen's transposed sum walks all 36 with a strided read)
-  Mat6 C;
-  for (int c = 0; c < 6; ++c)
-    for (int r = 0; r <= c; ++r) {
-      const double e = -(Y(r, c) + Y(c, r));
-      C(r, c) = e;
-      C(c, r) = e;
+using Inertia = RigidInertiaT<double>;
+
+// The "Coriolis inertia" V x* I - I V x of a world inertia I = (m, h, J) (about the world origin)
+// moving with V = [w; v]: the time derivative of I, itself of an inertia's form with zero mass,
+// [dJ, [dh]; [dh]^T, 0], with dh = w x h + m v and dJ = [w] J - J [w] - ([h][v] + [v][h]), where
+// [w] J - J [w] = Y + Y^T for Y = [w] J (J symmetric) and [h][v] + [v][h] = v h^T + h v^T - 2 (h.v) 1
+Inertia inertia_rate(const Vec6& V, const Inertia& I) {
+  const Vec3 w = V.head<3>(), v = V.tail<3>();
+  Inertia r;
+  r.m = 0.0;
+  r.h = w.cross(I.h) + I.m * v;
+  Mat3 Y;
+  for (int c = 0; c < 3; ++c) Y.col(c) = w.cross(Vec3(I.I.col(c)));
+  const double hv2 = 2.0 * I.h.dot(v);
+  for (int c = 0; c < 3; ++c)
+    for (int k = 0; k <= c; ++k) {
+      double e = Y(k, c) + Y(c, k) - v[k] * I.h[c] - I.h[k] * v[c];
+      if (k == c) e += hv2;
+      r.I(k, c) = e;
+      r.I(c, k) = e;
     }
-  return C;
+  return r;
 }
 
-// H(h) u = u x* h
-void add_momentum_operator(const Vec6& h, Mat6& B) {
-  const Mat3 n = skew<double>(Vec3(h.head<3>())), f = skew<double>(Vec3(h.tail<3>()));
-  B.topLeftCorner<3, 3>() -= n;
-  B.topRightCorner<3, 3>() -= f;
-  B.bottomLeftCorner<3, 3>() -= f;
+// an inertia rate (zero mass) applied to a motion [x; y]: [dJ x + dh x y; -dh x x]
+Vec6 apply_rate(const Inertia& B, const Vec6& m) {
+  const Vec3 x = m.head<3>(), y = m.tail<3>();
+  Vec6 r;
+  r << B.I * x + B.h.cross(y), x.cross(B.h);
+  return r;
 }
 
 struct BodyAD {
@@ -209,10 +208,13 @@ void TreeDerivatives::size_for(const Model& model) {
   Vpar_.assign(nu, Vec6::Zero());
   Apar_.assign(nu, Vec6::Zero());
   Vu_.assign(nu, Vec6::Zero());
-  I_.assign(nb, Mat6::Zero());
-  Ic_.assign(nb, Mat6::Zero());
-  Bc_.assign(nb, Mat6::Zero());
+  I_.assign(nb, Inertia());
+  Ic_.assign(nb, Inertia());
+  Bc_.assign(nb, Inertia());
+  hb_.assign(nb, Vec6::Zero());
+  fv_.assign(nb, Vec6::Zero());
   hc_.assign(nb, Vec6::Zero());
+  cu_.assign(nu, Vec6::Zero());
   F_.assign(nb, Vec6::Zero());
   PR_.assign(nu, Rows12::Zero());
   {
@@ -231,10 +233,12 @@ void TreeDerivatives::size_for(const Model& model) {
     }
     sub_begin_[nb] = static_cast<int>(sub_bodies_.size());
   }
-  Icom_.assign(nb, Mat3::Zero());
+  com_.assign(nb, ComInertia());
   for (int i = 1; i < nb; ++i) {
     const Mat3 cx = skew<double>(model.com[i]);
-    Icom_[i] = model.inertia[i].topLeftCorner<3, 3>() - model.mass[i] * cx * cx.transpose();
+    com_[i].m = model.mass[i];
+    com_[i].c = model.com[i];
+    com_[i].Ic = model.inertia[i].topLeftCorner<3, 3>() - model.mass[i] * cx * cx.transpose();
   }
   qdd.setZero(nv);
   qdd_zero_.setZero(nv);
@@ -331,30 +335,34 @@ void TreeDerivatives::world_kinematics(const Eigen::VectorXd& q, const Eigen::Ve
     const SE3& g = d_.oMi[i];
     S_[i].resize(6, j.nv);
     for (int c = 0; c < j.nv; ++c) S_[i].col(c) = g.act_motion(Vec6(d_.Sb[i].col(c)));
-    // world spatial inertia about the world origin, from mass, com and rotational inertia
-    const double mass = m_->mass[i];
-    const Vec3 cw = g.act_point(m_->com[i]);
-    const Mat3 cx = skew<double>(cw);
-    Mat6& I = I_[i];
-    I.topLeftCorner<3, 3>().noalias() = g.R * Icom_[i] * g.R.transpose();
-    I.topLeftCorner<3, 3>().noalias() += mass * cx * cx.transpose();
-    I.topRightCorner<3, 3>() = mass * cx;
-    I.bottomLeftCorner<3, 3>() = mass * cx.transpose();
-    I.bottomRightCorner<3, 3>() = mass * Mat3::Identity();
+    // world inertia about the world origin, from mass, com and rotational inertia
+    com_[i].to_frame(g.R, g.p, I_[i]);
     const int p = j.parent;
     Vec6 Vp = p > 0 ? V_[p] : Vec6::Zero();
     for (int u = unit_begin_[i]; u < unit_end_[i]; ++u) {
       const Unit& un = units_[u];
+      const auto Su = S_[i].middleCols(un.iv - j.idx_v, un.n);
       Vpar_[u] = Vp;
-      Vp.noalias() += S_[i].middleCols(un.iv - j.idx_v, un.n) * v.segment(un.iv, un.n);
+      if (un.n == 1) {
+        const Vec6 vJ = Su.col(0) * v[un.iv];
+        Vp += vJ;
+        cu_[u] = cross_motion_scaled<double>(Vp, Su.col(0).data(), v[un.iv]);
+      } else {
+        const Vec6 vJ = Su * v.segment(un.iv, un.n);
+        Vp += vJ;
+        cu_[u] = crm(Vp, vJ);
+      }
       Vu_[u] = Vp;
     }
     V_[i] = Vp;
+    hb_[i] = I_[i].apply(Vp);
+    fv_[i] = crf(Vp, hb_[i]);
   }
 }
 
-// accelerations for joint accelerations a (gravity enters as A_0 = -g)
-void TreeDerivatives::accelerations(const Eigen::VectorXd& v, const Eigen::VectorXd& a) {
+// accelerations for joint accelerations a (gravity enters as A_0 = -g); the units' velocity-product
+// terms cu_ are world_kinematics'
+void TreeDerivatives::accelerations(const Eigen::VectorXd& a) {
   Vec6 A0 = Vec6::Zero();
   if (m_->has_gravity) A0.tail<3>() = -m_->gravity;
   for (int i = 1; i < m_->nbodies; ++i) {
@@ -365,20 +373,21 @@ void TreeDerivatives::accelerations(const Eigen::VectorXd& v, const Eigen::Vecto
       const Unit& un = units_[u];
       const auto Su = S_[i].middleCols(un.iv - j.idx_v, un.n);
       Apar_[u] = Ap;
-      const Vec6 vJ = Su * v.segment(un.iv, un.n);
-      Ap.noalias() += Su * a.segment(un.iv, un.n);
-      Ap += crm(Vu_[u], vJ);
+      if (un.n == 1) Ap += Su.col(0) * a[un.iv];
+      else Ap.noalias() += Su * a.segment(un.iv, un.n);
+      Ap += cu_[u];
     }
     A_[i] = Ap;
   }
 }
 
-// subtree composites of inertia, momentum and Coriolis inertia; the unit rows P, R
+// subtree composites of inertia, momentum and Coriolis inertia; the unit rows P = S^T Ic and
+// R = S^T (Bc + H(hc)) = (Bc S - S x* hc)^T (Ic, Bc symmetric; H(h)^T s = -(s x* h))
 void TreeDerivatives::composites() {
   for (int i = 1; i < m_->nbodies; ++i) {
     Ic_[i] = I_[i];
-    hc_[i].noalias() = I_[i] * V_[i];
-    Bc_[i] = coriolis_inertia(V_[i], I_[i]);
+    hc_[i] = hb_[i];
+    Bc_[i] = inertia_rate(V_[i], I_[i]);
   }
   for (int i = m_->nbodies - 1; i > 0; --i) {
     const int p = m_->parent[i];
@@ -390,25 +399,22 @@ void TreeDerivatives::composites() {
   }
   for (int i = 1; i < m_->nbodies; ++i) {
     if (unit_begin_[i] == unit_end_[i]) continue;
-    Mat6 BH = Bc_[i];
-    add_momentum_operator(hc_[i], BH);
     const JointModel& j = m_->joints[i];
     for (int u = unit_begin_[i]; u < unit_end_[i]; ++u) {
       const Unit& un = units_[u];
-      const auto Su = S_[i].middleCols(un.iv - j.idx_v, un.n);
-      PR_[u].topLeftCorner(un.n, 6).noalias() = Su.transpose() * Ic_[i];
-      PR_[u].topRightCorner(un.n, 6).noalias() = Su.transpose() * BH;
+      for (int c = 0; c < un.n; ++c) {
+        const Vec6 s = S_[i].col(un.iv - j.idx_v + c);
+        const Vec6 P = Ic_[i].apply(s);
+        const Vec6 R = apply_rate(Bc_[i], s) - crf(s, hc_[i]);
+        PR_[u].row(c) << P.transpose(), R.transpose();
+      }
     }
   }
 }
 
 // body forces of the RNEA and their subtree sums; tau = S^T F
 void TreeDerivatives::forces() {
-  for (int i = 1; i < m_->nbodies; ++i) {
-    const Vec6 h = I_[i] * V_[i];
-    F_[i].noalias() = I_[i] * A_[i];
-    F_[i] += crf(V_[i], h);
-  }
+  for (int i = 1; i < m_->nbodies; ++i) F_[i] = I_[i].apply(A_[i]) + fv_[i];
   for (int i = m_->nbodies - 1; i > 0; --i) {
     const JointModel& j = m_->joints[i];
     if (j.nv > 0) tau.segment(j.idx_v, j.nv).noalias() = S_[i].transpose() * F_[i];
@@ -458,7 +464,7 @@ void TreeDerivatives::inverse_mass_matrix() {
   const bool arm = m_->armature.size() != 0;
   // depth-first numbering: the subtrees' column ranges of siblings are disjoint, so one block
   // holds every body's forces (Fb_[0]); otherwise each body has its own, added to its parent's
-  for (int i = 1; i < nb; ++i) IA_[i] = I_[i];
+  for (int i = 1; i < nb; ++i) IA_[i] = I_[i].matrix();
   if (depth_first_) {
     Fb_[0].setZero();
   } else {
@@ -768,8 +774,6 @@ void TreeDerivatives::differentiate_rnea() {
   for (int i = 1; i < nb; ++i) {
     if (unit_begin_[i] == unit_end_[i]) continue;
     const JointModel& ji = m_->joints[i];
-    Mat6 BH = Bc_[i];
-    add_momentum_operator(hc_[i], BH);
     for (int k = unit_begin_[i]; k < unit_end_[i]; ++k) {
       const Unit& uk = units_[k];
       const Vec6& Vp = Vpar_[k];
@@ -805,8 +809,9 @@ void TreeDerivatives::differentiate_rnea() {
           }
         }
         // units above k: the whole subtree's force change
-        const Vec6 G = crf(s, F_[i]) + Ic_[i] * dw - BH * u;
-        const Vec6 Gv = BH * s + Ic_[i] * cv;
+        // (Bc + H(hc)) x = Bc x + x x* hc
+        const Vec6 G = crf(s, F_[i]) + Ic_[i].apply(dw) - (apply_rate(Bc_[i], u) + crf(u, hc_[i]));
+        const Vec6 Gv = apply_rate(Bc_[i], s) + crf(s, hc_[i]) + Ic_[i].apply(cv);
         auto above = [&](int j) {
           const Unit& uj = units_[j];
           const auto Sj = S_[uj.body].middleCols(uj.iv - m_->joints[uj.body].idx_v, uj.n);
@@ -834,7 +839,7 @@ void TreeDerivatives::differentiate_rnea() {
 
 void TreeDerivatives::rnea_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& a) {
   world_kinematics(q, v);
-  accelerations(v, a);
+  accelerations(a);
   composites();
   forces();
   add_armature_force(*m_, a, tau);
@@ -1265,7 +1270,7 @@ void TreeDerivatives::compute(const Eigen::VectorXd& q, const Eigen::VectorXd& v
   const int nv = m_->nv, nu = m_->nu();
   // bias forces at qdd = 0, applied forces, mass matrix
   world_kinematics(q, v);
-  accelerations(v, qdd_zero_);
+  accelerations(qdd_zero_);
   composites();
   forces();
   scratch_ = tau;
@@ -1280,7 +1285,7 @@ void TreeDerivatives::compute(const Eigen::VectorXd& q, const Eigen::VectorXd& v
     articulated_solve(scratch_, qdd);
   }
   // inverse dynamics at the true accelerations, and its derivatives
-  accelerations(v, qdd);
+  accelerations(qdd);
   forces();
   add_armature_force(*m_, qdd, tau);
   differentiate_rnea();
@@ -1607,7 +1612,7 @@ void TreeDerivatives::compute_balance(const Eigen::VectorXd& q, const Eigen::Vec
 void TreeDerivatives::balance(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& u_all,
                               const Eigen::VectorXd& a, const Eigen::VectorXd& lambda) {
   world_kinematics(q, v);
-  accelerations(v, a);
+  accelerations(a);
   composites();
   forces();
   add_armature_force(*m_, a, tau);

@@ -148,7 +148,7 @@ class TreeDerivatives {
     int n = 0;     // columns
   };
   void world_kinematics(const Eigen::VectorXd& q, const Eigen::VectorXd& v);  // S, I, V
-  void accelerations(const Eigen::VectorXd& v, const Eigen::VectorXd& a);     // A
+  void accelerations(const Eigen::VectorXd& a);                               // A (after world_kinematics)
   void composites();                                                           // Ic, hc, Bc, P, R
   void forces();                                                               // F, tau
   void mass_matrix();                                                          // M from P and S
@@ -189,9 +189,13 @@ class TreeDerivatives {
   std::vector<Mat6xT<double>> S_;                // [nbodies] world motion subspace of the joint
   std::vector<Vec6T<double>> V_, A_;             // [nbodies]
   std::vector<Vec6T<double>> Vpar_, Apar_, Vu_;  // [units] velocity/acceleration the unit moves from; after it
-  std::vector<Mat6T<double>> I_, Ic_, Bc_;       // [nbodies]
-  std::vector<Eigen::Matrix3d> Icom_;            // [nbodies] rotational inertia about the com, body axes
-  std::vector<Vec6T<double>> hc_, F_;            // [nbodies]
+  // [nbodies] world inertia about the world origin, its subtree sum, and the subtree sum of their
+  // rates V x* I - I V x (an inertia of zero mass): 10 and 9 numbers rather than 6 x 6 matrices
+  std::vector<RigidInertiaT<double>> I_, Ic_, Bc_;
+  std::vector<ComInertia> com_;                  // [nbodies] mass, com, rotational inertia (body axes)
+  std::vector<Vec6T<double>> hb_, fv_;           // [nbodies] the body's momentum I V and V x* I V
+  std::vector<Vec6T<double>> hc_, F_;            // [nbodies] subtree momentum, subtree RNEA force
+  std::vector<Vec6T<double>> cu_;                // [units] Vu x (Su v): the unit's velocity-product term
   // [units] the rows [S^T Ic, S^T (Bc + H(hc))] side by side (P, R), padded to 6 rows: one contiguous
   // 12-vector per coordinate, so that each entry of the RNEA derivatives is one 12-term dot product
   using Rows12 = Eigen::Matrix<double, 6, 12, Eigen::RowMajor>;
