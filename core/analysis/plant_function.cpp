@@ -605,7 +605,7 @@ bool PlantFunction::analytic_jacobian(const Eigen::VectorXd& x, const Eigen::Vec
   td.compute(q_ref_, ws_.v, ws_.u_all, m.plant_outputs);
   if (J.rows() != 2 * n + ny_p || J.cols() != 2 * n + nu_p) J.resize(2 * n + ny_p, 2 * n + nu_p);
   // column by column, each in one contiguous pass (Eigen's block assignments walk the short
-  // columns of each block with an alignment prologue apiece: a fifth of the whole on tree28):
+  // columns of each block with an alignment prologue apiece: 3 of the 21 us on tree28):
   // [0 or the identity; the accelerations' derivatives; the outputs']
   for (int c = 0; c < 2 * n + nu_p; ++c) {
     double* col = J.col(c).data();

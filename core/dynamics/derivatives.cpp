@@ -319,6 +319,30 @@ void TreeDerivatives::size_for(const Model& model) {
   depth_first_ = true;
   for (int i = 1; i < nb; ++i)
     if (col_end_[i] - col_begin_[i] != sub_nv[i]) depth_first_ = false;
+  lambda_.assign(nv, -1);
+  col_sub_end_.assign(nv, 0);
+  {
+    bool ordered = true;
+    long work = 0;
+    for (int i = 1; i < nb; ++i) {
+      const JointModel& j = model.joints[i];
+      int above = -1;  // the last column of the nearest ancestor with one
+      for (int p = model.parent[i]; p > 0; p = model.parent[p])
+        if (model.joints[p].nv > 0) {
+          above = model.joints[p].idx_v + model.joints[p].nv - 1;
+          break;
+        }
+      for (int a = 0; a < j.nv; ++a) {
+        const int c = j.idx_v + a;
+        lambda_[c] = a == 0 ? above : c - 1;
+        if (lambda_[c] >= c) ordered = false;
+        col_sub_end_[c] = col_end_[i];
+        work += static_cast<long>(col_end_[i] - c) * (col_end_[i] - c);
+      }
+    }
+    tree_inverse_ = ordered && nv >= kDenseInverseBelow && nv < kRowsSolveFrom &&
+                    6 * work <= static_cast<long>(nv) * nv * nv;
+  }
   scratch_.setZero(nv);
   Jc.setZero(model.nc, nv);
   dc_dq.setZero(model.nc, nv);
@@ -591,6 +615,53 @@ void TreeDerivatives::inverse_mass_matrix() {
     for (int a = 0; a < j.nv; ++a) {
       const int r = j.idx_v + a;
       for (int c = 0; c < col_begin_[i]; ++c) Minv_(r, c) = Minv_(c, r);
+    }
+  }
+}
+
+// M^-1 of a branched tree's M by Featherstone's LTDL factorization (RBDA, section 6.5):
+// M = L^T D L, eliminated from the leaves up along the parent columns lambda, so that L keeps the
+// branch sparsity of M (L(k, i) only for i an ancestor of k). W = L^-1 is unit lower with the same
+// pattern (column k on k's subtree, inside the range [k, col_sub_end_[k]) and zero on the range's
+// other columns, which belong to other branches: their ancestors from k on are not k's), and
+// M^-1 = W D^-1 W^T = sum over k of w_k w_k^T / D(k): one rank-one update on each column's
+// subtree block, O(sum of the squared subtree widths) against a chain's n^3 / 3.
+void TreeDerivatives::tree_inverse() {
+  const int n = m_->nv;
+  double* H = chol_.data();          // column-major: M(k, i) then L(k, i) at H[k + i n], i <= k
+  double* W = chol_inv_.data();      // W(a, k) at W[a + k n], a in k's subtree
+  double* D = scratch_row_.data();
+  for (int k = 0; k < n; ++k)
+    for (int i = k; i >= 0; i = lambda_[i]) H[k + i * n] = M(k, i);
+  for (int k = n - 1; k >= 0; --k) {
+    const double d = H[k + k * n];
+    if (!(d > 0)) throw std::runtime_error("the mass matrix is not positive definite at this configuration");
+    D[k] = d;
+    for (int i = lambda_[k]; i >= 0; i = lambda_[i]) {
+      const double a = H[k + i * n] / d;
+      for (int j = i; j >= 0; j = lambda_[j]) H[i + j * n] -= a * H[k + j * n];
+      H[k + i * n] = a;
+    }
+  }
+  // L W = 1, column by column: W(a, k) = -sum over ancestors j of a from k on of L(a, j) W(j, k)
+  for (int k = 0; k < n; ++k) {
+    double* w = W + k * n;
+    w[k] = 1.0;
+    for (int a = k + 1; a < col_sub_end_[k]; ++a) {
+      double s = 0.0;
+      for (int j = lambda_[a]; j >= k; j = lambda_[j]) s -= H[a + j * n] * w[j];
+      w[a] = s;
+    }
+  }
+  Minv_.setZero();
+  for (int k = 0; k < n; ++k) {
+    const int e = col_sub_end_[k];
+    const double* w = W + k * n;
+    const double inv = 1.0 / D[k];
+    for (int b = k; b < e; ++b) {
+      const double f = w[b] * inv;
+      double* row = Minv_.row(b).data();
+      for (int a = k; a < e; ++a) row[a] += f * w[a];
     }
   }
 }
@@ -1276,9 +1347,10 @@ void TreeDerivatives::compute(const Eigen::VectorXd& q, const Eigen::VectorXd& v
   scratch_ = tau;
   applied_force_derivatives(q, v, u_all);
   scratch_ = Q - scratch_;
-  if (nv < kDenseInverseBelow) {
+  if (nv < kDenseInverseBelow || tree_inverse_) {
     mass_matrix();
-    small_inverse();
+    if (tree_inverse_) tree_inverse();
+    else small_inverse();
     qdd.noalias() = Minv_ * scratch_;
   } else {
     inverse_mass_matrix();

@@ -128,8 +128,8 @@ class TreeDerivatives {
   Eigen::VectorXd Q;                        // applied generalized forces
   Eigen::MatrixXd dQ_dq, dQ_dv, dQ_du;      // [nv x nv], [nv x nv], [nv x nu_all]
   // mass matrix at q: compute_constrained() fills it; compute() fills it below kDenseInverseBelow
-  // coordinates (M^-1 from its factors) and otherwise only through fill_mass_matrix(), after it
-  // (M^-1 from the articulated bodies)
+  // coordinates and on the branched trees tree_inverse takes (M^-1 from its factors), and
+  // otherwise only through fill_mass_matrix(), after it (M^-1 from the articulated bodies)
   Eigen::MatrixXd M;
   void fill_mass_matrix() { mass_matrix(); }
   // results of compute_constrained(), one row per constraint row [nc x nv]
@@ -156,6 +156,7 @@ class TreeDerivatives {
   void articulated_solve(const Eigen::VectorXd& f, Eigen::VectorXd& x);        // x = M^-1 f, the same bodies
   void articulated_solve_rows();                                               // X_ := M^-1 X_
   void small_inverse();                                                        // Minv_ from M (small nv)
+  void tree_inverse();                                                         // Minv_ from M, tree-sparse
   // from this many coordinates on, compute() solves for its derivatives by the articulated bodies
   // (48 nv^2 multiply-adds) rather than products with M^-1 (2 nv^3). Measured on the speed
   // models' chains (bench/pinocchio_bench.cpp, clang -O3): the products are faster up to 20 links
@@ -165,6 +166,14 @@ class TreeDerivatives {
   // (small_inverse) instead of the articulated bodies
   static constexpr int kDenseInverseBelow = 16;
   Eigen::MatrixXd chol_, chol_inv_;  // [nv x nv] small_inverse's L (1 / D on the diagonal), L^-1 (D on it)
+  // tree_inverse (Featherstone's M = L^T D L from the leaves up, which keeps M's branch sparsity):
+  // taken from kDenseInverseBelow to kRowsSolveFrom on trees (parents' columns first) whose sum
+  // over columns of the squared subtree range is at most half a chain's (n^3 / 3), where its
+  // O(that sum) beats the articulated bodies (tree28: 1.30 -> 1.03 of Pinocchio's derivatives);
+  // the parent column of each column (-1 at a root) and the end of its subtree's range (the
+  // contiguous superset of its columns: W is zero on the others)
+  std::vector<int> lambda_, col_sub_end_;
+  bool tree_inverse_ = false;
   Eigen::VectorXd scratch_row_;      // [nv]
   void differentiate_rnea();
   void applied_force_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& u);
