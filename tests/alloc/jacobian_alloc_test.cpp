@@ -11,6 +11,7 @@
 #include "dynamics/derivatives.hpp"
 #include "io/model_file.hpp"
 #include "dynamics/prepare.hpp"
+#include "models/speed_models.hpp"
 #include "counting_allocator.hpp"
 #include "tire_models.hpp"
 
@@ -73,6 +74,13 @@ TEST(NoAllocation, ExactJacobianEveryExample) {
   EXPECT_GE(motions, 3);
   // examples/ball_plate.json and rolling_disc.json: rolling's no-slip rows and their velocity map
   EXPECT_EQ(rolling, 2);
+}
+
+// the speed benchmarks' 28-coordinate tree takes M^-1 from its tree-sparse factors (tree_inverse)
+// and the 30-link chain from the articulated bodies: neither allocates
+TEST(NoAllocation, ExactJacobianTree28AndChain30) {
+  expect_no_allocation(compile(speed_models::tree28()), "tree28");
+  expect_no_allocation(compile(speed_models::chain(30)), "chain_30");
 }
 
 // rotor inertia (armature) on every joint of a branched tree (ball joints among them) and of a

@@ -248,7 +248,8 @@ TEST(TreeDerivatives, PlantJacobianMatchesAutodiffOnBranchedTrees) {
 }
 
 // compute() takes M^-1 from M's root-free Cholesky factors below 16 coordinates and from the
-// articulated bodies from 16 on: both sides of that size, on random trees (every joint type; the
+// articulated bodies from 16 on (branched trees of 16 to 31 coordinates from their tree-sparse
+// factors: tree28 in PlantJacobianMatchesAutodiffOnBranchedTrees): both sides of that size, on random trees (every joint type; the
 // rich one with every effect, actuator and sensor) and on the speed benchmarks' chains (at 31
 // links the factors' M^-1 gave 6.5e-12 against autodiff, the articulated bodies 1.6e-12 at 32:
 // the bound is kept low)
